@@ -1,0 +1,107 @@
+#include "app/pipeline_flags.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <sstream>
+
+#include "app/commands.h"
+#include "core/result_io.h"
+
+namespace calibench::app {
+
+void AddPipelineFlags(CLI::App& app, PipelineFlags& flags) {
+  PipelineOptions& o = flags.options;
+  app.add_option("--huber-delta", o.solver.huber_delta, "Huber threshold on the plane error")
+      ->capture_default_str();
+  app.add_option("--max-iterations", o.solver.max_iterations, "Gauss-Newton iterations")
+      ->capture_default_str();
+  app.add_option("--pairs", flags.pairs, "comma-separated pair ids to use (default: all)");
+  app.add_option("--initial-guess", flags.initial_guess,
+                 "cam_from_lidar to start from: a result.json, or 16 comma-separated numbers "
+                 "(row-major 4x4); default: closed form from the planes");
+  app.add_option("--threads", o.threads, "feature extraction threads")->capture_default_str();
+  app.add_option("--ransac-threshold", o.lidar_plane.ransac_threshold_m,
+                 "LiDAR plane RANSAC inlier distance [m]")
+      ->capture_default_str();
+  app.add_option("--ransac-seed", o.lidar_plane.seed, "RANSAC seed")->capture_default_str();
+}
+
+bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {
+  if (!flags.pairs.empty()) {
+    std::stringstream ss(flags.pairs);
+    std::string id;
+    while (std::getline(ss, id, ','))
+      if (!id.empty()) flags.options.pair_ids.push_back(id);
+  }
+  if (!flags.initial_guess.empty()) {
+    if (flags.initial_guess.find(',') != std::string::npos) {
+      std::stringstream ss(flags.initial_guess);
+      std::string number;
+      std::vector<double> values;
+      while (std::getline(ss, number, ',')) {
+        try {
+          values.push_back(std::stod(number));
+        } catch (const std::exception&) {
+          *why = "--initial-guess: '" + number + "' is not a number";
+          return false;
+        }
+      }
+      if (values.size() != 16) {
+        *why = "--initial-guess needs 16 numbers (row-major 4x4), got " + std::to_string(values.size());
+        return false;
+      }
+      Mat4 m;
+      for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = values[i];
+      Pose pose = Pose::Identity();
+      pose.linear() = NearestRotation(m.topLeftCorner<3, 3>());
+      pose.translation() = m.topRightCorner<3, 1>();
+      flags.options.initial_cam_from_lidar = pose;
+    } else {
+      flags.options.initial_cam_from_lidar = LoadResult(flags.initial_guess).cam_from_source;
+    }
+  }
+  return flags.options.Check(why);
+}
+
+ProgressCallback StderrProgress(const std::string& verb) {
+  const bool tty = isatty(fileno(stderr));
+  return [tty, verb](int done, int total, const std::string& id) {
+    std::fprintf(stderr, tty ? "\r[%d/%d] %s pair %s   " : "[%d/%d] %s pair %s\n", done, total,
+                 verb.c_str(), id.c_str());
+    if (tty && done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  };
+}
+
+int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
+                       const std::string& out_path, CalibrationOutcome* outcome_out) {
+  CalibrationOutcome outcome = CalibrateDataset(dataset, options, StderrProgress("extracted"));
+  std::printf("%s", FormatSummary(outcome).c_str());
+  bool input_error = false;
+  for (const PairFeatures& p : outcome.pairs) input_error |= p.input_error;
+  int code = kOk;
+  if (!outcome.solution) {
+    std::fprintf(stderr, "calibench: no calibration for %s: %s\n", dataset.manifest.string().c_str(),
+                 outcome.failure.c_str());
+    code = input_error ? kInputError : kNoCalibration;
+  } else {
+    if (!out_path.empty()) {
+      WriteResult(out_path, outcome, options.solver);
+      std::printf("wrote %s\n", out_path.c_str());
+    }
+    if (input_error) {
+      std::fprintf(stderr, "calibench: some pair files could not be read (see above); the result "
+                           "uses the remaining pairs\n");
+      code = kInputError;
+    } else if (!outcome.solution->observability.well_constrained) {
+      std::fprintf(stderr, "calibench: the result is NOT well constrained (weak directions listed "
+                           "above): add pairs with differently tilted boards\n");
+      code = kNotConstrained;
+    }
+  }
+  if (outcome_out) *outcome_out = std::move(outcome);
+  return code;
+}
+
+}  // namespace calibench::app

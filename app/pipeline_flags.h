@@ -1,0 +1,31 @@
+// Flags shared by the subcommands that run the pipeline, bound to core::PipelineOptions.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "core/pipeline.h"
+
+namespace calibench::app {
+
+struct PipelineFlags {
+  PipelineOptions options;
+  std::string pairs;          // comma-separated pair ids
+  std::string initial_guess;  // result.json, or 16 numbers (row-major 4x4)
+};
+
+void AddPipelineFlags(CLI::App& app, PipelineFlags& flags);
+
+// Applies the string flags; false with *why when they are malformed or the options fail Check.
+bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why);
+
+// Prints "[k/n] pair ID" progress to stderr (one line per pair when stderr is not a terminal).
+ProgressCallback StderrProgress(const std::string& verb);
+
+// Calibrates and prints the summary; writes the result when out_path is not empty. Returns the
+// exit code (kOk, kInputError when any pair file was unreadable, kNoCalibration,
+// kNotConstrained).
+int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
+                       const std::string& out_path, CalibrationOutcome* outcome_out = nullptr);
+
+}  // namespace calibench::app

@@ -1,0 +1,30 @@
+// Simulation flags shared by `simulate`, `demo` and `sweep`.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <string>
+
+#include "core/sim.h"
+
+namespace calibench::app {
+
+struct SimFlags {
+  std::string preset = "default";
+  std::string lidar, camera, board;
+  int pairs = 0;             // 0 = the preset's
+  double lidar_noise = -1;   // < 0 = the preset's
+  double image_noise = -1;   // < 0 = the preset's
+  double min_distance = 0;   // 0 = the preset's
+  double max_distance = 0;   // 0 = the preset's
+  std::uint64_t seed = 1;
+  bool no_clutter = false;
+};
+
+void AddSimFlags(CLI::App& app, SimFlags& flags);
+// Preset + overrides; false with *why for unknown names or options failing Check.
+bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* why);
+// a3, a4, paper, charuco-a3, charuco-a4; throws std::invalid_argument for others.
+BoardSpec NamedBoard(const std::string& name);
+
+}  // namespace calibench::app

@@ -1,0 +1,277 @@
+#include "core/dataset.h"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.h"
+#include "core/geometry.h"
+
+namespace calibench {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+[[noreturn]] void Fail(const fs::path& file, const std::string& problem) {
+  throw IoError(file.string() + ": " + problem);
+}
+
+json ReadJson(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) Fail(path, "cannot open file");
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    Fail(path, std::string("not valid JSON: ") + e.what());
+  }
+}
+
+template <typename T>
+T Get(const json& node, const char* key, const fs::path& file, const std::string& where) {
+  if (!node.contains(key)) Fail(file, "missing field '" + where + key + "'");
+  try {
+    return node.at(key).get<T>();
+  } catch (const json::exception& e) {
+    Fail(file, "field '" + where + key + "' has the wrong type: " + e.what());
+  }
+}
+
+fs::path Resolve(const fs::path& base_dir, const std::string& p) {
+  const fs::path path(p);
+  return path.is_absolute() ? path : (base_dir / path).lexically_normal();
+}
+
+CameraModel ParseInlineCamera(const json& node, const fs::path& file) {
+  CameraModel camera;
+  const std::string model = Get<std::string>(node, "model", file, "camera.");
+  const auto type = ParseCameraModelName(model);
+  if (!type)
+    Fail(file, "camera.model '" + model + "' is unknown (use pinhole-radtan or kannala-brandt)");
+  camera.type = *type;
+  camera.width = Get<int>(node, "width", file, "camera.");
+  camera.height = Get<int>(node, "height", file, "camera.");
+  camera.fx = Get<double>(node, "fx", file, "camera.");
+  camera.fy = Get<double>(node, "fy", file, "camera.");
+  camera.cx = Get<double>(node, "cx", file, "camera.");
+  camera.cy = Get<double>(node, "cy", file, "camera.");
+  camera.distortion = Get<std::vector<double>>(node, "distortion", file, "camera.");
+  return camera;
+}
+
+BoardSpec ParseTarget(const json& node, const fs::path& file) {
+  BoardSpec board;
+  const std::string type = Get<std::string>(node, "type", file, "target.");
+  if (type == "checkerboard") {
+    board.type = BoardType::kCheckerboard;
+    const auto corners = Get<std::vector<int>>(node, "inner_corners", file, "target.");
+    if (corners.size() != 2) Fail(file, "target.inner_corners must be [cols, rows]");
+    board.cols = corners[0];
+    board.rows = corners[1];
+  } else if (type == "charuco") {
+    board.type = BoardType::kCharuco;
+    const auto squares = Get<std::vector<int>>(node, "squares", file, "target.");
+    if (squares.size() != 2) Fail(file, "target.squares must be [cols, rows]");
+    board.cols = squares[0];
+    board.rows = squares[1];
+    board.marker_size = Get<double>(node, "marker_size", file, "target.");
+    board.dictionary = Get<std::string>(node, "dictionary", file, "target.");
+  } else {
+    Fail(file, "target.type '" + type + "' is unknown (use checkerboard or charuco)");
+  }
+  board.square_size = Get<double>(node, "square_size", file, "target.");
+  if (node.contains("board_size")) {
+    const auto size = Get<std::vector<double>>(node, "board_size", file, "target.");
+    if (size.size() != 2) Fail(file, "target.board_size must be [width, height] in metres");
+    board.board_width = size[0];
+    board.board_height = size[1];
+  }
+  std::string why;
+  if (!board.Check(&why)) Fail(file, "target: " + why);
+  return board;
+}
+
+json TargetToJson(const BoardSpec& board) {
+  json t;
+  if (board.type == BoardType::kCheckerboard) {
+    t["type"] = "checkerboard";
+    t["inner_corners"] = {board.cols, board.rows};
+  } else {
+    t["type"] = "charuco";
+    t["squares"] = {board.cols, board.rows};
+    t["marker_size"] = board.marker_size;
+    t["dictionary"] = board.dictionary;
+  }
+  t["square_size"] = board.square_size;
+  if (board.board_width > 0) t["board_size"] = {board.board_width, board.board_height};
+  return t;
+}
+
+json MatrixToJson(const Mat4& m) {
+  json rows = json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+  return rows;
+}
+
+Pose PoseFromJson(const json& node, const fs::path& file, const std::string& name) {
+  std::vector<std::vector<double>> rows;
+  try {
+    rows = node.get<std::vector<std::vector<double>>>();
+  } catch (const json::exception&) {
+    Fail(file, name + " must be a 4x4 matrix of numbers");
+  }
+  if (rows.size() != 4 || std::any_of(rows.begin(), rows.end(), [](auto& r) { return r.size() != 4; }))
+    Fail(file, name + " must be a 4x4 matrix");
+  Mat4 m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m(r, c) = rows[r][c];
+  const Mat3 rotation = m.topLeftCorner<3, 3>();
+  if (!m.allFinite() || (rotation * rotation.transpose() - Mat3::Identity()).norm() > 1e-4 ||
+      rotation.determinant() < 0 || (m.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9)
+    Fail(file, name + " is not a rigid transform (rotation not orthonormal or last row not 0 0 0 1)");
+  Pose pose = Pose::Identity();
+  pose.linear() = NearestRotation(rotation);
+  pose.translation() = m.topRightCorner<3, 1>();
+  return pose;
+}
+
+Dataset LoadManifest(const fs::path& manifest) {
+  const json root = ReadJson(manifest);
+  const fs::path base = manifest.parent_path();
+  Dataset dataset;
+  dataset.manifest = manifest;
+  const std::string format = root.value("format", "");
+  if (format != "calibench.dataset.v1")
+    Fail(manifest, "format is '" + format + "', expected 'calibench.dataset.v1'");
+  if (root.contains("camera_file")) {
+    dataset.camera = LoadCameraFile(Resolve(base, Get<std::string>(root, "camera_file", manifest, "")));
+  } else if (root.contains("camera")) {
+    const json& cam = root.at("camera");
+    dataset.camera = cam.contains("file") ? LoadCameraFile(Resolve(base, cam.at("file").get<std::string>()))
+                                          : ParseInlineCamera(cam, manifest);
+  } else {
+    Fail(manifest, "neither 'camera' nor 'camera_file' is given");
+  }
+  std::string why;
+  if (!dataset.camera.Check(&why)) Fail(manifest, "camera: " + why);
+  if (!root.contains("target")) Fail(manifest, "missing field 'target'");
+  dataset.target = ParseTarget(root.at("target"), manifest);
+  if (root.contains("lidar")) dataset.lidar_rings = root.at("lidar").value("rings", 0);
+  if (!root.contains("pairs") || !root.at("pairs").is_array())
+    Fail(manifest, "missing array 'pairs'");
+  std::map<std::string, int> seen;
+  for (const json& p : root.at("pairs")) {
+    PairEntry pair;
+    pair.id = Get<std::string>(p, "id", manifest, "pairs[].");
+    if (seen[pair.id]++) Fail(manifest, "pair id '" + pair.id + "' appears twice");
+    pair.cloud = Resolve(base, Get<std::string>(p, "cloud", manifest, "pairs[" + pair.id + "]."));
+    pair.image = Resolve(base, Get<std::string>(p, "image", manifest, "pairs[" + pair.id + "]."));
+    if (p.contains("lidar_seed")) {
+      const json& s = p.at("lidar_seed");
+      const auto point = Get<std::vector<double>>(s, "point", manifest, "lidar_seed.");
+      if (point.size() != 3) Fail(manifest, "pair " + pair.id + ": lidar_seed.point must be [x, y, z]");
+      LidarSeed seed{Vec3(point[0], point[1], point[2]), Get<double>(s, "radius", manifest, "lidar_seed.")};
+      if (!(seed.radius > 0) || !seed.point.allFinite())
+        Fail(manifest, "pair " + pair.id + ": lidar_seed needs a finite point and a radius > 0");
+      pair.lidar_seed = seed;
+    }
+    dataset.pairs.push_back(pair);
+  }
+  if (root.contains("ground_truth") && root.at("ground_truth").contains("cam_from_lidar"))
+    dataset.cam_from_lidar_ground_truth =
+        PoseFromJson(root.at("ground_truth").at("cam_from_lidar"), manifest, "ground_truth.cam_from_lidar");
+  return dataset;
+}
+
+// Folder shorthand: clouds/ and images/ paired by file stem, camera.yaml, target.json.
+Dataset LoadFolder(const fs::path& dir) {
+  Dataset dataset;
+  dataset.manifest = dir;
+  const fs::path camera_file = dir / "camera.yaml";
+  const fs::path target_file = dir / "target.json";
+  if (!fs::exists(camera_file)) Fail(dir, "folder dataset has no camera.yaml (and no dataset.json)");
+  if (!fs::exists(target_file)) Fail(dir, "folder dataset has no target.json (and no dataset.json)");
+  dataset.camera = LoadCameraFile(camera_file);
+  json target = ReadJson(target_file);
+  dataset.target = ParseTarget(target.contains("target") ? target.at("target") : target, target_file);
+  auto list = [&](const char* sub) {
+    std::map<std::string, fs::path> by_stem;
+    if (!fs::is_directory(dir / sub)) Fail(dir, std::string("folder dataset has no ") + sub + "/");
+    for (const auto& entry : fs::directory_iterator(dir / sub))
+      if (entry.is_regular_file()) by_stem[entry.path().stem().string()] = entry.path();
+    return by_stem;
+  };
+  const auto clouds = list("clouds");
+  const auto images = list("images");
+  for (const auto& [stem, cloud] : clouds) {
+    const auto image = images.find(stem);
+    if (image == images.end()) continue;
+    dataset.pairs.push_back(PairEntry{stem, cloud, image->second, std::nullopt});
+  }
+  if (dataset.pairs.empty()) Fail(dir, "no cloud/image pairs share a file stem");
+  return dataset;
+}
+
+}  // namespace
+
+bool BoardSpec::Check(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  const int min_count = type == BoardType::kCheckerboard ? 2 : 3;
+  if (cols < min_count || rows < min_count)
+    return fail(type == BoardType::kCheckerboard ? "inner_corners must be at least [2, 2]"
+                                                 : "squares must be at least [3, 3]");
+  if (!(square_size > 0)) return fail("square_size must be > 0 (metres)");
+  if (type == BoardType::kCharuco) {
+    if (!(marker_size > 0 && marker_size < square_size))
+      return fail("marker_size must be > 0 and smaller than square_size");
+    if (dictionary.empty()) return fail("charuco needs a dictionary such as DICT_4X4_50");
+  }
+  if (board_width < 0 || board_height < 0) return fail("board_size must be positive");
+  if (board_width > 0 && (board_width + 1e-9 < PatternWidth() || board_height + 1e-9 < PatternHeight()))
+    return fail("board_size is smaller than the printed pattern");
+  return true;
+}
+
+Dataset LoadDataset(const fs::path& path) {
+  if (!fs::exists(path)) Fail(path, "no such file or folder");
+  if (fs::is_directory(path)) {
+    if (fs::exists(path / "dataset.json")) return LoadManifest(fs::absolute(path / "dataset.json"));
+    return LoadFolder(fs::absolute(path));
+  }
+  return LoadManifest(fs::absolute(path));
+}
+
+void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
+  const fs::path base = fs::absolute(manifest_path).parent_path();
+  auto relative = [&](const fs::path& p) {
+    const fs::path rel = fs::absolute(p).lexically_relative(base);
+    return (rel.empty() || *rel.begin() == "..") ? fs::absolute(p).string() : rel.string();
+  };
+  json root;
+  root["format"] = "calibench.dataset.v1";
+  const CameraModel& c = dataset.camera;
+  root["camera"] = {{"model", CameraModelName(c.type)}, {"width", c.width}, {"height", c.height},
+                    {"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx}, {"cy", c.cy},
+                    {"distortion", c.distortion}};
+  root["target"] = TargetToJson(dataset.target);
+  if (dataset.lidar_rings > 0) root["lidar"] = {{"rings", dataset.lidar_rings}};
+  json pairs = json::array();
+  for (const PairEntry& p : dataset.pairs) {
+    json entry = {{"id", p.id}, {"cloud", relative(p.cloud)}, {"image", relative(p.image)}};
+    if (p.lidar_seed)
+      entry["lidar_seed"] = {{"point", {p.lidar_seed->point.x(), p.lidar_seed->point.y(), p.lidar_seed->point.z()}},
+                             {"radius", p.lidar_seed->radius}};
+    pairs.push_back(entry);
+  }
+  root["pairs"] = pairs;
+  if (dataset.cam_from_lidar_ground_truth)
+    root["ground_truth"] = {{"cam_from_lidar", MatrixToJson(dataset.cam_from_lidar_ground_truth->matrix())},
+                            {"direction", "x_in_cam = cam_from_lidar * x_in_lidar"}};
+  WriteFileAtomically(manifest_path, root.dump(2) + "\n");
+}
+
+}  // namespace calibench

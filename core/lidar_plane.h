@@ -1,0 +1,51 @@
+// LiDAR side of a pair: pick the board region (a brush on the LiDAR image or a seed point with a
+// radius), fit a plane by RANSAC (PCL), refit by least squares on the inliers, with covariance.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/cloud.h"
+#include "core/dataset.h"
+#include "core/geometry.h"
+#include "core/lidar_image.h"
+
+namespace calibench {
+
+struct LidarPlaneOptions {
+  double ransac_threshold_m = 0.03;  // inlier distance; ~3σ of typical spinning-LiDAR range noise
+  int ransac_iterations = 500;       // enough for > 50% inliers with a 1e-9 failure chance
+  int min_inliers = 20;              // fewer inliers = no plane (a board needs a few rings)
+  double min_inlier_fraction = 0.3;  // of the candidate points
+  std::uint64_t seed = 1;            // RANSAC sampling order; same seed, same plane
+  bool Check(std::string* why) const;
+};
+
+struct LidarPlaneFit {
+  Plane plane;                     // LiDAR frame, normal towards the LiDAR (d > 0)
+  Mat4 covariance = Mat4::Zero();  // of (n, d) from the least-squares refit; rank 3
+  std::vector<int> inliers;        // indices into the cloud
+  int num_candidates = 0;          // points in the brushed / seeded region
+  double rms_m = 0.0;              // point-to-plane RMS of the inliers
+};
+
+// Points within `seed.radius` (metres) of `seed.point`.
+std::vector<int> SelectSeedRegion(const LidarCloud& cloud, const LidarSeed& seed);
+
+// Points under brushed LiDAR-image pixels (indices into image.point_index).
+std::vector<int> SelectBrushRegion(const LidarImage& image, const std::vector<int>& pixels);
+
+// RANSAC + least-squares refit over the candidate points. nullopt with *why when the region is
+// empty, too small, or holds no plane with enough inliers.
+std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
+                                           const std::vector<int>& candidates,
+                                           const LidarPlaneOptions& options, std::string* why);
+
+// Least-squares (total least squares) plane through points with its (n, d) covariance, the
+// residual variance estimated from the fit. Needs >= 4 points not on a line.
+std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
+                                                  const std::vector<int>& indices);
+
+}  // namespace calibench

@@ -1,0 +1,187 @@
+#include "core/result_io.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/atomic_file.h"
+
+namespace calibench {
+using nlohmann::json;
+
+namespace {
+
+json PoseToJson(const Pose& pose) {
+  json m = json::array();
+  for (int r = 0; r < 4; ++r)
+    m.push_back({pose.matrix()(r, 0), pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3)});
+  const Eigen::Quaterniond q(pose.linear());
+  return {{"matrix", m},
+          {"translation_m", {pose.translation().x(), pose.translation().y(), pose.translation().z()}},
+          {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
+}
+
+json Vec4ToJson(const Vec4& v) { return {v[0], v[1], v[2], v[3]}; }
+
+}  // namespace
+
+Vec3 TranslationStd(const Mat6& covariance) {
+  return covariance.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
+}
+
+Vec3 RotationStdDeg(const Mat6& covariance) {
+  return covariance.diagonal().tail<3>().cwiseMax(0.0).cwiseSqrt() * (180.0 / M_PI);
+}
+
+std::string ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& options,
+                         const ResultNames& names) {
+  CALIBENCH_CHECK(outcome.solution.has_value());
+  const SolverResult& s = *outcome.solution;
+  const std::string forward = names.target + "_from_" + names.source;
+  const std::string backward = names.source + "_from_" + names.target;
+  json root;
+  root["format"] = "calibench.result.v1";
+  root["direction"] = "x_in_" + names.target + " = " + forward + " * x_in_" + names.source +
+                      "; " + backward + " is its inverse";
+  root[forward] = PoseToJson(s.cam_from_lidar);
+  root[backward] = PoseToJson(s.cam_from_lidar.inverse());
+  json cov = json::array();
+  for (int r = 0; r < 6; ++r) {
+    json row = json::array();
+    for (int c = 0; c < 6; ++c) row.push_back(s.covariance(r, c));
+    cov.push_back(row);
+  }
+  root["covariance_6x6"] = cov;
+  root["covariance_convention"] =
+      "right perturbation " + forward + " * Exp(delta), delta = [rho (m); phi (rad)]";
+  const Vec3 st = TranslationStd(s.covariance);
+  const Vec3 sr = RotationStdDeg(s.covariance);
+  root["std_translation_m"] = {st.x(), st.y(), st.z()};
+  root["std_rotation_deg"] = {sr.x(), sr.y(), sr.z()};
+  root["observability"] = {
+      {"eigenvalues", std::vector<double>(s.observability.eigenvalues.data(),
+                                          s.observability.eigenvalues.data() + 6)},
+      {"weak_directions", s.observability.weak_directions},
+      {"well_constrained", s.observability.well_constrained}};
+  root["solver"] = {{"method", names.method},
+                    {"iterations", s.iterations},
+                    {"converged", s.converged},
+                    {"cost_history", s.cost_history},
+                    {"huber_delta", options.huber_delta}};
+  json pairs = json::array();
+  size_t solved_index = 0;
+  for (const PairFeatures& p : outcome.pairs) {
+    json entry = {{"id", p.id}, {"status", PairStatusName(p.status)}, {"reason", p.reason}};
+    if (p.lidar) {
+      entry["lidar_plane"] = Vec4ToJson(p.lidar->plane.Coefficients());
+      entry["lidar_inliers"] = p.lidar->inliers.size();
+      entry["lidar_rms_m"] = p.lidar->rms_m;
+    }
+    if (p.camera) {
+      entry["camera_plane"] = Vec4ToJson(p.camera->plane.Coefficients());
+      entry["camera_corners"] = p.camera->num_corners;
+      entry["reprojection_rms_px"] = p.camera->reprojection_rms_px;
+    }
+    if (p.status == PairStatus::kAccepted && solved_index < s.residuals.size()) {
+      entry["residual"] = Vec4ToJson(s.residuals[solved_index]);
+      entry["robust_weight"] = s.robust_weights[solved_index];
+      ++solved_index;
+    }
+    pairs.push_back(entry);
+  }
+  root["pairs"] = pairs;
+  return root.dump(2) + "\n";
+}
+
+void WriteResult(const std::filesystem::path& path, const CalibrationOutcome& outcome,
+                 const SolverOptions& options, const ResultNames& names) {
+  WriteFileAtomically(path, ResultToJson(outcome, options, names));
+}
+
+LoadedResult LoadResult(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path.string() + ": cannot open result file");
+  json root;
+  try {
+    root = json::parse(in);
+  } catch (const json::exception& e) {
+    throw IoError(path.string() + ": not valid JSON: " + e.what());
+  }
+  if (root.value("format", "") != "calibench.result.v1")
+    throw IoError(path.string() + ": format is not calibench.result.v1");
+  const char* key = root.contains("cam_from_lidar") ? "cam_from_lidar" : "cam_from_lrf";
+  if (!root.contains(key)) throw IoError(path.string() + ": has neither cam_from_lidar nor cam_from_lrf");
+  LoadedResult result;
+  try {
+    const auto rows = root.at(key).at("matrix").get<std::vector<std::vector<double>>>();
+    if (rows.size() != 4) throw IoError(path.string() + ": " + key + ".matrix must be 4x4");
+    Mat4 m;
+    for (int r = 0; r < 4; ++r) {
+      if (rows[r].size() != 4) throw IoError(path.string() + ": " + key + ".matrix must be 4x4");
+      for (int c = 0; c < 4; ++c) m(r, c) = rows[r][c];
+    }
+    result.cam_from_source.matrix() = m;
+    if (root.contains("covariance_6x6")) {
+      const auto cov = root.at("covariance_6x6").get<std::vector<std::vector<double>>>();
+      for (int r = 0; r < 6 && r < static_cast<int>(cov.size()); ++r)
+        for (int c = 0; c < 6 && c < static_cast<int>(cov[r].size()); ++c) result.covariance(r, c) = cov[r][c];
+    }
+    result.well_constrained = root.at("observability").value("well_constrained", false);
+  } catch (const json::exception& e) {
+    throw IoError(path.string() + ": malformed result: " + e.what());
+  }
+  return result;
+}
+
+std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& names) {
+  std::ostringstream out;
+  char line[256];
+  int accepted = 0, failed = 0;
+  for (const PairFeatures& p : outcome.pairs) {
+    accepted += p.status == PairStatus::kAccepted;
+    failed += p.status == PairStatus::kFailed;
+  }
+  out << "pairs: " << outcome.pairs.size() << " (" << accepted << " accepted, " << failed
+      << " failed)\n";
+  for (const PairFeatures& p : outcome.pairs)
+    if (p.status == PairStatus::kFailed) out << "  pair " << p.id << " failed: " << p.reason << "\n";
+  if (!outcome.solution) {
+    out << "no calibration: " << outcome.failure << "\n";
+    return out.str();
+  }
+  const SolverResult& s = *outcome.solution;
+  const std::string fwd = names.target + "_from_" + names.source;
+  const std::string bwd = names.source + "_from_" + names.target;
+  auto print_pose = [&](const std::string& name, const std::string& words, const Pose& pose) {
+    out << name << "  (" << words << ")\n";
+    for (int r = 0; r < 3; ++r) {
+      std::snprintf(line, sizeof(line), "  [% .6f % .6f % .6f | % .6f]\n", pose.matrix()(r, 0),
+                    pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3));
+      out << line;
+    }
+  };
+  print_pose(fwd, "maps points from the " + names.source + " frame into the " + names.target + " frame",
+             s.cam_from_lidar);
+  print_pose(bwd, "maps points from the " + names.target + " frame into the " + names.source + " frame; "
+             "its translation is the " + names.target + " position in the " + names.source + " frame",
+             s.cam_from_lidar.inverse());
+  const Vec3 st = TranslationStd(s.covariance) * 1000.0;
+  const Vec3 sr = RotationStdDeg(s.covariance);
+  std::snprintf(line, sizeof(line), "std translation [mm]: %.2f %.2f %.2f   std rotation [deg]: %.3f %.3f %.3f\n",
+                st.x(), st.y(), st.z(), sr.x(), sr.y(), sr.z());
+  out << line;
+  std::snprintf(line, sizeof(line), "solver: %d iterations, %s, cost %.3e -> %.3e\n", s.iterations,
+                s.converged ? "converged" : "NOT converged", s.cost_history.front(), s.cost_history.back());
+  out << line;
+  if (s.observability.well_constrained) {
+    out << "observability: well constrained\n";
+  } else {
+    out << "observability: NOT well constrained; weak directions:\n";
+    for (const auto& d : s.observability.weak_directions) out << "  - " << d << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace calibench

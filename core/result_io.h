@@ -1,0 +1,41 @@
+// The calibench.result.v1 file (DESIGN.md "Result").
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "core/pipeline.h"
+
+namespace calibench {
+
+struct ResultNames {
+  std::string target = "cam";    // cam_from_<source>
+  std::string source = "lidar";  // "lidar" or "lrf"
+  std::string method = "ca2lib-gn";
+};
+
+// The result as JSON text. Requires outcome.solution.
+std::string ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& options,
+                         const ResultNames& names = {});
+
+// Writes atomically; throws IoError naming the file.
+void WriteResult(const std::filesystem::path& path, const CalibrationOutcome& outcome,
+                 const SolverOptions& options, const ResultNames& names = {});
+
+struct LoadedResult {
+  Pose cam_from_source = Pose::Identity();  // cam_from_lidar (or cam_from_lrf)
+  Mat6 covariance = Mat6::Zero();
+  bool well_constrained = false;
+};
+// Reads cam_from_lidar (or cam_from_lrf) and the covariance. Throws IoError naming the file.
+LoadedResult LoadResult(const std::filesystem::path& path);
+
+// Human-readable summary: both directions in words, standard deviations, observability, pairs.
+std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& names = {});
+
+// Standard deviations derived from a [rho; phi] covariance: translation (m), rotation (deg).
+Vec3 TranslationStd(const Mat6& covariance);
+Vec3 RotationStdDeg(const Mat6& covariance);
+
+}  // namespace calibench

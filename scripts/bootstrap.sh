@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The two README commands in one script:
+#   scripts/bootstrap.sh          install dependencies, build, run the demo
+#   scripts/bootstrap.sh --test   the same, then the whole test suite
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+run_tests=0
+[ "${1:-}" = "--test" ] && run_tests=1
+
+bash scripts/install_deps.sh
+
+BUILD_DIR=${CALIBENCH_BUILD_DIR:-build}
+JOBS=${CALIBENCH_JOBS:-$(nproc)}
+cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake --build "$BUILD_DIR" -j "$JOBS"
+
+# The main job: the demo (simulate, calibrate, print the result and its error).
+"$BUILD_DIR/calibench" demo --out "$BUILD_DIR/demo"
+
+if [ $run_tests -eq 1 ]; then
+  ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" --timeout 900
+fi

@@ -1,0 +1,335 @@
+// Cloud file formats: exact round trips of every writer, hand-written files with unusual field
+// types and layouts, real files from ../shared, and bad inputs that must raise IoError naming
+// the file.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <string>
+
+#include "core/cloud.h"
+#include "tests/test_support.h"
+
+namespace calibench {
+namespace {
+
+namespace fs = std::filesystem;
+
+LidarCloud RandomCloud(size_t n, bool intensity, bool ring, bool range, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> coord(-50.f, 50.f), value(0.f, 255.f);
+  std::uniform_int_distribution<int> ring_id(0, 127);
+  LidarCloud cloud;
+  for (size_t i = 0; i < n; ++i) {
+    cloud.points.emplace_back(coord(rng), coord(rng), coord(rng));
+    if (intensity) cloud.intensity.push_back(value(rng));
+    if (ring) cloud.ring.push_back(ring_id(rng));
+    if (range) cloud.range.push_back(cloud.points.back().norm());
+  }
+  cloud.width = static_cast<int>(n);
+  return cloud;
+}
+
+// Exact equality: every writer must reproduce the float bits.
+void ExpectSameCloud(const LidarCloud& actual, const LidarCloud& expected) {
+  ASSERT_EQ(actual.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) ASSERT_EQ(actual.points[i], expected.points[i]) << i;
+  EXPECT_EQ(actual.intensity, expected.intensity);
+  EXPECT_EQ(actual.ring, expected.ring);
+  EXPECT_EQ(actual.range, expected.range);
+  EXPECT_EQ(actual.width, expected.width);
+  EXPECT_EQ(actual.height, expected.height);
+}
+
+void WriteFile(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out << bytes;
+}
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+template <typename T>
+void Append(std::string* out, T value, bool big_endian = false) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  if (big_endian) std::reverse(bytes, bytes + sizeof(T));
+  out->append(bytes, sizeof(T));
+}
+
+// Runs LoadCloud and checks for an IoError whose message names the file and the problem.
+void ExpectLoadError(const fs::path& path, const std::string& problem) {
+  try {
+    LoadCloud(path);
+    ADD_FAILURE() << "no IoError for " << path;
+  } catch (const IoError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path.string()), std::string::npos) << what;
+    EXPECT_NE(what.find(problem), std::string::npos) << "expected '" << problem << "' in: " << what;
+  }
+}
+
+const std::string kPcdHeaderXyz =
+    "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\n"
+    "POINTS 3\nDATA ascii\n";
+
+TEST(CloudIo, PcdRoundTripEveryEncoding) {
+  const fs::path dir = test::TempDir("cloud_io_pcd_round_trip");
+  const LidarCloud cloud = RandomCloud(1000, true, true, true, 1);
+  for (const auto encoding :
+       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+    const fs::path path = dir / ("cloud" + std::to_string(static_cast<int>(encoding)) + ".pcd");
+    SavePcd(path, cloud, encoding);
+    ExpectSameCloud(LoadCloud(path), cloud);
+  }
+}
+
+TEST(CloudIo, PcdRoundTripOptionalChannels) {
+  const fs::path dir = test::TempDir("cloud_io_pcd_channels");
+  for (int mask = 0; mask < 8; ++mask) {
+    const LidarCloud cloud = RandomCloud(50, mask & 1, mask & 2, mask & 4, 10 + mask);
+    for (const auto encoding : {PcdEncoding::kAscii, PcdEncoding::kBinaryCompressed}) {
+      const fs::path path = dir / "cloud.pcd";
+      SavePcd(path, cloud, encoding);
+      ExpectSameCloud(LoadCloud(path), cloud);
+    }
+  }
+}
+
+TEST(CloudIo, PcdWritesRingAsU2) {
+  const fs::path path = test::TempDir("cloud_io_ring_u2") / "cloud.pcd";
+  SavePcd(path, RandomCloud(5, true, true, false, 2), PcdEncoding::kAscii);
+  const std::string text = ReadFile(path);
+  EXPECT_NE(text.find("FIELDS x y z intensity ring\nSIZE 4 4 4 4 2\nTYPE F F F F U\n"),
+            std::string::npos)
+      << text;
+  LidarCloud bad = RandomCloud(5, false, true, false, 2);
+  bad.ring[3] = 70000;
+  EXPECT_THROW(SavePcd(path, bad), IoError);
+}
+
+TEST(CloudIo, PlyAndKittiRoundTrip) {
+  const fs::path dir = test::TempDir("cloud_io_ply_kitti");
+  const LidarCloud cloud = RandomCloud(777, true, true, true, 3);
+  SavePly(dir / "cloud.ply", cloud);
+  ExpectSameCloud(LoadCloud(dir / "cloud.ply"), cloud);
+
+  SaveKittiBin(dir / "cloud.bin", cloud);
+  EXPECT_EQ(fs::file_size(dir / "cloud.bin"), 777u * 16u);
+  LidarCloud xyzi = cloud;  // KITTI keeps x y z intensity only
+  xyzi.ring.clear();
+  xyzi.range.clear();
+  ExpectSameCloud(LoadCloud(dir / "cloud.bin"), xyzi);
+}
+
+TEST(CloudIo, OrganizedCloudKeepsItsGrid) {
+  const fs::path dir = test::TempDir("cloud_io_organized");
+  LidarCloud cloud = RandomCloud(16 * 100, true, true, false, 4);
+  cloud.width = 100;
+  cloud.height = 16;
+  ASSERT_TRUE(cloud.IsOrganized());
+  for (const auto encoding :
+       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+    SavePcd(dir / "organized.pcd", cloud, encoding);
+    const LidarCloud loaded = LoadCloud(dir / "organized.pcd");
+    EXPECT_TRUE(loaded.IsOrganized());
+    ExpectSameCloud(loaded, cloud);
+  }
+  // One NaN point: it is dropped and the grid is gone (width = size, height = 1).
+  cloud.points[17].x() = std::numeric_limits<float>::quiet_NaN();
+  SavePcd(dir / "holed.pcd", cloud, PcdEncoding::kBinary);
+  const LidarCloud holed = LoadCloud(dir / "holed.pcd");
+  EXPECT_EQ(holed.size(), 1599u);
+  EXPECT_EQ(holed.height, 1);
+  EXPECT_EQ(holed.width, 1599);
+  EXPECT_EQ(holed.ring[17], cloud.ring[18]);
+  EXPECT_FALSE(holed.IsOrganized());
+}
+
+// ring as I1 (ascii), an extra COUNT 3 field before it, intensity named "i", rgb after.
+TEST(CloudIo, ReadsHandWrittenAsciiPcdWithOddFields) {
+  const fs::path path = test::TempDir("cloud_io_ascii_odd") / "odd.pcd";
+  WriteFile(path,
+            "# hand-written\nVERSION .7\nFIELDS x y z normal i ring rgb\nSIZE 4 4 8 4 2 1 4\n"
+            "TYPE F F F F U I F\nCOUNT 1 1 1 3 1 1 1\nWIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+            "POINTS 2\nDATA ascii\n1.5 -2 3.25 0.1 0.2 0.3 77 5 4.2e-38\r\n"
+            "\n-1e1 +2 nan 9 9 9 1 12 0\n");
+  const LidarCloud cloud = LoadCloud(path);
+  ASSERT_EQ(cloud.size(), 1u);  // the NaN point is dropped
+  EXPECT_EQ(cloud.points[0], Eigen::Vector3f(1.5f, -2.f, 3.25f));
+  EXPECT_EQ(cloud.intensity, std::vector<float>{77.f});
+  EXPECT_EQ(cloud.ring, std::vector<int>{5});
+  EXPECT_TRUE(cloud.range.empty());
+}
+
+// Binary PCDs with ring as U4 and as F, and a COUNT 3 field in the middle of the record.
+TEST(CloudIo, ReadsHandWrittenBinaryPcdWithOddRingTypes) {
+  const fs::path dir = test::TempDir("cloud_io_binary_odd");
+  for (const std::string ring_type : {"U 4", "F 4", "I 1"}) {
+    std::string bytes = "VERSION 0.6\nFIELDS x y z extra ring intensity\nSIZE 4 4 4 2 " +
+                        ring_type.substr(2) + " 8\nTYPE F F F I " + ring_type.substr(0, 1) +
+                        " F\nCOUNT 1 1 1 3 1 1\n"
+                        "WIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA binary\n";
+    for (int i = 0; i < 3; ++i) {
+      Append(&bytes, 0.5f * i);
+      Append(&bytes, -1.0f * i);
+      Append(&bytes, 2.0f + i);
+      for (int k = 0; k < 3; ++k) Append(&bytes, static_cast<int16_t>(-7));
+      if (ring_type == "U 4") Append(&bytes, static_cast<uint32_t>(10 + i));
+      if (ring_type == "F 4") Append(&bytes, static_cast<float>(10 + i));
+      if (ring_type == "I 1") Append(&bytes, static_cast<int8_t>(10 + i));
+      Append(&bytes, 100.0 + i);
+    }
+    WriteFile(dir / "odd.pcd", bytes);
+    const LidarCloud cloud = LoadCloud(dir / "odd.pcd");
+    ASSERT_EQ(cloud.size(), 3u) << ring_type;
+    EXPECT_EQ(cloud.points[2], Eigen::Vector3f(1.f, -2.f, 4.f)) << ring_type;
+    EXPECT_EQ(cloud.ring, (std::vector<int>{10, 11, 12})) << ring_type;
+    EXPECT_EQ(cloud.intensity, (std::vector<float>{100.f, 101.f, 102.f})) << ring_type;
+  }
+}
+
+// An element before the vertices (with a list property) and faces after them.
+TEST(CloudIo, ReadsAsciiAndBigEndianPly) {
+  const fs::path dir = test::TempDir("cloud_io_ply_read");
+  WriteFile(dir / "ascii.ply",
+            "ply\nformat ascii 1.0\ncomment test\nelement camera 1\nproperty list uchar int ids\n"
+            "element vertex 2\nproperty double x\nproperty float y\nproperty float z\n"
+            "property uchar ring\nproperty short intensity\nproperty float range\nend_header\n"
+            "3 1 2 3\n1 2 3 4 -5 3.7\n4 5 6 7 8 8.8\n3 0 1 1\n");
+  const LidarCloud ascii = LoadCloud(dir / "ascii.ply");
+  ASSERT_EQ(ascii.size(), 2u);
+  EXPECT_EQ(ascii.points[1], Eigen::Vector3f(4.f, 5.f, 6.f));
+  EXPECT_EQ(ascii.ring, (std::vector<int>{4, 7}));
+  EXPECT_EQ(ascii.intensity, (std::vector<float>{-5.f, 8.f}));
+  EXPECT_EQ(ascii.range, (std::vector<float>{3.7f, 8.8f}));
+
+  std::string bytes =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+      "property float z\nproperty uint16 ring\nproperty list uchar float normals\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  for (int i = 0; i < 2; ++i) {
+    for (float v : {1.25f + i, -2.5f, 3.f}) Append(&bytes, v, true);
+    Append(&bytes, static_cast<uint16_t>(300 + i), true);
+    Append(&bytes, static_cast<uint8_t>(2));
+    Append(&bytes, 0.f, true);
+    Append(&bytes, 1.f, true);
+  }
+  bytes += "garbage face data";
+  WriteFile(dir / "big.ply", bytes);
+  const LidarCloud big = LoadCloud(dir / "big.ply");
+  ASSERT_EQ(big.size(), 2u);
+  EXPECT_EQ(big.points[1], Eigen::Vector3f(2.25f, -2.5f, 3.f));
+  EXPECT_EQ(big.ring, (std::vector<int>{300, 301}));
+  EXPECT_FALSE(big.HasIntensity());
+}
+
+TEST(CloudIo, RealVlp16Scan) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  const LidarCloud cloud = LoadCloud(shared / "datasets/acfr-vlp16-chessboard/pcd/pose1_full.pcd");
+  ASSERT_EQ(cloud.size(), 23969u);
+  ASSERT_EQ(cloud.ring.size(), 23969u);
+  ASSERT_EQ(cloud.intensity.size(), 23969u);
+  EXPECT_EQ(cloud.height, 1);
+  EXPECT_EQ(*std::min_element(cloud.ring.begin(), cloud.ring.end()), 0);
+  EXPECT_EQ(*std::max_element(cloud.ring.begin(), cloud.ring.end()), 15);
+  EXPECT_EQ(std::count(cloud.ring.begin(), cloud.ring.end(), 0), 1067);
+  // First row of the file: 1.373171 -2.6457233 -0.79871565 4 0
+  EXPECT_EQ(cloud.points[0], Eigen::Vector3f(1.373171f, -2.6457233f, -0.79871565f));
+  EXPECT_EQ(cloud.intensity[0], 4.f);
+  // Ring 0 is the lowest beam (-15 degrees).
+  const Eigen::Vector3f p = cloud.points[0];
+  EXPECT_NEAR(std::atan2(p.z(), p.head<2>().norm()) * 180 / M_PI, -15.0, 0.01);
+}
+
+TEST(CloudIo, Real2dLidarScansWithRgbOnly) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  int files = 0;
+  for (const auto& entry :
+       fs::directory_iterator(shared / "datasets/acfr-rpg-2dlidar-chessboard/lasers")) {
+    if (entry.path().extension() != ".pcd") continue;
+    ++files;
+    const LidarCloud cloud = LoadCloud(entry.path());
+    EXPECT_GE(cloud.size(), 505u) << entry.path();
+    EXPECT_LE(cloud.size(), 507u) << entry.path();
+    EXPECT_FALSE(cloud.HasIntensity());
+    EXPECT_FALSE(cloud.HasRing());
+    EXPECT_TRUE(cloud.range.empty());
+    for (const auto& p : cloud.points) ASSERT_EQ(p.z(), 0.f);
+  }
+  EXPECT_EQ(files, 5);
+}
+
+TEST(CloudIo, BadInputsNameTheFileAndTheProblem) {
+  const fs::path dir = test::TempDir("cloud_io_bad");
+  ExpectLoadError(dir / "missing.pcd", "does not exist");
+  WriteFile(dir / "cloud.xyz", "1 2 3\n");
+  ExpectLoadError(dir / "cloud.xyz", "unknown cloud extension");
+
+  // Truncated binary data.
+  SavePcd(dir / "truncated.pcd", RandomCloud(100, true, false, false, 5), PcdEncoding::kBinary);
+  std::string bytes = ReadFile(dir / "truncated.pcd");
+  WriteFile(dir / "truncated.pcd", bytes.substr(0, bytes.size() - 10));
+  ExpectLoadError(dir / "truncated.pcd", "expected 1600 bytes of point data, file has 1590");
+
+  // Truncated ascii: a missing row, and a row cut in the middle.
+  WriteFile(dir / "rows.pcd", kPcdHeaderXyz + "1 2 3\n4 5 6\n");
+  ExpectLoadError(dir / "rows.pcd", "expected 3 points of ascii data, file has 2 rows");
+  WriteFile(dir / "cut.pcd", kPcdHeaderXyz + "1 2 3\n4 5 6\n7 8");
+  ExpectLoadError(dir / "cut.pcd", "line 12 has 2 values, expected 3");
+  WriteFile(dir / "word.pcd", kPcdHeaderXyz + "1 2 3\n4 five 6\n7 8 9\n");
+  ExpectLoadError(dir / "word.pcd", "cannot parse 'five'");
+
+  // Header problems.
+  WriteFile(dir / "noz.pcd",
+            "FIELDS x y intensity\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nPOINTS 1\n"
+            "DATA ascii\n1 2 3\n");
+  ExpectLoadError(dir / "noz.pcd", "no 'z' field");
+  WriteFile(dir / "type.pcd",
+            "FIELDS x y z\nSIZE 4 4 2\nTYPE F F F\nPOINTS 1\nDATA ascii\n1 2 3\n");
+  ExpectLoadError(dir / "type.pcd", "field 'z' has TYPE F with SIZE 2");
+  WriteFile(dir / "data.pcd", "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 1\nDATA zip\n");
+  ExpectLoadError(dir / "data.pcd", "unknown PCD DATA type 'zip'");
+  WriteFile(dir / "garbage.pcd", "\x01\x02garbage\n");
+  ExpectLoadError(dir / "garbage.pcd", "is this a PCD file?");
+
+  // Corrupt compressed data.
+  SavePcd(dir / "lzf.pcd", RandomCloud(100, false, false, false, 6),
+          PcdEncoding::kBinaryCompressed);
+  bytes = ReadFile(dir / "lzf.pcd");
+  const size_t data = bytes.find("DATA binary_compressed\n") + 23 + 8;
+  for (size_t i = data; i < bytes.size(); ++i) bytes[i] = static_cast<char>(0xff);
+  WriteFile(dir / "lzf.pcd", bytes);
+  ExpectLoadError(dir / "lzf.pcd", "LZF decompression");
+
+  // NaN points are dropped; a cloud of NaN points only is an error.
+  WriteFile(dir / "nan.pcd", kPcdHeaderXyz + "nan nan nan\n1 2 3\n4 inf 6\n");
+  EXPECT_EQ(LoadCloud(dir / "nan.pcd").size(), 1u);
+  WriteFile(dir / "allnan.pcd", kPcdHeaderXyz + "nan nan nan\nnan 2 3\n4 -inf 6\n");
+  ExpectLoadError(dir / "allnan.pcd", "none of its 3 points has finite x, y, z");
+
+  // KITTI: 20 bytes is not a whole number of points.
+  WriteFile(dir / "kitti.bin", std::string(20, '\0'));
+  ExpectLoadError(dir / "kitti.bin", "not a multiple of 16");
+
+  // PLY: truncated vertices, no vertex element.
+  WriteFile(dir / "short.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+            "property float y\nproperty float z\nend_header\n1 2 3\n4 5\n");
+  ExpectLoadError(dir / "short.ply", "PLY data ends inside vertex 1");
+  WriteFile(dir / "face.ply", "ply\nformat ascii 1.0\nelement face 0\nend_header\n");
+  ExpectLoadError(dir / "face.ply", "no vertex element");
+
+  // Writers: a folder that does not exist is the caller's job, and an error here.
+  EXPECT_THROW(SavePcd(dir / "no/such/dir/a.pcd", RandomCloud(3, false, false, false, 7)), IoError);
+  EXPECT_THROW(SavePly(dir / "no/such/dir/a.ply", RandomCloud(3, false, false, false, 7)), IoError);
+}
+
+}  // namespace
+}  // namespace calibench

@@ -1,0 +1,140 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/solver.h"
+#include "tests/test_support.h"
+
+namespace calibench {
+namespace {
+
+Pose GroundTruth() {
+  // LiDAR x forward / z up, camera z forward / y down, with an offset.
+  Mat3 axes;
+  axes << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  Pose cam_from_lidar = Pose::Identity();
+  cam_from_lidar.linear() = ExpSO3(Vec3(0.02, -0.03, 0.01)) * axes;
+  cam_from_lidar.translation() = Vec3(0.05, -0.12, 0.08);
+  return cam_from_lidar;
+}
+
+// Board planes in front of the camera with normals tilted up to max_tilt around the view axis.
+std::vector<PlanePair> MakePairs(int n, double max_tilt_rad, double noise_normal, double noise_d,
+                                 std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const Pose cam_from_lidar = GroundTruth();
+  std::vector<PlanePair> pairs;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 tilt_axis = Vec3(uniform(rng), uniform(rng), 0).normalized();
+    const Vec3 n_cam = ExpSO3(tilt_axis * max_tilt_rad * std::abs(uniform(rng))) * Vec3(0, 0, -1);
+    const Plane camera_plane{n_cam, 1.5 + 2.0 * std::abs(uniform(rng))};
+    Plane lidar_plane = TransformPlane(cam_from_lidar.inverse(), camera_plane);
+    lidar_plane.normal =
+        (lidar_plane.normal + noise_normal * Vec3(normal(rng), normal(rng), normal(rng))).normalized();
+    lidar_plane.distance += noise_d * normal(rng);
+    pairs.push_back({std::to_string(i), lidar_plane, camera_plane});
+  }
+  return pairs;
+}
+
+TEST(Solver, InitialGuessIsExactOnNoiseFreePlanes) {
+  const auto pairs = MakePairs(5, 0.6, 0, 0, 1);
+  std::string why;
+  const auto guess = InitialGuessFromPlanes(pairs, &why);
+  ASSERT_TRUE(guess) << why;
+  EXPECT_TRUE(test::MatrixNear(guess->matrix(), GroundTruth().matrix(), 1e-9));
+}
+
+TEST(Solver, GaussNewtonConvergesFromTheIdentityToTheTruth) {
+  const auto pairs = MakePairs(3, 0.6, 0, 0, 2);
+  PlaneAlignmentSolver solver(pairs, SolverOptions{}, Pose::Identity());
+  const SolverResult result = solver.Run();
+  EXPECT_TRUE(result.converged);
+  EXPECT_LT(RotationAngle(result.cam_from_lidar.linear(), GroundTruth().linear()), 1e-8);
+  EXPECT_LT((result.cam_from_lidar.translation() - GroundTruth().translation()).norm(), 1e-8);
+  EXPECT_TRUE(result.observability.well_constrained);
+  ASSERT_GE(result.cost_history.size(), 2u);
+  for (size_t i = 1; i < result.cost_history.size(); ++i)
+    EXPECT_LE(result.cost_history[i], result.cost_history[i - 1] + 1e-15);
+}
+
+TEST(Solver, StepsOneIterationAtATimeAndReportsEachOne) {
+  const auto pairs = MakePairs(6, 0.5, 0, 0, 3);
+  std::string why;
+  PlaneAlignmentSolver solver(pairs, SolverOptions{}, *InitialGuessFromPlanes(pairs, &why) *
+                                                          ExpSE3(Vec6::Constant(0.05)));
+  int reports = 0;
+  solver.Run([&](const IterationReport& it) {
+    EXPECT_EQ(it.iteration, static_cast<int>(solver.History().size()) - 1);
+    ++reports;
+  });
+  EXPECT_GE(reports, 3);
+  EXPECT_TRUE(solver.Done());
+}
+
+TEST(Solver, NoisyPlanesGiveSmallErrorAndAnHonestCovariance) {
+  const auto pairs = MakePairs(20, 0.6, 0.002, 0.003, 4);
+  std::string why;
+  PlaneAlignmentSolver solver(pairs, SolverOptions{}, *InitialGuessFromPlanes(pairs, &why));
+  const SolverResult result = solver.Run();
+  const double t_err = (result.cam_from_lidar.translation() - GroundTruth().translation()).norm();
+  EXPECT_LT(t_err, 0.01);
+  EXPECT_LT(RotationAngle(result.cam_from_lidar.linear(), GroundTruth().linear()), 0.2 * M_PI / 180);
+  // The standard deviations are of the same order as the noise, not zero and not huge.
+  const double sigma_t = std::sqrt(result.covariance.topLeftCorner<3, 3>().trace());
+  EXPECT_GT(sigma_t, 1e-4);
+  EXPECT_LT(sigma_t, 0.02);
+}
+
+TEST(Solver, HuberKernelDownWeightsAnOutlierPair) {
+  auto pairs = MakePairs(12, 0.6, 0.0005, 0.001, 5);
+  pairs[3].lidar_plane.distance += 0.5;  // a wrong plane
+  std::string why;
+  const Pose guess = *InitialGuessFromPlanes(pairs, &why);
+  SolverOptions options;
+  options.huber_delta = 0.02;
+  const SolverResult robust = PlaneAlignmentSolver(pairs, options, guess).Run();
+  options.huber_delta = 1e3;  // effectively least squares
+  const SolverResult plain = PlaneAlignmentSolver(pairs, options, guess).Run();
+  const double robust_err = (robust.cam_from_lidar.translation() - GroundTruth().translation()).norm();
+  const double plain_err = (plain.cam_from_lidar.translation() - GroundTruth().translation()).norm();
+  EXPECT_LT(robust_err, 0.5 * plain_err);
+  EXPECT_LT(robust.robust_weights[3], 0.2);
+  EXPECT_NEAR(robust.robust_weights[0], 1.0, 1e-12);
+}
+
+TEST(Solver, ParallelNormalsAreReportedNotGuessed) {
+  auto pairs = MakePairs(5, 0.0, 0, 0, 6);  // every board faces the camera squarely
+  std::string why;
+  EXPECT_FALSE(InitialGuessFromPlanes(pairs, &why));
+  EXPECT_NE(why.find("parallel"), std::string::npos);
+  // From a user guess, the solver runs but says which directions the data cannot fix.
+  const SolverResult result = PlaneAlignmentSolver(pairs, SolverOptions{}, GroundTruth()).Run();
+  EXPECT_FALSE(result.observability.well_constrained);
+  ASSERT_FALSE(result.observability.weak_directions.empty());
+  bool names_translation = false;
+  for (const auto& d : result.observability.weak_directions)
+    names_translation |= d.find("translation along camera") != std::string::npos;
+  EXPECT_TRUE(names_translation);
+}
+
+TEST(Solver, NearlyParallelNormalsAreWeak) {
+  const auto pairs = MakePairs(6, 0.5 * M_PI / 180, 0, 0, 7);
+  const SolverResult result = PlaneAlignmentSolver(pairs, SolverOptions{}, GroundTruth()).Run();
+  EXPECT_FALSE(result.observability.well_constrained);
+  const auto good = MakePairs(6, 0.5, 0, 0, 7);
+  EXPECT_TRUE(PlaneAlignmentSolver(good, SolverOptions{}, GroundTruth()).Run().observability.well_constrained);
+}
+
+TEST(Solver, OptionsCheckNamesTheBadField) {
+  SolverOptions options;
+  options.huber_delta = -1;
+  std::string why;
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("huber_delta"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace calibench

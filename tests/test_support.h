@@ -1,0 +1,51 @@
+// Helpers shared by the test suites: tolerance matchers for Eigen types, the shared/ folder,
+// temporary directories.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "core/types.h"
+
+namespace calibench::test {
+
+// ../shared when present. When it is missing: GTEST_SKIP with a clear message, unless the
+// environment sets CALIBENCH_REQUIRE_SHARED=1 (as .ci/run does), in which case the test fails.
+std::optional<std::filesystem::path> SharedDir();
+
+// A fresh, empty directory under the build tree for one test.
+std::filesystem::path TempDir(const std::string& name);
+
+// The calibench executable built next to the tests (from $CALIBENCH_EXE).
+std::string CalibenchExe();
+
+// Runs a shell command, returns its exit code; stdout+stderr go to *output when given.
+int RunCommand(const std::string& command, std::string* output = nullptr);
+
+template <typename A, typename B>
+::testing::AssertionResult MatrixNear(const A& actual, const B& expected, double tolerance) {
+  if (actual.rows() != expected.rows() || actual.cols() != expected.cols())
+    return ::testing::AssertionFailure() << "size mismatch";
+  const double err = (actual - expected).cwiseAbs().maxCoeff();
+  if (err <= tolerance) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "max abs difference " << err << " > " << tolerance
+                                       << "\nactual:\n" << actual << "\nexpected:\n" << expected;
+}
+
+}  // namespace calibench::test
+
+// Skips (or fails under CALIBENCH_REQUIRE_SHARED=1) when ../shared is absent; binds `shared`.
+#define CALIBENCH_REQUIRE_SHARED_DIR(shared)                                               \
+  const auto shared##_opt = ::calibench::test::SharedDir();                                \
+  if (!shared##_opt) {                                                                     \
+    if (std::getenv("CALIBENCH_REQUIRE_SHARED") &&                                         \
+        std::string(std::getenv("CALIBENCH_REQUIRE_SHARED")) == "1") {                     \
+      FAIL() << "../shared is required (CALIBENCH_REQUIRE_SHARED=1) but was not found";    \
+    }                                                                                      \
+    GTEST_SKIP() << "../shared/datasets not found next to the repository: skipping a test " \
+                    "on real data (set CALIBENCH_SHARED_DIR to point at it)";              \
+  }                                                                                        \
+  const std::filesystem::path shared = *shared##_opt
