@@ -35,10 +35,11 @@ BoardSpec NamedBoard(const std::string& name) {
   } else if (name == "charuco-a3" || name == "charuco-a4") {
     const bool a3 = name == "charuco-a3";
     b.type = BoardType::kCharuco;
-    b.cols = a3 ? 9 : 7;
-    b.rows = a3 ? 6 : 5;
-    b.square_size = a3 ? 0.04 : 0.035;
-    b.marker_size = a3 ? 0.03 : 0.026;
+    // Few, large squares: 4x4 markers must stay decodable (> ~12 px) at 3-4 m.
+    b.cols = a3 ? 6 : 5;
+    b.rows = a3 ? 4 : 3;
+    b.square_size = a3 ? 0.065 : 0.055;
+    b.marker_size = a3 ? 0.05 : 0.042;
     b.dictionary = "DICT_4X4_50";
     b.board_width = a3 ? 0.42 : 0.297;
     b.board_height = a3 ? 0.297 : 0.21;

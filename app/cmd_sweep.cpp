@@ -65,15 +65,15 @@ int RunSweep(int argc, char** argv) {
   app.add_option("--work-dir", work_dir, "where the simulated pools are written")->capture_default_str();
   app.add_option("--sizes", sizes_text, "numbers of pairs N")->capture_default_str();
   app.add_option("--subsets", subsets, "random subsets per N")->capture_default_str();
-  app.add_option("--noise", noise_text, "LiDAR range noise levels [m]")->capture_default_str();
-  app.add_option("--image-noise", image_noise_text, "image noise per level, [0,1] units")
+  app.add_option("--noise-levels", noise_text, "LiDAR range noise levels [m]")->capture_default_str();
+  app.add_option("--image-noise-levels", image_noise_text, "image noise per level, [0,1] units")
       ->capture_default_str();
   app.add_option("--table", table_path, "also write the markdown table here");
   SimFlags sim_flags;
   sim_flags.preset = "paper";
   AddSimFlags(app, sim_flags);
   PipelineFlags flags;
-  AddPipelineFlags(app, flags);
+  AddPipelineFlags(app, flags, /*with_selection=*/false);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -86,12 +86,12 @@ int RunSweep(int argc, char** argv) {
     noises = ParseList(noise_text);
     image_noises = ParseList(image_noise_text);
   } catch (const std::exception&) {
-    std::fprintf(stderr, "calibench sweep: --sizes/--noise/--image-noise take comma-separated numbers\n");
+    std::fprintf(stderr, "calibench sweep: --sizes/--noise-levels/--image-noise-levels take comma-separated numbers\n");
     return kUsage;
   }
   if (image_noises.size() != noises.size() || subsets < 1 || !FinalizePipelineFlags(flags, &why)) {
     std::fprintf(stderr, "calibench sweep: %s\n",
-                 why.empty() ? "--image-noise needs one value per --noise level, --subsets >= 1" : why.c_str());
+                 why.empty() ? "--image-noise-levels needs one value per --noise-levels entry, --subsets >= 1" : why.c_str());
     return kUsage;
   }
   std::vector<std::vector<Cell>> table(sizes.size(), std::vector<Cell>(noises.size()));

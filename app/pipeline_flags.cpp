@@ -10,16 +10,18 @@
 
 namespace calibench::app {
 
-void AddPipelineFlags(CLI::App& app, PipelineFlags& flags) {
+void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) {
   PipelineOptions& o = flags.options;
   app.add_option("--huber-delta", o.solver.huber_delta, "Huber threshold on the plane error")
       ->capture_default_str();
   app.add_option("--max-iterations", o.solver.max_iterations, "Gauss-Newton iterations")
       ->capture_default_str();
-  app.add_option("--pairs", flags.pairs, "comma-separated pair ids to use (default: all)");
-  app.add_option("--initial-guess", flags.initial_guess,
-                 "cam_from_lidar to start from: a result.json, or 16 comma-separated numbers "
-                 "(row-major 4x4); default: closed form from the planes");
+  if (with_selection) {
+    app.add_option("--pairs", flags.pairs, "comma-separated pair ids to use (default: all)");
+    app.add_option("--initial-guess", flags.initial_guess,
+                   "cam_from_lidar to start from: a result.json, or 16 comma-separated numbers "
+                   "(row-major 4x4); default: closed form from the planes");
+  }
   app.add_option("--threads", o.threads, "feature extraction threads")->capture_default_str();
   app.add_option("--ransac-threshold", o.lidar_plane.ransac_threshold_m,
                  "LiDAR plane RANSAC inlier distance [m]")

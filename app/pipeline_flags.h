@@ -14,7 +14,8 @@ struct PipelineFlags {
   std::string initial_guess;  // result.json, or 16 numbers (row-major 4x4)
 };
 
-void AddPipelineFlags(CLI::App& app, PipelineFlags& flags);
+// with_selection adds --pairs and --initial-guess (not wanted where pairs are simulated).
+void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection = true);
 
 // Applies the string flags; false with *why when they are malformed or the options fail Check.
 bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why);

@@ -21,6 +21,9 @@ struct BoardDetectionOptions {
   // OpenCV 4.6 ChArUco corner interpolation is offset by +0.5 px in x and y (OpenCV issue 25539).
   bool correct_charuco_offset = true;
   int min_corners = 6;  // fewer detected corners = failed detection
+  // Smallest ArUco marker perimeter as a fraction of the larger image side. OpenCV's default
+  // (0.03, i.e. ~11 px markers on a 1440 px image) drops the markers of small boards at range.
+  double min_marker_perimeter_rate = 0.01;
   bool Check(std::string* why) const;
 };
 

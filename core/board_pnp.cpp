@@ -2,8 +2,13 @@
 // residuals, covariances of the pose and of the board plane.
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <opencv2/calib3d.hpp>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "core/board_camera.h"
 #include "core/geometry.h"
@@ -34,7 +39,8 @@ std::optional<Linearization> Linearize(const CameraModel& camera, const BoardDet
   for (int i = 0; i < n; ++i) {
     const Vec3& x = detection.board_points[i];
     Eigen::Matrix<double, 2, 3> d_pixel_d_point;
-    const auto pixel = camera.Project(cam_from_board * x, with_jacobian ? &d_pixel_d_point : nullptr);
+    const auto pixel =
+        camera.Project(cam_from_board * x, with_jacobian ? &d_pixel_d_point : nullptr);
     if (!pixel) return std::nullopt;
     lin.residuals.segment<2>(2 * i) = *pixel - detection.pixels[i];
     if (with_jacobian) {
@@ -58,15 +64,18 @@ std::optional<Pose> Refine(const CameraModel& camera, const BoardDetection& dete
     const Vec6 g = lin->jacobian.transpose() * lin->residuals;
     Vec6 step = -h.ldlt().solve(g);
     if (!step.allFinite()) break;
+    // Step halving keeps the cost from rising when the linearization is poor (far start).
     bool improved = false;
-    for (int halving = 0; halving < 10 && !improved; ++halving, step *= 0.5) {
+    for (int halving = 0; halving < 10; ++halving) {
       const Pose candidate = pose * ExpSE3(step);
       auto next = Linearize(camera, detection, candidate, true);
       if (next && next->ssr <= lin->ssr) {
         pose = candidate;
         lin = std::move(next);
         improved = true;
+        break;
       }
+      step *= 0.5;
     }
     if (!improved || step.norm() < kStepTolerance) break;
   }

@@ -1,12 +1,13 @@
 #include "core/camera.h"
 
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 namespace calibench {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 // Beyond these incidence angles a point is never imaged: a pinhole cannot see 90 degrees, and a
 // fisheye ray at 180 degrees has no direction in the image plane.
 constexpr double kPinholeMaxAngle = 89.9 * kDeg;
@@ -157,7 +158,8 @@ double FisheyeW(double rho, double z, double n2, double theta) {
   const double t = rho / z;
   if (z > 0 && t < 1e-2) {
     const double t2 = t * t;
-    const double series = -2.0 / 3 + t2 * (4.0 / 5 + t2 * (-6.0 / 7 + t2 * (8.0 / 9 - t2 * 10.0 / 11)));
+    const double series =
+        -2.0 / 3 + t2 * (4.0 / 5 + t2 * (-6.0 / 7 + t2 * (8.0 / 9 - t2 * 10.0 / 11)));
     return series / (z * z * z);
   }
   return (rho * z / n2 - theta) / (rho * rho * rho);
@@ -171,7 +173,7 @@ std::optional<Vec2> ProjectFisheye(const CameraModel& cam, const Vec3& p,
   const double n2 = p.squaredNorm();
   const double theta = std::atan2(rho, p.z());
   if (!(n2 > 0) || !(theta < ValidityLimit(cam))) return std::nullopt;
-  if (rho == 0) {  // On the optical axis (z > 0 here): the limit of the general formula.
+  if (rho == 0 || theta == 0) {  // On the optical axis (z > 0): the general formula's limit.
     if (jacobian) *jacobian << cam.fx / p.z(), 0, 0, 0, cam.fy / p.z(), 0;
     return Vec2(cam.cx, cam.cy);
   }
@@ -308,8 +310,7 @@ std::optional<Vec3> CameraModel::Unproject(const Vec2& pixel) const {
   const std::optional<double> theta = UndistortTheta(*this, theta_d);
   if (!theta) return std::nullopt;
   const Vec2 direction = distorted / theta_d;
-  return Vec3(std::sin(*theta) * direction.x(), std::sin(*theta) * direction.y(),
-              std::cos(*theta));
+  return Vec3(std::sin(*theta) * direction.x(), std::sin(*theta) * direction.y(), std::cos(*theta));
 }
 
 }  // namespace calibench

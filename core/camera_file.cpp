@@ -42,8 +42,8 @@ YamlNode FromFileNode(const cv::FileNode& node) {
   } else if (node.isInt() || node.isReal()) {
     char buffer[64];
     // Shortest text that reads back as the same double: no digits lost on the way.
-    const double value = node.isInt() ? static_cast<double>(static_cast<int>(node))
-                                      : static_cast<double>(node);
+    const double value =
+        node.isInt() ? static_cast<double>(static_cast<int>(node)) : static_cast<double>(node);
     const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
     out.kind = YamlNode::Kind::kScalar;
     out.scalar.assign(buffer, result.ptr);
@@ -66,7 +66,8 @@ std::optional<YamlNode> ReadWithOpenCv(const std::filesystem::path& path, std::s
     }
     return FromFileNode(storage.root());
   } catch (const cv::Exception& e) {
-    *why = e.err;
+    // OpenCV's parsers put "file(line): problem" in `func` and their own name in `err`.
+    *why = e.code == cv::Error::StsParseError ? e.func : e.err;
     return std::nullopt;
   }
 }
@@ -107,8 +108,8 @@ std::vector<double> Numbers(const YamlNode& node, const std::string& what) {
   for (const YamlNode& item : node.items) {
     const std::optional<double> value = item.AsDouble();
     if (!value) {
-      throw Problem(what + " must contain numbers only, found " + Quote(item.scalar) +
-                    " (line " + std::to_string(item.line) + ")");
+      throw Problem(what + " must contain numbers only, found " + Quote(item.scalar) + " (line " +
+                    std::to_string(item.line) + ")");
     }
     values.push_back(*value);
   }
@@ -178,8 +179,10 @@ void SetModel(const std::string& name, std::vector<double> coefficients, CameraM
                   std::to_string(n));
   }
   if (lower == "rational_polynomial" && n != 8) {
-    throw Problem("rational_polynomial needs 8 distortion coefficients (k1 k2 p1 p2 k3 k4 k5 k6), "
-                  "got " + std::to_string(n));
+    throw Problem(
+        "rational_polynomial needs 8 distortion coefficients (k1 k2 p1 p2 k3 k4 k5 k6), "
+        "got " +
+        std::to_string(n));
   }
   if (lower == "plumb_bob" || lower == "rational_polynomial" || lower == "radtan" ||
       lower == "pinhole-radtan" || lower == "radial-tangential") {
@@ -209,8 +212,9 @@ CameraModel FromCameraMatrix(const YamlNode& root, bool opencv_file) {
   } else if (opencv_file) {
     SetModel("pinhole-radtan", coefficients, &camera);  // what cv::calibrateCamera writes
   } else {
-    throw Problem("'distortion_model' is missing; only OpenCV FileStorage files (with their "
-                  "%YAML:1.0 header) imply pinhole-radtan");
+    throw Problem(
+        "'distortion_model' is missing; only OpenCV FileStorage files (with their "
+        "%YAML:1.0 header) imply pinhole-radtan");
   }
   camera.width = Size(root.Find("image_width"), "image_width");
   camera.height = Size(root.Find("image_height"), "image_height");
@@ -282,8 +286,9 @@ CameraModel Interpret(const YamlNode& root, bool opencv_file) {
   } else if (root.Find("K") || root.Find("k")) {
     camera = FromCameraInfo(root);
   } else {
-    throw Problem("cannot tell the format: none of camera_matrix (OpenCV, ROS camera_calibration),"
-                  " K (ROS CameraInfo) or cam0 (Kalibr) is present");
+    throw Problem(
+        "cannot tell the format: none of camera_matrix (OpenCV, ROS camera_calibration),"
+        " K (ROS CameraInfo) or cam0 (Kalibr) is present");
   }
   // The size may be absent (0 = unknown); everything else must already be valid.
   CameraModel sized = camera;

@@ -5,15 +5,17 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 
 namespace calibench {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-#ifndef VALLEY
-#define VALLEY 0.5
-#endif
-constexpr double kValleyRatio = VALLEY;
+// Two density peaks are separate rings when the valley between them is below this fraction of
+// the lower peak. Two equal Gaussian rings d apart reach 0.7 at d = 2.9 sigma; a lower ratio
+// merged HDL-64 rings (1/3 degree apart) already at 0.1 degree of elevation noise.
+constexpr double kValleyRatio = 0.7;
 
 // Elevation above the x-y plane of the LiDAR frame, radians.
 double Elevation(const Eigen::Vector3f& p) {
@@ -99,7 +101,8 @@ std::vector<Cluster> SplitAtValleys(const std::vector<double>& sorted, Cluster r
   };
   auto distinct = [&](int a, int b) {
     const double low_peak = std::min(smooth[a], smooth[b]), v = smooth[valley(a, b)];
-    return (b - a) * bin > gap && v < kValleyRatio * low_peak && low_peak - v > 3 * std::sqrt(low_peak);
+    return (b - a) * bin > gap && v < kValleyRatio * low_peak &&
+           low_peak - v > 3 * std::sqrt(low_peak);
   };
   // Merge the least distinct neighbours first (drop the lower peak) until all pairs are distinct.
   for (bool merged = true; merged && peaks.size() > 1;) {
@@ -110,7 +113,10 @@ std::vector<Cluster> SplitAtValleys(const std::vector<double>& sorted, Cluster r
       if (distinct(peaks[k], peaks[k + 1])) continue;
       const double ratio =
           smooth[valley(peaks[k], peaks[k + 1])] / std::min(smooth[peaks[k]], smooth[peaks[k + 1]]);
-      if (ratio > worst_ratio) worst_ratio = ratio, worst = static_cast<int>(k);
+      if (ratio > worst_ratio) {
+        worst_ratio = ratio;
+        worst = static_cast<int>(k);
+      }
     }
     if (worst >= 0) {
       const int drop = smooth[peaks[worst]] < smooth[peaks[worst + 1]] ? worst : worst + 1;
@@ -125,7 +131,10 @@ std::vector<Cluster> SplitAtValleys(const std::vector<double>& sorted, Cluster r
     const size_t split = static_cast<size_t>(
         std::lower_bound(sorted.begin() + begin, sorted.begin() + run.end, boundary) -
         sorted.begin());
-    if (split > begin && split < run.end) parts.push_back({begin, split}), begin = split;
+    if (split > begin && split < run.end) {
+      parts.push_back({begin, split});
+      begin = split;
+    }
   }
   parts.push_back({begin, run.end});
   return parts;
@@ -135,7 +144,10 @@ std::vector<Cluster> SplitAtValleys(const std::vector<double>& sorted, Cluster r
 // renumber every ring above them; fold them into the nearest real ring.
 void MergeSlivers(const std::vector<double>& sorted, std::vector<Cluster>* clusters) {
   double sum = 0, sum_sq = 0;  // size of the cluster an average point belongs to
-  for (const Cluster& c : *clusters) sum += c.size(), sum_sq += double(c.size()) * c.size();
+  for (const Cluster& c : *clusters) {
+    sum += static_cast<double>(c.size());
+    sum_sq += static_cast<double>(c.size()) * static_cast<double>(c.size());
+  }
   const double min_size = 0.02 * sum_sq / std::max(sum, 1.0);
   while (clusters->size() > 1) {
     auto smallest =
@@ -198,16 +210,31 @@ bool LidarImageOptions::Check(std::string* why) const {
     if (why) *why = "columns must be 0 (automatic) or 1..65536, got " + std::to_string(columns);
     return false;
   }
-  if (!std::isfinite(ring_gap_rad) || ring_gap_rad <= 0 || ring_gap_rad >= 0.1) {
+  // Below 0.05 degrees the elevation histogram gets needlessly fine (and slow); above 0.1 rad
+  // (5.7 degrees) the gap exceeds the beam spacing of every spinning LiDAR.
+  constexpr double kMinGap = 0.05 * M_PI / 180.0, kMaxGap = 0.1;
+  if (!(ring_gap_rad >= kMinGap && ring_gap_rad < kMaxGap)) {
     if (why)
-      *why = "ring_gap_rad must be in (0, 0.1) rad (below the beam spacing), got " +
+      *why = "ring_gap_rad must be in [0.05 deg, 0.1 rad) and below the beam spacing, got " +
              std::to_string(ring_gap_rad);
     return false;
   }
   return true;
 }
 
+namespace {
+
+// Options are checked by the caller (CLI, GUI) before any work; reaching here with bad ones is a
+// programmer error.
+void RequireValid(const LidarImageOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) throw std::invalid_argument("LidarImageOptions: " + why);
+}
+
+}  // namespace
+
 std::vector<int> InferRings(const LidarCloud& cloud, const LidarImageOptions& options) {
+  RequireValid(options);
   if (cloud.HasRing()) {
     CALIBENCH_CHECK(cloud.ring.size() == cloud.size());
     return cloud.ring;
@@ -227,8 +254,6 @@ int AzimuthColumn(const Eigen::Vector3f& point, int columns) {
 }
 
 LidarImage ProjectById(const LidarCloud& cloud, const LidarImageOptions& options) {
-  std::string why;
-  if (!options.Check(&why)) throw std::invalid_argument("LidarImageOptions: " + why);
   const std::vector<int> rings = InferRings(cloud, options);
   std::vector<int> ring_ids = rings;
   std::sort(ring_ids.begin(), ring_ids.end());

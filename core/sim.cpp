@@ -1,11 +1,13 @@
 // Simulated datasets: options, presets, board placement and the files of SimulateDataset.
+#include "core/sim.h"
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <stdexcept>
 
 #include "core/cloud.h"
-#include "core/sim.h"
 
 namespace calibench {
 namespace {
@@ -146,6 +148,34 @@ bool SheetFitsRoom(const SimOptions& r, const LidarScene& scene, const Pose& lid
   return true;
 }
 
+// The whole sheet within the LiDAR's vertical field of view: a "valid measurement" in the sense
+// of Ca²Lib Section 4.1, where both sensors see the complete target.
+bool SheetInLidarFov(const SimOptions& r, const BeamTable& beams, const Pose& lidar_from_board) {
+  const auto [lowest, highest] =
+      std::minmax_element(beams.elevations_rad.begin(), beams.elevations_rad.end());
+  const double hw = 0.5 * r.board.SheetWidth(), hh = 0.5 * r.board.SheetHeight();
+  for (const Vec3& c : {Vec3(-hw, -hh, 0), Vec3(hw, -hh, 0), Vec3(hw, hh, 0), Vec3(-hw, hh, 0)}) {
+    const Vec3 p = lidar_from_board * c;
+    const double elevation = std::atan2(p.z(), std::hypot(p.x(), p.y()));
+    if (elevation < *lowest || elevation > *highest) return false;
+  }
+  return true;
+}
+
+// Where a user would brush: the centroid of the noise-free board returns.
+Vec3 BoardHitCentroid(const BeamTable& beams, const BoardPrint& print, const Pose& lidar_from_board,
+                      double azimuth_offset_rad) {
+  LidarScene board_only;
+  board_only.lidar_from_board = lidar_from_board;
+  board_only.clutter = false;
+  LidarScanOptions scan_options;
+  scan_options.azimuth_offset_rad = azimuth_offset_rad;
+  const LidarCloud hits = SimulateLidarScan(beams, print, board_only, scan_options).ToCloud();
+  Vec3 centroid = Vec3::Zero();
+  for (const auto& p : hits.points) centroid += p.cast<double>() / static_cast<double>(hits.size());
+  return hits.size() > 0 ? centroid : lidar_from_board.translation();
+}
+
 bool EnoughLidarHits(const BeamTable& beams, const BoardPrint& print, const Pose& lidar_from_board,
                      double azimuth_offset_rad) {
   LidarScene board_only;
@@ -154,13 +184,12 @@ bool EnoughLidarHits(const BeamTable& beams, const BoardPrint& print, const Pose
   LidarScanOptions scan_options;
   scan_options.azimuth_offset_rad = azimuth_offset_rad;
   const LidarScan scan = SimulateLidarScan(beams, print, board_only, scan_options);
-  std::vector<bool> ring_hit(beams.elevations_rad.size(), false);
-  int rings = 0;
-  for (int ring : scan.ring) {
-    if (ring_hit[ring]) continue;
-    ring_hit[ring] = true;
-    ++rings;
-  }
+  // A ring that only grazes a corner (one or two returns) does not help a plane fit.
+  constexpr int kMinPointsPerRing = 3;
+  std::vector<int> hits_per_ring(beams.elevations_rad.size(), 0);
+  for (int ring : scan.ring) ++hits_per_ring[ring];
+  const int rings = static_cast<int>(std::count_if(hits_per_ring.begin(), hits_per_ring.end(),
+                                                   [](int n) { return n >= kMinPointsPerRing; }));
   return rings >= kMinBoardRings && static_cast<int>(scan.size()) >= kMinBoardPoints;
 }
 
@@ -180,6 +209,7 @@ PairPlan PlanPair(const SimOptions& r, const BeamTable& beams, const BoardPrint&
     plan.cam_from_board = RandomBoardPose(r, *bearing, rng);
     const Pose lidar_from_board = lidar_from_cam * plan.cam_from_board;
     if (SheetInImage(r, plan.cam_from_board) && SheetFitsRoom(r, scene, lidar_from_board) &&
+        SheetInLidarFov(r, beams, lidar_from_board) &&
         EnoughLidarHits(beams, print, lidar_from_board, plan.azimuth_offset_rad)) {
       return plan;
     }
@@ -187,7 +217,8 @@ PairPlan PlanPair(const SimOptions& r, const BeamTable& beams, const BoardPrint&
   throw std::runtime_error(
       "simulation: cannot place the board of pair " + std::to_string(pair) + " in " +
       std::to_string(kMaxTriesPerPair) +
-      " tries: the whole sheet must be in the image with a 5% margin, in front of the LiDAR, " +
+      " tries: the whole sheet must be in the image with a 5% margin, in front of the LiDAR and "
+      "inside its vertical field of view, " +
       "above the floor and hit by >= 4 rings and >= 60 points of the " + LidarModelName(r.lidar) +
       "; try a larger board, a smaller max_distance_m or max_tilt_deg, or a LiDAR with more rings");
 }
@@ -330,7 +361,9 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
     entry.cloud = root / "clouds" / (entry.id + ".pcd");
     entry.image = root / "images" / (entry.id + ".png");
     scene.lidar_from_board = lidar_from_cam * plan.cam_from_board;
-    entry.lidar_seed = LidarSeed{scene.lidar_from_board.translation(), r.seed_radius_m};
+    entry.lidar_seed = LidarSeed{
+        BoardHitCentroid(beams, print, scene.lidar_from_board, plan.azimuth_offset_rad),
+        r.seed_radius_m};
 
     LidarScanOptions scan_options;
     scan_options.range_noise_m = r.lidar_range_noise_m;

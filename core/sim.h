@@ -18,7 +18,7 @@
 namespace calibench {
 
 enum class LidarModel { kHdl64, kVlp16, kOs0_128 };
-std::string LidarModelName(LidarModel model);                       // "hdl64", "vlp16", "os0-128"
+std::string LidarModelName(LidarModel model);  // "hdl64", "vlp16", "os0-128"
 std::optional<LidarModel> ParseLidarModelName(const std::string& name);
 
 // A spinning LiDAR's beam table: elevation per ring (radians, ring 0 = lowest) and azimuth bins.
@@ -31,18 +31,18 @@ BeamTable MakeBeamTable(LidarModel model);
 
 struct SimOptions {
   LidarModel lidar = LidarModel::kVlp16;
-  CameraModel camera;          // empty width = a default 1440x1080 pinhole-radtan (or fisheye)
-  bool fisheye = false;        // used only when `camera` is empty
-  BoardSpec board;             // cols == 0 = A3 checkerboard (7x5 inner corners, 40 mm squares)
+  CameraModel camera;    // empty width = a default 1440x1080 pinhole-radtan (or fisheye)
+  bool fisheye = false;  // used only when `camera` is empty
+  BoardSpec board;       // cols == 0 = A3 checkerboard (7x5 inner corners, 40 mm squares)
   int num_pairs = 20;
   double min_distance_m = 1.5;  // board centre distance from the camera
   double max_distance_m = 4.0;
-  double max_tilt_deg = 40.0;   // board normal vs. the camera viewing ray
+  double max_tilt_deg = 40.0;        // board normal vs. the camera viewing ray
   double lidar_range_noise_m = 0.0;  // Gaussian, along each ray
   double image_noise = 0.0;          // Gaussian pixel noise, in [0,1] intensity units (Gazebo)
   bool clutter = true;               // floor and walls
   Pose cam_from_lidar = Pose::Identity();  // ground truth; Identity() = the default mount below
-  double seed_radius_m = 0.0;        // lidar_seed radius; 0 = 0.4 * the smaller board side
+  double seed_radius_m = 0.0;              // lidar_seed radius; 0 = 0.4 * the smaller board side
   std::uint64_t seed = 1;
 
   bool Check(std::string* why) const;
@@ -74,8 +74,8 @@ class BoardPrint {
 
  private:
   BoardSpec board_;
-  Vec2 half_sheet_;    // metres
-  Vec2 half_pattern_;  // metres
+  Vec2 half_sheet_;                    // metres
+  Vec2 half_pattern_;                  // metres
   std::vector<std::uint8_t> texture_;  // ChArUco only: grey, row 0 at y = -pattern height / 2
   int texture_width_ = 0;
   int texture_height_ = 0;
@@ -87,8 +87,8 @@ class BoardPrint {
 struct LidarScene {
   Pose lidar_from_board = Pose::Identity();
   bool clutter = true;
-  double floor_z_m = -1.5;         // floor plane z = floor_z_m (metres, LiDAR frame)
-  double wall_distance_m = 6.0;    // walls at x = ±d and y = ±d (metres, LiDAR frame)
+  double floor_z_m = -1.5;       // floor plane z = floor_z_m (metres, LiDAR frame)
+  double wall_distance_m = 6.0;  // walls at x = ±d and y = ±d (metres, LiDAR frame)
 };
 
 struct LidarScanOptions {
@@ -102,10 +102,10 @@ enum class SimSurface : std::uint8_t { kBoard, kFloor, kWall };
 // One sweep in double precision (the PCD file stores floats). Intensities: white paper ~200,
 // black ink ~20, walls ~90, floor ~60 (0..255, with small Gaussian noise).
 struct LidarScan {
-  std::vector<Vec3> points;          // metres, LiDAR frame
-  std::vector<float> intensity;      // 0..255
-  std::vector<int> ring;             // 0 = lowest beam
-  std::vector<SimSurface> surface;   // what each return hit
+  std::vector<Vec3> points;         // metres, LiDAR frame
+  std::vector<float> intensity;     // 0..255
+  std::vector<int> ring;            // 0 = lowest beam
+  std::vector<SimSurface> surface;  // what each return hit
 
   size_t size() const { return points.size(); }
   // Unorganized cloud (height 1) with intensity and ring.
@@ -127,8 +127,8 @@ std::vector<Pose> SampleBoardPoses(const SimOptions& options);
 // centre, x along columns, y along rows, z away from the viewer). White sheet margin up to the
 // sheet size, then a mid-grey background (no clutter). Anti-aliased by supersampling.
 struct RenderOptions {
-  int supersampling = 4;        // samples per pixel along each axis
-  double image_noise = 0.0;     // Gaussian, [0,1] intensity units
+  int supersampling = 4;     // samples per pixel along each axis
+  double image_noise = 0.0;  // Gaussian, [0,1] intensity units
   std::uint8_t background = 100;
   std::uint64_t seed = 1;
 };

@@ -51,8 +51,7 @@ BoardGeometry MakeBoardGeometry(const Pose& lidar_from_board) {
   return g;
 }
 
-void IntersectBoard(const Vec3& dir, const BoardGeometry& g, const BoardPrint& print,
-                    RayHit* hit) {
+void IntersectBoard(const Vec3& dir, const BoardGeometry& g, const BoardPrint& print, RayHit* hit) {
   const double denom = g.normal.dot(dir);
   if (std::abs(denom) < 1e-12) return;
   const double range = g.offset / denom;

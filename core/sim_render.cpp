@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/aruco/charuco.hpp>
-#include <random>
 #include <stdexcept>
 
 #include "core/sim.h"
@@ -14,7 +13,8 @@ constexpr int kTexelsPerSquare = 100;  // ChArUco texture resolution
 constexpr double kInkGrey = 20.0;      // rendered grey of black ink (0..255)
 constexpr double kPaperGrey = 235.0;   // white paper, below 255 so that noise does not clip
 // Bearings are unprojected exactly on a grid of this pitch (pixels) and interpolated in between:
-// the interpolation error is below 1e-3 px for the cameras we simulate, Newton per sample is not.
+// the interpolation error is below 0.005 px for the cameras we simulate (measured), and Newton per
+// sample would cost ~0.5 us.
 constexpr int kNodeStep = 4;
 
 cv::Ptr<cv::aruco::Dictionary> DictionaryByName(const std::string& name) {
@@ -66,8 +66,8 @@ BoardPrint::BoardPrint(const BoardSpec& board)
       half_pattern_(0.5 * board.PatternWidth(), 0.5 * board.PatternHeight()) {
   CALIBENCH_CHECK(board.square_size > 0.0 && board.SquaresX() > 0 && board.SquaresY() > 0);
   if (board.type != BoardType::kCharuco) return;
-  const auto cv_board = MakeCharucoBoard(
-      board, 1.0f, static_cast<float>(board.marker_size / board.square_size));
+  const auto cv_board =
+      MakeCharucoBoard(board, 1.0f, static_cast<float>(board.marker_size / board.square_size));
   cv::Mat image;
   cv_board->draw(cv::Size(board.cols * kTexelsPerSquare, board.rows * kTexelsPerSquare), image, 0,
                  1);
@@ -82,20 +82,20 @@ double BoardPrint::Reflectance(const Vec2& xy) const {
   if (std::abs(xy.x()) > half_pattern_.x() || std::abs(xy.y()) > half_pattern_.y()) return 1.0;
   if (board_.type == BoardType::kCheckerboard) {
     // Square (0, 0), top left, is black, as on OpenCV's ChArUco drawing.
-    const int i = std::clamp(static_cast<int>(std::floor((xy.x() + half_pattern_.x()) /
-                                                         board_.square_size)),
-                             0, board_.SquaresX() - 1);
-    const int j = std::clamp(static_cast<int>(std::floor((xy.y() + half_pattern_.y()) /
-                                                         board_.square_size)),
-                             0, board_.SquaresY() - 1);
+    const int i =
+        std::clamp(static_cast<int>(std::floor((xy.x() + half_pattern_.x()) / board_.square_size)),
+                   0, board_.SquaresX() - 1);
+    const int j =
+        std::clamp(static_cast<int>(std::floor((xy.y() + half_pattern_.y()) / board_.square_size)),
+                   0, board_.SquaresY() - 1);
     return (i + j) % 2 == 0 ? 0.0 : 1.0;
   }
-  const int col = std::clamp(
-      static_cast<int>(std::floor((xy.x() + half_pattern_.x()) * texels_per_metre_)), 0,
-      texture_width_ - 1);
-  const int row = std::clamp(
-      static_cast<int>(std::floor((xy.y() + half_pattern_.y()) * texels_per_metre_)), 0,
-      texture_height_ - 1);
+  const int col =
+      std::clamp(static_cast<int>(std::floor((xy.x() + half_pattern_.x()) * texels_per_metre_)), 0,
+                 texture_width_ - 1);
+  const int row =
+      std::clamp(static_cast<int>(std::floor((xy.y() + half_pattern_.y()) * texels_per_metre_)), 0,
+                 texture_height_ - 1);
   return texture_[static_cast<size_t>(row) * texture_width_ + col] / 255.0;
 }
 
@@ -166,7 +166,8 @@ class BoardRayGrid {
     nodes_.resize(static_cast<size_t>(nodes_x_) * nodes_y_);
     for (int b = 0; b < nodes_y_; ++b) {
       for (int a = 0; a < nodes_x_; ++a) {
-        nodes_[b * nodes_x_ + a] = Exact(box.x0 - 0.5 + a * kNodeStep, box.y0 - 0.5 + b * kNodeStep);
+        nodes_[b * nodes_x_ + a] =
+            Exact(box.x0 - 0.5 + a * kNodeStep, box.y0 - 0.5 + b * kNodeStep);
       }
     }
   }
@@ -243,12 +244,12 @@ class BoardShader {
     const int band_pattern = Band(xy, half_pattern_);
     if (band_pattern != 4) return 10 + band_pattern;  // margin bands
     const BoardSpec& board = print_.board();
-    const int i = std::clamp(
-        static_cast<int>(std::floor((xy.x() + half_pattern_.x()) / board.square_size)), 0,
-        board.SquaresX() - 1);
-    const int j = std::clamp(
-        static_cast<int>(std::floor((xy.y() + half_pattern_.y()) / board.square_size)), 0,
-        board.SquaresY() - 1);
+    const int i =
+        std::clamp(static_cast<int>(std::floor((xy.x() + half_pattern_.x()) / board.square_size)),
+                   0, board.SquaresX() - 1);
+    const int j =
+        std::clamp(static_cast<int>(std::floor((xy.y() + half_pattern_.y()) / board.square_size)),
+                   0, board.SquaresY() - 1);
     const int square = j * board.SquaresX() + i;
     return uniform_square_[square] ? 100 + square : -1;
   }
@@ -300,6 +301,26 @@ void RenderBox(const BoardRayGrid& grid, const BoardShader& shader, const PixelB
   }
 }
 
+// Gaussian noise by Box-Muller on SplitMix64: 5x faster than std::normal_distribution on
+// mt19937_64, which dominated the render time of large images.
+void AddGaussianNoise(double sigma, std::uint64_t seed, std::vector<double>* values) {
+  std::uint64_t state = seed;
+  auto next = [&state] {
+    std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  };
+  constexpr double kTwoPow53 = 9007199254740992.0;
+  for (size_t i = 0; i < values->size(); i += 2) {
+    const double u1 = ((next() >> 11) + 1) / kTwoPow53;  // (0, 1]
+    const double u2 = (next() >> 11) / kTwoPow53;        // [0, 1)
+    const double radius = sigma * std::sqrt(-2.0 * std::log(u1));
+    (*values)[i] += radius * std::cos(2.0 * M_PI * u2);
+    if (i + 1 < values->size()) (*values)[i + 1] += radius * std::sin(2.0 * M_PI * u2);
+  }
+}
+
 }  // namespace
 
 ImageU8 RenderBoardImage(const CameraModel& camera, const BoardSpec& board,
@@ -325,11 +346,9 @@ ImageU8 RenderBoardImage(const CameraModel& camera, const BoardSpec& board,
   image.height = camera.height;
   image.channels = 3;
   image.data.resize(grey.size() * 3);
-  std::mt19937_64 rng(options.seed);
-  std::normal_distribution<double> noise(0.0, options.image_noise * 255.0);
+  if (options.image_noise > 0.0) AddGaussianNoise(options.image_noise * 255.0, options.seed, &grey);
   for (size_t p = 0; p < grey.size(); ++p) {
-    const double value = options.image_noise > 0.0 ? grey[p] + noise(rng) : grey[p];
-    const auto v = static_cast<std::uint8_t>(std::lround(std::clamp(value, 0.0, 255.0)));
+    const auto v = static_cast<std::uint8_t>(std::lround(std::clamp(grey[p], 0.0, 255.0)));
     image.data[3 * p] = image.data[3 * p + 1] = image.data[3 * p + 2] = v;
   }
   return image;

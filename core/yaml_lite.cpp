@@ -1,15 +1,29 @@
+// The block (indentation) half of the YAML subset reader; flow collections and quoted scalars
+// are in yaml_lite_flow.cpp.
 #include "core/yaml_lite.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/yaml_lite_internal.h"
 
 namespace calibench {
 namespace {
 
-// Deeper nesting than this is not a camera file; the limit keeps recursion bounded on garbage.
-constexpr int kMaxDepth = 64;
+using yaml_lite_internal::FlowClosed;
+using yaml_lite_internal::kMaxDepth;
+using yaml_lite_internal::ParseError;
+using yaml_lite_internal::ParseFlow;
+using yaml_lite_internal::QuoteCanStart;
+using yaml_lite_internal::ReadQuoted;
+using yaml_lite_internal::Scalar;
+using yaml_lite_internal::SkipQuoted;
+using yaml_lite_internal::StepInsideQuote;
+using yaml_lite_internal::Trim;
 
 struct Line {
   int indent = 0;    // leading spaces
@@ -17,49 +31,8 @@ struct Line {
   int number = 0;    // 1-based
 };
 
-class ParseError : public std::runtime_error {
- public:
-  ParseError(int line, const std::string& problem)
-      : std::runtime_error("line " + std::to_string(line) + ": " + problem) {}
-};
-
-std::string Trim(const std::string& s) {
-  const size_t first = s.find_first_not_of(" \t");
-  if (first == std::string::npos) return "";
-  return s.substr(first, s.find_last_not_of(" \t") - first + 1);
-}
-
 bool StartsSequenceItem(const std::string& text) {
   return text == "-" || (text.size() > 1 && text[0] == '-' && text[1] == ' ');
-}
-
-// A quote opens a scalar only where a scalar can start: at the beginning, or after one of the
-// indicators ": - [ { , ?" (so the apostrophe in "don't" is text).
-bool QuoteCanStart(const std::string& s, size_t from, size_t i) {
-  while (i > from && s[i - 1] == ' ') --i;
-  if (i == from) return true;
-  const char c = s[i - 1];
-  return c == ':' || c == '-' || c == '[' || c == '{' || c == ',' || c == '?';
-}
-
-// Advances past one character of quoted text starting at s[*i] (inside `quote`); returns false
-// at the closing quote. Handles \" in double quotes and '' in single quotes.
-bool StepInsideQuote(const std::string& s, size_t* i, char quote) {
-  const char c = s[*i];
-  if (quote == '"' && c == '\\') {
-    *i += 2;
-    return true;
-  }
-  if (c != quote) {
-    ++*i;
-    return true;
-  }
-  if (quote == '\'' && *i + 1 < s.size() && s[*i + 1] == '\'') {
-    *i += 2;
-    return true;
-  }
-  ++*i;
-  return false;
 }
 
 // The content of raw[from..] without its comment; `quote` carries an open quote across lines.
@@ -113,46 +86,6 @@ std::vector<Line> SplitLines(const std::string& text) {
   return lines;
 }
 
-// Reads a quoted scalar starting at s[*pos] (the quote); *pos ends after the closing quote.
-std::string ReadQuoted(const std::string& s, size_t* pos, int line) {
-  const char quote = s[(*pos)++];
-  std::string out;
-  while (*pos < s.size()) {
-    const char c = s[(*pos)++];
-    if (c == quote) {
-      if (quote == '\'' && *pos < s.size() && s[*pos] == '\'') {
-        out += '\'';
-        ++*pos;
-        continue;
-      }
-      return out;
-    }
-    if (quote == '"' && c == '\\' && *pos < s.size()) {
-      const char e = s[(*pos)++];
-      switch (e) {
-        case 'n': out += '\n'; break;
-        case 't': out += '\t'; break;
-        case 'r': out += '\r'; break;
-        case '0': out += '\0'; break;
-        default: out += e;  // \\ \" \/ and anything else stand for themselves
-      }
-      continue;
-    }
-    out += c;
-  }
-  throw ParseError(line, "unclosed quote");
-}
-
-YamlNode Scalar(const std::string& text, bool quoted, int line) {
-  YamlNode node;
-  node.line = line;
-  if (!quoted && (text == "~" || text == "null" || text == "Null" || text == "NULL")) return node;
-  node.kind = YamlNode::Kind::kScalar;
-  node.scalar = text;
-  node.quoted = quoted;
-  return node;
-}
-
 // Drops tags (!!opencv-matrix) and anchors (&a) in front of a value.
 std::string StripProperties(std::string text, int line) {
   while (!text.empty() && (text[0] == '!' || text[0] == '&')) {
@@ -187,138 +120,6 @@ bool SplitKey(const std::string& text, int line, std::string* key, std::string* 
   *rest = Trim(text.substr(colon + 1));
   return true;
 }
-
-// s[*i] is an opening quote; moves *i past the closing quote. False if the text ends first.
-bool SkipQuoted(const std::string& s, size_t* i) {
-  const char quote = s[(*i)++];
-  while (*i < s.size()) {
-    if (!StepInsideQuote(s, i, quote)) return true;
-  }
-  return false;
-}
-
-// Whether a flow text, starting at its opening bracket, has closed it (quotes respected).
-bool FlowClosed(const std::string& s) {
-  int depth = 0;
-  size_t i = 0;
-  while (i < s.size()) {
-    const char c = s[i];
-    if ((c == '"' || c == '\'') && QuoteCanStart(s, 0, i)) {
-      if (!SkipQuoted(s, &i)) return false;
-      continue;
-    }
-    if (c == '[' || c == '{') ++depth;
-    if ((c == ']' || c == '}') && --depth <= 0) return true;
-    ++i;
-  }
-  return false;
-}
-
-// Flow collections: [a, b], {k: v}, nested, with quoted or plain scalars.
-class FlowParser {
- public:
-  FlowParser(const std::string& text, int line) : s_(text), line_(line) {}
-
-  YamlNode Parse(int depth) {
-    YamlNode node = Node(depth);
-    SkipSpaces();
-    if (pos_ < s_.size()) Fail("unexpected text after the closing bracket");
-    return node;
-  }
-
- private:
-  [[noreturn]] void Fail(const std::string& problem) const { throw ParseError(line_, problem); }
-  void SkipSpaces() {
-    while (pos_ < s_.size() && (s_[pos_] == ' ' || s_[pos_] == '\t')) ++pos_;
-  }
-  bool Peek(char c) {
-    SkipSpaces();
-    return pos_ < s_.size() && s_[pos_] == c;
-  }
-  // Plain scalar up to a flow indicator, or up to ':' followed by a separator (a key).
-  std::string Plain() {
-    const size_t start = pos_;
-    while (pos_ < s_.size()) {
-      const char c = s_[pos_];
-      if (c == ',' || c == '[' || c == ']' || c == '{' || c == '}') break;
-      if (c == ':' && (pos_ + 1 == s_.size() || std::string(" ,]}").find(s_[pos_ + 1]) !=
-                                                    std::string::npos)) {
-        break;
-      }
-      ++pos_;
-    }
-    return Trim(s_.substr(start, pos_ - start));
-  }
-
-  YamlNode Node(int depth) {
-    if (depth > kMaxDepth) Fail("nesting deeper than " + std::to_string(kMaxDepth));
-    SkipSpaces();
-    if (pos_ < s_.size() && (s_[pos_] == '!' || s_[pos_] == '&')) {
-      while (pos_ < s_.size() && s_[pos_] != ' ') ++pos_;
-      SkipSpaces();
-    }
-    if (pos_ >= s_.size()) Fail("unclosed bracket");
-    const char c = s_[pos_];
-    if (c == '[') return Sequence(depth);
-    if (c == '{') return Map(depth);
-    if (c == '"' || c == '\'') return Scalar(ReadQuoted(s_, &pos_, line_), true, line_);
-    if (c == '*') Fail("aliases (*name) are not supported");
-    const std::string text = Plain();
-    if (text.empty()) Fail(std::string("unexpected '") + c + "'");
-    return Scalar(text, false, line_);
-  }
-
-  YamlNode Sequence(int depth) {
-    YamlNode node;
-    node.kind = YamlNode::Kind::kSequence;
-    node.line = line_;
-    ++pos_;
-    while (!Peek(']')) {
-      node.items.push_back(Node(depth + 1));
-      if (Peek(',')) {
-        ++pos_;
-      } else if (!Peek(']')) {
-        Fail("expected ',' or ']'");
-      }
-    }
-    ++pos_;
-    return node;
-  }
-
-  YamlNode Map(int depth) {
-    YamlNode node;
-    node.kind = YamlNode::Kind::kMap;
-    node.line = line_;
-    ++pos_;
-    while (!Peek('}')) {
-      if (pos_ >= s_.size()) Fail("unclosed '{'");
-      const std::string key = s_[pos_] == '"' || s_[pos_] == '\'' ? ReadQuoted(s_, &pos_, line_)
-                                                                  : Plain();
-      if (key.empty()) Fail("empty key in '{ }'");
-      YamlNode value;
-      value.line = line_;
-      if (Peek(':')) {
-        ++pos_;
-        if (!Peek(',') && !Peek('}')) value = Node(depth + 1);
-      }
-      for (const auto& entry : node.entries) {
-        if (entry.first == key) Fail("duplicate key '" + key + "'");
-      }
-      node.entries.emplace_back(key, std::move(value));
-      if (Peek(',')) {
-        ++pos_;
-      } else if (!Peek('}')) {
-        Fail("expected ',' or '}'");
-      }
-    }
-    ++pos_;
-    return node;
-  }
-
-  const std::string& s_;
-  int line_;
-  size_t pos_ = 0;
-};
 
 // Block structure by indentation over the pre-split lines.
 class BlockParser {
@@ -406,23 +207,30 @@ class BlockParser {
     }
     if (text[0] == '[' || text[0] == '{') {
       const std::string joined = JoinUntil(text, owner, number, FlowClosed, "unclosed bracket");
-      return FlowParser(joined, number).Parse(depth);
+      return ParseFlow(joined, number, depth);
     }
-    if (text[0] == '"' || text[0] == '\'') {
-      const auto closed = [](const std::string& s) {
-        size_t i = 0;
-        return SkipQuoted(s, &i);
-      };
-      const std::string joined = JoinUntil(text, owner, number, closed, "unclosed quote");
-      size_t pos = 0;
-      const std::string value = ReadQuoted(joined, &pos, number);
-      if (!Trim(joined.substr(pos)).empty()) {
-        throw ParseError(number, "unexpected text after a quoted scalar");
-      }
-      return Scalar(value, true, number);
-    }
+    if (text[0] == '"' || text[0] == '\'') return Quoted(text, owner, number);
     if (text[0] == '|' || text[0] == '>') return BlockScalar(text, owner, number);
-    std::string value = text;  // a plain scalar, possibly continued on deeper lines
+    return Plain(text, owner, number);
+  }
+
+  YamlNode Quoted(const std::string& text, int owner, int number) {
+    const auto closed = [](const std::string& s) {
+      size_t i = 0;
+      return SkipQuoted(s, &i);
+    };
+    const std::string joined = JoinUntil(text, owner, number, closed, "unclosed quote");
+    size_t pos = 0;
+    const std::string value = ReadQuoted(joined, &pos, number);
+    if (!Trim(joined.substr(pos)).empty()) {
+      throw ParseError(number, "unexpected text after a quoted scalar");
+    }
+    return Scalar(value, true, number);
+  }
+
+  // A plain scalar, possibly continued on deeper lines (joined by spaces).
+  YamlNode Plain(const std::string& text, int owner, int number) {
+    std::string value = text;
     while (const Line* next = Current()) {
       if (next->indent <= owner) break;
       std::string key, ignored;

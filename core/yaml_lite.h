@@ -4,9 +4,10 @@
 // Supported: block maps and sequences nested by indentation (including "- key: value" items and
 // sequences written at their key's indentation), flow sequences and maps ([..], {..}, across
 // lines), plain, single- and double-quoted scalars (across lines), literal/folded block scalars
-// (| and >), comments, directives (%...), document markers (--- and ...), tags (!!...) and
-// anchors (&...), which are ignored. Not supported: aliases (*...), complex keys (? ...),
-// several documents (reading stops at the second ---), tabs in indentation.
+// (| and >; inside them " #" still starts a comment and blank lines are dropped), comments,
+// directives (%...), document markers (--- and ...), tags (!!...) and anchors (&...), which are
+// ignored. Not supported: aliases (*...), complex keys (? ...), several documents (reading stops at
+// the second ---), tabs in indentation.
 #pragma once
 
 #include <optional>
@@ -20,9 +21,9 @@ struct YamlNode {
   enum class Kind { kNull, kScalar, kSequence, kMap };
 
   Kind kind = Kind::kNull;
-  std::string scalar;   // kScalar: the text, quotes removed and escapes resolved
-  bool quoted = false;  // kScalar written in quotes
-  std::vector<YamlNode> items;                         // kSequence
+  std::string scalar;           // kScalar: the text, quotes removed and escapes resolved
+  bool quoted = false;          // kScalar written in quotes
+  std::vector<YamlNode> items;  // kSequence
   std::vector<std::pair<std::string, YamlNode>> entries;  // kMap, in file order, unique keys
   int line = 0;  // 1-based line where the node starts; 0 when not from a text
 

@@ -1,6 +1,6 @@
-// Camera side of a pair: planar PnP through the camera model (exact and noisy synthetic corners,
-// covariance calibration, plane Jacobian), detection accuracy on rendered boards (checkerboard and
-// ChArUco, against the projected truth), and real images from ../shared.
+// Camera side of a pair: planar PnP through the camera model on synthetic corners (exact pose,
+// covariance against Monte Carlo, plane Jacobian against numeric differences, failures) and the
+// whole camera side (detection + pose) on real images from ../shared.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -11,91 +11,22 @@
 
 #include "core/board_camera.h"
 #include "core/geometry.h"
+#include "core/image.h"
 #include "core/sim.h"
+#include "tests/core/board_test_scenes.h"
 #include "tests/test_support.h"
 
 namespace calibench {
 namespace {
 
+using test::A3Checkerboard;
+using test::BoardPose;
+using test::FisheyeCamera;
+using test::kDeg;
 using test::MatrixNear;
-
-constexpr double kDeg = M_PI / 180.0;
-
-CameraModel PinholeCamera() {
-  CameraModel c;
-  c.type = CameraModelType::kPinholeRadTan;
-  c.width = 1440;
-  c.height = 1080;
-  c.fx = c.fy = 1000.0;
-  c.cx = 719.5;
-  c.cy = 539.5;
-  c.distortion = {-0.1, 0.05, 0.0005, -0.0003, 0.0};
-  return c;
-}
-
-CameraModel FisheyeCamera() {
-  CameraModel c;
-  c.type = CameraModelType::kKannalaBrandt;
-  c.width = 1440;
-  c.height = 1080;
-  c.fx = c.fy = 450.0;
-  c.cx = 719.5;
-  c.cy = 539.5;
-  c.distortion = {-0.01, 0.005, -0.002, 0.0005};
-  return c;
-}
-
-// A3 sheet, 7x5 inner corners, 40 mm squares.
-BoardSpec A3Checkerboard() {
-  BoardSpec b;
-  b.type = BoardType::kCheckerboard;
-  b.cols = 7;
-  b.rows = 5;
-  b.square_size = 0.04;
-  b.board_width = 0.42;
-  b.board_height = 0.297;
-  return b;
-}
-
-BoardSpec A3Charuco(const std::string& dictionary) {
-  BoardSpec b;
-  b.type = BoardType::kCharuco;
-  b.cols = 5;
-  b.rows = 7;
-  b.square_size = 0.04;
-  b.marker_size = 0.03;
-  b.dictionary = dictionary;
-  b.board_width = 0.297;
-  b.board_height = 0.42;
-  return b;
-}
-
-// Board centre at `centre` (camera frame), print facing the camera (board z along +z_cam before
-// the tilt), tilted by `tilt` about an oblique in-plane axis.
-Pose BoardPose(const Vec3& centre, double tilt_rad) {
-  Pose pose = Pose::Identity();
-  pose.linear() = ExpSO3(tilt_rad * Vec3(0.8, 0.6, 0.0)) * ExpSO3(Vec3(0, 0, 0.1));
-  pose.translation() = centre;
-  return pose;
-}
-
-BoardDetection ProjectCorners(const CameraModel& camera, const BoardSpec& board, const Pose& pose) {
-  BoardDetection detection;
-  const std::vector<Vec3> points = BoardCornerPoints(board);
-  for (size_t i = 0; i < points.size(); ++i) {
-    const auto pixel = camera.Project(pose * points[i]);
-    CALIBENCH_CHECK(pixel.has_value());
-    detection.pixels.push_back(*pixel);
-    detection.board_points.push_back(points[i]);
-    detection.ids.push_back(static_cast<int>(i));
-  }
-  return detection;
-}
-
-Vec4 PlaneOf(const Pose& cam_from_board) {
-  return OrientTowardsOrigin(TransformPlane(cam_from_board, Plane{Vec3::UnitZ(), 0.0}))
-      .Coefficients();
-}
+using test::PinholeCamera;
+using test::PlaneOf;
+using test::ProjectCorners;
 
 TEST(BoardCamera, OptionsCheck) {
   std::string why;
@@ -167,8 +98,8 @@ TEST_P(PnpSynthetic, PlaneCovarianceUsesTheNumericPlaneJacobian) {
   EXPECT_TRUE(MatrixNear(obs->plane_covariance, expected, 1e-6 * expected.cwiseAbs().maxCoeff()));
   EXPECT_TRUE(MatrixNear(obs->plane.Coefficients(), PlaneOf(obs->cam_from_board), 1e-12));
   // n is unit: the covariance is rank 3, with the null direction (n, 0).
-  EXPECT_LT((obs->plane_covariance * Vec4(obs->plane.normal.x(), obs->plane.normal.y(),
-                                          obs->plane.normal.z(), 0.0))
+  EXPECT_LT((obs->plane_covariance *
+             Vec4(obs->plane.normal.x(), obs->plane.normal.y(), obs->plane.normal.z(), 0.0))
                 .norm(),
             1e-9 * obs->plane_covariance.norm());
 }
@@ -244,26 +175,98 @@ TEST(BoardCamera, PnpFailsWithAReason) {
   EXPECT_FALSE(EstimateBoardPose(broken, full, PnpOptions{}, &why));
   EXPECT_FALSE(why.empty());
 
-  // A fisheye sees past 90 degrees: a board behind the camera still has pixels.
+  // A fisheye sees past 90 degrees: a board beside the camera, its centre slightly behind it,
+  // still has pixels, and the pose is found but must be refused.
   const CameraModel fisheye = FisheyeCamera();
   Pose behind = Pose::Identity();
-  behind.linear() = ExpSO3(Vec3(0, M_PI, 0));  // print facing the camera from behind it
-  behind.translation() = Vec3(0.0, 0.0, -0.3);
-  BoardDetection back;
-  for (const Vec3& x : BoardCornerPoints(A3Checkerboard())) {
-    const Vec3 p = behind * x + Vec3(1.0, 0.0, 0.0);  // sideways, so that every corner images
-    const auto pixel = fisheye.Project(p);
-    if (!pixel) continue;
-    back.pixels.push_back(*pixel);
-    back.board_points.push_back(x);
-    back.ids.push_back(static_cast<int>(back.ids.size()));
-  }
-  if (back.pixels.size() >= 4) {
-    why.clear();
-    const auto obs = EstimateBoardPose(fisheye, back, PnpOptions{}, &why);
-    EXPECT_FALSE(obs);
-    EXPECT_FALSE(why.empty());
-  }
+  behind.linear() = ExpSO3(Vec3(0.0, M_PI / 2, 0.0));  // print facing the camera, board z = +x
+  behind.translation() = Vec3(1.0, 0.0, -0.02);
+  const BoardDetection back = ProjectCorners(fisheye, A3Checkerboard(), behind);
+  why.clear();
+  EXPECT_FALSE(EstimateBoardPose(fisheye, back, PnpOptions{}, &why));
+  EXPECT_EQ(why, "the board is behind the camera");
+}
+
+// ---- Real images (../shared) -------------------------------------------------------------------
+
+// ACFR VLP-16 dataset, pose16: a 7x5 chessboard with 95 mm squares, fisheye camera.
+TEST(BoardCamera, RealFisheyeChessboard) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  const ImageU8 image = LoadImage(shared / "datasets/acfr-vlp16-chessboard/images/pose16.png");
+  CameraModel camera;
+  camera.type = CameraModelType::kKannalaBrandt;
+  camera.width = 1920;
+  camera.height = 1208;
+  camera.fx = 1176.93;
+  camera.fy = 1177.72;
+  camera.cx = 962.275;
+  camera.cy = 612.725;
+  camera.distortion = {-0.0540096, -0.0784275, 0.0959641, -0.0515253};
+  BoardSpec board;
+  board.cols = 7;
+  board.rows = 5;
+  board.square_size = 0.095;
+  std::string why;
+  const auto detection = DetectBoard(image, board, BoardDetectionOptions{}, &why);
+  ASSERT_TRUE(detection) << why;
+  EXPECT_EQ(detection->pixels.size(), 35u);
+  const auto obs = EstimateBoardPose(camera, *detection, PnpOptions{}, &why);
+  ASSERT_TRUE(obs) << why;
+  const Vec3 centre = obs->cam_from_board.translation();
+  std::printf(
+      "[ acfr pose16 ] rms %.3f px, sigma %.3f px, centre %.3f %.3f %.3f m, normal %.3f "
+      "%.3f %.3f, d %.3f m\n",
+      obs->reprojection_rms_px, obs->corner_sigma_px, centre.x(), centre.y(), centre.z(),
+      obs->plane.normal.x(), obs->plane.normal.y(), obs->plane.normal.z(), obs->plane.distance);
+  EXPECT_LT(obs->reprojection_rms_px, 1.0);
+  // poses.csv, sample 16 (the ACFR tool's own camera-side estimate): centre (-334.6, -399.5,
+  // 2347.0) mm, normal (0.2426, 0.3148, -0.9176), which also points towards the camera.
+  EXPECT_TRUE(MatrixNear(centre, Vec3(-0.3346, -0.3995, 2.3470), 0.02));
+  EXPECT_GT(obs->plane.normal.dot(Vec3(0.2426, 0.3148, -0.9176).normalized()),
+            std::cos(1.0 * kDeg));
+  EXPECT_GT(obs->plane.distance, 0.0);
+}
+
+// OpenCV's ChArUco calibration tutorial image with OpenCV's own intrinsics for it.
+TEST(BoardCamera, RealCharucoTutorialImage) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  const ImageU8 image = LoadImage(shared / "datasets/opencv-charuco-intrinsics/images/img_00.jpg");
+  CameraModel camera;
+  camera.type = CameraModelType::kPinholeRadTan;
+  camera.width = 640;
+  camera.height = 480;
+  camera.fx = 452.51072219637672;
+  camera.fy = 456.76707935146891;
+  camera.cx = 317.70297317353277;
+  camera.cy = 277.75155919135995;
+  camera.distortion = {0.12136925618707872, -1.0854664722560681, 1.1786843796668460e-04,
+                       -4.6240686046485508e-04, 2.9542589406810080};
+  BoardSpec board;
+  board.type = BoardType::kCharuco;
+  board.cols = 5;
+  board.rows = 7;
+  board.square_size = 0.04;
+  board.marker_size = 0.02;
+  board.dictionary = "DICT_6X6_250";
+  std::string why;
+  const auto detection = DetectBoard(image, board, BoardDetectionOptions{}, &why);
+  ASSERT_TRUE(detection) << why;
+  EXPECT_GE(detection->pixels.size(), 15u);
+  const auto obs = EstimateBoardPose(camera, *detection, PnpOptions{}, &why);
+  ASSERT_TRUE(obs) << why;
+  std::printf("[ charuco img_00 ] %zu corners, rms %.3f px, distance %.3f m\n",
+              detection->pixels.size(), obs->reprojection_rms_px, obs->plane.distance);
+  EXPECT_LT(obs->reprojection_rms_px, 1.0);
+  // The OpenCV 4.6 offset on a real image: the corrected corners lie 0.5 px up-left of OpenCV's.
+  BoardDetectionOptions uncorrected;
+  uncorrected.correct_charuco_offset = false;
+  const auto raw = DetectBoard(image, board, uncorrected, &why);
+  ASSERT_TRUE(raw) << why;
+  ASSERT_EQ(raw->ids, detection->ids);
+  Vec2 shift = Vec2::Zero();
+  for (size_t i = 0; i < raw->pixels.size(); ++i) shift += detection->pixels[i] - raw->pixels[i];
+  shift /= static_cast<double>(raw->pixels.size());
+  EXPECT_TRUE(MatrixNear(shift, Vec2(-0.5, -0.5), 0.03)) << shift.transpose();
 }
 
 }  // namespace

@@ -1,21 +1,21 @@
 // Camera models against OpenCV (cv::projectPoints, cv::fisheye::projectPoints), round trips
 // through Unproject, analytic Jacobians against central differences, and Check.
-#include "core/camera.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <opencv2/calib3d.hpp>
 #include <random>
 #include <vector>
 
+#include "core/camera.h"
 #include "tests/test_support.h"
 
 namespace calibench {
 namespace {
 
-CameraModel MakeCamera(CameraModelType type, int width, int height, double fx, double fy,
-                       double cx, double cy, std::vector<double> distortion) {
+CameraModel MakeCamera(CameraModelType type, int width, int height, double fx, double fy, double cx,
+                       double cy, std::vector<double> distortion) {
   CameraModel c;
   c.type = type;
   c.width = width;
@@ -52,8 +52,8 @@ CameraModel RationalCamera() {
 }
 // ../shared acfr-vlp16-chessboard camera_info.yaml (fisheye).
 CameraModel Vlp16Camera() {
-  return MakeCamera(CameraModelType::kKannalaBrandt, 1920, 1208, 1176.93, 1177.72, 962.275,
-                    612.725, {-0.0540096, -0.0784275, 0.0959641, -0.0515253});
+  return MakeCamera(CameraModelType::kKannalaBrandt, 1920, 1208, 1176.93, 1177.72, 962.275, 612.725,
+                    {-0.0540096, -0.0784275, 0.0959641, -0.0515253});
 }
 // A near-equidistant 200-degree lens, which images points behind the camera plane.
 CameraModel WideFisheyeCamera() {
@@ -82,7 +82,7 @@ std::vector<Vec3> RandomPinholePoints(const CameraModel& c, int n, std::mt19937*
 std::vector<Vec3> RandomFisheyePoints(double theta_min, double theta_max, int n,
                                       std::mt19937* rng) {
   std::uniform_real_distribution<double> theta(theta_min, theta_max);
-  std::uniform_real_distribution<double> phi(-M_PI, M_PI);
+  std::uniform_real_distribution<double> phi(-std::numbers::pi, std::numbers::pi);
   std::uniform_real_distribution<double> range(0.3, 30.0);
   std::vector<Vec3> points;
   for (int i = 0; i < n; ++i) {
@@ -114,12 +114,12 @@ void ExpectMatchesOpenCv(const CameraModel& c, const std::vector<Vec3>& points,
     Eigen::Matrix<double, 2, 3> jacobian;
     const std::optional<Vec2> pixel = c.Project(points[i], &jacobian);
     ASSERT_TRUE(pixel) << "point " << points[i].transpose();
-    max_pixel_error = std::max(max_pixel_error, (*pixel - Vec2(cv_pixels[i].x, cv_pixels[i].y))
-                                                    .cwiseAbs()
-                                                    .maxCoeff());
+    max_pixel_error = std::max(
+        max_pixel_error, (*pixel - Vec2(cv_pixels[i].x, cv_pixels[i].y)).cwiseAbs().maxCoeff());
     for (int r = 0; r < 2; ++r) {
       for (int k = 0; k < 3; ++k) {
-        const double expected = cv_jacobian.at<double>(static_cast<int>(2 * i) + r, tvec_column + k);
+        const double expected =
+            cv_jacobian.at<double>(static_cast<int>(2 * i) + r, tvec_column + k);
         max_jacobian_error = std::max(max_jacobian_error, std::abs(jacobian(r, k) - expected) /
                                                               jacobian.cwiseAbs().maxCoeff());
       }
@@ -135,7 +135,8 @@ TEST(CameraModelTest, NamesRoundTripAndNothingElseParses) {
   }
   EXPECT_EQ(CameraModelName(CameraModelType::kPinholeRadTan), "pinhole-radtan");
   EXPECT_EQ(CameraModelName(CameraModelType::kKannalaBrandt), "kannala-brandt");
-  for (const char* name : {"", "pinhole", "fisheye", "equidistant", "plumb_bob", "Pinhole-RadTan"}) {
+  for (const char* name :
+       {"", "pinhole", "fisheye", "equidistant", "plumb_bob", "Pinhole-RadTan"}) {
     EXPECT_FALSE(ParseCameraModelName(name)) << name;
   }
 }
@@ -194,7 +195,8 @@ TEST(CameraModelTest, FisheyeMatchesOpenCvFisheyeProjectPoints) {
   std::mt19937 rng(11);
   // The VLP-16 lens is one-to-one up to about 70 degrees; its image corners are at 63 degrees.
   const CameraModel c = Vlp16Camera();
-  const std::vector<Vec3> points = RandomFisheyePoints(0.0, 65 * M_PI / 180, 2000, &rng);
+  const std::vector<Vec3> points =
+      RandomFisheyePoints(0.0, 65 * std::numbers::pi / 180, 2000, &rng);
   std::vector<cv::Point2d> cv_pixels;
   cv::Mat cv_jacobian;
   cv::fisheye::projectPoints(ToCv(points), cv_pixels, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0),
@@ -220,7 +222,7 @@ TEST(CameraModelTest, PinholeRejectsPointsBehindAndBeyondTheFold) {
 TEST(CameraModelTest, FisheyeRejectsRaysBeyondTheFoldAndHandlesTheAxis) {
   const CameraModel c = Vlp16Camera();
   // d theta_d / d theta < 0 at 80 degrees for these coefficients (cv::fisheye would fold it in).
-  const double t = 80 * M_PI / 180, t2 = t * t;
+  const double t = 80 * std::numbers::pi / 180, t2 = t * t;
   const auto& k = c.distortion;
   ASSERT_LT(1 + 3 * k[0] * t2 + 5 * k[1] * t2 * t2 + 7 * k[2] * std::pow(t2, 3) +
                 9 * k[3] * std::pow(t2, 4),
@@ -248,7 +250,7 @@ TEST(CameraModelTest, FisheyeRejectsRaysBeyondTheFoldAndHandlesTheAxis) {
 
 TEST(CameraModelTest, WideFisheyeImagesPointsBehindTheCameraPlane) {
   const CameraModel c = WideFisheyeCamera();
-  const double t = 100 * M_PI / 180;
+  const double t = 100 * std::numbers::pi / 180;
   const Vec3 behind(std::sin(t) * 0.6, std::sin(t) * 0.8, std::cos(t));
   ASSERT_LT(behind.z(), 0);
   const std::optional<Vec2> pixel = c.Project(behind * 3.0);

@@ -1,10 +1,9 @@
 // Image I/O: the real palette PNG from ../shared, lossless round trips, and errors naming the file.
-#include "core/image.h"
-
 #include <gtest/gtest.h>
 
 #include <fstream>
 
+#include "core/image.h"
 #include "core/types.h"
 #include "tests/test_support.h"
 

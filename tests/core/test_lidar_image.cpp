@@ -114,6 +114,11 @@ TEST(LidarImage, OptionsCheck) {
   options.ring_gap_rad = 0;
   EXPECT_FALSE(options.Check(&why));
   EXPECT_NE(why.find("ring_gap_rad"), std::string::npos);
+  EXPECT_THROW(ProjectById(LidarCloud(), options), std::invalid_argument);
+  options.ring_gap_rad = 0.15 * kDeg;
+  const LidarImage empty = ProjectById(LidarCloud(), options);
+  EXPECT_EQ(empty.rows, 0);
+  EXPECT_TRUE(empty.point_index.empty());
 }
 
 TEST(LidarImage, ProjectsCloudWithRingField) {

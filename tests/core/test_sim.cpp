@@ -54,9 +54,10 @@ BoardSpec Charuco() {
 // A board pose from a centre and rotation angles (radians) about x, y, then z of the board.
 Pose MakePose(const Vec3& centre, const Mat3& base, double rx, double ry, double rz) {
   Pose pose = Pose::Identity();
-  pose.linear() = base * (Eigen::AngleAxisd(rx, Vec3::UnitX()) *
-                          Eigen::AngleAxisd(ry, Vec3::UnitY()) * Eigen::AngleAxisd(rz, Vec3::UnitZ()))
-                             .toRotationMatrix();
+  pose.linear() =
+      base * (Eigen::AngleAxisd(rx, Vec3::UnitX()) * Eigen::AngleAxisd(ry, Vec3::UnitY()) *
+              Eigen::AngleAxisd(rz, Vec3::UnitZ()))
+                 .toRotationMatrix();
   pose.translation() = centre;
   return pose;
 }
@@ -84,7 +85,8 @@ cv::Mat GreyOf(const ImageU8& image) {
 std::vector<Vec2> ProjectCorners(const CameraModel& camera, const BoardSpec& board,
                                  const Pose& cam_from_board) {
   std::vector<Vec2> pixels;
-  for (const Vec3& p : BoardCornerPoints(board)) pixels.push_back(*camera.Project(cam_from_board * p));
+  for (const Vec3& p : BoardCornerPoints(board))
+    pixels.push_back(*camera.Project(cam_from_board * p));
   return pixels;
 }
 
@@ -100,16 +102,25 @@ double MeanNearestError(const std::vector<cv::Point2f>& detected, const std::vec
   return sum / detected.size();
 }
 
+const cv::TermCriteria kSubPixCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4);
+
 double CheckerboardCornerError(const CameraModel& camera, const Pose& cam_from_board) {
   const BoardSpec board = A3();
-  RenderOptions options;
-  const cv::Mat grey = GreyOf(RenderBoardImage(camera, board, cam_from_board, options));
+  const cv::Mat grey = GreyOf(RenderBoardImage(camera, board, cam_from_board, RenderOptions{}));
+  // findChessboardCornersSB costs ~0.5 s on the full frame: search the board's region only.
+  const std::vector<Vec2> truth = ProjectCorners(camera, board, cam_from_board);
+  std::vector<cv::Point> truth_points;
+  for (const Vec2& t : truth) truth_points.emplace_back(cvRound(t.x()), cvRound(t.y()));
+  constexpr int kPad = 120;  // pixels around the inner corners: the outer squares and a margin
+  const cv::Rect roi =
+      (cv::boundingRect(truth_points) + cv::Size(2 * kPad, 2 * kPad) - cv::Point(kPad, kPad)) &
+      cv::Rect(0, 0, camera.width, camera.height);
   std::vector<cv::Point2f> corners;
-  EXPECT_TRUE(cv::findChessboardCornersSB(grey, cv::Size(board.cols, board.rows), corners));
+  EXPECT_TRUE(cv::findChessboardCornersSB(grey(roi), cv::Size(board.cols, board.rows), corners));
   if (corners.size() != static_cast<size_t>(board.cols * board.rows)) return 1e9;
-  cv::cornerSubPix(grey, corners, cv::Size(5, 5), cv::Size(-1, -1),
-                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
-  return MeanNearestError(corners, ProjectCorners(camera, board, cam_from_board));
+  for (cv::Point2f& c : corners) c += cv::Point2f(roi.x, roi.y);
+  cv::cornerSubPix(grey, corners, cv::Size(5, 5), cv::Size(-1, -1), kSubPixCriteria);
+  return MeanNearestError(corners, truth);
 }
 
 TEST(SimBeams, TablesMatchTheSensors) {
@@ -134,7 +145,7 @@ TEST(SimBeams, TablesMatchTheSensors) {
     EXPECT_EQ(ParseLidarModelName(LidarModelName(e.model)), e.model);
   }
   const BeamTable hdl = MakeBeamTable(LidarModel::kHdl64);
-  EXPECT_NEAR(hdl.elevations_rad[1] - hdl.elevations_rad[0], 0.5 * kDeg, 1e-4);    // lower block
+  EXPECT_NEAR(hdl.elevations_rad[1] - hdl.elevations_rad[0], 0.5 * kDeg, 1e-4);  // lower block
   EXPECT_NEAR(hdl.elevations_rad[63] - hdl.elevations_rad[62], kDeg / 3, 1e-3);  // upper block
   EXPECT_NEAR(hdl.elevations_rad[32], -8.33 * kDeg, 1e-12);
   EXPECT_EQ(MakeBeamTable(LidarModel::kVlp16).elevations_rad[1], -13.0 * kDeg);
@@ -293,19 +304,30 @@ TEST(SimRender, CharucoDetectionMatchesCornerPoints) {
   ASSERT_EQ(ids.size(), 24u);
   const std::vector<Vec2> truth = ProjectCorners(camera, board, pose);
   Vec2 mean_offset = Vec2::Zero();
-  for (size_t k = 0; k < ids.size(); ++k) mean_offset += Vec2(corners[k].x, corners[k].y) - truth[ids[k]];
+  for (size_t k = 0; k < ids.size(); ++k)
+    mean_offset += Vec2(corners[k].x, corners[k].y) - truth[ids[k]];
   mean_offset /= ids.size();
   double spread = 0.0;
   for (size_t k = 0; k < ids.size(); ++k) {
     const Vec2 offset = Vec2(corners[k].x, corners[k].y) - truth[ids[k]];
-    EXPECT_LT(offset.norm(), 1.0) << "corner id " << ids[k];
+    EXPECT_LT(offset.norm(), 1.2) << "corner id " << ids[k];
     spread += (offset - mean_offset).norm() / ids.size();
   }
+  // OpenCV 4.6 reports ChArUco corners +0.5 px off in x and y (OpenCV issue 25539), and refines
+  // them only to its 0.1 px stopping criterion: a scatter of ~0.2 px about the offset.
   std::cout << "[ measured ] charuco (OpenCV 4.6 interpolateCornersCharuco): mean offset "
-            << mean_offset.transpose() << " px, mean spread about it " << spread << " px\n";
-  // OpenCV 4.6 reports ChArUco corners +0.5 px off in x and y (OpenCV issue 25539).
+            << mean_offset.transpose() << " px, mean scatter about it " << spread << " px\n";
   EXPECT_TRUE(test::MatrixNear(mean_offset, Vec2(0.5, 0.5), 0.1));
-  EXPECT_LT(spread, 0.1);
+  EXPECT_LT(spread, 0.3);
+  // Refined again to convergence, the corners agree with the projected truth.
+  cv::cornerSubPix(grey, corners, cv::Size(5, 5), cv::Size(-1, -1), kSubPixCriteria);
+  double refined = 0.0;
+  for (size_t k = 0; k < ids.size(); ++k) {
+    refined += (Vec2(corners[k].x, corners[k].y) - truth[ids[k]]).norm() / ids.size();
+  }
+  std::cout << "[ measured ] charuco corners re-refined by cornerSubPix: mean error " << refined
+            << " px\n";
+  EXPECT_LT(refined, 0.1);
 }
 
 TEST(SimRender, DeterministicForASeedAndFast) {
@@ -363,8 +385,8 @@ TEST(SimOptionsTest, PresetsAndDefaultMount) {
   EXPECT_LT((cam_from_lidar.linear() * Vec3::UnitX() - Vec3::UnitZ()).norm(), 0.05);
   EXPECT_LT((cam_from_lidar.linear() * Vec3::UnitY() + Vec3::UnitX()).norm(), 0.05);
   EXPECT_LT((cam_from_lidar.linear() * Vec3::UnitZ() + Vec3::UnitY()).norm(), 0.05);
-  EXPECT_TRUE(test::MatrixNear(cam_from_lidar.inverse().translation(), Vec3(0.08, 0.05, -0.10),
-                               1e-12));
+  EXPECT_TRUE(
+      test::MatrixNear(cam_from_lidar.inverse().translation(), Vec3(0.08, 0.05, -0.10), 1e-12));
 }
 
 TEST(SimPoses, SampledBoardsSatisfyTheConstraints) {
@@ -425,8 +447,11 @@ TEST(SimDataset, WritesTheFilesDeterministically) {
     // The board as the LiDAR sees it: >= 4 rings and >= 60 points within 5 sigma of its plane.
     const Pose board_from_lidar = (lidar_from_cam * poses[k]).inverse();
     ASSERT_TRUE(pair.lidar_seed);
-    EXPECT_TRUE(test::MatrixNear(pair.lidar_seed->point, board_from_lidar.inverse().translation(),
-                                 1e-9));
+    // The seed is where a user would brush: the centroid of the board returns, on the sheet.
+    const Vec3 seed_on_board = board_from_lidar * pair.lidar_seed->point;
+    EXPECT_NEAR(seed_on_board.z(), 0.0, 1e-6);
+    EXPECT_LT(std::abs(seed_on_board.x()), 0.21);
+    EXPECT_LT(std::abs(seed_on_board.y()), 0.1485);
     const LidarCloud cloud = LoadCloud(pair.cloud);
     ASSERT_TRUE(cloud.HasRing());
     std::set<int> rings;
@@ -442,7 +467,7 @@ TEST(SimDataset, WritesTheFilesDeterministically) {
     EXPECT_GE(on_board, 60);
     const ImageU8 image = LoadImage(pair.image);
     std::vector<cv::Point2f> corners;
-    EXPECT_TRUE(cv::findChessboardCornersSB(GreyOf(image), cv::Size(7, 5), corners)) << pair.image;
+    EXPECT_TRUE(cv::findChessboardCorners(GreyOf(image), cv::Size(7, 5), corners)) << pair.image;
   }
 }
 

@@ -1,9 +1,9 @@
 // The YAML subset reader on the shapes ROS, Kalibr and OpenCV files take, and on broken text.
-#include "core/yaml_lite.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+
+#include "core/yaml_lite.h"
 
 namespace calibench {
 namespace {
@@ -41,7 +41,7 @@ TEST(YamlLiteTest, RosCameraCalibrationFile) {
   EXPECT_EQ(root.Find("distortion_model")->scalar, "plumb_bob");
   const YamlNode* k = root.Find("camera_matrix");
   ASSERT_TRUE(k);
-  EXPECT_EQ(k->line, 3);
+  EXPECT_EQ(k->line, 4);  // where its first entry is
   EXPECT_EQ(k->Find("rows")->AsDouble(), 3.0);
   EXPECT_EQ(Doubles(*k->Find("data")),
             (std::vector<double>{484.130454, 0, 457.177461, 0, 484.452449, 364.861413, 0, 0, 1}));

@@ -2,6 +2,8 @@
 // problem, and a non-zero exit code; nothing crashes and no made-up result is printed.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -17,7 +19,8 @@ using nlohmann::json;
 class CliBadInput : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(test::TempDir("cli_bad_input"));
+    // ctest runs each test in its own process, possibly in parallel: one folder per process.
+    dir_ = new fs::path(test::TempDir("cli_bad_input_" + std::to_string(getpid())));
     SimOptions sim = SimPreset("default");
     sim.num_pairs = 5;
     sim.seed = 5;

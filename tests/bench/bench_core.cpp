@@ -1,0 +1,117 @@
+// Speed of the pipeline's stages (Google Benchmark). Figures go to the closing note / README.
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <map>
+#include <random>
+
+#include "core/board_camera.h"
+#include "core/cloud.h"
+#include "core/image.h"
+#include "core/lidar_plane.h"
+#include "core/pipeline.h"
+#include "core/sim.h"
+#include "core/solver.h"
+#include "tests/acfr_manifest.h"
+
+namespace calibench {
+namespace {
+namespace fs = std::filesystem;
+
+fs::path BenchDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "calibench_bench" / name;
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::optional<fs::path> AcfrDir() {
+  const fs::path dir = fs::path(CALIBENCH_SHARED_DIR_DEFAULT) / "datasets/acfr-vlp16-chessboard";
+  if (fs::is_directory(dir)) return dir;
+  return std::nullopt;
+}
+
+void BM_GaussNewton40Pairs(benchmark::State& state) {
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> normal(0, 1);
+  const Pose truth = ExpSE3((Vec6() << 0.05, -0.1, 0.08, 1.2, -1.2, 1.2).finished());
+  std::vector<PlanePair> pairs;
+  for (int i = 0; i < 40; ++i) {
+    const Vec3 n = (Vec3(0, 0, -1) + 0.4 * Vec3(normal(rng), normal(rng), 0)).normalized();
+    const Plane cam{n, 2.0 + std::abs(normal(rng))};
+    Plane lidar = TransformPlane(truth.inverse(), cam);
+    lidar.distance += 0.005 * normal(rng);
+    pairs.push_back({std::to_string(i), lidar, cam});
+  }
+  std::string why;
+  for (auto _ : state) {
+    const Pose guess = *InitialGuessFromPlanes(pairs, &why);
+    benchmark::DoNotOptimize(PlaneAlignmentSolver(pairs, SolverOptions{}, guess).Run());
+  }
+}
+BENCHMARK(BM_GaussNewton40Pairs)->Unit(benchmark::kMicrosecond);
+
+// One simulated pair per LiDAR model, made once.
+const Dataset& SimulatedPair(LidarModel lidar) {
+  static std::map<LidarModel, Dataset> cache;
+  auto it = cache.find(lidar);
+  if (it != cache.end()) return it->second;
+  SimOptions sim = SimPreset("default");
+  sim.lidar = lidar;
+  sim.num_pairs = 1;
+  return cache[lidar] = SimulateDataset(sim, BenchDir("pair_" + LidarModelName(lidar)));
+}
+
+void BM_LidarPlaneExtraction(benchmark::State& state) {
+  const Dataset& dataset = SimulatedPair(static_cast<LidarModel>(state.range(0)));
+  const LidarCloud cloud = LoadCloud(dataset.pairs[0].cloud);
+  state.SetLabel(LidarModelName(static_cast<LidarModel>(state.range(0))) + ", " +
+                 std::to_string(cloud.size()) + " points");
+  std::string why;
+  for (auto _ : state) {
+    const auto region = SelectSeedRegion(cloud, *dataset.pairs[0].lidar_seed);
+    benchmark::DoNotOptimize(FitBoardPlane(cloud, region, LidarPlaneOptions{}, &why));
+  }
+}
+BENCHMARK(BM_LidarPlaneExtraction)
+    ->Arg(static_cast<int>(LidarModel::kVlp16))
+    ->Arg(static_cast<int>(LidarModel::kOs0_128))
+    ->Unit(benchmark::kMillisecond);
+
+void BM_BoardDetectionAndPnp1920x1208(benchmark::State& state) {
+  const auto dir = AcfrDir();
+  if (!dir) {
+    state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
+    return;
+  }
+  const fs::path manifest = test::WriteAcfrManifest(*dir, BenchDir("acfr"));
+  const Dataset dataset = LoadDataset(manifest);
+  const ImageU8 image = LoadImage(dataset.pairs[15].image);
+  std::string why;
+  for (auto _ : state) {
+    const auto detection = DetectBoard(image, dataset.target, BoardDetectionOptions{}, &why);
+    if (!detection) {
+      state.SkipWithError(why.c_str());
+      return;
+    }
+    benchmark::DoNotOptimize(EstimateBoardPose(dataset.camera, *detection, PnpOptions{}, &why));
+  }
+}
+BENCHMARK(BM_BoardDetectionAndPnp1920x1208)->Unit(benchmark::kMillisecond);
+
+void BM_CalibrateReal40Pairs2Threads(benchmark::State& state) {
+  const auto dir = AcfrDir();
+  if (!dir) {
+    state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
+    return;
+  }
+  const Dataset dataset = LoadDataset(test::WriteAcfrManifest(*dir, BenchDir("acfr")));
+  PipelineOptions options;
+  options.threads = 2;
+  for (auto _ : state) benchmark::DoNotOptimize(CalibrateDataset(dataset, options));
+}
+BENCHMARK(BM_CalibrateReal40Pairs2Threads)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+}  // namespace
+}  // namespace calibench
+
+BENCHMARK_MAIN();
