@@ -8,9 +8,10 @@
 namespace calibench::app {
 
 int RunCalibrate(int argc, char** argv) {
-  CLI::App app{"Calibrate a 3D LiDAR to a camera from board planes (Ca²Lib plane-to-plane "
-               "Gauss-Newton with a Huber kernel).",
-               "calibench calibrate"};
+  CLI::App app{
+      "Calibrate a 3D LiDAR to a camera from board planes (Ca²Lib plane-to-plane "
+      "Gauss-Newton with a Huber kernel).",
+      "calibench calibrate"};
   std::string dataset_path, out_path;
   app.add_option("--dataset,-d", dataset_path, "dataset.json or dataset folder")->required();
   app.add_option("--out,-o", out_path, "result file (calibench.result.v1)");

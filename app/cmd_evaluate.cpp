@@ -11,9 +11,9 @@
 namespace calibench::app {
 namespace {
 
-void PrintError(const PoseError& error, const Mat6& covariance) {
-  const Vec3 st = TranslationStd(covariance) * 1000.0;
-  const Vec3 sr = RotationStdDeg(covariance);
+void PrintError(const PoseError& error, const Mat6& covariance, const Pose& cam_from_lidar) {
+  const Vec3 st = TranslationStd(covariance, cam_from_lidar) * 1000.0;
+  const Vec3 sr = RotationStdDeg(covariance, cam_from_lidar);
   std::printf("error against ground truth: translation %.2f mm, rotation %.3f deg\n",
               error.translation_m * 1000.0, error.rotation_rad * 180.0 / M_PI);
   std::printf("reported std: translation %.2f mm, rotation %.3f deg (root of summed variances)\n",
@@ -28,7 +28,8 @@ int RunEvaluate(int argc, char** argv) {
   std::string result_path, dataset_path;
   double max_translation_mm = -1, max_rotation_deg = -1;
   app.add_option("--result,-r", result_path, "result.json")->required();
-  app.add_option("--dataset,-d", dataset_path, "dataset with ground_truth.cam_from_lidar")->required();
+  app.add_option("--dataset,-d", dataset_path, "dataset with ground_truth.cam_from_lidar")
+      ->required();
   app.add_option("--max-translation-mm", max_translation_mm, "fail (exit 5) above this error");
   app.add_option("--max-rotation-deg", max_rotation_deg, "fail (exit 5) above this error");
   try {
@@ -43,10 +44,12 @@ int RunEvaluate(int argc, char** argv) {
                  dataset.manifest.string().c_str());
     return kInputError;
   }
-  const PoseError error = ComputePoseError(result.cam_from_source, *dataset.cam_from_lidar_ground_truth);
-  PrintError(error, result.covariance);
-  const bool too_far = (max_translation_mm >= 0 && error.translation_m * 1000 > max_translation_mm) ||
-                       (max_rotation_deg >= 0 && error.rotation_rad * 180 / M_PI > max_rotation_deg);
+  const PoseError error =
+      ComputePoseError(result.cam_from_source, *dataset.cam_from_lidar_ground_truth);
+  PrintError(error, result.covariance, result.cam_from_source);
+  const bool too_far =
+      (max_translation_mm >= 0 && error.translation_m * 1000 > max_translation_mm) ||
+      (max_rotation_deg >= 0 && error.rotation_rad * 180 / M_PI > max_rotation_deg);
   return too_far ? kAccuracyFailed : kOk;
 }
 
@@ -78,8 +81,9 @@ int RunDemo(int argc, char** argv) {
   CalibrationOutcome outcome;
   const int code = CalibrateAndReport(dataset, options, out_dir + "/result.json", &outcome);
   if (outcome.solution && dataset.cam_from_lidar_ground_truth)
-    PrintError(ComputePoseError(outcome.solution->cam_from_lidar, *dataset.cam_from_lidar_ground_truth),
-               outcome.solution->covariance);
+    PrintError(
+        ComputePoseError(outcome.solution->cam_from_lidar, *dataset.cam_from_lidar_ground_truth),
+        outcome.solution->covariance, outcome.solution->cam_from_lidar);
   return code;
 }
 

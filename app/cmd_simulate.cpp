@@ -49,7 +49,8 @@ BoardSpec NamedBoard(const std::string& name) {
     b.rows = 5;
     b.square_size = 0.2;
   } else {
-    throw std::invalid_argument("unknown board '" + name + "' (a3, a4, paper, charuco-a3, charuco-a4)");
+    throw std::invalid_argument("unknown board '" + name +
+                                "' (a3, a4, paper, charuco-a3, charuco-a4)");
   }
   return b;
 }
@@ -97,8 +98,9 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
 }
 
 int RunSimulate(int argc, char** argv) {
-  CLI::App app{"Write a synthetic LiDAR + camera dataset (PCD, PNG, dataset.json) with ground truth.",
-               "calibench simulate"};
+  CLI::App app{
+      "Write a synthetic LiDAR + camera dataset (PCD, PNG, dataset.json) with ground truth.",
+      "calibench simulate"};
   std::string out_dir;
   app.add_option("--out,-o", out_dir, "output folder")->required();
   SimFlags flags;

@@ -7,11 +7,11 @@ namespace calibench::app {
 // Exit codes shared by every subcommand.
 enum ExitCode : int {
   kOk = 0,
-  kUsage = 1,            // bad flags or options
-  kInputError = 2,       // a file is missing, unreadable or malformed
-  kNoCalibration = 3,    // too few usable pairs, no initial guess
-  kNotConstrained = 4,   // a result was written but the planes do not fix all six dof
-  kAccuracyFailed = 5,   // evaluate: error above the given bounds
+  kUsage = 1,           // bad flags or options
+  kInputError = 2,      // a file is missing, unreadable or malformed
+  kNoCalibration = 3,   // too few usable pairs, no initial guess
+  kNotConstrained = 4,  // a result was written but the planes do not fix all six dof
+  kAccuracyFailed = 5,  // evaluate: error above the given bounds
 };
 
 int RunCalibrate(int argc, char** argv);

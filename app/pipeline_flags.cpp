@@ -50,7 +50,8 @@ bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {
         }
       }
       if (values.size() != 16) {
-        *why = "--initial-guess needs 16 numbers (row-major 4x4), got " + std::to_string(values.size());
+        *why = "--initial-guess needs 16 numbers (row-major 4x4), got " +
+               std::to_string(values.size());
         return false;
       }
       Mat4 m;
@@ -84,8 +85,8 @@ int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
   for (const PairFeatures& p : outcome.pairs) input_error |= p.input_error;
   int code = kOk;
   if (!outcome.solution) {
-    std::fprintf(stderr, "calibench: no calibration for %s: %s\n", dataset.manifest.string().c_str(),
-                 outcome.failure.c_str());
+    std::fprintf(stderr, "calibench: no calibration for %s: %s\n",
+                 dataset.manifest.string().c_str(), outcome.failure.c_str());
     code = input_error ? kInputError : kNoCalibration;
   } else {
     if (!out_path.empty()) {
@@ -93,12 +94,14 @@ int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
       std::printf("wrote %s\n", out_path.c_str());
     }
     if (input_error) {
-      std::fprintf(stderr, "calibench: some pair files could not be read (see above); the result "
-                           "uses the remaining pairs\n");
+      std::fprintf(stderr,
+                   "calibench: some pair files could not be read (see above); the result "
+                   "uses the remaining pairs\n");
       code = kInputError;
     } else if (!outcome.solution->observability.well_constrained) {
-      std::fprintf(stderr, "calibench: the result is NOT well constrained (weak directions listed "
-                           "above): add pairs with differently tilted boards\n");
+      std::fprintf(stderr,
+                   "calibench: the result is NOT well constrained (weak directions listed "
+                   "above): add pairs with differently tilted boards\n");
       code = kNotConstrained;
     }
   }

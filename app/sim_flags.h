@@ -12,11 +12,11 @@ namespace calibench::app {
 struct SimFlags {
   std::string preset = "default";
   std::string lidar, camera, board;
-  int pairs = 0;             // 0 = the preset's
-  double lidar_noise = -1;   // < 0 = the preset's
-  double image_noise = -1;   // < 0 = the preset's
-  double min_distance = 0;   // 0 = the preset's
-  double max_distance = 0;   // 0 = the preset's
+  int pairs = 0;            // 0 = the preset's
+  double lidar_noise = -1;  // < 0 = the preset's
+  double image_noise = -1;  // < 0 = the preset's
+  double min_distance = 0;  // 0 = the preset's
+  double max_distance = 0;  // 0 = the preset's
   std::uint64_t seed = 1;
   bool no_clutter = false;
 };

@@ -20,8 +20,8 @@ std::optional<CameraModelType> ParseCameraModelName(const std::string& name);
 
 struct CameraModel {
   CameraModelType type = CameraModelType::kPinholeRadTan;
-  int width = 0;   // pixels
-  int height = 0;  // pixels
+  int width = 0;                          // pixels
+  int height = 0;                         // pixels
   double fx = 0, fy = 0, cx = 0, cy = 0;  // pixels
   // pinhole-radtan: 4, 5 or 8 values; kannala-brandt: exactly 4.
   std::vector<double> distortion;

@@ -121,7 +121,8 @@ Pose PoseFromJson(const json& node, const fs::path& file, const std::string& nam
   } catch (const json::exception&) {
     Fail(file, name + " must be a 4x4 matrix of numbers");
   }
-  if (rows.size() != 4 || std::any_of(rows.begin(), rows.end(), [](auto& r) { return r.size() != 4; }))
+  if (rows.size() != 4 ||
+      std::any_of(rows.begin(), rows.end(), [](auto& r) { return r.size() != 4; }))
     Fail(file, name + " must be a 4x4 matrix");
   Mat4 m;
   for (int r = 0; r < 4; ++r)
@@ -129,7 +130,8 @@ Pose PoseFromJson(const json& node, const fs::path& file, const std::string& nam
   const Mat3 rotation = m.topLeftCorner<3, 3>();
   if (!m.allFinite() || (rotation * rotation.transpose() - Mat3::Identity()).norm() > 1e-4 ||
       rotation.determinant() < 0 || (m.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9)
-    Fail(file, name + " is not a rigid transform (rotation not orthonormal or last row not 0 0 0 1)");
+    Fail(file,
+         name + " is not a rigid transform (rotation not orthonormal or last row not 0 0 0 1)");
   Pose pose = Pose::Identity();
   pose.linear() = NearestRotation(rotation);
   pose.translation() = m.topRightCorner<3, 1>();
@@ -145,11 +147,13 @@ Dataset LoadManifest(const fs::path& manifest) {
   if (format != "calibench.dataset.v1")
     Fail(manifest, "format is '" + format + "', expected 'calibench.dataset.v1'");
   if (root.contains("camera_file")) {
-    dataset.camera = LoadCameraFile(Resolve(base, Get<std::string>(root, "camera_file", manifest, "")));
+    dataset.camera =
+        LoadCameraFile(Resolve(base, Get<std::string>(root, "camera_file", manifest, "")));
   } else if (root.contains("camera")) {
     const json& cam = root.at("camera");
-    dataset.camera = cam.contains("file") ? LoadCameraFile(Resolve(base, cam.at("file").get<std::string>()))
-                                          : ParseInlineCamera(cam, manifest);
+    dataset.camera = cam.contains("file")
+                         ? LoadCameraFile(Resolve(base, cam.at("file").get<std::string>()))
+                         : ParseInlineCamera(cam, manifest);
   } else {
     Fail(manifest, "neither 'camera' nor 'camera_file' is given");
   }
@@ -170,8 +174,10 @@ Dataset LoadManifest(const fs::path& manifest) {
     if (p.contains("lidar_seed")) {
       const json& s = p.at("lidar_seed");
       const auto point = Get<std::vector<double>>(s, "point", manifest, "lidar_seed.");
-      if (point.size() != 3) Fail(manifest, "pair " + pair.id + ": lidar_seed.point must be [x, y, z]");
-      LidarSeed seed{Vec3(point[0], point[1], point[2]), Get<double>(s, "radius", manifest, "lidar_seed.")};
+      if (point.size() != 3)
+        Fail(manifest, "pair " + pair.id + ": lidar_seed.point must be [x, y, z]");
+      LidarSeed seed{Vec3(point[0], point[1], point[2]),
+                     Get<double>(s, "radius", manifest, "lidar_seed.")};
       if (!(seed.radius > 0) || !seed.point.allFinite())
         Fail(manifest, "pair " + pair.id + ": lidar_seed needs a finite point and a radius > 0");
       pair.lidar_seed = seed;
@@ -179,8 +185,8 @@ Dataset LoadManifest(const fs::path& manifest) {
     dataset.pairs.push_back(pair);
   }
   if (root.contains("ground_truth") && root.at("ground_truth").contains("cam_from_lidar"))
-    dataset.cam_from_lidar_ground_truth =
-        PoseFromJson(root.at("ground_truth").at("cam_from_lidar"), manifest, "ground_truth.cam_from_lidar");
+    dataset.cam_from_lidar_ground_truth = PoseFromJson(root.at("ground_truth").at("cam_from_lidar"),
+                                                       manifest, "ground_truth.cam_from_lidar");
   return dataset;
 }
 
@@ -190,11 +196,14 @@ Dataset LoadFolder(const fs::path& dir) {
   dataset.manifest = dir;
   const fs::path camera_file = dir / "camera.yaml";
   const fs::path target_file = dir / "target.json";
-  if (!fs::exists(camera_file)) Fail(dir, "folder dataset has no camera.yaml (and no dataset.json)");
-  if (!fs::exists(target_file)) Fail(dir, "folder dataset has no target.json (and no dataset.json)");
+  if (!fs::exists(camera_file))
+    Fail(dir, "folder dataset has no camera.yaml (and no dataset.json)");
+  if (!fs::exists(target_file))
+    Fail(dir, "folder dataset has no target.json (and no dataset.json)");
   dataset.camera = LoadCameraFile(camera_file);
   json target = ReadJson(target_file);
-  dataset.target = ParseTarget(target.contains("target") ? target.at("target") : target, target_file);
+  dataset.target =
+      ParseTarget(target.contains("target") ? target.at("target") : target, target_file);
   auto list = [&](const char* sub) {
     std::map<std::string, fs::path> by_stem;
     if (!fs::is_directory(dir / sub)) Fail(dir, std::string("folder dataset has no ") + sub + "/");
@@ -231,7 +240,8 @@ bool BoardSpec::Check(std::string* why) const {
     if (dictionary.empty()) return fail("charuco needs a dictionary such as DICT_4X4_50");
   }
   if (board_width < 0 || board_height < 0) return fail("board_size must be positive");
-  if (board_width > 0 && (board_width + 1e-9 < PatternWidth() || board_height + 1e-9 < PatternHeight()))
+  if (board_width > 0 &&
+      (board_width + 1e-9 < PatternWidth() || board_height + 1e-9 < PatternHeight()))
     return fail("board_size is smaller than the printed pattern");
   return true;
 }
@@ -254,8 +264,13 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
   json root;
   root["format"] = "calibench.dataset.v1";
   const CameraModel& c = dataset.camera;
-  root["camera"] = {{"model", CameraModelName(c.type)}, {"width", c.width}, {"height", c.height},
-                    {"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx}, {"cy", c.cy},
+  root["camera"] = {{"model", CameraModelName(c.type)},
+                    {"width", c.width},
+                    {"height", c.height},
+                    {"fx", c.fx},
+                    {"fy", c.fy},
+                    {"cx", c.cx},
+                    {"cy", c.cy},
                     {"distortion", c.distortion}};
   root["target"] = TargetToJson(dataset.target);
   if (dataset.lidar_rings > 0) root["lidar"] = {{"rings", dataset.lidar_rings}};
@@ -263,14 +278,16 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
   for (const PairEntry& p : dataset.pairs) {
     json entry = {{"id", p.id}, {"cloud", relative(p.cloud)}, {"image", relative(p.image)}};
     if (p.lidar_seed)
-      entry["lidar_seed"] = {{"point", {p.lidar_seed->point.x(), p.lidar_seed->point.y(), p.lidar_seed->point.z()}},
-                             {"radius", p.lidar_seed->radius}};
+      entry["lidar_seed"] = {
+          {"point", {p.lidar_seed->point.x(), p.lidar_seed->point.y(), p.lidar_seed->point.z()}},
+          {"radius", p.lidar_seed->radius}};
     pairs.push_back(entry);
   }
   root["pairs"] = pairs;
   if (dataset.cam_from_lidar_ground_truth)
-    root["ground_truth"] = {{"cam_from_lidar", MatrixToJson(dataset.cam_from_lidar_ground_truth->matrix())},
-                            {"direction", "x_in_cam = cam_from_lidar * x_in_lidar"}};
+    root["ground_truth"] = {
+        {"cam_from_lidar", MatrixToJson(dataset.cam_from_lidar_ground_truth->matrix())},
+        {"direction", "x_in_cam = cam_from_lidar * x_in_lidar"}};
   WriteFileAtomically(manifest_path, root.dump(2) + "\n");
 }
 

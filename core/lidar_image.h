@@ -20,14 +20,16 @@ struct LidarImageOptions {
 std::vector<int> InferRings(const LidarCloud& cloud, const LidarImageOptions& options);
 
 struct LidarImage {
-  int rows = 0;     // number of rings; row 0 is the highest ring (drawn on top)
-  int columns = 0;  // azimuth bins; column 0 at azimuth +pi (left), increasing clockwise seen from above
+  int rows = 0;  // number of rings; row 0 is the highest ring (drawn on top)
+  int columns =
+      0;  // azimuth bins; column 0 at azimuth +pi (left), increasing clockwise seen from above
   // Per pixel: index into the cloud, -1 where no point fell (Eq. (10)–(12)).
   std::vector<int> point_index;
   std::vector<float> intensity;  // NaN where empty; raw intensity (range when the cloud has none)
   std::vector<float> range;      // metres, NaN where empty
   std::vector<int> ring_of_row;  // ring id shown in each row
-  // Per point: the pixel it landed in (row * columns + col), or -1 when another point won the pixel.
+  // Per point: the pixel it landed in (row * columns + col), or -1 when another point won the
+  // pixel.
   std::vector<int> pixel_of_point;
 
   int PixelIndex(int row, int col) const { return row * columns + col; }

@@ -30,7 +30,8 @@ std::vector<int> SelectSeedRegion(const LidarCloud& cloud, const LidarSeed& seed
   const Eigen::Vector3f centre = seed.point.cast<float>();
   const float radius_sq = static_cast<float>(seed.radius * seed.radius);
   for (size_t i = 0; i < cloud.size(); ++i)
-    if ((cloud.points[i] - centre).squaredNorm() <= radius_sq) indices.push_back(static_cast<int>(i));
+    if ((cloud.points[i] - centre).squaredNorm() <= radius_sq)
+      indices.push_back(static_cast<int>(i));
   return indices;
 }
 
@@ -61,11 +62,13 @@ std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
   if (eigen.eigenvalues()[1] < 1e-6 * eigen.eigenvalues()[2] || eigen.eigenvalues()[1] <= 0)
     return std::nullopt;
   LidarPlaneFit fit;
-  fit.plane = OrientTowardsOrigin(Plane{eigen.eigenvectors().col(0), -eigen.eigenvectors().col(0).dot(centroid)});
+  fit.plane = OrientTowardsOrigin(
+      Plane{eigen.eigenvectors().col(0), -eigen.eigenvectors().col(0).dot(centroid)});
   fit.inliers = indices;
   fit.num_candidates = static_cast<int>(indices.size());
   double sum_sq = 0.0;
-  for (int i : indices) sum_sq += std::pow(fit.plane.SignedDistance(cloud.points[i].cast<double>()), 2);
+  for (int i : indices)
+    sum_sq += std::pow(fit.plane.SignedDistance(cloud.points[i].cast<double>()), 2);
   fit.rms_m = std::sqrt(sum_sq / indices.size());
   // Covariance: residual r_i = n·x_i + d, with n perturbed in its tangent plane (basis B):
   // J_i = [x_iᵀ B, 1], Σ = σ² (JᵀJ)⁻¹ with σ² from the residuals (3 parameters).
@@ -106,7 +109,8 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
   std::shuffle(order.begin(), order.end(), rng);
   pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
   points->reserve(order.size());
-  for (int i : order) points->push_back(pcl::PointXYZ(cloud.points[i].x(), cloud.points[i].y(), cloud.points[i].z()));
+  for (int i : order)
+    points->push_back(pcl::PointXYZ(cloud.points[i].x(), cloud.points[i].y(), cloud.points[i].z()));
   pcl::SampleConsensusModelPlane<pcl::PointXYZ>::Ptr model(
       new pcl::SampleConsensusModelPlane<pcl::PointXYZ>(points, false));
   pcl::RandomSampleConsensus<pcl::PointXYZ> ransac(model, options.ransac_threshold_m);
@@ -122,7 +126,8 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
   if (!fit) return fail("the RANSAC inliers lie on a line (a single ring?): no plane");
   std::vector<int> refined;
   for (int i : candidates)
-    if (std::abs(fit->plane.SignedDistance(cloud.points[i].cast<double>())) <= options.ransac_threshold_m)
+    if (std::abs(fit->plane.SignedDistance(cloud.points[i].cast<double>())) <=
+        options.ransac_threshold_m)
       refined.push_back(i);
   if (refined.size() >= 4) {
     if (auto again = FitPlaneLeastSquares(cloud, refined)) fit = again;

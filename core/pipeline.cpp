@@ -27,10 +27,14 @@ bool PipelineOptions::Check(std::string* why) const {
 
 std::string PairStatusName(PairStatus status) {
   switch (status) {
-    case PairStatus::kPending: return "pending";
-    case PairStatus::kAccepted: return "accepted";
-    case PairStatus::kRejected: return "rejected";
-    case PairStatus::kFailed: return "failed";
+    case PairStatus::kPending:
+      return "pending";
+    case PairStatus::kAccepted:
+      return "accepted";
+    case PairStatus::kRejected:
+      return "rejected";
+    case PairStatus::kFailed:
+      return "failed";
   }
   return "unknown";
 }
@@ -59,14 +63,16 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
                 std::to_string(dataset.camera.width) + "x" + std::to_string(dataset.camera.height));
 
   if (!pair.lidar_seed)
-    return fail("no lidar_seed for this pair: brush the board in the workbench or add lidar_seed "
-                "to the manifest");
+    return fail(
+        "no lidar_seed for this pair: brush the board in the workbench or add lidar_seed "
+        "to the manifest");
   const std::vector<int> region = SelectSeedRegion(cloud, *pair.lidar_seed);
   std::string why;
   features.lidar = FitBoardPlane(cloud, region, options.lidar_plane, &why);
-  if (!features.lidar) return fail("LiDAR: " + why + " (seed at " +
-                                   std::to_string(pair.lidar_seed->point.norm()).substr(0, 4) +
-                                   " m, radius " + std::to_string(pair.lidar_seed->radius).substr(0, 4) + " m)");
+  if (!features.lidar)
+    return fail("LiDAR: " + why + " (seed at " +
+                std::to_string(pair.lidar_seed->point.norm()).substr(0, 4) + " m, radius " +
+                std::to_string(pair.lidar_seed->radius).substr(0, 4) + " m)");
 
   const auto detection = DetectBoard(image, dataset.target, options.detection, &why);
   if (!detection) return fail("camera: " + why);
@@ -97,7 +103,8 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
       }
     }
   };
-  const int num_threads = std::max(1, std::min<int>(options.threads, static_cast<int>(selected.size())));
+  const int num_threads =
+      std::max(1, std::min<int>(options.threads, static_cast<int>(selected.size())));
   std::vector<std::thread> threads;
   for (int t = 1; t < num_threads; ++t) threads.emplace_back(worker);
   worker();
@@ -105,7 +112,8 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
   return SolveFromFeatures(std::move(features), options);
 }
 
-CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs, const PipelineOptions& options) {
+CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,
+                                     const PipelineOptions& options) {
   CalibrationOutcome outcome;
   outcome.pairs = std::move(pairs);
   std::vector<PlanePair> planes;

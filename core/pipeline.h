@@ -18,10 +18,10 @@ struct PipelineOptions {
   BoardDetectionOptions detection;
   PnpOptions pnp;
   SolverOptions solver;
-  std::vector<std::string> pair_ids;             // empty = every pair of the dataset
-  std::optional<Pose> initial_cam_from_lidar;    // user guess; else the closed form from planes
-  int threads = 1;                               // feature extraction workers
-  int min_pairs = 3;                             // planes fix all 6 dof from 3 pairs on
+  std::vector<std::string> pair_ids;           // empty = every pair of the dataset
+  std::optional<Pose> initial_cam_from_lidar;  // user guess; else the closed form from planes
+  int threads = 1;                             // feature extraction workers
+  int min_pairs = 3;                           // planes fix all 6 dof from 3 pairs on
   bool Check(std::string* why) const;
 };
 
@@ -31,8 +31,8 @@ std::string PairStatusName(PairStatus status);  // "pending", "accepted", "rejec
 struct PairFeatures {
   std::string id;
   PairStatus status = PairStatus::kPending;
-  std::string reason;              // why failed / rejected, human-readable
-  bool input_error = false;        // the pair's files could not be read
+  std::string reason;        // why failed / rejected, human-readable
+  bool input_error = false;  // the pair's files could not be read
   std::optional<LidarPlaneFit> lidar;
   std::optional<CameraBoardObservation> camera;
 };
@@ -57,7 +57,8 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
 
 // Solves from already extracted features; pairs not kAccepted are ignored. Pairs with a
 // (lidar, camera) plane and status kPending count as accepted.
-CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs, const PipelineOptions& options);
+CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,
+                                     const PipelineOptions& options);
 
 // Translation (metres) and rotation (radians) error of an estimate against a reference.
 struct PoseError {

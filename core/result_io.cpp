@@ -16,23 +16,29 @@ namespace {
 json PoseToJson(const Pose& pose) {
   json m = json::array();
   for (int r = 0; r < 4; ++r)
-    m.push_back({pose.matrix()(r, 0), pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3)});
+    m.push_back(
+        {pose.matrix()(r, 0), pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3)});
   const Eigen::Quaterniond q(pose.linear());
-  return {{"matrix", m},
-          {"translation_m", {pose.translation().x(), pose.translation().y(), pose.translation().z()}},
-          {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
+  return {
+      {"matrix", m},
+      {"translation_m", {pose.translation().x(), pose.translation().y(), pose.translation().z()}},
+      {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
 }
 
 json Vec4ToJson(const Vec4& v) { return {v[0], v[1], v[2], v[3]}; }
 
 }  // namespace
 
-Vec3 TranslationStd(const Mat6& covariance) {
-  return covariance.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
+Vec3 TranslationStd(const Mat6& covariance, const Pose& cam_from_lidar) {
+  const Mat3& r = cam_from_lidar.linear();
+  const Mat3 in_cam = r * covariance.topLeftCorner<3, 3>() * r.transpose();
+  return in_cam.diagonal().cwiseMax(0.0).cwiseSqrt();
 }
 
-Vec3 RotationStdDeg(const Mat6& covariance) {
-  return covariance.diagonal().tail<3>().cwiseMax(0.0).cwiseSqrt() * (180.0 / M_PI);
+Vec3 RotationStdDeg(const Mat6& covariance, const Pose& cam_from_lidar) {
+  const Mat3& r = cam_from_lidar.linear();
+  const Mat3 in_cam = r * covariance.bottomRightCorner<3, 3>() * r.transpose();
+  return in_cam.diagonal().cwiseMax(0.0).cwiseSqrt() * (180.0 / M_PI);
 }
 
 std::string ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& options,
@@ -43,8 +49,8 @@ std::string ResultToJson(const CalibrationOutcome& outcome, const SolverOptions&
   const std::string backward = names.source + "_from_" + names.target;
   json root;
   root["format"] = "calibench.result.v1";
-  root["direction"] = "x_in_" + names.target + " = " + forward + " * x_in_" + names.source +
-                      "; " + backward + " is its inverse";
+  root["direction"] = "x_in_" + names.target + " = " + forward + " * x_in_" + names.source + "; " +
+                      backward + " is its inverse";
   root[forward] = PoseToJson(s.cam_from_lidar);
   root[backward] = PoseToJson(s.cam_from_lidar.inverse());
   json cov = json::array();
@@ -56,10 +62,11 @@ std::string ResultToJson(const CalibrationOutcome& outcome, const SolverOptions&
   root["covariance_6x6"] = cov;
   root["covariance_convention"] =
       "right perturbation " + forward + " * Exp(delta), delta = [rho (m); phi (rad)]";
-  const Vec3 st = TranslationStd(s.covariance);
-  const Vec3 sr = RotationStdDeg(s.covariance);
+  const Vec3 st = TranslationStd(s.covariance, s.cam_from_lidar);
+  const Vec3 sr = RotationStdDeg(s.covariance, s.cam_from_lidar);
   root["std_translation_m"] = {st.x(), st.y(), st.z()};
   root["std_rotation_deg"] = {sr.x(), sr.y(), sr.z()};
+  root["std_frame"] = "camera axes (x right, y down, z forward) of " + forward;
   root["observability"] = {
       {"eigenvalues", std::vector<double>(s.observability.eigenvalues.data(),
                                           s.observability.eigenvalues.data() + 6)},
@@ -112,7 +119,8 @@ LoadedResult LoadResult(const std::filesystem::path& path) {
   if (root.value("format", "") != "calibench.result.v1")
     throw IoError(path.string() + ": format is not calibench.result.v1");
   const char* key = root.contains("cam_from_lidar") ? "cam_from_lidar" : "cam_from_lrf";
-  if (!root.contains(key)) throw IoError(path.string() + ": has neither cam_from_lidar nor cam_from_lrf");
+  if (!root.contains(key))
+    throw IoError(path.string() + ": has neither cam_from_lidar nor cam_from_lrf");
   LoadedResult result;
   try {
     const auto rows = root.at(key).at("matrix").get<std::vector<std::vector<double>>>();
@@ -126,7 +134,8 @@ LoadedResult LoadResult(const std::filesystem::path& path) {
     if (root.contains("covariance_6x6")) {
       const auto cov = root.at("covariance_6x6").get<std::vector<std::vector<double>>>();
       for (int r = 0; r < 6 && r < static_cast<int>(cov.size()); ++r)
-        for (int c = 0; c < 6 && c < static_cast<int>(cov[r].size()); ++c) result.covariance(r, c) = cov[r][c];
+        for (int c = 0; c < 6 && c < static_cast<int>(cov[r].size()); ++c)
+          result.covariance(r, c) = cov[r][c];
     }
     result.well_constrained = root.at("observability").value("well_constrained", false);
   } catch (const json::exception& e) {
@@ -145,8 +154,29 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
   }
   out << "pairs: " << outcome.pairs.size() << " (" << accepted << " accepted, " << failed
       << " failed)\n";
-  for (const PairFeatures& p : outcome.pairs)
-    if (p.status == PairStatus::kFailed) out << "  pair " << p.id << " failed: " << p.reason << "\n";
+  size_t solved_index = 0;
+  for (const PairFeatures& p : outcome.pairs) {
+    if (p.status == PairStatus::kFailed) {
+      out << "  pair " << p.id << " failed: " << p.reason << "\n";
+      continue;
+    }
+    if (!p.lidar || !p.camera) continue;
+    std::snprintf(line, sizeof(line),
+                  "  pair %-8s %-8s lidar %5zu inliers rms %5.1f mm | camera %3d corners rms "
+                  "%.2f px",
+                  p.id.c_str(), PairStatusName(p.status).c_str(), p.lidar->inliers.size(),
+                  p.lidar->rms_m * 1e3, p.camera->num_corners, p.camera->reprojection_rms_px);
+    out << line;
+    if (outcome.solution && p.status == PairStatus::kAccepted &&
+        solved_index < outcome.solution->residuals.size()) {
+      std::snprintf(line, sizeof(line), " | |e| %.4f weight %.2f",
+                    outcome.solution->residuals[solved_index].norm(),
+                    outcome.solution->robust_weights[solved_index]);
+      out << line;
+      ++solved_index;
+    }
+    out << "\n";
+  }
   if (!outcome.solution) {
     out << "no calibration: " << outcome.failure << "\n";
     return out.str();
@@ -162,18 +192,25 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
       out << line;
     }
   };
-  print_pose(fwd, "maps points from the " + names.source + " frame into the " + names.target + " frame",
+  print_pose(fwd,
+             "maps points from the " + names.source + " frame into the " + names.target + " frame",
              s.cam_from_lidar);
-  print_pose(bwd, "maps points from the " + names.target + " frame into the " + names.source + " frame; "
-             "its translation is the " + names.target + " position in the " + names.source + " frame",
+  print_pose(bwd,
+             "maps points from the " + names.target + " frame into the " + names.source +
+                 " frame; "
+                 "its translation is the " +
+                 names.target + " position in the " + names.source + " frame",
              s.cam_from_lidar.inverse());
-  const Vec3 st = TranslationStd(s.covariance) * 1000.0;
-  const Vec3 sr = RotationStdDeg(s.covariance);
-  std::snprintf(line, sizeof(line), "std translation [mm]: %.2f %.2f %.2f   std rotation [deg]: %.3f %.3f %.3f\n",
-                st.x(), st.y(), st.z(), sr.x(), sr.y(), sr.z());
+  const Vec3 st = TranslationStd(s.covariance, s.cam_from_lidar) * 1000.0;
+  const Vec3 sr = RotationStdDeg(s.covariance, s.cam_from_lidar);
+  std::snprintf(
+      line, sizeof(line),
+      "std (camera axes x/y/z) translation [mm]: %.2f %.2f %.2f   rotation [deg]: %.3f %.3f %.3f\n",
+      st.x(), st.y(), st.z(), sr.x(), sr.y(), sr.z());
   out << line;
   std::snprintf(line, sizeof(line), "solver: %d iterations, %s, cost %.3e -> %.3e\n", s.iterations,
-                s.converged ? "converged" : "NOT converged", s.cost_history.front(), s.cost_history.back());
+                s.converged ? "converged" : "NOT converged", s.cost_history.front(),
+                s.cost_history.back());
   out << line;
   if (s.observability.well_constrained) {
     out << "observability: well constrained\n";

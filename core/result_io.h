@@ -34,8 +34,10 @@ LoadedResult LoadResult(const std::filesystem::path& path);
 // Human-readable summary: both directions in words, standard deviations, observability, pairs.
 std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& names = {});
 
-// Standard deviations derived from a [rho; phi] covariance: translation (m), rotation (deg).
-Vec3 TranslationStd(const Mat6& covariance);
-Vec3 RotationStdDeg(const Mat6& covariance);
+// Standard deviations of cam_from_lidar along the camera axes, from the covariance of its right
+// perturbation: the translation of T·Exp([rho; phi]) moves by R·rho and its rotation by R·phi to
+// first order, so both blocks are rotated into the camera frame. Metres and degrees.
+Vec3 TranslationStd(const Mat6& covariance, const Pose& cam_from_lidar);
+Vec3 RotationStdDeg(const Mat6& covariance, const Pose& cam_from_lidar);
 
 }  // namespace calibench

@@ -299,10 +299,11 @@ SimOptions SimPreset(const std::string& name) {
   SimOptions options;  // camera left empty: the default pinhole, or fisheye when asked for
   options.board = A3Checkerboard();
   if (name == "default" || name == "demo") {
-    options.lidar = LidarModel::kVlp16;
-    options.num_pairs = name == "demo" ? 12 : 20;
-    options.min_distance_m = 1.5;
-    options.max_distance_m = 4.0;
+    // The demo shows a well-posed session: a 128-beam LiDAR sees an A3 sheet with 10+ rings.
+    options.lidar = name == "demo" ? LidarModel::kOs0_128 : LidarModel::kVlp16;
+    options.num_pairs = name == "demo" ? 16 : 20;
+    options.min_distance_m = name == "demo" ? 1.2 : 1.5;
+    options.max_distance_m = name == "demo" ? 3.0 : 4.0;
     options.lidar_range_noise_m = 0.005;
     options.image_noise = 0.005;
     return options;
@@ -361,9 +362,9 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
     entry.cloud = root / "clouds" / (entry.id + ".pcd");
     entry.image = root / "images" / (entry.id + ".png");
     scene.lidar_from_board = lidar_from_cam * plan.cam_from_board;
-    entry.lidar_seed = LidarSeed{
-        BoardHitCentroid(beams, print, scene.lidar_from_board, plan.azimuth_offset_rad),
-        r.seed_radius_m};
+    entry.lidar_seed =
+        LidarSeed{BoardHitCentroid(beams, print, scene.lidar_from_board, plan.azimuth_offset_rad),
+                  r.seed_radius_m};
 
     LidarScanOptions scan_options;
     scan_options.range_noise_m = r.lidar_range_noise_m;

@@ -53,7 +53,8 @@ struct SimOptions {
 Pose DefaultCamFromLidar();
 
 // Presets: "default" (VLP-16, pinhole, A3 checkerboard), "paper" (Ca²Lib Section 4.1:
-// HDL-64, 6x8-square checkerboard with 0.2 m squares, 1440x1080 camera), "demo".
+// HDL-64, 6x8-square checkerboard with 0.2 m squares, 1440x1080 camera), "demo" (OS0-128,
+// A3 checkerboard, 16 pairs at 1.2-3 m).
 // Throws std::invalid_argument naming the known presets for any other name.
 SimOptions SimPreset(const std::string& name);
 

@@ -24,13 +24,15 @@ bool SolverOptions::Check(std::string* why) const {
 
 std::optional<Pose> InitialGuessFromPlanes(const std::vector<PlanePair>& pairs, std::string* why) {
   if (pairs.size() < 2) {
-    if (why) *why = "need at least 2 plane pairs for an initial guess, got " +
-                    std::to_string(pairs.size());
+    if (why)
+      *why =
+          "need at least 2 plane pairs for an initial guess, got " + std::to_string(pairs.size());
     return std::nullopt;
   }
   // Rotation: argmax sum n_c · R n_l (Kabsch on the normals).
   Mat3 correlation = Mat3::Zero();
-  for (const PlanePair& p : pairs) correlation += p.camera_plane.normal * p.lidar_plane.normal.transpose();
+  for (const PlanePair& p : pairs)
+    correlation += p.camera_plane.normal * p.lidar_plane.normal.transpose();
   Eigen::JacobiSVD<Mat3> svd(correlation, Eigen::ComputeFullU | Eigen::ComputeFullV);
   if (svd.singularValues()[1] < 1e-6 * svd.singularValues()[0]) {
     if (why) *why = "all board normals are parallel: the rotation is not determined";
@@ -50,7 +52,6 @@ std::optional<Pose> InitialGuessFromPlanes(const std::vector<PlanePair>& pairs, 
   cam_from_lidar.translation() = cod.solve(b);
   return cam_from_lidar;
 }
-
 
 ObservabilityReport AnalyseObservability(const Mat6& information, const Pose& cam_from_lidar,
                                          double weak_eigenvalue_ratio) {
@@ -80,7 +81,8 @@ ObservabilityReport AnalyseObservability(const Mat6& information, const Pose& ca
           kAxisNames[axis] + (kind == 1 ? " through the LiDAR origin" : ""));
     }
   }
-  for (int i = 0; i < num_weak && report.weak_directions.size() < static_cast<size_t>(num_weak); ++i) {
+  for (int i = 0; i < num_weak && report.weak_directions.size() < static_cast<size_t>(num_weak);
+       ++i) {
     // A weak direction that is no single axis: describe the eigenvector itself.
     const Vec6 v = eigen.eigenvectors().col(i);
     const Vec3 t = rotation * v.head<3>();
@@ -115,12 +117,13 @@ double PlaneAlignmentSolver::HuberCost(double error_norm) const {
   return error_norm <= delta ? 0.5 * error_norm * error_norm : delta * (error_norm - 0.5 * delta);
 }
 
-PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(const Pose& cam_from_lidar) const {
+PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(
+    const Pose& cam_from_lidar) const {
   Linearization lin;
   Eigen::Matrix<double, 4, 6> jacobian;
   for (const PlanePair& pair : pairs_) {
-    const Vec4 e = PlaneAlignmentResidual(cam_from_lidar, pair.lidar_plane, pair.camera_plane,
-                                          &jacobian);
+    const Vec4 e =
+        PlaneAlignmentResidual(cam_from_lidar, pair.lidar_plane, pair.camera_plane, &jacobian);
     const double norm = e.norm();
     const double w = HuberWeight(norm);  // Eq. (14) by iteratively reweighted least squares
     lin.information += w * jacobian.transpose() * jacobian;
@@ -149,15 +152,16 @@ bool PlaneAlignmentSolver::Step() {
   }
   if (cost <= lin.cost) cam_from_lidar_ = candidate;
   const double step_norm = cost <= lin.cost ? delta.norm() : 0.0;
-  history_.push_back({static_cast<int>(history_.size()), std::min(cost, lin.cost), step_norm,
-                      cam_from_lidar_});
+  history_.push_back(
+      {static_cast<int>(history_.size()), std::min(cost, lin.cost), step_norm, cam_from_lidar_});
   converged_ = step_norm < options_.step_tolerance ||
                (lin.cost - cost >= 0 && lin.cost - cost <= 1e-15 * std::max(1.0, lin.cost));
   done_ = converged_ || static_cast<int>(history_.size()) > options_.max_iterations;
   return !done_;
 }
 
-SolverResult PlaneAlignmentSolver::Run(const std::function<void(const IterationReport&)>& on_iteration) {
+SolverResult PlaneAlignmentSolver::Run(
+    const std::function<void(const IterationReport&)>& on_iteration) {
   if (on_iteration && history_.size() == 1) on_iteration(history_.front());
   while (Step()) {
     if (on_iteration) on_iteration(history_.back());
@@ -173,8 +177,8 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   result.iterations = static_cast<int>(history_.size()) - 1;
   for (const IterationReport& it : history_) result.cost_history.push_back(it.cost);
   for (const PlanePair& pair : pairs_) {
-    const Vec4 e = PlaneAlignmentResidual(cam_from_lidar_, pair.lidar_plane, pair.camera_plane,
-                                          nullptr);
+    const Vec4 e =
+        PlaneAlignmentResidual(cam_from_lidar_, pair.lidar_plane, pair.camera_plane, nullptr);
     result.residuals.push_back(e);
     result.robust_weights.push_back(HuberWeight(e.norm()));
   }
@@ -182,8 +186,7 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   // The paper's residual carries no noise model: scale the inverse information by the
   // a-posteriori variance factor of the 4 residuals per pair (6 parameters estimated).
   const int redundancy = 4 * static_cast<int>(pairs_.size()) - 6;
-  const double variance_factor =
-      redundancy > 0 ? lin.weighted_squared_error / redundancy : 0.0;
+  const double variance_factor = redundancy > 0 ? lin.weighted_squared_error / redundancy : 0.0;
   Eigen::SelfAdjointEigenSolver<Mat6> eigen(lin.information);
   Vec6 inverse_eigenvalues;
   for (int i = 0; i < 6; ++i) {

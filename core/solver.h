@@ -20,8 +20,8 @@ struct PlanePair {
 };
 
 struct SolverOptions {
-  double huber_delta = 0.1;     // Huber threshold on |e_p| (Eq. (6) mixes unitless and metres)
-  int max_iterations = 50;      // Gauss-Newton iterations
+  double huber_delta = 0.1;      // Huber threshold on |e_p| (Eq. (6) mixes unitless and metres)
+  int max_iterations = 50;       // Gauss-Newton iterations
   double step_tolerance = 1e-9;  // stop when |delta| (m, rad) falls below this
   // A direction of the information matrix whose eigenvalue is below this fraction of the largest
   // is reported weak (about 2 degrees of spread of the board normals around it).
@@ -37,7 +37,7 @@ struct IterationReport {
 };
 
 struct ObservabilityReport {
-  Vec6 eigenvalues = Vec6::Zero();  // of the information matrix JᵀWJ, ascending
+  Vec6 eigenvalues = Vec6::Zero();           // of the information matrix JᵀWJ, ascending
   std::vector<std::string> weak_directions;  // in words, camera frame
   bool well_constrained = false;
 };
@@ -47,8 +47,8 @@ struct SolverResult {
   Mat6 covariance = Mat6::Zero();  // right perturbation of cam_from_lidar, [rho; phi]
   bool converged = false;
   int iterations = 0;
-  std::vector<double> cost_history;  // one entry per iteration, the initial cost first
-  std::vector<Vec4> residuals;       // per pair, Eq. (6) at the solution
+  std::vector<double> cost_history;    // one entry per iteration, the initial cost first
+  std::vector<Vec4> residuals;         // per pair, Eq. (6) at the solution
   std::vector<double> robust_weights;  // per pair, Huber IRLS weight at the solution
   ObservabilityReport observability;
 };

@@ -25,11 +25,11 @@ class IoError : public std::runtime_error {
 };
 
 // Programmer errors: a broken invariant, never bad user input.
-#define CALIBENCH_CHECK(cond)                                                                \
-  do {                                                                                       \
-    if (!(cond))                                                                             \
+#define CALIBENCH_CHECK(cond)                                                              \
+  do {                                                                                     \
+    if (!(cond))                                                                           \
       throw std::logic_error(std::string("check failed: " #cond " at ") + __FILE__ + ":" + \
-                             std::to_string(__LINE__));                                      \
+                             std::to_string(__LINE__));                                    \
   } while (0)
 
 }  // namespace calibench

@@ -15,10 +15,10 @@ Pose AcfrReferenceCamFromLidar() {
   // README: R = Rz(yaw) Ry(pitch) Rx(roll), p_lidar = R p_cam + t (lidar_from_cam), mean of 50.
   const double roll = -1.69539, pitch = -0.02093, yaw = -1.49289;
   Pose lidar_from_cam = Pose::Identity();
-  lidar_from_cam.linear() = (Eigen::AngleAxisd(yaw, Vec3::UnitZ()) *
-                             Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
-                             Eigen::AngleAxisd(roll, Vec3::UnitX()))
-                                .toRotationMatrix();
+  lidar_from_cam.linear() =
+      (Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
+       Eigen::AngleAxisd(roll, Vec3::UnitX()))
+          .toRotationMatrix();
   lidar_from_cam.translation() = Vec3(0.06263, 0.00389, -0.19583);
   return lidar_from_cam.inverse();
 }
@@ -42,7 +42,8 @@ std::filesystem::path WriteAcfrManifest(const std::filesystem::path& dataset_dir
   }
   constexpr int kRowsPerSample = 19;
   if (rows.empty() || rows.size() % kRowsPerSample != 0)
-    throw IoError(csv.string() + ": expected blocks of 19 rows, got " + std::to_string(rows.size()));
+    throw IoError(csv.string() + ": expected blocks of 19 rows, got " +
+                  std::to_string(rows.size()));
 
   Dataset dataset;
   dataset.camera = LoadCameraFile(dataset_dir / "camera_info.yaml");
@@ -60,7 +61,8 @@ std::filesystem::path WriteAcfrManifest(const std::filesystem::path& dataset_dir
     pair.id = "pose" + std::to_string(n);
     pair.cloud = dataset_dir / "pcd" / ("pose" + std::to_string(n) + "_full.pcd");
     pair.image = dataset_dir / "images" / ("pose" + std::to_string(n) + ".png");
-    pair.lidar_seed = LidarSeed{Vec3(centre_mm[0], centre_mm[1], centre_mm[2]) / 1000.0, seed_radius_m};
+    pair.lidar_seed =
+        LidarSeed{Vec3(centre_mm[0], centre_mm[1], centre_mm[2]) / 1000.0, seed_radius_m};
     dataset.pairs.push_back(pair);
   }
   dataset.cam_from_lidar_ground_truth = AcfrReferenceCamFromLidar();

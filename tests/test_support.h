@@ -31,21 +31,23 @@ template <typename A, typename B>
     return ::testing::AssertionFailure() << "size mismatch";
   const double err = (actual - expected).cwiseAbs().maxCoeff();
   if (err <= tolerance) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "max abs difference " << err << " > " << tolerance
-                                       << "\nactual:\n" << actual << "\nexpected:\n" << expected;
+  return ::testing::AssertionFailure()
+         << "max abs difference " << err << " > " << tolerance << "\nactual:\n"
+         << actual << "\nexpected:\n"
+         << expected;
 }
 
 }  // namespace calibench::test
 
 // Skips (or fails under CALIBENCH_REQUIRE_SHARED=1) when ../shared is absent; binds `shared`.
-#define CALIBENCH_REQUIRE_SHARED_DIR(shared)                                               \
-  const auto shared##_opt = ::calibench::test::SharedDir();                                \
-  if (!shared##_opt) {                                                                     \
-    if (std::getenv("CALIBENCH_REQUIRE_SHARED") &&                                         \
-        std::string(std::getenv("CALIBENCH_REQUIRE_SHARED")) == "1") {                     \
-      FAIL() << "../shared is required (CALIBENCH_REQUIRE_SHARED=1) but was not found";    \
-    }                                                                                      \
+#define CALIBENCH_REQUIRE_SHARED_DIR(shared)                                                \
+  const auto shared##_opt = ::calibench::test::SharedDir();                                 \
+  if (!shared##_opt) {                                                                      \
+    if (std::getenv("CALIBENCH_REQUIRE_SHARED") &&                                          \
+        std::string(std::getenv("CALIBENCH_REQUIRE_SHARED")) == "1") {                      \
+      FAIL() << "../shared is required (CALIBENCH_REQUIRE_SHARED=1) but was not found";     \
+    }                                                                                       \
     GTEST_SKIP() << "../shared/datasets not found next to the repository: skipping a test " \
-                    "on real data (set CALIBENCH_SHARED_DIR to point at it)";              \
-  }                                                                                        \
+                    "on real data (set CALIBENCH_SHARED_DIR to point at it)";               \
+  }                                                                                         \
   const std::filesystem::path shared = *shared##_opt

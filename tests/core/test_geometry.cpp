@@ -44,8 +44,8 @@ TEST(Geometry, ExpSO3IsARotationAndMatchesEigenAngleAxis) {
     const Mat3 r = ExpSO3(phi);
     EXPECT_TRUE(MatrixNear(r * r.transpose(), Mat3::Identity(), 1e-12));
     EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
-    EXPECT_TRUE(MatrixNear(r, Eigen::AngleAxisd(phi.norm(), phi.normalized()).toRotationMatrix(),
-                           1e-12));
+    EXPECT_TRUE(
+        MatrixNear(r, Eigen::AngleAxisd(phi.norm(), phi.normalized()).toRotationMatrix(), 1e-12));
   }
 }
 
@@ -118,8 +118,8 @@ TEST(Geometry, PlaneAlignmentJacobianMatchesNumericDifferences) {
     const Pose cam_from_lidar = ExpSE3(RandomTangent(rng, 0.5, 1.0));
     const Plane lidar_plane = RandomPlane(rng);
     // Camera plane near the transformed one, so residuals are small but non-zero.
-    Plane camera_plane = TransformPlane(ExpSE3(RandomTangent(rng, 0.05, 0.05)) * cam_from_lidar,
-                                        lidar_plane);
+    Plane camera_plane =
+        TransformPlane(ExpSE3(RandomTangent(rng, 0.05, 0.05)) * cam_from_lidar, lidar_plane);
     Eigen::Matrix<double, 4, 6> analytic;
     PlaneAlignmentResidual(cam_from_lidar, lidar_plane, camera_plane, &analytic);
     Eigen::Matrix<double, 4, 6> numeric;

@@ -25,7 +25,8 @@ LidarCloud BoardCloud(double noise_m, std::uint64_t seed, Plane* truth) {
     cloud.points.push_back((p + normal(rng) * ray).cast<float>());  // noise along the ray
   }
   for (int i = 0; i < 150; ++i)  // a wall 2 m behind the board
-    cloud.points.push_back(Eigen::Vector3f(5.0f, 0.2f + 0.3f * uniform(rng), -0.1f + 0.3f * uniform(rng)));
+    cloud.points.push_back(
+        Eigen::Vector3f(5.0f, 0.2f + 0.3f * uniform(rng), -0.1f + 0.3f * uniform(rng)));
   return cloud;
 }
 

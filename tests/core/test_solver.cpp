@@ -32,7 +32,8 @@ std::vector<PlanePair> MakePairs(int n, double max_tilt_rad, double noise_normal
     const Plane camera_plane{n_cam, 1.5 + 2.0 * std::abs(uniform(rng))};
     Plane lidar_plane = TransformPlane(cam_from_lidar.inverse(), camera_plane);
     lidar_plane.normal =
-        (lidar_plane.normal + noise_normal * Vec3(normal(rng), normal(rng), normal(rng))).normalized();
+        (lidar_plane.normal + noise_normal * Vec3(normal(rng), normal(rng), normal(rng)))
+            .normalized();
     lidar_plane.distance += noise_d * normal(rng);
     pairs.push_back({std::to_string(i), lidar_plane, camera_plane});
   }
@@ -63,8 +64,8 @@ TEST(Solver, GaussNewtonConvergesFromTheIdentityToTheTruth) {
 TEST(Solver, StepsOneIterationAtATimeAndReportsEachOne) {
   const auto pairs = MakePairs(6, 0.5, 0, 0, 3);
   std::string why;
-  PlaneAlignmentSolver solver(pairs, SolverOptions{}, *InitialGuessFromPlanes(pairs, &why) *
-                                                          ExpSE3(Vec6::Constant(0.05)));
+  PlaneAlignmentSolver solver(pairs, SolverOptions{},
+                              *InitialGuessFromPlanes(pairs, &why) * ExpSE3(Vec6::Constant(0.05)));
   int reports = 0;
   solver.Run([&](const IterationReport& it) {
     EXPECT_EQ(it.iteration, static_cast<int>(solver.History().size()) - 1);
@@ -81,7 +82,8 @@ TEST(Solver, NoisyPlanesGiveSmallErrorAndAnHonestCovariance) {
   const SolverResult result = solver.Run();
   const double t_err = (result.cam_from_lidar.translation() - GroundTruth().translation()).norm();
   EXPECT_LT(t_err, 0.01);
-  EXPECT_LT(RotationAngle(result.cam_from_lidar.linear(), GroundTruth().linear()), 0.2 * M_PI / 180);
+  EXPECT_LT(RotationAngle(result.cam_from_lidar.linear(), GroundTruth().linear()),
+            0.2 * M_PI / 180);
   // The standard deviations are of the same order as the noise, not zero and not huge.
   const double sigma_t = std::sqrt(result.covariance.topLeftCorner<3, 3>().trace());
   EXPECT_GT(sigma_t, 1e-4);
@@ -98,8 +100,10 @@ TEST(Solver, HuberKernelDownWeightsAnOutlierPair) {
   const SolverResult robust = PlaneAlignmentSolver(pairs, options, guess).Run();
   options.huber_delta = 1e3;  // effectively least squares
   const SolverResult plain = PlaneAlignmentSolver(pairs, options, guess).Run();
-  const double robust_err = (robust.cam_from_lidar.translation() - GroundTruth().translation()).norm();
-  const double plain_err = (plain.cam_from_lidar.translation() - GroundTruth().translation()).norm();
+  const double robust_err =
+      (robust.cam_from_lidar.translation() - GroundTruth().translation()).norm();
+  const double plain_err =
+      (plain.cam_from_lidar.translation() - GroundTruth().translation()).norm();
   EXPECT_LT(robust_err, 0.5 * plain_err);
   EXPECT_LT(robust.robust_weights[3], 0.2);
   EXPECT_NEAR(robust.robust_weights[0], 1.0, 1e-12);
@@ -125,7 +129,9 @@ TEST(Solver, NearlyParallelNormalsAreWeak) {
   const SolverResult result = PlaneAlignmentSolver(pairs, SolverOptions{}, GroundTruth()).Run();
   EXPECT_FALSE(result.observability.well_constrained);
   const auto good = MakePairs(6, 0.5, 0, 0, 7);
-  EXPECT_TRUE(PlaneAlignmentSolver(good, SolverOptions{}, GroundTruth()).Run().observability.well_constrained);
+  EXPECT_TRUE(PlaneAlignmentSolver(good, SolverOptions{}, GroundTruth())
+                  .Run()
+                  .observability.well_constrained);
 }
 
 TEST(Solver, OptionsCheckNamesTheBadField) {

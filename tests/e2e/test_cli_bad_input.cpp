@@ -1,7 +1,6 @@
 // Bad input through the real executable: every case gets a message that names the file and the
 // problem, and a non-zero exit code; nothing crashes and no made-up result is printed.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <fstream>
@@ -42,7 +41,8 @@ class CliBadInput : public ::testing::Test {
     std::ofstream(path) << manifest.dump(2);
     return path;
   }
-  static int Calibrate(const fs::path& manifest, std::string* output, const std::string& extra = "") {
+  static int Calibrate(const fs::path& manifest, std::string* output,
+                       const std::string& extra = "") {
     return test::RunCommand(test::CalibenchExe() + " calibrate --dataset " + manifest.string() +
                                 " --out " + (*dir_ / "result.json").string() + " " + extra,
                             output);
@@ -117,7 +117,8 @@ TEST_F(CliBadInput, MissingImageAndAnImageWithoutABoard) {
   // A blank image of the right size: that pair fails with a reason, the rest go on (exit 0).
   json blank = Manifest();
   const std::string blank_png = (*dir_ / "blank.png").string();
-  ASSERT_EQ(test::RunCommand("cp " + blank["pairs"][0]["image"].get<std::string>() + " " + blank_png), 0);
+  ASSERT_EQ(
+      test::RunCommand("cp " + blank["pairs"][0]["image"].get<std::string>() + " " + blank_png), 0);
   ImageU8 image = LoadImage(blank_png);
   std::fill(image.data.begin(), image.data.end(), 128);
   SaveImage(blank_png, image);

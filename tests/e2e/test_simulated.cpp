@@ -76,9 +76,9 @@ TEST_P(SimulatedCalibration, RecoversTheGroundTruth) {
       ComputePoseError(outcome.solution->cam_from_lidar, *dataset.cam_from_lidar_ground_truth);
   std::printf("[%s] %d pairs: translation error %.2f mm, rotation error %.3f deg\n", name.c_str(),
               accepted, error.translation_m * 1e3, error.rotation_rad * 180 / M_PI);
-  // Twenty A3 boards at 1.2–3 m (fisheye 1–2 m) with 5 mm range noise. The paper's unweighted solver is far from
-  // efficient on boards this small (a VLP-16 sees them with 2–5 rings): measured 5–26 mm and
-  // 0.15–0.55 deg at N = 10 over this matrix. Bounds: 25 mm and 0.6 deg.
+  // Twenty A3 boards at 1.2–3 m (fisheye 1–2 m) with 5 mm range noise. The paper's unweighted
+  // solver is far from efficient on boards this small (a VLP-16 sees them with 2–5 rings): measured
+  // 5–26 mm and 0.15–0.55 deg at N = 10 over this matrix. Bounds: 25 mm and 0.6 deg.
   EXPECT_LT(error.translation_m, 0.025);
   EXPECT_LT(error.rotation_rad, 0.6 * M_PI / 180);
   EXPECT_TRUE(outcome.solution->converged);
@@ -95,7 +95,8 @@ std::string ParamName(const ::testing::TestParamInfo<Param>& info) {
 
 INSTANTIATE_TEST_SUITE_P(
     AllSensorsAndTargets, SimulatedCalibration,
-    ::testing::Combine(::testing::Values(LidarModel::kHdl64, LidarModel::kVlp16, LidarModel::kOs0_128),
+    ::testing::Combine(::testing::Values(LidarModel::kHdl64, LidarModel::kVlp16,
+                                         LidarModel::kOs0_128),
                        ::testing::Bool(),
                        ::testing::Values(BoardType::kCheckerboard, BoardType::kCharuco)),
     ParamName);
