@@ -1,7 +1,11 @@
 #include "core/image.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <system_error>
 
 #include "core/types.h"
@@ -55,6 +59,22 @@ void SaveImage(const std::filesystem::path& path, const ImageU8& image) {
     reason = e.err;  // e.g. an extension no encoder handles
   }
   if (!written) throw IoError("cannot write image '" + path.string() + "': " + reason);
+}
+
+ImageU8 ResizeImage(const ImageU8& image, int max_width) {
+  if (image.empty() || image.width <= max_width) return image;
+  const cv::Mat source(image.height, image.width, CV_8UC(image.channels),
+                       const_cast<std::uint8_t*>(image.data.data()));
+  const int height = std::max(1, static_cast<int>(std::lround(
+                                     static_cast<double>(image.height) * max_width / image.width)));
+  cv::Mat resized;
+  cv::resize(source, resized, cv::Size(max_width, height), 0, 0, cv::INTER_AREA);
+  ImageU8 out;
+  out.width = resized.cols;
+  out.height = resized.rows;
+  out.channels = image.channels;
+  out.data.assign(resized.data, resized.data + resized.total() * resized.elemSize());
+  return out;
 }
 
 }  // namespace calibench

@@ -379,7 +379,8 @@ TEST(SimOptionsTest, PresetsAndDefaultMount) {
   EXPECT_EQ(paper.num_pairs, 53);
   EXPECT_DOUBLE_EQ(paper.board.PatternWidth(), 1.6);
   EXPECT_DOUBLE_EQ(paper.board.SheetHeight(), 1.2);
-  EXPECT_EQ(SimPreset("demo").num_pairs, 12);
+  EXPECT_EQ(SimPreset("demo").num_pairs, 16);
+  EXPECT_EQ(SimPreset("demo").lidar, LidarModel::kOs0_128);
   EXPECT_DOUBLE_EQ(SimPreset("default").lidar_range_noise_m, 0.005);
   const Pose cam_from_lidar = DefaultCamFromLidar();
   EXPECT_LT((cam_from_lidar.linear() * Vec3::UnitX() - Vec3::UnitZ()).norm(), 0.05);

@@ -1,0 +1,306 @@
+// ui/gfx on headless contexts: a known scene drawn into a Framebuffer and checked pixel by pixel
+// against hand-computed projections, the same scene drawn by EGL and by OSMesa and compared (two
+// render paths, no stored image), read-back orientation and resizing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <numbers>
+#include <random>
+
+#include "core/image.h"
+#include "tests/test_support.h"
+#include "ui/gfx/context.h"
+#include "ui/gfx/framebuffer.h"
+#include "ui/gfx/gl_api.h"  // first GL header of this file: glGetError for the checks
+#include "ui/gfx/renderers.h"
+
+namespace calibench::gfx {
+namespace {
+
+bool GlRequired() {
+  const char* env = std::getenv("CALIBENCH_REQUIRE_GL");
+  return env && std::string(env) == "1";
+}
+
+// Binds `context` to a current headless context of `backend`. When the backend is unavailable:
+// GTEST_SKIP with the reason, or a failure under CALIBENCH_REQUIRE_GL=1 (as CI sets it).
+#define CALIBENCH_REQUIRE_GL_CONTEXT(context, backend)                                       \
+  std::string context##_why;                                                                 \
+  const std::unique_ptr<GlContext> context = CreateHeadlessContext(backend, &context##_why); \
+  if (!context) {                                                                            \
+    if (GlRequired()) FAIL() << "CALIBENCH_REQUIRE_GL=1 but: " << context##_why;             \
+    GTEST_SKIP() << "no headless GL context (" << context##_why << "): skipping a GL test";  \
+  }                                                                                          \
+  RecordProperty("gl_context", context->Description())
+
+constexpr int kWidth = 320, kHeight = 240;
+constexpr float kFovy = 60.0f * std::numbers::pi_v<float> / 180.0f;  // radians
+constexpr float kCameraZ = 5.0f;  // metres; the camera looks from (0, 0, 5) down -z
+constexpr float kClear[3] = {51 / 255.0f, 102 / 255.0f, 153 / 255.0f};  // RGB, exact in 8 bits
+constexpr float kPointSize = 9.0f;                                      // pixels
+const Rgba kTriangleColor{255, 0, 0, 128};
+
+// Pixel (column, row counted from the top) where the scene camera sees world point p: a pinhole
+// worked out by hand, independently of Perspective() and LookAt().
+Eigen::Vector2i ExpectedPixel(const Eigen::Vector3f& p) {
+  const float half_height = (kCameraZ - p.z()) * std::tan(0.5f * kFovy);
+  const float ndc_x = p.x() / (half_height * kWidth / kHeight), ndc_y = p.y() / half_height;
+  return {static_cast<int>(std::floor(0.5f * (ndc_x + 1.0f) * kWidth)),
+          static_cast<int>(std::floor(0.5f * (1.0f - ndc_y) * kHeight))};
+}
+
+Matrix4f SceneViewProjection() {
+  return Perspective(kFovy, static_cast<float>(kWidth) / kHeight, 0.1f, 100.0f) *
+         LookAt({0, 0, kCameraZ}, {0, 0, 0}, {0, 1, 0});
+}
+
+// BGR at (column, row) of a read-back image.
+Eigen::Vector3i Bgr(const ImageU8& image, int x, int y) {
+  const std::uint8_t* p = image.Row(y) + 3 * x;
+  return {p[0], p[1], p[2]};
+}
+
+::testing::AssertionResult ColorNear(const ImageU8& image, int x, int y,
+                                     const Eigen::Vector3i& expected_bgr, int tolerance) {
+  const Eigen::Vector3i actual = Bgr(image, x, y);
+  if ((actual - expected_bgr).cwiseAbs().maxCoeff() <= tolerance) {
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure()
+         << "pixel (" << x << ", " << y << ") is BGR " << actual.transpose() << ", expected "
+         << expected_bgr.transpose() << " +- " << tolerance;
+}
+
+// A 5x3 BGR image (odd width: 15-byte rows) and a 3x3 grey one (3-byte rows).
+ImageU8 ColorImage() {
+  ImageU8 image{5, 3, 3, {}};
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 5; ++x) {
+      image.data.insert(image.data.end(), {static_cast<std::uint8_t>(40 * x + 10),
+                                           static_cast<std::uint8_t>(60 * y + 20), 200});
+    }
+  }
+  return image;
+}
+ImageU8 GreyImage() {
+  ImageU8 image{3, 3, 1, {}};
+  for (int i = 0; i < 9; ++i) image.data.push_back(static_cast<std::uint8_t>(50 + 20 * i));
+  return image;
+}
+
+// Scene points: opaque markers on z = 0, one inside the translucent triangle's footprint behind
+// it (z = 0) and one in front of it (z = 2).
+const std::vector<Eigen::Vector3f> kPoints = {
+    {0, 0, 0}, {1, 0, 0}, {-1, -0.5f, 0}, {-2.0f, 0.9f, 0}, {-1.0f, 0.55f, 2.0f}};
+const std::vector<Rgba> kPointColors = {
+    {255, 0, 0, 255}, {0, 255, 0, 255}, {0, 0, 255, 255}, {255, 255, 255, 255}, {0, 255, 255, 255}};
+// The triangle lies on z = 1 over the upper left, covering the last two points.
+const std::vector<Eigen::Vector3f> kTriangle = {{-3, 0.3f, 1}, {-0.5f, 0.3f, 1}, {-3, 2.2f, 1}};
+const std::vector<Eigen::Vector3f> kLine = {{-2, -1, 0}, {2, -1, 0}};
+
+// Draws the scene into `target` and reads it back. `cloud_points` adds that many random points
+// far behind everything (for comparing backends on busier content).
+ImageU8 RenderScene(Framebuffer* target, int cloud_points) {
+  target->Resize(kWidth, kHeight);
+  target->Clear(kClear[0], kClear[1], kClear[2], 1.0f);
+  ImageTexture color_image, grey_image;
+  color_image.Upload(ColorImage(), /*linear_filtering=*/false);
+  grey_image.Upload(GreyImage(), /*linear_filtering=*/false);
+  color_image.Draw(0.5f, -1.0f, 1.0f, -0.5f);   // pixels [240, 320) x [180, 240)
+  grey_image.Draw(-1.0f, -1.0f, -0.5f, -0.5f);  // pixels [0, 80) x [180, 240)
+  const Matrix4f view_projection = SceneViewProjection();
+  PointRenderer points;
+  std::vector<Eigen::Vector3f> positions = kPoints;
+  std::vector<Rgba> colors = kPointColors;
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  for (int i = 0; i < cloud_points; ++i) {
+    positions.emplace_back(8 * uniform(random), 6 * uniform(random), -4 + 2 * uniform(random));
+    colors.push_back({static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(3 * i), 128, 255});
+  }
+  points.Upload(positions, colors);
+  points.Draw(view_projection, kPointSize);
+  LineRenderer line;
+  line.Upload(kLine, {{255, 0, 255, 255}, {255, 0, 255, 255}});
+  line.Draw(view_projection, 1.0f);
+  TriangleRenderer triangle;
+  triangle.Upload(kTriangle, {kTriangleColor, kTriangleColor, kTriangleColor});
+  triangle.Draw(view_projection);
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+  return target->ReadPixels();
+}
+
+// Expected 8-bit result of "over" blending of `source` (with alpha) onto `destination`.
+Eigen::Vector3i Over(const Rgba& source, const Eigen::Vector3i& destination_bgr) {
+  const double a = source.a / 255.0;
+  const Eigen::Vector3d src(source.b, source.g, source.r);
+  return (a * src + (1 - a) * destination_bgr.cast<double>()).array().round().cast<int>();
+}
+
+TEST(GfxProjection, PerspectiveAndLookAtFollowOpenGlConventions) {
+  const Matrix4f view = LookAt({1, 2, 3}, {1, 2, -7}, {0, 1, 0});
+  EXPECT_TRUE(
+      test::MatrixNear(view * Eigen::Vector4f(1, 2, 3, 1), Eigen::Vector4f(0, 0, 0, 1), 1e-6));
+  EXPECT_TRUE(
+      test::MatrixNear(view * Eigen::Vector4f(1, 2, -7, 1), Eigen::Vector4f(0, 0, -10, 1), 1e-5));
+  const Matrix4f projection = Perspective(kFovy, 2.0f, 0.5f, 50.0f);
+  const auto ndc = [&](const Eigen::Vector3f& p) {
+    const Eigen::Vector4f clip = projection * p.homogeneous();
+    return Eigen::Vector3f(clip.head<3>() / clip.w());
+  };
+  EXPECT_NEAR(ndc({0, 0, -0.5f}).z(), -1.0f, 1e-5);  // near plane
+  EXPECT_NEAR(ndc({0, 0, -50.0f}).z(), 1.0f, 1e-4);  // far plane
+  // The top edge of the view at distance d is d tan(fovy / 2); the right edge twice that.
+  const float edge = 4.0f * std::tan(0.5f * kFovy);
+  EXPECT_TRUE(
+      test::MatrixNear(ndc({2 * edge, edge, -4.0f}).head<2>(), Eigen::Vector2f(1, 1), 1e-5));
+}
+
+TEST(GfxRender, KnownSceneHasExpectedPixels) {
+  CALIBENCH_REQUIRE_GL_CONTEXT(context, HeadlessBackend::kEgl);
+  Framebuffer target;
+  const ImageU8 image = RenderScene(&target, 0);
+  ASSERT_EQ(image.width, kWidth);
+  ASSERT_EQ(image.height, kHeight);
+  const Eigen::Vector3i background(153, 102, 51);
+  EXPECT_TRUE(ColorNear(image, 160, 20, background, 0));
+  // Opaque round points at their hand-computed pixels; the sprite's corner is cut off.
+  for (size_t i = 0; i < 3; ++i) {
+    const Eigen::Vector2i at = ExpectedPixel(kPoints[i]);
+    const Rgba& c = kPointColors[i];
+    EXPECT_TRUE(ColorNear(image, at.x(), at.y(), {c.b, c.g, c.r}, 0)) << "point " << i;
+    EXPECT_TRUE(ColorNear(image, at.x() + 3, at.y(), {c.b, c.g, c.r}, 0)) << "point " << i;
+    EXPECT_TRUE(ColorNear(image, at.x() + 4, at.y() + 4, background, 0)) << "point " << i;
+  }
+  // The line's row, found within one pixel of the projection (rasterization rules differ).
+  const Eigen::Vector2i line_at = ExpectedPixel({0, -1, 0});
+  int magenta_rows = 0;
+  for (int dy = -1; dy <= 1; ++dy) {
+    magenta_rows += ColorNear(image, line_at.x(), line_at.y() + dy, {255, 0, 255}, 0) ? 1 : 0;
+  }
+  EXPECT_GE(magenta_rows, 1);
+  EXPECT_TRUE(ColorNear(image, line_at.x(), line_at.y() + 4, background, 0));
+  // The translucent triangle blends over the background and over the point behind it (depth
+  // test passes), but not over the point in front of it (depth test fails).
+  const Eigen::Vector2i inside = ExpectedPixel({-2.2f, 0.9f, 1.0f});
+  EXPECT_TRUE(ColorNear(image, inside.x(), inside.y(), Over(kTriangleColor, background), 2));
+  const Eigen::Vector2i behind = ExpectedPixel(kPoints[3]);
+  EXPECT_TRUE(ColorNear(image, behind.x(), behind.y(), Over(kTriangleColor, {255, 255, 255}), 2));
+  const Eigen::Vector2i in_front = ExpectedPixel(kPoints[4]);
+  EXPECT_TRUE(ColorNear(image, in_front.x(), in_front.y(), {255, 255, 0}, 0));
+  // Image texels (nearest filtering): the BGR image's texel (x, y) covers 16x20 pixels from
+  // (240, 180), the grey one's 80/3 x 20 pixels from (0, 180).
+  const ImageU8 color = ColorImage(), grey = GreyImage();
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 5; ++x) {
+      EXPECT_TRUE(ColorNear(image, 248 + 16 * x, 190 + 20 * y, Bgr(color, x, y), 0));
+    }
+    for (int x = 0; x < 3; ++x) {
+      const int g = grey.Row(y)[x];
+      EXPECT_TRUE(ColorNear(image, (80 * x + 40) / 3, 190 + 20 * y, {g, g, g}, 0));
+    }
+  }
+}
+
+TEST(GfxRender, EglAndOsMesaDrawTheSameScene) {
+  ImageU8 egl_image, osmesa_image;
+  std::string egl_description;
+  {
+    CALIBENCH_REQUIRE_GL_CONTEXT(egl, HeadlessBackend::kEgl);
+    Framebuffer target;
+    egl_image = RenderScene(&target, 3000);
+    egl_description = egl->Description();
+  }
+  CALIBENCH_REQUIRE_GL_CONTEXT(osmesa, HeadlessBackend::kOsMesa);
+  Framebuffer target;
+  osmesa_image = RenderScene(&target, 3000);
+  // Two rasterizers may round blending and point coverage differently; a few pixels may differ
+  // by more (an edge pixel in or out), never many.
+  constexpr int kChannelTolerance = 3;
+  constexpr double kMaxDifferingFraction = 0.002;
+  ImageU8 diff{kWidth, kHeight, 3, std::vector<std::uint8_t>(kWidth * kHeight * 3, 0)};
+  int differing = 0;
+  for (size_t i = 0; i < egl_image.data.size(); i += 3) {
+    int worst = 0;
+    for (int c = 0; c < 3; ++c)
+      worst = std::max(worst, std::abs(egl_image.data[i + c] - osmesa_image.data[i + c]));
+    if (worst > kChannelTolerance) {
+      ++differing;
+      diff.data[i + 2] = 255;
+    }
+  }
+  const int allowed = static_cast<int>(kMaxDifferingFraction * kWidth * kHeight);
+  if (differing > allowed) {
+    const auto dir = test::TempDir("gfx_egl_vs_osmesa");
+    SaveImage(dir / "egl.png", egl_image);
+    SaveImage(dir / "osmesa.png", osmesa_image);
+    SaveImage(dir / "diff.png", diff);
+    ADD_FAILURE() << differing << " pixels differ by more than " << kChannelTolerance
+                  << " (at most " << allowed << " allowed) between " << egl_description << " and "
+                  << osmesa->Description() << "; images in " << dir;
+  }
+}
+
+TEST(GfxFramebuffer, ReadPixelsReturnsTopRowFirst) {
+  CALIBENCH_REQUIRE_GL_CONTEXT(context, HeadlessBackend::kAuto);
+  Framebuffer target;
+  target.Resize(kWidth, kHeight);
+  target.Clear(0, 0, 0, 1);
+  PointRenderer point;
+  point.Upload({{0.0f, 0.9f, 0.0f}}, {{255, 0, 0, 255}});
+  point.Draw(Matrix4f::Identity(), 5.0f);  // NDC y = 0.9: near the top edge of the target
+  const ImageU8 image = target.ReadPixels();
+  const int top_row = static_cast<int>(0.5 * (1.0 - 0.9) * kHeight);  // 12
+  EXPECT_TRUE(ColorNear(image, kWidth / 2, top_row, {0, 0, 255}, 0));
+  EXPECT_TRUE(ColorNear(image, kWidth / 2, kHeight - 1 - top_row, {0, 0, 0}, 0));
+}
+
+TEST(GfxFramebuffer, ResizeReallocatesOnlyOnChange) {
+  CALIBENCH_REQUIRE_GL_CONTEXT(context, HeadlessBackend::kAuto);
+  Framebuffer target;
+  target.Resize(kWidth, kHeight);
+  const std::uint32_t texture = target.color_texture();
+  target.Resize(kWidth, kHeight);
+  EXPECT_EQ(target.color_texture(), texture);
+  target.Resize(65, 33);  // odd width: read-back rows of 195 bytes
+  EXPECT_EQ(target.width(), 65);
+  EXPECT_EQ(target.height(), 33);
+  target.Clear(1.0f, 0.0f, 0.0f, 1.0f);
+  PointRenderer point;
+  point.Upload({{0, 0, 0}}, {{0, 255, 0, 255}});
+  point.Draw(Matrix4f::Identity(), 3.0f);
+  const ImageU8 image = target.ReadPixels();
+  ASSERT_EQ(image.width, 65);
+  ASSERT_EQ(image.height, 33);
+  ASSERT_EQ(image.data.size(), 65u * 33u * 3u);
+  EXPECT_TRUE(ColorNear(image, 64, 32, {0, 0, 255}, 0));
+  EXPECT_TRUE(ColorNear(image, 32, 16, {0, 255, 0}, 0));
+  EXPECT_THROW(target.Resize(0, 10), std::invalid_argument);
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+TEST(GfxRenderers, RejectMismatchedUploads) {
+  CALIBENCH_REQUIRE_GL_CONTEXT(context, HeadlessBackend::kAuto);
+  LineRenderer lines;
+  EXPECT_THROW(lines.Upload({{0, 0, 0}}, {{}}), std::invalid_argument);  // odd vertex count
+  TriangleRenderer triangles;
+  EXPECT_THROW(triangles.Upload({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{}}), std::invalid_argument);
+  ImageTexture texture;
+  EXPECT_THROW(texture.Upload(ImageU8{2, 2, 4, std::vector<std::uint8_t>(16)}),
+               std::invalid_argument);
+}
+
+TEST(GfxContext, ParsesBackendNames) {
+  HeadlessBackend backend = HeadlessBackend::kAuto;
+  EXPECT_TRUE(ParseHeadlessBackend("osmesa", &backend));
+  EXPECT_EQ(backend, HeadlessBackend::kOsMesa);
+  EXPECT_TRUE(ParseHeadlessBackend("egl", &backend));
+  EXPECT_EQ(backend, HeadlessBackend::kEgl);
+  EXPECT_TRUE(ParseHeadlessBackend("auto", &backend));
+  EXPECT_EQ(backend, HeadlessBackend::kAuto);
+  EXPECT_FALSE(ParseHeadlessBackend("EGL", &backend));
+}
+
+}  // namespace
+}  // namespace calibench::gfx
