@@ -2,6 +2,8 @@
 // returns the process exit code (see ExitCode).
 #pragma once
 
+#include <string>
+
 namespace calibench::app {
 
 // Exit codes shared by every subcommand.
@@ -19,5 +21,15 @@ int RunEvaluate(int argc, char** argv);
 int RunSimulate(int argc, char** argv);
 int RunDemo(int argc, char** argv);
 int RunSweep(int argc, char** argv);
+int RunGui(int argc, char** argv);
+int RunRender(int argc, char** argv);
+
+// Shared by `gui` and `demo`: opens the workbench window on a dataset or session.
+int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
+                 const std::string& screenshot, int quit_after_frames);
+// Shared by `render` and `demo`: draws one view (or the workbench) headless into a PNG.
+int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
+                   bool solve, const std::string& view, int width, int height,
+                   const std::string& out, const std::string& backend_name);
 
 }  // namespace calibench::app

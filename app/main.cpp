@@ -21,6 +21,10 @@ constexpr Command kCommands[] = {
     {"evaluate", calibench::app::RunEvaluate, "score a result against a dataset's ground truth"},
     {"simulate", calibench::app::RunSimulate, "write a synthetic dataset with ground truth"},
     {"demo", calibench::app::RunDemo, "simulate the demo dataset, calibrate it, print the error"},
+    {"gui", calibench::app::RunGui,
+     "the workbench window: brush, accept/reject pairs, solve, inspect (--dataset or --session)"},
+    {"render", calibench::app::RunRender,
+     "draw the workbench or one view to PNG without a window (EGL / OSMesa)"},
     {"sweep", calibench::app::RunSweep,
      "the paper's Table 1 protocol: error vs. number of pairs and noise on simulated data"},
 };

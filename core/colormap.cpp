@@ -22,14 +22,14 @@ std::uint8_t ToByte(double unit) {
 
 // Turbo (Anton Mikhailov, Google 2019) by the published polynomial approximation of Ruofei Du
 // (Apache-2.0): a quintic per channel. It departs from Google's 256-entry table by up to
-// ~32/255 at the dark-red end (mean ~6/255); hue order and endpoints are kept.
+// ~32/255 at the dark-red end (mean ~6/255); the hue order is kept.
 std::array<std::uint8_t, 3> Turbo(double x) {
   const double v[6] = {1.0, x, x * x, x * x * x, x * x * x * x, x * x * x * x * x};
-  constexpr double kRed[6] = {0.13572138,    4.61539260,  -42.66032258,
+  constexpr double kRed[6] = {0.13572138,   4.61539260,    -42.66032258,
                               132.13108234, -152.94239396, 59.28637943};
   constexpr double kGreen[6] = {0.09140261,   2.19418839, 4.84296658,
                                 -14.18503333, 4.27729857, 2.82956604};
-  constexpr double kBlue[6] = {0.10667330,   12.64194608, -60.58204836,
+  constexpr double kBlue[6] = {0.10667330,   12.64194608,  -60.58204836,
                                110.36276771, -89.90310912, 27.34824973};
   double r = 0, g = 0, b = 0;
   for (int k = 0; k < 6; ++k) {
@@ -42,7 +42,7 @@ std::array<std::uint8_t, 3> Turbo(double x) {
 
 // Viridis (van der Walt & Smith, matplotlib) as a degree-7 least-squares polynomial per channel,
 // fitted by us to the 256 matplotlib samples (as shipped in OpenCV's COLORMAP_VIRIDIS). Largest
-// deviation from the table 2.6/255 (at t = 0); tests/core/test_colormap.cpp checks it.
+// deviation from the table 3/255 after rounding (mean 0.55/255); test_colormap.cpp checks it.
 std::array<std::uint8_t, 3> Viridis(double t) {
   // Rows: coefficients of t^0 .. t^7; columns: R, G, B in [0, 1].
   constexpr double kCoeff[8][3] = {
@@ -109,7 +109,8 @@ std::array<std::uint8_t, 3> MapColor(Colormap map, double t) {
 ImageU8 RenderLidarImage(const LidarImage& image, LidarChannel channel, Colormap map) {
   const size_t pixels = static_cast<size_t>(image.rows) * image.columns;
   CALIBENCH_CHECK(image.point_index.size() == pixels);
-  const std::vector<float>& values = channel == LidarChannel::kRange ? image.range : image.intensity;
+  const std::vector<float>& values =
+      channel == LidarChannel::kRange ? image.range : image.intensity;
   CALIBENCH_CHECK(channel == LidarChannel::kRing || values.size() == pixels);
   const RobustRange range = channel == LidarChannel::kRing ? RobustRange{} : RangeOf(image, values);
 

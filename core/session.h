@@ -71,7 +71,8 @@ std::string LidarChannelName(LidarChannel channel);
 std::string CameraImageModeName(CameraImageMode mode);
 std::string VisibilityModeName(VisibilityMode mode);
 
-// The part of a SolverResult the session keeps (per-pair residuals are recomputed on load).
+// The part of a SolverResult the session keeps. Per-pair residuals and weights are not kept: they
+// follow from the pairs' planes at cam_from_lidar.
 struct SessionResult {
   Pose cam_from_lidar = Pose::Identity();  // x_in_cam = cam_from_lidar * x_in_lidar
   Mat6 covariance = Mat6::Zero();          // right perturbation, [rho (m); phi (rad)]
@@ -81,7 +82,7 @@ struct SessionResult {
   std::vector<std::string> weak_directions;
   bool well_constrained = false;
 
-  // Exact (bitwise-value) comparison, so a file round trip can be checked with ==.
+  // Exact value comparison (no tolerance), so a file round trip can be checked with ==.
   bool operator==(const SessionResult& other) const;
 };
 SessionResult SessionResultFromSolver(const SolverResult& solver);
@@ -113,7 +114,8 @@ void ApplySessionOptions(const Session& session, PipelineOptions* options);
 // The session as JSON text for a file at session_path: the dataset path is written relative to
 // the session file's folder when it lies under it, absolute otherwise. Doubles round-trip
 // exactly; non-finite ones are written as the strings "nan", "inf", "-inf".
-// An empty session_path writes the dataset path absolute. Requires a non-empty session.dataset.
+// An empty session_path writes the dataset path absolute. Requires a non-empty session.dataset,
+// version 1, and brush masks whose pixels are sorted, unique and inside their image.
 std::string SessionToJson(const Session& session, const std::filesystem::path& session_path = {});
 
 // Parses session text read from source_path (named in errors; relative dataset paths resolve
@@ -129,7 +131,8 @@ Session LoadSession(const std::filesystem::path& path);
 void SaveSession(const std::filesystem::path& path, const Session& session);
 
 // Undo/redo over whole session states. Push the state after every edit that should be
-// undoable; Undo/Redo return the state to restore (nullopt when there is none).
+// undoable; Undo/Redo return the state to restore (nullopt when there is none). The view is part
+// of each state: a caller that should not undo camera moves keeps its current view on restore.
 class SessionHistory {
  public:
   explicit SessionHistory(std::size_t max_depth = 100);  // undo steps kept, >= 1

@@ -69,6 +69,10 @@ Json Numbers(const double* values, int count) {
 // Masks are blobs in row-major order, so [start, count] runs are far shorter than pixel lists.
 Json BrushToJson(const BrushMask& mask) {
   Json runs = Json::array();
+  const long long size = static_cast<long long>(mask.rows) * mask.columns;
+  for (size_t i = 0; i < mask.pixels.size(); ++i)  // a broken mask would save an unloadable file
+    CALIBENCH_CHECK(mask.pixels[i] >= 0 && mask.pixels[i] < size &&
+                    (i == 0 || mask.pixels[i] > mask.pixels[i - 1]));
   for (size_t i = 0; i < mask.pixels.size();) {
     size_t j = i + 1;
     while (j < mask.pixels.size() && mask.pixels[j] == mask.pixels[j - 1] + 1) ++j;
@@ -93,20 +97,19 @@ Json ViewToJson(const ViewState& v) {
           {"brush_radius_px", Number(v.brush_radius_px)}};
 }
 
+Json Rows(const Eigen::MatrixXd& m) {
+  Json rows = Json::array();
+  for (int r = 0; r < m.rows(); ++r) {
+    const Eigen::RowVectorXd row = m.row(r);
+    rows.push_back(Numbers(row.data(), static_cast<int>(row.size())));
+  }
+  return rows;
+}
+
 Json ResultToJson(const SessionResult& r) {
-  Json matrix = Json::array();
-  for (int row = 0; row < 4; ++row) {
-    const Eigen::Vector4d values = r.cam_from_lidar.matrix().row(row).transpose();
-    matrix.push_back(Numbers(values.data(), 4));
-  }
-  Json covariance = Json::array();
-  for (int row = 0; row < 6; ++row) {
-    const Vec6 values = r.covariance.row(row).transpose();
-    covariance.push_back(Numbers(values.data(), 6));
-  }
   return {{"direction", kDirection},
-          {"cam_from_lidar", {{"matrix", matrix}}},
-          {"covariance_6x6", covariance},
+          {"cam_from_lidar", {{"matrix", Rows(r.cam_from_lidar.matrix())}}},
+          {"covariance_6x6", Rows(r.covariance)},
           {"covariance_convention",
            "right perturbation cam_from_lidar * Exp(delta), delta = [rho (m); phi (rad)]"},
           {"iterations", r.iterations},

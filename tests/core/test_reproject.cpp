@@ -76,8 +76,8 @@ Rates Score(const TwoPlanes& scene, const std::vector<bool>& visible) {
       open_visible += visible[i];
     }
   }
-  return {static_cast<double>(occluded_hidden) / occluded,
-          static_cast<double>(near_visible) / near, static_cast<double>(open_visible) / open};
+  return {static_cast<double>(occluded_hidden) / occluded, static_cast<double>(near_visible) / near,
+          static_cast<double>(open_visible) / open};
 }
 
 // Points on a sphere, evenly spread (Fibonacci lattice).
@@ -94,8 +94,10 @@ std::vector<Vec3> SpherePoints(const Vec3& centre, double radius, int count) {
 
 TEST(HiddenPointRemoval, TwoParallelPlanesAcrossRadiusExponents) {
   const TwoPlanes scene = MakeTwoPlanes(4000, 16000, 3);
-  // 2.5 is the default; 4 and 5 probe the float precision of the flipped shell handed to qhull.
-  for (const double exponent : {2.0, 2.5, 3.5, 4.0, 5.0}) {
+  // The recommended range. Below it HPR hides a wider band of the wall next to the plate's
+  // shadow (about sqrt(depth gap / R) radians wide); above it, wall points behind the gaps
+  // between plate samples start to show (already 31 % of them at 4.0 for this plate density).
+  for (const double exponent : {2.5, 3.0, 3.5}) {
     HprOptions options;
     options.radius_exponent = exponent;
     const Rates rates = Score(scene, HiddenPointRemoval(scene.points, options));
@@ -103,6 +105,23 @@ TEST(HiddenPointRemoval, TwoParallelPlanesAcrossRadiusExponents) {
     EXPECT_GE(rates.occluded_hidden, 0.90);
     EXPECT_GE(rates.near_visible, 0.80);
     EXPECT_GE(rates.unoccluded_far_visible, 0.80);
+  }
+}
+
+TEST(HiddenPointRemoval, DoesNotDependOnTheSceneScale) {
+  // R scales with the scene, so the answer must not change between millimetres and kilometres:
+  // the flip is done in double and normalised before qhull sees float coordinates.
+  const TwoPlanes scene = MakeTwoPlanes(1000, 4000, 9);
+  HprOptions options;
+  options.radius_exponent = 3.5;
+  const std::vector<bool> reference = HiddenPointRemoval(scene.points, options);
+  for (const double scale : {1e-3, 1e4}) {
+    std::vector<Vec3> scaled;
+    for (const Vec3& p : scene.points) scaled.push_back(scale * p);
+    const std::vector<bool> visible = HiddenPointRemoval(scaled, options);
+    int same = 0;
+    for (size_t i = 0; i < visible.size(); ++i) same += visible[i] == reference[i];
+    EXPECT_GE(same, static_cast<int>(visible.size()) - 2) << "scale " << scale;
   }
 }
 
@@ -147,8 +166,9 @@ TEST(HiddenPointRemoval, PlaneThroughTheCentreIsSolvedInThatPlane) {
     points.emplace_back(0.5 * unit(rng), 0.0, 2.0);
     truth.push_back(0);
   }
+  // The far segment reaches well beyond the shadow: HPR hides a band next to it (see above).
   for (int i = 0; i < 1200; ++i) {
-    const double x = 2.0 * unit(rng);
+    const double x = 4.0 * unit(rng);
     points.emplace_back(x, 0.0, 4.0);
     truth.push_back(std::abs(x) < 1.0 ? 1 : 2);
   }
@@ -276,7 +296,8 @@ TEST(ColorizeCloud, ReadsBackThePixelCoordinates) {
     }
   }
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> pick_u(0.0, camera.width - 1.0), pick_v(0.0, camera.height - 1.0);
+  std::uniform_real_distribution<double> pick_u(0.0, camera.width - 1.0),
+      pick_v(0.0, camera.height - 1.0);
   LidarCloud cloud;
   for (int i = 0; i < 200; ++i) {
     const Vec3 ray = *camera.Unproject(Vec2(pick_u(rng), pick_v(rng)));
@@ -322,8 +343,8 @@ TEST(ColorizeCloud, NoColourOutsideASmallerImage) {
   ASSERT_EQ(projected.size(), 2u);
   ImageU8 image{1000, 1000, 3, {}};  // smaller than the camera says
   image.data.assign(1000 * 1000 * 3, 200);
-  const CloudColors colors = ColorizeCloud(camera, Pose::Identity(), cloud, image,
-                                           std::vector<bool>(2, true), projected);
+  const CloudColors colors =
+      ColorizeCloud(camera, Pose::Identity(), cloud, image, std::vector<bool>(2, true), projected);
   EXPECT_TRUE(colors.has_color[0]);
   EXPECT_FALSE(colors.has_color[1]);
 }

@@ -278,8 +278,16 @@ TEST(SessionTest, BrushMasksOutsideTheirImageOrUnsortedAreRejected) {
   ExpectRejected(dir, with_runs("[[1, 0]]"), "count must be at least 1");
   ExpectRejected(dir, with_runs("[[1, 2, 3]]"), "[start, count]");
   ExpectRejected(dir, Edit(good, "\"image_rows\": 2", "\"image_rows\": 0"), "at least 1");
-  ExpectRejected(dir, Edit(good, "\"image_rows\": 2", "\"image_rows\": 2000000"),
+  ExpectRejected(dir, Edit(good, "\"image_rows\": 2", "\"image_rows\": 100000000"),
                  "image too large");
+}
+
+TEST(SessionTest, SavingABrokenMaskIsAProgrammerError) {
+  Session s = FullSession("/d/dataset.json");
+  s.pairs[0].brush = Mask(2, 3, {3, 1});  // unsorted: would save a file that cannot load
+  EXPECT_THROW(SessionToJson(s), std::logic_error);
+  s.pairs[0].brush = Mask(2, 3, {6});
+  EXPECT_THROW(SessionToJson(s), std::logic_error);
 }
 
 TEST(SessionTest, BrushFromAnotherLidarImageLayoutIsRefused) {

@@ -1,0 +1,191 @@
+// `calibench gui` (the workbench window) and `calibench render` (the same views, headless).
+
+// gl_api.h first: it declares GL for everything below (and sets GLFW_INCLUDE_NONE).
+#include <GLFW/glfw3.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+
+#include "app/commands.h"
+#include "core/image.h"
+#include "ui/controller.h"
+#include "ui/gfx/context.h"
+#include "ui/gfx/framebuffer.h"
+#include "ui/gfx/gl_api.h"
+#include "ui/imgui_host.h"
+#include "ui/workbench.h"
+
+namespace calibench::app {
+namespace {
+
+bool ParseSize(const std::string& text, int* width, int* height) {
+  return std::sscanf(text.c_str(), "%dx%d", width, height) == 2 && *width >= 64 && *height >= 64 &&
+         *width <= 8192 && *height <= 8192;
+}
+
+// Opens the dataset or session the flags name; false (message printed) when neither is given.
+bool OpenInput(ui::Controller& controller, const std::string& dataset, const std::string& session,
+               const char* command) {
+  if (!session.empty()) {
+    controller.OpenSession(session);
+  } else if (!dataset.empty()) {
+    controller.OpenDataset(dataset);
+  } else {
+    std::fprintf(stderr, "calibench %s: give --dataset or --session\n", command);
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
+                 const std::string& screenshot, int quit_after_frames) {
+  std::string why;
+  auto context = gfx::WindowContext::Create(width, height, "Calibench", &why);
+  if (!context) {
+    std::fprintf(stderr,
+                 "calibench gui: cannot open a window: %s\n"
+                 "(no display? `calibench render` draws the same views to PNG)\n",
+                 why.c_str());
+    return kInputError;
+  }
+  ui::Controller controller;
+  if (!OpenInput(controller, dataset, session, "gui")) return kUsage;
+  ui::ImGuiHost host(context->window());
+  ui::Workbench workbench;
+  gfx::Framebuffer frame_target;  // the whole window is drawn offscreen, then blitted
+  auto last = std::chrono::steady_clock::now();
+  for (int frame = 0; !glfwWindowShouldClose(context->window()); ++frame) {
+    glfwPollEvents();
+    int fb_width = 0, fb_height = 0;
+    glfwGetFramebufferSize(context->window(), &fb_width, &fb_height);
+    if (fb_width <= 0 || fb_height <= 0) continue;
+    const auto now = std::chrono::steady_clock::now();
+    const double dt = std::chrono::duration<double>(now - last).count();
+    last = now;
+    host.NewFrame(fb_width, fb_height, dt);
+    for (const ui::Intent& intent :
+         workbench.Frame(controller.GetSnapshot(), fb_width, fb_height, ui::Layout::kWorkbench, dt))
+      controller.Apply(intent);
+    frame_target.Resize(fb_width, fb_height);
+    frame_target.Bind();
+    frame_target.Clear(0.06f, 0.06f, 0.07f, 1.0f);
+    host.Render();
+    const bool last_frame = quit_after_frames > 0 && frame + 1 >= quit_after_frames;
+    if (last_frame && !screenshot.empty()) {
+      SaveImage(screenshot, frame_target.ReadPixels());
+      std::printf("wrote %s\n", screenshot.c_str());
+    }
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, frame_target.framebuffer());
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glBlitFramebuffer(0, 0, fb_width, fb_height, 0, 0, fb_width, fb_height, GL_COLOR_BUFFER_BIT,
+                      GL_NEAREST);
+    glfwSwapBuffers(context->window());
+    if (last_frame) break;
+  }
+  return kOk;
+}
+
+int RunGui(int argc, char** argv) {
+  CLI::App app{
+      "The Calibench workbench: LiDAR image, camera frame and 3D view; brush, accept or "
+      "reject pairs, solve and inspect.",
+      "calibench gui"};
+  std::string dataset, session, size = "1600x900", screenshot;
+  int quit_after_frames = 0;
+  app.add_option("--dataset,-d", dataset, "dataset.json or dataset folder");
+  app.add_option("--session,-s", session, "a saved session (calibench.session.v1)");
+  app.add_option("--size", size, "window size WxH")->capture_default_str();
+  app.add_option("--screenshot", screenshot, "write the last frame to this PNG");
+  app.add_option("--quit-after-frames", quit_after_frames, "close after N frames (tests)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kOk : kUsage;
+  }
+  int width = 0, height = 0;
+  if (!ParseSize(size, &width, &height)) {
+    std::fprintf(stderr, "calibench gui: --size must be WxH, e.g. 1600x900\n");
+    return kUsage;
+  }
+  return RunGuiWindow(dataset, session, width, height, screenshot, quit_after_frames);
+}
+
+int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
+                   bool solve, const std::string& view, int width, int height,
+                   const std::string& out, const std::string& backend_name) {
+  ui::Layout layout;
+  gfx::HeadlessBackend backend;
+  if (!ui::ParseLayout(view, &layout)) {
+    std::fprintf(stderr, "calibench render: --view must be lidar, camera, 3d or workbench\n");
+    return kUsage;
+  }
+  if (!gfx::ParseHeadlessBackend(backend_name, &backend)) {
+    std::fprintf(stderr, "calibench render: --gl must be auto, egl or osmesa\n");
+    return kUsage;
+  }
+  std::string why;
+  auto context = gfx::CreateHeadlessContext(backend, &why);
+  if (!context) {
+    std::fprintf(stderr, "calibench render: no headless OpenGL: %s\n", why.c_str());
+    return kInputError;
+  }
+  ui::Controller controller;
+  if (!OpenInput(controller, dataset, session, "render")) return kUsage;
+  controller.WaitIdle();
+  if (!pair.empty()) {
+    const ui::Snapshot s = controller.GetSnapshot();
+    int index = -1;
+    for (size_t i = 0; i < s.pairs.size(); ++i)
+      if (s.pairs[i].id == pair) index = static_cast<int>(i);
+    if (index < 0) {
+      std::fprintf(stderr, "calibench render: no pair '%s' in %s\n", pair.c_str(),
+                   s.dataset_path.string().c_str());
+      return kInputError;
+    }
+    controller.Apply(ui::SelectPair{index});
+  }
+  if (solve) controller.Apply(ui::RunSolver{});
+  controller.WaitIdle();
+  ui::ImGuiHost host(nullptr);
+  ui::Workbench workbench;
+  // A few frames: ImGui sizes tables and windows on the first ones.
+  const ImageU8 picture =
+      ui::RenderWorkbenchHeadless(controller, workbench, host, layout, width, height, /*frames=*/4);
+  SaveImage(out, picture);
+  std::printf("wrote %s (%dx%d, %s, %s)\n", out.c_str(), width, height, view.c_str(),
+              context->Description().c_str());
+  return kOk;
+}
+
+int RunRender(int argc, char** argv) {
+  CLI::App app{
+      "Draw the workbench views to PNG without a window (EGL surfaceless or OSMesa): "
+      "exactly what the window shows.",
+      "calibench render"};
+  std::string dataset, session, pair, view = "workbench", size = "1600x900", out, gl = "auto";
+  bool solve = false;
+  app.add_option("--dataset,-d", dataset, "dataset.json or dataset folder");
+  app.add_option("--session,-s", session, "a saved session");
+  app.add_option("--pair", pair, "pair id to show (default: the session's selection)");
+  app.add_flag("--solve", solve, "run the solver before drawing");
+  app.add_option("--view", view, "lidar | camera | 3d | workbench")->capture_default_str();
+  app.add_option("--size", size, "WxH")->capture_default_str();
+  app.add_option("--out,-o", out, "PNG file")->required();
+  app.add_option("--gl", gl, "auto | egl | osmesa")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kOk : kUsage;
+  }
+  int width = 0, height = 0;
+  if (!ParseSize(size, &width, &height)) {
+    std::fprintf(stderr, "calibench render: --size must be WxH, e.g. 1600x900\n");
+    return kUsage;
+  }
+  return RenderHeadless(dataset, session, pair, solve, view, width, height, out, gl);
+}
+
+}  // namespace calibench::app

@@ -1,0 +1,579 @@
+#include "ui/controller.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/result_io.h"
+
+namespace calibench::ui {
+namespace {
+
+constexpr int kThumbnailWidth = 160;  // pixels
+
+std::vector<int> SeedBrush(const LidarCloud& cloud, const LidarImage& image,
+                           const LidarSeed& seed) {
+  std::vector<int> pixels;
+  for (int i : SelectSeedRegion(cloud, seed))
+    if (image.pixel_of_point[i] >= 0) pixels.push_back(image.pixel_of_point[i]);
+  std::sort(pixels.begin(), pixels.end());
+  pixels.erase(std::unique(pixels.begin(), pixels.end()), pixels.end());
+  return pixels;
+}
+
+// Pixels of a circle on the LiDAR image; columns wrap around (azimuth is periodic).
+std::vector<int> CirclePixels(int rows, int columns, int row, int column, float radius) {
+  std::vector<int> pixels;
+  const int r = static_cast<int>(std::ceil(radius));
+  for (int dr = -r; dr <= r; ++dr) {
+    const int y = row + dr;
+    if (y < 0 || y >= rows) continue;
+    for (int dc = -r; dc <= r; ++dc) {
+      if (dr * dr + dc * dc > radius * radius) continue;
+      const int x = ((column + dc) % columns + columns) % columns;
+      pixels.push_back(y * columns + x);
+    }
+  }
+  std::sort(pixels.begin(), pixels.end());
+  return pixels;
+}
+
+}  // namespace
+
+Controller::Controller() : worker_([this] { WorkerLoop(); }) {}
+
+Controller::~Controller() {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    stop_ = true;
+    queue_.clear();
+  }
+  queue_cv_.notify_all();
+  worker_.join();
+}
+
+void Controller::Enqueue(std::function<void()> job) {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    queue_.push_back(std::move(job));
+  }
+  queue_cv_.notify_one();
+}
+
+void Controller::WorkerLoop() {
+  for (;;) {
+    std::function<void()> job;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      queue_cv_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+      if (stop_) return;
+      job = std::move(queue_.front());
+      queue_.pop_front();
+      ++running_jobs_;
+    }
+    try {
+      job();
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      SetStatus(std::string("error: ") + e.what(), true);
+    }
+    {
+      std::lock_guard<std::mutex> lock(queue_mutex_);
+      --running_jobs_;
+    }
+    idle_cv_.notify_all();
+  }
+}
+
+void Controller::WaitIdle() {
+  std::unique_lock<std::mutex> lock(queue_mutex_);
+  idle_cv_.wait(lock, [&] { return queue_.empty() && running_jobs_ == 0; });
+}
+
+Snapshot Controller::GetSnapshot() const {
+  Snapshot copy;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    copy = state_;
+  }
+  std::lock_guard<std::mutex> lock(queue_mutex_);
+  copy.busy = !queue_.empty() || running_jobs_ > 0;
+  return copy;
+}
+
+void Controller::SetStatus(const std::string& message, bool error) {
+  state_.status_line = message;
+  state_.status_is_error = error;
+  ++state_.generation;
+}
+
+void Controller::OpenDataset(const std::filesystem::path& dataset_path,
+                             std::filesystem::path session_path) {
+  const Dataset dataset = LoadDataset(dataset_path);
+  if (session_path.empty()) {
+    const auto folder = std::filesystem::is_directory(dataset.manifest)
+                            ? dataset.manifest
+                            : dataset.manifest.parent_path();
+    session_path = folder / "calibench.session.json";
+  }
+  Session session = NewSession(dataset);
+  session.dataset = dataset.manifest;
+  Open(dataset, std::move(session), session_path);
+}
+
+void Controller::OpenSession(const std::filesystem::path& session_path) {
+  Session session = LoadSession(session_path);  // throws IoError; never rewrites the file
+  const Dataset dataset = LoadDataset(session.dataset);
+  if (session.pairs.size() != dataset.pairs.size())
+    throw IoError(session_path.string() + ": the session has " +
+                  std::to_string(session.pairs.size()) + " pairs but " + dataset.manifest.string() +
+                  " has " + std::to_string(dataset.pairs.size()));
+  for (size_t i = 0; i < dataset.pairs.size(); ++i)
+    if (session.pairs[i].id != dataset.pairs[i].id)
+      throw IoError(session_path.string() + ": pair " + std::to_string(i) + " is '" +
+                    session.pairs[i].id + "' in the session but '" + dataset.pairs[i].id +
+                    "' in the dataset");
+  Open(dataset, std::move(session), session_path);
+}
+
+void Controller::Open(const Dataset& dataset, Session session, std::filesystem::path session_path) {
+  WaitIdle();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_ = Snapshot{};
+    state_.dataset = dataset;
+    state_.dataset_path = dataset.manifest;
+    state_.session_path = session_path;
+    state_.pairs.resize(dataset.pairs.size());
+    for (size_t i = 0; i < dataset.pairs.size(); ++i) state_.pairs[i].id = dataset.pairs[i].id;
+    state_.loading_total = static_cast<int>(dataset.pairs.size());
+    session_ = std::move(session);
+    ApplySessionToState(session_);
+    history_.Reset(session_);
+    autosaver_ = std::make_unique<Autosaver>(session_path);
+    SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
+                  dataset.manifest.string(),
+              false);
+  }
+  for (int i = 0; i < static_cast<int>(dataset.pairs.size()); ++i)
+    Enqueue([this, i] { LoadPair(i); });
+  Enqueue([this] { EnsureSelectedImage(); });
+}
+
+void Controller::ApplySessionToState(const Session& session) {
+  ApplySessionOptions(session, &pipeline_);
+  state_.view = session.view;
+  state_.huber_delta = session.huber_delta;
+  state_.max_iterations = session.max_iterations;
+  for (size_t i = 0; i < session.pairs.size() && i < state_.pairs.size(); ++i) {
+    PairView& pair = state_.pairs[i];
+    pair.status = session.pairs[i].status;
+    pair.reason = session.pairs[i].reason;
+    if (session.pairs[i].brush) pair.brush_pixels = session.pairs[i].brush->pixels;
+  }
+  state_.selected = -1;
+  for (size_t i = 0; i < state_.pairs.size(); ++i)
+    if (state_.pairs[i].id == session.view.selected_pair) state_.selected = static_cast<int>(i);
+  if (state_.selected < 0 && !state_.pairs.empty()) state_.selected = 0;
+  state_.solver = SolverView{};
+  if (session.result) {
+    SolverResult r;
+    r.cam_from_lidar = session.result->cam_from_lidar;
+    r.covariance = session.result->covariance;
+    r.iterations = session.result->iterations;
+    r.converged = session.result->converged;
+    r.cost_history = session.result->cost_history;
+    r.observability.weak_directions = session.result->weak_directions;
+    r.observability.well_constrained = session.result->well_constrained;
+    state_.solver.result = r;
+  }
+  state_.can_undo = history_.CanUndo();
+  state_.can_redo = history_.CanRedo();
+  ++state_.generation;
+}
+
+void Controller::CommitEdit() {
+  const bool had_selected =
+      state_.selected >= 0 && state_.selected < static_cast<int>(state_.pairs.size());
+  state_.view.selected_pair = had_selected ? state_.pairs[state_.selected].id : "";
+  session_.view = state_.view;
+  session_.huber_delta = state_.huber_delta;
+  session_.max_iterations = state_.max_iterations;
+  for (size_t i = 0; i < state_.pairs.size(); ++i) {
+    PairState& p = session_.pairs[i];
+    const PairView& v = state_.pairs[i];
+    p.status = v.status;
+    p.reason = v.reason;
+    if (v.lidar_image) {
+      BrushMask mask{v.lidar_image->rows, v.lidar_image->columns, v.brush_pixels};
+      if (!p.brush || p.brush->pixels != mask.pixels) p.brush_from_seed = false;
+      p.brush = mask;
+    }
+  }
+  session_.result.reset();
+  if (state_.solver.result) session_.result = SessionResultFromSolver(*state_.solver.result);
+  history_.Push(session_);
+  state_.can_undo = history_.CanUndo();
+  state_.can_redo = history_.CanRedo();
+  try {
+    if (autosaver_) autosaver_->Save(session_);
+  } catch (const IoError& e) {
+    SetStatus(std::string("autosave failed: ") + e.what(), true);
+  }
+  ++state_.generation;
+}
+
+void Controller::LoadPair(int index) {
+  PairEntry entry;
+  CameraModel camera;
+  BoardSpec target;
+  std::vector<int> saved_brush;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    entry = state_.dataset->pairs[index];
+    camera = state_.dataset->camera;
+    target = state_.dataset->target;
+    saved_brush = state_.pairs[index].brush_pixels;
+  }
+  PairView loaded;
+  try {
+    auto cloud = std::make_shared<LidarCloud>(LoadCloud(entry.cloud));
+    auto lidar_image = std::make_shared<LidarImage>(ProjectById(*cloud, LidarImageOptions{}));
+    const ImageU8 image = LoadImage(entry.image);
+    loaded.thumbnail = std::make_shared<ImageU8>(ResizeImage(image, kThumbnailWidth));
+    std::string why;
+    loaded.detection = DetectBoard(image, target, pipeline_.detection, &why);
+    if (loaded.detection)
+      loaded.camera = EstimateBoardPose(camera, *loaded.detection, pipeline_.pnp, &why);
+    if (!loaded.camera) loaded.camera_failure = why;
+    loaded.brush_pixels = saved_brush;
+    if (loaded.brush_pixels.empty() && entry.lidar_seed)
+      loaded.brush_pixels = SeedBrush(*cloud, *lidar_image, *entry.lidar_seed);
+    loaded.cloud = cloud;
+    loaded.lidar_image = lidar_image;
+  } catch (const IoError& e) {
+    loaded.camera_failure = e.what();
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  PairView& pair = state_.pairs[index];
+  pair.loaded = true;
+  pair.cloud = loaded.cloud;
+  pair.lidar_image = loaded.lidar_image;
+  pair.thumbnail = loaded.thumbnail;
+  pair.detection = loaded.detection;
+  pair.camera = loaded.camera;
+  pair.camera_failure = loaded.camera_failure;
+  pair.brush_pixels = loaded.brush_pixels;
+  ++state_.loading_done;
+  ++state_.generation;
+  if (pair.cloud) Enqueue([this, index] { RefitLidar(index); });
+  if (!pair.cloud) {
+    pair.status = PairStatus::kFailed;
+    pair.reason = pair.camera_failure;
+  }
+  if (state_.loading_done == state_.loading_total)
+    SetStatus("loaded " + std::to_string(state_.loading_total) + " pairs", false);
+}
+
+void Controller::RefitLidar(int index) {
+  std::shared_ptr<const LidarCloud> cloud;
+  std::shared_ptr<const LidarImage> image;
+  std::vector<int> brush;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cloud = state_.pairs[index].cloud;
+    image = state_.pairs[index].lidar_image;
+    brush = state_.pairs[index].brush_pixels;
+  }
+  if (!cloud || !image) return;
+  std::string why;
+  std::optional<LidarPlaneFit> fit;
+  if (brush.empty()) {
+    why = "no board region: brush the board on the LiDAR image";
+  } else {
+    fit = FitBoardPlane(*cloud, SelectBrushRegion(*image, brush), pipeline_.lidar_plane, &why);
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  PairView& pair = state_.pairs[index];
+  if (pair.brush_pixels != brush) return;  // a newer stroke queued its own refit
+  pair.lidar = fit;
+  pair.lidar_failure = fit ? "" : why;
+  // A pair with both planes is usable; the user rejects what looks wrong.
+  if (pair.status == PairStatus::kPending || pair.status == PairStatus::kFailed) {
+    const bool usable = pair.lidar && pair.camera;
+    pair.status = usable ? PairStatus::kAccepted : PairStatus::kFailed;
+    pair.reason = usable ? "" : (!pair.camera ? "camera: " + pair.camera_failure : "LiDAR: " + why);
+  }
+  ++state_.generation;
+  if (state_.loading_done == state_.loading_total) {
+    RecomputeResiduals();
+    CommitEdit();
+  }
+}
+
+void Controller::RecomputeResiduals() {
+  for (PairView& pair : state_.pairs) pair.residual.reset();
+  if (!state_.solver.result) return;
+  SolverOptions options;
+  options.huber_delta = state_.huber_delta;
+  for (PairView& pair : state_.pairs) {
+    if (pair.status != PairStatus::kAccepted || !pair.lidar || !pair.camera) continue;
+    pair.residual = PlaneAlignmentResidual(state_.solver.result->cam_from_lidar, pair.lidar->plane,
+                                           pair.camera->plane, nullptr);
+    const double norm = pair.residual->norm();
+    pair.robust_weight = norm <= options.huber_delta ? 1.0 : options.huber_delta / norm;
+  }
+}
+
+void Controller::Solve() {
+  std::vector<PlanePair> planes;
+  SolverOptions options;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const PairView& pair : state_.pairs)
+      if (pair.status == PairStatus::kAccepted && pair.lidar && pair.camera)
+        planes.push_back({pair.id, pair.lidar->plane, pair.camera->plane});
+    options = pipeline_.solver;
+    options.huber_delta = state_.huber_delta;
+    options.max_iterations = state_.max_iterations;
+    state_.solver = SolverView{};
+    state_.solver.running = true;
+    ++state_.generation;
+  }
+  std::string why;
+  std::optional<Pose> guess;
+  if (static_cast<int>(planes.size()) < pipeline_.min_pairs) {
+    why = "only " + std::to_string(planes.size()) + " accepted pair(s) with both planes; need " +
+          std::to_string(pipeline_.min_pairs);
+  } else {
+    guess = InitialGuessFromPlanes(planes, &why);
+  }
+  if (!guess) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_.solver.running = false;
+    state_.solver.failure = why;
+    SetStatus("no calibration: " + why, true);
+    return;
+  }
+  PlaneAlignmentSolver solver(planes, options, *guess);
+  const SolverResult result = solver.Run([this](const IterationReport& it) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_.solver.iterations.push_back(it);
+    ++state_.generation;
+  });
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_.solver.running = false;
+  state_.solver.result = result;
+  state_.solver.solved_pair_ids.clear();
+  for (const PlanePair& p : planes) state_.solver.solved_pair_ids.push_back(p.id);
+  RecomputeResiduals();
+  SetStatus("solved with " + std::to_string(planes.size()) + " pairs in " +
+                std::to_string(result.iterations) + " iterations" +
+                (result.observability.well_constrained ? "" : " (NOT well constrained)"),
+            !result.observability.well_constrained);
+  CommitEdit();
+  const int selected = state_.selected;
+  if (selected >= 0) Enqueue([this, selected] { ComputeReprojection(selected); });
+}
+
+void Controller::ComputeReprojection(int index) {
+  std::shared_ptr<const LidarCloud> cloud;
+  std::optional<Pose> cam_from_lidar;
+  CameraModel camera;
+  ViewState view;
+  std::string id;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (index < 0 || index >= static_cast<int>(state_.pairs.size()) || !state_.solver.result)
+      return;
+    cloud = state_.pairs[index].cloud;
+    cam_from_lidar = state_.solver.result->cam_from_lidar;
+    camera = state_.dataset->camera;
+    view = state_.view;
+    id = state_.pairs[index].id;
+  }
+  if (!cloud) return;
+  auto reprojection = std::make_shared<Reprojection>();
+  reprojection->pair_id = id;
+  reprojection->points = ProjectCloud(camera, *cam_from_lidar, *cloud);
+  if (view.visibility == VisibilityMode::kHpr) {
+    std::vector<Vec3> in_cam;
+    in_cam.reserve(reprojection->points.size());
+    for (const ProjectedPoint& p : reprojection->points)
+      in_cam.push_back(*cam_from_lidar * cloud->points[p.index].cast<double>());
+    HprOptions options;
+    options.radius_exponent = view.hpr_radius_exponent;
+    reprojection->visible = HiddenPointRemoval(in_cam, options);
+  } else if (view.visibility == VisibilityMode::kZBuffer) {
+    reprojection->visible = ZBufferVisibility(camera, reprojection->points, ZBufferOptions{});
+  } else {
+    reprojection->visible.assign(reprojection->points.size(), true);
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_.reprojection = reprojection;
+  ++state_.generation;
+}
+
+void Controller::EnsureSelectedImage() {
+  std::filesystem::path path;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (state_.selected < 0 || !state_.dataset) return;
+    path = state_.dataset->pairs[state_.selected].image;
+  }
+  std::shared_ptr<const ImageU8> image;
+  try {
+    image = std::make_shared<ImageU8>(LoadImage(path));
+  } catch (const IoError& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    SetStatus(e.what(), true);
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (state_.selected >= 0 && state_.dataset->pairs[state_.selected].image == path) {
+    state_.selected_image = image;
+    ++state_.generation;
+  }
+}
+
+void Controller::Apply(const Intent& intent) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!state_.dataset) return;
+  const int num_pairs = static_cast<int>(state_.pairs.size());
+  auto valid = [&](int index) { return index >= 0 && index < num_pairs; };
+  if (const auto* select = std::get_if<SelectPair>(&intent)) {
+    if (!valid(select->index) || select->index == state_.selected) return;
+    state_.selected = select->index;
+    state_.selected_image.reset();
+    state_.reprojection.reset();
+    CommitEdit();
+    Enqueue([this] { EnsureSelectedImage(); });
+    const int index = select->index;
+    Enqueue([this, index] { ComputeReprojection(index); });
+  } else if (const auto* status = std::get_if<SetPairStatus>(&intent)) {
+    if (!valid(status->index)) return;
+    PairView& pair = state_.pairs[status->index];
+    if (status->status == PairStatus::kAccepted && !(pair.lidar && pair.camera)) {
+      SetStatus("pair " + pair.id + " cannot be accepted: " +
+                    (!pair.camera ? "no camera plane (" + pair.camera_failure + ")"
+                                  : "no LiDAR plane (" + pair.lidar_failure + ")"),
+                true);
+      return;
+    }
+    pair.status = status->status;
+    pair.reason = status->status == PairStatus::kRejected ? "rejected by the user" : "";
+    SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
+                  (state_.solver.result ? "; press Run to re-solve" : ""),
+              false);
+    CommitEdit();
+  } else if (const auto* stroke = std::get_if<BrushStroke>(&intent)) {
+    if (!valid(stroke->index)) return;
+    PairView& pair = state_.pairs[stroke->index];
+    if (!pair.lidar_image) return;
+    const auto circle = CirclePixels(pair.lidar_image->rows, pair.lidar_image->columns, stroke->row,
+                                     stroke->column, stroke->radius_px);
+    std::vector<int> merged;
+    if (stroke->erase) {
+      std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), circle.begin(),
+                          circle.end(), std::back_inserter(merged));
+    } else {
+      std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), circle.begin(),
+                     circle.end(), std::back_inserter(merged));
+    }
+    if (merged == pair.brush_pixels) return;
+    pair.brush_pixels = std::move(merged);
+    CommitEdit();
+    const int index = stroke->index;
+    Enqueue([this, index] { RefitLidar(index); });
+  } else if (const auto* clear = std::get_if<ClearBrush>(&intent)) {
+    if (!valid(clear->index)) return;
+    state_.pairs[clear->index].brush_pixels.clear();
+    CommitEdit();
+    const int index = clear->index;
+    Enqueue([this, index] { RefitLidar(index); });
+  } else if (std::holds_alternative<RunSolver>(intent)) {
+    Enqueue([this] { Solve(); });
+  } else if (std::holds_alternative<ResetSolver>(intent)) {
+    state_.solver = SolverView{};
+    state_.reprojection.reset();
+    RecomputeResiduals();
+    CommitEdit();
+  } else if (const auto* options = std::get_if<SetSolverOptions>(&intent)) {
+    SolverOptions check;
+    check.huber_delta = options->huber_delta;
+    check.max_iterations = options->max_iterations;
+    std::string why;
+    if (!check.Check(&why)) {
+      SetStatus("solver options: " + why, true);
+      return;
+    }
+    state_.huber_delta = options->huber_delta;
+    state_.max_iterations = options->max_iterations;
+    CommitEdit();
+  } else if (const auto* view = std::get_if<SetView>(&intent)) {
+    const bool visibility_changed =
+        view->view.visibility != state_.view.visibility ||
+        view->view.hpr_radius_exponent != state_.view.hpr_radius_exponent;
+    state_.view = view->view;
+    CommitEdit();
+    if (visibility_changed) {
+      const int index = state_.selected;
+      Enqueue([this, index] { ComputeReprojection(index); });
+    }
+  } else if (const auto* export_result = std::get_if<ExportResult>(&intent)) {
+    if (!state_.solver.result) {
+      SetStatus("nothing to export: run the solver first", true);
+      return;
+    }
+    CalibrationOutcome outcome;
+    for (const PairView& pair : state_.pairs) {
+      PairFeatures f;
+      f.id = pair.id;
+      f.status = pair.status;
+      f.reason = pair.reason;
+      f.lidar = pair.lidar;
+      f.camera = pair.camera;
+      if (f.status == PairStatus::kAccepted && !(f.lidar && f.camera))
+        f.status = PairStatus::kFailed;
+      outcome.pairs.push_back(f);
+    }
+    outcome.solution = state_.solver.result;
+    // Residuals in the result follow the accepted pairs in order, as the solve used them.
+    outcome.solution->residuals.clear();
+    outcome.solution->robust_weights.clear();
+    for (const PairView& pair : state_.pairs)
+      if (pair.status == PairStatus::kAccepted && pair.residual) {
+        outcome.solution->residuals.push_back(*pair.residual);
+        outcome.solution->robust_weights.push_back(pair.robust_weight);
+      }
+    SolverOptions options;
+    options.huber_delta = state_.huber_delta;
+    try {
+      WriteResult(export_result->path, outcome, options);
+      SetStatus("exported " + export_result->path.string(), false);
+    } catch (const IoError& e) {
+      SetStatus(e.what(), true);
+    }
+  } else if (const auto* save = std::get_if<SaveSessionAs>(&intent)) {
+    try {
+      SaveSession(save->path, session_);
+      autosaver_ = std::make_unique<Autosaver>(save->path);
+      state_.session_path = save->path;
+      SetStatus("saved session " + save->path.string(), false);
+    } catch (const IoError& e) {
+      SetStatus(e.what(), true);
+    }
+  } else if (std::holds_alternative<Undo>(intent) || std::holds_alternative<Redo>(intent)) {
+    const auto restored = std::holds_alternative<Undo>(intent) ? history_.Undo() : history_.Redo();
+    if (!restored) return;
+    std::vector<std::vector<int>> before;
+    for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
+    session_ = *restored;
+    ApplySessionToState(session_);
+    RecomputeResiduals();
+    if (autosaver_) autosaver_->Save(session_);
+    for (int i = 0; i < num_pairs; ++i)
+      if (state_.pairs[i].brush_pixels != before[i]) Enqueue([this, i] { RefitLidar(i); });
+  }
+}
+
+}  // namespace calibench::ui

@@ -1,0 +1,110 @@
+#include "ui/gfx/context.h"
+
+#include <stdexcept>
+
+#include "ui/gfx/context_internal.h"
+#include "ui/gfx/gl_loader.h"
+
+// No GL header from GLFW: this file makes no GL call (LoadGl does them).
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+namespace calibench::gfx {
+namespace {
+
+// GLFW reports errors through a callback, not a return value; keep the last one for *why.
+// GLFW is main-thread only, so these need no lock.
+std::string last_glfw_error;
+int glfw_windows = 0;  // glfwTerminate with the last window
+
+void RecordGlfwError(int code, const char* description) {
+  last_glfw_error = description ? description : ("GLFW error " + std::to_string(code));
+}
+
+void* GlfwProc(const char* name) { return reinterpret_cast<void*>(glfwGetProcAddress(name)); }
+
+void ReleaseGlfw() {
+  if (--glfw_windows == 0) glfwTerminate();
+}
+
+}  // namespace
+
+bool ParseHeadlessBackend(const std::string& name, HeadlessBackend* backend) {
+  if (name == "auto") {
+    *backend = HeadlessBackend::kAuto;
+  } else if (name == "egl") {
+    *backend = HeadlessBackend::kEgl;
+  } else if (name == "osmesa") {
+    *backend = HeadlessBackend::kOsMesa;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+std::unique_ptr<GlContext> CreateHeadlessContext(HeadlessBackend backend, std::string* why) {
+  std::string egl_why, osmesa_why;
+  std::unique_ptr<GlContext> context;
+  if (backend == HeadlessBackend::kEgl || backend == HeadlessBackend::kAuto) {
+    context = internal::CreateEglContext(&egl_why);
+    if (context || backend == HeadlessBackend::kEgl) {
+      if (!context && why) *why = egl_why;
+      return context;
+    }
+  }
+  context = internal::CreateOsMesaContext(&osmesa_why);
+  if (!context && why) *why = egl_why.empty() ? osmesa_why : egl_why + "; " + osmesa_why;
+  return context;
+}
+
+std::unique_ptr<WindowContext> WindowContext::Create(int width, int height,
+                                                     const std::string& title, std::string* why) {
+  std::string reason;
+  if (!why) why = &reason;
+  glfwSetErrorCallback(RecordGlfwError);
+  last_glfw_error.clear();
+  if (glfw_windows == 0 && !glfwInit()) {
+    *why = "GLFW: cannot initialise (" + last_glfw_error + ")";
+    return nullptr;
+  }
+  ++glfw_windows;
+  glfwDefaultWindowHints();
+  glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_API);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  GLFWwindow* window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+  if (window == nullptr) {
+    *why = "GLFW: cannot open a " + std::to_string(width) + "x" + std::to_string(height) +
+           " window with an OpenGL 3.3 core context (" + last_glfw_error + ")";
+    ReleaseGlfw();
+    return nullptr;
+  }
+  std::unique_ptr<WindowContext> context(new WindowContext(window));
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(1);  // vsync: the workbench redraws every frame and need not outrun the screen
+  if (!LoadGl(GlfwProc, why)) {
+    *why = "GLFW window: " + *why;
+    return nullptr;
+  }
+  context->description_ = "GLFW window: " + CurrentGlSummary();
+  return context;
+}
+
+WindowContext::~WindowContext() {
+  glfwDestroyWindow(window_);
+  ReleaseGlfw();
+}
+
+void WindowContext::MakeCurrent() {
+  // Release first: a "still current" GLX context would not be re-bound, while an OSMesa context
+  // made current meanwhile owns Mesa's GL dispatch (see context_egl.cpp).
+  if (glfwGetCurrentContext() == window_) glfwMakeContextCurrent(nullptr);
+  glfwMakeContextCurrent(window_);
+  std::string why;
+  if (!LoadGl(GlfwProc, &why)) throw std::runtime_error("GLFW window: " + why);
+}
+
+std::string WindowContext::Description() const { return description_; }
+
+}  // namespace calibench::gfx

@@ -1,0 +1,46 @@
+// OpenGL 3.3 core contexts: a GLFW window (on screen), EGL surfaceless (headless; Mesa llvmpipe
+// here, NVIDIA EGL where a GPU exists) and OSMesa (headless fallback). GL entry points are loaded
+// per context through gl_api.h, so the same binary draws with any of them.
+#pragma once
+
+#include <memory>
+#include <string>
+
+struct GLFWwindow;
+
+namespace calibench::gfx {
+
+enum class HeadlessBackend { kAuto, kEgl, kOsMesa };
+// "auto", "egl", "osmesa"; false for anything else.
+bool ParseHeadlessBackend(const std::string& name, HeadlessBackend* backend);
+
+class GlContext {
+ public:
+  virtual ~GlContext() = default;
+  virtual void MakeCurrent() = 0;
+  // e.g. "EGL surfaceless: Mesa llvmpipe (LLVM 15), OpenGL 4.5 core".
+  virtual std::string Description() const = 0;
+};
+
+// A headless context with GL loaded and current. Rendering goes into gfx::Framebuffer objects.
+// nullptr with *why when the backend is unavailable (kAuto tries EGL, then OSMesa).
+std::unique_ptr<GlContext> CreateHeadlessContext(HeadlessBackend backend, std::string* why);
+
+// A GLFW window with a GL 3.3 core context, GL loaded and current. nullptr with *why when no
+// display is available. The window is destroyed with the context.
+class WindowContext : public GlContext {
+ public:
+  static std::unique_ptr<WindowContext> Create(int width, int height, const std::string& title,
+                                               std::string* why);
+  ~WindowContext() override;
+  void MakeCurrent() override;
+  std::string Description() const override;
+  GLFWwindow* window() const { return window_; }
+
+ private:
+  explicit WindowContext(GLFWwindow* window) : window_(window) {}
+  GLFWwindow* window_ = nullptr;
+  std::string description_;
+};
+
+}  // namespace calibench::gfx

@@ -1,0 +1,59 @@
+// One frame of the workbench: the three views side by side on top (LiDAR image, camera frame,
+// 3D), the measurements list and the solver panel below, a status line at the bottom. Reads a
+// controller Snapshot, issues ImGui calls, returns the user's Intents. Owns only GL resources
+// and view-local state (zoom, pan, replay position). Used identically by the window and by the
+// headless renderer, which is what makes `calibench render` show what the window shows.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ui/controller.h"
+#include "ui/gfx/framebuffer.h"
+#include "ui/gfx/renderers.h"
+
+namespace calibench::ui {
+
+enum class Layout { kWorkbench, kLidarOnly, kCameraOnly, kSceneOnly };
+// "workbench", "lidar", "camera", "3d"; false for others.
+bool ParseLayout(const std::string& name, Layout* layout);
+
+class Workbench {
+ public:
+  Workbench();
+  ~Workbench();
+  // Call between ImGui::NewFrame() and ImGui::Render(); width/height of the display in pixels.
+  // replay_seconds advances the solver replay (seconds since the last frame).
+  std::vector<Intent> Frame(const Snapshot& snapshot, int width, int height, Layout layout,
+                            double seconds_since_last_frame);
+
+ private:
+  struct ViewRect {
+    float x, y, w, h;
+  };
+  void LidarView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
+  void CameraView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
+  void SceneView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
+  void MeasurementsPanel(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
+  void SolverPanel(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
+  void StatusLine(const Snapshot& s, const ViewRect& r);
+  void HandleKeys(const Snapshot& s, std::vector<Intent>* intents);
+  const Pose* DisplayedEstimate(const Snapshot& s) const;
+
+  // GL resources, created lazily inside a current context.
+  struct Gl;
+  std::unique_ptr<Gl> gl_;
+  // View-local state.
+  float lidar_zoom_ = 3.0f;    // horizontal zoom of the LiDAR image (1 = all 360 degrees)
+  float lidar_center_ = 0.5f;  // centre column as a fraction of the image width
+  float camera_zoom_ = 1.0f;
+  double replay_position_ = -1;  // iteration shown; < 0 = the last one
+  bool replaying_ = false;
+  std::string export_path_ = "result.json";
+  std::string session_path_ = "session.json";
+  std::uint64_t lidar_key_ = ~0ull, camera_key_ = ~0ull, scene_key_ = ~0ull;
+};
+
+}  // namespace calibench::ui
