@@ -1,7 +1,10 @@
 // `calibench gui` (the workbench window) and `calibench render` (the same views, headless).
 
+// clang-format off
 // gl_api.h first: it declares GL for everything below (and sets GLFW_INCLUDE_NONE).
+#include "ui/gfx/gl_api.h"
 #include <GLFW/glfw3.h>
+// clang-format on
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -12,7 +15,6 @@
 #include "ui/controller.h"
 #include "ui/gfx/context.h"
 #include "ui/gfx/framebuffer.h"
-#include "ui/gfx/gl_api.h"
 #include "ui/imgui_host.h"
 #include "ui/workbench.h"
 

@@ -297,8 +297,9 @@ void Controller::RefitLidar(int index) {
   if (pair.brush_pixels != brush) return;  // a newer stroke queued its own refit
   pair.lidar = fit;
   pair.lidar_failure = fit ? "" : why;
-  // A pair with both planes is usable; the user rejects what looks wrong.
-  if (pair.status == PairStatus::kPending || pair.status == PairStatus::kFailed) {
+  // A pair with both planes is usable and accepted unless the user rejected it; one that lost a
+  // plane fails with the reason.
+  if (pair.status != PairStatus::kRejected) {
     const bool usable = pair.lidar && pair.camera;
     pair.status = usable ? PairStatus::kAccepted : PairStatus::kFailed;
     pair.reason = usable ? "" : (!pair.camera ? "camera: " + pair.camera_failure : "LiDAR: " + why);

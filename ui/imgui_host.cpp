@@ -1,13 +1,16 @@
-// gl_api.h first: it declares GL for everything below (and sets GLFW_INCLUDE_NONE).
 #include "ui/imgui_host.h"
 
+// clang-format off
+// gl_api.h first: it declares GL for everything below (and sets GLFW_INCLUDE_NONE).
+#include "ui/gfx/gl_api.h"
 #include <GLFW/glfw3.h>
+// clang-format on
+
 #include <imgui.h>
 
 #include <filesystem>
 
 #include "ui/gfx/framebuffer.h"
-#include "ui/gfx/gl_api.h"
 
 // Debian's ImGui backends, compiled in third_party/imgui with our GL loader.
 #include <backends/imgui_impl_glfw.h>

@@ -1,0 +1,169 @@
+// The workbench controller without any window: load, brush, accept/reject, solve, undo, sessions.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "tests/test_support.h"
+#include "tests/ui/ui_fixture.h"
+#include "ui/controller.h"
+
+namespace calibench::ui {
+namespace {
+
+Snapshot Loaded(Controller& controller) {
+  controller.WaitIdle();
+  return controller.GetSnapshot();
+}
+
+TEST(Controller, LoadsEveryPairAndExtractsBothPlanes) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), test::TempDir("controller_load") / "s.json");
+  const Snapshot s = Loaded(controller);
+  ASSERT_EQ(s.pairs.size(), 4u);
+  EXPECT_EQ(s.loading_done, 4);
+  EXPECT_EQ(s.selected, 0);
+  ASSERT_TRUE(s.selected_image);
+  for (const PairView& p : s.pairs) {
+    EXPECT_TRUE(p.loaded);
+    EXPECT_EQ(p.status, PairStatus::kAccepted) << p.id << ": " << p.reason;
+    EXPECT_TRUE(p.lidar) << p.lidar_failure;
+    EXPECT_TRUE(p.camera) << p.camera_failure;
+    EXPECT_FALSE(p.brush_pixels.empty());  // from the manifest's lidar_seed
+    ASSERT_TRUE(p.thumbnail);
+    EXPECT_EQ(p.thumbnail->width, 160);
+  }
+}
+
+TEST(Controller, BrushStrokesRefitThePlaneAndErasingRemovesIt) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), test::TempDir("controller_brush") / "s.json");
+  Snapshot s = Loaded(controller);
+  controller.Apply(ClearBrush{1});
+  s = Loaded(controller);
+  EXPECT_TRUE(s.pairs[1].brush_pixels.empty());
+  EXPECT_FALSE(s.pairs[1].lidar);
+  EXPECT_NE(s.pairs[1].lidar_failure.find("brush"), std::string::npos);
+  EXPECT_EQ(s.pairs[1].status, PairStatus::kFailed);
+  // Paint a disc where the board is (the pixel of a board inlier of another controller's fit).
+  Controller reference;
+  reference.OpenDataset(test::UiDataset(), test::TempDir("controller_brush_ref") / "s.json");
+  const Snapshot r = Loaded(reference);
+  const int inlier = r.pairs[1].lidar->inliers[r.pairs[1].lidar->inliers.size() / 2];
+  const int pixel = r.pairs[1].lidar_image->pixel_of_point[inlier];
+  const int columns = r.pairs[1].lidar_image->columns;
+  controller.Apply(BrushStroke{1, pixel / columns, pixel % columns, 5.0f, false});
+  s = Loaded(controller);
+  ASSERT_TRUE(s.pairs[1].lidar) << s.pairs[1].lidar_failure;
+  EXPECT_EQ(s.pairs[1].status, PairStatus::kAccepted);
+  EXPECT_LT(
+      std::acos(std::min(1.0, s.pairs[1].lidar->plane.normal.dot(r.pairs[1].lidar->plane.normal))),
+      0.05);
+  EXPECT_NEAR(s.pairs[1].lidar->plane.distance, r.pairs[1].lidar->plane.distance, 0.02);
+  // Erasing the same disc removes the region again.
+  controller.Apply(BrushStroke{1, pixel / columns, pixel % columns, 5.0f, true});
+  s = Loaded(controller);
+  EXPECT_TRUE(s.pairs[1].brush_pixels.empty());
+}
+
+TEST(Controller, RejectAcceptSolveAndUndo) {
+  Controller controller;
+  const auto dir = test::TempDir("controller_solve");
+  controller.OpenDataset(test::UiDataset(), dir / "s.json");
+  Loaded(controller);
+  controller.Apply(SetPairStatus{2, PairStatus::kRejected});
+  Snapshot s = controller.GetSnapshot();
+  EXPECT_EQ(s.pairs[2].status, PairStatus::kRejected);
+  controller.Apply(RunSolver{});
+  s = Loaded(controller);
+  ASSERT_TRUE(s.solver.result) << s.solver.failure;
+  EXPECT_TRUE(s.solver.result->converged);
+  EXPECT_EQ(s.solver.solved_pair_ids.size(), 3u);
+  EXPECT_GE(s.solver.iterations.size(), 2u);
+  EXPECT_FALSE(s.pairs[2].residual);  // rejected: not in the solve
+  EXPECT_TRUE(s.pairs[0].residual);
+  ASSERT_TRUE(s.reprojection);
+  EXPECT_GT(s.reprojection->points.size(), 100u);
+  // Three A3 boards fix the extrinsic only roughly (the paper's N = 3 row); what matters here is
+  // that the workbench solves what the batch pipeline solves from the same pairs.
+  const Dataset dataset = LoadDataset(test::UiDataset());
+  const PoseError error =
+      ComputePoseError(s.solver.result->cam_from_lidar, *dataset.cam_from_lidar_ground_truth);
+  EXPECT_LT(error.translation_m, 0.15);
+  EXPECT_LT(error.rotation_rad, 2.0 * M_PI / 180);
+  PipelineOptions batch;
+  batch.pair_ids = {"0000", "0001", "0003"};
+  const CalibrationOutcome reference = CalibrateDataset(dataset, batch);
+  ASSERT_TRUE(reference.solution);
+  const PoseError difference =
+      ComputePoseError(s.solver.result->cam_from_lidar, reference.solution->cam_from_lidar);
+  EXPECT_LT(difference.translation_m, 0.005);
+  EXPECT_LT(difference.rotation_rad, 0.1 * M_PI / 180);
+  // Undo brings the rejected pair back to accepted (the solve is undone first).
+  controller.Apply(Undo{});
+  controller.Apply(Undo{});
+  s = Loaded(controller);
+  EXPECT_EQ(s.pairs[2].status, PairStatus::kAccepted);
+  controller.Apply(Redo{});
+  s = Loaded(controller);
+  EXPECT_EQ(s.pairs[2].status, PairStatus::kRejected);
+}
+
+TEST(Controller, FewerThanThreePairsSaySoInsteadOfSolving) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), test::TempDir("controller_few") / "s.json");
+  Loaded(controller);
+  controller.Apply(SetPairStatus{0, PairStatus::kRejected});
+  controller.Apply(SetPairStatus{1, PairStatus::kRejected});
+  controller.Apply(RunSolver{});
+  const Snapshot s = Loaded(controller);
+  EXPECT_FALSE(s.solver.result);
+  EXPECT_NE(s.solver.failure.find("only 2"), std::string::npos) << s.solver.failure;
+  EXPECT_TRUE(s.status_is_error);
+}
+
+TEST(Controller, EveryEditAutosavesAndTheSessionReopensExactly) {
+  const auto dir = test::TempDir("controller_session");
+  const auto session_path = dir / "work.session.json";
+  Session saved;
+  {
+    Controller controller;
+    controller.OpenDataset(test::UiDataset(), session_path);
+    Loaded(controller);
+    controller.Apply(SetPairStatus{3, PairStatus::kRejected});
+    controller.Apply(SelectPair{1});
+    controller.Apply(RunSolver{});
+    Loaded(controller);
+    ASSERT_TRUE(std::filesystem::exists(session_path));
+    saved = LoadSession(session_path);
+  }
+  EXPECT_EQ(saved.pairs[3].status, PairStatus::kRejected);
+  EXPECT_EQ(saved.view.selected_pair, "0001");
+  ASSERT_TRUE(saved.result);
+  Controller reopened;
+  reopened.OpenSession(session_path);
+  const Snapshot s = Loaded(reopened);
+  EXPECT_EQ(s.selected, 1);
+  EXPECT_EQ(s.pairs[3].status, PairStatus::kRejected);
+  ASSERT_TRUE(s.solver.result);
+  EXPECT_TRUE(s.solver.result->cam_from_lidar.isApprox(saved.result->cam_from_lidar, 0));
+  EXPECT_TRUE(s.pairs[0].residual);             // recomputed from the planes on load
+  EXPECT_EQ(LoadSession(session_path), saved);  // reopening rewrote nothing
+}
+
+TEST(Controller, ACorruptSessionIsReportedAndLeftUntouched) {
+  const auto path = test::TempDir("controller_corrupt") / "broken.session.json";
+  const std::string text = "{\"format\": \"calibench.session.v1\", \"version\": 1, \"pairs\": [";
+  std::ofstream(path) << text;
+  Controller controller;
+  try {
+    controller.OpenSession(path);
+    FAIL() << "a corrupt session must not open";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("broken.session.json"), std::string::npos) << e.what();
+  }
+  std::ifstream in(path);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), {}), text);
+}
+
+}  // namespace
+}  // namespace calibench::ui

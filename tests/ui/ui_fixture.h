@@ -1,0 +1,11 @@
+// A small simulated dataset shared by the workbench tests (made once per test process).
+#pragma once
+
+#include <filesystem>
+
+namespace calibench::test {
+
+// Four OS0-128 + pinhole pairs with an A3 checkerboard, seed 3: the goldens depend on it.
+std::filesystem::path UiDataset();
+
+}  // namespace calibench::test
