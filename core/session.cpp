@@ -2,6 +2,8 @@
 // session_json.cpp.
 #include "core/session.h"
 
+#include <algorithm>
+
 #include <fstream>
 #include <sstream>
 #include <utility>
@@ -23,7 +25,11 @@ bool SessionResult::operator==(const SessionResult& other) const {
   return cam_from_lidar.matrix() == other.cam_from_lidar.matrix() &&
          covariance == other.covariance && iterations == other.iterations &&
          converged == other.converged && cost_history == other.cost_history &&
-         weak_directions == other.weak_directions && well_constrained == other.well_constrained;
+         weak_directions == other.weak_directions && well_constrained == other.well_constrained &&
+         step_history == other.step_history &&
+         std::equal(estimate_history.begin(), estimate_history.end(),
+                    other.estimate_history.begin(), other.estimate_history.end(),
+                    [](const Pose& a, const Pose& b) { return a.matrix() == b.matrix(); });
 }
 
 SessionResult SessionResultFromSolver(const SolverResult& solver) {
@@ -33,7 +39,9 @@ SessionResult SessionResultFromSolver(const SolverResult& solver) {
           solver.converged,
           solver.cost_history,
           solver.observability.weak_directions,
-          solver.observability.well_constrained};
+          solver.observability.well_constrained,
+          {},
+          {}};
 }
 
 std::filesystem::path NormalizeSessionPath(const std::filesystem::path& path) {

@@ -81,6 +81,10 @@ struct SessionResult {
   std::vector<double> cost_history;  // Eq. (14) cost per iteration, the initial cost first
   std::vector<std::string> weak_directions;
   bool well_constrained = false;
+  // Per iteration (same length as cost_history when recorded): |delta| and the estimate, so that
+  // a reopened session shows and replays the same convergence. May be empty.
+  std::vector<double> step_history;
+  std::vector<Pose> estimate_history;
 
   // Exact value comparison (no tolerance), so a file round trip can be checked with ==.
   bool operator==(const SessionResult& other) const;

@@ -106,6 +106,12 @@ Json Rows(const Eigen::MatrixXd& m) {
   return rows;
 }
 
+Json EstimateHistory(const std::vector<Pose>& estimates) {
+  Json list = Json::array();
+  for (const Pose& pose : estimates) list.push_back(Rows(pose.matrix()));
+  return list;
+}
+
 Json ResultToJson(const SessionResult& r) {
   return {{"direction", kDirection},
           {"cam_from_lidar", {{"matrix", Rows(r.cam_from_lidar.matrix())}}},
@@ -116,7 +122,9 @@ Json ResultToJson(const SessionResult& r) {
           {"converged", r.converged},
           {"cost_history", Numbers(r.cost_history.data(), static_cast<int>(r.cost_history.size()))},
           {"weak_directions", r.weak_directions},
-          {"well_constrained", r.well_constrained}};
+          {"well_constrained", r.well_constrained},
+          {"step_history", Numbers(r.step_history.data(), static_cast<int>(r.step_history.size()))},
+          {"estimate_history", EstimateHistory(r.estimate_history)}};
 }
 
 // Like dump(2), but arrays of plain values stay on one line: a matrix row, a pixel run or the
@@ -330,6 +338,16 @@ SessionResult ReadResult(const Fields& f) {
     r.weak_directions.push_back(d.get<std::string>());
   }
   r.well_constrained = f.Bool("well_constrained");
+  // The convergence record is optional: a session without it still opens, without replay.
+  if (f.Has("step_history"))
+    for (const Json& v : f.Array("step_history"))
+      r.step_history.push_back(ToDouble(v, f.Path("step_history")));
+  if (f.Has("estimate_history"))
+    for (const Json& m : f.Array("estimate_history")) {
+      Pose pose = Pose::Identity();
+      pose.matrix() = ReadSquare<4>(m, f.Path("estimate_history"));
+      r.estimate_history.push_back(pose);
+    }
   return r;
 }
 

@@ -185,6 +185,13 @@ void Controller::ApplySessionToState(const Session& session) {
     r.observability.weak_directions = session.result->weak_directions;
     r.observability.well_constrained = session.result->well_constrained;
     state_.solver.result = r;
+    // The recorded convergence, so that the solver panel and the replay look as they did.
+    const auto& costs = session.result->cost_history;
+    const auto& steps = session.result->step_history;
+    const auto& estimates = session.result->estimate_history;
+    if (steps.size() == costs.size() && estimates.size() == costs.size())
+      for (size_t i = 0; i < costs.size(); ++i)
+        state_.solver.iterations.push_back({static_cast<int>(i), costs[i], steps[i], estimates[i]});
   }
   state_.can_undo = history_.CanUndo();
   state_.can_redo = history_.CanRedo();
@@ -210,7 +217,13 @@ void Controller::CommitEdit() {
     }
   }
   session_.result.reset();
-  if (state_.solver.result) session_.result = SessionResultFromSolver(*state_.solver.result);
+  if (state_.solver.result) {
+    session_.result = SessionResultFromSolver(*state_.solver.result);
+    for (const IterationReport& it : state_.solver.iterations) {
+      session_.result->step_history.push_back(it.step_norm);
+      session_.result->estimate_history.push_back(it.cam_from_lidar);
+    }
+  }
   history_.Push(session_);
   state_.can_undo = history_.CanUndo();
   state_.can_redo = history_.CanRedo();
