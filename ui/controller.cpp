@@ -283,8 +283,12 @@ void Controller::LoadPair(int index) {
     pair.status = PairStatus::kFailed;
     pair.reason = pair.camera_failure;
   }
-  if (state_.loading_done == state_.loading_total)
+  if (state_.loading_done == state_.loading_total) {
     SetStatus("loaded " + std::to_string(state_.loading_total) + " pairs", false);
+    // A reopened session with a result shows its reprojection again.
+    const int selected = state_.selected;
+    if (state_.solver.result) Enqueue([this, selected] { ComputeReprojection(selected); });
+  }
 }
 
 void Controller::RefitLidar(int index) {

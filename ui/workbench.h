@@ -29,6 +29,13 @@ class Workbench {
   std::vector<Intent> Frame(const Snapshot& snapshot, int width, int height, Layout layout,
                             double seconds_since_last_frame);
 
+  // Where the last frame drew the LiDAR image (screen pixels) and which horizontal texture range
+  // [u0, u1] it showed: lets tests (and tools) aim the brush at a LiDAR pixel.
+  struct ImageRect {
+    float x = 0, y = 0, w = 0, h = 0, u0 = 0, u1 = 1;
+  };
+  const ImageRect& lidar_image_rect() const { return lidar_image_rect_; }
+
  private:
   struct ViewRect {
     float x, y, w, h;
@@ -53,6 +60,7 @@ class Workbench {
   bool replaying_ = false;
   std::string export_path_ = "result.json";
   std::string session_path_ = "session.json";
+  ImageRect lidar_image_rect_;
   std::uint64_t lidar_key_ = ~0ull, camera_key_ = ~0ull, scene_key_ = ~0ull;
 };
 

@@ -112,6 +112,7 @@ void Workbench::LidarView(const Snapshot& s, const ViewRect& r, std::vector<Inte
   const ImVec2 uv0(lidar_center_ - span / 2, 0), uv1(lidar_center_ + span / 2, 1);
   const ImVec2 origin = ImGui::GetCursorScreenPos();
   ImGui::Image(TextureId(gl_->lidar_picture.texture()), avail, uv0, uv1);
+  lidar_image_rect_ = {origin.x, origin.y, avail.x, avail.y, uv0.x, uv1.x};
   const float px_per_col = avail.x / (span * image.columns);
   const float px_per_row = avail.y / image.rows;
   auto to_image = [&](ImVec2 screen, float* col, float* row) {

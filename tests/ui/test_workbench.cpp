@@ -1,0 +1,210 @@
+// The workbench drawn headless (EGL surfaceless, Mesa llvmpipe): golden screenshots of each view
+// and of the whole layout before and after a solve, panels driven frame by frame with synthetic
+// input, and a saved-and-reopened session that must render identically.
+#include <gtest/gtest.h>
+#include <imgui.h>
+
+#include <cstdlib>
+
+#include "core/image.h"
+#include "tests/test_support.h"
+#include "tests/ui/ui_fixture.h"
+#include "ui/controller.h"
+#include "ui/gfx/context.h"
+#include "ui/imgui_host.h"
+#include "ui/workbench.h"
+
+namespace calibench::ui {
+namespace {
+
+// Per-channel tolerance and the share of pixels allowed beyond it: llvmpipe is deterministic,
+// the slack covers font hinting and rasteriser differences between Mesa builds.
+constexpr int kChannelTolerance = 24;
+constexpr double kMaxDifferingFraction = 0.003;
+
+std::unique_ptr<gfx::GlContext> HeadlessOrSkip() {
+  std::string why;
+  auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &why);
+  if (!context && std::getenv("CALIBENCH_REQUIRE_GL")) ADD_FAILURE() << "no headless GL: " << why;
+  return context;
+}
+
+// Compares with tests/ui/goldens/<name>.png; CALIBENCH_UPDATE_GOLDENS=1 rewrites the golden.
+// On failure writes actual.png and diff.png under the build tree and names them.
+void ExpectMatchesGolden(const ImageU8& actual, const std::string& name) {
+  const std::filesystem::path golden =
+      std::filesystem::path(CALIBENCH_GOLDEN_DIR) / (name + ".png");
+  if (const char* update = std::getenv("CALIBENCH_UPDATE_GOLDENS");
+      update && std::string(update) == "1") {
+    SaveImage(golden, actual);
+    std::printf("updated golden %s\n", golden.c_str());
+    return;
+  }
+  ASSERT_TRUE(std::filesystem::exists(golden))
+      << golden << " is missing: run once with CALIBENCH_UPDATE_GOLDENS=1 and look at it";
+  const ImageU8 expected = LoadImage(golden);
+  ASSERT_EQ(expected.width, actual.width) << name;
+  ASSERT_EQ(expected.height, actual.height) << name;
+  ImageU8 diff = actual;
+  size_t differing = 0;
+  for (size_t p = 0; p < actual.data.size() / 3; ++p) {
+    int worst = 0;
+    for (int c = 0; c < 3; ++c)
+      worst = std::max(worst, std::abs(actual.data[3 * p + c] - expected.data[3 * p + c]));
+    const bool bad = worst > kChannelTolerance;
+    differing += bad;
+    for (int c = 0; c < 3; ++c)
+      diff.data[3 * p + c] = bad ? (c == 2 ? 255 : 0) : actual.data[3 * p + c] / 4;
+  }
+  const double fraction = static_cast<double>(differing) / (actual.width * actual.height);
+  if (fraction > kMaxDifferingFraction) {
+    const auto dir = test::TempDir("golden_failure_" + name);
+    SaveImage(dir / "actual.png", actual);
+    SaveImage(dir / "diff.png", diff);
+    ADD_FAILURE() << name << ": " << differing << " pixels (" << fraction * 100
+                  << " %) differ by more than " << kChannelTolerance << "; see "
+                  << dir / "actual.png"
+                  << " and " << dir / "diff.png";
+  }
+}
+
+class WorkbenchRender : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    context_ = HeadlessOrSkip();
+    if (!context_) GTEST_SKIP() << "no headless OpenGL (EGL or OSMesa) on this machine";
+    host_ = std::make_unique<ImGuiHost>(nullptr);
+  }
+  void TearDown() override { host_.reset(); }
+  ImageU8 Render(Controller& controller, Layout layout, int width, int height) {
+    Workbench workbench;
+    return RenderWorkbenchHeadless(controller, workbench, *host_, layout, width, height, 4);
+  }
+  std::unique_ptr<gfx::GlContext> context_;
+  std::unique_ptr<ImGuiHost> host_;
+};
+
+TEST_F(WorkbenchRender, GoldenViewsBeforeAndAfterASolve) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), test::TempDir("golden_session") / "s.json");
+  controller.WaitIdle();
+  ExpectMatchesGolden(Render(controller, Layout::kLidarOnly, 480, 300), "lidar_before");
+  ExpectMatchesGolden(Render(controller, Layout::kCameraOnly, 480, 300), "camera_before");
+  ExpectMatchesGolden(Render(controller, Layout::kSceneOnly, 480, 300), "scene_before");
+  ExpectMatchesGolden(Render(controller, Layout::kWorkbench, 1280, 720), "workbench_before");
+  controller.Apply(RunSolver{});
+  controller.WaitIdle();
+  ExpectMatchesGolden(Render(controller, Layout::kCameraOnly, 480, 300), "camera_after");
+  ExpectMatchesGolden(Render(controller, Layout::kSceneOnly, 480, 300), "scene_after");
+  ExpectMatchesGolden(Render(controller, Layout::kWorkbench, 1280, 720), "workbench_after");
+}
+
+// One frame with the given input; returns the intents the panels produced (not yet applied).
+std::vector<Intent> FrameWithInput(Controller& controller, Workbench& workbench, ImGuiHost& host,
+                                   Layout layout, ImVec2 mouse, bool mouse_down, int key) {
+  ImGuiIO& io = ImGui::GetIO();
+  io.MousePos = mouse;
+  io.MouseDown[0] = mouse_down;
+  for (bool& k : io.KeysDown) k = false;
+  if (key >= 0) io.KeysDown[key] = true;
+  controller.WaitIdle();
+  host.NewFrame(1280, 720, 1.0 / 60.0);
+  auto intents = workbench.Frame(controller.GetSnapshot(), 1280, 720, layout, 1.0 / 60.0);
+  ImGui::Render();
+  return intents;
+}
+
+TEST_F(WorkbenchRender, PanelsDrivenFrameByFrame) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), test::TempDir("panels_session") / "s.json");
+  controller.WaitIdle();
+  // Where the board is on the LiDAR image, from the seeded fit; then clear the brush.
+  const Snapshot start = controller.GetSnapshot();
+  const PairView& pair = start.pairs[0];
+  const int board_pixel =
+      pair.lidar_image->pixel_of_point[pair.lidar->inliers[pair.lidar->inliers.size() / 2]];
+  const int columns = pair.lidar_image->columns, rows = pair.lidar_image->rows;
+  controller.Apply(ClearBrush{0});
+  controller.WaitIdle();
+  ASSERT_FALSE(controller.GetSnapshot().pairs[0].lidar);
+
+  Workbench workbench;
+  FrameWithInput(controller, workbench, *host_, Layout::kLidarOnly, {-1, -1}, false, -1);
+  const auto& rect = workbench.lidar_image_rect();
+  const float u = (board_pixel % columns + 0.5f) / columns;
+  const ImVec2 aim(rect.x + (u - rect.u0) / (rect.u1 - rect.u0) * rect.w,
+                   rect.y + (board_pixel / columns + 0.5f) / rows * rect.h);
+  ASSERT_GT(aim.x, rect.x);
+  ASSERT_LT(aim.x, rect.x + rect.w);
+  // A brush stroke: the LiDAR view returns it, the controller fits the plane.
+  const auto stroke =
+      FrameWithInput(controller, workbench, *host_, Layout::kLidarOnly, aim, true, -1);
+  ASSERT_EQ(stroke.size(), 1u);
+  const auto* brush = std::get_if<BrushStroke>(&stroke[0]);
+  ASSERT_TRUE(brush);
+  EXPECT_EQ(brush->row * columns + brush->column, board_pixel);
+  EXPECT_FALSE(brush->erase);
+  for (const Intent& i : stroke) controller.Apply(i);
+  controller.WaitIdle();
+  ASSERT_TRUE(controller.GetSnapshot().pairs[0].lidar)
+      << controller.GetSnapshot().pairs[0].lidar_failure;
+  EXPECT_EQ(controller.GetSnapshot().pairs[0].status, PairStatus::kAccepted);
+
+  // R rejects, A accepts the selected pair.
+  FrameWithInput(controller, workbench, *host_, Layout::kWorkbench, {-1, -1}, false, -1);
+  auto intents =
+      FrameWithInput(controller, workbench, *host_, Layout::kWorkbench, {-1, -1}, false, 'R');
+  ASSERT_EQ(intents.size(), 1u);
+  controller.Apply(intents[0]);
+  EXPECT_EQ(controller.GetSnapshot().pairs[0].status, PairStatus::kRejected);
+  FrameWithInput(controller, workbench, *host_, Layout::kWorkbench, {-1, -1}, false, -1);
+  intents = FrameWithInput(controller, workbench, *host_, Layout::kWorkbench, {-1, -1}, false, 'A');
+  ASSERT_EQ(intents.size(), 1u);
+  controller.Apply(intents[0]);
+  EXPECT_EQ(controller.GetSnapshot().pairs[0].status, PairStatus::kAccepted);
+
+  // F5 runs the solver, which converges.
+  FrameWithInput(controller, workbench, *host_, Layout::kWorkbench, {-1, -1}, false, -1);
+  intents = FrameWithInput(controller, workbench, *host_, Layout::kWorkbench, {-1, -1}, false, 294);
+  ASSERT_EQ(intents.size(), 1u);
+  EXPECT_TRUE(std::holds_alternative<RunSolver>(intents[0]));
+  controller.Apply(intents[0]);
+  controller.WaitIdle();
+  const Snapshot solved = controller.GetSnapshot();
+  ASSERT_TRUE(solved.solver.result);
+  EXPECT_TRUE(solved.solver.result->converged);
+}
+
+TEST_F(WorkbenchRender, ASavedAndReopenedSessionRendersIdentically) {
+  const auto path = test::TempDir("reopen_session") / "work.session.json";
+  ImageU8 before;
+  {
+    Controller controller;
+    controller.OpenDataset(test::UiDataset(), path);
+    controller.WaitIdle();
+    controller.Apply(SelectPair{2});
+    controller.Apply(SetPairStatus{1, PairStatus::kRejected});
+    controller.Apply(RunSolver{});
+    controller.WaitIdle();
+    before = Render(controller, Layout::kWorkbench, 1280, 720);
+  }
+  Controller reopened;
+  reopened.OpenSession(path);
+  reopened.WaitIdle();
+  const ImageU8 after = Render(reopened, Layout::kWorkbench, 1280, 720);
+  ASSERT_EQ(before.data.size(), after.data.size());
+  // Everything but the status line (the last message, "solved ..." vs "loaded ...") must match.
+  const size_t status_bytes = static_cast<size_t>(40) * before.width * 3;
+  size_t differing = 0;
+  for (size_t i = 0; i + status_bytes < before.data.size(); ++i)
+    differing += before.data[i] != after.data[i];
+  if (differing) {
+    const auto dir = test::TempDir("reopen_failure");
+    SaveImage(dir / "before.png", before);
+    SaveImage(dir / "after.png", after);
+  }
+  EXPECT_EQ(differing, 0u) << "see before.png / after.png in test_tmp/reopen_failure";
+}
+
+}  // namespace
+}  // namespace calibench::ui
