@@ -1,6 +1,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
@@ -62,6 +63,9 @@ int RunDemo(int argc, char** argv) {
   SimFlags sim_flags;
   sim_flags.preset = "demo";
   AddSimFlags(app, sim_flags);
+  bool no_gui = false;
+  app.add_flag("--no-gui", no_gui,
+               "never open the workbench window (the views are rendered to PNG instead)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -84,7 +88,15 @@ int RunDemo(int argc, char** argv) {
     PrintError(
         ComputePoseError(outcome.solution->cam_from_lidar, *dataset.cam_from_lidar_ground_truth),
         outcome.solution->covariance, outcome.solution->cam_from_lidar);
-  return code;
+  if (code != kOk) return code;
+  // With a display the workbench opens on the demo; without one its views are rendered to PNG.
+  const char* display = std::getenv("DISPLAY");
+  if (!no_gui && display && *display) {
+    std::printf("opening the workbench on %s (close the window to finish)\n",
+                dataset.manifest.string().c_str());
+    return RunGuiWindow(dataset.manifest.string(), "", 1600, 900, "", 0);
+  }
+  return RenderDemoViews(dataset.manifest.string(), out_dir);
 }
 
 }  // namespace calibench::app

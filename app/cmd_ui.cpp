@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 
 #include "app/commands.h"
 #include "core/image.h"
@@ -159,6 +160,40 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
   SaveImage(out, picture);
   std::printf("wrote %s (%dx%d, %s, %s)\n", out.c_str(), width, height, view.c_str(),
               context->Description().c_str());
+  return kOk;
+}
+
+int RenderDemoViews(const std::string& dataset, const std::string& out_dir) {
+  std::string why;
+  auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &why);
+  if (!context) {
+    std::fprintf(stderr, "calibench demo: no headless OpenGL to render the views: %s\n",
+                 why.c_str());
+    return kInputError;
+  }
+  ui::Controller controller;
+  controller.OpenDataset(dataset, std::filesystem::path(out_dir) / "calibench.session.json");
+  controller.WaitIdle();
+  controller.Apply(ui::RunSolver{});
+  controller.WaitIdle();
+  ui::ImGuiHost host(nullptr);
+  const struct {
+    ui::Layout layout;
+    const char* file;
+    int width, height;
+  } kViews[] = {{ui::Layout::kWorkbench, "workbench.png", 1600, 900},
+                {ui::Layout::kLidarOnly, "view_lidar.png", 800, 450},
+                {ui::Layout::kCameraOnly, "view_camera.png", 800, 600},
+                {ui::Layout::kSceneOnly, "view_3d.png", 800, 600}};
+  for (const auto& view : kViews) {
+    ui::Workbench workbench;
+    const std::string path = out_dir + "/" + view.file;
+    SaveImage(path, ui::RenderWorkbenchHeadless(controller, workbench, host, view.layout,
+                                                view.width, view.height, 4));
+    std::printf("rendered %s\n", path.c_str());
+  }
+  std::printf("session: %s/calibench.session.json (open it with `calibench gui --session ...`)\n",
+              out_dir.c_str());
   return kOk;
 }
 

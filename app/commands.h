@@ -31,5 +31,7 @@ int RunGuiWindow(const std::string& dataset, const std::string& session, int wid
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
                    bool solve, const std::string& view, int width, int height,
                    const std::string& out, const std::string& backend_name);
+// `demo` on a machine without a display: solve and write the workbench and each view as PNG.
+int RenderDemoViews(const std::string& dataset, const std::string& out_dir);
 
 }  // namespace calibench::app

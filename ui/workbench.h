@@ -55,6 +55,7 @@ class Workbench {
   // View-local state.
   float lidar_zoom_ = 3.0f;    // horizontal zoom of the LiDAR image (1 = all 360 degrees)
   float lidar_center_ = 0.5f;  // centre column as a fraction of the image width
+  std::string lidar_centered_on_;  // pair whose brush the LiDAR view was last centred on
   float camera_zoom_ = 1.0f;
   double replay_position_ = -1;  // iteration shown; < 0 = the last one
   bool replaying_ = false;

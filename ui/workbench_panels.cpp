@@ -141,7 +141,7 @@ void Workbench::SolverPanel(const Snapshot& s, const ViewRect& r, std::vector<In
     intents->push_back(SetSolverOptions{delta, iterations});
   const bool solved = !s.solver.iterations.empty();
   ImGui::BeginDisabled(s.solver.running);
-  if (ImGui::Button("Run")) {
+  if (ImGui::Button("Run (F5)")) {
     intents->push_back(RunSolver{});
     replay_position_ = -1;
     replaying_ = false;

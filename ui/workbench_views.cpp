@@ -33,7 +33,8 @@ gfx::Rgba ToRgba(const std::array<std::uint8_t, 3>& rgb, std::uint8_t alpha = 25
   return {rgb[0], rgb[1], rgb[2], alpha};
 }
 
-// The LiDAR picture with the brush (white veil) and the plane inliers (green) composed in.
+// The LiDAR picture with the brush (white veil) and the plane inliers (magenta: no perceptual
+// colour map uses it) composed in.
 ImageU8 ComposeLidarPicture(const PairView& pair, LidarChannel channel) {
   ImageU8 picture = RenderLidarImage(*pair.lidar_image, channel, Colormap::kTurbo);
   auto blend = [&](int pixel, int r, int g, int b, float alpha) {
@@ -46,7 +47,7 @@ ImageU8 ComposeLidarPicture(const PairView& pair, LidarChannel channel) {
   if (pair.lidar)
     for (int i : pair.lidar->inliers)
       if (pair.lidar_image->pixel_of_point[i] >= 0)
-        blend(pair.lidar_image->pixel_of_point[i], 40, 230, 90, 0.85f);
+        blend(pair.lidar_image->pixel_of_point[i], 255, 40, 220, 0.9f);
   return picture;
 }
 
@@ -104,6 +105,18 @@ void Workbench::LidarView(const Snapshot& s, const ViewRect& r, std::vector<Inte
   if (key != lidar_key_) {
     gl_->lidar_picture.Upload(ComposeLidarPicture(*pair, s.view.lidar_channel), false);
     lidar_key_ = key;
+  }
+  // A newly selected pair opens centred on its brush (the board), not on a fixed azimuth.
+  if (lidar_centered_on_ != pair->id && !pair->brush_pixels.empty()) {
+    // Circular mean: the brush may straddle the image's left/right seam.
+    double sx = 0, sy = 0;
+    for (int pixel : pair->brush_pixels) {
+      const double a = 2 * M_PI * ((pixel % image.columns) + 0.5) / image.columns;
+      sx += std::cos(a), sy += std::sin(a);
+    }
+    const double mean = std::atan2(sy, sx);
+    lidar_center_ = static_cast<float>((mean < 0 ? mean + 2 * M_PI : mean) / (2 * M_PI));
+    lidar_centered_on_ = pair->id;
   }
   // Horizontal zoom around lidar_center_; rows stretched to the view height.
   const ImVec2 avail = ImGui::GetContentRegionAvail();

@@ -1,0 +1,60 @@
+// A real window: `calibench gui` under Xvfb for a few frames, with a screenshot of what it showed.
+#include <gtest/gtest.h>
+
+#include "core/image.h"
+#include "tests/test_support.h"
+
+namespace calibench {
+namespace {
+
+// The mean absolute difference between neighbouring pixels: ~0 for an empty panel, large for a
+// picture (a LiDAR image, a camera frame, a point cloud).
+double Texture(const ImageU8& image, int x0, int y0, int x1, int y1) {
+  double sum = 0;
+  int count = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x + 1 < x1; ++x) {
+      const std::uint8_t* p = image.Row(y) + 3 * x;
+      sum += std::abs(p[0] - p[3]) + std::abs(p[1] - p[4]) + std::abs(p[2] - p[5]);
+      ++count;
+    }
+  return count ? sum / count : 0;
+}
+
+TEST(GuiWindow, OpensUnderXvfbAndShowsTheThreeViews) {
+  std::string output;
+  if (test::RunCommand("command -v xvfb-run", &output) != 0) {
+    if (std::getenv("CALIBENCH_REQUIRE_SHARED")) FAIL() << "xvfb-run is not installed";
+    GTEST_SKIP() << "xvfb-run is not installed (apt-get install xvfb xauth)";
+  }
+  const auto dir = test::TempDir("gui_window");
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " simulate --preset demo --pairs 3 --out " +
+                                 (dir / "data").string(),
+                             &output),
+            0)
+      << output;
+  const auto shot = dir / "window.png";
+  const int code = test::RunCommand(
+      "xvfb-run -a -s '-screen 0 1600x900x24' " + test::CalibenchExe() + " gui --dataset " +
+          (dir / "data/dataset.json").string() + " --size 1600x900 --quit-after-frames 90 " +
+          "--screenshot " + shot.string(),
+      &output);
+  ASSERT_EQ(code, 0) << output;
+  const ImageU8 image = LoadImage(shot);
+  ASSERT_EQ(image.width, 1600);
+  ASSERT_EQ(image.height, 900);
+  // The three views side by side in the top half each show a picture once the pairs loaded.
+  for (int view = 0; view < 3; ++view) {
+    const int x0 = view * 533 + 20, x1 = (view + 1) * 533 - 20;
+    EXPECT_GT(Texture(image, x0, 120, x1, 440), 3.0)
+        << "view " << view << " looks empty; see " << shot;
+  }
+  // The title bars of the views (the theme's blue) are where the layout puts them.
+  for (int x : {10, 543, 1076}) {
+    const std::uint8_t* p = image.Row(8) + 3 * x;
+    EXPECT_GT(p[0], p[2]) << "no title bar at x = " << x << "; see " << shot;  // blue > red (BGR)
+  }
+}
+
+}  // namespace
+}  // namespace calibench
