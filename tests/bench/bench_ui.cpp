@@ -1,0 +1,86 @@
+// Workbench costs on llvmpipe: a full frame at 1600x900 with a 131k-point OS0-128 cloud and a
+// 1440x1080 image, and the memory a 40-pair session holds.
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/sim.h"
+#include "ui/controller.h"
+#include "ui/gfx/context.h"
+#include "ui/imgui_host.h"
+#include "ui/workbench.h"
+
+namespace calibench {
+namespace {
+
+// Resident memory now (kB), from /proc/self/status.
+long ResidentKb() {
+  std::ifstream status("/proc/self/status");
+  std::string key;
+  long value = 0;
+  while (status >> key) {
+    if (key == "VmRSS:") {
+      status >> value;
+      return value;
+    }
+    status.ignore(1 << 10, '\n');
+  }
+  return 0;
+}
+
+std::filesystem::path SimulatedDemo(int pairs) {
+  const auto dir = std::filesystem::temp_directory_path() / "calibench_bench" /
+                   ("ui_demo_" + std::to_string(pairs));
+  if (!std::filesystem::exists(dir / "dataset.json")) {
+    SimOptions sim = SimPreset("demo");  // OS0-128 (131072 beams), 1440x1080 pinhole camera
+    sim.num_pairs = pairs;
+    SimulateDataset(sim, dir);
+  }
+  return dir / "dataset.json";
+}
+
+void BM_WorkbenchFrame1600x900(benchmark::State& state) {
+  std::string why;
+  auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &why);
+  if (!context) {
+    state.SkipWithError(why.c_str());
+    return;
+  }
+  ui::Controller controller;
+  controller.OpenDataset(SimulatedDemo(3),
+                         std::filesystem::temp_directory_path() / "bench_ui.json");
+  controller.WaitIdle();
+  controller.Apply(ui::RunSolver{});  // reprojection with hidden-point removal in the camera view
+  controller.WaitIdle();
+  ui::ImGuiHost host(nullptr);
+  ui::Workbench workbench;
+  const ui::Snapshot snapshot = controller.GetSnapshot();
+  state.SetLabel(std::to_string(snapshot.pairs[0].cloud->size()) + " points, " +
+                 std::to_string(snapshot.reprojection ? snapshot.reprojection->points.size() : 0) +
+                 " reprojected; " + context->Description());
+  ui::RenderWorkbenchHeadless(controller, workbench, host, ui::Layout::kWorkbench, 1600, 900, 2);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(ui::RenderWorkbenchHeadless(controller, workbench, host,
+                                                         ui::Layout::kWorkbench, 1600, 900, 1));
+}
+BENCHMARK(BM_WorkbenchFrame1600x900)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_Session40PairsMemory(benchmark::State& state) {
+  const auto manifest = SimulatedDemo(40);
+  for (auto _ : state) {
+    const long before = ResidentKb();
+    ui::Controller controller;
+    controller.OpenDataset(manifest, std::filesystem::temp_directory_path() / "bench_ui40.json");
+    controller.WaitIdle();
+    state.counters["rss_MiB"] = (ResidentKb() - before) / 1024.0;
+    state.counters["points_per_pair"] =
+        static_cast<double>(controller.GetSnapshot().pairs[0].cloud->size());
+  }
+}
+BENCHMARK(BM_Session40PairsMemory)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+}  // namespace
+}  // namespace calibench
