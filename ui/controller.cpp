@@ -439,8 +439,15 @@ void Controller::EnsureSelectedImage() {
     path = state_.dataset->pairs[state_.selected].image;
   }
   std::shared_ptr<const ImageU8> image;
+  std::shared_ptr<const UndistortedView> undistorted;
   try {
     image = std::make_shared<ImageU8>(LoadImage(path));
+    CameraModel camera;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      camera = state_.dataset->camera;
+    }
+    undistorted = std::make_shared<UndistortedView>(Undistort(camera, *image));
   } catch (const IoError& e) {
     std::lock_guard<std::mutex> lock(mutex_);
     SetStatus(e.what(), true);
@@ -449,6 +456,7 @@ void Controller::EnsureSelectedImage() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (state_.selected >= 0 && state_.dataset->pairs[state_.selected].image == path) {
     state_.selected_image = image;
+    state_.selected_undistorted = undistorted;
     ++state_.generation;
   }
 }
@@ -462,6 +470,7 @@ void Controller::Apply(const Intent& intent) {
     if (!valid(select->index) || select->index == state_.selected) return;
     state_.selected = select->index;
     state_.selected_image.reset();
+    state_.selected_undistorted.reset();
     state_.reprojection.reset();
     CommitEdit();
     Enqueue([this] { EnsureSelectedImage(); });

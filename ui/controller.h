@@ -26,6 +26,7 @@
 #include "core/reproject.h"
 #include "core/session.h"
 #include "core/solver.h"
+#include "core/undistort.h"
 
 namespace calibench::ui {
 
@@ -71,6 +72,7 @@ struct Snapshot {
   std::vector<PairView> pairs;
   int selected = -1;
   std::shared_ptr<const ImageU8> selected_image;  // full-resolution camera image of `selected`
+  std::shared_ptr<const UndistortedView> selected_undistorted;  // the same, distortion removed
   SolverView solver;
   std::shared_ptr<const Reprojection> reprojection;
   ViewState view;

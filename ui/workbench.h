@@ -53,12 +53,15 @@ class Workbench {
   struct Gl;
   std::unique_ptr<Gl> gl_;
   // View-local state.
-  float lidar_zoom_ = 3.0f;    // horizontal zoom of the LiDAR image (1 = all 360 degrees)
-  float lidar_center_ = 0.5f;  // centre column as a fraction of the image width
+  float lidar_zoom_ = 3.0f;        // horizontal zoom of the LiDAR image (1 = all 360 degrees)
+  float lidar_center_ = 0.5f;      // centre column as a fraction of the image width
   std::string lidar_centered_on_;  // pair whose brush the LiDAR view was last centred on
-  float camera_zoom_ = 1.0f;
+  float camera_zoom_ = 1.0f;       // 1 = the whole image; wheel zooms about the mouse
+  float camera_center_x_ = 0.5f;   // visible centre, fractions of the image
+  float camera_center_y_ = 0.5f;
   double replay_position_ = -1;  // iteration shown; < 0 = the last one
   bool replaying_ = false;
+  bool scene_camera_colors_ = true;  // 3D cloud coloured from the image once a solve exists
   std::string export_path_ = "result.json";
   std::string session_path_ = "session.json";
   ImageRect lidar_image_rect_;

@@ -14,13 +14,11 @@ namespace calibench::ui {
 struct Workbench::Gl {
   gfx::ImageTexture lidar_picture;
   gfx::ImageTexture camera_image;
-  const ImageU8* camera_image_source = nullptr;
+  const ImageU8* camera_image_source = nullptr;  // what camera_image holds
   gfx::Framebuffer camera_target;
   gfx::PointRenderer camera_points;
   gfx::Framebuffer scene_target;
   gfx::PointRenderer scene_points;
-  const LidarCloud* scene_cloud = nullptr;
-  int scene_channel = -1;
   gfx::LineRenderer scene_lines;
   gfx::TriangleRenderer scene_quads;
   std::map<std::string, std::unique_ptr<gfx::ImageTexture>> thumbnails;

@@ -7,6 +7,7 @@
 
 #include "core/colormap.h"
 #include "core/geometry.h"
+#include "core/reproject.h"
 #include "core/sim.h"
 #include "ui/workbench.h"
 #include "ui/workbench_gl.h"
@@ -155,31 +156,35 @@ void Workbench::LidarView(const Snapshot& s, const ViewRect& r, std::vector<Inte
 void Workbench::CameraView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents) {
   if (!BeginView("Camera", r.x, r.y, r.w, r.h)) return ImGui::End();
   const PairView* pair = s.selected >= 0 ? &s.pairs[s.selected] : nullptr;
-  const auto image = s.selected_image;
-  if (!pair || !image || !s.dataset) {
+  if (!pair || !s.selected_image || !s.dataset) {
     ImGui::TextDisabled("loading image ...");
     return ImGui::End();
   }
-  const CameraModel& camera = s.dataset->camera;
-  static const char* kVisibility[] = {"hidden-point removal", "z-buffer", "no occlusion"};
-  int visibility = static_cast<int>(s.view.visibility);
   ViewState view = s.view;
-  ImGui::SetNextItemWidth(160);
+  static const char* kModes[] = {"raw", "undistorted"};
+  int mode = static_cast<int>(view.camera_image);
+  ImGui::SetNextItemWidth(110);
+  if (ImGui::Combo("##mode", &mode, kModes, 2))
+    view.camera_image = static_cast<CameraImageMode>(mode);
+  static const char* kVisibility[] = {"hidden-point removal", "z-buffer", "no occlusion"};
+  int visibility = static_cast<int>(view.visibility);
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(150);
   if (ImGui::Combo("##visibility", &visibility, kVisibility, 3))
     view.visibility = static_cast<VisibilityMode>(visibility);
   ImGui::SameLine();
-  ImGui::SetNextItemWidth(80);
+  ImGui::SetNextItemWidth(70);
   float size = static_cast<float>(view.point_size_px),
         opacity = static_cast<float>(view.point_opacity);
   if (ImGui::SliderFloat("size", &size, 1.0f, 8.0f, "%.1f")) view.point_size_px = size;
   ImGui::SameLine();
-  ImGui::SetNextItemWidth(80);
+  ImGui::SetNextItemWidth(70);
   if (ImGui::SliderFloat("opacity", &opacity, 0.1f, 1.0f, "%.2f")) view.point_opacity = opacity;
   if (view.visibility == VisibilityMode::kHpr) {
     ImGui::SameLine();
-    ImGui::SetNextItemWidth(80);
+    ImGui::SetNextItemWidth(70);
     float exponent = static_cast<float>(view.hpr_radius_exponent);
-    if (ImGui::SliderFloat("HPR radius 10^", &exponent, 1.0f, 4.0f, "%.1f"))
+    if (ImGui::SliderFloat("HPR 10^", &exponent, 1.0f, 4.0f, "%.1f"))
       view.hpr_radius_exponent = exponent;
   }
   if (!(view == s.view)) intents->push_back(SetView{view});
@@ -191,39 +196,73 @@ void Workbench::CameraView(const Snapshot& s, const ViewRect& r, std::vector<Int
     ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "board not found: %s", pair->camera_failure.c_str());
   }
 
+  // What is shown: the raw image with the real lens, or the undistorted one with its pinhole.
+  const bool undistorted =
+      s.view.camera_image == CameraImageMode::kUndistorted && s.selected_undistorted;
+  const ImageU8& image = undistorted ? s.selected_undistorted->image : *s.selected_image;
+  const CameraModel& lens = s.dataset->camera;
+  const CameraModel& shown = undistorted ? s.selected_undistorted->pinhole : lens;
   const ImVec2 avail = ImGui::GetContentRegionAvail();
-  const float scale = std::min(avail.x / camera.width, avail.y / camera.height);
-  const int tw = std::max(1, static_cast<int>(camera.width * scale));
-  const int th = std::max(1, static_cast<int>(camera.height * scale));
-  const bool show_points = s.reprojection && s.reprojection->pair_id == pair->id;
+  const float fit = std::min(avail.x / image.width, avail.y / image.height);
+  const int tw = std::max(1, static_cast<int>(image.width * fit));
+  const int th = std::max(1, static_cast<int>(image.height * fit));
+  // Zoom and pan: the visible part of the image is [u0, u0 + span] x [v0, v0 + span] (fractions).
+  const float span = 1.0f / camera_zoom_;
+  camera_center_x_ = std::clamp(camera_center_x_, span / 2, 1 - span / 2);
+  camera_center_y_ = std::clamp(camera_center_y_, span / 2, 1 - span / 2);
+  const float u0 = camera_center_x_ - span / 2, v0 = camera_center_y_ - span / 2;
+  // Image pixel -> NDC of the view's framebuffer (y up) and -> screen.
+  auto to_ndc = [&](const Vec2& px) {
+    return Eigen::Vector3f(static_cast<float>(((px.x() + 0.5) / image.width - u0) / span * 2 - 1),
+                           static_cast<float>(1 - ((px.y() + 0.5) / image.height - v0) / span * 2),
+                           0.0f);
+  };
+  const ImVec2 origin = ImGui::GetCursorScreenPos();
+  auto to_screen = [&](const Vec2& px) {
+    return ImVec2(origin.x + static_cast<float>(((px.x() + 0.5) / image.width - u0) / span * tw),
+                  origin.y + static_cast<float>(((px.y() + 0.5) / image.height - v0) / span * th));
+  };
+  // A raw-image pixel as shown (through the pinhole when undistorted).
+  auto shown_pixel = [&](const Vec2& raw) -> std::optional<Vec2> {
+    if (!undistorted) return raw;
+    const auto ray = lens.Unproject(raw);
+    return ray ? shown.Project(*ray) : std::nullopt;
+  };
+  const bool show_points = s.reprojection && s.reprojection->pair_id == pair->id && s.solver.result;
   const std::uint64_t key =
-      reinterpret_cast<std::uintptr_t>(image.get()) ^
+      reinterpret_cast<std::uintptr_t>(&image) ^
       (show_points ? reinterpret_cast<std::uintptr_t>(s.reprojection.get()) << 1 : 0) ^
-      (static_cast<std::uint64_t>(tw) << 48) ^
+      (static_cast<std::uint64_t>(tw) << 48) ^ (static_cast<std::uint64_t>(th) << 36) ^
       static_cast<std::uint64_t>(view.point_size_px * 1000) * 7919 ^
-      static_cast<std::uint64_t>(view.point_opacity * 1000) * 104729;
+      static_cast<std::uint64_t>(view.point_opacity * 1000) * 104729 ^
+      static_cast<std::uint64_t>(camera_zoom_ * 1e4) * 15485863 ^
+      static_cast<std::uint64_t>(camera_center_x_ * 1e6) * 32452843 ^
+      static_cast<std::uint64_t>(camera_center_y_ * 1e6) * 49979687;
   if (key != camera_key_) {
     camera_key_ = key;
-    if (gl_->camera_image_source != image.get()) {
-      gl_->camera_image.Upload(*image, true);
-      gl_->camera_image_source = image.get();
+    if (gl_->camera_image_source != &image) {
+      gl_->camera_image.Upload(image, true);
+      gl_->camera_image_source = &image;
     }
     gl_->camera_target.Resize(tw, th);
     gl_->camera_target.Bind();
     gl_->camera_target.Clear(0.1f, 0.1f, 0.1f, 1.0f);
-    gl_->camera_image.Draw(-1, -1, 1, 1);
+    const Eigen::Vector3f top_left = to_ndc({-0.5, -0.5});
+    const Eigen::Vector3f bottom_right = to_ndc({image.width - 0.5, image.height - 0.5});
+    gl_->camera_image.Draw(top_left.x(), bottom_right.y(), bottom_right.x(), top_left.y());
     if (show_points) {
       std::vector<Eigen::Vector3f> positions;
       std::vector<gfx::Rgba> colors;
       const Reprojection& rp = *s.reprojection;
+      const Pose& cam_from_lidar = s.solver.result->cam_from_lidar;
       for (size_t i = 0; i < rp.points.size(); ++i) {
         if (!rp.visible.empty() && !rp.visible[i]) continue;
-        // Pixel centres to NDC (y up).
-        const float x =
-            static_cast<float>(2.0 * (rp.points[i].pixel.x() + 0.5) / camera.width - 1.0);
-        const float y =
-            static_cast<float>(1.0 - 2.0 * (rp.points[i].pixel.y() + 0.5) / camera.height);
-        positions.emplace_back(x, y, 0.0f);
+        std::optional<Vec2> px = rp.points[i].pixel;
+        if (undistorted)
+          px = shown.Project(cam_from_lidar *
+                             pair->cloud->points[rp.points[i].index].cast<double>());
+        if (!px) continue;
+        positions.push_back(to_ndc(*px));
         colors.push_back(ToRgba(MapColor(Colormap::kTurbo, rp.points[i].depth_m / 20.0)));
       }
       gl_->camera_points.Upload(positions, colors);
@@ -231,19 +270,17 @@ void Workbench::CameraView(const Snapshot& s, const ViewRect& r, std::vector<Int
                               static_cast<float>(view.point_opacity));
     }
   }
-  const ImVec2 origin = ImGui::GetCursorScreenPos();
   ImGui::Image(TextureId(gl_->camera_target.color_texture()), ImVec2(tw, th), ImVec2(0, 1),
                ImVec2(1, 0));
+  const bool hovered = ImGui::IsItemHovered();
   ImDrawList* draw = ImGui::GetWindowDrawList();
-  auto to_screen = [&](const Vec2& px) {
-    return ImVec2(origin.x + static_cast<float>((px.x() + 0.5) * scale),
-                  origin.y + static_cast<float>((px.y() + 0.5) * scale));
-  };
+  draw->PushClipRect(origin, ImVec2(origin.x + tw, origin.y + th), true);
   if (pair->detection)
     for (const Vec2& corner : pair->detection->pixels)
-      draw->AddCircle(to_screen(corner), 3.0f, IM_COL32(255, 220, 0, 255));
+      if (const auto px = shown_pixel(corner))
+        draw->AddCircle(to_screen(*px), 3.0f, IM_COL32(255, 220, 0, 255));
   if (pair->camera) {
-    // Sheet outline (edges subdivided: fisheye lenses bend them) and board axes.
+    // Sheet outline (edges subdivided: lenses bend them) and board axes.
     const BoardSpec& board = s.dataset->target;
     const double hw = board.SheetWidth() / 2, hh = board.SheetHeight() / 2;
     const Vec3 corners[4] = {{-hw, -hh, 0}, {hw, -hh, 0}, {hw, hh, 0}, {-hw, hh, 0}};
@@ -251,27 +288,44 @@ void Workbench::CameraView(const Snapshot& s, const ViewRect& r, std::vector<Int
     for (int e = 0; e < 4; ++e)
       for (int k = 0; k < 16; ++k) {
         const Vec3 p = corners[e] + (corners[(e + 1) % 4] - corners[e]) * (k / 16.0);
-        if (const auto px = camera.Project(pair->camera->cam_from_board * p))
+        if (const auto px = shown.Project(pair->camera->cam_from_board * p))
           outline.push_back(to_screen(*px));
       }
     if (outline.size() > 2)
       draw->AddPolyline(outline.data(), static_cast<int>(outline.size()),
                         IM_COL32(80, 200, 255, 255), ImDrawFlags_Closed, 2.0f);
     const double axis = 0.5 * std::min(hw, hh);
-    const auto o = camera.Project(pair->camera->cam_from_board * Vec3::Zero());
+    const auto o = shown.Project(pair->camera->cam_from_board * Vec3::Zero());
     const ImU32 axis_colors[3] = {IM_COL32(255, 60, 60, 255), IM_COL32(60, 255, 60, 255),
                                   IM_COL32(80, 120, 255, 255)};
     for (int a = 0; a < 3 && o; ++a) {
       const Vec3 tip = pair->camera->cam_from_board * (Vec3::Unit(a) * (a == 2 ? -axis : axis));
-      if (const auto px = camera.Project(tip))
+      if (const auto px = shown.Project(tip))
         draw->AddLine(to_screen(*o), to_screen(*px), axis_colors[a], 2.0f);
     }
   } else {
     draw->AddText(ImVec2(origin.x + 12, origin.y + 12), IM_COL32(255, 90, 80, 255),
                   ("board not found: " + pair->camera_failure).c_str());
   }
-  if (ImGui::IsItemHovered() && !s.solver.result)
-    ImGui::SetTooltip("run the solver to project the LiDAR points into this image");
+  draw->PopClipRect();
+  if (hovered) {
+    const ImGuiIO& io = ImGui::GetIO();
+    if (io.MouseWheel != 0) {
+      // Zoom about the pixel under the mouse.
+      const float mx = u0 + (io.MousePos.x - origin.x) / tw * span;
+      const float my = v0 + (io.MousePos.y - origin.y) / th * span;
+      camera_zoom_ = std::clamp(camera_zoom_ * std::pow(1.25f, io.MouseWheel), 1.0f, 32.0f);
+      const float new_span = 1.0f / camera_zoom_;
+      camera_center_x_ = mx - (io.MousePos.x - origin.x) / tw * new_span + new_span / 2;
+      camera_center_y_ = my - (io.MousePos.y - origin.y) / th * new_span + new_span / 2;
+    }
+    if (ImGui::IsMouseDragging(ImGuiMouseButton_Right)) {
+      camera_center_x_ -= io.MouseDelta.x / tw * span;
+      camera_center_y_ -= io.MouseDelta.y / th * span;
+    }
+    if (!s.solver.result)
+      ImGui::SetTooltip("run the solver to project the LiDAR points into this image");
+  }
   ImGui::End();
 }
 
@@ -283,32 +337,56 @@ void Workbench::SceneView(const Snapshot& s, const ViewRect& r, std::vector<Inte
     return ImGui::End();
   }
   static const char* kColorings[] = {"intensity", "range", "ring"};
-  int coloring = static_cast<int>(s.view.lidar_channel);
-  ImGui::TextDisabled("colour: %s (LiDAR view)   drag: orbit, right-drag: pan, wheel: zoom",
-                      kColorings[coloring]);
+  const int coloring = static_cast<int>(s.view.lidar_channel);
+  const bool can_use_camera =
+      s.reprojection && s.reprojection->pair_id == pair->id && s.selected_image && s.solver.result;
+  ImGui::Checkbox("camera colours", &scene_camera_colors_);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("colour the cloud from the camera image (after a solve)");
+  ImGui::SameLine();
+  ImGui::TextDisabled(
+      "else %s (LiDAR view); magenta: plane inliers. drag: orbit, right: pan, wheel: zoom",
+      kColorings[coloring]);
+  const bool camera_colors = scene_camera_colors_ && can_use_camera;
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const int tw = std::max(1, static_cast<int>(avail.x)),
             th = std::max(1, static_cast<int>(avail.y));
   const LidarCloud& cloud = *pair->cloud;
-  if (gl_->scene_cloud != &cloud || gl_->scene_channel != coloring) {
-    gl_->scene_cloud = &cloud;
-    gl_->scene_channel = coloring;
-    std::vector<float> values(cloud.size());
-    for (size_t i = 0; i < cloud.size(); ++i) {
-      if (coloring == 0)
-        values[i] = cloud.HasIntensity() ? cloud.intensity[i] : cloud.points[i].norm();
-      else if (coloring == 1)
-        values[i] = cloud.points[i].norm();
-      else
-        values[i] = cloud.HasRing() ? static_cast<float>(cloud.ring[i]) : cloud.points[i].z();
-    }
-    std::vector<float> sorted = values;
-    std::sort(sorted.begin(), sorted.end());
-    const float lo = sorted.empty() ? 0 : sorted[sorted.size() / 50];
-    const float hi = sorted.empty() ? 1 : sorted[sorted.size() - 1 - sorted.size() / 50];
+  const std::uint64_t key =
+      reinterpret_cast<std::uintptr_t>(&cloud) ^ (static_cast<std::uint64_t>(coloring) << 56) ^
+      (camera_colors ? reinterpret_cast<std::uintptr_t>(s.reprojection.get()) << 3 : 0) ^
+      ((pair->lidar ? pair->lidar->inliers.size() + 1 : 0) << 36);
+  if (key != scene_key_) {
+    scene_key_ = key;
     std::vector<gfx::Rgba> colors(cloud.size());
-    for (size_t i = 0; i < cloud.size(); ++i)
-      colors[i] = ToRgba(MapColor(Colormap::kTurbo, (values[i] - lo) / std::max(1e-6f, hi - lo)));
+    if (camera_colors) {
+      const CloudColors from_image =
+          ColorizeCloud(s.dataset->camera, s.solver.result->cam_from_lidar, cloud,
+                        *s.selected_image, s.reprojection->visible, s.reprojection->points);
+      for (size_t i = 0; i < cloud.size(); ++i)
+        colors[i] = from_image.has_color[i]
+                        ? gfx::Rgba{from_image.bgr[3 * i + 2], from_image.bgr[3 * i + 1],
+                                    from_image.bgr[3 * i], 255}
+                        : gfx::Rgba{70, 70, 76, 255};
+    } else {
+      std::vector<float> values(cloud.size());
+      for (size_t i = 0; i < cloud.size(); ++i) {
+        if (coloring == 0)
+          values[i] = cloud.HasIntensity() ? cloud.intensity[i] : cloud.points[i].norm();
+        else if (coloring == 1)
+          values[i] = cloud.points[i].norm();
+        else
+          values[i] = cloud.HasRing() ? static_cast<float>(cloud.ring[i]) : cloud.points[i].z();
+      }
+      std::vector<float> sorted = values;
+      std::sort(sorted.begin(), sorted.end());
+      const float lo = sorted.empty() ? 0 : sorted[sorted.size() / 50];
+      const float hi = sorted.empty() ? 1 : sorted[sorted.size() - 1 - sorted.size() / 50];
+      for (size_t i = 0; i < cloud.size(); ++i)
+        colors[i] = ToRgba(MapColor(Colormap::kTurbo, (values[i] - lo) / std::max(1e-6f, hi - lo)));
+    }
+    if (pair->lidar)
+      for (int i : pair->lidar->inliers) colors[i] = {255, 40, 220, 255};
     gl_->scene_points.Upload(cloud.points, colors);
   }
   // Orbit camera about the target (LiDAR frame, z up).
