@@ -162,15 +162,22 @@ bool SheetInLidarFov(const SimOptions& r, const BeamTable& beams, const Pose& li
   return true;
 }
 
-// Where a user would brush: the centroid of the noise-free board returns.
-Vec3 BoardHitCentroid(const BeamTable& beams, const BoardPrint& print, const Pose& lidar_from_board,
-                      double azimuth_offset_rad) {
+// The noise-free returns of the board alone (no room).
+LidarScan ScanBoardOnly(const BeamTable& beams, const BoardPrint& print,
+                        const Pose& lidar_from_board, double azimuth_offset_rad) {
   LidarScene board_only;
   board_only.lidar_from_board = lidar_from_board;
   board_only.clutter = false;
   LidarScanOptions scan_options;
   scan_options.azimuth_offset_rad = azimuth_offset_rad;
-  const LidarCloud hits = SimulateLidarScan(beams, print, board_only, scan_options).ToCloud();
+  return SimulateLidarScan(beams, print, board_only, scan_options);
+}
+
+// Where a user would brush: the centroid of the noise-free board returns.
+Vec3 BoardHitCentroid(const BeamTable& beams, const BoardPrint& print, const Pose& lidar_from_board,
+                      double azimuth_offset_rad) {
+  const LidarCloud hits =
+      ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad).ToCloud();
   Vec3 centroid = Vec3::Zero();
   for (const auto& p : hits.points) centroid += p.cast<double>() / static_cast<double>(hits.size());
   return hits.size() > 0 ? centroid : lidar_from_board.translation();
@@ -178,12 +185,7 @@ Vec3 BoardHitCentroid(const BeamTable& beams, const BoardPrint& print, const Pos
 
 bool EnoughLidarHits(const BeamTable& beams, const BoardPrint& print, const Pose& lidar_from_board,
                      double azimuth_offset_rad) {
-  LidarScene board_only;
-  board_only.lidar_from_board = lidar_from_board;
-  board_only.clutter = false;
-  LidarScanOptions scan_options;
-  scan_options.azimuth_offset_rad = azimuth_offset_rad;
-  const LidarScan scan = SimulateLidarScan(beams, print, board_only, scan_options);
+  const LidarScan scan = ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad);
   // A ring that only grazes a corner (one or two returns) does not help a plane fit.
   constexpr int kMinPointsPerRing = 3;
   std::vector<int> hits_per_ring(beams.elevations_rad.size(), 0);

@@ -15,8 +15,12 @@ JOBS=${CALIBENCH_JOBS:-$(nproc)}
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build "$BUILD_DIR" -j "$JOBS"
 
-# The main job: the demo (simulate, calibrate, print the result and its error).
-"$BUILD_DIR/calibench" demo --out "$BUILD_DIR/demo"
+# The main job: the demo (simulate, calibrate, print the result and its error), then the
+# workbench on it when there is a display, or its views rendered to PNG when there is none.
+# With --test the window never opens: the test suite must not wait for it.
+demo_flags=()
+[ $run_tests -eq 1 ] && demo_flags+=(--no-gui)
+"$BUILD_DIR/calibench" demo --out "$BUILD_DIR/demo" "${demo_flags[@]}"
 
 if [ $run_tests -eq 1 ]; then
   ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" --timeout 900
