@@ -163,7 +163,7 @@ std::string DatasetPathForFile(const std::filesystem::path& dataset,
 
 // ---- reading ----
 
-double ToDouble(const Json& value, const std::string& path) {
+double AsDouble(const Json& value, const std::string& path) {
   if (value.is_number()) return value.get<double>();
   if (value.is_string()) {
     const std::string& s = value.get_ref<const std::string&>();
@@ -214,7 +214,7 @@ class Fields {
   const Json& Array(const std::string& key, size_t size = 0) const {
     return ArrayOf(At(key), size, Path(key));
   }
-  double Number(const std::string& key) const { return ToDouble(At(key), Path(key)); }
+  double Number(const std::string& key) const { return AsDouble(At(key), Path(key)); }
   double Positive(const std::string& key) const {
     const double value = Number(key);
     if (!(value > 0) || !std::isfinite(value))
@@ -302,7 +302,7 @@ ViewState ReadView(const Fields& f) {
   v.orbit_pitch_rad = f.Number("orbit_pitch_rad");
   v.orbit_distance_m = f.Positive("orbit_distance_m");
   const Json& target = f.Array("orbit_target_m", 3);
-  for (int i = 0; i < 3; ++i) v.orbit_target[i] = ToDouble(target[i], f.Path("orbit_target_m"));
+  for (int i = 0; i < 3; ++i) v.orbit_target[i] = AsDouble(target[i], f.Path("orbit_target_m"));
   v.brush_radius_px = f.Positive("brush_radius_px");
   return v;
 }
@@ -314,7 +314,7 @@ Eigen::Matrix<double, N, N> ReadSquare(const Json& json, const std::string& path
   Eigen::Matrix<double, N, N> m;
   for (int r = 0; r < N; ++r) {
     ArrayOf(json[r], N, what);
-    for (int c = 0; c < N; ++c) m(r, c) = ToDouble(json[r][c], what);
+    for (int c = 0; c < N; ++c) m(r, c) = AsDouble(json[r][c], what);
   }
   return m;
 }
@@ -332,7 +332,7 @@ SessionResult ReadResult(const Fields& f) {
   r.iterations = f.Int("iterations");
   r.converged = f.Bool("converged");
   for (const Json& c : f.Array("cost_history"))
-    r.cost_history.push_back(ToDouble(c, f.Path("cost_history")));
+    r.cost_history.push_back(AsDouble(c, f.Path("cost_history")));
   for (const Json& d : f.Array("weak_directions")) {
     if (!d.is_string()) throw FormatError(f.Path("weak_directions") + ": must hold strings");
     r.weak_directions.push_back(d.get<std::string>());
@@ -341,7 +341,7 @@ SessionResult ReadResult(const Fields& f) {
   // The convergence record is optional: a session without it still opens, without replay.
   if (f.Has("step_history"))
     for (const Json& v : f.Array("step_history"))
-      r.step_history.push_back(ToDouble(v, f.Path("step_history")));
+      r.step_history.push_back(AsDouble(v, f.Path("step_history")));
   if (f.Has("estimate_history"))
     for (const Json& m : f.Array("estimate_history")) {
       Pose pose = Pose::Identity();
