@@ -19,6 +19,7 @@ struct Workbench::Gl {
   gfx::PointRenderer camera_points;
   gfx::Framebuffer scene_target;
   gfx::PointRenderer scene_points;
+  float scene_floor_z = -1.5f;  // metres, LiDAR frame; from the shown cloud
   gfx::LineRenderer scene_lines;
   gfx::TriangleRenderer scene_quads;
   std::map<std::string, std::unique_ptr<gfx::ImageTexture>> thumbnails;

@@ -388,6 +388,13 @@ void Workbench::SceneView(const Snapshot& s, const ViewRect& r, std::vector<Inte
     if (pair->lidar)
       for (int i : pair->lidar->inliers) colors[i] = {255, 40, 220, 255};
     gl_->scene_points.Upload(cloud.points, colors);
+    // The grid goes on the floor: a low percentile of the heights, robust to a few stray returns.
+    std::vector<float> heights(cloud.size());
+    for (size_t i = 0; i < cloud.size(); ++i) heights[i] = cloud.points[i].z();
+    if (!heights.empty()) {
+      std::nth_element(heights.begin(), heights.begin() + heights.size() / 50, heights.end());
+      gl_->scene_floor_z = heights[heights.size() / 50];
+    }
   }
   // Orbit camera about the target (LiDAR frame, z up).
   const ViewState& v = s.view;
@@ -412,7 +419,7 @@ void Workbench::SceneView(const Snapshot& s, const ViewRect& r, std::vector<Inte
     line_colors.push_back(c);
     line_colors.push_back(c);
   };
-  const double floor_z = -1.5;
+  const double floor_z = gl_->scene_floor_z;
   for (int k = -10; k <= 10; ++k) {
     const gfx::Rgba grid{70, 70, 78, 255};
     add_line({k * 1.0, -10, floor_z}, {k * 1.0, 10, floor_z}, grid);
