@@ -12,6 +12,10 @@ namespace calibench::app {
 
 void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) {
   PipelineOptions& o = flags.options;
+  app.add_option("--method", flags.method,
+                 "ca2lib-gn (the paper) | weighted-ml (residuals whitened by the planes' "
+                 "covariances)")
+      ->capture_default_str();
   app.add_option("--huber-delta", o.solver.huber_delta, "Huber threshold on the plane error")
       ->capture_default_str();
   app.add_option("--max-iterations", o.solver.max_iterations, "Gauss-Newton iterations")
@@ -30,6 +34,12 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
 }
 
 bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {
+  const auto method = ParseSolverMethod(flags.method);
+  if (!method) {
+    *why = "--method must be ca2lib-gn or weighted-ml, not '" + flags.method + "'";
+    return false;
+  }
+  flags.options.solver.method = *method;
   if (!flags.pairs.empty()) {
     std::stringstream ss(flags.pairs);
     std::string id;

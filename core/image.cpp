@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -65,8 +64,8 @@ ImageU8 ResizeImage(const ImageU8& image, int max_width) {
   if (image.empty() || image.width <= max_width) return image;
   const cv::Mat source(image.height, image.width, CV_8UC(image.channels),
                        const_cast<std::uint8_t*>(image.data.data()));
-  const int height = std::max(1, static_cast<int>(std::lround(
-                                     static_cast<double>(image.height) * max_width / image.width)));
+  const int height = std::max(1, static_cast<int>(std::lround(static_cast<double>(image.height) *
+                                                              max_width / image.width)));
   cv::Mat resized;
   cv::resize(source, resized, cv::Size(max_width, height), 0, 0, cv::INTER_AREA);
   ImageU8 out;

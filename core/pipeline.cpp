@@ -120,7 +120,8 @@ CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,
   for (PairFeatures& p : outcome.pairs) {
     if (p.status == PairStatus::kPending && p.lidar && p.camera) p.status = PairStatus::kAccepted;
     if (p.status != PairStatus::kAccepted) continue;
-    planes.push_back({p.id, p.lidar->plane, p.camera->plane});
+    planes.push_back(
+        {p.id, p.lidar->plane, p.camera->plane, p.lidar->covariance, p.camera->plane_covariance});
   }
   if (static_cast<int>(planes.size()) < options.min_pairs) {
     outcome.failure = "only " + std::to_string(planes.size()) + " usable pair(s); at least " +

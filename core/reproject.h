@@ -14,9 +14,9 @@
 namespace calibench {
 
 struct ProjectedPoint {
-  int index = 0;        // into the cloud
-  Vec2 pixel;           // pixels
-  double depth_m = 0;   // distance from the camera centre (metres)
+  int index = 0;       // into the cloud
+  Vec2 pixel;          // pixels
+  double depth_m = 0;  // distance from the camera centre (metres)
 };
 
 // Points of the cloud that land inside the image (in front of the camera, within the model's
@@ -34,7 +34,8 @@ struct HprOptions {
 // Katz et al. 2007 "Direct visibility of point sets": spherical flip about the camera centre,
 // convex hull (PCL / qhull); a point is visible iff its flipped image is a hull vertex. Takes the
 // points in the camera frame; returns a visibility flag per input point.
-std::vector<bool> HiddenPointRemoval(const std::vector<Vec3>& points_in_cam, const HprOptions& options);
+std::vector<bool> HiddenPointRemoval(const std::vector<Vec3>& points_in_cam,
+                                     const HprOptions& options);
 
 struct ZBufferOptions {
   int cell_px = 4;              // occlusion cells of cell_px x cell_px pixels

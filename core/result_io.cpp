@@ -72,7 +72,7 @@ std::string ResultToJson(const CalibrationOutcome& outcome, const SolverOptions&
                                           s.observability.eigenvalues.data() + 6)},
       {"weak_directions", s.observability.weak_directions},
       {"well_constrained", s.observability.well_constrained}};
-  root["solver"] = {{"method", names.method},
+  root["solver"] = {{"method", SolverMethodName(options.method)},
                     {"iterations", s.iterations},
                     {"converged", s.converged},
                     {"cost_history", s.cost_history},

@@ -12,7 +12,6 @@ namespace calibench {
 struct ResultNames {
   std::string target = "cam";    // cam_from_<source>
   std::string source = "lidar";  // "lidar" or "lrf"
-  std::string method = "ca2lib-gn";
 };
 
 // The result as JSON text. Requires outcome.solution.

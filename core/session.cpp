@@ -3,7 +3,6 @@
 #include "core/session.h"
 
 #include <algorithm>
-
 #include <fstream>
 #include <sstream>
 #include <utility>

@@ -61,7 +61,7 @@ struct ViewState {
   double orbit_pitch_rad = 0.35;  // elevation above the xy plane (about 20 degrees)
   double orbit_distance_m = 5.0;  // close enough to see the boards and both sensor frames
   std::array<double, 3> orbit_target = {1.5, 0.0, 0.0};  // in front of the LiDAR
-  double brush_radius_px = 6.0;  // circle brush on the LiDAR image, pixels
+  double brush_radius_px = 6.0;                          // circle brush on the LiDAR image, pixels
 
   bool operator==(const ViewState&) const = default;
 };

@@ -9,18 +9,77 @@
 
 namespace calibench {
 
+std::string SolverMethodName(SolverMethod method) {
+  return method == SolverMethod::kCa2libGn ? "ca2lib-gn" : "weighted-ml";
+}
+
+std::optional<SolverMethod> ParseSolverMethod(const std::string& name) {
+  if (name == "ca2lib-gn") return SolverMethod::kCa2libGn;
+  if (name == "weighted-ml") return SolverMethod::kWeightedMl;
+  return std::nullopt;
+}
+
 bool SolverOptions::Check(std::string* why) const {
   auto fail = [&](const std::string& message) {
     if (why) *why = message;
     return false;
   };
   if (!(huber_delta > 0)) return fail("huber_delta must be > 0");
+  if (!(whitened_huber_delta > 0)) return fail("whitened_huber_delta must be > 0 (sigmas)");
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
   if (!(step_tolerance > 0)) return fail("step_tolerance must be > 0");
   if (!(weak_eigenvalue_ratio > 0 && weak_eigenvalue_ratio < 1))
     return fail("weak_eigenvalue_ratio must be in (0, 1)");
   return true;
 }
+
+namespace {
+
+// The weighted method's minimal residual for one pair at cam_from_lidar (3-vector):
+//   r = [ B_cᵀ (n' − n_c) ; d' − d_c ],  (n', d') = TransformPlane(cam_from_lidar, lidar plane),
+// B_c an orthonormal basis of the camera normal's tangent plane (the normals' two free
+// directions; Eq. (6)'s 4-vector has a rank-3 covariance). Its covariance propagates both
+// planes' covariances; the Jacobian is w.r.t. the right perturbation [rho; phi].
+struct WeightedResidual {
+  Vec3 residual;
+  Eigen::Matrix<double, 3, 6> jacobian;
+  Mat3 covariance;
+};
+
+WeightedResidual ComputeWeightedResidual(const Pose& cam_from_lidar, const PlanePair& pair) {
+  const Mat3& r = cam_from_lidar.linear();
+  const Vec3& t = cam_from_lidar.translation();
+  const Plane moved = TransformPlane(cam_from_lidar, pair.lidar_plane);
+  const Vec3& n_c = pair.camera_plane.normal;
+  Eigen::Matrix<double, 3, 2> basis;
+  basis.col(0) = n_c.unitOrthogonal();
+  basis.col(1) = n_c.cross(basis.col(0));
+  WeightedResidual out;
+  out.residual.head<2>() = basis.transpose() * (moved.normal - n_c);
+  out.residual[2] = moved.distance - pair.camera_plane.distance;
+  // d/d(delta), as in PlaneAlignmentResidual: dn'/dphi = −R[n]x, dd'/drho = −nᵀ, dd'/dphi =
+  // tᵀR[n]x.
+  const Mat3 r_skew_n = r * Skew(pair.lidar_plane.normal);
+  out.jacobian.setZero();
+  out.jacobian.block<2, 3>(0, 3) = -basis.transpose() * r_skew_n;
+  out.jacobian.block<1, 3>(2, 0) = -pair.lidar_plane.normal.transpose();
+  out.jacobian.block<1, 3>(2, 3) = t.transpose() * r_skew_n;
+  // d r / d(n_l, d_l) and d r / d(n_c, d_c).
+  Eigen::Matrix<double, 3, 4> d_lidar = Eigen::Matrix<double, 3, 4>::Zero();
+  d_lidar.block<2, 3>(0, 0) = basis.transpose() * r;
+  d_lidar.block<1, 3>(2, 0) = -t.transpose() * r;
+  d_lidar(2, 3) = 1.0;
+  Eigen::Matrix<double, 3, 4> d_camera = Eigen::Matrix<double, 3, 4>::Zero();
+  d_camera.block<2, 3>(0, 0) = -basis.transpose();
+  d_camera(2, 3) = -1.0;
+  out.covariance = d_lidar * pair.lidar_covariance * d_lidar.transpose() +
+                   d_camera * pair.camera_covariance * d_camera.transpose();
+  // Floor: 1e-5 rad and 0.1 mm, so that a pair with an unknown (zero) covariance stays finite.
+  out.covariance.diagonal() += Vec3(1e-10, 1e-10, 1e-8);
+  return out;
+}
+
+}  // namespace
 
 std::optional<Pose> InitialGuessFromPlanes(const std::vector<PlanePair>& pairs, std::string* why) {
   if (pairs.size() < 2) {
@@ -108,27 +167,46 @@ PlaneAlignmentSolver::PlaneAlignmentSolver(std::vector<PlanePair> pairs,
   history_.push_back({0, Linearize(cam_from_lidar_).cost, 0.0, cam_from_lidar_});
 }
 
-double PlaneAlignmentSolver::HuberWeight(double error_norm) const {
-  return error_norm <= options_.huber_delta ? 1.0 : options_.huber_delta / error_norm;
+double PlaneAlignmentSolver::HuberDelta() const {
+  return options_.method == SolverMethod::kWeightedMl ? options_.whitened_huber_delta
+                                                      : options_.huber_delta;
 }
 
-double PlaneAlignmentSolver::HuberCost(double error_norm) const {
-  const double delta = options_.huber_delta;
+double PlaneAlignmentSolver::RobustWeight(double error_norm) const {
+  const double delta = HuberDelta();
+  return error_norm <= delta ? 1.0 : delta / error_norm;
+}
+
+double PlaneAlignmentSolver::RobustCost(double error_norm) const {
+  const double delta = HuberDelta();
   return error_norm <= delta ? 0.5 * error_norm * error_norm : delta * (error_norm - 0.5 * delta);
 }
 
 PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(
     const Pose& cam_from_lidar) const {
   Linearization lin;
+  if (options_.method == SolverMethod::kWeightedMl) {
+    for (const PlanePair& pair : pairs_) {
+      const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar, pair);
+      const Mat3 information = w.covariance.inverse();
+      const double mahalanobis = std::sqrt(w.residual.dot(information * w.residual));
+      const double weight = RobustWeight(mahalanobis);
+      lin.information += weight * w.jacobian.transpose() * information * w.jacobian;
+      lin.gradient += weight * w.jacobian.transpose() * information * w.residual;
+      lin.cost += RobustCost(mahalanobis);
+      lin.weighted_squared_error += weight * mahalanobis * mahalanobis;
+    }
+    return lin;
+  }
   Eigen::Matrix<double, 4, 6> jacobian;
   for (const PlanePair& pair : pairs_) {
     const Vec4 e =
         PlaneAlignmentResidual(cam_from_lidar, pair.lidar_plane, pair.camera_plane, &jacobian);
     const double norm = e.norm();
-    const double w = HuberWeight(norm);  // Eq. (14) by iteratively reweighted least squares
+    const double w = RobustWeight(norm);  // Eq. (14) by iteratively reweighted least squares
     lin.information += w * jacobian.transpose() * jacobian;
     lin.gradient += w * jacobian.transpose() * e;
-    lin.cost += HuberCost(norm);
+    lin.cost += RobustCost(norm);
     lin.weighted_squared_error += w * e.squaredNorm();
   }
   return lin;
@@ -176,16 +254,25 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   result.converged = converged_;
   result.iterations = static_cast<int>(history_.size()) - 1;
   for (const IterationReport& it : history_) result.cost_history.push_back(it.cost);
+  const bool weighted = options_.method == SolverMethod::kWeightedMl;
   for (const PlanePair& pair : pairs_) {
     const Vec4 e =
         PlaneAlignmentResidual(cam_from_lidar_, pair.lidar_plane, pair.camera_plane, nullptr);
     result.residuals.push_back(e);
-    result.robust_weights.push_back(HuberWeight(e.norm()));
+    if (weighted) {
+      const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar_, pair);
+      result.robust_weights.push_back(
+          RobustWeight(std::sqrt(w.residual.dot(w.covariance.inverse() * w.residual))));
+    } else {
+      result.robust_weights.push_back(RobustWeight(e.norm()));
+    }
   }
   const Linearization lin = Linearize(cam_from_lidar_);
-  // The paper's residual carries no noise model: scale the inverse information by the
-  // a-posteriori variance factor of the 4 residuals per pair (6 parameters estimated).
-  const int redundancy = 4 * static_cast<int>(pairs_.size()) - 6;
+  // The inverse information scaled by the a-posteriori variance factor: for the paper's residual,
+  // which has no noise model, that is the noise estimate itself (4 residuals per pair); for the
+  // weighted residual (3 per pair) it absorbs what the feature covariances miss on real sensors.
+  const int per_pair = weighted ? 3 : 4;
+  const int redundancy = per_pair * static_cast<int>(pairs_.size()) - 6;
   const double variance_factor = redundancy > 0 ? lin.weighted_squared_error / redundancy : 0.0;
   Eigen::SelfAdjointEigenSolver<Mat6> eigen(lin.information);
   Vec6 inverse_eigenvalues;

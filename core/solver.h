@@ -17,10 +17,23 @@ struct PlanePair {
   std::string id;
   Plane lidar_plane;   // LiDAR frame, normal towards the LiDAR (d > 0)
   Plane camera_plane;  // camera frame, normal towards the camera (d > 0)
+  // Covariances of (n, d) (rank 3). Used by the weighted method; zero = unknown.
+  Mat4 lidar_covariance = Mat4::Zero();
+  Mat4 camera_covariance = Mat4::Zero();
 };
 
+enum class SolverMethod {
+  kCa2libGn,    // the paper: unweighted plane-to-plane error, Eq. (6), Huber on |e|
+  kWeightedMl,  // residuals whitened by both planes' covariances, Huber on the Mahalanobis norm
+};
+std::string SolverMethodName(SolverMethod method);  // "ca2lib-gn", "weighted-ml"
+std::optional<SolverMethod> ParseSolverMethod(const std::string& name);
+
 struct SolverOptions {
-  double huber_delta = 0.1;      // Huber threshold on |e_p| (Eq. (6) mixes unitless and metres)
+  SolverMethod method = SolverMethod::kCa2libGn;
+  double huber_delta = 0.1;  // Huber threshold on |e_p| (Eq. (6) mixes unitless and metres)
+  // kWeightedMl: Huber threshold on the whitened residual, in standard deviations.
+  double whitened_huber_delta = 3.0;
   int max_iterations = 50;       // Gauss-Newton iterations
   double step_tolerance = 1e-9;  // stop when |delta| (m, rad) falls below this
   // A direction of the information matrix whose eigenvalue is below this fraction of the largest
@@ -87,8 +100,9 @@ class PlaneAlignmentSolver {
     double weighted_squared_error = 0.0;
   };
   Linearization Linearize(const Pose& cam_from_lidar) const;
-  double HuberWeight(double error_norm) const;
-  double HuberCost(double error_norm) const;
+  double HuberDelta() const;  // huber_delta or whitened_huber_delta, by method
+  double RobustWeight(double error_norm) const;
+  double RobustCost(double error_norm) const;
 
   std::vector<PlanePair> pairs_;
   SolverOptions options_;
