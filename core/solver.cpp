@@ -282,8 +282,17 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   }
   result.covariance = variance_factor * eigen.eigenvectors() * inverse_eigenvalues.asDiagonal() *
                       eigen.eigenvectors().transpose();
-  result.observability =
-      AnalyseObservability(lin.information, cam_from_lidar_, options_.weak_eigenvalue_ratio);
+  // Observability is a property of the geometry, not of the noise: judge it on the unweighted
+  // plane-to-plane information (Eq. (6) Jacobians, unit weights), whose eigenvalues compare like
+  // with like for either method; whitened information mixes 1/m² and 1/rad² scales.
+  Mat6 geometric_information = Mat6::Zero();
+  Eigen::Matrix<double, 4, 6> jacobian;
+  for (const PlanePair& pair : pairs_) {
+    PlaneAlignmentResidual(cam_from_lidar_, pair.lidar_plane, pair.camera_plane, &jacobian);
+    geometric_information += jacobian.transpose() * jacobian;
+  }
+  result.observability = AnalyseObservability(geometric_information, cam_from_lidar_,
+                                              options_.weak_eigenvalue_ratio);
   if (redundancy <= 0) {
     result.observability.well_constrained = false;
     result.observability.weak_directions.push_back(
