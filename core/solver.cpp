@@ -291,8 +291,8 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
     PlaneAlignmentResidual(cam_from_lidar_, pair.lidar_plane, pair.camera_plane, &jacobian);
     geometric_information += jacobian.transpose() * jacobian;
   }
-  result.observability = AnalyseObservability(geometric_information, cam_from_lidar_,
-                                              options_.weak_eigenvalue_ratio);
+  result.observability =
+      AnalyseObservability(geometric_information, cam_from_lidar_, options_.weak_eigenvalue_ratio);
   if (redundancy <= 0) {
     result.observability.well_constrained = false;
     result.observability.weak_directions.push_back(
