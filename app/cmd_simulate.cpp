@@ -22,39 +22,6 @@ void AddSimFlags(CLI::App& app, SimFlags& flags) {
   app.add_flag("--no-clutter", flags.no_clutter, "no floor and walls");
 }
 
-BoardSpec NamedBoard(const std::string& name) {
-  BoardSpec b;
-  if (name == "a3" || name == "a4") {
-    const bool a3 = name == "a3";
-    b.type = BoardType::kCheckerboard;
-    b.cols = a3 ? 7 : 5;
-    b.rows = a3 ? 5 : 4;
-    b.square_size = a3 ? 0.04 : 0.035;
-    b.board_width = a3 ? 0.42 : 0.297;
-    b.board_height = a3 ? 0.297 : 0.21;
-  } else if (name == "charuco-a3" || name == "charuco-a4") {
-    const bool a3 = name == "charuco-a3";
-    b.type = BoardType::kCharuco;
-    // Few, large squares: 4x4 markers must stay decodable (> ~12 px) at 3-4 m.
-    b.cols = a3 ? 6 : 5;
-    b.rows = a3 ? 4 : 3;
-    b.square_size = a3 ? 0.065 : 0.055;
-    b.marker_size = a3 ? 0.05 : 0.042;
-    b.dictionary = "DICT_4X4_50";
-    b.board_width = a3 ? 0.42 : 0.297;
-    b.board_height = a3 ? 0.297 : 0.21;
-  } else if (name == "paper") {
-    b.type = BoardType::kCheckerboard;
-    b.cols = 7;
-    b.rows = 5;
-    b.square_size = 0.2;
-  } else {
-    throw std::invalid_argument("unknown board '" + name +
-                                "' (a3, a4, paper, charuco-a3, charuco-a4)");
-  }
-  return b;
-}
-
 bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* why) {
   try {
     *options = SimPreset(flags.preset);
@@ -81,7 +48,7 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
   }
   if (!flags.board.empty()) {
     try {
-      options->board = NamedBoard(flags.board);
+      options->board = BoardPreset(flags.board);
     } catch (const std::exception& e) {
       *why = e.what();
       return false;

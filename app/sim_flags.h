@@ -24,7 +24,5 @@ struct SimFlags {
 void AddSimFlags(CLI::App& app, SimFlags& flags);
 // Preset + overrides; false with *why for unknown names or options failing Check.
 bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* why);
-// a3, a4, paper, charuco-a3, charuco-a4; throws std::invalid_argument for others.
-BoardSpec NamedBoard(const std::string& name);
 
 }  // namespace calibench::app

@@ -39,6 +39,11 @@ std::string PairStatusName(PairStatus status) {
   return "unknown";
 }
 
+PlanePair MakePlanePair(const std::string& id, const LidarPlaneFit& lidar,
+                        const CameraBoardObservation& camera) {
+  return {id, lidar.plane, camera.plane, lidar.covariance, camera.plane_covariance};
+}
+
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
                                  const PipelineOptions& options) {
   PairFeatures features;
@@ -120,8 +125,7 @@ CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,
   for (PairFeatures& p : outcome.pairs) {
     if (p.status == PairStatus::kPending && p.lidar && p.camera) p.status = PairStatus::kAccepted;
     if (p.status != PairStatus::kAccepted) continue;
-    planes.push_back(
-        {p.id, p.lidar->plane, p.camera->plane, p.lidar->covariance, p.camera->plane_covariance});
+    planes.push_back(MakePlanePair(p.id, *p.lidar, *p.camera));
   }
   if (static_cast<int>(planes.size()) < options.min_pairs) {
     outcome.failure = "only " + std::to_string(planes.size()) + " usable pair(s); at least " +

@@ -37,6 +37,10 @@ struct PairFeatures {
   std::optional<CameraBoardObservation> camera;
 };
 
+// The solver's input for one pair: both planes with their covariances.
+PlanePair MakePlanePair(const std::string& id, const LidarPlaneFit& lidar,
+                        const CameraBoardObservation& camera);
+
 // Loads the pair's files and extracts both planes. Never throws for bad data: the pair comes
 // back kFailed with the reason (unreadable files name the file).
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,

@@ -27,41 +27,11 @@ std::uint64_t MixSeed(std::uint64_t seed, std::uint64_t pair, std::uint64_t stre
   return z ^ (z >> 31);
 }
 
-CameraModel DefaultSimCamera(bool fisheye) {
-  CameraModel camera;
-  camera.width = 1440;
-  camera.height = 1080;
-  camera.cx = 719.5;
-  camera.cy = 539.5;
-  if (fisheye) {
-    camera.type = CameraModelType::kKannalaBrandt;
-    camera.fx = camera.fy = 450.0;
-    camera.distortion = {-0.01, 0.005, -0.002, 0.0005};
-  } else {
-    camera.type = CameraModelType::kPinholeRadTan;
-    camera.fx = camera.fy = 1000.0;
-    camera.distortion = {-0.1, 0.05, 0.0005, -0.0003, 0.0};
-  }
-  return camera;
-}
-
-// A3 sheet with 7x5 inner corners of 40 mm squares.
-BoardSpec A3Checkerboard() {
-  BoardSpec board;
-  board.type = BoardType::kCheckerboard;
-  board.cols = 7;
-  board.rows = 5;
-  board.square_size = 0.04;
-  board.board_width = 0.42;
-  board.board_height = 0.297;
-  return board;
-}
-
 // The options with every "0 = default" field replaced by its value.
 SimOptions Resolve(const SimOptions& options) {
   SimOptions r = options;
   if (r.camera.width == 0) r.camera = DefaultSimCamera(r.fisheye);
-  if (r.board.cols == 0) r.board = A3Checkerboard();
+  if (r.board.cols == 0) r.board = BoardPreset("a3");
   r.board.board_width = r.board.SheetWidth();
   r.board.board_height = r.board.SheetHeight();
   if (r.cam_from_lidar.matrix() == Mat4::Identity()) r.cam_from_lidar = DefaultCamFromLidar();
@@ -251,6 +221,24 @@ std::string PairId(int pair) {
 
 }  // namespace
 
+CameraModel DefaultSimCamera(bool fisheye) {
+  CameraModel camera;
+  camera.width = 1440;
+  camera.height = 1080;
+  camera.cx = 719.5;
+  camera.cy = 539.5;
+  if (fisheye) {
+    camera.type = CameraModelType::kKannalaBrandt;
+    camera.fx = camera.fy = 450.0;
+    camera.distortion = {-0.01, 0.005, -0.002, 0.0005};
+  } else {
+    camera.type = CameraModelType::kPinholeRadTan;
+    camera.fx = camera.fy = 1000.0;
+    camera.distortion = {-0.1, 0.05, 0.0005, -0.0003, 0.0};
+  }
+  return camera;
+}
+
 bool SimOptions::Check(std::string* why) const {
   auto fail = [why](const std::string& message) {
     if (why) *why = message;
@@ -297,9 +285,45 @@ Pose DefaultCamFromLidar() {
   return cam_from_lidar;
 }
 
+BoardSpec BoardPreset(const std::string& name) {
+  BoardSpec b;
+  if (name == "a3" || name == "a4") {
+    const bool a3 = name == "a3";
+    b.type = BoardType::kCheckerboard;
+    b.cols = a3 ? 7 : 5;
+    b.rows = a3 ? 5 : 4;
+    b.square_size = a3 ? 0.04 : 0.035;
+    b.board_width = a3 ? 0.42 : 0.297;
+    b.board_height = a3 ? 0.297 : 0.21;
+  } else if (name == "charuco-a3" || name == "charuco-a4") {
+    const bool a3 = name == "charuco-a3";
+    // Few, large squares: 4x4 markers must stay decodable (> ~12 px) at 3-4 m.
+    b.type = BoardType::kCharuco;
+    b.cols = a3 ? 6 : 5;
+    b.rows = a3 ? 4 : 3;
+    b.square_size = a3 ? 0.065 : 0.055;
+    b.marker_size = a3 ? 0.05 : 0.042;
+    b.dictionary = "DICT_4X4_50";
+    b.board_width = a3 ? 0.42 : 0.297;
+    b.board_height = a3 ? 0.297 : 0.21;
+  } else if (name == "paper") {
+    // Ca²Lib Section 4.1: 8x6 squares of 0.2 m (7x5 inner corners) printed edge to edge.
+    b.type = BoardType::kCheckerboard;
+    b.cols = 7;
+    b.rows = 5;
+    b.square_size = 0.2;
+    b.board_width = 1.6;
+    b.board_height = 1.2;
+  } else {
+    throw std::invalid_argument("unknown board '" + name +
+                                "' (known: a3, a4, charuco-a3, charuco-a4, paper)");
+  }
+  return b;
+}
+
 SimOptions SimPreset(const std::string& name) {
   SimOptions options;  // camera left empty: the default pinhole, or fisheye when asked for
-  options.board = A3Checkerboard();
+  options.board = BoardPreset("a3");
   if (name == "default" || name == "demo") {
     // The demo shows a well-posed session: a 128-beam LiDAR sees an A3 sheet with 10+ rings.
     options.lidar = name == "demo" ? LidarModel::kOs0_128 : LidarModel::kVlp16;
@@ -313,11 +337,7 @@ SimOptions SimPreset(const std::string& name) {
   if (name == "paper") {
     // Ca²Lib Section 4.1: HDL-64, 8x6 squares of 0.2 m (7x5 inner corners) printed edge to edge.
     options.lidar = LidarModel::kHdl64;
-    options.board.cols = 7;
-    options.board.rows = 5;
-    options.board.square_size = 0.2;
-    options.board.board_width = 1.6;
-    options.board.board_height = 1.2;
+    options.board = BoardPreset("paper");
     options.num_pairs = 53;
     options.min_distance_m = 3.0;
     options.max_distance_m = 8.0;

@@ -48,6 +48,15 @@ struct SimOptions {
   bool Check(std::string* why) const;
 };
 
+// The simulator's cameras, 1440x1080: pinhole rad-tan (fx = 1000 px) or Kannala-Brandt fisheye
+// (fx = 450 px).
+CameraModel DefaultSimCamera(bool fisheye);
+
+// Named printable boards: "a3", "a4" (checkerboards), "charuco-a3", "charuco-a4" (few, large
+// squares so that 4x4 markers decode at 3-4 m) and "paper" (Ca²Lib's 8x6 squares of 0.2 m).
+// Throws std::invalid_argument naming the known boards for any other name.
+BoardSpec BoardPreset(const std::string& name);
+
 // The default mount: LiDAR x forward, z up; camera z forward, y down; camera 10 cm below and
 // 5 cm left of the LiDAR with a small rotation, so that the solver cannot get lucky with axes.
 Pose DefaultCamFromLidar();

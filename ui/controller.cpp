@@ -331,14 +331,23 @@ void Controller::RefitLidar(int index) {
 void Controller::RecomputeResiduals() {
   for (PairView& pair : state_.pairs) pair.residual.reset();
   if (!state_.solver.result) return;
-  SolverOptions options;
-  options.huber_delta = state_.huber_delta;
+  // The solver's own residuals and robust weights at the shown estimate, over the pairs that
+  // are accepted now (after a reload, or after accept/reject since the last solve).
+  std::vector<PlanePair> planes;
+  std::vector<PairView*> solved;
   for (PairView& pair : state_.pairs) {
     if (pair.status != PairStatus::kAccepted || !pair.lidar || !pair.camera) continue;
-    pair.residual = PlaneAlignmentResidual(state_.solver.result->cam_from_lidar, pair.lidar->plane,
-                                           pair.camera->plane, nullptr);
-    const double norm = pair.residual->norm();
-    pair.robust_weight = norm <= options.huber_delta ? 1.0 : options.huber_delta / norm;
+    planes.push_back(MakePlanePair(pair.id, *pair.lidar, *pair.camera));
+    solved.push_back(&pair);
+  }
+  if (planes.empty()) return;
+  SolverOptions options = pipeline_.solver;
+  options.huber_delta = state_.huber_delta;
+  const SolverResult at_estimate =
+      PlaneAlignmentSolver(planes, options, state_.solver.result->cam_from_lidar).Summarize();
+  for (size_t i = 0; i < solved.size(); ++i) {
+    solved[i]->residual = at_estimate.residuals[i];
+    solved[i]->robust_weight = at_estimate.robust_weights[i];
   }
 }
 
@@ -349,7 +358,7 @@ void Controller::Solve() {
     std::lock_guard<std::mutex> lock(mutex_);
     for (const PairView& pair : state_.pairs)
       if (pair.status == PairStatus::kAccepted && pair.lidar && pair.camera)
-        planes.push_back({pair.id, pair.lidar->plane, pair.camera->plane});
+        planes.push_back(MakePlanePair(pair.id, *pair.lidar, *pair.camera));
     options = pipeline_.solver;
     options.huber_delta = state_.huber_delta;
     options.max_iterations = state_.max_iterations;

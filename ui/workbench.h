@@ -43,6 +43,9 @@ class Workbench {
   void LidarView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
   void CameraView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
   void SceneView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
+  // Draws the 3D scene (grid, axes, cloud, board quads) into gl_->scene_target.
+  void DrawScene(const Snapshot& s, const PairView& pair, const gfx::Matrix4f& view_projection,
+                 const Pose* estimate, int width, int height);
   void MeasurementsPanel(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
   void SolverPanel(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
   void StatusLine(const Snapshot& s, const ViewRect& r);
@@ -65,6 +68,7 @@ class Workbench {
   std::string export_path_ = "result.json";
   std::string session_path_ = "session.json";
   ImageRect lidar_image_rect_;
+  std::uint64_t scene_frame_key_ = 0;  // what the 3D framebuffer last showed
   std::uint64_t lidar_key_ = ~0ull, camera_key_ = ~0ull, scene_key_ = ~0ull;
 };
 

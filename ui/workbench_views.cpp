@@ -329,6 +329,80 @@ void Workbench::CameraView(const Snapshot& s, const ViewRect& r, std::vector<Int
   ImGui::End();
 }
 
+void Workbench::DrawScene(const Snapshot& s, const PairView& pair,
+                          const gfx::Matrix4f& view_projection, const Pose* estimate, int tw,
+                          int th) {
+  const LidarCloud& cloud = *pair.cloud;
+  const ViewState& v = s.view;
+  // Lines: ground grid, LiDAR axes, camera axes at the displayed estimate.
+  std::vector<Eigen::Vector3f> lines;
+  std::vector<gfx::Rgba> line_colors;
+  auto add_line = [&](const Vec3& a, const Vec3& b, gfx::Rgba c) {
+    lines.push_back(a.cast<float>());
+    lines.push_back(b.cast<float>());
+    line_colors.push_back(c);
+    line_colors.push_back(c);
+  };
+  const double floor_z = gl_->scene_floor_z;
+  for (int k = -10; k <= 10; ++k) {
+    const gfx::Rgba grid{70, 70, 78, 255};
+    add_line({k * 1.0, -10, floor_z}, {k * 1.0, 10, floor_z}, grid);
+    add_line({-10, k * 1.0, floor_z}, {10, k * 1.0, floor_z}, grid);
+  }
+  auto add_axes = [&](const Pose& world_from_frame, double length) {
+    const gfx::Rgba colors[3] = {{255, 60, 60, 255}, {60, 230, 60, 255}, {80, 120, 255, 255}};
+    for (int a = 0; a < 3; ++a)
+      add_line(world_from_frame.translation(), world_from_frame * (Vec3::Unit(a) * length),
+               colors[a]);
+  };
+  add_axes(Pose::Identity(), 0.5);
+  std::vector<Eigen::Vector3f> quads;
+  std::vector<gfx::Rgba> quad_colors;
+  auto add_quad = [&](const Vec3(&c)[4], gfx::Rgba color) {
+    for (int k : {0, 1, 2, 0, 2, 3}) {
+      quads.push_back(c[k].cast<float>());
+      quad_colors.push_back(color);
+    }
+  };
+  if (pair.lidar) {
+    // The LiDAR board: the inliers' extent in the fitted plane.
+    const Vec3 n = pair.lidar->plane.normal;
+    Vec3 centroid = Vec3::Zero();
+    for (int i : pair.lidar->inliers) centroid += cloud.points[i].cast<double>();
+    centroid /= std::max<size_t>(1, pair.lidar->inliers.size());
+    const Vec3 u = n.unitOrthogonal(), w = n.cross(u);
+    double u0 = 1e9, u1 = -1e9, w0 = 1e9, w1 = -1e9;
+    for (int i : pair.lidar->inliers) {
+      const Vec3 d = cloud.points[i].cast<double>() - centroid;
+      u0 = std::min(u0, d.dot(u)), u1 = std::max(u1, d.dot(u));
+      w0 = std::min(w0, d.dot(w)), w1 = std::max(w1, d.dot(w));
+    }
+    const Vec3 c[4] = {centroid + u0 * u + w0 * w, centroid + u1 * u + w0 * w,
+                       centroid + u1 * u + w1 * w, centroid + u0 * u + w1 * w};
+    add_quad(c, {60, 140, 255, 110});
+  }
+  if (estimate) {
+    const Pose lidar_from_cam = estimate->inverse();
+    add_axes(lidar_from_cam, 0.3);
+    if (pair.camera) {
+      const BoardSpec& board = s.dataset->target;
+      const double hw = board.SheetWidth() / 2, hh = board.SheetHeight() / 2;
+      const Pose lidar_from_board = lidar_from_cam * pair.camera->cam_from_board;
+      const Vec3 c[4] = {lidar_from_board * Vec3(-hw, -hh, 0), lidar_from_board * Vec3(hw, -hh, 0),
+                         lidar_from_board * Vec3(hw, hh, 0), lidar_from_board * Vec3(-hw, hh, 0)};
+      add_quad(c, {255, 150, 40, 110});
+    }
+  }
+  gl_->scene_target.Resize(tw, th);
+  gl_->scene_target.Bind();
+  gl_->scene_target.Clear(0.08f, 0.08f, 0.1f, 1.0f);
+  gl_->scene_lines.Upload(lines, line_colors);
+  gl_->scene_lines.Draw(view_projection);
+  gl_->scene_points.Draw(view_projection, static_cast<float>(v.point_size_px));
+  gl_->scene_quads.Upload(quads, quad_colors);
+  gl_->scene_quads.Draw(view_projection);
+}
+
 void Workbench::SceneView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents) {
   if (!BeginView("3D", r.x, r.y, r.w, r.h)) return ImGui::End();
   const PairView* pair = s.selected >= 0 ? &s.pairs[s.selected] : nullptr;
@@ -409,75 +483,23 @@ void Workbench::SceneView(const Snapshot& s, const ViewRect& r, std::vector<Inte
   const gfx::Matrix4f view_projection =
       gfx::Perspective(0.9f, static_cast<float>(tw) / th, 0.05f, 500.0f) *
       gfx::LookAt(eye, target, Eigen::Vector3f::UnitZ());
-
-  // Lines: ground grid, LiDAR axes, camera axes at the displayed estimate.
-  std::vector<Eigen::Vector3f> lines;
-  std::vector<gfx::Rgba> line_colors;
-  auto add_line = [&](const Vec3& a, const Vec3& b, gfx::Rgba c) {
-    lines.push_back(a.cast<float>());
-    lines.push_back(b.cast<float>());
-    line_colors.push_back(c);
-    line_colors.push_back(c);
-  };
-  const double floor_z = gl_->scene_floor_z;
-  for (int k = -10; k <= 10; ++k) {
-    const gfx::Rgba grid{70, 70, 78, 255};
-    add_line({k * 1.0, -10, floor_z}, {k * 1.0, 10, floor_z}, grid);
-    add_line({-10, k * 1.0, floor_z}, {10, k * 1.0, floor_z}, grid);
-  }
-  auto add_axes = [&](const Pose& world_from_frame, double length) {
-    const gfx::Rgba colors[3] = {{255, 60, 60, 255}, {60, 230, 60, 255}, {80, 120, 255, 255}};
-    for (int a = 0; a < 3; ++a)
-      add_line(world_from_frame.translation(), world_from_frame * (Vec3::Unit(a) * length),
-               colors[a]);
-  };
-  add_axes(Pose::Identity(), 0.5);
   const Pose* estimate = DisplayedEstimate(s);
-  std::vector<Eigen::Vector3f> quads;
-  std::vector<gfx::Rgba> quad_colors;
-  auto add_quad = [&](const Vec3(&c)[4], gfx::Rgba color) {
-    for (int k : {0, 1, 2, 0, 2, 3}) {
-      quads.push_back(c[k].cast<float>());
-      quad_colors.push_back(color);
-    }
+
+  // Redraw only when something shown changed: the cloud and its colours, the view, the point
+  // size or the estimate (131k points on llvmpipe cost most of a frame).
+  std::uint64_t frame_key = scene_key_ ^ 0xcbf29ce484222325ull;
+  auto mix = [&frame_key](const void* data, size_t bytes) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < bytes; ++i) frame_key = (frame_key ^ p[i]) * 0x100000001b3ull;
   };
-  if (pair->lidar) {
-    // The LiDAR board: the inliers' extent in the fitted plane.
-    const Vec3 n = pair->lidar->plane.normal;
-    Vec3 centroid = Vec3::Zero();
-    for (int i : pair->lidar->inliers) centroid += cloud.points[i].cast<double>();
-    centroid /= std::max<size_t>(1, pair->lidar->inliers.size());
-    const Vec3 u = n.unitOrthogonal(), w = n.cross(u);
-    double u0 = 1e9, u1 = -1e9, w0 = 1e9, w1 = -1e9;
-    for (int i : pair->lidar->inliers) {
-      const Vec3 d = cloud.points[i].cast<double>() - centroid;
-      u0 = std::min(u0, d.dot(u)), u1 = std::max(u1, d.dot(u));
-      w0 = std::min(w0, d.dot(w)), w1 = std::max(w1, d.dot(w));
-    }
-    const Vec3 c[4] = {centroid + u0 * u + w0 * w, centroid + u1 * u + w0 * w,
-                       centroid + u1 * u + w1 * w, centroid + u0 * u + w1 * w};
-    add_quad(c, {60, 140, 255, 110});
+  mix(view_projection.data(), sizeof(float) * 16);
+  mix(&v.point_size_px, sizeof(double));
+  if (estimate) mix(estimate->matrix().data(), sizeof(double) * 16);
+  if (frame_key != scene_frame_key_ || gl_->scene_target.width() != tw ||
+      gl_->scene_target.height() != th) {
+    scene_frame_key_ = frame_key;
+    DrawScene(s, *pair, view_projection, estimate, tw, th);
   }
-  if (estimate) {
-    const Pose lidar_from_cam = estimate->inverse();
-    add_axes(lidar_from_cam, 0.3);
-    if (pair->camera) {
-      const BoardSpec& board = s.dataset->target;
-      const double hw = board.SheetWidth() / 2, hh = board.SheetHeight() / 2;
-      const Pose lidar_from_board = lidar_from_cam * pair->camera->cam_from_board;
-      const Vec3 c[4] = {lidar_from_board * Vec3(-hw, -hh, 0), lidar_from_board * Vec3(hw, -hh, 0),
-                         lidar_from_board * Vec3(hw, hh, 0), lidar_from_board * Vec3(-hw, hh, 0)};
-      add_quad(c, {255, 150, 40, 110});
-    }
-  }
-  gl_->scene_target.Resize(tw, th);
-  gl_->scene_target.Bind();
-  gl_->scene_target.Clear(0.08f, 0.08f, 0.1f, 1.0f);
-  gl_->scene_lines.Upload(lines, line_colors);
-  gl_->scene_lines.Draw(view_projection);
-  gl_->scene_points.Draw(view_projection, static_cast<float>(v.point_size_px));
-  gl_->scene_quads.Upload(quads, quad_colors);
-  gl_->scene_quads.Draw(view_projection);
   ImGui::Image(TextureId(gl_->scene_target.color_texture()), ImVec2(tw, th), ImVec2(0, 1),
                ImVec2(1, 0));
   if (ImGui::IsItemHovered()) {

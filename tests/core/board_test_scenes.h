@@ -14,41 +14,10 @@ namespace calibench::test {
 
 constexpr double kDeg = M_PI / 180.0;
 
-inline CameraModel PinholeCamera() {
-  CameraModel c;
-  c.type = CameraModelType::kPinholeRadTan;
-  c.width = 1440;
-  c.height = 1080;
-  c.fx = c.fy = 1000.0;
-  c.cx = 719.5;
-  c.cy = 539.5;
-  c.distortion = {-0.1, 0.05, 0.0005, -0.0003, 0.0};
-  return c;
-}
-
-inline CameraModel FisheyeCamera() {
-  CameraModel c;
-  c.type = CameraModelType::kKannalaBrandt;
-  c.width = 1440;
-  c.height = 1080;
-  c.fx = c.fy = 450.0;
-  c.cx = 719.5;
-  c.cy = 539.5;
-  c.distortion = {-0.01, 0.005, -0.002, 0.0005};
-  return c;
-}
-
-// A3 sheet, 7x5 inner corners, 40 mm squares.
-inline BoardSpec A3Checkerboard() {
-  BoardSpec b;
-  b.type = BoardType::kCheckerboard;
-  b.cols = 7;
-  b.rows = 5;
-  b.square_size = 0.04;
-  b.board_width = 0.42;
-  b.board_height = 0.297;
-  return b;
-}
+// The simulator's 1440x1080 cameras and A3 checkerboard.
+inline CameraModel PinholeCamera() { return DefaultSimCamera(false); }
+inline CameraModel FisheyeCamera() { return DefaultSimCamera(true); }
+inline BoardSpec A3Checkerboard() { return BoardPreset("a3"); }
 
 inline BoardSpec A3Charuco(const std::string& dictionary) {
   BoardSpec b;

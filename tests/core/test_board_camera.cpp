@@ -193,15 +193,9 @@ TEST(BoardCamera, PnpFailsWithAReason) {
 TEST(BoardCamera, RealFisheyeChessboard) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
   const ImageU8 image = LoadImage(shared / "datasets/acfr-vlp16-chessboard/images/pose16.png");
-  CameraModel camera;
-  camera.type = CameraModelType::kKannalaBrandt;
-  camera.width = 1920;
-  camera.height = 1208;
-  camera.fx = 1176.93;
-  camera.fy = 1177.72;
-  camera.cx = 962.275;
-  camera.cy = 612.725;
-  camera.distortion = {-0.0540096, -0.0784275, 0.0959641, -0.0515253};
+  const CameraModel camera =
+      LoadCameraFile(shared / "datasets/acfr-vlp16-chessboard/camera_info.yaml");
+  ASSERT_EQ(camera.type, CameraModelType::kKannalaBrandt);
   BoardSpec board;
   board.cols = 7;
   board.rows = 5;

@@ -12,23 +12,16 @@
 namespace calibench {
 namespace {
 
-// An A3 sheet. The fisheye camera (fx = 450 px) needs fewer, larger ChArUco squares so that its
-// 4x4 markers stay decodable (about 15 px wide) at 2 m.
+// An A3 sheet. The fisheye camera (fx = 450 px) needs fewer, larger ChArUco squares than the
+// "charuco-a3" preset so that its 4x4 markers stay decodable (about 15 px wide) at 2 m.
 BoardSpec A3Board(BoardType type, bool fisheye) {
-  BoardSpec b;
-  b.type = type;
-  b.square_size = 0.04;
-  b.board_width = 0.42;
-  b.board_height = 0.297;
-  if (type == BoardType::kCheckerboard) {
-    b.cols = 7;
-    b.rows = 5;
-  } else {
-    b.cols = fisheye ? 5 : 6;  // large squares so that the markers decode at range
-    b.rows = fisheye ? 3 : 4;
-    b.square_size = fisheye ? 0.08 : 0.065;
-    b.marker_size = fisheye ? 0.064 : 0.05;
-    b.dictionary = "DICT_4X4_50";
+  if (type == BoardType::kCheckerboard) return BoardPreset("a3");
+  BoardSpec b = BoardPreset("charuco-a3");
+  if (fisheye) {
+    b.cols = 5;
+    b.rows = 3;
+    b.square_size = 0.08;
+    b.marker_size = 0.064;
   }
   return b;
 }
