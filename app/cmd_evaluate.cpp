@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
@@ -24,6 +25,13 @@ void PrintError(const PoseError& error, const Mat6& covariance, const Pose& cam_
 }  // namespace
 
 int RunEvaluate(int argc, char** argv) {
+  // LRF results (cam_from_lrf) and the stereo-baseline check live in cmd_lrf.cpp.
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--stereo") return RunEvaluateLrf(argc, argv);
+    if ((arg == "--dataset" || arg == "-d") && i + 1 < argc && IsLrfManifest(argv[i + 1]))
+      return RunEvaluateLrf(argc, argv);
+  }
   CLI::App app{"Score a calibench.result.v1 file against a dataset's ground_truth.",
                "calibench evaluate"};
   std::string result_path, dataset_path;

@@ -1,5 +1,6 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <string>
 
 #include "app/commands.h"
 #include "app/sim_flags.h"
@@ -65,6 +66,9 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
 }
 
 int RunSimulate(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--kind" || std::string(argv[i]).rfind("--kind=", 0) == 0)
+      return RunSimulateLrf(argc, argv);
   CLI::App app{
       "Write a synthetic LiDAR + camera dataset (PCD, PNG, dataset.json) with ground truth.",
       "calibench simulate"};

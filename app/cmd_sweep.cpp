@@ -65,6 +65,9 @@ Cell RunSubsets(const std::vector<PairFeatures>& pool, int n, int subsets, const
 }  // namespace
 
 int RunSweep(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--kind" || std::string(argv[i]).rfind("--kind=", 0) == 0)
+      return RunSweepLrf(argc, argv);
   CLI::App app{"Error vs. number of pairs and LiDAR noise (Ca²Lib Table 1 protocol).",
                "calibench sweep"};
   std::string work_dir = "out/sweep", sizes_text = "3,4,5,10,20,30,39",

@@ -17,6 +17,8 @@
 #include "ui/gfx/context.h"
 #include "ui/gfx/framebuffer.h"
 #include "ui/imgui_host.h"
+#include "ui/lrf_controller.h"
+#include "ui/lrf_workbench.h"
 #include "ui/workbench.h"
 
 namespace calibench::app {
@@ -39,6 +41,99 @@ bool OpenInput(ui::Controller& controller, const std::string& dataset, const std
     return false;
   }
   return true;
+}
+
+// The LRF workbench in a window (a calibench.lrf-dataset.v1 manifest).
+int RunLrfGuiWindow(const std::string& dataset, int width, int height,
+                    const std::string& screenshot, int quit_after_frames) {
+  std::string why;
+  auto context = gfx::WindowContext::Create(width, height, "Calibench (2D LRF)", &why);
+  if (!context) {
+    std::fprintf(stderr,
+                 "calibench gui: cannot open a window: %s\n"
+                 "(no display? `calibench render` draws the same views to PNG)\n",
+                 why.c_str());
+    return kInputError;
+  }
+  ui::LrfController controller;
+  controller.Open(dataset);  // a bad manifest shows its error in the window's status line
+  ui::ImGuiHost host(context->window());
+  ui::LrfWorkbench workbench;
+  gfx::Framebuffer frame_target;
+  auto last = std::chrono::steady_clock::now();
+  for (int frame = 0; !glfwWindowShouldClose(context->window()); ++frame) {
+    glfwPollEvents();
+    int fb_width = 0, fb_height = 0;
+    glfwGetFramebufferSize(context->window(), &fb_width, &fb_height);
+    if (fb_width <= 0 || fb_height <= 0) continue;
+    const auto now = std::chrono::steady_clock::now();
+    const double dt = std::chrono::duration<double>(now - last).count();
+    last = now;
+    host.NewFrame(fb_width, fb_height, dt);
+    for (const ui::LrfIntent& intent : workbench.Frame(controller.GetSnapshot(), fb_width,
+                                                       fb_height, ui::LrfLayout::kWorkbench, dt))
+      controller.Apply(intent);
+    frame_target.Resize(fb_width, fb_height);
+    frame_target.Bind();
+    frame_target.Clear(0.06f, 0.06f, 0.07f, 1.0f);
+    host.Render();
+    const bool last_frame = quit_after_frames > 0 && frame + 1 >= quit_after_frames;
+    if (last_frame && !screenshot.empty()) {
+      SaveImage(screenshot, frame_target.ReadPixels());
+      std::printf("wrote %s\n", screenshot.c_str());
+    }
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, frame_target.framebuffer());
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glBlitFramebuffer(0, 0, fb_width, fb_height, 0, 0, fb_width, fb_height, GL_COLOR_BUFFER_BIT,
+                      GL_NEAREST);
+    glfwSwapBuffers(context->window());
+    if (last_frame) break;
+  }
+  return kOk;
+}
+
+int RenderLrfHeadless(const std::string& dataset, const std::string& pair, bool solve,
+                      const std::string& view, int width, int height, const std::string& out,
+                      gfx::HeadlessBackend backend) {
+  ui::LrfLayout layout;
+  if (!ui::ParseLrfLayout(view, &layout)) {
+    std::fprintf(stderr,
+                 "calibench render: for an LRF dataset --view must be scan, depth, 3d or "
+                 "workbench\n");
+    return kUsage;
+  }
+  std::string why;
+  auto context = gfx::CreateHeadlessContext(backend, &why);
+  if (!context) {
+    std::fprintf(stderr, "calibench render: no headless OpenGL: %s\n", why.c_str());
+    return kInputError;
+  }
+  ui::LrfController controller;
+  if (!controller.Open(dataset)) {
+    std::fprintf(stderr, "calibench render: %s\n", controller.GetSnapshot().status_line.c_str());
+    return kInputError;
+  }
+  controller.WaitIdle();
+  if (!pair.empty()) {
+    const ui::LrfSnapshot s = controller.GetSnapshot();
+    int index = -1;
+    for (size_t i = 0; i < s.pairs.size(); ++i)
+      if (s.pairs[i].id == pair) index = static_cast<int>(i);
+    if (index < 0) {
+      std::fprintf(stderr, "calibench render: no pair '%s' in %s\n", pair.c_str(), dataset.c_str());
+      return kInputError;
+    }
+    controller.Apply(ui::LrfSelectPair{index});
+  }
+  if (solve) controller.Apply(ui::LrfRunSolver{});
+  controller.WaitIdle();
+  ui::ImGuiHost host(nullptr);
+  ui::LrfWorkbench workbench;
+  SaveImage(out, ui::RenderLrfWorkbenchHeadless(controller, workbench, host, layout, width, height,
+                                                /*frames=*/4));
+  std::printf("wrote %s (%dx%d, %s, %s)\n", out.c_str(), width, height, view.c_str(),
+              context->Description().c_str());
+  return kOk;
 }
 
 }  // namespace
@@ -98,7 +193,8 @@ int RunGui(int argc, char** argv) {
       "calibench gui"};
   std::string dataset, session, size = "1600x900", screenshot;
   int quit_after_frames = 0;
-  app.add_option("--dataset,-d", dataset, "dataset.json or dataset folder");
+  app.add_option("--dataset,-d", dataset,
+                 "dataset.json or dataset folder, or an LRF manifest (calibench.lrf-dataset.v1)");
   app.add_option("--session,-s", session, "a saved session (calibench.session.v1)");
   app.add_option("--size", size, "window size WxH")->capture_default_str();
   app.add_option("--screenshot", screenshot, "write the last frame to this PNG");
@@ -113,6 +209,8 @@ int RunGui(int argc, char** argv) {
     std::fprintf(stderr, "calibench gui: --size must be WxH, e.g. 1600x900\n");
     return kUsage;
   }
+  if (!dataset.empty() && IsLrfManifest(dataset))
+    return RunLrfGuiWindow(dataset, width, height, screenshot, quit_after_frames);
   return RunGuiWindow(dataset, session, width, height, screenshot, quit_after_frames);
 }
 
@@ -121,6 +219,13 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
                    const std::string& out, const std::string& backend_name) {
   ui::Layout layout;
   gfx::HeadlessBackend backend;
+  if (!dataset.empty() && IsLrfManifest(dataset)) {
+    if (!gfx::ParseHeadlessBackend(backend_name, &backend)) {
+      std::fprintf(stderr, "calibench render: --gl must be auto, egl or osmesa\n");
+      return kUsage;
+    }
+    return RenderLrfHeadless(dataset, pair, solve, view, width, height, out, backend);
+  }
   if (!ui::ParseLayout(view, &layout)) {
     std::fprintf(stderr, "calibench render: --view must be lidar, camera, 3d or workbench\n");
     return kUsage;
@@ -208,7 +313,9 @@ int RunRender(int argc, char** argv) {
   app.add_option("--session,-s", session, "a saved session");
   app.add_option("--pair", pair, "pair id to show (default: the session's selection)");
   app.add_flag("--solve", solve, "run the solver before drawing");
-  app.add_option("--view", view, "lidar | camera | 3d | workbench")->capture_default_str();
+  app.add_option("--view", view,
+                 "lidar | camera | 3d | workbench (LRF datasets: scan | depth | 3d | workbench)")
+      ->capture_default_str();
   app.add_option("--size", size, "WxH")->capture_default_str();
   app.add_option("--out,-o", out, "PNG file")->required();
   app.add_option("--gl", gl, "auto | egl | osmesa")->capture_default_str();

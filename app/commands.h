@@ -21,6 +21,13 @@ int RunEvaluate(int argc, char** argv);
 int RunSimulate(int argc, char** argv);
 int RunDemo(int argc, char** argv);
 int RunSweep(int argc, char** argv);
+int RunLrfCalibrate(int argc, char** argv);
+// `simulate --kind lrf` and the LRF side of `evaluate` (dispatched from RunSimulate/RunEvaluate).
+int RunSimulateLrf(int argc, char** argv);
+int RunEvaluateLrf(int argc, char** argv);
+int RunSweepLrf(int argc, char** argv);
+// True when the file is a calibench.lrf-dataset.v1 manifest.
+bool IsLrfManifest(const std::string& path);
 int RunGui(int argc, char** argv);
 int RunRender(int argc, char** argv);
 

@@ -18,6 +18,9 @@ struct Command {
 constexpr Command kCommands[] = {
     {"calibrate", calibench::app::RunCalibrate,
      "calibrate a LiDAR to a camera from a dataset manifest; writes calibench.result.v1"},
+    {"lrf-calibrate", calibench::app::RunLrfCalibrate,
+     "calibrate a 2D laser rangefinder to a depth camera (three-face target) or an RGB camera "
+     "(checkerboard)"},
     {"evaluate", calibench::app::RunEvaluate, "score a result against a dataset's ground truth"},
     {"simulate", calibench::app::RunSimulate, "write a synthetic dataset with ground truth"},
     {"demo", calibench::app::RunDemo, "simulate the demo dataset, calibrate it, print the error"},
@@ -31,7 +34,7 @@ constexpr Command kCommands[] = {
 
 void PrintUsage() {
   std::printf("usage: calibench <command> [options]   (calibench <command> --help)\n\ncommands:\n");
-  for (const Command& c : kCommands) std::printf("  %-10s %s\n", c.name, c.help);
+  for (const Command& c : kCommands) std::printf("  %-14s %s\n", c.name, c.help);
 }
 
 }  // namespace

@@ -1,0 +1,81 @@
+// The LRF methods end to end: load an observation's files, extract its features, solve, and
+// write the result (calibench.result.v1 with cam_from_lrf / lrf_from_cam).
+//
+// Three-face target + depth camera (papers/lrf-depth-camera-vboard.txt): scan corners and face
+// lines, depth faces and their intersection lines, then paper-linear / refined / adaptive.
+// Checkerboard + RGB camera (Zhang & Pless 2004): scan points on the board, the board plane from
+// PnP (core pipeline), then the same refinement.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/board_camera.h"
+#include "core/lrf_dataset.h"
+#include "core/lrf_features.h"
+#include "core/lrf_solver.h"
+#include "core/pipeline.h"
+
+namespace calibench {
+
+struct LrfPipelineOptions {
+  ScanFeatureOptions scan;
+  DepthFeatureOptions depth;
+  BoardScanOptions board_scan;
+  BoardDetectionOptions detection;  // checkerboard case
+  PnpOptions pnp;                   // checkerboard case
+  LrfSolverOptions solver;
+  // Algorithm 1: > 0 = add observations in order until the newest one's Eq. (12) error falls
+  // below this (metres); 0 = use every accepted observation.
+  double adaptive_error_threshold_m = 0.0;
+  std::vector<std::string> pair_ids;  // empty = every pair
+  int threads = 1;
+  bool Check(std::string* why) const;
+};
+
+struct LrfPairFeatures {
+  std::string id;
+  PairStatus status = PairStatus::kPending;
+  std::string reason;
+  bool input_error = false;
+  LaserScan scan;                            // as loaded (empty on input error)
+  std::optional<LrfObservation> three_face;  // features (ok or not) for the three-face target
+  std::optional<DepthImage> depth;           // three-face: the depth frame (for display)
+  std::optional<BoardScanPoints> board_scan; // checkerboard: scan points on the board
+  std::optional<CameraBoardObservation> camera;  // checkerboard: PnP
+};
+
+// Never throws for bad data: the pair comes back kFailed with the reason (files named).
+LrfPairFeatures ExtractLrfPairFeatures(const LrfDataset& dataset, const LrfPairEntry& pair,
+                                       const LrfPipelineOptions& options);
+
+struct LrfCalibrationOutcome {
+  std::vector<LrfPairFeatures> pairs;
+  std::optional<LrfSolution> solution;  // absent when no calibration could be computed
+  std::string failure;                  // why `solution` is absent
+  std::optional<AdaptiveLrfResult> adaptive;  // when options.adaptive_error_threshold_m > 0
+};
+
+using LrfProgressCallback = std::function<void(int done, int total, const std::string& pair_id)>;
+
+LrfCalibrationOutcome CalibrateLrfDataset(const LrfDataset& dataset,
+                                          const LrfPipelineOptions& options,
+                                          const LrfProgressCallback& progress = {});
+// Solves from already extracted pairs (accepted ones only; pending ones with features count as
+// accepted), with the dataset's initial guess when the linear seed fails.
+LrfCalibrationOutcome SolveLrfFromFeatures(std::vector<LrfPairFeatures> pairs,
+                                           const LrfDataset& dataset,
+                                           const LrfPipelineOptions& options);
+
+// calibench.result.v1 with cam_from_lrf / lrf_from_cam; per pair: status, reason, corner and
+// face figures. Requires outcome.solution. WriteLrfResult writes atomically (IoError on failure).
+std::string LrfResultToJson(const LrfCalibrationOutcome& outcome,
+                            const LrfPipelineOptions& options);
+void WriteLrfResult(const std::filesystem::path& path, const LrfCalibrationOutcome& outcome,
+                    const LrfPipelineOptions& options);
+std::string FormatLrfSummary(const LrfCalibrationOutcome& outcome);
+
+}  // namespace calibench
