@@ -288,6 +288,19 @@ void WriteLrfResult(const std::filesystem::path& path, const LrfCalibrationOutco
   WriteFileAtomically(path, LrfResultToJson(outcome, options));
 }
 
+std::string LrfResidualText(const LrfSolution& solution, LrfTargetType target) {
+  if (target == LrfTargetType::kThreeFace)
+    return "Eq. (12) mean corner-to-line distance " + Millimetres(solution.mean_point_to_line_m);
+  double sum_sq = 0.0;
+  int count = 0;
+  for (double rms : solution.point_to_plane_rms_m) {
+    if (!std::isfinite(rms)) continue;
+    sum_sq += rms * rms;
+    ++count;
+  }
+  return "board point-to-plane RMS " + Millimetres(count ? std::sqrt(sum_sq / count) : 0.0);
+}
+
 std::string FormatLrfSummary(const LrfCalibrationOutcome& outcome) {
   std::ostringstream out;
   int accepted = 0;
@@ -307,6 +320,10 @@ std::string FormatLrfSummary(const LrfCalibrationOutcome& outcome) {
   const Vec3 rpy = LogSO3(pose.linear()) * 180.0 / M_PI;
   const Vec3 st = TranslationStd(s.covariance, pose) * 1e3;
   const Vec3 sr = RotationStdDeg(s.covariance, pose);
+  const LrfTargetType target = !outcome.pairs.empty() && !outcome.pairs.front().three_face &&
+                                       outcome.pairs.front().board_scan
+                                   ? LrfTargetType::kCheckerboard
+                                   : LrfTargetType::kThreeFace;
   char text[512];
   std::snprintf(text, sizeof(text),
                 "method %s, %d iterations%s\n"
@@ -314,10 +331,10 @@ std::string FormatLrfSummary(const LrfCalibrationOutcome& outcome) {
                 "camera axes)\n"
                 "              rotation vector [%.3f, %.3f, %.3f] deg (std %.3f / %.3f / %.3f "
                 "deg)\n"
-                "mean corner-to-line error (Eq. 12): %s\n",
+                "%s\n",
                 LrfMethodName(s.method).c_str(), s.iterations, s.converged ? ", converged" : "",
                 t.x(), t.y(), t.z(), st.x(), st.y(), st.z(), rpy.x(), rpy.y(), rpy.z(), sr.x(),
-                sr.y(), sr.z(), Millimetres(s.mean_point_to_line_m).c_str());
+                sr.y(), sr.z(), LrfResidualText(s, target).c_str());
   out << text;
   if (outcome.adaptive)
     out << "adaptive (Algorithm 1): " << outcome.adaptive->observations_used << " observations used"

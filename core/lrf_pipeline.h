@@ -78,4 +78,8 @@ void WriteLrfResult(const std::filesystem::path& path, const LrfCalibrationOutco
                     const LrfPipelineOptions& options);
 std::string FormatLrfSummary(const LrfCalibrationOutcome& outcome);
 
+// The solution's residual in words: the Eq. (12) mean corner-to-line distance for the three-face
+// target, the RMS point-to-plane distance of the board scan points for the checkerboard.
+std::string LrfResidualText(const LrfSolution& solution, LrfTargetType target);
+
 }  // namespace calibench

@@ -241,9 +241,12 @@ void LrfController::Solve() {
   UpdatePairFigures();
   const bool well = solution.observability.well_constrained;
   char line[256];
-  std::snprintf(line, sizeof(line), "solved (%s) with %zu pairs: Eq. (12) mean %.1f mm%s",
+  std::snprintf(line, sizeof(line), "solved (%s) with %zu pairs: %s%s",
                 LrfMethodName(solution.method).c_str(), solver.solved_pair_ids.size(),
-                solution.mean_point_to_line_m * 1e3, well ? "" : " (NOT well constrained)");
+                LrfResidualText(solution, state_.dataset ? state_.dataset->target_type
+                                                         : LrfTargetType::kThreeFace)
+                    .c_str(),
+                well ? "" : " (NOT well constrained)");
   SetStatus(line, !well);
 }
 

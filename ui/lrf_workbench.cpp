@@ -795,7 +795,7 @@ void LrfWorkbench::SolverPanel(const LrfSnapshot& s, const ViewRect& r,
     const Pose& pose = solution.cam_from_lrf;
     ImGui::Text("cam_from_lrf");
     ImGui::SameLine();
-    ImGui::TextDisabled("(x_cam = T * x_lrf)");
+    ImGui::TextDisabled("(x_cam = cam_from_lrf * x_lrf)");
     for (int row = 0; row < 3; ++row)
       ImGui::Text("  % .5f % .5f % .5f | % .4f", pose.matrix()(row, 0), pose.matrix()(row, 1),
                   pose.matrix()(row, 2), pose.matrix()(row, 3));
@@ -803,8 +803,11 @@ void LrfWorkbench::SolverPanel(const LrfSnapshot& s, const ViewRect& r,
     const Vec3& sr = s.solver.std_rotation_deg;
     ImGui::Text("std (camera x/y/z): %.1f %.1f %.1f mm, %.3f %.3f %.3f deg", st.x(), st.y(), st.z(),
                 sr.x(), sr.y(), sr.z());
-    ImGui::Text("Eq. (12) mean corner-to-line distance: %.1f mm over %zu pairs",
-                solution.mean_point_to_line_m * 1e3, s.solver.solved_pair_ids.size());
+    ImGui::Text(
+        "%s over %zu pairs",
+        LrfResidualText(solution, s.dataset ? s.dataset->target_type : LrfTargetType::kThreeFace)
+            .c_str(),
+        s.solver.solved_pair_ids.size());
     if (s.dataset && s.dataset->cam_from_lrf_ground_truth) {
       const Pose& truth = *s.dataset->cam_from_lrf_ground_truth;
       ImGui::TextDisabled("vs ground truth: %.1f mm, %.3f deg",

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -147,6 +148,89 @@ TEST_F(LrfCli, BadInputNamesTheFileAndKeepsTheOtherObservations) {
   EXPECT_EQ(test::RunCommand(Exe() + " lrf-calibrate --dataset " + empty_scan.string(), &out), 2)
       << out;
   EXPECT_NE(out.find("empty_scan.json"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace calibench
+
+namespace calibench {
+namespace {
+
+// The five real pairs of ../shared/datasets/acfr-rpg-2dlidar-chessboard (TurtleBot3: a 360°
+// 2D LiDAR above a 640x480 camera; an 11x8 chessboard of 19 mm squares taped to a white board
+// standing on the floor). The board plane is the white board's, so every scan return on it is
+// on the camera's board plane (Zhang & Pless).
+fs::path WriteRpgManifest(const fs::path& shared, const fs::path& dir) {
+  const fs::path data = shared / "datasets/acfr-rpg-2dlidar-chessboard";
+  std::vector<fs::path> images, scans;
+  for (const auto& e : fs::directory_iterator(data / "images")) images.push_back(e.path());
+  for (const auto& e : fs::directory_iterator(data / "lasers")) scans.push_back(e.path());
+  std::sort(images.begin(), images.end());
+  std::sort(scans.begin(), scans.end());
+  json manifest = {
+      {"format", "calibench.lrf-dataset.v1"},
+      // The authors' intrinsics (cam_intrinsic.py constants, see the dataset README).
+      {"camera",
+       {{"model", "pinhole-radtan"},
+        {"width", 640},
+        {"height", 480},
+        {"fx", 519.26845842},
+        {"fy", 518.89359517},
+        {"cx", 331.11197675},
+        {"cy", 229.43433605},
+        {"distortion", {0.11418155, 0.19343114, -0.00268067, 0.00371577, -1.09539701}}}},
+      {"target", {{"type", "checkerboard"}, {"inner_corners", {11, 8}}, {"square_size", 0.019}}},
+      // The nominal mount: LiDAR x forward, level, above the camera.
+      {"initial_guess",
+       {{"cam_from_lrf", {{0, -1, 0, 0}, {0, 0, -1, -0.1}, {1, 0, 0, 0}, {0, 0, 0, 1}}}}}};
+  json pairs = json::array();
+  for (size_t i = 0; i < images.size() && i < scans.size(); ++i) {
+    // The user's selection on the scan plot: the board ahead, within 1.6 m.
+    pairs.push_back({{"id", std::to_string(i)},
+                     {"scan", scans[i].string()},
+                     {"image", images[i].string()},
+                     {"scan_region",
+                      {{"angle_min_deg", -45},
+                       {"angle_max_deg", 45},
+                       {"range_min", 0.3},
+                       {"range_max", 1.6}}}});
+  }
+  manifest["pairs"] = pairs;
+  const fs::path path = dir / "rpg.json";
+  std::ofstream(path) << manifest.dump(2);
+  return path;
+}
+
+TEST(LrfRealData, AcfrRpgFivePairsLoadExtractAndSolve) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  const fs::path manifest = WriteRpgManifest(shared, test::TempDir("lrf_rpg"));
+  const LrfDataset dataset = LoadLrfDataset(manifest);
+  ASSERT_EQ(dataset.pairs.size(), 5u);
+  const LrfCalibrationOutcome outcome = CalibrateLrfDataset(dataset, LrfPipelineOptions{});
+  for (const LrfPairFeatures& p : outcome.pairs) {
+    EXPECT_EQ(p.status, PairStatus::kAccepted) << p.id << ": " << p.reason;
+    ASSERT_TRUE(p.board_scan && p.camera) << p.id;
+    EXPECT_GE(p.board_scan->points.size(), 30u) << p.id;
+    EXPECT_LT(p.camera->reprojection_rms_px, 0.5) << p.id;
+  }
+  ASSERT_TRUE(outcome.solution) << outcome.failure;
+  const LrfSolution& s = *outcome.solution;
+  std::printf("%s", FormatLrfSummary(outcome).c_str());
+  // Scan returns sit on the camera's board planes to within a few millimetres.
+  for (size_t i = 0; i < s.point_to_plane_rms_m.size(); ++i) {
+    std::printf("pair %zu: %zu board points, point-to-plane RMS %.1f mm\n", i,
+                outcome.pairs[i].board_scan->points.size(), s.point_to_plane_rms_m[i] * 1e3);
+    EXPECT_LT(s.point_to_plane_rms_m[i], 0.010);
+  }
+  // Boards standing upright and a level scan cannot fix the LiDAR's height or its tilt: the
+  // solver says so instead of inventing them.
+  EXPECT_FALSE(s.observability.well_constrained);
+  EXPECT_FALSE(s.observability.weak_directions.empty());
+  // The observable part agrees with the robot: the scan looks forward and level (within 10°
+  // of the nominal mount) and the LiDAR sits above and behind the camera.
+  const Mat3 nominal = (Mat3() << 0, -1, 0, 0, 0, -1, 1, 0, 0).finished();
+  EXPECT_LT(RotationAngle(s.cam_from_lrf.linear(), nominal) * 180 / M_PI, 10.0);
+  EXPECT_LT(s.cam_from_lrf.translation().z(), 0.0);
 }
 
 }  // namespace
