@@ -2,13 +2,18 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "app/sim_flags.h"
+#include "core/crlb.h"
 #include "core/dataset.h"
+#include "core/pipeline.h"
 #include "core/result_io.h"
+#include "core/sim.h"
 
 namespace calibench::app {
 namespace {
@@ -24,6 +29,25 @@ void PrintError(const PoseError& error, const Mat6& covariance, const Pose& cam_
 
 }  // namespace
 
+namespace {
+
+// The corner noise of a simulated dataset, measured as the mean of the PnP residual-based
+// estimates over its pairs (the renderer's noise has no closed-form pixel σ).
+double MeasureCornerSigma(const Dataset& dataset) {
+  PipelineOptions options;
+  double sum = 0.0;
+  int count = 0;
+  for (const PairEntry& pair : dataset.pairs) {
+    const PairFeatures f = ExtractPairFeatures(dataset, pair, options);
+    if (!f.camera) continue;
+    sum += f.camera->corner_sigma_px;
+    ++count;
+  }
+  return count > 0 ? sum / count : 0.0;
+}
+
+}  // namespace
+
 int RunEvaluate(int argc, char** argv) {
   // LRF results (cam_from_lrf) and the stereo-baseline check live in cmd_lrf.cpp.
   for (int i = 1; i < argc; ++i) {
@@ -32,22 +56,82 @@ int RunEvaluate(int argc, char** argv) {
     if ((arg == "--dataset" || arg == "-d") && i + 1 < argc && IsLrfManifest(argv[i + 1]))
       return RunEvaluateLrf(argc, argv);
   }
-  CLI::App app{"Score a calibench.result.v1 file against a dataset's ground_truth.",
-               "calibench evaluate"};
+  // `evaluate --sweep ...` is the Table 1 protocol (cmd_sweep.cpp) under the name issue 5 uses.
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--sweep") {
+      std::vector<char*> rest;
+      for (int k = 0; k < argc; ++k)
+        if (k != i) rest.push_back(argv[k]);
+      return RunSweep(static_cast<int>(rest.size()), rest.data());
+    }
+  }
+  CLI::App app{
+      "Score a calibench.result.v1 file against a dataset's ground_truth, and/or print "
+      "the Cramér–Rao bound of a simulated dataset.",
+      "calibench evaluate"};
   std::string result_path, dataset_path;
-  double max_translation_mm = -1, max_rotation_deg = -1;
-  app.add_option("--result,-r", result_path, "result.json")->required();
+  double max_translation_mm = -1, max_rotation_deg = -1, corner_sigma_px = 0;
+  bool crlb = false, sweep = false;
+  app.add_option("--result,-r", result_path, "result.json (optional with --crlb)");
   app.add_option("--dataset,-d", dataset_path, "dataset with ground_truth.cam_from_lidar")
       ->required();
   app.add_option("--max-translation-mm", max_translation_mm, "fail (exit 5) above this error");
   app.add_option("--max-rotation-deg", max_rotation_deg, "fail (exit 5) above this error");
+  app.add_flag("--crlb", crlb,
+               "print the Cramér–Rao bound of a simulated dataset (from its simulation record: "
+               "range noise, poses) and, with --result, error / bound");
+  app.add_option("--corner-sigma-px", corner_sigma_px,
+                 "corner noise the bound assumes [px]; default: measured from the dataset's "
+                 "PnP residuals");
+  app.add_flag("--sweep", sweep, "run the Table 1 sweep instead (see `calibench sweep --help`)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? kOk : kUsage;
   }
-  const LoadedResult result = LoadResult(result_path);
+  if (result_path.empty() && !crlb) {
+    std::fprintf(stderr, "calibench evaluate: --result is required (unless --crlb)\n");
+    return kUsage;
+  }
   const Dataset dataset = LoadDataset(dataset_path);
+  std::optional<CramerRaoBound> bound;
+  if (crlb) {
+    const SimOptions sim = SimOptionsFromDataset(dataset);
+    if (!(sim.lidar_range_noise_m > 0)) {
+      std::fprintf(stderr,
+                   "calibench evaluate: %s: the simulation has no LiDAR range noise, so the "
+                   "bound is zero\n",
+                   dataset.manifest.string().c_str());
+      return kInputError;
+    }
+    if (corner_sigma_px <= 0) corner_sigma_px = MeasureCornerSigma(dataset);
+    if (!(corner_sigma_px > 0)) {
+      std::fprintf(stderr,
+                   "calibench evaluate: no board found to measure the corner noise; "
+                   "give --corner-sigma-px\n");
+      return kInputError;
+    }
+    const SimulationBoundInput input = MakeSimulationBoundInput(sim, corner_sigma_px);
+    if (dataset.cam_from_lidar_ground_truth &&
+        !dataset.cam_from_lidar_ground_truth->isApprox(input.cam_from_lidar, 1e-9)) {
+      std::fprintf(stderr,
+                   "calibench evaluate: %s: the simulation record does not reproduce "
+                   "the ground truth\n",
+                   dataset.manifest.string().c_str());
+      return kInputError;
+    }
+    bound = SimulationBound(input);
+    const Vec3 st = TranslationStd(bound->covariance, input.cam_from_lidar) * 1000.0;
+    const Vec3 sr = RotationStdDeg(bound->covariance, input.cam_from_lidar);
+    std::printf(
+        "Cramér–Rao bound (%zu pairs, range noise %.1f mm, corner noise %.3f px): translation "
+        "%.2f mm RMS (std x/y/z %.2f / %.2f / %.2f mm, camera axes), rotation %.3f deg RMS\n",
+        input.pairs.size(), sim.lidar_range_noise_m * 1e3, corner_sigma_px,
+        bound->translation_rms_m * 1e3, st.x(), st.y(), st.z(), bound->rotation_rms_deg);
+    (void)sr;
+  }
+  if (result_path.empty()) return kOk;
+  const LoadedResult result = LoadResult(result_path);
   if (!dataset.cam_from_lidar_ground_truth) {
     std::fprintf(stderr, "calibench evaluate: %s has no ground_truth.cam_from_lidar\n",
                  dataset.manifest.string().c_str());
@@ -56,6 +140,10 @@ int RunEvaluate(int argc, char** argv) {
   const PoseError error =
       ComputePoseError(result.cam_from_source, *dataset.cam_from_lidar_ground_truth);
   PrintError(error, result.covariance, result.cam_from_source);
+  if (bound)
+    std::printf("error / bound: translation %.2f, rotation %.2f\n",
+                error.translation_m / bound->translation_rms_m,
+                error.rotation_rad * 180 / M_PI / bound->rotation_rms_deg);
   const bool too_far =
       (max_translation_mm >= 0 && error.translation_m * 1000 > max_translation_mm) ||
       (max_rotation_deg >= 0 && error.rotation_rad * 180 / M_PI > max_rotation_deg);

@@ -13,8 +13,9 @@ namespace calibench::app {
 void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) {
   PipelineOptions& o = flags.options;
   app.add_option("--method", flags.method,
-                 "ca2lib-gn (the paper) | weighted-ml (residuals whitened by the planes' "
-                 "covariances)")
+                 "weighted-ml (default: residuals whitened by both planes' covariances) | "
+                 "ca2lib-gn (the paper's unweighted Gauss-Newton) | kim (Kim et al. 2020: "
+                 "closed form from the normals, the paper's baseline)")
       ->capture_default_str();
   app.add_option("--huber-delta", o.solver.huber_delta, "Huber threshold on the plane error")
       ->capture_default_str();
@@ -36,7 +37,7 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
 bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {
   const auto method = ParseSolverMethod(flags.method);
   if (!method) {
-    *why = "--method must be ca2lib-gn or weighted-ml, not '" + flags.method + "'";
+    *why = "--method must be weighted-ml, ca2lib-gn or kim, not '" + flags.method + "'";
     return false;
   }
   flags.options.solver.method = *method;

@@ -12,7 +12,7 @@ struct PipelineFlags {
   PipelineOptions options;
   std::string pairs;          // comma-separated pair ids
   std::string initial_guess;  // result.json, or 16 numbers (row-major 4x4)
-  std::string method = "ca2lib-gn";
+  std::string method = "weighted-ml";
 };
 
 // with_selection adds --pairs and --initial-guess (not wanted where pairs are simulated).

@@ -187,6 +187,21 @@ Dataset LoadManifest(const fs::path& manifest) {
   if (root.contains("ground_truth") && root.at("ground_truth").contains("cam_from_lidar"))
     dataset.cam_from_lidar_ground_truth = PoseFromJson(root.at("ground_truth").at("cam_from_lidar"),
                                                        manifest, "ground_truth.cam_from_lidar");
+  if (root.contains("simulation")) {
+    const json& sim = root.at("simulation");
+    SimulationRecord record;
+    record.lidar_model = Get<std::string>(sim, "lidar_model", manifest, "simulation.");
+    record.num_pairs = Get<int>(sim, "num_pairs", manifest, "simulation.");
+    record.min_distance_m = Get<double>(sim, "min_distance_m", manifest, "simulation.");
+    record.max_distance_m = Get<double>(sim, "max_distance_m", manifest, "simulation.");
+    record.max_tilt_deg = Get<double>(sim, "max_tilt_deg", manifest, "simulation.");
+    record.lidar_range_noise_m = Get<double>(sim, "lidar_range_noise_m", manifest, "simulation.");
+    record.image_noise = Get<double>(sim, "image_noise", manifest, "simulation.");
+    record.clutter = Get<bool>(sim, "clutter", manifest, "simulation.");
+    record.seed_radius_m = Get<double>(sim, "seed_radius_m", manifest, "simulation.");
+    record.seed = Get<std::uint64_t>(sim, "seed", manifest, "simulation.");
+    dataset.simulation = record;
+  }
   return dataset;
 }
 
@@ -288,6 +303,15 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
     root["ground_truth"] = {
         {"cam_from_lidar", MatrixToJson(dataset.cam_from_lidar_ground_truth->matrix())},
         {"direction", "x_in_cam = cam_from_lidar * x_in_lidar"}};
+  if (dataset.simulation) {
+    const SimulationRecord& r = *dataset.simulation;
+    root["simulation"] = {
+        {"lidar_model", r.lidar_model},       {"num_pairs", r.num_pairs},
+        {"min_distance_m", r.min_distance_m}, {"max_distance_m", r.max_distance_m},
+        {"max_tilt_deg", r.max_tilt_deg},     {"lidar_range_noise_m", r.lidar_range_noise_m},
+        {"image_noise", r.image_noise},       {"clutter", r.clutter},
+        {"seed_radius_m", r.seed_radius_m},   {"seed", r.seed}};
+  }
   WriteFileAtomically(manifest_path, root.dump(2) + "\n");
 }
 

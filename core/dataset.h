@@ -2,6 +2,7 @@
 // camera intrinsics files (inline JSON, OpenCV FileStorage YAML, ROS camera_info YAML, Kalibr).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -53,6 +54,22 @@ struct PairEntry {
   std::optional<LidarSeed> lidar_seed;
 };
 
+// What `calibench simulate` was asked for, so that every pair's noise-free geometry can be
+// re-created (SimOptionsFromDataset in sim.h) for the Cramér–Rao bound. Camera, board and ground
+// truth are the dataset's own.
+struct SimulationRecord {
+  std::string lidar_model;  // "hdl64", "vlp16", "os0-128"
+  int num_pairs = 0;
+  double min_distance_m = 0.0;
+  double max_distance_m = 0.0;
+  double max_tilt_deg = 0.0;
+  double lidar_range_noise_m = 0.0;  // 1σ along each ray
+  double image_noise = 0.0;          // [0,1] intensity units
+  bool clutter = true;
+  double seed_radius_m = 0.0;
+  std::uint64_t seed = 1;
+};
+
 struct Dataset {
   std::filesystem::path manifest;  // the file read (or the folder for the shorthand)
   CameraModel camera;
@@ -60,6 +77,7 @@ struct Dataset {
   int lidar_rings = 0;  // 0 = unknown
   std::vector<PairEntry> pairs;
   std::optional<Pose> cam_from_lidar_ground_truth;
+  std::optional<SimulationRecord> simulation;
 };
 
 // Loads a manifest file, or a folder with clouds/ + images/ (paired by stem), camera.yaml and

@@ -20,6 +20,10 @@ struct LidarPlaneOptions {
   int min_inliers = 20;              // fewer inliers = no plane (a board needs a few rings)
   double min_inlier_fraction = 0.3;  // of the candidate points
   std::uint64_t seed = 1;            // RANSAC sampling order; same seed, same plane
+  // Final fit by maximum likelihood on the ranges along the rays (FitPlaneRangeMl). LiDAR noise
+  // lies along each ray, so the total-least-squares plane of a tilted board is biased (the bias
+  // grows with σ² and the tilt); false keeps the total-least-squares refit.
+  bool fit_ranges_ml = true;
   bool Check(std::string* why) const;
 };
 
@@ -31,7 +35,8 @@ struct LidarPlaneFit {
   double rms_m = 0.0;              // point-to-plane RMS of the inliers
 };
 
-// Points within `seed.radius` (metres) of `seed.point`.
+// Points on rays within the cone that a disc of `seed.radius` (metres) around `seed.point`
+// subtends from the LiDAR, and within max(3 radius, 0.3 m) of its range.
 std::vector<int> SelectSeedRegion(const LidarCloud& cloud, const LidarSeed& seed);
 
 // Points under brushed LiDAR-image pixels (indices into image.point_index).
@@ -47,5 +52,14 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
 // residual variance estimated from the fit. Needs >= 4 points not on a line.
 std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
                                                   const std::vector<int>& indices);
+
+// Maximum likelihood plane under range noise along the rays from the LiDAR origin: minimises
+// Σ (r_i − r̂_i)², r_i = |x_i|, r̂_i = −d / (n·u_i) the range at which ray u_i = x_i/|x_i| meets
+// the plane (Gauss-Newton on n's tangent plane and d, started at `initial`). Covariance
+// σ̂² (JᵀJ)⁻¹ with σ̂² from the range residuals; rms_m is the range RMS. nullopt when fewer than 4
+// points, a ray parallel to the plane, or no convergence.
+std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
+                                             const std::vector<int>& indices,
+                                             const Plane& initial);
 
 }  // namespace calibench

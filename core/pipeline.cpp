@@ -133,7 +133,7 @@ CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,
                       " with different board orientations are needed";
     return outcome;
   }
-  if (options.initial_cam_from_lidar) {
+  if (options.initial_cam_from_lidar && options.solver.method != SolverMethod::kKim) {
     outcome.initial_cam_from_lidar = *options.initial_cam_from_lidar;
   } else {
     std::string why;

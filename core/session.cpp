@@ -63,6 +63,7 @@ Session NewSession(const Dataset& dataset) {
 }
 
 void ApplySessionOptions(const Session& session, PipelineOptions* options) {
+  options->solver.method = session.method;
   options->solver.huber_delta = session.huber_delta;
   options->solver.max_iterations = session.max_iterations;
   options->lidar_plane.ransac_threshold_m = session.ransac_threshold_m;

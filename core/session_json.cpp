@@ -352,6 +352,14 @@ SessionResult ReadResult(const Fields& f) {
 }
 
 void ReadOptions(const Fields& f, Session* s) {
+  // Sessions written before the method was selectable have no "method": the default applies.
+  if (f.Has("method")) {
+    const std::string name = f.String("method");
+    const auto method = ParseSolverMethod(name);
+    if (!method)
+      throw FormatError(f.Path("method") + ": '" + name + "' is not weighted-ml, ca2lib-gn or kim");
+    s->method = *method;
+  }
   s->huber_delta = f.Positive("huber_delta");
   s->max_iterations = f.Int("max_iterations");
   if (s->max_iterations < 1) throw FormatError(f.Path("max_iterations") + ": must be at least 1");
@@ -410,7 +418,8 @@ std::string SessionToJson(const Session& session, const std::filesystem::path& s
                {"version", session.version},
                {"dataset", DatasetPathForFile(session.dataset, session_path)},
                {"options",
-                {{"huber_delta", Number(session.huber_delta)},
+                {{"method", SolverMethodName(session.method)},
+                 {"huber_delta", Number(session.huber_delta)},
                  {"max_iterations", session.max_iterations},
                  {"ransac_threshold_m", Number(session.ransac_threshold_m)}}},
                {"pairs", pairs},

@@ -360,6 +360,58 @@ std::vector<Pose> SampleBoardPoses(const SimOptions& options) {
   return poses;
 }
 
+SimOptions ResolveSimOptions(const SimOptions& options) { return Resolve(options); }
+
+std::vector<SimPairTruth> SimulatePairTruth(const SimOptions& options) {
+  CheckOrThrow(options);
+  const SimOptions r = Resolve(options);
+  const BeamTable beams = MakeBeamTable(r.lidar);
+  const BoardPrint print(r.board);
+  const Pose lidar_from_cam = r.cam_from_lidar.inverse();
+  std::vector<SimPairTruth> truth;
+  for (const PairPlan& plan : PlanPairs(r, beams, print, RoomScene(r))) {
+    SimPairTruth pair;
+    pair.cam_from_board = plan.cam_from_board;
+    const LidarScan scan =
+        ScanBoardOnly(beams, print, lidar_from_cam * plan.cam_from_board, plan.azimuth_offset_rad);
+    for (const Eigen::Vector3f& p : scan.ToCloud().points)
+      pair.lidar_board_points.push_back(p.cast<double>());
+    truth.push_back(std::move(pair));
+  }
+  return truth;
+}
+
+SimOptions SimOptionsFromDataset(const Dataset& dataset) {
+  if (!dataset.simulation)
+    throw IoError(dataset.manifest.string() +
+                  ": no \"simulation\" record (only datasets written by `calibench simulate` "
+                  "carry the noise settings the bound needs)");
+  const SimulationRecord& record = *dataset.simulation;
+  SimOptions options;
+  const auto lidar = ParseLidarModelName(record.lidar_model);
+  if (!lidar)
+    throw IoError(dataset.manifest.string() + ": simulation.lidar_model '" + record.lidar_model +
+                  "' is not hdl64, vlp16 or os0-128");
+  options.lidar = *lidar;
+  options.camera = dataset.camera;
+  options.board = dataset.target;
+  options.num_pairs = record.num_pairs;
+  options.min_distance_m = record.min_distance_m;
+  options.max_distance_m = record.max_distance_m;
+  options.max_tilt_deg = record.max_tilt_deg;
+  options.lidar_range_noise_m = record.lidar_range_noise_m;
+  options.image_noise = record.image_noise;
+  options.clutter = record.clutter;
+  options.seed_radius_m = record.seed_radius_m;
+  options.seed = record.seed;
+  if (dataset.cam_from_lidar_ground_truth)
+    options.cam_from_lidar = *dataset.cam_from_lidar_ground_truth;
+  std::string why;
+  if (!options.Check(&why))
+    throw IoError(dataset.manifest.string() + ": simulation record: " + why);
+  return options;
+}
+
 Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& out_dir) {
   CheckOrThrow(options);
   const SimOptions r = Resolve(options);
@@ -376,6 +428,18 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
   dataset.target = r.board;
   dataset.lidar_rings = static_cast<int>(beams.elevations_rad.size());
   dataset.cam_from_lidar_ground_truth = r.cam_from_lidar;
+  SimulationRecord record;
+  record.lidar_model = LidarModelName(r.lidar);
+  record.num_pairs = r.num_pairs;
+  record.min_distance_m = r.min_distance_m;
+  record.max_distance_m = r.max_distance_m;
+  record.max_tilt_deg = r.max_tilt_deg;
+  record.lidar_range_noise_m = r.lidar_range_noise_m;
+  record.image_noise = r.image_noise;
+  record.clutter = r.clutter;
+  record.seed_radius_m = r.seed_radius_m;
+  record.seed = r.seed;
+  dataset.simulation = record;
   const Pose lidar_from_cam = r.cam_from_lidar.inverse();
   for (int k = 0; k < r.num_pairs; ++k) {
     const PairPlan plan = PlanPair(r, beams, print, scene, k);

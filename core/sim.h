@@ -149,6 +149,22 @@ ImageU8 RenderBoardImage(const CameraModel& camera, const BoardSpec& board,
 // corners row-major (x fastest); ChArUco chessboard corners by id (OpenCV's id order).
 std::vector<Vec3> BoardCornerPoints(const BoardSpec& board);
 
+// The options with every default filled in (camera, board with its sheet size, mount, seed
+// radius), as the simulator uses them.
+SimOptions ResolveSimOptions(const SimOptions& options);
+
+// Each pair's noise-free geometry as SimulateDataset places it: the board pose and the board's
+// returns without range noise (LiDAR frame, the board alone). For the Cramér–Rao bound.
+struct SimPairTruth {
+  Pose cam_from_board = Pose::Identity();
+  std::vector<Vec3> lidar_board_points;
+};
+std::vector<SimPairTruth> SimulatePairTruth(const SimOptions& options);
+
+// The simulator's options as recorded in a dataset it wrote (Dataset::simulation); throws
+// IoError naming the manifest when the dataset carries no simulation record.
+SimOptions SimOptionsFromDataset(const Dataset& dataset);
+
 // Writes dataset.json, clouds/NNNN.pcd and images/NNNN.png under out_dir and returns the dataset
 // as written (absolute paths, ground truth set). Throws IoError on write failures,
 // std::invalid_argument for options that fail Check, std::runtime_error as SampleBoardPoses.

@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -10,12 +11,21 @@
 namespace calibench {
 
 std::string SolverMethodName(SolverMethod method) {
-  return method == SolverMethod::kCa2libGn ? "ca2lib-gn" : "weighted-ml";
+  switch (method) {
+    case SolverMethod::kCa2libGn:
+      return "ca2lib-gn";
+    case SolverMethod::kWeightedMl:
+      return "weighted-ml";
+    case SolverMethod::kKim:
+      return "kim";
+  }
+  return "unknown";
 }
 
 std::optional<SolverMethod> ParseSolverMethod(const std::string& name) {
   if (name == "ca2lib-gn") return SolverMethod::kCa2libGn;
   if (name == "weighted-ml") return SolverMethod::kWeightedMl;
+  if (name == "kim") return SolverMethod::kKim;
   return std::nullopt;
 }
 
@@ -28,6 +38,8 @@ bool SolverOptions::Check(std::string* why) const {
   if (!(whitened_huber_delta > 0)) return fail("whitened_huber_delta must be > 0 (sigmas)");
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
   if (!(step_tolerance > 0)) return fail("step_tolerance must be > 0");
+  if (!(outlier_gate == 0 || outlier_gate >= 2))
+    return fail("outlier_gate must be 0 (off) or at least 2 robust scales");
   if (!(weak_eigenvalue_ratio > 0 && weak_eigenvalue_ratio < 1))
     return fail("weak_eigenvalue_ratio must be in (0, 1)");
   return true;
@@ -164,7 +176,11 @@ PlaneAlignmentSolver::PlaneAlignmentSolver(std::vector<PlanePair> pairs,
   std::string why;
   CALIBENCH_CHECK(options_.Check(&why));
   CALIBENCH_CHECK(!pairs_.empty());
+  gated_.assign(pairs_.size(), 0);
+  iteration_budget_ = options_.max_iterations;
   history_.push_back({0, Linearize(cam_from_lidar_).cost, 0.0, cam_from_lidar_});
+  // Kim et al.'s estimate is the closed form itself: nothing to iterate.
+  if (options_.method == SolverMethod::kKim) done_ = converged_ = true;
 }
 
 double PlaneAlignmentSolver::HuberDelta() const {
@@ -186,8 +202,9 @@ PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(
     const Pose& cam_from_lidar) const {
   Linearization lin;
   if (options_.method == SolverMethod::kWeightedMl) {
-    for (const PlanePair& pair : pairs_) {
-      const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar, pair);
+    for (size_t i = 0; i < pairs_.size(); ++i) {
+      if (gated_[i]) continue;
+      const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar, pairs_[i]);
       const Mat3 information = w.covariance.inverse();
       const double mahalanobis = std::sqrt(w.residual.dot(information * w.residual));
       const double weight = RobustWeight(mahalanobis);
@@ -234,8 +251,49 @@ bool PlaneAlignmentSolver::Step() {
       {static_cast<int>(history_.size()), std::min(cost, lin.cost), step_norm, cam_from_lidar_});
   converged_ = step_norm < options_.step_tolerance ||
                (lin.cost - cost >= 0 && lin.cost - cost <= 1e-15 * std::max(1.0, lin.cost));
-  done_ = converged_ || static_cast<int>(history_.size()) > options_.max_iterations;
+  done_ = converged_ || static_cast<int>(history_.size()) > iteration_budget_;
+  if (done_ && GateOutliers()) {
+    // Continue from here without the gated pairs, with a fresh iteration budget; costs before
+    // and after are not comparable.
+    history_.back().cost = Linearize(cam_from_lidar_).cost;
+    done_ = converged_ = false;
+    iteration_budget_ = static_cast<int>(history_.size()) + options_.max_iterations;
+  }
   return !done_;
+}
+
+bool PlaneAlignmentSolver::GateOutliers() {
+  // Up to three rounds, each judged afresh at the current estimate: a gross outlier drags the
+  // first estimate, so good pairs may look bad until it is gone, and come back then.
+  if (gating_rounds_ >= 3 || options_.method != SolverMethod::kWeightedMl ||
+      options_.outlier_gate <= 0)
+    return false;
+  ++gating_rounds_;
+  std::vector<double> norms;
+  for (const PlanePair& pair : pairs_) {
+    const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar_, pair);
+    norms.push_back(std::sqrt(w.residual.dot(w.covariance.inverse() * w.residual)));
+  }
+  std::vector<double> sorted = norms;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  // The median of a χ(3) variable is 1.538.
+  const double scale = std::max(1.0, sorted[sorted.size() / 2] / 1.538);
+  // Only the worst pair beyond the gate goes per round: it is the one most likely to be the
+  // cause of the others' residuals.
+  std::vector<char> gated = gated_;
+  for (size_t i = 0; i < pairs_.size(); ++i)
+    if (gated[i] && norms[i] <= options_.outlier_gate * scale) gated[i] = 0;  // back in
+  int worst = -1;
+  for (size_t i = 0; i < pairs_.size(); ++i)
+    if (!gated[i] && norms[i] > options_.outlier_gate * scale &&
+        (worst < 0 || norms[i] > norms[worst]))
+      worst = static_cast<int>(i);
+  if (worst >= 0) gated[worst] = 1;
+  // Never gate so much that the problem loses its redundancy.
+  if (std::count(gated.begin(), gated.end(), 0) < 3) return false;
+  const bool changed = gated != gated_;
+  gated_ = gated;
+  return changed;
 }
 
 SolverResult PlaneAlignmentSolver::Run(
@@ -246,6 +304,15 @@ SolverResult PlaneAlignmentSolver::Run(
   }
   if (on_iteration && history_.size() > 1) on_iteration(history_.back());
   return Summarize();
+}
+
+Mat6 WeightedPlaneInformation(const std::vector<PlanePair>& pairs, const Pose& cam_from_lidar) {
+  Mat6 information = Mat6::Zero();
+  for (const PlanePair& pair : pairs) {
+    const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar, pair);
+    information += w.jacobian.transpose() * w.covariance.inverse() * w.jacobian;
+  }
+  return information;
 }
 
 SolverResult PlaneAlignmentSolver::Summarize() const {
@@ -261,8 +328,10 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
     result.residuals.push_back(e);
     if (weighted) {
       const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar_, pair);
+      const bool gated = gated_[&pair - pairs_.data()];
       result.robust_weights.push_back(
-          RobustWeight(std::sqrt(w.residual.dot(w.covariance.inverse() * w.residual))));
+          gated ? 0.0
+                : RobustWeight(std::sqrt(w.residual.dot(w.covariance.inverse() * w.residual))));
     } else {
       result.robust_weights.push_back(RobustWeight(e.norm()));
     }
@@ -272,7 +341,9 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   // which has no noise model, that is the noise estimate itself (4 residuals per pair); for the
   // weighted residual (3 per pair) it absorbs what the feature covariances miss on real sensors.
   const int per_pair = weighted ? 3 : 4;
-  const int redundancy = per_pair * static_cast<int>(pairs_.size()) - 6;
+  const int used_pairs = static_cast<int>(pairs_.size()) -
+                         static_cast<int>(std::count(gated_.begin(), gated_.end(), 1));
+  const int redundancy = per_pair * used_pairs - 6;
   const double variance_factor = redundancy > 0 ? lin.weighted_squared_error / redundancy : 0.0;
   Eigen::SelfAdjointEigenSolver<Mat6> eigen(lin.information);
   Vec6 inverse_eigenvalues;

@@ -25,15 +25,22 @@ struct PlanePair {
 enum class SolverMethod {
   kCa2libGn,    // the paper: unweighted plane-to-plane error, Eq. (6), Huber on |e|
   kWeightedMl,  // residuals whitened by both planes' covariances, Huber on the Mahalanobis norm
+  kKim,         // Kim et al. 2020, the paper's baseline: InitialGuessFromPlanes, no refinement
 };
-std::string SolverMethodName(SolverMethod method);  // "ca2lib-gn", "weighted-ml"
+std::string SolverMethodName(SolverMethod method);  // "ca2lib-gn", "weighted-ml", "kim"
 std::optional<SolverMethod> ParseSolverMethod(const std::string& name);
 
 struct SolverOptions {
-  SolverMethod method = SolverMethod::kCa2libGn;
+  SolverMethod method = SolverMethod::kWeightedMl;
   double huber_delta = 0.1;  // Huber threshold on |e_p| (Eq. (6) mixes unitless and metres)
   // kWeightedMl: Huber threshold on the whitened residual, in standard deviations.
   double whitened_huber_delta = 3.0;
+  // kWeightedMl: once converged, the worst pair whose Mahalanobis residual exceeds outlier_gate
+  // robust scales is given weight 0 and the solve continues (up to three rounds; a gated pair
+  // whose residual falls back inside the gate returns). The robust scale is the median
+  // Mahalanobis norm over its χ(3) expectation (1.54), at least 1: on real sensors, whose plane
+  // residuals exceed the propagated noise, the gate widens with them. 0 = no gating.
+  double outlier_gate = 4.0;
   int max_iterations = 50;       // Gauss-Newton iterations
   double step_tolerance = 1e-9;  // stop when |delta| (m, rad) falls below this
   // A direction of the information matrix whose eigenvalue is below this fraction of the largest
@@ -62,7 +69,7 @@ struct SolverResult {
   int iterations = 0;
   std::vector<double> cost_history;    // one entry per iteration, the initial cost first
   std::vector<Vec4> residuals;         // per pair, Eq. (6) at the solution
-  std::vector<double> robust_weights;  // per pair, Huber IRLS weight at the solution
+  std::vector<double> robust_weights;  // per pair, Huber IRLS weight at the solution (0 = gated)
   ObservabilityReport observability;
 };
 
@@ -74,6 +81,11 @@ std::optional<Pose> InitialGuessFromPlanes(const std::vector<PlanePair>& pairs, 
 // Observability of the extrinsic from a set of planes at an estimate.
 ObservabilityReport AnalyseObservability(const Mat6& information, const Pose& cam_from_lidar,
                                          double weak_eigenvalue_ratio);
+
+// Σ Jᵢᵀ Sᵢ⁻¹ Jᵢ of the weighted residual (SolverMethod::kWeightedMl) at cam_from_lidar, with each
+// pair's own covariances, no robust weights and no variance factor. With noise-free planes and the
+// features' Cramér–Rao covariances this is the Fisher information of the extrinsic.
+Mat6 WeightedPlaneInformation(const std::vector<PlanePair>& pairs, const Pose& cam_from_lidar);
 
 // Eq. (14) solved by Gauss-Newton with iteratively reweighted Huber weights.
 class PlaneAlignmentSolver {
@@ -104,7 +116,13 @@ class PlaneAlignmentSolver {
   double RobustWeight(double error_norm) const;
   double RobustCost(double error_norm) const;
 
+  // One round of outlier gating (SolverOptions::outlier_gate); true when the gated set changed.
+  bool GateOutliers();
+
   std::vector<PlanePair> pairs_;
+  std::vector<char> gated_;  // per pair: dropped as an outlier
+  int gating_rounds_ = 0;
+  int iteration_budget_ = 0;  // history size at which Step stops
   SolverOptions options_;
   Pose cam_from_lidar_;
   std::vector<IterationReport> history_;

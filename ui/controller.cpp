@@ -162,6 +162,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
 void Controller::ApplySessionToState(const Session& session) {
   ApplySessionOptions(session, &pipeline_);
   state_.view = session.view;
+  state_.method = session.method;
   state_.huber_delta = session.huber_delta;
   state_.max_iterations = session.max_iterations;
   for (size_t i = 0; i < session.pairs.size() && i < state_.pairs.size(); ++i) {
@@ -203,6 +204,7 @@ void Controller::CommitEdit() {
       state_.selected >= 0 && state_.selected < static_cast<int>(state_.pairs.size());
   state_.view.selected_pair = had_selected ? state_.pairs[state_.selected].id : "";
   session_.view = state_.view;
+  session_.method = state_.method;
   session_.huber_delta = state_.huber_delta;
   session_.max_iterations = state_.max_iterations;
   for (size_t i = 0; i < state_.pairs.size(); ++i) {
@@ -342,6 +344,7 @@ void Controller::RecomputeResiduals() {
   }
   if (planes.empty()) return;
   SolverOptions options = pipeline_.solver;
+  options.method = state_.method;
   options.huber_delta = state_.huber_delta;
   const SolverResult at_estimate =
       PlaneAlignmentSolver(planes, options, state_.solver.result->cam_from_lidar).Summarize();
@@ -360,6 +363,7 @@ void Controller::Solve() {
       if (pair.status == PairStatus::kAccepted && pair.lidar && pair.camera)
         planes.push_back(MakePlanePair(pair.id, *pair.lidar, *pair.camera));
     options = pipeline_.solver;
+    options.method = state_.method;
     options.huber_delta = state_.huber_delta;
     options.max_iterations = state_.max_iterations;
     state_.solver = SolverView{};
@@ -542,8 +546,12 @@ void Controller::Apply(const Intent& intent) {
       SetStatus("solver options: " + why, true);
       return;
     }
+    const bool method_changed = state_.method != options->method;
+    state_.method = options->method;
     state_.huber_delta = options->huber_delta;
     state_.max_iterations = options->max_iterations;
+    // Residuals and weights shown for the current estimate depend on the method.
+    if (method_changed) RecomputeResiduals();
     CommitEdit();
   } else if (const auto* view = std::get_if<SetView>(&intent)) {
     const bool visibility_changed =
@@ -582,6 +590,7 @@ void Controller::Apply(const Intent& intent) {
         outcome.solution->robust_weights.push_back(pair.robust_weight);
       }
     SolverOptions options;
+    options.method = state_.method;
     options.huber_delta = state_.huber_delta;
     try {
       WriteResult(export_result->path, outcome, options);

@@ -76,6 +76,7 @@ struct Snapshot {
   SolverView solver;
   std::shared_ptr<const Reprojection> reprojection;
   ViewState view;
+  SolverMethod method = SolverOptions{}.method;
   double huber_delta = SolverOptions{}.huber_delta;
   int max_iterations = SolverOptions{}.max_iterations;
   bool can_undo = false, can_redo = false;
@@ -108,6 +109,7 @@ struct ResetSolver {};
 struct SetSolverOptions {
   double huber_delta;
   int max_iterations;
+  SolverMethod method = SolverOptions{}.method;
 };
 struct SetView {
   ViewState view;

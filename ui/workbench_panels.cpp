@@ -128,9 +128,30 @@ void Workbench::SolverPanel(const Snapshot& s, const ViewRect& r, std::vector<In
   ImGui::SetNextWindowPos({r.x, r.y});
   ImGui::SetNextWindowSize({r.w, r.h});
   if (!ImGui::Begin("Solver", nullptr, kPanelFlags)) return ImGui::End();
-  ImGui::TextDisabled("method: ca2lib-gn (plane-to-plane Gauss-Newton, Huber kernel)");
+  static constexpr SolverMethod kMethods[] = {SolverMethod::kWeightedMl, SolverMethod::kCa2libGn,
+                                              SolverMethod::kKim};
+  static constexpr const char* kMethodHelp[] = {
+      "weighted-ml: both planes' covariances whiten the residual (default)",
+      "ca2lib-gn: the paper's unweighted plane-to-plane Gauss-Newton",
+      "kim: closed form from the normals (Kim et al. 2020), no refinement"};
+  int method_index = 0;
+  for (int i = 0; i < 3; ++i)
+    if (kMethods[i] == s.method) method_index = i;
   double delta = s.huber_delta;
   int iterations = s.max_iterations;
+  SolverMethod method = s.method;
+  ImGui::SetNextItemWidth(140);
+  if (ImGui::BeginCombo("method", SolverMethodName(s.method).c_str())) {
+    for (int i = 0; i < 3; ++i) {
+      if (ImGui::Selectable(SolverMethodName(kMethods[i]).c_str(), i == method_index))
+        method = kMethods[i];
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", kMethodHelp[i]);
+    }
+    ImGui::EndCombo();
+  }
+  if (method != s.method) intents->push_back(SetSolverOptions{delta, iterations, method});
+  ImGui::SameLine();
+  ImGui::TextDisabled("%s", kMethodHelp[method_index]);
   ImGui::SetNextItemWidth(120);
   ImGui::InputDouble("Huber delta", &delta, 0.01, 0.1, "%.3f");
   const bool delta_done = ImGui::IsItemDeactivatedAfterEdit();
@@ -138,7 +159,7 @@ void Workbench::SolverPanel(const Snapshot& s, const ViewRect& r, std::vector<In
   ImGui::SetNextItemWidth(100);
   ImGui::InputInt("max iterations", &iterations);
   if (delta_done || ImGui::IsItemDeactivatedAfterEdit())
-    intents->push_back(SetSolverOptions{delta, iterations});
+    intents->push_back(SetSolverOptions{delta, iterations, s.method});
   const bool solved = !s.solver.iterations.empty();
   ImGui::BeginDisabled(s.solver.running);
   if (ImGui::Button("Run (F5)")) {

@@ -117,3 +117,82 @@ TEST(LidarPlane, OptionsCheck) {
 
 }  // namespace
 }  // namespace calibench
+
+namespace calibench {
+namespace {
+
+// A steeply tilted board far away with heavy range noise: the regime where noise along the rays
+// biases a total-least-squares plane (points spread along the rays, not along the normal).
+LidarCloud TiltedBoardCloud(double noise_m, std::uint64_t seed, Plane* truth) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, noise_m);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const Vec3 centre(5.0, 0.5, 0.0);
+  // Board normal 60° away from the ray to its centre.
+  const Mat3 board_axes = ExpSO3(Vec3(0.0, 0.0, 60.0 * M_PI / 180.0));
+  const Vec3 u = board_axes.col(1), v = board_axes.col(2);
+  *truth = OrientTowardsOrigin(Plane{board_axes.col(0), -board_axes.col(0).dot(centre)});
+  LidarCloud cloud;
+  for (int i = 0; i < 300; ++i) {
+    const Vec3 p = centre + 0.21 * uniform(rng) * u + 0.15 * uniform(rng) * v;
+    cloud.points.push_back((p + normal(rng) * p.normalized()).cast<float>());
+  }
+  return cloud;
+}
+
+struct FitStats {
+  Vec4 mean_error = Vec4::Zero();
+  Vec4 rms_error = Vec4::Zero();
+  double mean_normalised = 0.0;  // mean of eᵀ Σ⁺ e over trials (3 dof: expect ~3)
+};
+
+template <typename FitFn>
+FitStats RepeatFits(int trials, double noise_m, FitFn fit_fn) {
+  FitStats stats;
+  for (int t = 0; t < trials; ++t) {
+    Plane truth;
+    const LidarCloud cloud = TiltedBoardCloud(noise_m, 500 + t, &truth);
+    std::vector<int> all(cloud.size());
+    std::iota(all.begin(), all.end(), 0);
+    const std::optional<LidarPlaneFit> fit = fit_fn(cloud, all);
+    EXPECT_TRUE(fit);
+    if (!fit) continue;
+    const Vec4 e = fit->plane.Coefficients() - truth.Coefficients();
+    stats.mean_error += e / trials;
+    stats.rms_error += e.cwiseAbs2() / trials;
+    Eigen::JacobiSVD<Mat4> svd(fit->covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Vec4 inv_s = Vec4::Zero();
+    for (int k = 0; k < 3; ++k) inv_s(k) = 1.0 / svd.singularValues()(k);
+    const Mat4 pinv = svd.matrixV() * inv_s.asDiagonal() * svd.matrixU().transpose();
+    stats.mean_normalised += e.dot(pinv * e) / trials;
+  }
+  stats.rms_error = stats.rms_error.cwiseSqrt();
+  return stats;
+}
+
+TEST(LidarPlane, RangeMaximumLikelihoodRemovesTheTiltBiasOfLeastSquares) {
+  const int trials = 300;
+  const double noise_m = 0.03;
+  const FitStats tls = RepeatFits(trials, noise_m, [](const LidarCloud& c, const auto& idx) {
+    return FitPlaneLeastSquares(c, idx);
+  });
+  const FitStats ml = RepeatFits(trials, noise_m, [](const LidarCloud& c, const auto& idx) {
+    auto start = FitPlaneLeastSquares(c, idx);
+    return start ? FitPlaneRangeMl(c, idx, start->plane) : std::nullopt;
+  });
+  // Bias relative to the per-fit scatter: the mean over `trials` fits has std rms/sqrt(trials).
+  const double standard_error_d = ml.rms_error(3) / std::sqrt(trials);
+  std::printf("d bias: TLS %.2f mm, ML %.2f mm (standard error %.2f mm); rms TLS %.2f, ML %.2f\n",
+              tls.mean_error(3) * 1e3, ml.mean_error(3) * 1e3, standard_error_d * 1e3,
+              tls.rms_error(3) * 1e3, ml.rms_error(3) * 1e3);
+  std::printf("normal bias: TLS %.4f, ML %.4f; normalised error TLS %.2f ML %.2f (3 dof)\n",
+              tls.mean_error.head<3>().norm(), ml.mean_error.head<3>().norm(),
+              tls.mean_normalised, ml.mean_normalised);
+  EXPECT_LT(std::abs(ml.mean_error(3)), 3.0 * standard_error_d);
+  EXPECT_GT(std::abs(tls.mean_error(3)), 5.0 * std::abs(ml.mean_error(3)));
+  // The ML covariance describes its scatter: mean normalised error ≈ 3 (χ²(3)).
+  EXPECT_NEAR(ml.mean_normalised, 3.0, 0.6);
+}
+
+}  // namespace
+}  // namespace calibench

@@ -96,6 +96,7 @@ TEST(Solver, HuberKernelDownWeightsAnOutlierPair) {
   std::string why;
   const Pose guess = *InitialGuessFromPlanes(pairs, &why);
   SolverOptions options;
+  options.method = SolverMethod::kCa2libGn;  // the paper's Huber on |e|
   options.huber_delta = 0.02;
   const SolverResult robust = PlaneAlignmentSolver(pairs, options, guess).Run();
   options.huber_delta = 1e3;  // effectively least squares
@@ -200,7 +201,9 @@ TEST(WeightedSolver, BeatsTheUnweightedSolverWhenNoiseDiffersBetweenPairs) {
     options.method = SolverMethod::kWeightedMl;
     options.whitened_huber_delta = 1e3;  // Gaussian data: plain weighted least squares
     const SolverResult weighted = PlaneAlignmentSolver(pairs, options, guess).Run();
-    const SolverResult plain = PlaneAlignmentSolver(pairs, SolverOptions{}, guess).Run();
+    SolverOptions paper;
+    paper.method = SolverMethod::kCa2libGn;
+    const SolverResult plain = PlaneAlignmentSolver(pairs, paper, guess).Run();
     weighted_sq +=
         (weighted.cam_from_lidar.translation() - GroundTruth().translation()).squaredNorm();
     plain_sq += (plain.cam_from_lidar.translation() - GroundTruth().translation()).squaredNorm();
@@ -220,9 +223,43 @@ TEST(WeightedSolver, BeatsTheUnweightedSolverWhenNoiseDiffersBetweenPairs) {
 }
 
 TEST(WeightedSolver, MethodNamesRoundTrip) {
-  for (SolverMethod m : {SolverMethod::kCa2libGn, SolverMethod::kWeightedMl})
+  for (SolverMethod m : {SolverMethod::kCa2libGn, SolverMethod::kWeightedMl, SolverMethod::kKim})
     EXPECT_EQ(ParseSolverMethod(SolverMethodName(m)), m);
-  EXPECT_FALSE(ParseSolverMethod("kim"));
+  EXPECT_FALSE(ParseSolverMethod("levenberg"));
+  // The weighted estimator is the default (issue 5).
+  EXPECT_EQ(SolverOptions{}.method, SolverMethod::kWeightedMl);
+}
+
+TEST(WeightedSolver, GatesAGrossOutlierAndKeepsTheOthers) {
+  auto pairs = HeteroscedasticPairs(12, 7);
+  pairs[4].lidar_plane.distance += 0.3;  // a wrong plane, far beyond its covariance
+  std::string why;
+  const Pose guess = *InitialGuessFromPlanes(pairs, &why);
+  const SolverResult gated = PlaneAlignmentSolver(pairs, SolverOptions{}, guess).Run();
+  EXPECT_EQ(gated.robust_weights[4], 0.0);
+  for (size_t i = 0; i < pairs.size(); ++i)
+    if (i != 4) EXPECT_GT(gated.robust_weights[i], 0.0) << i;
+  SolverOptions no_gate;
+  no_gate.outlier_gate = 0.0;
+  const SolverResult huber_only = PlaneAlignmentSolver(pairs, no_gate, guess).Run();
+  const double gated_err =
+      (gated.cam_from_lidar.translation() - GroundTruth().translation()).norm();
+  const double huber_err =
+      (huber_only.cam_from_lidar.translation() - GroundTruth().translation()).norm();
+  EXPECT_LT(gated_err, huber_err);
+}
+
+TEST(KimBaseline, IsTheClosedFormWithoutIterations) {
+  const auto pairs = MakePairs(10, 0.6, 0.0005, 0.001, 9);
+  std::string why;
+  const Pose guess = *InitialGuessFromPlanes(pairs, &why);
+  SolverOptions options;
+  options.method = SolverMethod::kKim;
+  PlaneAlignmentSolver solver(pairs, options, guess);
+  const SolverResult result = solver.Run();
+  EXPECT_EQ(result.iterations, 0);
+  EXPECT_TRUE(test::MatrixNear(result.cam_from_lidar.matrix(), guess.matrix(), 0.0));
+  EXPECT_GT(result.covariance.trace(), 0.0);
 }
 
 }  // namespace
