@@ -9,6 +9,9 @@
 #include "core/cloud.h"
 #include "core/image.h"
 #include "core/lidar_plane.h"
+#include "core/lrf_features.h"
+#include "core/lrf_sim.h"
+#include "core/lrf_solver.h"
 #include "core/pipeline.h"
 #include "core/sim.h"
 #include "core/solver.h"
@@ -110,6 +113,47 @@ void BM_CalibrateReal40Pairs2Threads(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(CalibrateDataset(dataset, options));
 }
 BENCHMARK(BM_CalibrateReal40Pairs2Threads)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+// One simulated three-face observation (R2000 scan, 1280x720 ZED-like depth).
+const LrfSimObservation& LrfObservationForBench() {
+  static const LrfSimObservation observation = [] {
+    LrfSimOptions options = *LrfSimPreset("paper");
+    options.observations = 1;
+    return RenderLrfObservation(options, SampleTargetPoses(options).front(), 1);
+  }();
+  return observation;
+}
+
+void BM_LrfScanFeatures(benchmark::State& state) {
+  const LrfSimObservation& o = LrfObservationForBench();
+  for (auto _ : state)
+    benchmark::DoNotOptimize(ExtractScanFeatures(o.scan, ThreeFaceTarget{}, ScanFeatureOptions{}));
+}
+BENCHMARK(BM_LrfScanFeatures)->Unit(benchmark::kMillisecond);
+
+void BM_LrfDepthFeatures1280x720(benchmark::State& state) {
+  const LrfSimObservation& o = LrfObservationForBench();
+  for (auto _ : state)
+    benchmark::DoNotOptimize(
+        ExtractDepthFeatures(o.depth, ThreeFaceTarget{}, DepthFeatureOptions{}));
+}
+BENCHMARK(BM_LrfDepthFeatures1280x720)->Unit(benchmark::kMillisecond);
+
+void BM_LrfRefinedSolve10Observations(benchmark::State& state) {
+  LrfSimOptions options = *LrfSimPreset("paper");
+  options.observations = 12;
+  std::vector<LrfObservation> observations;
+  for (const Pose& pose : SampleTargetPoses(options)) {
+    const LrfSimObservation o = RenderLrfObservation(options, pose, observations.size() + 7);
+    LrfObservation f;
+    f.scan = ExtractScanFeatures(o.scan, options.target, ScanFeatureOptions{});
+    f.depth = ExtractDepthFeatures(o.depth, options.target, DepthFeatureOptions{});
+    if (f.scan.ok && f.depth.ok) observations.push_back(f);
+    if (observations.size() == 10) break;
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(SolveLrf(observations, LrfSolverOptions{}));
+}
+BENCHMARK(BM_LrfRefinedSolve10Observations)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace calibench
