@@ -477,6 +477,20 @@ DepthImage LoadDepthPng(const fs::path& path, const DepthIntrinsics& intrinsics)
       depth.depth_m[static_cast<size_t>(v) * image.cols + u] =
           static_cast<float>(row[u] * intrinsics.depth_scale);
   }
+  // A wrong depth_scale (metres per unit) shows in the median depth: a millimetre PNG read with
+  // scale 1 puts the scene kilometres away, one read with 1e-6 within millimetres. Depth
+  // cameras see between a few centimetres and a few tens of metres.
+  std::vector<float> valid;
+  for (float z : depth.depth_m)
+    if (z > 0) valid.push_back(z);
+  if (!valid.empty()) {
+    std::nth_element(valid.begin(), valid.begin() + valid.size() / 2, valid.end());
+    const double median = valid[valid.size() / 2];
+    if (median > 50.0 || median < 0.05)
+      Fail(path, "the median depth is " + std::to_string(median) + " m with depth_scale " +
+                     std::to_string(intrinsics.depth_scale) +
+                     " m per unit: the scale looks wrong (0.001 for millimetre PNGs)");
+  }
   return depth;
 }
 

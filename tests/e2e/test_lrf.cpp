@@ -144,6 +144,14 @@ TEST_F(LrfCli, BadInputNamesTheFileAndKeepsTheOtherObservations) {
   EXPECT_NE(test::RunCommand(Exe() + " lrf-calibrate --dataset " + wrong_path.string(), &out), 0);
   EXPECT_NE(out.find("0002.png"), std::string::npos) << out;
 
+  // A depth scale that does not match the PNGs (metres per unit: 1 instead of 0.001).
+  json scaled = manifest;
+  scaled["depth_camera"]["depth_scale"] = 1.0;
+  const fs::path scaled_path = *dir_ / "wrong_scale.json";
+  std::ofstream(scaled_path) << scaled.dump(2);
+  EXPECT_NE(test::RunCommand(Exe() + " lrf-calibrate --dataset " + scaled_path.string(), &out), 0);
+  EXPECT_NE(out.find("the scale looks wrong"), std::string::npos) << out;
+
   // A manifest that is not an LRF manifest.
   EXPECT_EQ(test::RunCommand(Exe() + " lrf-calibrate --dataset " + empty_scan.string(), &out), 2)
       << out;
