@@ -11,24 +11,13 @@
 
 #include "core/atomic_file.h"
 #include "core/image.h"
+#include "core/json_io.h"
 #include "core/result_io.h"
 
 namespace calibench {
 using nlohmann::json;
 
 namespace {
-
-json PoseToJson(const Pose& pose) {
-  json m = json::array();
-  for (int r = 0; r < 4; ++r)
-    m.push_back(
-        {pose.matrix()(r, 0), pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3)});
-  const Eigen::Quaterniond q(pose.linear());
-  return {
-      {"matrix", m},
-      {"translation_m", {pose.translation().x(), pose.translation().y(), pose.translation().z()}},
-      {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
-}
 
 std::string Millimetres(double metres) {
   char text[32];
@@ -210,8 +199,8 @@ std::string LrfResultToJson(const LrfCalibrationOutcome& outcome,
   json root;
   root["format"] = "calibench.result.v1";
   root["direction"] = "x_in_cam = cam_from_lrf * x_in_lrf; lrf_from_cam is its inverse";
-  root["cam_from_lrf"] = PoseToJson(s.cam_from_lrf);
-  root["lrf_from_cam"] = PoseToJson(s.cam_from_lrf.inverse());
+  root["cam_from_lrf"] = json_io::PoseToResultJson(s.cam_from_lrf);
+  root["lrf_from_cam"] = json_io::PoseToResultJson(s.cam_from_lrf.inverse());
   json cov = json::array();
   for (int r = 0; r < 6; ++r) {
     json row = json::array();

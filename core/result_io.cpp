@@ -7,23 +7,12 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
+#include "core/json_io.h"
 
 namespace calibench {
 using nlohmann::json;
 
 namespace {
-
-json PoseToJson(const Pose& pose) {
-  json m = json::array();
-  for (int r = 0; r < 4; ++r)
-    m.push_back(
-        {pose.matrix()(r, 0), pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3)});
-  const Eigen::Quaterniond q(pose.linear());
-  return {
-      {"matrix", m},
-      {"translation_m", {pose.translation().x(), pose.translation().y(), pose.translation().z()}},
-      {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
-}
 
 json Vec4ToJson(const Vec4& v) { return {v[0], v[1], v[2], v[3]}; }
 
@@ -51,8 +40,8 @@ std::string ResultToJson(const CalibrationOutcome& outcome, const SolverOptions&
   root["format"] = "calibench.result.v1";
   root["direction"] = "x_in_" + names.target + " = " + forward + " * x_in_" + names.source + "; " +
                       backward + " is its inverse";
-  root[forward] = PoseToJson(s.cam_from_lidar);
-  root[backward] = PoseToJson(s.cam_from_lidar.inverse());
+  root[forward] = json_io::PoseToResultJson(s.cam_from_lidar);
+  root[backward] = json_io::PoseToResultJson(s.cam_from_lidar.inverse());
   json cov = json::array();
   for (int r = 0; r < 6; ++r) {
     json row = json::array();
