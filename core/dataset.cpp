@@ -33,19 +33,7 @@ Dataset LoadManifest(const fs::path& manifest) {
   const std::string format = root.value("format", "");
   if (format != "calibench.dataset.v1")
     Fail(manifest, "format is '" + format + "', expected 'calibench.dataset.v1'");
-  if (root.contains("camera_file")) {
-    dataset.camera =
-        LoadCameraFile(Resolve(base, Get<std::string>(root, "camera_file", manifest, "")));
-  } else if (root.contains("camera")) {
-    const json& cam = root.at("camera");
-    dataset.camera = cam.contains("file")
-                         ? LoadCameraFile(Resolve(base, cam.at("file").get<std::string>()))
-                         : ParseInlineCamera(cam, manifest);
-  } else {
-    Fail(manifest, "neither 'camera' nor 'camera_file' is given");
-  }
-  std::string why;
-  if (!dataset.camera.Check(&why)) Fail(manifest, "camera: " + why);
+  dataset.camera = json_io::ParseManifestCamera(root, manifest);
   if (!root.contains("target")) Fail(manifest, "missing field 'target'");
   dataset.target = ParseTarget(root.at("target"), manifest);
   if (root.contains("lidar")) dataset.lidar_rings = root.at("lidar").value("rings", 0);
@@ -158,22 +146,10 @@ Dataset LoadDataset(const fs::path& path) {
 }
 
 void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
-  const fs::path base = fs::absolute(manifest_path).parent_path();
-  auto relative = [&](const fs::path& p) {
-    const fs::path rel = fs::absolute(p).lexically_relative(base);
-    return (rel.empty() || *rel.begin() == "..") ? fs::absolute(p).string() : rel.string();
-  };
+  auto relative = [&](const fs::path& p) { return json_io::PathForManifest(p, manifest_path); };
   json root;
   root["format"] = "calibench.dataset.v1";
-  const CameraModel& c = dataset.camera;
-  root["camera"] = {{"model", CameraModelName(c.type)},
-                    {"width", c.width},
-                    {"height", c.height},
-                    {"fx", c.fx},
-                    {"fy", c.fy},
-                    {"cx", c.cx},
-                    {"cy", c.cy},
-                    {"distortion", c.distortion}};
+  root["camera"] = json_io::CameraToJson(dataset.camera);
   root["target"] = TargetToJson(dataset.target);
   if (dataset.lidar_rings > 0) root["lidar"] = {{"rings", dataset.lidar_rings}};
   json pairs = json::array();

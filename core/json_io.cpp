@@ -135,4 +135,39 @@ json PoseToResultJson(const Pose& pose) {
       {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
 }
 
+CameraModel ParseManifestCamera(const json& root, const fs::path& manifest) {
+  const fs::path base = manifest.parent_path();
+  CameraModel camera;
+  if (root.contains("camera_file")) {
+    camera = LoadCameraFile(Resolve(base, Get<std::string>(root, "camera_file", manifest, "")));
+  } else if (root.contains("camera")) {
+    const json& cam = root.at("camera");
+    camera = cam.contains("file")
+                 ? LoadCameraFile(Resolve(base, Get<std::string>(cam, "file", manifest, "camera.")))
+                 : ParseInlineCamera(cam, manifest);
+  } else {
+    Fail(manifest, "neither 'camera' nor 'camera_file' is given");
+  }
+  std::string why;
+  if (!camera.Check(&why)) Fail(manifest, "camera: " + why);
+  return camera;
+}
+
+json CameraToJson(const CameraModel& c) {
+  return {{"model", CameraModelName(c.type)},
+          {"width", c.width},
+          {"height", c.height},
+          {"fx", c.fx},
+          {"fy", c.fy},
+          {"cx", c.cx},
+          {"cy", c.cy},
+          {"distortion", c.distortion}};
+}
+
+std::string PathForManifest(const fs::path& path, const fs::path& manifest) {
+  const fs::path base = fs::absolute(manifest).parent_path();
+  const fs::path rel = fs::absolute(path).lexically_relative(base);
+  return (rel.empty() || *rel.begin() == "..") ? fs::absolute(path).string() : rel.string();
+}
+
 }  // namespace calibench::json_io

@@ -38,6 +38,17 @@ std::filesystem::path Resolve(const std::filesystem::path& base_dir, const std::
 // The inline "camera" object of a manifest (model, size, focal lengths, centre, distortion).
 CameraModel ParseInlineCamera(const json& node, const std::filesystem::path& file);
 
+// The manifest's camera: "camera_file" (OpenCV / ROS / Kalibr file), "camera": {"file": ...}, or
+// an inline "camera" object; validated with CameraModel::Check.
+CameraModel ParseManifestCamera(const json& root, const std::filesystem::path& manifest);
+// The inline form ParseInlineCamera reads.
+json CameraToJson(const CameraModel& camera);
+
+// A path as a manifest stores it: relative to the manifest's folder when it lies under it,
+// absolute otherwise.
+std::string PathForManifest(const std::filesystem::path& path,
+                            const std::filesystem::path& manifest);
+
 // A "target" object: checkerboard (inner_corners) or charuco (squares, marker_size,
 // dictionary), square_size, optional board_size; validated with BoardSpec::Check.
 BoardSpec ParseTarget(const json& node, const std::filesystem::path& file);

@@ -59,7 +59,6 @@ std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
 // σ̂² (JᵀJ)⁻¹ with σ̂² from the range residuals; rms_m is the range RMS. nullopt when fewer than 4
 // points, a ray parallel to the plane, or no convergence.
 std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
-                                             const std::vector<int>& indices,
-                                             const Plane& initial);
+                                             const std::vector<int>& indices, const Plane& initial);
 
 }  // namespace calibench

@@ -65,24 +65,6 @@ DepthIntrinsics ParseDepthCamera(const json& node, const fs::path& file) {
   return in;
 }
 
-CameraModel ParseCamera(const json& root, const fs::path& manifest) {
-  const fs::path base = manifest.parent_path();
-  CameraModel camera;
-  if (root.contains("camera_file")) {
-    camera = LoadCameraFile(Resolve(base, Get<std::string>(root, "camera_file", manifest, "")));
-  } else if (root.contains("camera")) {
-    const json& cam = root.at("camera");
-    camera = cam.contains("file")
-                 ? LoadCameraFile(Resolve(base, Get<std::string>(cam, "file", manifest, "camera.")))
-                 : ParseInlineCamera(cam, manifest);
-  } else {
-    Fail(manifest, "a checkerboard dataset needs 'camera' or 'camera_file'");
-  }
-  std::string why;
-  if (!camera.Check(&why)) Fail(manifest, "camera: " + why);
-  return camera;
-}
-
 ScanRegion ParseScanRegion(const json& node, const fs::path& file, const std::string& where) {
   ScanRegion region;
   region.angle_min = GetOr(node, "angle_min_deg", -180.0, file, where) * kDeg;
@@ -237,7 +219,7 @@ LrfDataset LoadLrfDataset(const fs::path& manifest_path) {
   } else if (type == "checkerboard" || type == "charuco") {
     dataset.target_type = LrfTargetType::kCheckerboard;
     dataset.board = ParseTarget(target, manifest);
-    dataset.camera = ParseCamera(root, manifest);
+    dataset.camera = json_io::ParseManifestCamera(root, manifest);
   } else {
     Fail(manifest, "target.type '" + type + "' is unknown (use three-face or checkerboard)");
   }
@@ -256,11 +238,7 @@ LrfDataset LoadLrfDataset(const fs::path& manifest_path) {
 }
 
 void SaveLrfDataset(const fs::path& manifest_path, const LrfDataset& dataset) {
-  const fs::path base = fs::absolute(manifest_path).parent_path();
-  auto relative = [&](const fs::path& p) {
-    const fs::path rel = fs::absolute(p).lexically_relative(base);
-    return (rel.empty() || *rel.begin() == "..") ? fs::absolute(p).string() : rel.string();
-  };
+  auto relative = [&](const fs::path& p) { return json_io::PathForManifest(p, manifest_path); };
   json root;
   root["format"] = kFormat;
   if (dataset.target_type == LrfTargetType::kThreeFace) {
@@ -277,15 +255,7 @@ void SaveLrfDataset(const fs::path& manifest_path, const LrfDataset& dataset) {
                       {"foot_y", t.foot_y},
                       {"ridge_height", t.ridge_height}};
   } else {
-    const CameraModel& c = dataset.camera;
-    root["camera"] = {{"model", CameraModelName(c.type)},
-                      {"width", c.width},
-                      {"height", c.height},
-                      {"fx", c.fx},
-                      {"fy", c.fy},
-                      {"cx", c.cx},
-                      {"cy", c.cy},
-                      {"distortion", c.distortion}};
+    root["camera"] = json_io::CameraToJson(dataset.camera);
     root["target"] = TargetToJson(dataset.board);
   }
   json pairs = json::array();

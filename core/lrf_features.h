@@ -41,15 +41,15 @@ ScanFeatures ExtractScanFeatures(const LaserScan& scan, const ThreeFaceTarget& t
                                  const ScanRegion* region = nullptr);
 
 struct DepthFeatureOptions {
-  int stride_px = 2;                 // back-project every stride-th pixel in u and v
+  int stride_px = 2;  // back-project every stride-th pixel in u and v
   double max_depth_m = 6.0;
   // RANSAC inlier distance: base + per_m2 · z² (the depth noise grows with z²), metres.
   double plane_threshold_m = 0.008;
   double plane_threshold_per_m2 = 0.004;
   int min_inliers_per_face = 150;
-  int max_planes = 8;                // planes extracted before choosing the target's three
-  double min_face_angle_deg = 8.0;   // faces closer to parallel fail with a reason
-  uint64_t seed = 7;                 // RANSAC sampling
+  int max_planes = 8;               // planes extracted before choosing the target's three
+  double min_face_angle_deg = 8.0;  // faces closer to parallel fail with a reason
+  uint64_t seed = 7;                // RANSAC sampling
   bool Check(std::string* why) const;
 };
 

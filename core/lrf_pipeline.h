@@ -41,10 +41,10 @@ struct LrfPairFeatures {
   PairStatus status = PairStatus::kPending;
   std::string reason;
   bool input_error = false;
-  LaserScan scan;                            // as loaded (empty on input error)
-  std::optional<LrfObservation> three_face;  // features (ok or not) for the three-face target
-  std::optional<DepthImage> depth;           // three-face: the depth frame (for display)
-  std::optional<BoardScanPoints> board_scan; // checkerboard: scan points on the board
+  LaserScan scan;                                // as loaded (empty on input error)
+  std::optional<LrfObservation> three_face;      // features (ok or not) for the three-face target
+  std::optional<DepthImage> depth;               // three-face: the depth frame (for display)
+  std::optional<BoardScanPoints> board_scan;     // checkerboard: scan points on the board
   std::optional<CameraBoardObservation> camera;  // checkerboard: PnP
 };
 
@@ -54,8 +54,8 @@ LrfPairFeatures ExtractLrfPairFeatures(const LrfDataset& dataset, const LrfPairE
 
 struct LrfCalibrationOutcome {
   std::vector<LrfPairFeatures> pairs;
-  std::optional<LrfSolution> solution;  // absent when no calibration could be computed
-  std::string failure;                  // why `solution` is absent
+  std::optional<LrfSolution> solution;        // absent when no calibration could be computed
+  std::string failure;                        // why `solution` is absent
   std::optional<AdaptiveLrfResult> adaptive;  // when options.adaptive_error_threshold_m > 0
 };
 

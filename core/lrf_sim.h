@@ -17,9 +17,9 @@
 namespace calibench {
 
 struct LrfSensorSpec {
-  double fov_deg = 360.0;            // centred on +x
-  double angular_step_deg = 0.042;   // R2000
-  double range_noise_m = 0.0125;     // 1σ; the R2000's ±25 mm taken as 2σ
+  double fov_deg = 360.0;           // centred on +x
+  double angular_step_deg = 0.042;  // R2000
+  double range_noise_m = 0.0125;    // 1σ; the R2000's ±25 mm taken as 2σ
   double range_min_m = 0.1;
   double range_max_m = 30.0;
   bool Check(std::string* why) const;
@@ -27,9 +27,9 @@ struct LrfSensorSpec {
 
 struct DepthCameraSpec {
   DepthIntrinsics intrinsics{1280, 720, 700.0, 700.0, 640.0, 360.0, 0.001};  // ZED-like HD720
-  double stereo_baseline_m = 0.12;     // of the depth camera's own stereo pair (noise model)
-  double disparity_noise_px = 0.15;    // 1σ; σ_z = z² σ_disp / (f b)
-  double max_depth_m = 10.0;           // beyond: no data
+  double stereo_baseline_m = 0.12;   // of the depth camera's own stereo pair (noise model)
+  double disparity_noise_px = 0.15;  // 1σ; σ_z = z² σ_disp / (f b)
+  double max_depth_m = 10.0;         // beyond: no data
   bool Check(std::string* why) const;
 };
 
@@ -45,13 +45,13 @@ struct LrfSimOptions {
   DepthCameraSpec depth;
   ThreeFaceTarget target;
   Pose cam_from_lrf = DefaultCamFromLrf();
-  double target_distance_min_m = 1.0;    // from the camera
+  double target_distance_min_m = 1.0;  // from the camera
   double target_distance_max_m = 3.0;
-  double target_max_yaw_deg = 30.0;      // about the target's y (up) axis
-  double target_max_tilt_deg = 10.0;     // about the target's x axis
-  bool clutter = true;                   // back wall, side wall and floor
-  bool stereo = false;                   // also a right depth camera
-  double stereo_right_baseline_m = 0.12; // right camera at +x of the left one
+  double target_max_yaw_deg = 30.0;       // about the target's y (up) axis
+  double target_max_tilt_deg = 10.0;      // about the target's x axis
+  bool clutter = true;                    // back wall, side wall and floor
+  bool stereo = false;                    // also a right depth camera
+  double stereo_right_baseline_m = 0.12;  // right camera at +x of the left one
   bool Check(std::string* why) const;
 };
 

@@ -36,9 +36,9 @@ std::optional<LrfMethod> ParseLrfMethod(const std::string& name);
 
 struct LrfSolverOptions {
   LrfMethod method = LrfMethod::kRefined;
-  double huber_delta_m = 0.03;   // Huber threshold on the point-to-plane distance (metres)
+  double huber_delta_m = 0.03;  // Huber threshold on the point-to-plane distance (metres)
   int max_iterations = 50;
-  double step_tolerance = 1e-10; // stop when |delta| (m, rad) falls below this
+  double step_tolerance = 1e-10;  // stop when |delta| (m, rad) falls below this
   // Eigenvalues of JᵀWJ below this fraction of the largest are weak (held at the seed, reported).
   double weak_eigenvalue_ratio = 1e-4;
   bool Check(std::string* why) const;
@@ -46,14 +46,14 @@ struct LrfSolverOptions {
 
 struct LrfSolution {
   bool ok = false;
-  std::string reason;                 // why not ok, in words
+  std::string reason;  // why not ok, in words
   LrfMethod method = LrfMethod::kRefined;
   Pose cam_from_lrf = Pose::Identity();
-  Mat6 covariance = Mat6::Zero();     // right perturbation of cam_from_lrf, [rho; phi]
+  Mat6 covariance = Mat6::Zero();  // right perturbation of cam_from_lrf, [rho; phi]
   ObservabilityReport observability;
   bool converged = false;
   int iterations = 0;
-  std::vector<double> cost_history;   // refined: per iteration, the seed's cost first
+  std::vector<double> cost_history;      // refined: per iteration, the seed's cost first
   std::vector<IterationReport> history;  // refined: estimate per iteration (cam_from_lidar field)
   // Per observation: Eq. (12) mean corner-to-line distance (metres) and, for refined, the RMS
   // point-to-plane distance of its scan points and the mean Huber weight.
@@ -124,7 +124,6 @@ AdaptiveLrfResult SolveLrfAdaptive(const std::vector<LrfObservation>& sequence,
 
 // Zhang & Pless: linear seed from the board rows (or `initial`), then the same refinement.
 LrfSolution SolveLrfBoard(const std::vector<LrfBoardObservation>& observations,
-                          const LrfSolverOptions& options,
-                          const std::optional<Pose>& initial = {});
+                          const LrfSolverOptions& options, const std::optional<Pose>& initial = {});
 
 }  // namespace calibench

@@ -65,12 +65,12 @@ struct DepthImage {
 
 // The three-face target (frame and naming above). Metres.
 struct ThreeFaceTarget {
-  double base_width = 0.80;        // PBDQ along x
-  double base_height = 0.60;       // PBDQ along y
-  double tent_half_width = 0.25;   // |B.x| = |D.x|
-  double apex_y = 0.25;            // A.y
-  double foot_y = -0.25;           // B.y = D.y = C.y
-  double ridge_height = 0.20;      // C.z
+  double base_width = 0.80;       // PBDQ along x
+  double base_height = 0.60;      // PBDQ along y
+  double tent_half_width = 0.25;  // |B.x| = |D.x|
+  double apex_y = 0.25;           // A.y
+  double foot_y = -0.25;          // B.y = D.y = C.y
+  double ridge_height = 0.20;     // C.z
   bool Check(std::string* why) const;
   Vec3 A() const { return Vec3(0.0, apex_y, 0.0); }
   Vec3 B() const { return Vec3(-tent_half_width, foot_y, 0.0); }
@@ -100,9 +100,9 @@ struct ScanFeatures {
   std::string reason;  // why not ok, in words
   // Points (LRF frame) per face: 0 = base (both outer segments), 1 = ABC, 2 = ACD.
   std::array<std::vector<Vec2>, 3> face_points;
-  std::array<Line2, 3> lines;     // fitted per face (0 = base from both outer segments)
-  std::array<Vec2, 3> corners;    // F = l0∩l1, G = l1∩l2, H = l2∩l0
-  double rms_m = 0.0;             // RMS point-to-line distance over all face points
+  std::array<Line2, 3> lines;       // fitted per face (0 = base from both outer segments)
+  std::array<Vec2, 3> corners;      // F = l0∩l1, G = l1∩l2, H = l2∩l0
+  double rms_m = 0.0;               // RMS point-to-line distance over all face points
   std::vector<int> target_indices;  // scan ray indices on the target polyline (for display)
 };
 
@@ -110,14 +110,14 @@ struct ScanFeatures {
 struct DepthFeatures {
   bool ok = false;
   std::string reason;
-  std::array<Plane, 3> planes;         // camera frame, normal towards the camera (d > 0)
+  std::array<Plane, 3> planes;  // camera frame, normal towards the camera (d > 0)
   std::array<Mat4, 3> plane_covariances{Mat4::Zero(), Mat4::Zero(), Mat4::Zero()};
-  std::array<Line3, 3> lines;          // AB, AC, AD
+  std::array<Line3, 3> lines;  // AB, AC, AD
   std::array<int, 3> inlier_counts{0, 0, 0};
-  double rms_m = 0.0;                  // RMS point-to-plane distance over the inliers
+  double rms_m = 0.0;  // RMS point-to-plane distance over the inliers
   // Per depth pixel: -1 = not on the target, 0..2 = face (for display). May be empty.
   std::vector<signed char> face_of_pixel;
-  double min_face_angle_deg = 0.0;     // smallest angle between two face normals
+  double min_face_angle_deg = 0.0;  // smallest angle between two face normals
 };
 
 // One observation of the three-face target.

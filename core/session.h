@@ -96,7 +96,7 @@ struct Session {
   // The manifest (or shorthand folder); absolute and lexically normal in memory.
   std::filesystem::path dataset;
   std::vector<PairState> pairs;                         // in the dataset's order
-  SolverMethod method = SolverOptions{}.method;          // solver (see SolverOptions)
+  SolverMethod method = SolverOptions{}.method;         // solver (see SolverOptions)
   double huber_delta = SolverOptions{}.huber_delta;     // Huber threshold (see SolverOptions)
   int max_iterations = SolverOptions{}.max_iterations;  // Gauss-Newton iterations
   double ransac_threshold_m = LidarPlaneOptions{}.ransac_threshold_m;  // LiDAR plane inliers

@@ -186,8 +186,8 @@ TEST(LidarPlane, RangeMaximumLikelihoodRemovesTheTiltBiasOfLeastSquares) {
               tls.mean_error(3) * 1e3, ml.mean_error(3) * 1e3, standard_error_d * 1e3,
               tls.rms_error(3) * 1e3, ml.rms_error(3) * 1e3);
   std::printf("normal bias: TLS %.4f, ML %.4f; normalised error TLS %.2f ML %.2f (3 dof)\n",
-              tls.mean_error.head<3>().norm(), ml.mean_error.head<3>().norm(),
-              tls.mean_normalised, ml.mean_normalised);
+              tls.mean_error.head<3>().norm(), ml.mean_error.head<3>().norm(), tls.mean_normalised,
+              ml.mean_normalised);
   EXPECT_LT(std::abs(ml.mean_error(3)), 3.0 * standard_error_d);
   EXPECT_GT(std::abs(tls.mean_error(3)), 5.0 * std::abs(ml.mean_error(3)));
   // The ML covariance describes its scatter: mean normalised error ≈ 3 (χ²(3)).
