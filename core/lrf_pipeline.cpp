@@ -1,17 +1,15 @@
 #include "core/lrf_pipeline.h"
 
-#include <atomic>
 #include <cmath>
 #include <cstdio>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include "core/atomic_file.h"
 #include "core/image.h"
 #include "core/json_io.h"
+#include "core/parallel.h"
 #include "core/result_io.h"
 
 namespace calibench {
@@ -112,25 +110,12 @@ LrfCalibrationOutcome CalibrateLrfDataset(const LrfDataset& dataset,
   for (const LrfPairEntry& pair : dataset.pairs)
     if (wanted.empty() || wanted.count(pair.id)) selected.push_back(&pair);
   std::vector<LrfPairFeatures> features(selected.size());
-  std::atomic<size_t> next{0};
-  std::atomic<int> done{0};
-  std::mutex progress_mutex;
-  auto worker = [&] {
-    for (size_t i = next++; i < selected.size(); i = next++) {
-      features[i] = ExtractLrfPairFeatures(dataset, *selected[i], options);
-      const int finished = ++done;
-      if (progress) {
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        progress(finished, static_cast<int>(selected.size()), selected[i]->id);
-      }
-    }
-  };
-  const int num_threads =
-      std::max(1, std::min<int>(options.threads, static_cast<int>(selected.size())));
-  std::vector<std::thread> threads;
-  for (int t = 1; t < num_threads; ++t) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
+  ParallelFor(
+      selected.size(), options.threads,
+      [&](size_t i) { features[i] = ExtractLrfPairFeatures(dataset, *selected[i], options); },
+      [&](int finished, size_t i) {
+        if (progress) progress(finished, static_cast<int>(selected.size()), selected[i]->id);
+      });
   return SolveLrfFromFeatures(std::move(features), dataset, options);
 }
 

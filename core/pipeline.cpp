@@ -1,13 +1,11 @@
 #include "core/pipeline.h"
 
 #include <algorithm>
-#include <atomic>
-#include <mutex>
 #include <set>
-#include <thread>
 
 #include "core/cloud.h"
 #include "core/image.h"
+#include "core/parallel.h"
 
 namespace calibench {
 
@@ -95,25 +93,12 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
     if (wanted.empty() || wanted.count(pair.id)) selected.push_back(&pair);
 
   std::vector<PairFeatures> features(selected.size());
-  std::atomic<size_t> next{0};
-  std::atomic<int> done{0};
-  std::mutex progress_mutex;
-  auto worker = [&] {
-    for (size_t i = next++; i < selected.size(); i = next++) {
-      features[i] = ExtractPairFeatures(dataset, *selected[i], options);
-      const int finished = ++done;
-      if (progress) {
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        progress(finished, static_cast<int>(selected.size()), selected[i]->id);
-      }
-    }
-  };
-  const int num_threads =
-      std::max(1, std::min<int>(options.threads, static_cast<int>(selected.size())));
-  std::vector<std::thread> threads;
-  for (int t = 1; t < num_threads; ++t) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
+  ParallelFor(
+      selected.size(), options.threads,
+      [&](size_t i) { features[i] = ExtractPairFeatures(dataset, *selected[i], options); },
+      [&](int finished, size_t i) {
+        if (progress) progress(finished, static_cast<int>(selected.size()), selected[i]->id);
+      });
   return SolveFromFeatures(std::move(features), options);
 }
 
