@@ -10,6 +10,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <memory>
 
 #include "app/commands.h"
 #include "core/image.h"
@@ -43,36 +45,36 @@ bool OpenInput(ui::Controller& controller, const std::string& dataset, const std
   return true;
 }
 
-// The LRF workbench in a window (a calibench.lrf-dataset.v1 manifest).
-int RunLrfGuiWindow(const std::string& dataset, int width, int height,
-                    const std::string& screenshot, int quit_after_frames) {
+// Opens the window or prints why not.
+std::unique_ptr<gfx::WindowContext> OpenWindow(int width, int height, const char* title) {
   std::string why;
-  auto context = gfx::WindowContext::Create(width, height, "Calibench (2D LRF)", &why);
-  if (!context) {
+  auto context = gfx::WindowContext::Create(width, height, title, &why);
+  if (!context)
     std::fprintf(stderr,
                  "calibench gui: cannot open a window: %s\n"
                  "(no display? `calibench render` draws the same views to PNG)\n",
                  why.c_str());
-    return kInputError;
-  }
-  ui::LrfController controller;
-  controller.Open(dataset);  // a bad manifest shows its error in the window's status line
-  ui::ImGuiHost host(context->window());
-  ui::LrfWorkbench workbench;
+  return context;
+}
+
+// The window's frame loop, shared by both workbenches: ui_frame(width, height, dt) issues the
+// ImGui calls of one frame and applies their intents. The frame is drawn offscreen, then blitted
+// (so that --screenshot reads exactly what is shown).
+void RunWindowLoop(gfx::WindowContext& context, ui::ImGuiHost& host,
+                   const std::function<void(int, int, double)>& ui_frame,
+                   const std::string& screenshot, int quit_after_frames) {
   gfx::Framebuffer frame_target;
   auto last = std::chrono::steady_clock::now();
-  for (int frame = 0; !glfwWindowShouldClose(context->window()); ++frame) {
+  for (int frame = 0; !glfwWindowShouldClose(context.window()); ++frame) {
     glfwPollEvents();
     int fb_width = 0, fb_height = 0;
-    glfwGetFramebufferSize(context->window(), &fb_width, &fb_height);
+    glfwGetFramebufferSize(context.window(), &fb_width, &fb_height);
     if (fb_width <= 0 || fb_height <= 0) continue;
     const auto now = std::chrono::steady_clock::now();
     const double dt = std::chrono::duration<double>(now - last).count();
     last = now;
     host.NewFrame(fb_width, fb_height, dt);
-    for (const ui::LrfIntent& intent : workbench.Frame(controller.GetSnapshot(), fb_width,
-                                                       fb_height, ui::LrfLayout::kWorkbench, dt))
-      controller.Apply(intent);
+    ui_frame(fb_width, fb_height, dt);
     frame_target.Resize(fb_width, fb_height);
     frame_target.Bind();
     frame_target.Clear(0.06f, 0.06f, 0.07f, 1.0f);
@@ -86,9 +88,28 @@ int RunLrfGuiWindow(const std::string& dataset, int width, int height,
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glBlitFramebuffer(0, 0, fb_width, fb_height, 0, 0, fb_width, fb_height, GL_COLOR_BUFFER_BIT,
                       GL_NEAREST);
-    glfwSwapBuffers(context->window());
+    glfwSwapBuffers(context.window());
     if (last_frame) break;
   }
+}
+
+// The LRF workbench in a window (a calibench.lrf-dataset.v1 manifest).
+int RunLrfGuiWindow(const std::string& dataset, int width, int height,
+                    const std::string& screenshot, int quit_after_frames) {
+  auto context = OpenWindow(width, height, "Calibench (2D LRF)");
+  if (!context) return kInputError;
+  ui::LrfController controller;
+  controller.Open(dataset);  // a bad manifest shows its error in the window's status line
+  ui::ImGuiHost host(context->window());
+  ui::LrfWorkbench workbench;
+  RunWindowLoop(
+      *context, host,
+      [&](int w, int h, double dt) {
+        for (const ui::LrfIntent& intent :
+             workbench.Frame(controller.GetSnapshot(), w, h, ui::LrfLayout::kWorkbench, dt))
+          controller.Apply(intent);
+      },
+      screenshot, quit_after_frames);
   return kOk;
 }
 
@@ -140,49 +161,20 @@ int RenderLrfHeadless(const std::string& dataset, const std::string& pair, bool 
 
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
                  const std::string& screenshot, int quit_after_frames) {
-  std::string why;
-  auto context = gfx::WindowContext::Create(width, height, "Calibench", &why);
-  if (!context) {
-    std::fprintf(stderr,
-                 "calibench gui: cannot open a window: %s\n"
-                 "(no display? `calibench render` draws the same views to PNG)\n",
-                 why.c_str());
-    return kInputError;
-  }
+  auto context = OpenWindow(width, height, "Calibench");
+  if (!context) return kInputError;
   ui::Controller controller;
   if (!OpenInput(controller, dataset, session, "gui")) return kUsage;
   ui::ImGuiHost host(context->window());
   ui::Workbench workbench;
-  gfx::Framebuffer frame_target;  // the whole window is drawn offscreen, then blitted
-  auto last = std::chrono::steady_clock::now();
-  for (int frame = 0; !glfwWindowShouldClose(context->window()); ++frame) {
-    glfwPollEvents();
-    int fb_width = 0, fb_height = 0;
-    glfwGetFramebufferSize(context->window(), &fb_width, &fb_height);
-    if (fb_width <= 0 || fb_height <= 0) continue;
-    const auto now = std::chrono::steady_clock::now();
-    const double dt = std::chrono::duration<double>(now - last).count();
-    last = now;
-    host.NewFrame(fb_width, fb_height, dt);
-    for (const ui::Intent& intent :
-         workbench.Frame(controller.GetSnapshot(), fb_width, fb_height, ui::Layout::kWorkbench, dt))
-      controller.Apply(intent);
-    frame_target.Resize(fb_width, fb_height);
-    frame_target.Bind();
-    frame_target.Clear(0.06f, 0.06f, 0.07f, 1.0f);
-    host.Render();
-    const bool last_frame = quit_after_frames > 0 && frame + 1 >= quit_after_frames;
-    if (last_frame && !screenshot.empty()) {
-      SaveImage(screenshot, frame_target.ReadPixels());
-      std::printf("wrote %s\n", screenshot.c_str());
-    }
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, frame_target.framebuffer());
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-    glBlitFramebuffer(0, 0, fb_width, fb_height, 0, 0, fb_width, fb_height, GL_COLOR_BUFFER_BIT,
-                      GL_NEAREST);
-    glfwSwapBuffers(context->window());
-    if (last_frame) break;
-  }
+  RunWindowLoop(
+      *context, host,
+      [&](int w, int h, double dt) {
+        for (const ui::Intent& intent :
+             workbench.Frame(controller.GetSnapshot(), w, h, ui::Layout::kWorkbench, dt))
+          controller.Apply(intent);
+      },
+      screenshot, quit_after_frames);
   return kOk;
 }
 
