@@ -16,6 +16,8 @@ void AddSimFlags(CLI::App& app, SimFlags& flags) {
                  "a3 | a4 | paper | charuco-a3 | charuco-a4 (default: the preset's)");
   app.add_option("--pairs", flags.pairs, "number of pairs (default: the preset's)");
   app.add_option("--lidar-noise", flags.lidar_noise, "LiDAR range noise sigma [m]");
+  app.add_option("--lidar-range-offset", flags.lidar_range_offset,
+                 "constant LiDAR range error [m]: measured range = true range + offset");
   app.add_option("--image-noise", flags.image_noise, "image noise sigma in [0,1] intensity units");
   app.add_option("--min-distance", flags.min_distance, "closest board distance [m]");
   app.add_option("--max-distance", flags.max_distance, "farthest board distance [m]");
@@ -57,6 +59,7 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
   }
   if (flags.pairs > 0) options->num_pairs = flags.pairs;
   if (flags.lidar_noise >= 0) options->lidar_range_noise_m = flags.lidar_noise;
+  options->lidar_range_offset_m = flags.lidar_range_offset;
   if (flags.image_noise >= 0) options->image_noise = flags.image_noise;
   if (flags.min_distance > 0) options->min_distance_m = flags.min_distance;
   if (flags.max_distance > 0) options->max_distance_m = flags.max_distance;

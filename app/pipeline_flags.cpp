@@ -21,6 +21,15 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
       ->capture_default_str();
   app.add_option("--max-iterations", o.solver.max_iterations, "Gauss-Newton iterations")
       ->capture_default_str();
+  app.add_flag("!--no-board-edges", o.solver.use_board_edges,
+               "weighted-ml: leave out the board-edge constraints (used by default for targets "
+               "whose sheet size is given)");
+  app.add_flag("!--no-edge-dilation", o.solver.estimate_edge_dilation,
+               "weighted-ml with board edges: do not estimate how much larger than the sheet the "
+               "LiDAR sees it (the beam's footprint; estimated by default)");
+  app.add_flag("--estimate-range-offset", o.solver.estimate_range_offset,
+               "weighted-ml: also estimate a constant LiDAR range offset (printed with its "
+               "standard deviation and its correlation with the translation)");
   if (with_selection) {
     app.add_option("--pairs", flags.pairs, "comma-separated pair ids to use (default: all)");
     app.add_option("--initial-guess", flags.initial_guess,
@@ -32,6 +41,9 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
                  "LiDAR plane RANSAC inlier distance [m]")
       ->capture_default_str();
   app.add_option("--ransac-seed", o.lidar_plane.seed, "RANSAC seed")->capture_default_str();
+  app.add_flag("!--no-board-growing", o.grow_to_board,
+               "fit the LiDAR plane on the brushed / seeded returns only, instead of growing the "
+               "region to the whole board (limited by the target's sheet size)");
 }
 
 bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {

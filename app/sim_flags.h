@@ -14,6 +14,7 @@ struct SimFlags {
   std::string lidar, camera, board;
   int pairs = 0;            // 0 = the preset's
   double lidar_noise = -1;  // < 0 = the preset's
+  double lidar_range_offset = 0;
   double image_noise = -1;  // < 0 = the preset's
   double min_distance = 0;  // 0 = the preset's
   double max_distance = 0;  // 0 = the preset's

@@ -71,6 +71,11 @@ Dataset LoadManifest(const fs::path& manifest) {
     record.max_distance_m = Get<double>(sim, "max_distance_m", manifest, "simulation.");
     record.max_tilt_deg = Get<double>(sim, "max_tilt_deg", manifest, "simulation.");
     record.lidar_range_noise_m = Get<double>(sim, "lidar_range_noise_m", manifest, "simulation.");
+    // Manifests written before the offset existed have none.
+    record.lidar_range_offset_m =
+        sim.contains("lidar_range_offset_m")
+            ? Get<double>(sim, "lidar_range_offset_m", manifest, "simulation.")
+            : 0.0;
     record.image_noise = Get<double>(sim, "image_noise", manifest, "simulation.");
     record.clutter = Get<bool>(sim, "clutter", manifest, "simulation.");
     record.seed_radius_m = Get<double>(sim, "seed_radius_m", manifest, "simulation.");
@@ -168,12 +173,17 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
         {"direction", "x_in_cam = cam_from_lidar * x_in_lidar"}};
   if (dataset.simulation) {
     const SimulationRecord& r = *dataset.simulation;
-    root["simulation"] = {
-        {"lidar_model", r.lidar_model},       {"num_pairs", r.num_pairs},
-        {"min_distance_m", r.min_distance_m}, {"max_distance_m", r.max_distance_m},
-        {"max_tilt_deg", r.max_tilt_deg},     {"lidar_range_noise_m", r.lidar_range_noise_m},
-        {"image_noise", r.image_noise},       {"clutter", r.clutter},
-        {"seed_radius_m", r.seed_radius_m},   {"seed", r.seed}};
+    root["simulation"] = {{"lidar_model", r.lidar_model},
+                          {"num_pairs", r.num_pairs},
+                          {"min_distance_m", r.min_distance_m},
+                          {"max_distance_m", r.max_distance_m},
+                          {"max_tilt_deg", r.max_tilt_deg},
+                          {"lidar_range_noise_m", r.lidar_range_noise_m},
+                          {"image_noise", r.image_noise},
+                          {"clutter", r.clutter},
+                          {"seed_radius_m", r.seed_radius_m},
+                          {"seed", r.seed},
+                          {"lidar_range_offset_m", r.lidar_range_offset_m}};
   }
   WriteFileAtomically(manifest_path, root.dump(2) + "\n");
 }

@@ -63,8 +63,9 @@ struct SimulationRecord {
   double min_distance_m = 0.0;
   double max_distance_m = 0.0;
   double max_tilt_deg = 0.0;
-  double lidar_range_noise_m = 0.0;  // 1σ along each ray
-  double image_noise = 0.0;          // [0,1] intensity units
+  double lidar_range_noise_m = 0.0;   // 1σ along each ray
+  double lidar_range_offset_m = 0.0;  // measured = true range + offset
+  double image_noise = 0.0;           // [0,1] intensity units
   bool clutter = true;
   double seed_radius_m = 0.0;
   std::uint64_t seed = 1;

@@ -22,8 +22,104 @@ bool LidarPlaneOptions::Check(std::string* why) const {
   if (min_inliers < 4) return fail("min_inliers must be >= 4");
   if (!(min_inlier_fraction >= 0 && min_inlier_fraction <= 1))
     return fail("min_inlier_fraction must be in [0, 1]");
+  if (!(grow_radius_m >= 0) || !std::isfinite(grow_radius_m))
+    return fail("grow_radius_m must be >= 0 (metres; 0 = no growing)");
+  if (!(sheet_size_m.minCoeff() >= 0) || !sheet_size_m.allFinite())
+    return fail("sheet_size_m must be >= 0 (metres; 0 = unknown)");
+  if (!edges.Check(why)) return false;
   return true;
 }
+
+double BoardGrowRadius(const BoardSpec& board) {
+  return 1.05 * 0.5 * std::hypot(board.SheetWidth(), board.SheetHeight()) + 0.02;
+}
+
+namespace {
+
+// Range residual r − r̂ of a return against a plane (r̂ where its ray meets the plane); nullopt
+// for rays within ~1° of the plane.
+std::optional<double> RangeResidual(const Plane& plane, const Vec3& x) {
+  const double range = x.norm();
+  if (!(range > 0)) return std::nullopt;
+  const double cos_incidence = plane.normal.dot(x) / range;
+  if (std::abs(cos_incidence) < 0.02) return std::nullopt;
+  return range + plane.distance / cos_incidence;
+}
+
+// The range band for inliers: 3σ̂ of the fit, at least the RANSAC threshold and at most five
+// times it (see FitBoardPlane).
+double RangeBand(const LidarPlaneOptions& options, double rms_m) {
+  return std::min(5.0 * options.ransac_threshold_m,
+                  std::max(options.ransac_threshold_m, 3.0 * rms_m));
+}
+
+// Maximum-likelihood refit with the band re-drawn around each new plane, over `candidates`.
+std::optional<LidarPlaneFit> RefineRangeMl(const LidarCloud& cloud,
+                                           const std::vector<int>& candidates,
+                                           const LidarPlaneFit& start,
+                                           const LidarPlaneOptions& options) {
+  std::optional<LidarPlaneFit> fit;
+  std::vector<int> inliers = start.inliers;
+  Plane plane = start.plane;
+  for (int round = 0; round < 4; ++round) {
+    auto ml = FitPlaneRangeMl(cloud, inliers, plane);
+    if (!ml) break;
+    fit = ml;
+    const double band_m = RangeBand(options, ml->rms_m);
+    std::vector<int> reselected;
+    for (int i : candidates) {
+      const auto residual = RangeResidual(ml->plane, cloud.points[i].cast<double>());
+      if (residual && std::abs(*residual) <= band_m) reselected.push_back(i);
+    }
+    if (reselected == inliers || reselected.size() < 4) break;
+    inliers = std::move(reselected);
+    plane = ml->plane;
+  }
+  return fit;
+}
+
+// Where the inliers' rays meet the plane, averaged: the board centre when the inliers cover it.
+Vec3 InlierCentre(const LidarCloud& cloud, const LidarPlaneFit& fit) {
+  Vec3 sum = Vec3::Zero();
+  for (int i : fit.inliers) {
+    const Vec3 x = cloud.points[i].cast<double>();
+    const Vec3 ray = x.normalized();
+    sum += ray * (-fit.plane.distance / fit.plane.normal.dot(ray));
+  }
+  return sum / std::max<size_t>(1, fit.inliers.size());
+}
+
+// FitBoardPlane's growing step (LidarPlaneOptions::grow_radius_m): candidates are the returns in
+// the band whose ray meets the plane inside the disc around the current centre; the centre moves
+// to the grown inliers' mean and the disc is drawn again until it settles. Selection is by ray
+// direction and the band only, as for the seed region, so that it does not bias the plane.
+LidarPlaneFit GrowToBoard(const LidarCloud& cloud, LidarPlaneFit fit,
+                          const LidarPlaneOptions& options) {
+  Vec3 centre = InlierCentre(cloud, fit);
+  for (int round = 0; round < 4; ++round) {
+    const double gate_m = 2.0 * RangeBand(options, fit.rms_m);
+    std::vector<int> candidates;
+    for (size_t i = 0; i < cloud.size(); ++i) {
+      const Vec3 x = cloud.points[i].cast<double>();
+      const auto residual = RangeResidual(fit.plane, x);
+      if (!residual || std::abs(*residual) > gate_m) continue;
+      const Vec3 on_plane = x - x.normalized() * *residual;
+      if ((on_plane - centre).norm() <= options.grow_radius_m)
+        candidates.push_back(static_cast<int>(i));
+    }
+    auto grown = RefineRangeMl(cloud, candidates, fit, options);
+    if (!grown || grown->inliers.size() < fit.inliers.size()) break;
+    fit = *grown;
+    fit.grown = true;
+    const Vec3 next_centre = InlierCentre(cloud, fit);
+    const bool settled = (next_centre - centre).norm() < 0.005;
+    centre = next_centre;
+    if (settled) break;
+  }
+  return fit;
+}
+
+}  // namespace
 
 std::vector<int> SelectSeedRegion(const LidarCloud& cloud, const LidarSeed& seed) {
   // A cone of rays around the seed's direction (the disc of `radius` seen from the LiDAR) and a
@@ -124,11 +220,13 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
   };
   // Residual e_i = r_i − r̂_i, r̂_i = −d/(n·u_i). With n ← n + B δ and d ← d + δ_d:
   // ∂r̂/∂δ = d (u_iᵀ B)/(n·u_i)², ∂r̂/∂δ_d = −1/(n·u_i); ∂e/∂· = −∂r̂/∂·.
+  Vec3 sum_jacobian = Vec3::Zero();  // Σ ∂e_i/∂θ at the last linearisation
   auto linearize = [&](const Plane& p, Mat3* normal_matrix, Vec3* gradient, double* sum_sq) {
     const Eigen::Matrix<double, 3, 2> b = tangent_of(p.normal);
     *normal_matrix = Mat3::Zero();
     *gradient = Vec3::Zero();
     *sum_sq = 0.0;
+    sum_jacobian.setZero();
     for (size_t k = 0; k < rays.size(); ++k) {
       const double cos_incidence = p.normal.dot(rays[k]);
       // A ray grazing the plane (|cos| < 0.02, beyond 88.9°) has no finite predicted range.
@@ -141,6 +239,7 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
       *normal_matrix += j.transpose() * j;
       *gradient += j.transpose() * e;
       *sum_sq += e * e;
+      sum_jacobian += j.transpose();
     }
     return true;
   };
@@ -172,6 +271,9 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
   to_coefficients.topLeftCorner<3, 2>() = tangent_of(plane.normal);
   to_coefficients(3, 2) = 1.0;
   fit.covariance = to_coefficients * local_cov * to_coefficients.transpose();
+  // A range offset b adds b to every residual; the Gauss-Newton solution then moves by
+  // −(JᵀJ)⁻¹ Jᵀ 1 per metre of b.
+  fit.range_offset_jacobian = to_coefficients * (-normal_matrix.ldlt().solve(sum_jacobian));
   return fit;
 }
 
@@ -233,26 +335,7 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
     // around the maximum-likelihood plane in range units (|r − r̂| ≤ max(threshold, 3σ̂_r)): a
     // band around the biased least-squares plane would truncate the range noise on one side and
     // carry the bias into the ML fit.
-    std::vector<int> inliers = fit->inliers;
-    Plane start = fit->plane;
-    for (int round = 0; round < 4; ++round) {
-      auto ml = FitPlaneRangeMl(cloud, inliers, start);
-      if (!ml) break;
-      fit = ml;
-      const double band_m = std::min(5.0 * options.ransac_threshold_m,
-                                     std::max(options.ransac_threshold_m, 3.0 * ml->rms_m));
-      std::vector<int> reselected;
-      for (int i : candidates) {
-        const Vec3 x = cloud.points[i].cast<double>();
-        const double cos_incidence = ml->plane.normal.dot(x.normalized());
-        if (std::abs(cos_incidence) < 0.02) continue;
-        if (std::abs(x.norm() + ml->plane.distance / cos_incidence) <= band_m)
-          reselected.push_back(i);
-      }
-      if (reselected == inliers || reselected.size() < 4) break;
-      inliers = std::move(reselected);
-      start = ml->plane;
-    }
+    if (auto ml = RefineRangeMl(cloud, candidates, *fit, options)) fit = ml;
   }
   fit->num_candidates = static_cast<int>(candidates.size());
   const int n = static_cast<int>(fit->inliers.size());
@@ -262,6 +345,12 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
   if (n < options.min_inlier_fraction * candidates.size())
     return fail("plane explains only " + std::to_string(n) + " of " +
                 std::to_string(candidates.size()) + " selected points");
+  if (options.grow_radius_m > 0 && options.fit_ranges_ml) fit = GrowToBoard(cloud, *fit, options);
+  // Edge points need the whole board's returns: the ends of a brushed patch are not its edges.
+  if (fit->grown && options.sheet_size_m.minCoeff() > 0) {
+    fit->edge_points = ExtractBoardEdgePoints(cloud, fit->inliers, fit->plane, options.edges);
+    fit->sheet_size_m = options.sheet_size_m;
+  }
   return fit;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/board_edges.h"
 #include "core/cloud.h"
 #include "core/dataset.h"
 #include "core/geometry.h"
@@ -24,15 +25,36 @@ struct LidarPlaneOptions {
   // lies along each ray, so the total-least-squares plane of a tilted board is biased (the bias
   // grows with σ² and the tilt); false keeps the total-least-squares refit.
   bool fit_ranges_ml = true;
+  // Grow the fit from the selected region to the whole board: every return within the range band
+  // of the plane whose ray meets the plane within this radius (metres) of the board centre found
+  // from those returns. A brush or seed disc usually covers a third of the board; the returns it
+  // leaves out carry the rest of the plane's information (the far boards' tilt above all).
+  // 0 = keep the selected region. Set from the target by BoardGrowRadius.
+  double grow_radius_m = 0.0;
+  // The sheet's [width, height] in metres when known: the grown fit then also finds the rings'
+  // crossings of the sheet's edges (LidarPlaneFit::edge_points). 0 = unknown, no edge points.
+  Vec2 sheet_size_m = Vec2::Zero();
+  BoardEdgeOptions edges;
   bool Check(std::string* why) const;
 };
+
+// The grow radius for a target: half the sheet's diagonal, 5% and 2 cm more so that the corners'
+// returns stay in while the centre estimate settles.
+double BoardGrowRadius(const BoardSpec& board);
 
 struct LidarPlaneFit {
   Plane plane;                     // LiDAR frame, normal towards the LiDAR (d > 0)
   Mat4 covariance = Mat4::Zero();  // of (n, d) from the least-squares refit; rank 3
   std::vector<int> inliers;        // indices into the cloud
   int num_candidates = 0;          // points in the brushed / seeded region
-  double rms_m = 0.0;              // point-to-plane RMS of the inliers
+  bool grown = false;              // inliers extend beyond the region (grow_radius_m)
+  // How the fitted (n, d) moves per metre of a range offset added to every return (FitPlaneRangeMl
+  // only; zero = unknown): the solver's handle on a LiDAR range offset.
+  Vec4 range_offset_jacobian = Vec4::Zero();
+  // Where the rings leave the board (LidarPlaneOptions::sheet_size_m), with that sheet size.
+  std::vector<LidarEdgePoint> edge_points;
+  Vec2 sheet_size_m = Vec2::Zero();
+  double rms_m = 0.0;  // point-to-plane RMS of the inliers
 };
 
 // Points on rays within the cone that a disc of `seed.radius` (metres) around `seed.point`

@@ -37,9 +37,27 @@ std::string PairStatusName(PairStatus status) {
   return "unknown";
 }
 
+LidarPlaneOptions LidarPlaneOptionsFor(const PipelineOptions& options, const BoardSpec& target) {
+  LidarPlaneOptions lidar = options.lidar_plane;
+  if (options.grow_to_board && lidar.grow_radius_m == 0)
+    lidar.grow_radius_m = BoardGrowRadius(target);
+  // Edges only for a sheet whose size the target states: the pattern's extent is no edge.
+  if (target.board_width > 0 && target.board_height > 0 && lidar.sheet_size_m.isZero())
+    lidar.sheet_size_m = Vec2(target.board_width, target.board_height);
+  return lidar;
+}
+
 PlanePair MakePlanePair(const std::string& id, const LidarPlaneFit& lidar,
                         const CameraBoardObservation& camera) {
-  return {id, lidar.plane, camera.plane, lidar.covariance, camera.plane_covariance};
+  return {id,
+          lidar.plane,
+          camera.plane,
+          lidar.covariance,
+          camera.plane_covariance,
+          lidar.range_offset_jacobian,
+          lidar.edge_points,
+          camera.cam_from_board,
+          0.5 * lidar.sheet_size_m};
 }
 
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
@@ -71,7 +89,8 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
         "to the manifest");
   const std::vector<int> region = SelectSeedRegion(cloud, *pair.lidar_seed);
   std::string why;
-  features.lidar = FitBoardPlane(cloud, region, options.lidar_plane, &why);
+  features.lidar =
+      FitBoardPlane(cloud, region, LidarPlaneOptionsFor(options, dataset.target), &why);
   if (!features.lidar)
     return fail("LiDAR: " + why + " (seed at " +
                 std::to_string(pair.lidar_seed->point.norm()).substr(0, 4) + " m, radius " +

@@ -22,6 +22,9 @@ struct PipelineOptions {
   std::optional<Pose> initial_cam_from_lidar;  // user guess; else the closed form from planes
   int threads = 1;                             // feature extraction workers
   int min_pairs = 3;                           // planes fix all 6 dof from 3 pairs on
+  // LiDAR: grow each brushed / seeded region to the whole board, limited by the target's sheet
+  // size (LidarPlaneOptions::grow_radius_m = BoardGrowRadius(target)).
+  bool grow_to_board = true;
   bool Check(std::string* why) const;
 };
 
@@ -36,6 +39,9 @@ struct PairFeatures {
   std::optional<LidarPlaneFit> lidar;
   std::optional<CameraBoardObservation> camera;
 };
+
+// options.lidar_plane with the grow radius for `target` when options.grow_to_board.
+LidarPlaneOptions LidarPlaneOptionsFor(const PipelineOptions& options, const BoardSpec& target);
 
 // The solver's input for one pair: both planes with their covariances.
 PlanePair MakePlanePair(const std::string& id, const LidarPlaneFit& lidar,

@@ -65,7 +65,32 @@ std::string ResultToJson(const CalibrationOutcome& outcome, const SolverOptions&
                     {"iterations", s.iterations},
                     {"converged", s.converged},
                     {"cost_history", s.cost_history},
-                    {"huber_delta", options.huber_delta}};
+                    {"huber_delta", options.huber_delta},
+                    {"board_edge_points", s.num_edge_residuals},
+                    // What the data said about the noise models: 1 = they held.
+                    {"plane_variance_factor", s.plane_variance_factor},
+                    {"edge_variance_factor", s.edge_variance_factor},
+                    {"covariance_inflation", s.covariance_inflation}};
+  if (s.edge_dilation) {
+    root["solver"]["board_edge_dilation"] = {
+        {"value_m", s.edge_dilation->value_m},
+        {"sigma_m", s.edge_dilation->sigma_m},
+        {"spread_over_pairs_m", s.edge_dilation->spread_m},
+        {"meaning",
+         "how much larger than the sheet the LiDAR sees it, per side (mean of the "
+         "pairs' estimates)"}};
+  }
+  if (s.range_offset) {
+    const RangeOffsetEstimate& offset = *s.range_offset;
+    root["lidar_range_offset"] = {
+        {"value_m", offset.value_m},
+        {"sigma_m", offset.sigma_m},
+        {"convention", "measured range = true range + value_m; subtract it to correct"},
+        {"correlation_with_translation",
+         {offset.correlation_with_translation.x(), offset.correlation_with_translation.y(),
+          offset.correlation_with_translation.z()}},
+        {"well_determined", offset.well_determined}};
+  }
   json pairs = json::array();
   size_t solved_index = 0;
   for (const PairFeatures& p : outcome.pairs) {
@@ -197,6 +222,36 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
       "std (camera axes x/y/z) translation [mm]: %.2f %.2f %.2f   rotation [deg]: %.3f %.3f %.3f\n",
       st.x(), st.y(), st.z(), sr.x(), sr.y(), sr.z());
   out << line;
+  if (s.num_edge_residuals > 0) {
+    std::snprintf(line, sizeof(line), "board edges: %d ring crossings of the sheet's edges used",
+                  s.num_edge_residuals);
+    out << line;
+    if (s.edge_dilation) {
+      std::snprintf(line, sizeof(line),
+                    "; the LiDAR sees the sheet %+.1f ± %.1f mm larger per side (beam footprint; "
+                    "pairs spread %.1f mm)",
+                    s.edge_dilation->value_m * 1e3, s.edge_dilation->sigma_m * 1e3,
+                    s.edge_dilation->spread_m * 1e3);
+      out << line;
+    }
+    out << "\n";
+  }
+  if (s.range_offset) {
+    const Vec3& c = s.range_offset->correlation_with_translation;
+    std::snprintf(line, sizeof(line),
+                  "LiDAR range offset: %+.1f ± %.1f mm (measured = true + offset; correlation "
+                  "with translation x/y/z %.2f %.2f %.2f)%s\n",
+                  s.range_offset->value_m * 1e3, s.range_offset->sigma_m * 1e3, c.x(), c.y(), c.z(),
+                  s.range_offset->well_determined ? "" : " NOT well determined");
+    out << line;
+  }
+  if (s.covariance_inflation > 1.0) {
+    std::snprintf(line, sizeof(line),
+                  "covariance widened up to %.1fx (variance) by the spread over the pairs: the "
+                  "noise models underestimate this data\n",
+                  s.covariance_inflation);
+    out << line;
+  }
   std::snprintf(line, sizeof(line), "solver: %d iterations, %s, cost %.3e -> %.3e\n", s.iterations,
                 s.converged ? "converged" : "NOT converged", s.cost_history.front(),
                 s.cost_history.back());

@@ -26,6 +26,19 @@ bool SessionResult::operator==(const SessionResult& other) const {
          converged == other.converged && cost_history == other.cost_history &&
          weak_directions == other.weak_directions && well_constrained == other.well_constrained &&
          step_history == other.step_history &&
+         range_offset.has_value() == other.range_offset.has_value() &&
+         (!range_offset ||
+          (range_offset->value_m == other.range_offset->value_m &&
+           range_offset->sigma_m == other.range_offset->sigma_m &&
+           range_offset->correlation_with_translation ==
+               other.range_offset->correlation_with_translation &&
+           range_offset->well_determined == other.range_offset->well_determined)) &&
+         num_edge_residuals == other.num_edge_residuals &&
+         edge_dilation.has_value() == other.edge_dilation.has_value() &&
+         (!edge_dilation || (edge_dilation->value_m == other.edge_dilation->value_m &&
+                             edge_dilation->sigma_m == other.edge_dilation->sigma_m &&
+                             edge_dilation->spread_m == other.edge_dilation->spread_m)) &&
+         covariance_inflation == other.covariance_inflation &&
          std::equal(estimate_history.begin(), estimate_history.end(),
                     other.estimate_history.begin(), other.estimate_history.end(),
                     [](const Pose& a, const Pose& b) { return a.matrix() == b.matrix(); });
@@ -40,7 +53,11 @@ SessionResult SessionResultFromSolver(const SolverResult& solver) {
           solver.observability.weak_directions,
           solver.observability.well_constrained,
           {},
-          {}};
+          {},
+          solver.range_offset,
+          solver.num_edge_residuals,
+          solver.edge_dilation,
+          solver.covariance_inflation};
 }
 
 std::filesystem::path NormalizeSessionPath(const std::filesystem::path& path) {

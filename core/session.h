@@ -85,6 +85,12 @@ struct SessionResult {
   // a reopened session shows and replays the same convergence. May be empty.
   std::vector<double> step_history;
   std::vector<Pose> estimate_history;
+  // What the solve said beyond the pose (optional in the file): the range offset when estimated,
+  // the board edges used, the edge dilation and how far the pairs' spread widened the covariance.
+  std::optional<RangeOffsetEstimate> range_offset;
+  int num_edge_residuals = 0;
+  std::optional<EdgeDilationEstimate> edge_dilation;
+  double covariance_inflation = 1.0;
 
   // Exact value comparison (no tolerance), so a file round trip can be checked with ==.
   bool operator==(const SessionResult& other) const;
@@ -95,10 +101,11 @@ struct Session {
   int version = 1;  // of the file format; this build reads and writes 1
   // The manifest (or shorthand folder); absolute and lexically normal in memory.
   std::filesystem::path dataset;
-  std::vector<PairState> pairs;                         // in the dataset's order
-  SolverMethod method = SolverOptions{}.method;         // solver (see SolverOptions)
-  double huber_delta = SolverOptions{}.huber_delta;     // Huber threshold (see SolverOptions)
-  int max_iterations = SolverOptions{}.max_iterations;  // Gauss-Newton iterations
+  std::vector<PairState> pairs;                      // in the dataset's order
+  SolverMethod method = SolverOptions{}.method;      // solver (see SolverOptions)
+  double huber_delta = SolverOptions{}.huber_delta;  // Huber threshold (see SolverOptions)
+  bool estimate_range_offset = false;  // weighted-ml: LiDAR range offset (see SolverOptions)
+  int max_iterations = SolverOptions{}.max_iterations;                 // Gauss-Newton iterations
   double ransac_threshold_m = LidarPlaneOptions{}.ransac_threshold_m;  // LiDAR plane inliers
   ViewState view;
   std::optional<SessionResult> result;  // the last solve, if any

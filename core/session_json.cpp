@@ -113,18 +113,34 @@ Json EstimateHistory(const std::vector<Pose>& estimates) {
 }
 
 Json ResultToJson(const SessionResult& r) {
-  return {{"direction", kDirection},
-          {"cam_from_lidar", {{"matrix", Rows(r.cam_from_lidar.matrix())}}},
-          {"covariance_6x6", Rows(r.covariance)},
-          {"covariance_convention",
-           "right perturbation cam_from_lidar * Exp(delta), delta = [rho (m); phi (rad)]"},
-          {"iterations", r.iterations},
-          {"converged", r.converged},
-          {"cost_history", Numbers(r.cost_history.data(), static_cast<int>(r.cost_history.size()))},
-          {"weak_directions", r.weak_directions},
-          {"well_constrained", r.well_constrained},
-          {"step_history", Numbers(r.step_history.data(), static_cast<int>(r.step_history.size()))},
-          {"estimate_history", EstimateHistory(r.estimate_history)}};
+  Json json = {
+      {"direction", kDirection},
+      {"cam_from_lidar", {{"matrix", Rows(r.cam_from_lidar.matrix())}}},
+      {"covariance_6x6", Rows(r.covariance)},
+      {"covariance_convention",
+       "right perturbation cam_from_lidar * Exp(delta), delta = [rho (m); phi (rad)]"},
+      {"iterations", r.iterations},
+      {"converged", r.converged},
+      {"cost_history", Numbers(r.cost_history.data(), static_cast<int>(r.cost_history.size()))},
+      {"weak_directions", r.weak_directions},
+      {"well_constrained", r.well_constrained},
+      {"step_history", Numbers(r.step_history.data(), static_cast<int>(r.step_history.size()))},
+      {"estimate_history", EstimateHistory(r.estimate_history)},
+      {"board_edge_points", r.num_edge_residuals},
+      {"covariance_inflation", r.covariance_inflation}};
+  if (r.range_offset) {
+    const RangeOffsetEstimate& o = *r.range_offset;
+    json["lidar_range_offset"] = {
+        {"value_m", o.value_m},
+        {"sigma_m", o.sigma_m},
+        {"correlation_with_translation", Numbers(o.correlation_with_translation.data(), 3)},
+        {"well_determined", o.well_determined}};
+  }
+  if (r.edge_dilation)
+    json["board_edge_dilation"] = {{"value_m", r.edge_dilation->value_m},
+                                   {"sigma_m", r.edge_dilation->sigma_m},
+                                   {"spread_m", r.edge_dilation->spread_m}};
+  return json;
 }
 
 // Like dump(2), but arrays of plain values stay on one line: a matrix row, a pixel run or the
@@ -348,6 +364,26 @@ SessionResult ReadResult(const Fields& f) {
       pose.matrix() = ReadSquare<4>(m, f.Path("estimate_history"));
       r.estimate_history.push_back(pose);
     }
+  // Written since the board edges and the range offset; older sessions open without them.
+  if (f.Has("board_edge_points")) r.num_edge_residuals = f.Int("board_edge_points");
+  if (f.Has("covariance_inflation")) r.covariance_inflation = f.Number("covariance_inflation");
+  if (f.Has("lidar_range_offset")) {
+    const Fields o = f.Object("lidar_range_offset");
+    RangeOffsetEstimate offset;
+    offset.value_m = o.Number("value_m");
+    offset.sigma_m = o.Number("sigma_m");
+    const Json& c = o.Array("correlation_with_translation", 3);
+    for (int k = 0; k < 3; ++k)
+      offset.correlation_with_translation[k] =
+          AsDouble(c[k], o.Path("correlation_with_translation"));
+    offset.well_determined = o.Bool("well_determined");
+    r.range_offset = offset;
+  }
+  if (f.Has("board_edge_dilation")) {
+    const Fields d = f.Object("board_edge_dilation");
+    r.edge_dilation =
+        EdgeDilationEstimate{d.Number("value_m"), d.Number("sigma_m"), d.Number("spread_m")};
+  }
   return r;
 }
 
@@ -360,6 +396,8 @@ void ReadOptions(const Fields& f, Session* s) {
       throw FormatError(f.Path("method") + ": '" + name + "' is not weighted-ml, ca2lib-gn or kim");
     s->method = *method;
   }
+  // Optional: sessions written before the range offset existed do not estimate it.
+  if (f.Has("estimate_range_offset")) s->estimate_range_offset = f.Bool("estimate_range_offset");
   s->huber_delta = f.Positive("huber_delta");
   s->max_iterations = f.Int("max_iterations");
   if (s->max_iterations < 1) throw FormatError(f.Path("max_iterations") + ": must be at least 1");
@@ -420,6 +458,7 @@ std::string SessionToJson(const Session& session, const std::filesystem::path& s
                {"options",
                 {{"method", SolverMethodName(session.method)},
                  {"huber_delta", Number(session.huber_delta)},
+                 {"estimate_range_offset", session.estimate_range_offset},
                  {"max_iterations", session.max_iterations},
                  {"ransac_threshold_m", Number(session.ransac_threshold_m)}}},
                {"pairs", pairs},

@@ -253,6 +253,8 @@ bool SimOptions::Check(std::string* why) const {
   if (!(lidar_range_noise_m >= 0.0) || !std::isfinite(lidar_range_noise_m)) {
     return fail("lidar_range_noise_m must be >= 0");
   }
+  if (!(std::abs(lidar_range_offset_m) <= 0.5))
+    return fail("lidar_range_offset_m must be within ±0.5 m");
   if (!(image_noise >= 0.0) || !std::isfinite(image_noise)) return fail("image_noise must be >= 0");
   if (!(seed_radius_m >= 0.0) || !std::isfinite(seed_radius_m)) {
     return fail("seed_radius_m must be >= 0 (0 = automatic)");
@@ -400,6 +402,7 @@ SimOptions SimOptionsFromDataset(const Dataset& dataset) {
   options.max_distance_m = record.max_distance_m;
   options.max_tilt_deg = record.max_tilt_deg;
   options.lidar_range_noise_m = record.lidar_range_noise_m;
+  options.lidar_range_offset_m = record.lidar_range_offset_m;
   options.image_noise = record.image_noise;
   options.clutter = record.clutter;
   options.seed_radius_m = record.seed_radius_m;
@@ -435,6 +438,7 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
   record.max_distance_m = r.max_distance_m;
   record.max_tilt_deg = r.max_tilt_deg;
   record.lidar_range_noise_m = r.lidar_range_noise_m;
+  record.lidar_range_offset_m = r.lidar_range_offset_m;
   record.image_noise = r.image_noise;
   record.clutter = r.clutter;
   record.seed_radius_m = r.seed_radius_m;
@@ -454,6 +458,7 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
 
     LidarScanOptions scan_options;
     scan_options.range_noise_m = r.lidar_range_noise_m;
+    scan_options.range_offset_m = r.lidar_range_offset_m;
     scan_options.azimuth_offset_rad = plan.azimuth_offset_rad;
     scan_options.seed = MixSeed(r.seed, k, 1);
     SavePcd(entry.cloud, SimulateLidarScan(beams, print, scene, scan_options).ToCloud(),

@@ -39,8 +39,10 @@ struct SimOptions {
   double max_distance_m = 4.0;
   double max_tilt_deg = 40.0;        // board normal vs. the camera viewing ray
   double lidar_range_noise_m = 0.0;  // Gaussian, along each ray
-  double image_noise = 0.0;          // Gaussian pixel noise, in [0,1] intensity units (Gazebo)
-  bool clutter = true;               // floor and walls
+  // Constant error of the LiDAR's range calibration: measured range = true range + offset (m).
+  double lidar_range_offset_m = 0.0;
+  double image_noise = 0.0;  // Gaussian pixel noise, in [0,1] intensity units (Gazebo)
+  bool clutter = true;       // floor and walls
   Pose cam_from_lidar = Pose::Identity();  // ground truth; Identity() = the default mount below
   double seed_radius_m = 0.0;              // lidar_seed radius; 0 = 0.4 * the smaller board side
   std::uint64_t seed = 1;
@@ -103,6 +105,7 @@ struct LidarScene {
 
 struct LidarScanOptions {
   double range_noise_m = 0.0;       // Gaussian, along each ray (metres)
+  double range_offset_m = 0.0;      // added to every range (metres)
   double azimuth_offset_rad = 0.0;  // azimuth of step 0 (the firing phase of this sweep)
   std::uint64_t seed = 1;           // range and intensity noise
 };

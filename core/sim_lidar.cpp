@@ -170,7 +170,7 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
       IntersectBoard(dir, board, print, &hit);
       if (scene.clutter) IntersectRoom(dir, scene, &hit);
       if (hit.range >= beams.max_range_m || hit.range < kMinRangeM) continue;
-      double range = hit.range;
+      double range = hit.range + options.range_offset_m;
       if (options.range_noise_m > 0.0) range += options.range_noise_m * unit_normal(rng);
       const double intensity = SurfaceIntensity(hit, print) + kIntensityNoise * unit_normal(rng);
       scan.points.push_back(range * dir);

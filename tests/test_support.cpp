@@ -1,8 +1,12 @@
 #include "tests/test_support.h"
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+
+#include "core/geometry.h"
+#include "tests/acfr_manifest.h"
 
 namespace calibench::test {
 
@@ -34,6 +38,34 @@ int RunCommand(const std::string& command, std::string* output) {
   const int status = pclose(pipe);
   if (output) *output = text;
   return WEXITSTATUS(status);
+}
+
+void ExpectNearAcfrReference(const Pose& cam_from_lidar, const char* what) {
+  const Pose reference = AcfrReferenceCamFromLidar();
+  const Vec3 difference =
+      cam_from_lidar.inverse().translation() - reference.inverse().translation();
+  const double angle = RotationAngle(cam_from_lidar.linear(), reference.linear());
+  std::printf(
+      "%s: %.1f mm, %.3f deg from the authors' reference (LiDAR frame x/y/z %+.1f / %+.1f / "
+      "%+.1f mm)\n",
+      what, difference.norm() * 1e3, angle * 180 / M_PI, difference.x() * 1e3, difference.y() * 1e3,
+      difference.z() * 1e3);
+  EXPECT_LT(std::abs(difference.x()), 2 * 0.004);
+  EXPECT_LT(std::abs(difference.y()), 2 * 0.018);
+  EXPECT_LT(std::abs(difference.z()), 2 * 0.030);
+  EXPECT_LT(angle, 2 * 0.66 * M_PI / 180);
+}
+
+SimOptions A3Hdl64Options(int pairs, double range_noise_m, std::uint64_t seed) {
+  SimOptions options = SimPreset("paper");
+  options.board = BoardPreset("a3");
+  options.lidar = LidarModel::kHdl64;
+  options.min_distance_m = 1.5;
+  options.max_distance_m = 6.0;
+  options.num_pairs = pairs;
+  options.lidar_range_noise_m = range_noise_m;
+  options.seed = seed;
+  return options;
 }
 
 }  // namespace calibench::test

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "core/sim.h"
 #include "core/types.h"
 
 namespace calibench::test {
@@ -36,6 +37,14 @@ template <typename A, typename B>
          << actual << "\nexpected:\n"
          << expected;
 }
+
+// Checks (gtest EXPECTs) that an estimate lies within twice the reference's own spread: the
+// authors give it for lidar_from_cam (the camera's position in the LiDAR frame) as 4 / 18 / 30 mm
+// in x / y / z and 0.40–0.66 deg per angle. Prints the differences, prefixed by `what`.
+void ExpectNearAcfrReference(const Pose& cam_from_lidar, const char* what);
+
+// The issue-5 protocol's simulation: an A3 checkerboard, an HDL-64, boards at 1.5–6 m.
+SimOptions A3Hdl64Options(int pairs, double range_noise_m, std::uint64_t seed);
 
 }  // namespace calibench::test
 

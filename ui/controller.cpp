@@ -165,6 +165,7 @@ void Controller::ApplySessionToState(const Session& session) {
   state_.method = session.method;
   state_.huber_delta = session.huber_delta;
   state_.max_iterations = session.max_iterations;
+  state_.estimate_range_offset = session.estimate_range_offset;
   for (size_t i = 0; i < session.pairs.size() && i < state_.pairs.size(); ++i) {
     PairView& pair = state_.pairs[i];
     pair.status = session.pairs[i].status;
@@ -185,6 +186,10 @@ void Controller::ApplySessionToState(const Session& session) {
     r.cost_history = session.result->cost_history;
     r.observability.weak_directions = session.result->weak_directions;
     r.observability.well_constrained = session.result->well_constrained;
+    r.range_offset = session.result->range_offset;
+    r.num_edge_residuals = session.result->num_edge_residuals;
+    r.edge_dilation = session.result->edge_dilation;
+    r.covariance_inflation = session.result->covariance_inflation;
     state_.solver.result = r;
     // The recorded convergence, so that the solver panel and the replay look as they did.
     const auto& costs = session.result->cost_history;
@@ -207,6 +212,7 @@ void Controller::CommitEdit() {
   session_.method = state_.method;
   session_.huber_delta = state_.huber_delta;
   session_.max_iterations = state_.max_iterations;
+  session_.estimate_range_offset = state_.estimate_range_offset;
   for (size_t i = 0; i < state_.pairs.size(); ++i) {
     PairState& p = session_.pairs[i];
     const PairView& v = state_.pairs[i];
@@ -297,8 +303,10 @@ void Controller::RefitLidar(int index) {
   std::shared_ptr<const LidarCloud> cloud;
   std::shared_ptr<const LidarImage> image;
   std::vector<int> brush;
+  BoardSpec target;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    target = state_.dataset->target;
     cloud = state_.pairs[index].cloud;
     image = state_.pairs[index].lidar_image;
     brush = state_.pairs[index].brush_pixels;
@@ -309,7 +317,8 @@ void Controller::RefitLidar(int index) {
   if (brush.empty()) {
     why = "no board region: brush the board on the LiDAR image";
   } else {
-    fit = FitBoardPlane(*cloud, SelectBrushRegion(*image, brush), pipeline_.lidar_plane, &why);
+    fit = FitBoardPlane(*cloud, SelectBrushRegion(*image, brush),
+                        LidarPlaneOptionsFor(pipeline_, target), &why);
   }
   std::lock_guard<std::mutex> lock(mutex_);
   PairView& pair = state_.pairs[index];
@@ -343,15 +352,27 @@ void Controller::RecomputeResiduals() {
     solved.push_back(&pair);
   }
   if (planes.empty()) return;
-  SolverOptions options = pipeline_.solver;
-  options.method = state_.method;
-  options.huber_delta = state_.huber_delta;
+  SolverOptions options = SolverOptionsFromState();
+  const auto& offset = state_.solver.result->range_offset;
   const SolverResult at_estimate =
-      PlaneAlignmentSolver(planes, options, state_.solver.result->cam_from_lidar).Summarize();
+      PlaneAlignmentSolver(planes, options, state_.solver.result->cam_from_lidar,
+                           offset ? offset->value_m : 0.0)
+          .Summarize();
   for (size_t i = 0; i < solved.size(); ++i) {
     solved[i]->residual = at_estimate.residuals[i];
     solved[i]->robust_weight = at_estimate.robust_weights[i];
   }
+}
+
+SolverOptions Controller::SolverOptionsFromState() const {
+  SolverOptions options = pipeline_.solver;
+  options.method = state_.method;
+  options.huber_delta = state_.huber_delta;
+  options.max_iterations = state_.max_iterations;
+  // The offset belongs to the weighted method; the checkbox keeps its value across methods.
+  options.estimate_range_offset =
+      state_.estimate_range_offset && state_.method == SolverMethod::kWeightedMl;
+  return options;
 }
 
 void Controller::Solve() {
@@ -362,10 +383,7 @@ void Controller::Solve() {
     for (const PairView& pair : state_.pairs)
       if (pair.status == PairStatus::kAccepted && pair.lidar && pair.camera)
         planes.push_back(MakePlanePair(pair.id, *pair.lidar, *pair.camera));
-    options = pipeline_.solver;
-    options.method = state_.method;
-    options.huber_delta = state_.huber_delta;
-    options.max_iterations = state_.max_iterations;
+    options = SolverOptionsFromState();
     state_.solver = SolverView{};
     state_.solver.running = true;
     ++state_.generation;
@@ -546,8 +564,10 @@ void Controller::Apply(const Intent& intent) {
       SetStatus("solver options: " + why, true);
       return;
     }
-    const bool method_changed = state_.method != options->method;
+    const bool method_changed = state_.method != options->method ||
+                                state_.estimate_range_offset != options->estimate_range_offset;
     state_.method = options->method;
+    state_.estimate_range_offset = options->estimate_range_offset;
     state_.huber_delta = options->huber_delta;
     state_.max_iterations = options->max_iterations;
     // Residuals and weights shown for the current estimate depend on the method.
@@ -589,9 +609,7 @@ void Controller::Apply(const Intent& intent) {
         outcome.solution->residuals.push_back(*pair.residual);
         outcome.solution->robust_weights.push_back(pair.robust_weight);
       }
-    SolverOptions options;
-    options.method = state_.method;
-    options.huber_delta = state_.huber_delta;
+    const SolverOptions options = SolverOptionsFromState();
     try {
       WriteResult(export_result->path, outcome, options);
       SetStatus("exported " + export_result->path.string(), false);

@@ -79,6 +79,7 @@ struct Snapshot {
   SolverMethod method = SolverOptions{}.method;
   double huber_delta = SolverOptions{}.huber_delta;
   int max_iterations = SolverOptions{}.max_iterations;
+  bool estimate_range_offset = false;  // weighted-ml only
   bool can_undo = false, can_redo = false;
   int loading_done = 0, loading_total = 0;
   bool busy = false;        // worker has queued or running jobs
@@ -110,6 +111,7 @@ struct SetSolverOptions {
   double huber_delta;
   int max_iterations;
   SolverMethod method = SolverOptions{}.method;
+  bool estimate_range_offset = false;
 };
 struct SetView {
   ViewState view;
@@ -151,6 +153,7 @@ class Controller {
   void LoadPair(int index);
   void RefitLidar(int index);
   void Solve();
+  SolverOptions SolverOptionsFromState() const;  // the user's choices over pipeline_.solver
   void ComputeReprojection(int index);
   void EnsureSelectedImage();
   void RecomputeResiduals();  // call with mutex_ held

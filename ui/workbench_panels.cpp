@@ -149,7 +149,18 @@ void Workbench::SolverPanel(const Snapshot& s, const ViewRect& r, std::vector<In
     }
     ImGui::EndCombo();
   }
-  if (method != s.method) intents->push_back(SetSolverOptions{delta, iterations, method});
+  if (method != s.method)
+    intents->push_back(SetSolverOptions{delta, iterations, method, s.estimate_range_offset});
+  ImGui::SameLine();
+  ImGui::BeginDisabled(s.method != SolverMethod::kWeightedMl);
+  bool estimate_offset = s.estimate_range_offset;
+  if (ImGui::Checkbox("range offset", &estimate_offset))
+    intents->push_back(SetSolverOptions{delta, iterations, s.method, estimate_offset});
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip(
+        "weighted-ml: also estimate a constant LiDAR range offset (measured = true + offset),\n"
+        "reported with its standard deviation and its correlation with the translation");
+  ImGui::EndDisabled();
   ImGui::SameLine();
   ImGui::TextDisabled("%s", kMethodHelp[method_index]);
   ImGui::SetNextItemWidth(120);
@@ -159,7 +170,7 @@ void Workbench::SolverPanel(const Snapshot& s, const ViewRect& r, std::vector<In
   ImGui::SetNextItemWidth(100);
   ImGui::InputInt("max iterations", &iterations);
   if (delta_done || ImGui::IsItemDeactivatedAfterEdit())
-    intents->push_back(SetSolverOptions{delta, iterations, s.method});
+    intents->push_back(SetSolverOptions{delta, iterations, s.method, s.estimate_range_offset});
   const bool solved = !s.solver.iterations.empty();
   ImGui::BeginDisabled(s.solver.running);
   if (ImGui::Button("Run (F5)")) {
@@ -234,6 +245,22 @@ void Workbench::SolverPanel(const Snapshot& s, const ViewRect& r, std::vector<In
     const Vec3 sr = RotationStdDeg(res.covariance, res.cam_from_lidar);
     ImGui::Text("std (camera x/y/z): %.1f %.1f %.1f mm, %.3f %.3f %.3f deg", st.x(), st.y(), st.z(),
                 sr.x(), sr.y(), sr.z());
+    if (res.covariance_inflation > 1.0)
+      ImGui::TextWrapped(
+          "std widened by the spread over the pairs (variance x%.1f): the noise "
+          "models underestimate this data",
+          res.covariance_inflation);
+    if (res.range_offset) {
+      const Vec3& c = res.range_offset->correlation_with_translation;
+      ImGui::Text("range offset: %+.1f ± %.1f mm (correlation with translation %.2f %.2f %.2f)",
+                  res.range_offset->value_m * 1e3, res.range_offset->sigma_m * 1e3, c.x(), c.y(),
+                  c.z());
+    }
+    if (res.edge_dilation) {
+      ImGui::Text("board edges: %d crossings, sheet seen %+.1f ± %.1f mm larger per side",
+                  res.num_edge_residuals, res.edge_dilation->value_m * 1e3,
+                  res.edge_dilation->sigma_m * 1e3);
+    }
     if (res.observability.well_constrained) {
       ImGui::TextColored({0.45f, 0.85f, 0.45f, 1}, "well constrained (%d iterations, %s)",
                          res.iterations, res.converged ? "converged" : "not converged");

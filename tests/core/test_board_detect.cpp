@@ -97,6 +97,21 @@ ImageU8 Render(const CameraModel& camera, const BoardSpec& board, const Pose& po
   return RenderBoardImage(camera, board, pose, options);
 }
 
+// The bias of one distance and tilt is measured over this many renders, each moved by a fraction
+// of a pixel and turned a little in its plane: one render's corners sit at fixed sub-pixel
+// phases, and their errors (~0.07 px RMS over 24–35 corners) leave a single image's mean
+// uncertain by ±0.013 px, as large as the bias to be ruled out. Over the jittered renders the
+// standard error of the mean is ~0.005 px.
+constexpr int kJitteredRenders = 6;
+
+Pose Jittered(const Pose& pose, int k, double distance_m) {
+  // Steps of about 0.37 px and 0.23 px at 1000 px focal length, and 1 degree about the normal.
+  Pose moved = pose;
+  moved.translation() += Vec3(0.37e-3 * k, 0.23e-3 * k, 0.0) * distance_m;
+  moved.linear() = pose.linear() * ExpSO3(Vec3(0, 0, 1.0 * kDeg * k));
+  return moved;
+}
+
 // Plane error against the truth: angle (deg), distance (mm), Mahalanobis over the 3 free dims,
 // and the predicted standard deviation of the normal in its worst direction (deg).
 struct PlaneError {
@@ -128,46 +143,66 @@ TEST(BoardDetect, RenderedCheckerboardCornersAreUnbiased) {
     // 4.5 px squares (fisheye at 5 m) are below what findChessboardCornersSB finds.
     for (const double distance : fisheye ? std::vector{1.5, 3.0} : std::vector{1.5, 3.0, 5.0}) {
       for (const double tilt : {0.0, 30.0, 50.0}) {
-        const Pose pose = BoardPose(Vec3(0.05, -0.03, 1.0) * distance, tilt * kDeg);
-        const CameraModel camera =
-            CropToBoard(fisheye ? FisheyeCamera() : PinholeCamera(), board, pose);
-        const ImageU8 image = Render(camera, board, pose);
-        const std::vector<Vec2> truth = TruePixels(camera, board, pose);
-        std::string why;
-        const auto detection = DetectBoard(image, board, BoardDetectionOptions{}, &why);
-        ASSERT_TRUE(detection) << why << " at " << distance << " m, " << tilt << " deg";
-        ASSERT_EQ(detection->pixels.size(), 35u);
-        const Offsets ours = NearestOffsets(detection->pixels, truth);
-        ours_all.Add(ours);
-        // findChessboardCornersSB alone, for comparison.
-        const cv::Mat grey(image.height, image.width, CV_8UC3,
-                           const_cast<std::uint8_t*>(image.data.data()));
-        cv::Mat grey1;
-        cv::cvtColor(grey, grey1, cv::COLOR_BGR2GRAY);
-        std::vector<cv::Point2f> sb;
-        const int flags =
-            cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY | cv::CALIB_CB_NORMALIZE_IMAGE;
-        ASSERT_TRUE(cv::findChessboardCornersSB(grey1, cv::Size(7, 5), sb, flags));
-        std::vector<Vec2> sb_pixels;
-        for (const cv::Point2f& c : sb) sb_pixels.emplace_back(c.x, c.y);
-        const Offsets sb_only = NearestOffsets(sb_pixels, truth);
-        sb_all.Add(sb_only);
-        const auto obs = EstimateBoardPose(camera, *detection, PnpOptions{}, &why);
-        ASSERT_TRUE(obs) << why;
-        const PlaneError plane = ComparePlane(*obs, pose);
-        std::printf(
-            "[ checker ] %s %.1f m %2.0f deg: ours mean (%+.3f, %+.3f) rms %.3f | SB alone mean "
-            "(%+.3f, %+.3f) rms %.3f | plane %.3f deg (sigma %.3f) %+.2f mm, Mahalanobis %.1f\n",
-            fisheye ? "fisheye" : "pinhole", distance, tilt, ours.Mean().x(), ours.Mean().y(),
-            ours.Rms(), sb_only.Mean().x(), sb_only.Mean().y(), sb_only.Rms(), plane.angle_deg,
-            plane.normal_sigma_deg, plane.distance_mm, plane.mahalanobis);
-        EXPECT_LT(ours.Mean().cwiseAbs().maxCoeff(), 0.03);
-        EXPECT_LT(ours.Rms(), 0.12);
-        ExpectPlaneNearTruth(plane);
-        if (!fisheye && distance == 3.0) {
-          EXPECT_LT(plane.angle_deg, 0.2);
-          EXPECT_LT(std::abs(plane.distance_mm), 2.0);
+        Offsets ours, sb_only;
+        int detected = 0;
+        for (int k = 0; k < kJitteredRenders; ++k) {
+          const Pose pose =
+              Jittered(BoardPose(Vec3(0.05, -0.03, 1.0) * distance, tilt * kDeg), k, distance);
+          const CameraModel camera =
+              CropToBoard(fisheye ? FisheyeCamera() : PinholeCamera(), board, pose);
+          const ImageU8 image = Render(camera, board, pose);
+          const std::vector<Vec2> truth = TruePixels(camera, board, pose);
+          std::string why;
+          const auto detection = DetectBoard(image, board, BoardDetectionOptions{}, &why);
+          // The fisheye board at 3 m and 50 degrees (squares ~6 px across) is at the edge of
+          // what the detector finds: a render may be missed, and the count is checked below.
+          if (!detection) continue;
+          ASSERT_EQ(detection->pixels.size(), 35u);
+          ++detected;
+          ours.Add(NearestOffsets(detection->pixels, truth));
+          // findChessboardCornersSB alone, for comparison.
+          const cv::Mat grey(image.height, image.width, CV_8UC3,
+                             const_cast<std::uint8_t*>(image.data.data()));
+          cv::Mat grey1;
+          cv::cvtColor(grey, grey1, cv::COLOR_BGR2GRAY);
+          std::vector<cv::Point2f> sb;
+          const int flags =
+              cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY | cv::CALIB_CB_NORMALIZE_IMAGE;
+          if (cv::findChessboardCornersSB(grey1, cv::Size(7, 5), sb, flags)) {
+            std::vector<Vec2> sb_pixels;
+            for (const cv::Point2f& c : sb) sb_pixels.emplace_back(c.x, c.y);
+            sb_only.Add(NearestOffsets(sb_pixels, truth));
+          }
+          if (detected > 1) continue;  // the plane check on the first detected render
+          const auto obs = EstimateBoardPose(camera, *detection, PnpOptions{}, &why);
+          ASSERT_TRUE(obs) << why;
+          const PlaneError plane = ComparePlane(*obs, pose);
+          std::printf(
+              "[ checker ] %s %.1f m %2.0f deg: plane %.3f deg (sigma %.3f) %+.2f mm, "
+              "Mahalanobis %.1f\n",
+              fisheye ? "fisheye" : "pinhole", distance, tilt, plane.angle_deg,
+              plane.normal_sigma_deg, plane.distance_mm, plane.mahalanobis);
+          ExpectPlaneNearTruth(plane);
+          if (!fisheye && distance == 3.0) {
+            EXPECT_LT(plane.angle_deg, 0.2);
+            EXPECT_LT(std::abs(plane.distance_mm), 2.0);
+          }
         }
+        EXPECT_GE(detected, kJitteredRenders - 2) << distance << " m, " << tilt << " deg";
+        if (detected == 0) continue;
+        ours_all.Add(ours);
+        sb_all.Add(sb_only);
+        std::printf(
+            "[ checker ] %s %.1f m %2.0f deg, %d of %d renders: ours mean (%+.4f, %+.4f) rms %.3f "
+            "| SB "
+            "alone mean (%+.4f, %+.4f) rms %.3f\n",
+            fisheye ? "fisheye" : "pinhole", distance, tilt, detected, kJitteredRenders,
+            ours.Mean().x(), ours.Mean().y(), ours.Rms(), sb_only.Mean().x(), sb_only.Mean().y(),
+            sb_only.Rms());
+        // Issue 5: no bias above 0.02 px at any distance and tilt.
+        EXPECT_LT(ours.Mean().cwiseAbs().maxCoeff(), 0.02)
+            << distance << " m, " << tilt << " deg, " << (fisheye ? "fisheye" : "pinhole");
+        EXPECT_LT(ours.Rms(), 0.12);
       }
     }
     std::printf(
@@ -175,7 +210,7 @@ TEST(BoardDetect, RenderedCheckerboardCornersAreUnbiased) {
         "%+.4f) rms %.3f\n",
         fisheye ? "fisheye" : "pinhole", ours_all.Mean().x(), ours_all.Mean().y(), ours_all.Rms(),
         sb_all.Mean().x(), sb_all.Mean().y(), sb_all.Rms());
-    EXPECT_LT(ours_all.Mean().cwiseAbs().maxCoeff(), 0.02);
+    EXPECT_LT(ours_all.Mean().cwiseAbs().maxCoeff(), 0.01);
     EXPECT_LT(ours_all.Rms(), 0.1);
   }
 }
@@ -197,40 +232,51 @@ TEST(BoardDetect, RenderedCharucoOffsetIsMeasuredAndCorrected) {
   for (const Case& c : cases) {
     const BoardSpec board = A3Charuco(c.dictionary);
     for (const double tilt : {0.0, 30.0, 50.0}) {
-      const Pose pose = BoardPose(Vec3(0.05, -0.03, 1.0) * c.distance, tilt * kDeg);
-      const CameraModel camera =
-          CropToBoard(c.fisheye ? FisheyeCamera() : PinholeCamera(), board, pose);
-      const ImageU8 image = Render(camera, board, pose);
-      const std::vector<Vec2> truth = TruePixels(camera, board, pose);
-      auto offsets = [&](const BoardDetection& d) {
-        Offsets o;
-        for (size_t i = 0; i < d.pixels.size(); ++i) o.Add(d.pixels[i] - truth[d.ids[i]]);
-        return o;
-      };
-      std::string why;
-      BoardDetectionOptions options;
-      const auto corrected = DetectBoard(image, board, options, &why);
-      ASSERT_TRUE(corrected) << why;
-      options.correct_charuco_offset = false;
-      const auto raw = DetectBoard(image, board, options, &why);
-      ASSERT_TRUE(raw) << why;
-      const Offsets ours = offsets(*corrected), opencv = offsets(*raw);
+      Offsets ours, opencv;
+      for (int k = 0; k < kJitteredRenders; ++k) {
+        const Pose pose =
+            Jittered(BoardPose(Vec3(0.05, -0.03, 1.0) * c.distance, tilt * kDeg), k, c.distance);
+        const CameraModel camera =
+            CropToBoard(c.fisheye ? FisheyeCamera() : PinholeCamera(), board, pose);
+        const ImageU8 image = Render(camera, board, pose);
+        const std::vector<Vec2> truth = TruePixels(camera, board, pose);
+        auto offsets = [&](const BoardDetection& d) {
+          Offsets o;
+          for (size_t i = 0; i < d.pixels.size(); ++i) o.Add(d.pixels[i] - truth[d.ids[i]]);
+          return o;
+        };
+        std::string why;
+        BoardDetectionOptions options;
+        const auto corrected = DetectBoard(image, board, options, &why);
+        ASSERT_TRUE(corrected) << why;
+        options.correct_charuco_offset = false;
+        const auto raw = DetectBoard(image, board, options, &why);
+        ASSERT_TRUE(raw) << why;
+        EXPECT_GE(corrected->pixels.size(), 20u);
+        ours.Add(offsets(*corrected));
+        opencv.Add(offsets(*raw));
+        if (k > 0) continue;
+        const auto obs = EstimateBoardPose(camera, *corrected, PnpOptions{}, &why);
+        ASSERT_TRUE(obs) << why;
+        const PlaneError plane = ComparePlane(*obs, pose);
+        std::printf("[ charuco ] %s %s %.1f m %2.0f deg: plane %.3f deg (sigma %.3f) %+.2f mm\n",
+                    c.dictionary, c.fisheye ? "fisheye" : "pinhole", c.distance, tilt,
+                    plane.angle_deg, plane.normal_sigma_deg, plane.distance_mm);
+        ExpectPlaneNearTruth(plane);
+      }
       corrected_all.Add(ours);
       raw_all.Add(opencv);
-      const auto obs = EstimateBoardPose(camera, *corrected, PnpOptions{}, &why);
-      ASSERT_TRUE(obs) << why;
-      const PlaneError plane = ComparePlane(*obs, pose);
       std::printf(
-          "[ charuco ] %s %s %.1f m %2.0f deg: %d corners, corrected mean (%+.3f, %+.3f) rms %.3f "
-          "| "
-          "OpenCV mean (%+.3f, %+.3f) rms %.3f | plane %.3f deg (sigma %.3f) %+.2f mm\n",
-          c.dictionary, c.fisheye ? "fisheye" : "pinhole", c.distance, tilt, ours.n,
-          ours.Mean().x(), ours.Mean().y(), ours.Rms(), opencv.Mean().x(), opencv.Mean().y(),
-          opencv.Rms(), plane.angle_deg, plane.normal_sigma_deg, plane.distance_mm);
-      EXPECT_GE(ours.n, 20);
-      EXPECT_LT(ours.Mean().cwiseAbs().maxCoeff(), 0.04);
+          "[ charuco ] %s %s %.1f m %2.0f deg, %d renders: %d corners, corrected mean (%+.4f, "
+          "%+.4f) rms %.3f | OpenCV mean (%+.3f, %+.3f) rms %.3f\n",
+          c.dictionary, c.fisheye ? "fisheye" : "pinhole", c.distance, tilt, kJitteredRenders,
+          ours.n, ours.Mean().x(), ours.Mean().y(), ours.Rms(), opencv.Mean().x(),
+          opencv.Mean().y(), opencv.Rms());
+      // Issue 5: no bias above 0.02 px at any distance and tilt.
+      EXPECT_LT(ours.Mean().cwiseAbs().maxCoeff(), 0.02)
+          << c.dictionary << (c.fisheye ? " fisheye " : " pinhole ") << c.distance << " m, " << tilt
+          << " deg";
       EXPECT_LT(ours.Rms(), 0.2);
-      ExpectPlaneNearTruth(plane);
     }
   }
   std::printf(
@@ -238,7 +284,7 @@ TEST(BoardDetect, RenderedCharucoOffsetIsMeasuredAndCorrected) {
       "%+.4f) rms %.3f\n",
       corrected_all.Mean().x(), corrected_all.Mean().y(), corrected_all.Rms(), raw_all.Mean().x(),
       raw_all.Mean().y(), raw_all.Rms());
-  EXPECT_LT(corrected_all.Mean().cwiseAbs().maxCoeff(), 0.02);
+  EXPECT_LT(corrected_all.Mean().cwiseAbs().maxCoeff(), 0.01);
   EXPECT_LT(corrected_all.Rms(), 0.12);
   // OpenCV 4.6's offset (issue 25539). If this fails, OpenCV changed: re-measure the correction.
   EXPECT_NEAR(raw_all.Mean().x(), 0.5, 0.06);

@@ -237,8 +237,10 @@ TEST(WeightedSolver, GatesAGrossOutlierAndKeepsTheOthers) {
   const Pose guess = *InitialGuessFromPlanes(pairs, &why);
   const SolverResult gated = PlaneAlignmentSolver(pairs, SolverOptions{}, guess).Run();
   EXPECT_EQ(gated.robust_weights[4], 0.0);
-  for (size_t i = 0; i < pairs.size(); ++i)
-    if (i != 4) EXPECT_GT(gated.robust_weights[i], 0.0) << i;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (i == 4) continue;
+    EXPECT_GT(gated.robust_weights[i], 0.0) << i;
+  }
   SolverOptions no_gate;
   no_gate.outlier_gate = 0.0;
   const SolverResult huber_only = PlaneAlignmentSolver(pairs, no_gate, guess).Run();

@@ -32,20 +32,13 @@ struct Pool {
 
 // The issue's protocol: an A3 checkerboard, an HDL-64, boards at 1.5–6 m.
 SimOptions A3Hdl64(double range_noise_m, std::uint64_t seed) {
-  SimOptions options = SimPreset("paper");
-  options.board = BoardPreset("a3");
-  options.lidar = LidarModel::kHdl64;
-  options.min_distance_m = 1.5;
-  options.max_distance_m = 6.0;
-  options.num_pairs = kPoolPairs;
-  options.lidar_range_noise_m = range_noise_m;
-  options.seed = seed;
-  return options;
+  return test::A3Hdl64Options(kPoolPairs, range_noise_m, seed);
 }
 
 Pool MakePool(double range_noise_m, std::uint64_t seed) {
   const SimOptions options = A3Hdl64(range_noise_m, seed);
-  const auto dir = test::TempDir("accuracy_bound_" + std::to_string(seed));
+  const auto dir = test::TempDir("accuracy_bound_" + std::to_string(seed) + "_" +
+                                 std::to_string(static_cast<int>(range_noise_m * 1e3)) + "mm");
   const Dataset dataset = SimulateDataset(options, dir);
   Pool pool;
   pool.truth = *dataset.cam_from_lidar_ground_truth;
@@ -69,10 +62,12 @@ struct TrialStats {
   double mean_chi2 = 0;
 };
 
-TrialStats RunTrials(const Pool& pool, SolverMethod method, std::uint64_t seed) {
+TrialStats RunTrials(const Pool& pool, SolverMethod method, std::uint64_t seed,
+                     bool board_edges = true) {
   std::mt19937_64 rng(seed);
   PipelineOptions options;
   options.solver.method = method;
+  options.solver.use_board_edges = board_edges;
   TrialStats stats;
   int below = 0;
   std::vector<int> order(pool.features.size());
@@ -113,7 +108,7 @@ TrialStats RunTrials(const Pool& pool, SolverMethod method, std::uint64_t seed) 
 
 void Report(const char* name, double noise_mm, const TrialStats& s) {
   std::printf(
-      "%-12s %4.0f mm: RMSE %.2f mm / %.3f deg, bound %.2f mm / %.3f deg, ratio %.2f / %.2f, "
+      "%-24s %4.0f mm: RMSE %.2f mm / %.3f deg, bound %.2f mm / %.3f deg, ratio %.2f / %.2f, "
       "chi2<12.59 %.2f, mean chi2 %.2f\n",
       name, noise_mm, s.rmse_t_mm, s.rmse_r_deg, s.bound_t_mm, s.bound_r_deg,
       s.rmse_t_mm / s.bound_t_mm, s.rmse_r_deg / s.bound_r_deg, s.chi2_fraction, s.mean_chi2);
@@ -127,25 +122,28 @@ TEST_P(AccuracyBound, WeightedSitsAtTheBoundAndHalvesThePaperSolver) {
   ASSERT_GE(pool.features.size(), 40u) << "too few usable pairs in the pool";
   std::printf("pool: %zu usable pairs, corner sigma %.3f px\n", pool.features.size(),
               pool.corner_sigma_px);
+  // The bound (calibench evaluate --crlb) is that of the plane pairs: the weighted estimator is
+  // held to it with the board edges off, and the default (edges on) must do at least as well.
+  const TrialStats planes_only = RunTrials(pool, SolverMethod::kWeightedMl, 7, false);
   const TrialStats weighted = RunTrials(pool, SolverMethod::kWeightedMl, 7);
   const TrialStats paper = RunTrials(pool, SolverMethod::kCa2libGn, 7);
   const TrialStats kim = RunTrials(pool, SolverMethod::kKim, 7);
-  Report("weighted-ml", noise_m * 1e3, weighted);
+  Report("weighted-ml, planes only", noise_m * 1e3, planes_only);
+  Report("weighted-ml + edges", noise_m * 1e3, weighted);
   Report("ca2lib-gn", noise_m * 1e3, paper);
   Report("kim", noise_m * 1e3, kim);
-  // Issue 5 asks for 1.3x the bound. Reached at 8 mm (see README); at 20 mm the far, sparsely
-  // hit boards leave the plane fits non-linear (their errors are not Gaussian at the size of
-  // their covariance) and the ratio is about 2.7: this guards what is reached.
-  const bool low_noise = noise_m < 0.01;
-  const double bound_factor = low_noise ? 1.3 : 3.2;
-  EXPECT_LE(weighted.rmse_t_mm, bound_factor * weighted.bound_t_mm);
-  EXPECT_LE(weighted.rmse_r_deg, (bound_factor + 0.2) * weighted.bound_r_deg);
-  EXPECT_LE(weighted.rmse_t_mm, 0.5 * paper.rmse_t_mm);
-  EXPECT_LE(weighted.rmse_r_deg, 0.5 * paper.rmse_r_deg);
-  if (low_noise) {
-    // Calibrated covariance: the fraction of normalised errors below χ²(6)'s 95% quantile.
-    EXPECT_GE(weighted.chi2_fraction, 0.90);
-    EXPECT_LE(weighted.chi2_fraction, 0.98);
+  // Issue 5: the weighted estimator within 1.3x the bound, at most half the paper solver's error,
+  // and its reported covariance calibrated (the fraction of normalised errors below χ²(6)'s 95%
+  // quantile in [0.90, 0.98]), with and without the edges.
+  EXPECT_LE(planes_only.rmse_t_mm, 1.3 * planes_only.bound_t_mm);
+  EXPECT_LE(planes_only.rmse_r_deg, 1.3 * planes_only.bound_r_deg);
+  EXPECT_LE(planes_only.rmse_t_mm, 0.5 * paper.rmse_t_mm);
+  EXPECT_LE(planes_only.rmse_r_deg, 0.5 * paper.rmse_r_deg);
+  EXPECT_LE(weighted.rmse_t_mm, planes_only.rmse_t_mm);
+  EXPECT_LE(weighted.rmse_r_deg, planes_only.rmse_r_deg);
+  for (const TrialStats* stats : {&planes_only, &weighted}) {
+    EXPECT_GE(stats->chi2_fraction, 0.90);
+    EXPECT_LE(stats->chi2_fraction, 0.98);
   }
 }
 

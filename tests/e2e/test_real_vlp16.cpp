@@ -2,7 +2,9 @@
 // chessboard pairs, the authors' reference extrinsic with a spread of about 4/18/30 mm).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <utility>
 #include <vector>
@@ -35,12 +37,16 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
   ASSERT_TRUE(all.solution) << all.failure;
   EXPECT_GE(accepted, 36);
   const Pose reference = test::AcfrReferenceCamFromLidar();
-  const PoseError error = ComputePoseError(all.solution->cam_from_lidar, reference);
-  std::printf("all %d pairs: %.1f mm, %.3f deg from the authors' reference\n", accepted,
-              error.translation_m * 1e3, error.rotation_rad * 180 / M_PI);
-  EXPECT_LT(error.translation_m, 0.04);
-  EXPECT_LT(error.rotation_rad, 1.0 * M_PI / 180);
+  std::printf("%d pairs accepted\n", accepted);
+  test::ExpectNearAcfrReference(all.solution->cam_from_lidar, "all pairs");
   EXPECT_TRUE(all.solution->observability.well_constrained);
+  ASSERT_TRUE(all.solution->edge_dilation);
+  std::printf("board edges: %d crossings, sheet seen %.1f ± %.1f mm larger per side\n",
+              all.solution->num_edge_residuals, all.solution->edge_dilation->value_m * 1e3,
+              all.solution->edge_dilation->sigma_m * 1e3);
+  // Half the VLP-16's beam footprint at 2–3 m is a few millimetres to a centimetre.
+  EXPECT_GT(all.solution->edge_dilation->value_m, 0.002);
+  EXPECT_LT(all.solution->edge_dilation->value_m, 0.015);
 
   // Spread over 10 random subsets of 20 pairs (features extracted once), for the default
   // weighted estimator and the paper's, with the weighted solver's reported σ beside it.
@@ -52,13 +58,16 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
     double max_angle = 0;
     Vec3 mean_reported_std = Vec3::Zero();
   };
+  // CALIBENCH_REAL_SUBSETS widens the protocol's 10 subsets for steadier figures (not asserted).
+  const char* subsets_env = std::getenv("CALIBENCH_REAL_SUBSETS");
+  const int kSubsets = subsets_env ? std::max(10, std::atoi(subsets_env)) : 10;
   auto subsets = [&](SolverMethod method) {
     std::mt19937_64 rng(2024);
     PipelineOptions o = options;
     o.solver.method = method;
     std::vector<Pose> estimates;
     Spread spread;
-    for (int s = 0; s < 10; ++s) {
+    for (int s = 0; s < kSubsets; ++s) {
       std::vector<PairFeatures> subset = pool;
       std::shuffle(subset.begin(), subset.end(), rng);
       subset.resize(20);
@@ -67,7 +76,7 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
       if (!outcome.solution) continue;
       estimates.push_back(outcome.solution->cam_from_lidar);
       spread.mean_reported_std +=
-          TranslationStd(outcome.solution->covariance, outcome.solution->cam_from_lidar) / 10.0;
+          TranslationStd(outcome.solution->covariance, outcome.solution->cam_from_lidar) / kSubsets;
     }
     Vec3 mean = Vec3::Zero();
     for (const Pose& p : estimates) mean += p.translation() / estimates.size();
@@ -84,17 +93,74 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
   for (const auto& [name, sp] : {std::pair<const char*, Spread>{"weighted-ml", weighted},
                                  std::pair<const char*, Spread>{"ca2lib-gn", paper}}) {
     std::printf(
-        "%s, 10 subsets of 20: translation std x/y/z = %.1f / %.1f / %.1f mm, max rotation from "
+        "%s, %d subsets of 20: translation std x/y/z = %.1f / %.1f / %.1f mm, max rotation from "
         "the all-pairs estimate %.3f deg; mean reported std %.1f / %.1f / %.1f mm\n",
-        name, sp.translation_std.x() * 1e3, sp.translation_std.y() * 1e3,
+        name, kSubsets, sp.translation_std.x() * 1e3, sp.translation_std.y() * 1e3,
         sp.translation_std.z() * 1e3, sp.max_angle * 180 / M_PI, sp.mean_reported_std.x() * 1e3,
         sp.mean_reported_std.y() * 1e3, sp.mean_reported_std.z() * 1e3);
   }
+  // Item 7 of issue 5: the optional range offset (the authors' README says their VLP-16 needed
+  // a 30 mm correction). Reported with its σ and its correlation with the translation.
+  PipelineOptions with_offset = options;
+  with_offset.solver.estimate_range_offset = true;
+  const CalibrationOutcome offset_outcome = SolveFromFeatures(pool, with_offset);
+  ASSERT_TRUE(offset_outcome.solution) << offset_outcome.failure;
+  ASSERT_TRUE(offset_outcome.solution->range_offset);
+  const RangeOffsetEstimate& offset = *offset_outcome.solution->range_offset;
+  const PoseError offset_error =
+      ComputePoseError(offset_outcome.solution->cam_from_lidar, reference);
+  std::printf(
+      "with the range offset: %+.1f ± %.1f mm (correlation with translation x/y/z %.2f %.2f "
+      "%.2f), %.1f mm, %.3f deg from the authors' reference\n",
+      offset.value_m * 1e3, offset.sigma_m * 1e3, offset.correlation_with_translation.x(),
+      offset.correlation_with_translation.y(), offset.correlation_with_translation.z(),
+      offset_error.translation_m * 1e3, offset_error.rotation_rad * 180 / M_PI);
+  // What the data says: −23 ± 1.3 mm, near the −30 mm the authors' README names for their
+  // sensor, and well determined with the board edges (without them ± 5 mm, correlated 0.99 with
+  // the camera-z translation). It moves the estimate further from the authors' mean (their tool
+  // ran without the correction), so it stays off by default.
+  EXPECT_TRUE(offset.well_determined);
+  EXPECT_LT(offset.value_m, -0.01);
+  EXPECT_GT(offset.value_m, -0.05);
+  EXPECT_GT(offset.correlation_with_translation.cwiseAbs().maxCoeff(), 0.5);
+  const Vec3 std_plain = TranslationStd(all.solution->covariance, all.solution->cam_from_lidar);
+  const Vec3 std_offset =
+      TranslationStd(offset_outcome.solution->covariance, offset_outcome.solution->cam_from_lidar);
+  std::printf("translation std without / with the offset: z %.1f / %.1f mm\n", std_plain.z() * 1e3,
+              std_offset.z() * 1e3);
+  EXPECT_GE(std_offset.z(), 0.9 * std_plain.z());
+
   const Vec3 spread = weighted.translation_std;
   const double max_angle = weighted.max_angle;
-  // Subsets must agree with each other well inside the authors' own spread (4/18/30 mm).
+  // Subsets must agree with each other well inside the authors' own spread (4/18/30 mm). Against
+  // the paper's estimator: rotation and camera-y translation (the boards' vertical in-plane
+  // direction, which the edges fix) agree much better; camera x and z do not improve on this
+  // sensor: they are held to within 1.3 times (the edge crossings carry per-ring errors of a few
+  // millimetres that no noise model here describes; see README, "Real data").
   EXPECT_LT(spread.maxCoeff(), 0.02);
   EXPECT_LT(max_angle, 1.0 * M_PI / 180);
+  EXPECT_LT(max_angle, 0.5 * paper.max_angle);
+  EXPECT_LT(spread.y(), 0.8 * paper.translation_std.y());
+  EXPECT_LT(spread.x(), 1.3 * paper.translation_std.x());
+  EXPECT_LT(spread.z(), 1.3 * paper.translation_std.z());
+  // Calibrated uncertainty: subsets of 20 drawn from the same 40 pairs share half their pairs on
+  // average, so their spread is √((40 − 20) / (40 − 1)) = 0.72 times that of independent sets of
+  // 20 pairs (the finite-population correction), which is what the reported σ describes.
+  const double shared_pairs_factor = std::sqrt((pool.size() - 20.0) / (pool.size() - 1.0));
+  const Vec3 independent_spread = spread / shared_pairs_factor;
+  std::printf(
+      "weighted-ml: reported σ / spread of independent sets x/y/z = %.2f / %.2f / %.2f (raw "
+      "subset spread: %.2f / %.2f / %.2f)\n",
+      weighted.mean_reported_std.x() / independent_spread.x(),
+      weighted.mean_reported_std.y() / independent_spread.y(),
+      weighted.mean_reported_std.z() / independent_spread.z(),
+      weighted.mean_reported_std.x() / spread.x(), weighted.mean_reported_std.y() / spread.y(),
+      weighted.mean_reported_std.z() / spread.z());
+  for (int k = 0; k < 3; ++k) {
+    const double ratio = weighted.mean_reported_std[k] / independent_spread[k];
+    EXPECT_GT(ratio, 0.5) << "axis " << k;
+    EXPECT_LT(ratio, 2.0) << "axis " << k;
+  }
 }
 
 }  // namespace

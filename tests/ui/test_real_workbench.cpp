@@ -50,12 +50,7 @@ TEST(RealWorkbench, OpensBrushesSolvesAndReprojects) {
   controller.WaitIdle();
   s = controller.GetSnapshot();
   ASSERT_TRUE(s.solver.result) << s.solver.failure;
-  const PoseError error =
-      ComputePoseError(s.solver.result->cam_from_lidar, test::AcfrReferenceCamFromLidar());
-  std::printf("workbench on the real set: %.1f mm, %.3f deg from the authors' reference\n",
-              error.translation_m * 1e3, error.rotation_rad * 180 / M_PI);
-  EXPECT_LT(error.translation_m, 0.04);
-  EXPECT_LT(error.rotation_rad, 1.0 * M_PI / 180);
+  test::ExpectNearAcfrReference(s.solver.result->cam_from_lidar, "workbench on the real set");
   ASSERT_TRUE(s.reprojection);
   EXPECT_EQ(s.reprojection->pair_id, "pose16");
   size_t visible = 0;
