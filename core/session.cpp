@@ -39,6 +39,8 @@ bool SessionResult::operator==(const SessionResult& other) const {
                              edge_dilation->sigma_m == other.edge_dilation->sigma_m &&
                              edge_dilation->spread_m == other.edge_dilation->spread_m)) &&
          covariance_inflation == other.covariance_inflation &&
+         plane_variance_factor == other.plane_variance_factor &&
+         edge_variance_factor == other.edge_variance_factor &&
          std::equal(estimate_history.begin(), estimate_history.end(),
                     other.estimate_history.begin(), other.estimate_history.end(),
                     [](const Pose& a, const Pose& b) { return a.matrix() == b.matrix(); });
@@ -57,7 +59,9 @@ SessionResult SessionResultFromSolver(const SolverResult& solver) {
           solver.range_offset,
           solver.num_edge_residuals,
           solver.edge_dilation,
-          solver.covariance_inflation};
+          solver.covariance_inflation,
+          solver.plane_variance_factor,
+          solver.edge_variance_factor};
 }
 
 std::filesystem::path NormalizeSessionPath(const std::filesystem::path& path) {

@@ -91,6 +91,8 @@ struct SessionResult {
   int num_edge_residuals = 0;
   std::optional<EdgeDilationEstimate> edge_dilation;
   double covariance_inflation = 1.0;
+  double plane_variance_factor = 1.0;
+  double edge_variance_factor = 1.0;
 
   // Exact value comparison (no tolerance), so a file round trip can be checked with ==.
   bool operator==(const SessionResult& other) const;

@@ -127,7 +127,9 @@ Json ResultToJson(const SessionResult& r) {
       {"step_history", Numbers(r.step_history.data(), static_cast<int>(r.step_history.size()))},
       {"estimate_history", EstimateHistory(r.estimate_history)},
       {"board_edge_points", r.num_edge_residuals},
-      {"covariance_inflation", r.covariance_inflation}};
+      {"covariance_inflation", r.covariance_inflation},
+      {"plane_variance_factor", r.plane_variance_factor},
+      {"edge_variance_factor", r.edge_variance_factor}};
   if (r.range_offset) {
     const RangeOffsetEstimate& o = *r.range_offset;
     json["lidar_range_offset"] = {
@@ -367,6 +369,8 @@ SessionResult ReadResult(const Fields& f) {
   // Written since the board edges and the range offset; older sessions open without them.
   if (f.Has("board_edge_points")) r.num_edge_residuals = f.Int("board_edge_points");
   if (f.Has("covariance_inflation")) r.covariance_inflation = f.Number("covariance_inflation");
+  if (f.Has("plane_variance_factor")) r.plane_variance_factor = f.Positive("plane_variance_factor");
+  if (f.Has("edge_variance_factor")) r.edge_variance_factor = f.Positive("edge_variance_factor");
   if (f.Has("lidar_range_offset")) {
     const Fields o = f.Object("lidar_range_offset");
     RangeOffsetEstimate offset;

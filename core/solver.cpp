@@ -444,6 +444,13 @@ bool PlaneAlignmentSolver::EstimateVarianceComponents() {
   return std::abs(edge_factor - 1) > 0.05 || std::abs(plane_factor - 1) > 0.05;
 }
 
+void PlaneAlignmentSolver::SetVarianceFactors(double plane_variance_factor,
+                                              double edge_variance_factor) {
+  CALIBENCH_CHECK(plane_variance_factor > 0 && edge_variance_factor > 0);
+  plane_variance_scale_ = plane_variance_factor;
+  edge_variance_scale_ = edge_variance_factor;
+}
+
 SolverResult PlaneAlignmentSolver::Run(
     const std::function<void(const IterationReport&)>& on_iteration) {
   if (on_iteration && history_.size() == 1) on_iteration(history_.front());
@@ -465,6 +472,7 @@ Mat6 WeightedPlaneInformation(const std::vector<PlanePair>& pairs, const Pose& c
 
 SolverResult PlaneAlignmentSolver::Summarize() const {
   SolverResult result;
+  result.method = options_.method;
   result.cam_from_lidar = cam_from_lidar_;
   result.converged = converged_;
   result.iterations = static_cast<int>(history_.size()) - 1;
@@ -479,7 +487,9 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
       const bool gated = gated_[&pair - pairs_.data()];
       result.robust_weights.push_back(
           gated ? 0.0
-                : RobustWeight(std::sqrt(w.residual.dot(w.covariance.inverse() * w.residual))));
+                // As the solver weighed it: with the planes' variance component.
+                : RobustWeight(std::sqrt(w.residual.dot(w.covariance.inverse() * w.residual) /
+                                         plane_variance_scale_)));
     } else {
       result.robust_weights.push_back(RobustWeight(e.norm()));
     }

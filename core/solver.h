@@ -114,6 +114,7 @@ struct ObservabilityReport {
 };
 
 struct SolverResult {
+  SolverMethod method = SolverMethod::kWeightedMl;  // the method that produced it
   Pose cam_from_lidar = Pose::Identity();
   Mat6 covariance = Mat6::Zero();  // right perturbation of cam_from_lidar, [rho; phi]
   bool converged = false;
@@ -167,6 +168,10 @@ class PlaneAlignmentSolver {
   SolverResult Run(const std::function<void(const IterationReport&)>& on_iteration = {});
   // Covariance, residuals, weights and observability at the current estimate.
   SolverResult Summarize() const;
+  // Starts from known variance factors of the planes and the edges (a finished solve's
+  // SolverResult::plane_variance_factor / edge_variance_factor), so that Summarize at its
+  // estimate weighs the residuals as that solve did.
+  void SetVarianceFactors(double plane_variance_factor, double edge_variance_factor);
 
  private:
   // Parameters [rho; phi; b]: the pose's right perturbation and the range offset (its row and

@@ -190,6 +190,9 @@ void Controller::ApplySessionToState(const Session& session) {
     r.num_edge_residuals = session.result->num_edge_residuals;
     r.edge_dilation = session.result->edge_dilation;
     r.covariance_inflation = session.result->covariance_inflation;
+    r.method = session.method;
+    r.plane_variance_factor = session.result->plane_variance_factor;
+    r.edge_variance_factor = session.result->edge_variance_factor;
     state_.solver.result = r;
     // The recorded convergence, so that the solver panel and the replay look as they did.
     const auto& costs = session.result->cost_history;
@@ -354,10 +357,15 @@ void Controller::RecomputeResiduals() {
   if (planes.empty()) return;
   SolverOptions options = SolverOptionsFromState();
   const auto& offset = state_.solver.result->range_offset;
-  const SolverResult at_estimate =
-      PlaneAlignmentSolver(planes, options, state_.solver.result->cam_from_lidar,
-                           offset ? offset->value_m : 0.0)
-          .Summarize();
+  PlaneAlignmentSolver solver(planes, options, state_.solver.result->cam_from_lidar,
+                              offset ? offset->value_m : 0.0);
+  // Weighed as the solve weighed them: with the variance factors it found on this data.
+  const SolverResult& solved_result = *state_.solver.result;
+  if (solved_result.method == options.method && solved_result.plane_variance_factor > 0 &&
+      solved_result.edge_variance_factor > 0)
+    solver.SetVarianceFactors(solved_result.plane_variance_factor,
+                              solved_result.edge_variance_factor);
+  const SolverResult at_estimate = solver.Summarize();
   for (size_t i = 0; i < solved.size(); ++i) {
     solved[i]->residual = at_estimate.residuals[i];
     solved[i]->robust_weight = at_estimate.robust_weights[i];
