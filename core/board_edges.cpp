@@ -25,10 +25,9 @@ namespace {
 
 // Where the ray through x meets the plane; nullopt for rays (nearly) parallel to it.
 std::optional<Vec3> OnPlane(const Plane& plane, const Vec3& x) {
-  const Vec3 ray = x.normalized();
-  const double cos_incidence = plane.normal.dot(ray);
-  if (std::abs(cos_incidence) < 0.02) return std::nullopt;
-  return ray * (-plane.distance / cos_incidence);
+  const auto range = RangeOnPlane(plane, x);
+  if (!range) return std::nullopt;
+  return x.normalized() * *range;
 }
 
 }  // namespace

@@ -80,6 +80,14 @@ Plane TransformPlane(const Pose& b_from_a, const Plane& plane_in_a) {
   return out;
 }
 
+std::optional<double> RangeOnPlane(const Plane& plane, const Vec3& point) {
+  const double range = point.norm();
+  if (!(range > 0)) return std::nullopt;
+  const double cos_incidence = plane.normal.dot(point) / range;
+  if (std::abs(cos_incidence) < 0.02) return std::nullopt;
+  return -plane.distance / cos_incidence;
+}
+
 Plane OrientTowardsOrigin(const Plane& plane) {
   if (plane.distance >= 0) return plane;
   return Plane{-plane.normal, -plane.distance};

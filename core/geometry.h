@@ -5,6 +5,8 @@
 // Perturbations are applied on the right: T · Exp(delta).
 #pragma once
 
+#include <optional>
+
 #include "core/types.h"
 
 namespace calibench {
@@ -47,6 +49,11 @@ Plane TransformPlane(const Pose& b_from_a, const Plane& plane_in_a);
 // Flips (n, d) so that the normal points towards the origin of its frame (d > 0): the DESIGN.md
 // orientation of board planes in both sensor frames.
 Plane OrientTowardsOrigin(const Plane& plane);
+
+// The range at which the ray from the frame's origin through `point` meets the plane, r̂ =
+// −d / (n·u) with u the ray's unit direction; nullopt at the origin and for rays within ~1° of
+// the plane (|n·u| < 0.02), whose range is unbounded.
+std::optional<double> RangeOnPlane(const Plane& plane, const Vec3& point);
 
 // Eq. (6): e = [n_i - n_j ; n_j·(p(pi_j) - p(pi_i))], 4-vector, first three unitless, last metres.
 Vec4 PlaneToPlaneError(const Plane& plane_i, const Plane& plane_j);

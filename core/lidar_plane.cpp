@@ -39,11 +39,9 @@ namespace {
 // Range residual r − r̂ of a return against a plane (r̂ where its ray meets the plane); nullopt
 // for rays within ~1° of the plane.
 std::optional<double> RangeResidual(const Plane& plane, const Vec3& x) {
-  const double range = x.norm();
-  if (!(range > 0)) return std::nullopt;
-  const double cos_incidence = plane.normal.dot(x) / range;
-  if (std::abs(cos_incidence) < 0.02) return std::nullopt;
-  return range + plane.distance / cos_incidence;
+  const auto on_plane = RangeOnPlane(plane, x);
+  if (!on_plane) return std::nullopt;
+  return x.norm() - *on_plane;
 }
 
 // The range band for inliers: 3σ̂ of the fit, at least the RANSAC threshold and at most five
@@ -81,12 +79,15 @@ std::optional<LidarPlaneFit> RefineRangeMl(const LidarCloud& cloud,
 // Where the inliers' rays meet the plane, averaged: the board centre when the inliers cover it.
 Vec3 InlierCentre(const LidarCloud& cloud, const LidarPlaneFit& fit) {
   Vec3 sum = Vec3::Zero();
+  int count = 0;
   for (int i : fit.inliers) {
     const Vec3 x = cloud.points[i].cast<double>();
-    const Vec3 ray = x.normalized();
-    sum += ray * (-fit.plane.distance / fit.plane.normal.dot(ray));
+    if (const auto range = RangeOnPlane(fit.plane, x)) {
+      sum += x.normalized() * *range;
+      ++count;
+    }
   }
-  return sum / std::max<size_t>(1, fit.inliers.size());
+  return sum / std::max(1, count);
 }
 
 // FitBoardPlane's growing step (LidarPlaneOptions::grow_radius_m): candidates are the returns in

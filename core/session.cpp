@@ -25,19 +25,8 @@ bool SessionResult::operator==(const SessionResult& other) const {
          covariance == other.covariance && iterations == other.iterations &&
          converged == other.converged && cost_history == other.cost_history &&
          weak_directions == other.weak_directions && well_constrained == other.well_constrained &&
-         step_history == other.step_history &&
-         range_offset.has_value() == other.range_offset.has_value() &&
-         (!range_offset ||
-          (range_offset->value_m == other.range_offset->value_m &&
-           range_offset->sigma_m == other.range_offset->sigma_m &&
-           range_offset->correlation_with_translation ==
-               other.range_offset->correlation_with_translation &&
-           range_offset->well_determined == other.range_offset->well_determined)) &&
-         num_edge_residuals == other.num_edge_residuals &&
-         edge_dilation.has_value() == other.edge_dilation.has_value() &&
-         (!edge_dilation || (edge_dilation->value_m == other.edge_dilation->value_m &&
-                             edge_dilation->sigma_m == other.edge_dilation->sigma_m &&
-                             edge_dilation->spread_m == other.edge_dilation->spread_m)) &&
+         step_history == other.step_history && range_offset == other.range_offset &&
+         num_edge_residuals == other.num_edge_residuals && edge_dilation == other.edge_dilation &&
          covariance_inflation == other.covariance_inflation &&
          plane_variance_factor == other.plane_variance_factor &&
          edge_variance_factor == other.edge_variance_factor &&
@@ -62,6 +51,25 @@ SessionResult SessionResultFromSolver(const SolverResult& solver) {
           solver.covariance_inflation,
           solver.plane_variance_factor,
           solver.edge_variance_factor};
+}
+
+SolverResult SolverResultFromSession(const SessionResult& session, SolverMethod method) {
+  SolverResult r;
+  r.method = method;
+  r.cam_from_lidar = session.cam_from_lidar;
+  r.covariance = session.covariance;
+  r.iterations = session.iterations;
+  r.converged = session.converged;
+  r.cost_history = session.cost_history;
+  r.observability.weak_directions = session.weak_directions;
+  r.observability.well_constrained = session.well_constrained;
+  r.range_offset = session.range_offset;
+  r.num_edge_residuals = session.num_edge_residuals;
+  r.edge_dilation = session.edge_dilation;
+  r.covariance_inflation = session.covariance_inflation;
+  r.plane_variance_factor = session.plane_variance_factor;
+  r.edge_variance_factor = session.edge_variance_factor;
+  return r;
 }
 
 std::filesystem::path NormalizeSessionPath(const std::filesystem::path& path) {

@@ -98,6 +98,9 @@ struct SessionResult {
   bool operator==(const SessionResult& other) const;
 };
 SessionResult SessionResultFromSolver(const SolverResult& solver);
+// The reverse, for a reopened session: what the file keeps of a solve (no per-pair residuals,
+// no observability eigenvalues); `method` is the session's solver method.
+SolverResult SolverResultFromSession(const SessionResult& session, SolverMethod method);
 
 struct Session {
   int version = 1;  // of the file format; this build reads and writes 1

@@ -257,10 +257,12 @@ void PlaneAlignmentSolver::LinearizeEdges(const Pose& cam_from_lidar, double ran
   // outside its edge. It is the robust weighted mean of the residuals at this pose, and
   // eliminating it (variable projection) centres the Jacobians on their weighted mean.
   double dilation = 0.0;
+  double weight_sum = 0.0;
   std::vector<double> weights(rows.size());
   const bool with_dilation = options_.estimate_edge_dilation && rows.size() >= 3;
   for (int pass = 0; pass < (with_dilation ? 4 : 1); ++pass) {
-    double weighted_sum = 0.0, weight_sum = 0.0;
+    double weighted_sum = 0.0;
+    weight_sum = 0.0;
     for (size_t k = 0; k < rows.size(); ++k) {
       const double whitened = (rows[k].residual - dilation) / rows[k].sigma;
       weights[k] = RobustWeight(std::abs(whitened)) / (rows[k].sigma * rows[k].sigma);
@@ -272,11 +274,7 @@ void PlaneAlignmentSolver::LinearizeEdges(const Pose& cam_from_lidar, double ran
   Eigen::Matrix<double, 1, kNumParameters> mean_jacobian =
       Eigen::Matrix<double, 1, kNumParameters>::Zero();
   if (with_dilation) {
-    double weight_sum = 0.0;
-    for (size_t k = 0; k < rows.size(); ++k) {
-      mean_jacobian += weights[k] * rows[k].jacobian;
-      weight_sum += weights[k];
-    }
+    for (size_t k = 0; k < rows.size(); ++k) mean_jacobian += weights[k] * rows[k].jacobian;
     mean_jacobian /= weight_sum;
     ++lin->num_edge_dilations;
     lin->pair_dilations_m.push_back(dilation);
@@ -341,7 +339,7 @@ bool PlaneAlignmentSolver::Step() {
   const Linearization lin = LinearizeHere();
   // Normal equations of Eq. (13)–(14); an LDLT with a tiny damping keeps rank-deficient
   // (degenerate) problems finite: unobservable directions then simply do not move. The offset's
-  // and the dilation's rows are all zero unless estimated, and they stay put then.
+  // row is all zero unless it is estimated, and it stays put then.
   Mat7 damped = lin.information;
   damped.diagonal().array() += 1e-12 * std::max(1.0, lin.information.diagonal().maxCoeff());
   if (lin.information(kRangeOffset, kRangeOffset) == 0) damped(kRangeOffset, kRangeOffset) = 1.0;
@@ -539,9 +537,8 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   // n/(n − p), measures that spread from the data; the reported covariance is the larger of the
   // two in every direction (beyond the sandwich's own sampling noise).
   const int clusters = static_cast<int>(lin.pair_gradients.size());
-  if (options_.method == SolverMethod::kWeightedMl && options_.sandwich_covariance &&
-      clusters > num_parameters + 2 && variance_factor > 0 &&
-      eigen.eigenvalues()[0] > 1e-12 * largest) {
+  if (weighted && options_.sandwich_covariance && clusters > num_parameters + 2 &&
+      variance_factor > 0 && eigen.eigenvalues()[0] > 1e-12 * largest) {
     Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
     for (const Vec7& g : lin.pair_gradients) {
       const Eigen::VectorXd active_g = g(active);

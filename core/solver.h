@@ -97,6 +97,7 @@ struct RangeOffsetEstimate {
   // sigma below SolverOptions::range_offset_max_sigma_m. A high correlation alone is no failure:
   // it shows in the translation's (marginal) standard deviation.
   bool well_determined = false;
+  bool operator==(const RangeOffsetEstimate&) const = default;
 };
 
 // How much larger than the sheet the LiDAR sees it, per side (SolverOptions::
@@ -105,6 +106,7 @@ struct EdgeDilationEstimate {
   double value_m = 0.0;
   double sigma_m = 0.0;
   double spread_m = 0.0;
+  bool operator==(const EdgeDilationEstimate&) const = default;
 };
 
 struct ObservabilityReport {

@@ -178,22 +178,7 @@ void Controller::ApplySessionToState(const Session& session) {
   if (state_.selected < 0 && !state_.pairs.empty()) state_.selected = 0;
   state_.solver = SolverView{};
   if (session.result) {
-    SolverResult r;
-    r.cam_from_lidar = session.result->cam_from_lidar;
-    r.covariance = session.result->covariance;
-    r.iterations = session.result->iterations;
-    r.converged = session.result->converged;
-    r.cost_history = session.result->cost_history;
-    r.observability.weak_directions = session.result->weak_directions;
-    r.observability.well_constrained = session.result->well_constrained;
-    r.range_offset = session.result->range_offset;
-    r.num_edge_residuals = session.result->num_edge_residuals;
-    r.edge_dilation = session.result->edge_dilation;
-    r.covariance_inflation = session.result->covariance_inflation;
-    r.method = session.method;
-    r.plane_variance_factor = session.result->plane_variance_factor;
-    r.edge_variance_factor = session.result->edge_variance_factor;
-    state_.solver.result = r;
+    state_.solver.result = SolverResultFromSession(*session.result, session.method);
     // The recorded convergence, so that the solver panel and the replay look as they did.
     const auto& costs = session.result->cost_history;
     const auto& steps = session.result->step_history;
