@@ -91,6 +91,19 @@ std::string ResultToJson(const CalibrationOutcome& outcome, const SolverOptions&
           offset.correlation_with_translation.z()}},
         {"well_determined", offset.well_determined}};
   }
+  if (s.unmodelled_range_offset) {
+    const RangeOffsetEstimate& offset = *s.unmodelled_range_offset;
+    root["unmodelled_lidar_range_offset"] = {
+        {"value_m", offset.value_m},
+        {"sigma_m", offset.sigma_m},
+        {"convention", "measured range = true range + value_m; subtract it to correct"},
+        {"meaning",
+         "not estimated, yet significant in the data (score test at the solution); the pose "
+         "does not include it: estimate it (--estimate-range-offset) or correct the clouds"},
+        {"correlation_with_translation",
+         {offset.correlation_with_translation.x(), offset.correlation_with_translation.y(),
+          offset.correlation_with_translation.z()}}};
+  }
   json pairs = json::array();
   size_t solved_index = 0;
   for (const PairFeatures& p : outcome.pairs) {
@@ -243,6 +256,14 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
                   "with translation x/y/z %.2f %.2f %.2f)%s\n",
                   s.range_offset->value_m * 1e3, s.range_offset->sigma_m * 1e3, c.x(), c.y(), c.z(),
                   s.range_offset->well_determined ? "" : " NOT well determined");
+    out << line;
+  }
+  if (s.unmodelled_range_offset) {
+    std::snprintf(line, sizeof(line),
+                  "WARNING: the data shows a LiDAR range offset of %+.1f ± %.1f mm that this "
+                  "solve left out; rerun with --estimate-range-offset (or correct the clouds)\n",
+                  s.unmodelled_range_offset->value_m * 1e3,
+                  s.unmodelled_range_offset->sigma_m * 1e3);
     out << line;
   }
   if (s.covariance_inflation > 1.0) {

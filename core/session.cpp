@@ -26,6 +26,7 @@ bool SessionResult::operator==(const SessionResult& other) const {
          converged == other.converged && cost_history == other.cost_history &&
          weak_directions == other.weak_directions && well_constrained == other.well_constrained &&
          step_history == other.step_history && range_offset == other.range_offset &&
+         unmodelled_range_offset == other.unmodelled_range_offset &&
          num_edge_residuals == other.num_edge_residuals && edge_dilation == other.edge_dilation &&
          covariance_inflation == other.covariance_inflation &&
          plane_variance_factor == other.plane_variance_factor &&
@@ -46,6 +47,7 @@ SessionResult SessionResultFromSolver(const SolverResult& solver) {
           {},
           {},
           solver.range_offset,
+          solver.unmodelled_range_offset,
           solver.num_edge_residuals,
           solver.edge_dilation,
           solver.covariance_inflation,
@@ -64,6 +66,7 @@ SolverResult SolverResultFromSession(const SessionResult& session, SolverMethod 
   r.observability.weak_directions = session.weak_directions;
   r.observability.well_constrained = session.well_constrained;
   r.range_offset = session.range_offset;
+  r.unmodelled_range_offset = session.unmodelled_range_offset;
   r.num_edge_residuals = session.num_edge_residuals;
   r.edge_dilation = session.edge_dilation;
   r.covariance_inflation = session.covariance_inflation;

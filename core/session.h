@@ -88,6 +88,7 @@ struct SessionResult {
   // What the solve said beyond the pose (optional in the file): the range offset when estimated,
   // the board edges used, the edge dilation and how far the pairs' spread widened the covariance.
   std::optional<RangeOffsetEstimate> range_offset;
+  std::optional<RangeOffsetEstimate> unmodelled_range_offset;  // SolverResult's
   int num_edge_residuals = 0;
   std::optional<EdgeDilationEstimate> edge_dilation;
   double covariance_inflation = 1.0;

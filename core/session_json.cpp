@@ -112,6 +112,13 @@ Json EstimateHistory(const std::vector<Pose>& estimates) {
   return list;
 }
 
+Json RangeOffsetToJson(const RangeOffsetEstimate& o) {
+  return {{"value_m", o.value_m},
+          {"sigma_m", o.sigma_m},
+          {"correlation_with_translation", Numbers(o.correlation_with_translation.data(), 3)},
+          {"well_determined", o.well_determined}};
+}
+
 Json ResultToJson(const SessionResult& r) {
   Json json = {
       {"direction", kDirection},
@@ -130,14 +137,9 @@ Json ResultToJson(const SessionResult& r) {
       {"covariance_inflation", r.covariance_inflation},
       {"plane_variance_factor", r.plane_variance_factor},
       {"edge_variance_factor", r.edge_variance_factor}};
-  if (r.range_offset) {
-    const RangeOffsetEstimate& o = *r.range_offset;
-    json["lidar_range_offset"] = {
-        {"value_m", o.value_m},
-        {"sigma_m", o.sigma_m},
-        {"correlation_with_translation", Numbers(o.correlation_with_translation.data(), 3)},
-        {"well_determined", o.well_determined}};
-  }
+  if (r.range_offset) json["lidar_range_offset"] = RangeOffsetToJson(*r.range_offset);
+  if (r.unmodelled_range_offset)
+    json["unmodelled_lidar_range_offset"] = RangeOffsetToJson(*r.unmodelled_range_offset);
   if (r.edge_dilation)
     json["board_edge_dilation"] = {{"value_m", r.edge_dilation->value_m},
                                    {"sigma_m", r.edge_dilation->sigma_m},
@@ -337,6 +339,17 @@ Eigen::Matrix<double, N, N> ReadSquare(const Json& json, const std::string& path
   return m;
 }
 
+RangeOffsetEstimate ReadRangeOffset(const Fields& o) {
+  RangeOffsetEstimate offset;
+  offset.value_m = o.Number("value_m");
+  offset.sigma_m = o.Number("sigma_m");
+  const Json& c = o.Array("correlation_with_translation", 3);
+  for (int k = 0; k < 3; ++k)
+    offset.correlation_with_translation[k] = AsDouble(c[k], o.Path("correlation_with_translation"));
+  offset.well_determined = o.Bool("well_determined");
+  return offset;
+}
+
 SessionResult ReadResult(const Fields& f) {
   SessionResult r;
   const Fields pose = f.Object("cam_from_lidar");
@@ -371,18 +384,9 @@ SessionResult ReadResult(const Fields& f) {
   if (f.Has("covariance_inflation")) r.covariance_inflation = f.Number("covariance_inflation");
   if (f.Has("plane_variance_factor")) r.plane_variance_factor = f.Positive("plane_variance_factor");
   if (f.Has("edge_variance_factor")) r.edge_variance_factor = f.Positive("edge_variance_factor");
-  if (f.Has("lidar_range_offset")) {
-    const Fields o = f.Object("lidar_range_offset");
-    RangeOffsetEstimate offset;
-    offset.value_m = o.Number("value_m");
-    offset.sigma_m = o.Number("sigma_m");
-    const Json& c = o.Array("correlation_with_translation", 3);
-    for (int k = 0; k < 3; ++k)
-      offset.correlation_with_translation[k] =
-          AsDouble(c[k], o.Path("correlation_with_translation"));
-    offset.well_determined = o.Bool("well_determined");
-    r.range_offset = offset;
-  }
+  if (f.Has("lidar_range_offset")) r.range_offset = ReadRangeOffset(f.Object("lidar_range_offset"));
+  if (f.Has("unmodelled_lidar_range_offset"))
+    r.unmodelled_range_offset = ReadRangeOffset(f.Object("unmodelled_lidar_range_offset"));
   if (f.Has("board_edge_dilation")) {
     const Fields d = f.Object("board_edge_dilation");
     r.edge_dilation =

@@ -43,6 +43,8 @@ bool SolverOptions::Check(std::string* why) const {
   if (!(weak_eigenvalue_ratio > 0 && weak_eigenvalue_ratio < 1))
     return fail("weak_eigenvalue_ratio must be in (0, 1)");
   if (!(range_offset_max_sigma_m > 0)) return fail("range_offset_max_sigma_m must be > 0 (metres)");
+  if (!(range_offset_significance > 0))
+    return fail("range_offset_significance must be > 0 (standard deviations)");
   if (!(edge_floor_sigma_m > 0)) return fail("edge_floor_sigma_m must be > 0 (metres)");
   if (estimate_range_offset && method != SolverMethod::kWeightedMl)
     return fail("a range offset is estimated by the weighted-ml method only, not by " +
@@ -248,8 +250,7 @@ void PlaneAlignmentSolver::LinearizeEdges(const Pose& cam_from_lidar, double ran
     row.jacobian.setZero();
     row.jacobian.head<6>() = edge_jacobian;
     // d e / d b: the point moves by −b·ray, and d e / d ρ is d e / d(point) in this frame.
-    if (options_.estimate_range_offset)
-      row.jacobian[kRangeOffset] = -edge_jacobian.head<3>().dot(ray);
+    row.jacobian[kRangeOffset] = -edge_jacobian.head<3>().dot(ray);
     rows.push_back(row);
   }
   if (rows.empty()) return;
@@ -304,7 +305,7 @@ PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(const Pose& 
       const Vec7 gradient_before = lin.gradient;
       const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar, pairs_[i], range_offset_m);
       jacobian.leftCols<6>() = w.jacobian;
-      if (options_.estimate_range_offset) jacobian.col(kRangeOffset) = w.offset_jacobian;
+      jacobian.col(kRangeOffset) = w.offset_jacobian;
       const Mat3 information = w.covariance.inverse() / plane_variance_scale_;
       const double mahalanobis = std::sqrt(w.residual.dot(information * w.residual));
       const double weight = RobustWeight(mahalanobis);
@@ -338,12 +339,18 @@ bool PlaneAlignmentSolver::Step() {
   if (done_) return false;
   const Linearization lin = LinearizeHere();
   // Normal equations of Eq. (13)–(14); an LDLT with a tiny damping keeps rank-deficient
-  // (degenerate) problems finite: unobservable directions then simply do not move. The offset's
-  // row is all zero unless it is estimated, and it stays put then.
+  // (degenerate) problems finite: unobservable directions then simply do not move. The offset
+  // stays put unless it is estimated (and when the data says nothing about it).
   Mat7 damped = lin.information;
-  damped.diagonal().array() += 1e-12 * std::max(1.0, lin.information.diagonal().maxCoeff());
-  if (lin.information(kRangeOffset, kRangeOffset) == 0) damped(kRangeOffset, kRangeOffset) = 1.0;
-  Vec7 delta = -damped.ldlt().solve(lin.gradient);
+  Vec7 gradient = lin.gradient;
+  if (!options_.estimate_range_offset) {
+    damped.row(kRangeOffset).setZero();
+    damped.col(kRangeOffset).setZero();
+    gradient[kRangeOffset] = 0.0;
+  }
+  if (damped(kRangeOffset, kRangeOffset) == 0) damped(kRangeOffset, kRangeOffset) = 1.0;
+  damped.diagonal().array() += 1e-12 * std::max(1.0, damped.diagonal().maxCoeff());
+  Vec7 delta = -damped.ldlt().solve(gradient);
   auto cost_at = [&](const Vec7& step) {
     return Linearize(cam_from_lidar_ * ExpSE3(step.head<6>()), range_offset_m_ + step[kRangeOffset])
         .cost;
@@ -563,21 +570,56 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
     }
   }
   result.covariance = covariance.topLeftCorner<6, 6>();
+  // The offset's correlation with the camera-frame translation R ρ (right perturbation).
+  auto correlation_with_translation = [&](const Mat7& joint_covariance) {
+    const Mat3& rotation = cam_from_lidar_.linear();
+    const Mat3 translation_covariance =
+        rotation * joint_covariance.topLeftCorner<3, 3>() * rotation.transpose();
+    const Vec3 cross = rotation * joint_covariance.block<3, 1>(0, kRangeOffset);
+    const double offset_sigma =
+        std::sqrt(std::max(0.0, joint_covariance(kRangeOffset, kRangeOffset)));
+    Vec3 correlation = Vec3::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const double denominator = std::sqrt(translation_covariance(k, k)) * offset_sigma;
+      correlation[k] = denominator > 0 ? cross[k] / denominator : 0.0;
+    }
+    return correlation;
+  };
   if (options_.estimate_range_offset) {
     RangeOffsetEstimate offset;
     offset.value_m = range_offset_m_;
     offset.sigma_m = std::sqrt(std::max(0.0, covariance(kRangeOffset, kRangeOffset)));
-    // Camera-frame translation error R ρ (right perturbation).
-    const Mat3& rotation = cam_from_lidar_.linear();
-    const Mat3 translation_covariance =
-        rotation * covariance.topLeftCorner<3, 3>() * rotation.transpose();
-    const Vec3 cross = rotation * covariance.block<3, 1>(0, kRangeOffset);
-    for (int k = 0; k < 3; ++k) {
-      const double denominator = std::sqrt(translation_covariance(k, k)) * offset.sigma_m;
-      offset.correlation_with_translation[k] = denominator > 0 ? cross[k] / denominator : 0.0;
-    }
+    offset.correlation_with_translation = correlation_with_translation(covariance);
     offset.well_determined = offset.sigma_m < options_.range_offset_max_sigma_m;
     result.range_offset = offset;
+  } else if (weighted && variance_factor > 0 && lin.information(kRangeOffset, kRangeOffset) > 0) {
+    // Score test for the offset left out: one Gauss-Newton step in the joint parameters from
+    // the solution. The pose's gradient is zero there, so the step is the offset's own, less what
+    // the pose would absorb; its variance is the joint one's, like the pose's no smaller than the
+    // pairs' spread says (sandwich).
+    const Eigen::LDLT<Mat7> joint(lin.information);
+    const Mat7 joint_inverse = joint.solve(Mat7::Identity());
+    const Vec7 step = -joint_inverse * lin.gradient;
+    double variance = variance_factor * joint_inverse(kRangeOffset, kRangeOffset);
+    if (options_.sandwich_covariance && clusters > kNumParameters + 2) {
+      double meat = 0.0;
+      for (const Vec7& g : lin.pair_gradients)
+        meat += std::pow(joint_inverse.row(kRangeOffset).dot(g), 2);
+      variance =
+          std::max(variance, static_cast<double>(clusters) / (clusters - kNumParameters) * meat);
+    }
+    const double sigma = std::sqrt(variance);
+    if (joint.info() == Eigen::Success && std::isfinite(step[kRangeOffset]) && sigma > 0 &&
+        sigma < options_.range_offset_max_sigma_m &&
+        std::abs(step[kRangeOffset]) > options_.range_offset_significance * sigma) {
+      RangeOffsetEstimate offset;
+      offset.value_m = range_offset_m_ + step[kRangeOffset];
+      offset.sigma_m = sigma;
+      offset.correlation_with_translation =
+          correlation_with_translation(variance_factor * joint_inverse);
+      offset.well_determined = true;
+      result.unmodelled_range_offset = offset;
+    }
   }
   // Observability is a property of the geometry, not of the noise: judge it on the unweighted
   // plane-to-plane information (Eq. (6) Jacobians, unit weights), whose eigenvalues compare like

@@ -71,6 +71,10 @@ struct SolverOptions {
   // Above this standard deviation (metres) the offset is reported as not determined by the data
   // (a weak direction).
   double range_offset_max_sigma_m = 0.01;
+  // kWeightedMl without estimate_range_offset: a score test at the solution asks whether the data
+  // shows a range offset all the same; one beyond this many standard deviations (and determined
+  // within range_offset_max_sigma_m) is reported (SolverResult::unmodelled_range_offset).
+  double range_offset_significance = 3.0;
   int max_iterations = 50;       // Gauss-Newton iterations
   double step_tolerance = 1e-9;  // stop when |delta| (m, rad) falls below this
   // A direction of the information matrix whose eigenvalue is below this fraction of the largest
@@ -125,7 +129,11 @@ struct SolverResult {
   std::vector<Vec4> residuals;         // per pair, Eq. (6) at the solution
   std::vector<double> robust_weights;  // per pair, Huber IRLS weight at the solution (0 = gated)
   ObservabilityReport observability;
-  std::optional<RangeOffsetEstimate> range_offset;    // SolverOptions::estimate_range_offset
+  std::optional<RangeOffsetEstimate> range_offset;  // SolverOptions::estimate_range_offset
+  // Not estimated, yet significant in the data (SolverOptions::range_offset_significance): the
+  // offset one Gauss-Newton step from the solution would estimate, with its standard deviation.
+  // The pose above does not include it; estimating it would move the pose.
+  std::optional<RangeOffsetEstimate> unmodelled_range_offset;
   int num_edge_residuals = 0;                         // board-edge points used (use_board_edges)
   std::optional<EdgeDilationEstimate> edge_dilation;  // estimate_edge_dilation, with edges
   // A-posteriori variance factors of the planes' and the edges' residuals (kWeightedMl; 1 = their
@@ -176,8 +184,9 @@ class PlaneAlignmentSolver {
   void SetVarianceFactors(double plane_variance_factor, double edge_variance_factor);
 
  private:
-  // Parameters [rho; phi; b]: the pose's right perturbation and the range offset (its row and
-  // column stay zero unless estimated).
+  // Parameters [rho; phi; b]: the pose's right perturbation and the range offset. The offset's
+  // row and column are always filled (kWeightedMl), so that an offset left out can be tested;
+  // it moves only when estimated.
   static constexpr int kNumParameters = 7;
   static constexpr int kRangeOffset = 6;
   using Mat7 = Eigen::Matrix<double, kNumParameters, kNumParameters>;

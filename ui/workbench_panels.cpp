@@ -238,6 +238,13 @@ void Workbench::SolverPanel(const Snapshot& s, const ViewRect& r, std::vector<In
     ImGui::TextColored({1.0f, 0.4f, 0.35f, 1}, "%s", s.solver.failure.c_str());
   if (s.solver.result) {
     const SolverResult& res = *s.solver.result;
+    // First, so that it is seen without scrolling: the estimate below leaves it out.
+    if (res.unmodelled_range_offset)
+      ImGui::TextColored({1.0f, 0.75f, 0.3f, 1},
+                         "the data shows a LiDAR range offset of %+.1f ± %.1f mm that this solve "
+                         "left out: tick \"range offset\" and solve again",
+                         res.unmodelled_range_offset->value_m * 1e3,
+                         res.unmodelled_range_offset->sigma_m * 1e3);
     PrintPose("cam_from_lidar", "x_cam = T * x_lidar", res.cam_from_lidar);
     PrintPose("lidar_from_cam", "camera position and axes in the LiDAR frame",
               res.cam_from_lidar.inverse());

@@ -90,6 +90,13 @@ Session FullSession(const fs::path& dataset) {
     estimate.translation().x() += 0.01 / (i + 1);
     r.estimate_history.push_back(estimate);
   }
+  r.range_offset = RangeOffsetEstimate{-0.0234, 0.0012, Vec3(-0.07, 0.07, 0.72), true};
+  r.unmodelled_range_offset = RangeOffsetEstimate{-0.0218, 0.0056, Vec3(0.1, -0.2, 1.0 / 3), true};
+  r.num_edge_residuals = 671;
+  r.edge_dilation = EdgeDilationEstimate{0.0067, 0.0003, 0.002};
+  r.covariance_inflation = 11.2;
+  r.plane_variance_factor = 30.0 / 7;
+  r.edge_variance_factor = 1.85;
   s.result = r;
   return s;
 }

@@ -18,6 +18,7 @@ namespace {
 struct Solved {
   PoseError error;
   std::optional<RangeOffsetEstimate> offset;
+  std::optional<RangeOffsetEstimate> unmodelled_offset;  // the score test's, when left out
   Vec3 translation_std = Vec3::Zero();
 };
 
@@ -43,6 +44,7 @@ std::pair<Solved, Solved> SolveBoth(double offset_m, std::uint64_t seed) {
     solved.error =
         ComputePoseError(outcome.solution->cam_from_lidar, *dataset.cam_from_lidar_ground_truth);
     solved.offset = outcome.solution->range_offset;
+    solved.unmodelled_offset = outcome.solution->unmodelled_range_offset;
     solved.translation_std =
         TranslationStd(outcome.solution->covariance, outcome.solution->cam_from_lidar);
     return solved;
@@ -71,6 +73,13 @@ TEST(RangeOffset, RecoveredWithItsUncertaintyAndRemovedFromTheTranslation) {
   // Left out, it biases the translation by about its own size; estimated, the bias is gone.
   EXPECT_GT(plain.error.translation_m, 0.010);
   EXPECT_LT(with_offset.error.translation_m, 0.4 * plain.error.translation_m);
+  // Left out, the solve still says that the data shows it (score test), near the truth.
+  ASSERT_TRUE(plain.unmodelled_offset);
+  EXPECT_FALSE(with_offset.unmodelled_offset);
+  const RangeOffsetEstimate& hint = *plain.unmodelled_offset;
+  std::printf("left out: unmodelled offset %+.1f ± %.1f mm\n", hint.value_m * 1e3,
+              hint.sigma_m * 1e3);
+  EXPECT_LT(std::abs(hint.value_m - 0.030), 3 * hint.sigma_m);
 }
 
 TEST(RangeOffset, ZeroOffsetIsFoundZeroAndCostsLittle) {
@@ -83,6 +92,8 @@ TEST(RangeOffset, ZeroOffsetIsFoundZeroAndCostsLittle) {
       b.sigma_m * 1e3);
   EXPECT_LT(std::abs(b.value_m), 3 * b.sigma_m);
   EXPECT_LT(with_offset.error.translation_m, 0.010);
+  // Nothing to report when the sensor has no offset.
+  EXPECT_FALSE(plain.unmodelled_offset);
 }
 
 TEST(RangeOffset, OnlyTheWeightedSolverEstimatesIt) {

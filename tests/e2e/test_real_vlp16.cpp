@@ -49,7 +49,8 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
   EXPECT_LT(all.solution->edge_dilation->value_m, 0.015);
 
   // Spread over 10 random subsets of 20 pairs (features extracted once), for the default
-  // weighted estimator and the paper's, with the weighted solver's reported σ beside it.
+  // weighted estimator, the same with the LiDAR range offset estimated, and the paper's, with the
+  // reported σ beside it.
   std::vector<PairFeatures> pool;
   for (const PairFeatures& p : all.pairs)
     if (p.status == PairStatus::kAccepted) pool.push_back(p);
@@ -61,10 +62,8 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
   // CALIBENCH_REAL_SUBSETS widens the protocol's 10 subsets for steadier figures (not asserted).
   const char* subsets_env = std::getenv("CALIBENCH_REAL_SUBSETS");
   const int kSubsets = subsets_env ? std::max(10, std::atoi(subsets_env)) : 10;
-  auto subsets = [&](SolverMethod method) {
+  auto subsets = [&](const PipelineOptions& o) {
     std::mt19937_64 rng(2024);
-    PipelineOptions o = options;
-    o.solver.method = method;
     std::vector<Pose> estimates;
     Spread spread;
     for (int s = 0; s < kSubsets; ++s) {
@@ -88,16 +87,24 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
     spread.translation_std = spread.translation_std.cwiseSqrt();
     return spread;
   };
-  const Spread weighted = subsets(SolverMethod::kWeightedMl);
-  const Spread paper = subsets(SolverMethod::kCa2libGn);
-  for (const auto& [name, sp] : {std::pair<const char*, Spread>{"weighted-ml", weighted},
-                                 std::pair<const char*, Spread>{"ca2lib-gn", paper}}) {
+  PipelineOptions paper_options = options;
+  paper_options.solver.method = SolverMethod::kCa2libGn;
+  PipelineOptions offset_options = options;
+  offset_options.solver.estimate_range_offset = true;
+  const Spread weighted = subsets(options);
+  const Spread weighted_offset = subsets(offset_options);
+  const Spread paper = subsets(paper_options);
+  for (const auto& [name, sp] :
+       {std::pair<const char*, Spread>{"weighted-ml", weighted},
+        std::pair<const char*, Spread>{"weighted-ml + range offset", weighted_offset},
+        std::pair<const char*, Spread>{"ca2lib-gn", paper}}) {
     std::printf(
-        "%s, %d subsets of 20: translation std x/y/z = %.1f / %.1f / %.1f mm, max rotation from "
-        "the all-pairs estimate %.3f deg; mean reported std %.1f / %.1f / %.1f mm\n",
+        "%s, %d subsets of 20: translation std x/y/z = %.2f / %.2f / %.2f mm (RMS %.2f mm), max "
+        "rotation from the all-pairs estimate %.3f deg; mean reported std %.1f / %.1f / %.1f mm\n",
         name, kSubsets, sp.translation_std.x() * 1e3, sp.translation_std.y() * 1e3,
-        sp.translation_std.z() * 1e3, sp.max_angle * 180 / M_PI, sp.mean_reported_std.x() * 1e3,
-        sp.mean_reported_std.y() * 1e3, sp.mean_reported_std.z() * 1e3);
+        sp.translation_std.z() * 1e3, sp.translation_std.norm() * 1e3, sp.max_angle * 180 / M_PI,
+        sp.mean_reported_std.x() * 1e3, sp.mean_reported_std.y() * 1e3,
+        sp.mean_reported_std.z() * 1e3);
   }
   // Item 7 of issue 5: the optional range offset (the authors' README says their VLP-16 needed
   // a 30 mm correction). Reported with its σ and its correlation with the translation.
@@ -120,6 +127,14 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
   // the camera-z translation). It moves the estimate further from the authors' mean (their tool
   // ran without the correction), so it stays off by default.
   EXPECT_TRUE(offset.well_determined);
+  EXPECT_FALSE(offset_outcome.solution->unmodelled_range_offset);
+  // The default solve, which leaves the offset out, says that the data shows one, near where
+  // estimating it lands.
+  ASSERT_TRUE(all.solution->unmodelled_range_offset);
+  const RangeOffsetEstimate& unmodelled = *all.solution->unmodelled_range_offset;
+  std::printf("default solve: unmodelled range offset %+.1f ± %.1f mm\n", unmodelled.value_m * 1e3,
+              unmodelled.sigma_m * 1e3);
+  EXPECT_NEAR(unmodelled.value_m, offset.value_m, 3 * unmodelled.sigma_m);
   EXPECT_LT(offset.value_m, -0.01);
   EXPECT_GT(offset.value_m, -0.05);
   EXPECT_GT(offset.correlation_with_translation.cwiseAbs().maxCoeff(), 0.5);
@@ -130,36 +145,49 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
               std_offset.z() * 1e3);
   EXPECT_GE(std_offset.z(), 0.9 * std_plain.z());
 
-  const Vec3 spread = weighted.translation_std;
-  const double max_angle = weighted.max_angle;
-  // Subsets must agree with each other well inside the authors' own spread (4/18/30 mm). Against
-  // the paper's estimator: rotation and camera-y translation (the boards' vertical in-plane
-  // direction, which the edges fix) agree much better; camera x and z do not improve on this
-  // sensor: they are held to within 1.3 times (the edge crossings carry per-ring errors of a few
-  // millimetres that no noise model here describes; see README, "Real data").
-  EXPECT_LT(spread.maxCoeff(), 0.02);
-  EXPECT_LT(max_angle, 1.0 * M_PI / 180);
-  EXPECT_LT(max_angle, 0.5 * paper.max_angle);
-  EXPECT_LT(spread.y(), 0.8 * paper.translation_std.y());
-  EXPECT_LT(spread.x(), 1.3 * paper.translation_std.x());
-  EXPECT_LT(spread.z(), 1.3 * paper.translation_std.z());
+  // Spread against the paper's estimator. Subsets must agree with each other well inside the
+  // authors' own spread (4/18/30 mm). The default's rotation and camera-y translation (the boards'
+  // vertical in-plane direction, which the edges fix) are much steadier than the paper's, and so is
+  // its translation as a whole; camera x and z alone are no steadier. What moves x is the VLP-16's
+  // uncorrected range offset (the dataset's README: the sensor needs about −30 mm): a range error
+  // moves each board along its rays, sideways for the boards off to one side, and which boards a
+  // subset holds decides how much of that shows. Estimated, the offset halves the x spread;
+  // per-ring angle offsets of the LiDAR, which we suspected first, explain almost nothing of the
+  // edge residuals (README, "Real data"). z pays for the offset it shares its information with.
+  const double kDegree = M_PI / 180;
+  for (const Spread* sp : {&weighted, &weighted_offset}) {
+    EXPECT_LT(sp->translation_std.maxCoeff(), 0.02);
+    EXPECT_LT(sp->max_angle, 1.0 * kDegree);
+    EXPECT_LT(sp->max_angle, 0.5 * paper.max_angle);
+    EXPECT_LT(sp->translation_std.norm(), 0.95 * paper.translation_std.norm());
+    EXPECT_LT(sp->translation_std.y(), 0.8 * paper.translation_std.y());
+    EXPECT_LT(sp->translation_std.z(), 1.3 * paper.translation_std.z());
+  }
+  EXPECT_LT(weighted.translation_std.x(), 1.3 * paper.translation_std.x());
+  EXPECT_LT(weighted_offset.translation_std.x(), 0.7 * paper.translation_std.x());
+  EXPECT_LT(weighted_offset.translation_std.norm(), 0.75 * paper.translation_std.norm());
   // Calibrated uncertainty: subsets of 20 drawn from the same 40 pairs share half their pairs on
   // average, so their spread is √((40 − 20) / (40 − 1)) = 0.72 times that of independent sets of
   // 20 pairs (the finite-population correction), which is what the reported σ describes.
   const double shared_pairs_factor = std::sqrt((pool.size() - 20.0) / (pool.size() - 1.0));
-  const Vec3 independent_spread = spread / shared_pairs_factor;
-  std::printf(
-      "weighted-ml: reported σ / spread of independent sets x/y/z = %.2f / %.2f / %.2f (raw "
-      "subset spread: %.2f / %.2f / %.2f)\n",
-      weighted.mean_reported_std.x() / independent_spread.x(),
-      weighted.mean_reported_std.y() / independent_spread.y(),
-      weighted.mean_reported_std.z() / independent_spread.z(),
-      weighted.mean_reported_std.x() / spread.x(), weighted.mean_reported_std.y() / spread.y(),
-      weighted.mean_reported_std.z() / spread.z());
-  for (int k = 0; k < 3; ++k) {
-    const double ratio = weighted.mean_reported_std[k] / independent_spread[k];
-    EXPECT_GT(ratio, 0.5) << "axis " << k;
-    EXPECT_LT(ratio, 2.0) << "axis " << k;
+  for (const auto& [name, sp] :
+       {std::pair<const char*, Spread>{"weighted-ml", weighted},
+        std::pair<const char*, Spread>{"weighted-ml + range offset", weighted_offset}}) {
+    const Vec3 independent_spread = sp.translation_std / shared_pairs_factor;
+    std::printf(
+        "%s: reported σ / spread of independent sets x/y/z = %.2f / %.2f / %.2f (raw subset "
+        "spread: %.2f / %.2f / %.2f)\n",
+        name, sp.mean_reported_std.x() / independent_spread.x(),
+        sp.mean_reported_std.y() / independent_spread.y(),
+        sp.mean_reported_std.z() / independent_spread.z(),
+        sp.mean_reported_std.x() / sp.translation_std.x(),
+        sp.mean_reported_std.y() / sp.translation_std.y(),
+        sp.mean_reported_std.z() / sp.translation_std.z());
+    for (int k = 0; k < 3; ++k) {
+      const double ratio = sp.mean_reported_std[k] / independent_spread[k];
+      EXPECT_GT(ratio, 0.5) << name << ", axis " << k;
+      EXPECT_LT(ratio, 2.0) << name << ", axis " << k;
+    }
   }
 }
 
