@@ -80,29 +80,21 @@ std::string ResultToJson(const CalibrationOutcome& outcome, const SolverOptions&
          "how much larger than the sheet the LiDAR sees it, per side (mean of the "
          "pairs' estimates)"}};
   }
-  if (s.range_offset) {
-    const RangeOffsetEstimate& offset = *s.range_offset;
-    root["lidar_range_offset"] = {
-        {"value_m", offset.value_m},
-        {"sigma_m", offset.sigma_m},
-        {"convention", "measured range = true range + value_m; subtract it to correct"},
-        {"correlation_with_translation",
-         {offset.correlation_with_translation.x(), offset.correlation_with_translation.y(),
-          offset.correlation_with_translation.z()}},
-        {"well_determined", offset.well_determined}};
-  }
+  auto offset_json = [](const RangeOffsetEstimate& offset) {
+    return json{{"value_m", offset.value_m},
+                {"sigma_m", offset.sigma_m},
+                {"convention", "measured range = true range + value_m; subtract it to correct"},
+                {"correlation_with_translation",
+                 {offset.correlation_with_translation.x(), offset.correlation_with_translation.y(),
+                  offset.correlation_with_translation.z()}},
+                {"well_determined", offset.well_determined}};
+  };
+  if (s.range_offset) root["lidar_range_offset"] = offset_json(*s.range_offset);
   if (s.unmodelled_range_offset) {
-    const RangeOffsetEstimate& offset = *s.unmodelled_range_offset;
-    root["unmodelled_lidar_range_offset"] = {
-        {"value_m", offset.value_m},
-        {"sigma_m", offset.sigma_m},
-        {"convention", "measured range = true range + value_m; subtract it to correct"},
-        {"meaning",
-         "not estimated, yet significant in the data (score test at the solution); the pose "
-         "does not include it: estimate it (--estimate-range-offset) or correct the clouds"},
-        {"correlation_with_translation",
-         {offset.correlation_with_translation.x(), offset.correlation_with_translation.y(),
-          offset.correlation_with_translation.z()}}};
+    root["unmodelled_lidar_range_offset"] = offset_json(*s.unmodelled_range_offset);
+    root["unmodelled_lidar_range_offset"]["meaning"] =
+        "not estimated, yet significant in the data (score test at the solution); the pose does "
+        "not include it: estimate it (--estimate-range-offset) or correct the clouds";
   }
   json pairs = json::array();
   size_t solved_index = 0;
