@@ -40,7 +40,8 @@ struct PairFeatures {
   std::optional<CameraBoardObservation> camera;
 };
 
-// options.lidar_plane with the grow radius for `target` when options.grow_to_board.
+// options.lidar_plane for `target`: its grow radius (when options.grow_to_board) and its sheet size
+// (for the board edges), where options.lidar_plane leaves them unset.
 LidarPlaneOptions LidarPlaneOptionsFor(const PipelineOptions& options, const BoardSpec& target);
 
 // The solver's input for one pair: both planes with their covariances.

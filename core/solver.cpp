@@ -297,6 +297,7 @@ void PlaneAlignmentSolver::LinearizeEdges(const Pose& cam_from_lidar, double ran
 PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(const Pose& cam_from_lidar,
                                                                     double range_offset_m) const {
   Linearization lin;
+  lin.pair_weights.assign(pairs_.size(), 0.0);
   if (options_.method == SolverMethod::kWeightedMl) {
     Eigen::Matrix<double, 3, kNumParameters> jacobian =
         Eigen::Matrix<double, 3, kNumParameters>::Zero();
@@ -309,6 +310,7 @@ PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(const Pose& 
       const Mat3 information = w.covariance.inverse() / plane_variance_scale_;
       const double mahalanobis = std::sqrt(w.residual.dot(information * w.residual));
       const double weight = RobustWeight(mahalanobis);
+      lin.pair_weights[i] = weight;
       lin.information += weight * jacobian.transpose() * information * jacobian;
       lin.gradient += weight * jacobian.transpose() * information * w.residual;
       lin.cost += RobustCost(mahalanobis);
@@ -321,11 +323,13 @@ PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(const Pose& 
     return lin;
   }
   Eigen::Matrix<double, 4, 6> jacobian;
-  for (const PlanePair& pair : pairs_) {
+  for (size_t i = 0; i < pairs_.size(); ++i) {
+    const PlanePair& pair = pairs_[i];
     const Vec4 e =
         PlaneAlignmentResidual(cam_from_lidar, pair.lidar_plane, pair.camera_plane, &jacobian);
     const double norm = e.norm();
     const double w = RobustWeight(norm);  // Eq. (14) by iteratively reweighted least squares
+    lin.pair_weights[i] = w;
     lin.information.topLeftCorner<6, 6>() += w * jacobian.transpose() * jacobian;
     lin.gradient.head<6>() += w * jacobian.transpose() * e;
     lin.cost += RobustCost(norm);
@@ -483,23 +487,12 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   result.iterations = static_cast<int>(history_.size()) - 1;
   for (const IterationReport& it : history_) result.cost_history.push_back(it.cost);
   const bool weighted = options_.method == SolverMethod::kWeightedMl;
-  for (const PlanePair& pair : pairs_) {
-    const Vec4 e = PlaneAlignmentResidual(
-        cam_from_lidar_, CorrectedLidarPlane(pair, range_offset_m_), pair.camera_plane, nullptr);
-    result.residuals.push_back(e);
-    if (weighted) {
-      const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar_, pair, range_offset_m_);
-      const bool gated = gated_[&pair - pairs_.data()];
-      result.robust_weights.push_back(
-          gated ? 0.0
-                // As the solver weighed it: with the planes' variance component.
-                : RobustWeight(std::sqrt(w.residual.dot(w.covariance.inverse() * w.residual) /
-                                         plane_variance_scale_)));
-    } else {
-      result.robust_weights.push_back(RobustWeight(e.norm()));
-    }
-  }
+  for (const PlanePair& pair : pairs_)
+    result.residuals.push_back(PlaneAlignmentResidual(
+        cam_from_lidar_, CorrectedLidarPlane(pair, range_offset_m_), pair.camera_plane, nullptr));
   const Linearization lin = LinearizeHere();
+  // As the solver weighed them: with the planes' variance component, 0 for gated pairs.
+  result.robust_weights = lin.pair_weights;
   // The inverse information scaled by the a-posteriori variance factor: for the paper's residual,
   // which has no noise model, that is the noise estimate itself (4 residuals per pair); for the
   // weighted residual (3 per pair) it absorbs what the feature covariances miss on real sensors.

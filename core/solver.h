@@ -202,6 +202,7 @@ class PlaneAlignmentSolver {
     std::vector<double> pair_dilations_m;  // those pairs' dilations
     Mat7 edge_information = Mat7::Zero();  // the edges' part of `information`
     std::vector<Vec7> pair_gradients;      // kWeightedMl: each used pair's share of `gradient`
+    std::vector<double> pair_weights;      // per pair, its planes' robust weight (0 = gated)
     double edge_weighted_squared_error = 0.0;
   };
   Linearization Linearize(const Pose& cam_from_lidar, double range_offset_m) const;
