@@ -3,7 +3,7 @@
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
-#include "core/dataset.h"
+#include "core/io/dataset.h"
 
 namespace calibench::app {
 

@@ -9,11 +9,12 @@
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "app/sim_flags.h"
-#include "core/crlb.h"
-#include "core/dataset.h"
-#include "core/pipeline.h"
-#include "core/result_io.h"
-#include "core/sim.h"
+#include "core/estimation/uncertainty.h"
+#include "core/io/dataset.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/result_io.h"
+#include "core/sim/crlb.h"
+#include "core/sim/sim.h"
 
 namespace calibench::app {
 namespace {

@@ -9,10 +9,11 @@
 #include <sstream>
 
 #include "app/commands.h"
-#include "core/lrf_pipeline.h"
-#include "core/lrf_sim.h"
-#include "core/lrf_sweep.h"
-#include "core/result_io.h"
+#include "core/lidar_camera/result_io.h"
+#include "core/lrf/pipeline.h"
+#include "core/lrf/result_io.h"
+#include "core/sim/lrf_sim.h"
+#include "core/sim/lrf_sweep.h"
 
 namespace calibench::app {
 namespace {

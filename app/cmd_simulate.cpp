@@ -4,7 +4,7 @@
 
 #include "app/commands.h"
 #include "app/sim_flags.h"
-#include "core/sim.h"
+#include "core/sim/sim.h"
 
 namespace calibench::app {
 

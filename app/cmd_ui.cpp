@@ -14,14 +14,15 @@
 #include <memory>
 
 #include "app/commands.h"
-#include "core/image.h"
-#include "ui/controller.h"
+#include "core/base/image.h"
+#include "core/io/image_io.h"
 #include "ui/gfx/context.h"
 #include "ui/gfx/framebuffer.h"
-#include "ui/imgui_host.h"
-#include "ui/lrf_controller.h"
-#include "ui/lrf_workbench.h"
-#include "ui/workbench.h"
+#include "ui/lidar_camera/controller.h"
+#include "ui/lidar_camera/workbench.h"
+#include "ui/lrf/controller.h"
+#include "ui/lrf/workbench.h"
+#include "ui/widgets/imgui_host.h"
 
 namespace calibench::app {
 namespace {
@@ -150,8 +151,8 @@ int RenderLrfHeadless(const std::string& dataset, const std::string& pair, bool 
   controller.WaitIdle();
   ui::ImGuiHost host(nullptr);
   ui::LrfWorkbench workbench;
-  SaveImage(out, ui::RenderLrfWorkbenchHeadless(controller, workbench, host, layout, width, height,
-                                                /*frames=*/4));
+  SaveImage(out, ui::RenderWorkbenchHeadless(controller, workbench, host, layout, width, height,
+                                             /*frames=*/4));
   std::printf("wrote %s (%dx%d, %s, %s)\n", out.c_str(), width, height, view.c_str(),
               context->Description().c_str());
   return kOk;

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "app/commands.h"
-#include "core/types.h"
+#include "core/base/types.h"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "app/commands.h"
-#include "core/result_io.h"
+#include "core/lidar_camera/result_io.h"
 
 namespace calibench::app {
 

@@ -4,7 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "core/pipeline.h"
+#include "core/lidar_camera/pipeline.h"
 
 namespace calibench::app {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "core/sim.h"
+#include "core/sim/sim.h"
 
 namespace calibench::app {
 

@@ -6,8 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "core/dataset.h"
-#include "core/geometry.h"
+#include "core/geometry/geometry.h"
+#include "core/io/camera_file.h"
+#include "core/io/dataset.h"
 
 namespace calibench::test {
 

@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-#include "core/types.h"
+#include "core/base/types.h"
 
 namespace calibench::test {
 

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "core/geometry.h"
+#include "core/geometry/geometry.h"
 #include "tests/acfr_manifest.h"
 
 namespace calibench::test {

@@ -8,8 +8,8 @@
 #include <optional>
 #include <string>
 
-#include "core/sim.h"
-#include "core/types.h"
+#include "core/base/types.h"
+#include "core/sim/sim.h"
 
 namespace calibench::test {
 

@@ -5,16 +5,18 @@
 #include <map>
 #include <random>
 
-#include "core/board_camera.h"
-#include "core/cloud.h"
-#include "core/image.h"
-#include "core/lidar_plane.h"
-#include "core/lrf_features.h"
-#include "core/lrf_sim.h"
-#include "core/lrf_solver.h"
-#include "core/pipeline.h"
-#include "core/sim.h"
-#include "core/solver.h"
+#include "core/base/image.h"
+#include "core/io/cloud_io.h"
+#include "core/io/image_io.h"
+#include "core/lidar/cloud.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/solver.h"
+#include "core/lrf/features.h"
+#include "core/lrf/solver.h"
+#include "core/sim/lrf_sim.h"
+#include "core/sim/sim.h"
+#include "core/target/board_camera.h"
+#include "core/target/lidar_plane.h"
 #include "tests/acfr_manifest.h"
 
 namespace calibench {

@@ -9,9 +9,10 @@
 #include <filesystem>
 #include <string>
 
-#include "core/cloud.h"
-#include "core/reproject.h"
-#include "core/sim.h"
+#include "core/io/cloud_io.h"
+#include "core/lidar/cloud.h"
+#include "core/reproject/reproject.h"
+#include "core/sim/sim.h"
 
 namespace calibench {
 namespace {

@@ -7,11 +7,11 @@
 #include <fstream>
 #include <string>
 
-#include "core/sim.h"
-#include "ui/controller.h"
+#include "core/sim/sim.h"
 #include "ui/gfx/context.h"
-#include "ui/imgui_host.h"
-#include "ui/workbench.h"
+#include "ui/lidar_camera/controller.h"
+#include "ui/lidar_camera/workbench.h"
+#include "ui/widgets/imgui_host.h"
 
 namespace calibench {
 namespace {

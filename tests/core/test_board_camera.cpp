@@ -9,10 +9,12 @@
 #include <random>
 #include <string>
 
-#include "core/board_camera.h"
-#include "core/geometry.h"
-#include "core/image.h"
-#include "core/sim.h"
+#include "core/base/image.h"
+#include "core/geometry/geometry.h"
+#include "core/io/camera_file.h"
+#include "core/io/image_io.h"
+#include "core/sim/sim.h"
+#include "core/target/board_camera.h"
 #include "tests/core/board_test_scenes.h"
 #include "tests/test_support.h"
 

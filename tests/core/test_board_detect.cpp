@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "core/board_camera.h"
-#include "core/geometry.h"
-#include "core/sim.h"
+#include "core/geometry/geometry.h"
+#include "core/sim/sim.h"
+#include "core/target/board_camera.h"
 #include "tests/core/board_test_scenes.h"
 #include "tests/test_support.h"
 

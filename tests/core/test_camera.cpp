@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "core/camera.h"
+#include "core/camera/camera.h"
 #include "tests/test_support.h"
 
 namespace calibench {

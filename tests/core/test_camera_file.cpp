@@ -5,7 +5,8 @@
 #include <fstream>
 #include <opencv2/core.hpp>
 
-#include "core/dataset.h"
+#include "core/io/dataset.h"
+#include "core/io/camera_file.h"
 #include "tests/test_support.h"
 
 namespace calibench {

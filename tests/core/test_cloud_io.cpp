@@ -11,7 +11,8 @@
 #include <random>
 #include <string>
 
-#include "core/cloud.h"
+#include "core/io/cloud_io.h"
+#include "core/lidar/cloud.h"
 #include "tests/test_support.h"
 
 namespace calibench {

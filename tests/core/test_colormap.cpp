@@ -7,7 +7,7 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
-#include "core/colormap.h"
+#include "core/lidar/colormap.h"
 
 namespace calibench {
 namespace {

@@ -4,7 +4,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/dataset.h"
+#include "core/io/dataset.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -2,7 +2,7 @@
 
 #include <random>
 
-#include "core/geometry.h"
+#include "core/geometry/geometry.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -3,8 +3,9 @@
 
 #include <fstream>
 
-#include "core/image.h"
-#include "core/types.h"
+#include "core/base/image.h"
+#include "core/base/types.h"
+#include "core/io/image_io.h"
 #include "tests/test_support.h"
 
 namespace calibench {

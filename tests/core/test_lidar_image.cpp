@@ -7,8 +7,9 @@
 #include <numeric>
 #include <random>
 
-#include "core/cloud.h"
-#include "core/lidar_image.h"
+#include "core/io/cloud_io.h"
+#include "core/lidar/cloud.h"
+#include "core/lidar/lidar_image.h"
 #include "tests/test_support.h"
 
 namespace calibench {

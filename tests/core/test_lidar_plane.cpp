@@ -3,7 +3,7 @@
 #include <numeric>
 #include <random>
 
-#include "core/lidar_plane.h"
+#include "core/target/lidar_plane.h"
 #include "tests/test_support.h"
 
 namespace calibench {

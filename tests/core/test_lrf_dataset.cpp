@@ -5,8 +5,9 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
-#include "core/cloud.h"
-#include "core/lrf_dataset.h"
+#include "core/io/cloud_io.h"
+#include "core/lidar/cloud.h"
+#include "core/lrf/dataset.h"
 #include "tests/test_support.h"
 
 namespace calibench {

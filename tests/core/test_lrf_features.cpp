@@ -9,8 +9,8 @@
 #include <random>
 #include <sstream>
 
-#include "core/lrf_features.h"
-#include "core/lrf_sim.h"
+#include "core/lrf/features.h"
+#include "core/sim/lrf_sim.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -5,7 +5,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "core/lrf_sim.h"
+#include "core/sim/lrf_sim.h"
 #include "tests/test_support.h"
 
 namespace calibench {

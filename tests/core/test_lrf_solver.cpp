@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <random>
 
-#include "core/lrf_solver.h"
+#include "core/lrf/solver.h"
 #include "tests/test_support.h"
 
 namespace calibench {

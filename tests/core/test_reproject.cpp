@@ -8,7 +8,7 @@
 #include <limits>
 #include <random>
 
-#include "core/reproject.h"
+#include "core/reproject/reproject.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -10,7 +10,7 @@
 #include <random>
 #include <sstream>
 
-#include "core/session.h"
+#include "core/session/session.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -11,9 +11,11 @@
 #include <opencv2/imgproc.hpp>
 #include <set>
 
-#include "core/cloud.h"
-#include "core/dataset.h"
-#include "core/sim.h"
+#include "core/io/cloud_io.h"
+#include "core/io/dataset.h"
+#include "core/io/image_io.h"
+#include "core/lidar/cloud.h"
+#include "core/sim/sim.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -2,7 +2,7 @@
 
 #include <random>
 
-#include "core/solver.h"
+#include "core/lidar_camera/solver.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -1,7 +1,7 @@
 #include <gtest/gtest.h>
 
-#include "core/sim.h"
-#include "core/undistort.h"
+#include "core/camera/undistort.h"
+#include "core/sim/sim.h"
 
 namespace calibench {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "core/yaml_lite.h"
+#include "core/io/yaml_lite.h"
 
 namespace calibench {
 namespace {

@@ -9,9 +9,9 @@
 #include <random>
 #include <vector>
 
-#include "core/crlb.h"
-#include "core/pipeline.h"
-#include "core/sim.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/sim/crlb.h"
+#include "core/sim/sim.h"
 #include "tests/test_support.h"
 
 namespace calibench {

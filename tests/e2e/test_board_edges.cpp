@@ -10,9 +10,9 @@
 #include <random>
 #include <vector>
 
-#include "core/board_edges.h"
-#include "core/pipeline.h"
-#include "core/sim.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/sim/sim.h"
+#include "core/target/board_edges.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -6,8 +6,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/image.h"
-#include "core/sim.h"
+#include "core/base/image.h"
+#include "core/io/image_io.h"
+#include "core/sim/sim.h"
 #include "tests/test_support.h"
 
 namespace calibench {

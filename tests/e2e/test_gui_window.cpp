@@ -1,7 +1,8 @@
 // A real window: `calibench gui` under Xvfb for a few frames, with a screenshot of what it showed.
 #include <gtest/gtest.h>
 
-#include "core/image.h"
+#include "core/base/image.h"
+#include "core/io/image_io.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -10,8 +10,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/lrf_pipeline.h"
-#include "core/lrf_sim.h"
+#include "core/lrf/pipeline.h"
+#include "core/lrf/result_io.h"
+#include "core/sim/lrf_sim.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -7,9 +7,10 @@
 #include <cstdio>
 #include <vector>
 
-#include "core/pipeline.h"
-#include "core/result_io.h"
-#include "core/sim.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/estimation/uncertainty.h"
+#include "core/lidar_camera/result_io.h"
+#include "core/sim/sim.h"
 #include "tests/test_support.h"
 
 namespace calibench {

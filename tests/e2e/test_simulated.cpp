@@ -5,8 +5,8 @@
 #include <cmath>
 #include <tuple>
 
-#include "core/pipeline.h"
-#include "core/sim.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/sim/sim.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "core/io/image_io.h"
 #include "tests/test_support.h"
 
 namespace calibench::ui {

@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "core/image.h"
+#include "core/base/image.h"
 #include "ui/gfx/context.h"
 
 namespace calibench::ui {

@@ -5,7 +5,7 @@
 
 #include "tests/test_support.h"
 #include "tests/ui/ui_fixture.h"
-#include "ui/controller.h"
+#include "ui/lidar_camera/controller.h"
 
 namespace calibench::ui {
 namespace {

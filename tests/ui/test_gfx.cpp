@@ -8,7 +8,8 @@
 #include <numbers>
 #include <random>
 
-#include "core/image.h"
+#include "core/base/image.h"
+#include "core/io/image_io.h"
 #include "tests/test_support.h"
 #include "ui/gfx/context.h"
 #include "ui/gfx/framebuffer.h"

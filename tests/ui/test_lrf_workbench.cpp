@@ -10,15 +10,15 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/geometry.h"
-#include "core/image.h"
-#include "core/lrf_sim.h"
+#include "core/base/image.h"
+#include "core/geometry/geometry.h"
+#include "core/sim/lrf_sim.h"
 #include "tests/test_support.h"
 #include "tests/ui/golden.h"
 #include "ui/gfx/context.h"
-#include "ui/imgui_host.h"
-#include "ui/lrf_controller.h"
-#include "ui/lrf_workbench.h"
+#include "ui/lrf/controller.h"
+#include "ui/lrf/workbench.h"
+#include "ui/widgets/imgui_host.h"
 
 namespace calibench::ui {
 namespace {
@@ -185,7 +185,7 @@ class LrfWorkbenchRender : public ::testing::Test {
   void TearDown() override { host_.reset(); }
   ImageU8 Render(LrfController& controller, LrfLayout layout, int width, int height) {
     LrfWorkbench workbench;
-    return RenderLrfWorkbenchHeadless(controller, workbench, *host_, layout, width, height, 4);
+    return RenderWorkbenchHeadless(controller, workbench, *host_, layout, width, height, 4);
   }
   std::unique_ptr<gfx::GlContext> context_;
   std::unique_ptr<ImGuiHost> host_;

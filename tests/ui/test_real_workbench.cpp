@@ -5,7 +5,7 @@
 
 #include "tests/acfr_manifest.h"
 #include "tests/test_support.h"
-#include "ui/controller.h"
+#include "ui/lidar_camera/controller.h"
 
 namespace calibench::ui {
 namespace {

@@ -6,14 +6,15 @@
 
 #include <cstdlib>
 
-#include "core/image.h"
+#include "core/base/image.h"
+#include "core/io/image_io.h"
 #include "tests/test_support.h"
 #include "tests/ui/golden.h"
 #include "tests/ui/ui_fixture.h"
-#include "ui/controller.h"
 #include "ui/gfx/context.h"
-#include "ui/imgui_host.h"
-#include "ui/workbench.h"
+#include "ui/lidar_camera/controller.h"
+#include "ui/lidar_camera/workbench.h"
+#include "ui/widgets/imgui_host.h"
 
 namespace calibench::ui {
 namespace {

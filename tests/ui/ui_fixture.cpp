@@ -2,7 +2,7 @@
 
 #include <unistd.h>
 
-#include "core/sim.h"
+#include "core/sim/sim.h"
 #include "tests/test_support.h"
 
 namespace calibench::test {

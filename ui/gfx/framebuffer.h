@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "core/image.h"
+#include "core/base/image.h"
 
 namespace calibench::gfx {
 

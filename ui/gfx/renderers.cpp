@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/types.h"
+#include "core/base/types.h"
 #include "ui/gfx/gl_api.h"
 #include "ui/gfx/shader.h"
 #include "ui/gfx/shader_sources.h"

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/image.h"
+#include "core/base/image.h"
 
 namespace calibench::gfx {
 

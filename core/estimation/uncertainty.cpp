@@ -1,0 +1,67 @@
+#include "core/estimation/uncertainty.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace calibench {
+
+ObservabilityReport AnalyseObservability(const Mat6& information, const Pose& cam_from_lidar,
+                                         double weak_eigenvalue_ratio) {
+  ObservabilityReport report;
+  Eigen::SelfAdjointEigenSolver<Mat6> eigen(information);
+  report.eigenvalues = eigen.eigenvalues();
+  const double largest = std::max(report.eigenvalues[5], 1e-300);
+  int num_weak = 0;
+  while (num_weak < 6 && report.eigenvalues[num_weak] < weak_eigenvalue_ratio * largest) ++num_weak;
+  if (num_weak == 0) {
+    report.well_constrained = true;
+    return report;
+  }
+  // Weak eigenvalues are often (nearly) repeated, so single eigenvectors are arbitrary mixtures.
+  // Name instead each camera-frame axis motion that lies mostly inside the weak subspace; the
+  // perturbation acts on the right, so a camera-frame direction a is rho (or phi) = Rᵀ a.
+  const Eigen::MatrixXd weak_basis = eigen.eigenvectors().leftCols(num_weak);
+  const Mat3& rotation = cam_from_lidar.linear();
+  static const char* kAxisNames[3] = {"x (right)", "y (down)", "z (forward)"};
+  for (int kind = 0; kind < 2; ++kind) {
+    for (int axis = 0; axis < 3; ++axis) {
+      Vec6 motion = Vec6::Zero();
+      motion.segment<3>(3 * kind) = rotation.transpose() * Vec3::Unit(axis);
+      if ((weak_basis.transpose() * motion).squaredNorm() < 0.5) continue;
+      report.weak_directions.push_back(
+          std::string(kind == 0 ? "translation along camera " : "rotation about camera ") +
+          kAxisNames[axis] + (kind == 1 ? " through the LiDAR origin" : ""));
+    }
+  }
+  for (int i = 0; i < num_weak && report.weak_directions.size() < static_cast<size_t>(num_weak);
+       ++i) {
+    // A weak direction that is no single axis: describe the eigenvector itself.
+    const Vec6 v = eigen.eigenvectors().col(i);
+    const Vec3 t = rotation * v.head<3>();
+    const Vec3 r = rotation * v.tail<3>();
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  "combined motion: translation [%.2f, %.2f, %.2f] with rotation [%.2f, %.2f, "
+                  "%.2f] (camera frame, eigenvalue ratio %.1e)",
+                  t.x(), t.y(), t.z(), r.x(), r.y(), r.z(), report.eigenvalues[i] / largest);
+    report.weak_directions.push_back(text);
+  }
+  report.well_constrained = false;
+  return report;
+}
+
+Vec3 TranslationStd(const Mat6& covariance, const Pose& cam_from_lidar) {
+  const Mat3& r = cam_from_lidar.linear();
+  const Mat3 in_cam = r * covariance.topLeftCorner<3, 3>() * r.transpose();
+  return in_cam.diagonal().cwiseMax(0.0).cwiseSqrt();
+}
+
+Vec3 RotationStdDeg(const Mat6& covariance, const Pose& cam_from_lidar) {
+  const Mat3& r = cam_from_lidar.linear();
+  const Mat3 in_cam = r * covariance.bottomRightCorner<3, 3>() * r.transpose();
+  return in_cam.diagonal().cwiseMax(0.0).cwiseSqrt() * (180.0 / M_PI);
+}
+
+}  // namespace calibench

@@ -1,0 +1,37 @@
+// What every estimator reports besides its estimate: the iterations, the observability of the six
+// degrees of freedom, and standard deviations in the camera's axes. Shared by both methods.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/base/types.h"
+
+namespace calibench {
+
+struct IterationReport {
+  int iteration = 0;       // 0 = the initial estimate
+  double cost = 0.0;       // sum of Huber costs, Eq. (14)
+  double step_norm = 0.0;  // |delta|
+  Pose cam_from_lidar = Pose::Identity();
+  double range_offset_m = 0.0;  // SolverOptions::estimate_range_offset
+};
+
+struct ObservabilityReport {
+  Vec6 eigenvalues = Vec6::Zero();           // of the information matrix JᵀWJ, ascending
+  std::vector<std::string> weak_directions;  // in words, camera frame
+  bool well_constrained = false;
+};
+
+// Observability of cam_from_<sensor> from its information matrix (right perturbation, [rho; phi])
+// at an estimate: eigenvalues, and the weak directions named in camera axes.
+ObservabilityReport AnalyseObservability(const Mat6& information, const Pose& cam_from_lidar,
+                                         double weak_eigenvalue_ratio);
+
+// Standard deviations of cam_from_lidar along the camera axes, from the covariance of its right
+// perturbation: the translation of T·Exp([rho; phi]) moves by R·rho and its rotation by R·phi to
+// first order, so both blocks are rotated into the camera frame. Metres and degrees.
+Vec3 TranslationStd(const Mat6& covariance, const Pose& cam_from_lidar);
+Vec3 RotationStdDeg(const Mat6& covariance, const Pose& cam_from_lidar);
+
+}  // namespace calibench

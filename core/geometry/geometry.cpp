@@ -1,0 +1,146 @@
+#include "core/geometry/geometry.h"
+
+#include <Eigen/SVD>
+#include <cmath>
+
+namespace calibench {
+namespace {
+constexpr double kSmallAngle = 1e-8;
+}  // namespace
+
+Mat3 Skew(const Vec3& v) {
+  Mat3 m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+Mat3 ExpSO3(const Vec3& phi) {
+  const double theta = phi.norm();
+  const Mat3 k = Skew(phi);
+  if (theta < kSmallAngle) return Mat3::Identity() + k + 0.5 * k * k;
+  return Mat3::Identity() + std::sin(theta) / theta * k +
+         (1.0 - std::cos(theta)) / (theta * theta) * k * k;
+}
+
+Vec3 LogSO3(const Mat3& rotation) {
+  const Eigen::AngleAxisd aa(rotation);
+  Vec3 phi = aa.angle() * aa.axis();
+  if (!phi.allFinite()) phi.setZero();
+  return phi;
+}
+
+Mat3 LeftJacobianSO3(const Vec3& phi) {
+  const double theta = phi.norm();
+  const Mat3 k = Skew(phi);
+  if (theta < kSmallAngle) return Mat3::Identity() + 0.5 * k + k * k / 6.0;
+  const double t2 = theta * theta;
+  return Mat3::Identity() + (1.0 - std::cos(theta)) / t2 * k +
+         (theta - std::sin(theta)) / (t2 * theta) * k * k;
+}
+
+Mat3 LeftJacobianInverseSO3(const Vec3& phi) {
+  const double theta = phi.norm();
+  const Mat3 k = Skew(phi);
+  if (theta < kSmallAngle) return Mat3::Identity() - 0.5 * k + k * k / 12.0;
+  const double half = 0.5 * theta;
+  const double cot_term = (1.0 - half * std::cos(half) / std::sin(half)) / (theta * theta);
+  return Mat3::Identity() - 0.5 * k + cot_term * k * k;
+}
+
+Pose ExpSE3(const Vec6& xi) {
+  const Vec3 rho = xi.head<3>();
+  const Vec3 phi = xi.tail<3>();
+  Pose pose = Pose::Identity();
+  pose.linear() = ExpSO3(phi);
+  pose.translation() = LeftJacobianSO3(phi) * rho;
+  return pose;
+}
+
+Vec6 LogSE3(const Pose& pose) {
+  const Vec3 phi = LogSO3(pose.linear());
+  Vec6 xi;
+  xi.head<3>() = LeftJacobianInverseSO3(phi) * pose.translation();
+  xi.tail<3>() = phi;
+  return xi;
+}
+
+Mat6 AdjointSE3(const Pose& pose) {
+  const Mat3 r = pose.linear();
+  Mat6 adj = Mat6::Zero();
+  adj.topLeftCorner<3, 3>() = r;
+  adj.topRightCorner<3, 3>() = Skew(pose.translation()) * r;
+  adj.bottomRightCorner<3, 3>() = r;
+  return adj;
+}
+
+Plane TransformPlane(const Pose& b_from_a, const Plane& plane_in_a) {
+  Plane out;
+  out.normal = b_from_a.linear() * plane_in_a.normal;
+  out.distance = plane_in_a.distance - out.normal.dot(b_from_a.translation());
+  return out;
+}
+
+std::optional<double> RangeOnPlane(const Plane& plane, const Vec3& point) {
+  const double range = point.norm();
+  if (!(range > 0)) return std::nullopt;
+  const double cos_incidence = plane.normal.dot(point) / range;
+  if (std::abs(cos_incidence) < 0.02) return std::nullopt;
+  return -plane.distance / cos_incidence;
+}
+
+Plane OrientTowardsOrigin(const Plane& plane) {
+  if (plane.distance >= 0) return plane;
+  return Plane{-plane.normal, -plane.distance};
+}
+
+Vec4 PlaneToPlaneError(const Plane& plane_i, const Plane& plane_j) {
+  Vec4 e;
+  e.head<3>() = plane_i.normal - plane_j.normal;
+  e[3] = plane_j.normal.dot(plane_j.ClosestPointToOrigin() - plane_i.ClosestPointToOrigin());
+  return e;
+}
+
+Vec4 PlaneAlignmentResidual(const Pose& cam_from_lidar, const Plane& lidar_plane,
+                            const Plane& camera_plane, Eigen::Matrix<double, 4, 6>* jacobian) {
+  const Plane moved = TransformPlane(cam_from_lidar, lidar_plane);
+  const Vec4 error = PlaneToPlaneError(moved, camera_plane);
+  if (jacobian) {
+    // Right perturbation X·Exp([rho; phi]) moves the LiDAR plane first:
+    //   n1 = Exp(phi) n ≈ n − [n]x phi,  d1 = d − n1·(J_l(phi) rho) ≈ d − n·rho,
+    // then X: n' = R n1, d' = d1 − n'·t. Hence
+    //   dn'/drho = 0, dn'/dphi = −R [n]x, dd'/drho = −nᵀ, dd'/dphi = tᵀ R [n]x.
+    const Mat3& rotation = cam_from_lidar.linear();
+    const Vec3& t = cam_from_lidar.translation();
+    const Mat3 r_skew_n = rotation * Skew(lidar_plane.normal);
+    Eigen::Matrix<double, 4, 6> d_plane;  // d(n', d')/d(delta)
+    d_plane.setZero();
+    d_plane.block<3, 3>(0, 3) = -r_skew_n;
+    d_plane.block<1, 3>(3, 0) = -lidar_plane.normal.transpose();
+    d_plane.block<1, 3>(3, 3) = t.transpose() * r_skew_n;
+    // Eq. (6) with pi_i = moved, pi_j = camera: e_n = n' − n_c,
+    // e_d = n_c·(−n_c d_c + n' d') = d' (n_c·n') − d_c.
+    Eigen::Matrix<double, 4, 4> d_error;  // d(e)/d(n', d')
+    d_error.setZero();
+    d_error.topLeftCorner<3, 3>().setIdentity();
+    d_error.block<1, 3>(3, 0) = moved.distance * camera_plane.normal.transpose();
+    d_error(3, 3) = camera_plane.normal.dot(moved.normal);
+    *jacobian = d_error * d_plane;
+  }
+  return error;
+}
+
+double RotationAngle(const Mat3& a, const Mat3& b) { return LogSO3(a.transpose() * b).norm(); }
+
+Mat3 NearestRotation(const Mat3& m) {
+  Eigen::JacobiSVD<Mat3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3 d = Mat3::Identity();
+  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  return svd.matrixU() * d * svd.matrixV().transpose();
+}
+
+PoseError ComputePoseError(const Pose& estimate, const Pose& reference) {
+  return {(estimate.translation() - reference.translation()).norm(),
+          RotationAngle(estimate.linear(), reference.linear())};
+}
+
+}  // namespace calibench

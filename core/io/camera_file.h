@@ -1,0 +1,17 @@
+// Camera intrinsics files: OpenCV FileStorage (YAML/XML), ROS camera_info YAML, Kalibr camchain.
+#pragma once
+
+#include <filesystem>
+
+#include "core/camera/camera.h"
+
+namespace calibench {
+
+// Reads intrinsics from an OpenCV FileStorage YAML/XML (camera_matrix, distortion_coefficients,
+// optional distortion_model), a ROS camera_info YAML (camera_calibration output or the CameraInfo
+// message fields K/D), or a Kalibr camchain (cam0). The model must be stated by the file
+// (plumb_bob / rational_polynomial / radtan -> pinhole-radtan; equidistant / fisheye ->
+// kannala-brandt); OpenCV FileStorage files without a model are pinhole-radtan by definition.
+CameraModel LoadCameraFile(const std::filesystem::path& path);
+
+}  // namespace calibench

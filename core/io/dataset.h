@@ -1,0 +1,58 @@
+// The calibench.dataset.v1 manifest (DESIGN.md "File contracts") and its folder shorthand.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/base/types.h"
+#include "core/camera/camera.h"
+#include "core/target/board.h"
+
+namespace calibench {
+
+struct PairEntry {
+  std::string id;
+  std::filesystem::path cloud;  // absolute after loading
+  std::filesystem::path image;  // absolute after loading
+  std::optional<LidarSeed> lidar_seed;
+};
+
+// What `calibench simulate` was asked for, so that every pair's noise-free geometry can be
+// re-created (SimOptionsFromDataset in sim.h) for the Cramér–Rao bound. Camera, board and ground
+// truth are the dataset's own.
+struct SimulationRecord {
+  std::string lidar_model;  // "hdl64", "vlp16", "os0-128"
+  int num_pairs = 0;
+  double min_distance_m = 0.0;
+  double max_distance_m = 0.0;
+  double max_tilt_deg = 0.0;
+  double lidar_range_noise_m = 0.0;   // 1σ along each ray
+  double lidar_range_offset_m = 0.0;  // measured = true range + offset
+  double image_noise = 0.0;           // [0,1] intensity units
+  bool clutter = true;
+  double seed_radius_m = 0.0;
+  std::uint64_t seed = 1;
+};
+
+struct Dataset {
+  std::filesystem::path manifest;  // the file read (or the folder for the shorthand)
+  CameraModel camera;
+  BoardSpec target;
+  int lidar_rings = 0;  // 0 = unknown
+  std::vector<PairEntry> pairs;
+  std::optional<Pose> cam_from_lidar_ground_truth;
+  std::optional<SimulationRecord> simulation;
+};
+
+// Loads a manifest file, or a folder with clouds/ + images/ (paired by stem), camera.yaml and
+// target.json. Relative paths resolve against the manifest's folder. Throws IoError naming the
+// file and the problem; validates the camera and the target.
+Dataset LoadDataset(const std::filesystem::path& path);
+
+// Writes a manifest; paths are written relative to the manifest's folder when they lie under it.
+void SaveDataset(const std::filesystem::path& manifest_path, const Dataset& dataset);
+
+}  // namespace calibench

@@ -1,0 +1,133 @@
+// The headless pipeline over plain data: load -> extract features (planes) -> solve.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/base/image.h"
+#include "core/base/parallel.h"
+#include "core/io/dataset.h"
+#include "core/lidar/cloud.h"
+#include "core/lidar/lidar_image.h"
+#include "core/lidar_camera/solver.h"
+#include "core/results/pair_status.h"
+#include "core/target/board_camera.h"
+#include "core/target/lidar_plane.h"
+
+namespace calibench {
+
+struct PipelineOptions {
+  LidarPlaneOptions lidar_plane;
+  BoardDetectionOptions detection;
+  PnpOptions pnp;
+  SolverOptions solver;
+  std::vector<std::string> pair_ids;           // empty = every pair of the dataset
+  std::optional<Pose> initial_cam_from_lidar;  // user guess; else the closed form from planes
+  int threads = 1;                             // feature extraction workers
+  int min_pairs = 3;                           // planes fix all 6 dof from 3 pairs on
+  // LiDAR: grow each brushed / seeded region to the whole board, limited by the target's sheet
+  // size (LidarPlaneOptions::grow_radius_m = BoardGrowRadius(target)).
+  bool grow_to_board = true;
+  bool Check(std::string* why) const;
+};
+
+struct PairFeatures {
+  std::string id;
+  PairStatus status = PairStatus::kPending;
+  std::string reason;        // why failed / rejected, human-readable
+  bool input_error = false;  // the pair's files could not be read
+  std::optional<LidarPlaneFit> lidar;
+  std::optional<CameraBoardObservation> camera;
+};
+
+// options.lidar_plane for `target`: its grow radius (when options.grow_to_board) and its sheet size
+// (for the board edges), where options.lidar_plane leaves them unset.
+LidarPlaneOptions LidarPlaneOptionsFor(const PipelineOptions& options, const BoardSpec& target);
+
+// The solver's input for one pair: both planes with their covariances.
+PlanePair MakePlanePair(const std::string& id, const LidarPlaneFit& lidar,
+                        const CameraBoardObservation& camera);
+
+// The pipeline's steps over one pair, in order: load its files, find the board in the image,
+// choose the LiDAR region, fit the LiDAR plane. ExtractPairFeatures runs them all; the workbench
+// runs the same functions one at a time (the LiDAR side again after every brush stroke).
+
+// A pair's files as loaded and checked against the camera.
+struct PairInputs {
+  LidarCloud cloud;
+  ImageU8 image;
+};
+// nullopt with *why naming the file when a file cannot be read or the image is not the camera's
+// size.
+std::optional<PairInputs> LoadPairInputs(const Dataset& dataset, const PairEntry& pair,
+                                         std::string* why);
+
+// The camera side: the board detected in the image and its plane by PnP; `failure` says why
+// `observation` is absent. `detection` is kept even when PnP fails.
+struct CameraFeatures {
+  std::optional<BoardDetection> detection;
+  std::optional<CameraBoardObservation> observation;
+  std::string failure;
+};
+CameraFeatures ExtractCameraFeatures(const Dataset& dataset, const ImageU8& image,
+                                     const PipelineOptions& options);
+
+// Where the user said the board is. A brush (LiDAR-image pixels on `image`) replaces the seed;
+// without a brush the seed's cone of rays is used (SelectSeedRegion). The one place that decides
+// which LiDAR points a plane is fitted to, for the CLI and the workbench alike.
+struct BoardHint {
+  const std::vector<int>* brush_pixels = nullptr;  // null or empty: no brush
+  const LidarImage* image = nullptr;               // the image the brush was painted on
+  std::optional<LidarSeed> seed;
+};
+// Candidate points (indices into the cloud); empty with *why when there is no hint.
+std::vector<int> SelectBoardRegion(const LidarCloud& cloud, const BoardHint& hint,
+                                   std::string* why);
+
+// The LiDAR side: the board plane fitted to the hint's region (SelectBoardRegion), grown to the
+// sheet (LidarPlaneOptionsFor). nullopt with *why ("LiDAR: ...", or the missing hint) when no
+// plane is found.
+std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const LidarCloud& cloud,
+                                                  const BoardHint& hint,
+                                                  const PipelineOptions& options, std::string* why);
+
+// The status of a pair from its two sides: kAccepted with both planes, else kFailed with the
+// first missing side's failure (LiDAR first; the camera's prefixed "camera: ").
+void SetStatusFromFeatures(PairFeatures* features, const std::string& lidar_failure,
+                           const std::string& camera_failure);
+
+// Loads the pair's files and extracts both planes (the steps above, the seed as the hint). Never
+// throws for bad data: the pair comes back kFailed with the reason (unreadable files name the
+// file).
+PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
+                                 const PipelineOptions& options);
+
+struct CalibrationOutcome {
+  std::vector<PairFeatures> pairs;
+  std::optional<SolverResult> solution;  // absent when no calibration could be computed
+  std::string failure;                   // why `solution` is absent
+  Pose initial_cam_from_lidar = Pose::Identity();
+};
+
+// Extracts every selected pair (in parallel with options.threads) and solves.
+CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,
+                                    const ProgressCallback& progress = {});
+
+using IterationCallback = std::function<void(const IterationReport&)>;
+
+// Solves from already extracted features; pairs not kAccepted are ignored. Pairs with a
+// (lidar, camera) plane and status kPending count as accepted. on_iteration (optional) sees every
+// Gauss-Newton iteration as it happens (the workbench's live cost plot).
+CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,
+                                     const PipelineOptions& options,
+                                     const IterationCallback& on_iteration = {});
+
+// The solver's residuals and robust weights at `solution` for the accepted pairs (in order),
+// weighed as that solve weighed them (its variance factors, when its method is options.solver's).
+// What the workbench shows after a status change, and what an exported result lists.
+void EvaluateAtSolution(const std::vector<PairFeatures>& pairs, const SolverOptions& options,
+                        SolverResult* solution);
+
+}  // namespace calibench

@@ -1,0 +1,205 @@
+#include "core/lidar_camera/result_io.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/results/result_json.h"
+
+namespace calibench {
+using nlohmann::json;
+
+namespace {
+
+json Vec4ToJson(const Vec4& v) { return {v[0], v[1], v[2], v[3]}; }
+
+json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& options,
+                  const ResultNames& names) {
+  CALIBENCH_CHECK(outcome.solution.has_value());
+  const SolverResult& s = *outcome.solution;
+  json root = ResultHeaderJson(names, s.cam_from_lidar, s.covariance, s.observability);
+  root["solver"] = {{"method", SolverMethodName(options.method)},
+                    {"iterations", s.iterations},
+                    {"converged", s.converged},
+                    {"cost_history", s.cost_history},
+                    {"huber_delta", options.huber_delta},
+                    {"board_edge_points", s.num_edge_residuals},
+                    // What the data said about the noise models: 1 = they held.
+                    {"plane_variance_factor", s.plane_variance_factor},
+                    {"edge_variance_factor", s.edge_variance_factor},
+                    {"covariance_inflation", s.covariance_inflation}};
+  if (s.edge_dilation) {
+    root["solver"]["board_edge_dilation"] = {
+        {"value_m", s.edge_dilation->value_m},
+        {"sigma_m", s.edge_dilation->sigma_m},
+        {"spread_over_pairs_m", s.edge_dilation->spread_m},
+        {"meaning",
+         "how much larger than the sheet the LiDAR sees it, per side (mean of the "
+         "pairs' estimates)"}};
+  }
+  auto offset_json = [](const RangeOffsetEstimate& offset) {
+    return json{{"value_m", offset.value_m},
+                {"sigma_m", offset.sigma_m},
+                {"convention", "measured range = true range + value_m; subtract it to correct"},
+                {"correlation_with_translation",
+                 {offset.correlation_with_translation.x(), offset.correlation_with_translation.y(),
+                  offset.correlation_with_translation.z()}},
+                {"well_determined", offset.well_determined}};
+  };
+  if (s.range_offset) root["lidar_range_offset"] = offset_json(*s.range_offset);
+  if (s.unmodelled_range_offset) {
+    root["unmodelled_lidar_range_offset"] = offset_json(*s.unmodelled_range_offset);
+    root["unmodelled_lidar_range_offset"]["meaning"] =
+        "not estimated, yet significant in the data (score test at the solution); the pose does "
+        "not include it: estimate it (--estimate-range-offset) or correct the clouds";
+  }
+  json pairs = json::array();
+  size_t solved_index = 0;
+  for (const PairFeatures& p : outcome.pairs) {
+    json entry = PairEntryJson(p.id, p.status, p.reason);
+    if (p.lidar) {
+      entry["lidar_plane"] = Vec4ToJson(p.lidar->plane.Coefficients());
+      entry["lidar_inliers"] = p.lidar->inliers.size();
+      entry["lidar_rms_m"] = p.lidar->rms_m;
+    }
+    if (p.camera) {
+      entry["camera_plane"] = Vec4ToJson(p.camera->plane.Coefficients());
+      entry["camera_corners"] = p.camera->num_corners;
+      entry["reprojection_rms_px"] = p.camera->reprojection_rms_px;
+    }
+    if (p.status == PairStatus::kAccepted && solved_index < s.residuals.size()) {
+      entry["residual"] = Vec4ToJson(s.residuals[solved_index]);
+      entry["robust_weight"] = s.robust_weights[solved_index];
+      ++solved_index;
+    }
+    pairs.push_back(entry);
+  }
+  root["pairs"] = pairs;
+  return root;
+}
+
+}  // namespace
+
+void WriteResult(const std::filesystem::path& path, const CalibrationOutcome& outcome,
+                 const SolverOptions& options, const ResultNames& names) {
+  WriteResultJson(path, ResultToJson(outcome, options, names));
+}
+
+std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& names) {
+  std::ostringstream out;
+  char line[256];
+  int accepted = 0, failed = 0;
+  for (const PairFeatures& p : outcome.pairs) {
+    accepted += p.status == PairStatus::kAccepted;
+    failed += p.status == PairStatus::kFailed;
+  }
+  out << "pairs: " << outcome.pairs.size() << " (" << accepted << " accepted, " << failed
+      << " failed)\n";
+  size_t solved_index = 0;
+  for (const PairFeatures& p : outcome.pairs) {
+    if (p.status == PairStatus::kFailed) {
+      out << "  pair " << p.id << " failed: " << p.reason << "\n";
+      continue;
+    }
+    if (!p.lidar || !p.camera) continue;
+    std::snprintf(line, sizeof(line),
+                  "  pair %-8s %-8s lidar %5zu inliers rms %5.1f mm | camera %3d corners rms "
+                  "%.2f px",
+                  p.id.c_str(), PairStatusName(p.status).c_str(), p.lidar->inliers.size(),
+                  p.lidar->rms_m * 1e3, p.camera->num_corners, p.camera->reprojection_rms_px);
+    out << line;
+    if (outcome.solution && p.status == PairStatus::kAccepted &&
+        solved_index < outcome.solution->residuals.size()) {
+      std::snprintf(line, sizeof(line), " | |e| %.4f weight %.2f",
+                    outcome.solution->residuals[solved_index].norm(),
+                    outcome.solution->robust_weights[solved_index]);
+      out << line;
+      ++solved_index;
+    }
+    out << "\n";
+  }
+  if (!outcome.solution) {
+    out << "no calibration: " << outcome.failure << "\n";
+    return out.str();
+  }
+  const SolverResult& s = *outcome.solution;
+  const std::string fwd = names.target + "_from_" + names.source;
+  const std::string bwd = names.source + "_from_" + names.target;
+  auto print_pose = [&](const std::string& name, const std::string& words, const Pose& pose) {
+    out << name << "  (" << words << ")\n";
+    for (int r = 0; r < 3; ++r) {
+      std::snprintf(line, sizeof(line), "  [% .6f % .6f % .6f | % .6f]\n", pose.matrix()(r, 0),
+                    pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3));
+      out << line;
+    }
+  };
+  print_pose(fwd,
+             "maps points from the " + names.source + " frame into the " + names.target + " frame",
+             s.cam_from_lidar);
+  print_pose(bwd,
+             "maps points from the " + names.target + " frame into the " + names.source +
+                 " frame; "
+                 "its translation is the " +
+                 names.target + " position in the " + names.source + " frame",
+             s.cam_from_lidar.inverse());
+  const Vec3 st = TranslationStd(s.covariance, s.cam_from_lidar) * 1000.0;
+  const Vec3 sr = RotationStdDeg(s.covariance, s.cam_from_lidar);
+  std::snprintf(
+      line, sizeof(line),
+      "std (camera axes x/y/z) translation [mm]: %.2f %.2f %.2f   rotation [deg]: %.3f %.3f %.3f\n",
+      st.x(), st.y(), st.z(), sr.x(), sr.y(), sr.z());
+  out << line;
+  if (s.num_edge_residuals > 0) {
+    std::snprintf(line, sizeof(line), "board edges: %d ring crossings of the sheet's edges used",
+                  s.num_edge_residuals);
+    out << line;
+    if (s.edge_dilation) {
+      std::snprintf(line, sizeof(line),
+                    "; the LiDAR sees the sheet %+.1f ± %.1f mm larger per side (beam footprint; "
+                    "pairs spread %.1f mm)",
+                    s.edge_dilation->value_m * 1e3, s.edge_dilation->sigma_m * 1e3,
+                    s.edge_dilation->spread_m * 1e3);
+      out << line;
+    }
+    out << "\n";
+  }
+  if (s.range_offset) {
+    const Vec3& c = s.range_offset->correlation_with_translation;
+    std::snprintf(line, sizeof(line),
+                  "LiDAR range offset: %+.1f ± %.1f mm (measured = true + offset; correlation "
+                  "with translation x/y/z %.2f %.2f %.2f)%s\n",
+                  s.range_offset->value_m * 1e3, s.range_offset->sigma_m * 1e3, c.x(), c.y(), c.z(),
+                  s.range_offset->well_determined ? "" : " NOT well determined");
+    out << line;
+  }
+  if (s.unmodelled_range_offset) {
+    std::snprintf(line, sizeof(line),
+                  "WARNING: the data shows a LiDAR range offset of %+.1f ± %.1f mm that this "
+                  "solve left out; rerun with --estimate-range-offset (or correct the clouds)\n",
+                  s.unmodelled_range_offset->value_m * 1e3,
+                  s.unmodelled_range_offset->sigma_m * 1e3);
+    out << line;
+  }
+  if (s.covariance_inflation > 1.0) {
+    std::snprintf(line, sizeof(line),
+                  "covariance widened up to %.1fx (variance) by the spread over the pairs: the "
+                  "noise models underestimate this data\n",
+                  s.covariance_inflation);
+    out << line;
+  }
+  std::snprintf(line, sizeof(line), "solver: %d iterations, %s, cost %.3e -> %.3e\n", s.iterations,
+                s.converged ? "converged" : "NOT converged", s.cost_history.front(),
+                s.cost_history.back());
+  out << line;
+  if (s.observability.well_constrained) {
+    out << "observability: well constrained\n";
+  } else {
+    out << "observability: NOT well constrained; weak directions:\n";
+    for (const auto& d : s.observability.weak_directions) out << "  - " << d << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace calibench

@@ -1,0 +1,607 @@
+#include "core/lidar_camera/solver.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace calibench {
+
+std::string SolverMethodName(SolverMethod method) {
+  switch (method) {
+    case SolverMethod::kCa2libGn:
+      return "ca2lib-gn";
+    case SolverMethod::kWeightedMl:
+      return "weighted-ml";
+    case SolverMethod::kKim:
+      return "kim";
+  }
+  return "unknown";
+}
+
+std::optional<SolverMethod> ParseSolverMethod(const std::string& name) {
+  if (name == "ca2lib-gn") return SolverMethod::kCa2libGn;
+  if (name == "weighted-ml") return SolverMethod::kWeightedMl;
+  if (name == "kim") return SolverMethod::kKim;
+  return std::nullopt;
+}
+
+bool SolverOptions::Check(std::string* why) const {
+  auto fail = [&](const std::string& message) {
+    if (why) *why = message;
+    return false;
+  };
+  if (!(huber_delta > 0)) return fail("huber_delta must be > 0");
+  if (!(whitened_huber_delta > 0)) return fail("whitened_huber_delta must be > 0 (sigmas)");
+  if (max_iterations < 1) return fail("max_iterations must be >= 1");
+  if (!(step_tolerance > 0)) return fail("step_tolerance must be > 0");
+  if (!(outlier_gate == 0 || outlier_gate >= 2))
+    return fail("outlier_gate must be 0 (off) or at least 2 robust scales");
+  if (!(weak_eigenvalue_ratio > 0 && weak_eigenvalue_ratio < 1))
+    return fail("weak_eigenvalue_ratio must be in (0, 1)");
+  if (!(range_offset_max_sigma_m > 0)) return fail("range_offset_max_sigma_m must be > 0 (metres)");
+  if (!(range_offset_significance > 0))
+    return fail("range_offset_significance must be > 0 (standard deviations)");
+  if (!(edge_floor_sigma_m > 0)) return fail("edge_floor_sigma_m must be > 0 (metres)");
+  if (estimate_range_offset && method != SolverMethod::kWeightedMl)
+    return fail("a range offset is estimated by the weighted-ml method only, not by " +
+                SolverMethodName(method));
+  return true;
+}
+
+namespace {
+
+// The weighted method's minimal residual for one pair at cam_from_lidar (3-vector):
+//   r = [ B_cᵀ (n' − n_c) ; d' − d_c ],  (n', d') = TransformPlane(cam_from_lidar, lidar plane),
+// B_c an orthonormal basis of the camera normal's tangent plane (the normals' two free
+// directions; Eq. (6)'s 4-vector has a rank-3 covariance). Its covariance propagates both
+// planes' covariances; the Jacobian is w.r.t. the right perturbation [rho; phi].
+struct WeightedResidual {
+  Vec3 residual;
+  Eigen::Matrix<double, 3, 6> jacobian;
+  Vec3 offset_jacobian;  // d r / d(range offset)
+  Mat3 covariance;
+};
+
+// With a range offset b the LiDAR plane the board really has is the fitted one moved back by
+// b · d(n, d)/db (first order; the offset is centimetres against metres of range).
+Plane CorrectedLidarPlane(const PlanePair& pair, double range_offset_m) {
+  if (range_offset_m == 0.0) return pair.lidar_plane;
+  const Vec4 c =
+      pair.lidar_plane.Coefficients() - range_offset_m * pair.lidar_range_offset_jacobian;
+  return Plane{c.head<3>().normalized(), c[3] / c.head<3>().norm()};
+}
+
+WeightedResidual ComputeWeightedResidual(const Pose& cam_from_lidar, const PlanePair& pair,
+                                         double range_offset_m = 0.0) {
+  const Mat3& r = cam_from_lidar.linear();
+  const Vec3& t = cam_from_lidar.translation();
+  const Plane lidar_plane = CorrectedLidarPlane(pair, range_offset_m);
+  const Plane moved = TransformPlane(cam_from_lidar, lidar_plane);
+  const Vec3& n_c = pair.camera_plane.normal;
+  Eigen::Matrix<double, 3, 2> basis;
+  basis.col(0) = n_c.unitOrthogonal();
+  basis.col(1) = n_c.cross(basis.col(0));
+  WeightedResidual out;
+  out.residual.head<2>() = basis.transpose() * (moved.normal - n_c);
+  out.residual[2] = moved.distance - pair.camera_plane.distance;
+  // d/d(delta), as in PlaneAlignmentResidual: dn'/dphi = −R[n]x, dd'/drho = −nᵀ, dd'/dphi =
+  // tᵀR[n]x.
+  const Mat3 r_skew_n = r * Skew(lidar_plane.normal);
+  out.jacobian.setZero();
+  out.jacobian.block<2, 3>(0, 3) = -basis.transpose() * r_skew_n;
+  out.jacobian.block<1, 3>(2, 0) = -lidar_plane.normal.transpose();
+  out.jacobian.block<1, 3>(2, 3) = t.transpose() * r_skew_n;
+  // d r / d(n_l, d_l) and d r / d(n_c, d_c).
+  Eigen::Matrix<double, 3, 4> d_lidar = Eigen::Matrix<double, 3, 4>::Zero();
+  d_lidar.block<2, 3>(0, 0) = basis.transpose() * r;
+  d_lidar.block<1, 3>(2, 0) = -t.transpose() * r;
+  d_lidar(2, 3) = 1.0;
+  out.offset_jacobian = -d_lidar * pair.lidar_range_offset_jacobian;
+  Eigen::Matrix<double, 3, 4> d_camera = Eigen::Matrix<double, 3, 4>::Zero();
+  d_camera.block<2, 3>(0, 0) = -basis.transpose();
+  d_camera(2, 3) = -1.0;
+  out.covariance = d_lidar * pair.lidar_covariance * d_lidar.transpose() +
+                   d_camera * pair.camera_covariance * d_camera.transpose();
+  // Floor: 1e-5 rad and 0.1 mm, so that a pair with an unknown (zero) covariance stays finite.
+  out.covariance.diagonal() += Vec3(1e-10, 1e-10, 1e-8);
+  return out;
+}
+
+}  // namespace
+
+std::optional<Pose> InitialGuessFromPlanes(const std::vector<PlanePair>& pairs, std::string* why) {
+  if (pairs.size() < 2) {
+    if (why)
+      *why =
+          "need at least 2 plane pairs for an initial guess, got " + std::to_string(pairs.size());
+    return std::nullopt;
+  }
+  // Rotation: argmax sum n_c · R n_l (Kabsch on the normals).
+  Mat3 correlation = Mat3::Zero();
+  for (const PlanePair& p : pairs)
+    correlation += p.camera_plane.normal * p.lidar_plane.normal.transpose();
+  Eigen::JacobiSVD<Mat3> svd(correlation, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  if (svd.singularValues()[1] < 1e-6 * svd.singularValues()[0]) {
+    if (why) *why = "all board normals are parallel: the rotation is not determined";
+    return std::nullopt;
+  }
+  Pose cam_from_lidar = Pose::Identity();
+  cam_from_lidar.linear() = NearestRotation(correlation);
+  // Translation: d_c = d_l − n_c·t  =>  n_cᵀ t = d_l − d_c.
+  Eigen::MatrixXd a(pairs.size(), 3);
+  Eigen::VectorXd b(pairs.size());
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    a.row(i) = pairs[i].camera_plane.normal.transpose();
+    b[i] = pairs[i].lidar_plane.distance - pairs[i].camera_plane.distance;
+  }
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(a);
+  cod.setThreshold(1e-3);  // minimum-norm along directions the normals do not span
+  cam_from_lidar.translation() = cod.solve(b);
+  return cam_from_lidar;
+}
+
+PlaneAlignmentSolver::PlaneAlignmentSolver(std::vector<PlanePair> pairs,
+                                           const SolverOptions& options,
+                                           const Pose& initial_cam_from_lidar,
+                                           double initial_range_offset_m)
+    : pairs_(std::move(pairs)),
+      options_(options),
+      cam_from_lidar_(initial_cam_from_lidar),
+      range_offset_m_(initial_range_offset_m) {
+  std::string why;
+  CALIBENCH_CHECK(options_.Check(&why));
+  CALIBENCH_CHECK(!pairs_.empty());
+  gated_.assign(pairs_.size(), 0);
+  iteration_budget_ = options_.max_iterations;
+  history_.push_back({0, LinearizeHere().cost, 0.0, cam_from_lidar_, range_offset_m_});
+  // Kim et al.'s estimate is the closed form itself: nothing to iterate.
+  if (options_.method == SolverMethod::kKim) done_ = converged_ = true;
+}
+
+double PlaneAlignmentSolver::HuberDelta() const {
+  return options_.method == SolverMethod::kWeightedMl ? options_.whitened_huber_delta
+                                                      : options_.huber_delta;
+}
+
+double PlaneAlignmentSolver::RobustWeight(double error_norm) const {
+  const double delta = HuberDelta();
+  return error_norm <= delta ? 1.0 : delta / error_norm;
+}
+
+double PlaneAlignmentSolver::RobustCost(double error_norm) const {
+  const double delta = HuberDelta();
+  return error_norm <= delta ? 0.5 * error_norm * error_norm : delta * (error_norm - 0.5 * delta);
+}
+
+std::vector<int> PlaneAlignmentSolver::ActiveParameters() const {
+  std::vector<int> active = {0, 1, 2, 3, 4, 5};
+  if (options_.estimate_range_offset) active.push_back(kRangeOffset);
+  return active;
+}
+
+void PlaneAlignmentSolver::LinearizeEdges(const Pose& cam_from_lidar, double range_offset_m,
+                                          const PlanePair& pair, Linearization* lin) const {
+  struct EdgeRow {
+    double residual = 0.0;  // signed distance outside the sheet's edge, metres
+    double sigma = 0.0;
+    Eigen::Matrix<double, 1, kNumParameters> jacobian;
+  };
+  std::vector<EdgeRow> rows;
+  rows.reserve(pair.lidar_edges.size());
+  Eigen::Matrix<double, 1, 6> edge_jacobian;
+  for (LidarEdgePoint edge : pair.lidar_edges) {
+    // The crossing lies on the fitted plane, which a range offset b moved along the rays: the
+    // board's own crossing is b closer along its ray.
+    const Vec3 ray = edge.point.normalized();
+    edge.point -= range_offset_m * ray;
+    EdgeRow row;
+    row.residual = BoardEdgeResidual(cam_from_lidar, pair.camera_from_board, pair.sheet_half_size_m,
+                                     edge, options_.edge_floor_sigma_m, &edge_jacobian, &row.sigma);
+    row.sigma *= std::sqrt(edge_variance_scale_);
+    row.jacobian.setZero();
+    row.jacobian.head<6>() = edge_jacobian;
+    // d e / d b: the point moves by −b·ray, and d e / d ρ is d e / d(point) in this frame.
+    row.jacobian[kRangeOffset] = -edge_jacobian.head<3>().dot(ray);
+    rows.push_back(row);
+  }
+  if (rows.empty()) return;
+  // The pair's dilation δ (SolverOptions::estimate_edge_dilation): every crossing should lie δ
+  // outside its edge. It is the robust weighted mean of the residuals at this pose, and
+  // eliminating it (variable projection) centres the Jacobians on their weighted mean.
+  double dilation = 0.0;
+  double weight_sum = 0.0;
+  std::vector<double> weights(rows.size());
+  const bool with_dilation = options_.estimate_edge_dilation && rows.size() >= 3;
+  for (int pass = 0; pass < (with_dilation ? 4 : 1); ++pass) {
+    double weighted_sum = 0.0;
+    weight_sum = 0.0;
+    for (size_t k = 0; k < rows.size(); ++k) {
+      const double whitened = (rows[k].residual - dilation) / rows[k].sigma;
+      weights[k] = RobustWeight(std::abs(whitened)) / (rows[k].sigma * rows[k].sigma);
+      weighted_sum += weights[k] * rows[k].residual;
+      weight_sum += weights[k];
+    }
+    if (with_dilation && pass < 3) dilation = weighted_sum / weight_sum;
+  }
+  Eigen::Matrix<double, 1, kNumParameters> mean_jacobian =
+      Eigen::Matrix<double, 1, kNumParameters>::Zero();
+  if (with_dilation) {
+    for (size_t k = 0; k < rows.size(); ++k) mean_jacobian += weights[k] * rows[k].jacobian;
+    mean_jacobian /= weight_sum;
+    ++lin->num_edge_dilations;
+    lin->pair_dilations_m.push_back(dilation);
+  }
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const double e = rows[k].residual - dilation;
+    const Eigen::Matrix<double, 1, kNumParameters> jacobian = rows[k].jacobian - mean_jacobian;
+    lin->information += weights[k] * jacobian.transpose() * jacobian;
+    lin->edge_information += weights[k] * jacobian.transpose() * jacobian;
+    lin->gradient += weights[k] * jacobian.transpose() * e;
+    lin->cost += RobustCost(std::abs(e / rows[k].sigma));
+    lin->weighted_squared_error += weights[k] * e * e;
+    lin->edge_weighted_squared_error += weights[k] * e * e;
+    ++lin->num_residuals;
+    ++lin->num_edge_residuals;
+  }
+}
+
+PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(const Pose& cam_from_lidar,
+                                                                    double range_offset_m) const {
+  Linearization lin;
+  lin.pair_weights.assign(pairs_.size(), 0.0);
+  if (options_.method == SolverMethod::kWeightedMl) {
+    Eigen::Matrix<double, 3, kNumParameters> jacobian =
+        Eigen::Matrix<double, 3, kNumParameters>::Zero();
+    for (size_t i = 0; i < pairs_.size(); ++i) {
+      if (gated_[i]) continue;
+      const Vec7 gradient_before = lin.gradient;
+      const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar, pairs_[i], range_offset_m);
+      jacobian.leftCols<6>() = w.jacobian;
+      jacobian.col(kRangeOffset) = w.offset_jacobian;
+      const Mat3 information = w.covariance.inverse() / plane_variance_scale_;
+      const double mahalanobis = std::sqrt(w.residual.dot(information * w.residual));
+      const double weight = RobustWeight(mahalanobis);
+      lin.pair_weights[i] = weight;
+      lin.information += weight * jacobian.transpose() * information * jacobian;
+      lin.gradient += weight * jacobian.transpose() * information * w.residual;
+      lin.cost += RobustCost(mahalanobis);
+      lin.weighted_squared_error += weight * mahalanobis * mahalanobis;
+      lin.num_residuals += 3;
+      if (options_.use_board_edges && pairs_[i].sheet_half_size_m.minCoeff() > 0)
+        LinearizeEdges(cam_from_lidar, range_offset_m, pairs_[i], &lin);
+      lin.pair_gradients.push_back(lin.gradient - gradient_before);
+    }
+    return lin;
+  }
+  Eigen::Matrix<double, 4, 6> jacobian;
+  for (size_t i = 0; i < pairs_.size(); ++i) {
+    const PlanePair& pair = pairs_[i];
+    const Vec4 e =
+        PlaneAlignmentResidual(cam_from_lidar, pair.lidar_plane, pair.camera_plane, &jacobian);
+    const double norm = e.norm();
+    const double w = RobustWeight(norm);  // Eq. (14) by iteratively reweighted least squares
+    lin.pair_weights[i] = w;
+    lin.information.topLeftCorner<6, 6>() += w * jacobian.transpose() * jacobian;
+    lin.gradient.head<6>() += w * jacobian.transpose() * e;
+    lin.cost += RobustCost(norm);
+    lin.weighted_squared_error += w * e.squaredNorm();
+    lin.num_residuals += 4;
+  }
+  return lin;
+}
+
+bool PlaneAlignmentSolver::Step() {
+  if (done_) return false;
+  const Linearization lin = LinearizeHere();
+  // Normal equations of Eq. (13)–(14); an LDLT with a tiny damping keeps rank-deficient
+  // (degenerate) problems finite: unobservable directions then simply do not move. The offset
+  // stays put unless it is estimated (and when the data says nothing about it).
+  Mat7 damped = lin.information;
+  Vec7 gradient = lin.gradient;
+  if (!options_.estimate_range_offset) {
+    damped.row(kRangeOffset).setZero();
+    damped.col(kRangeOffset).setZero();
+    gradient[kRangeOffset] = 0.0;
+  }
+  if (damped(kRangeOffset, kRangeOffset) == 0) damped(kRangeOffset, kRangeOffset) = 1.0;
+  damped.diagonal().array() += 1e-12 * std::max(1.0, damped.diagonal().maxCoeff());
+  Vec7 delta = -damped.ldlt().solve(gradient);
+  auto cost_at = [&](const Vec7& step) {
+    return Linearize(cam_from_lidar_ * ExpSE3(step.head<6>()), range_offset_m_ + step[kRangeOffset])
+        .cost;
+  };
+  double cost = cost_at(delta);
+  // Backtracking keeps Gauss-Newton monotone far from the solution (robust weights change).
+  for (int halvings = 0; cost > lin.cost && halvings < 10; ++halvings) {
+    delta *= 0.5;
+    cost = cost_at(delta);
+  }
+  if (cost <= lin.cost) {
+    cam_from_lidar_ = cam_from_lidar_ * ExpSE3(delta.head<6>());
+    range_offset_m_ += delta[kRangeOffset];
+  }
+  const double step_norm = cost <= lin.cost ? delta.norm() : 0.0;
+  history_.push_back({static_cast<int>(history_.size()), std::min(cost, lin.cost), step_norm,
+                      cam_from_lidar_, range_offset_m_});
+  converged_ = step_norm < options_.step_tolerance ||
+               (lin.cost - cost >= 0 && lin.cost - cost <= 1e-15 * std::max(1.0, lin.cost));
+  done_ = converged_ || static_cast<int>(history_.size()) > iteration_budget_;
+  if (done_ && (GateOutliers() || EstimateVarianceComponents())) {
+    // Continue from here without the gated pairs, with a fresh iteration budget; costs before
+    // and after are not comparable.
+    history_.back().cost = LinearizeHere().cost;
+    done_ = converged_ = false;
+    iteration_budget_ = static_cast<int>(history_.size()) + options_.max_iterations;
+  }
+  return !done_;
+}
+
+bool PlaneAlignmentSolver::GateOutliers() {
+  // Up to three rounds, each judged afresh at the current estimate: a gross outlier drags the
+  // first estimate, so good pairs may look bad until it is gone, and come back then.
+  if (gating_rounds_ >= 3 || options_.method != SolverMethod::kWeightedMl ||
+      options_.outlier_gate <= 0)
+    return false;
+  ++gating_rounds_;
+  std::vector<double> norms;
+  for (const PlanePair& pair : pairs_) {
+    const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar_, pair, range_offset_m_);
+    norms.push_back(std::sqrt(w.residual.dot(w.covariance.inverse() * w.residual)));
+  }
+  std::vector<double> sorted = norms;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  // The median of a χ(3) variable is 1.538.
+  const double scale = std::max(1.0, sorted[sorted.size() / 2] / 1.538);
+  // Only the worst pair beyond the gate goes per round: it is the one most likely to be the
+  // cause of the others' residuals.
+  std::vector<char> gated = gated_;
+  for (size_t i = 0; i < pairs_.size(); ++i)
+    if (gated[i] && norms[i] <= options_.outlier_gate * scale) gated[i] = 0;  // back in
+  int worst = -1;
+  for (size_t i = 0; i < pairs_.size(); ++i)
+    if (!gated[i] && norms[i] > options_.outlier_gate * scale &&
+        (worst < 0 || norms[i] > norms[worst]))
+      worst = static_cast<int>(i);
+  if (worst >= 0) gated[worst] = 1;
+  // Never gate so much that the problem loses its redundancy.
+  if (std::count(gated.begin(), gated.end(), 0) < 3) return false;
+  const bool changed = gated != gated_;
+  gated_ = gated;
+  return changed;
+}
+
+bool PlaneAlignmentSolver::EstimateVarianceComponents() {
+  // Förstner's variance component estimation for the two kinds of residual: each kind's
+  // variance factor is its weighted squared residuals over its share of the redundancy,
+  // r_g = n_g − tr(N⁻¹ N_g). Real sensors break the noise models differently (the planes by range
+  // biases and board flatness, the edges by beam width and mixed returns): one common factor
+  // would let the kind whose model is too optimistic dominate.
+  if (variance_component_rounds_ >= 6 || options_.method != SolverMethod::kWeightedMl ||
+      !options_.use_board_edges)
+    return false;
+  const Linearization lin = LinearizeHere();
+  const int edges = lin.num_edge_residuals;
+  const int planes = lin.num_residuals - edges;
+  const std::vector<int> active = ActiveParameters();
+  const int num_parameters = static_cast<int>(active.size());
+  if (edges < num_parameters || planes < num_parameters) return false;
+  ++variance_component_rounds_;
+  const Eigen::MatrixXd information = lin.information(active, active);
+  const Eigen::MatrixXd edge_information = lin.edge_information(active, active);
+  const Eigen::MatrixXd covariance =
+      information.ldlt().solve(Eigen::MatrixXd::Identity(num_parameters, num_parameters));
+  const double edge_trace = (covariance * edge_information).trace();
+  // Each eliminated dilation takes one of its pair's edge residuals.
+  const double edge_redundancy = edges - lin.num_edge_dilations - edge_trace;
+  const double plane_redundancy = planes - (num_parameters - edge_trace);
+  if (!(edge_redundancy > 1) || !(plane_redundancy > 1)) return false;
+  const double edge_factor = lin.edge_weighted_squared_error / edge_redundancy;
+  const double plane_factor =
+      (lin.weighted_squared_error - lin.edge_weighted_squared_error) / plane_redundancy;
+  edge_variance_scale_ *= edge_factor;
+  plane_variance_scale_ *= plane_factor;
+  // Continue (a fresh solve with the new weights) while either factor moved by more than 5%.
+  return std::abs(edge_factor - 1) > 0.05 || std::abs(plane_factor - 1) > 0.05;
+}
+
+void PlaneAlignmentSolver::SetVarianceFactors(double plane_variance_factor,
+                                              double edge_variance_factor) {
+  CALIBENCH_CHECK(plane_variance_factor > 0 && edge_variance_factor > 0);
+  plane_variance_scale_ = plane_variance_factor;
+  edge_variance_scale_ = edge_variance_factor;
+}
+
+SolverResult PlaneAlignmentSolver::Run(
+    const std::function<void(const IterationReport&)>& on_iteration) {
+  if (on_iteration && history_.size() == 1) on_iteration(history_.front());
+  while (Step()) {
+    if (on_iteration) on_iteration(history_.back());
+  }
+  if (on_iteration && history_.size() > 1) on_iteration(history_.back());
+  return Summarize();
+}
+
+Mat6 WeightedPlaneInformation(const std::vector<PlanePair>& pairs, const Pose& cam_from_lidar) {
+  Mat6 information = Mat6::Zero();
+  for (const PlanePair& pair : pairs) {
+    const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar, pair);
+    information += w.jacobian.transpose() * w.covariance.inverse() * w.jacobian;
+  }
+  return information;
+}
+
+SolverResult PlaneAlignmentSolver::Summarize() const {
+  SolverResult result;
+  result.method = options_.method;
+  result.cam_from_lidar = cam_from_lidar_;
+  result.converged = converged_;
+  result.iterations = static_cast<int>(history_.size()) - 1;
+  for (const IterationReport& it : history_) result.cost_history.push_back(it.cost);
+  const bool weighted = options_.method == SolverMethod::kWeightedMl;
+  for (const PlanePair& pair : pairs_)
+    result.residuals.push_back(PlaneAlignmentResidual(
+        cam_from_lidar_, CorrectedLidarPlane(pair, range_offset_m_), pair.camera_plane, nullptr));
+  const Linearization lin = LinearizeHere();
+  // As the solver weighed them: with the planes' variance component, 0 for gated pairs.
+  result.robust_weights = lin.pair_weights;
+  // The inverse information scaled by the a-posteriori variance factor: for the paper's residual,
+  // which has no noise model, that is the noise estimate itself (4 residuals per pair); for the
+  // weighted residual (3 per pair) it absorbs what the feature covariances miss on real sensors.
+  const std::vector<int> active = ActiveParameters();
+  const int num_parameters = static_cast<int>(active.size());
+  const int redundancy = lin.num_residuals - lin.num_edge_dilations - num_parameters;
+  result.num_edge_residuals = lin.num_edge_residuals;
+  if (!lin.pair_dilations_m.empty()) {
+    const int n = static_cast<int>(lin.pair_dilations_m.size());
+    EdgeDilationEstimate dilation;
+    for (double d : lin.pair_dilations_m) dilation.value_m += d / n;
+    for (double d : lin.pair_dilations_m)
+      dilation.spread_m += (d - dilation.value_m) * (d - dilation.value_m);
+    dilation.spread_m = n > 1 ? std::sqrt(dilation.spread_m / (n - 1)) : 0.0;
+    dilation.sigma_m = dilation.spread_m / std::sqrt(n);
+    result.edge_dilation = dilation;
+  }
+  const double variance_factor = redundancy > 0 ? lin.weighted_squared_error / redundancy : 0.0;
+  // The a-posteriori variance factor of each kind of residual against its noise model: the
+  // component estimated for it times the common factor that remains.
+  result.plane_variance_factor = plane_variance_scale_ * variance_factor;
+  result.edge_variance_factor = edge_variance_scale_ * variance_factor;
+  // With the offset estimated, the pose covariance is the marginal of the joint one: the offset's
+  // uncertainty spreads into the translation it is correlated with.
+  const Eigen::MatrixXd information = lin.information(active, active);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(information);
+  Eigen::VectorXd inverse_eigenvalues(num_parameters);
+  const double largest = eigen.eigenvalues()[num_parameters - 1];
+  for (int i = 0; i < num_parameters; ++i) {
+    const double lambda = eigen.eigenvalues()[i];
+    inverse_eigenvalues[i] = lambda > 1e-12 * largest ? 1.0 / lambda : 1e12;
+  }
+  Mat7 covariance = Mat7::Zero();
+  const Eigen::MatrixXd model_covariance = variance_factor * eigen.eigenvectors() *
+                                           inverse_eigenvalues.asDiagonal() *
+                                           eigen.eigenvectors().transpose();
+  covariance(active, active) = model_covariance;
+  // The model's covariance trusts every residual to be independent. On real sensors they are
+  // not (a pair's edge points share its range-dependent beam footprint, its board's flatness,
+  // its rings' angle errors), which the model cannot see and the spread over pairs shows. The
+  // cluster-robust (sandwich) covariance with the pairs as clusters, H⁻¹ (Σᵢ gᵢgᵢᵀ) H⁻¹ scaled by
+  // n/(n − p), measures that spread from the data; the reported covariance is the larger of the
+  // two in every direction (beyond the sandwich's own sampling noise).
+  const int clusters = static_cast<int>(lin.pair_gradients.size());
+  if (weighted && options_.sandwich_covariance && clusters > num_parameters + 2 &&
+      variance_factor > 0 && eigen.eigenvalues()[0] > 1e-12 * largest) {
+    Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
+    for (const Vec7& g : lin.pair_gradients) {
+      const Eigen::VectorXd active_g = g(active);
+      meat += active_g * active_g.transpose();
+    }
+    const Eigen::MatrixXd inverse_information = model_covariance / variance_factor;
+    const Eigen::MatrixXd sandwich = static_cast<double>(clusters) / (clusters - num_parameters) *
+                                     inverse_information * meat * inverse_information;
+    // sandwich v = λ model v with vᵀ model v = 1: in the basis V, model = V⁻ᵀV⁻¹ and
+    // sandwich = V⁻ᵀΛV⁻¹, so V⁻ᵀ max(Λ, 1) V⁻¹ is the larger of the two along every direction.
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> generalized(sandwich,
+                                                                          model_covariance);
+    if (generalized.info() == Eigen::Success) {
+      // A variance ratio estimated from n clusters scatters by about √(2 / (n − p)) even when the
+      // model holds: only the excess beyond that one-σ noise inflates, so that a correct model
+      // keeps its covariance (and its χ² calibration) while a violated one widens.
+      const double noise = 1.0 + std::sqrt(2.0 / (clusters - num_parameters));
+      const Eigen::MatrixXd to_basis = generalized.eigenvectors().inverse();
+      const Eigen::VectorXd inflation = (generalized.eigenvalues() / noise).cwiseMax(1.0);
+      covariance(active, active) = to_basis.transpose() * inflation.asDiagonal() * to_basis;
+      result.covariance_inflation = inflation.maxCoeff();
+    }
+  }
+  result.covariance = covariance.topLeftCorner<6, 6>();
+  // The offset's correlation with the camera-frame translation R ρ (right perturbation).
+  auto correlation_with_translation = [&](const Mat7& joint_covariance) {
+    const Mat3& rotation = cam_from_lidar_.linear();
+    const Mat3 translation_covariance =
+        rotation * joint_covariance.topLeftCorner<3, 3>() * rotation.transpose();
+    const Vec3 cross = rotation * joint_covariance.block<3, 1>(0, kRangeOffset);
+    const double offset_sigma =
+        std::sqrt(std::max(0.0, joint_covariance(kRangeOffset, kRangeOffset)));
+    Vec3 correlation = Vec3::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const double denominator = std::sqrt(translation_covariance(k, k)) * offset_sigma;
+      correlation[k] = denominator > 0 ? cross[k] / denominator : 0.0;
+    }
+    return correlation;
+  };
+  if (options_.estimate_range_offset) {
+    RangeOffsetEstimate offset;
+    offset.value_m = range_offset_m_;
+    offset.sigma_m = std::sqrt(std::max(0.0, covariance(kRangeOffset, kRangeOffset)));
+    offset.correlation_with_translation = correlation_with_translation(covariance);
+    offset.well_determined = offset.sigma_m < options_.range_offset_max_sigma_m;
+    result.range_offset = offset;
+  } else if (weighted && variance_factor > 0 && lin.information(kRangeOffset, kRangeOffset) > 0) {
+    // Score test for the offset left out: one Gauss-Newton step in the joint parameters from
+    // the solution. The pose's gradient is zero there, so the step is the offset's own, less what
+    // the pose would absorb; its variance is the joint one's, like the pose's no smaller than the
+    // pairs' spread says (sandwich).
+    const Eigen::LDLT<Mat7> joint(lin.information);
+    const Mat7 joint_inverse = joint.solve(Mat7::Identity());
+    const Vec7 step = -joint_inverse * lin.gradient;
+    double variance = variance_factor * joint_inverse(kRangeOffset, kRangeOffset);
+    if (options_.sandwich_covariance && clusters > kNumParameters + 2) {
+      double meat = 0.0;
+      for (const Vec7& g : lin.pair_gradients)
+        meat += std::pow(joint_inverse.row(kRangeOffset).dot(g), 2);
+      variance =
+          std::max(variance, static_cast<double>(clusters) / (clusters - kNumParameters) * meat);
+    }
+    const double sigma = std::sqrt(variance);
+    if (joint.info() == Eigen::Success && std::isfinite(step[kRangeOffset]) && sigma > 0 &&
+        sigma < options_.range_offset_max_sigma_m &&
+        std::abs(step[kRangeOffset]) > options_.range_offset_significance * sigma) {
+      RangeOffsetEstimate offset;
+      offset.value_m = range_offset_m_ + step[kRangeOffset];
+      offset.sigma_m = sigma;
+      offset.correlation_with_translation =
+          correlation_with_translation(variance_factor * joint_inverse);
+      offset.well_determined = true;
+      result.unmodelled_range_offset = offset;
+    }
+  }
+  // Observability is a property of the geometry, not of the noise: judge it on the unweighted
+  // plane-to-plane information (Eq. (6) Jacobians, unit weights), whose eigenvalues compare like
+  // with like for either method; whitened information mixes 1/m² and 1/rad² scales.
+  Mat6 geometric_information = Mat6::Zero();
+  Eigen::Matrix<double, 4, 6> jacobian;
+  for (const PlanePair& pair : pairs_) {
+    PlaneAlignmentResidual(cam_from_lidar_, pair.lidar_plane, pair.camera_plane, &jacobian);
+    geometric_information += jacobian.transpose() * jacobian;
+  }
+  result.observability =
+      AnalyseObservability(geometric_information, cam_from_lidar_, options_.weak_eigenvalue_ratio);
+  if (result.range_offset && !result.range_offset->well_determined) {
+    const RangeOffsetEstimate& offset = *result.range_offset;
+    int axis = 0;
+    offset.correlation_with_translation.cwiseAbs().maxCoeff(&axis);
+    static const char* kAxisNames[3] = {"x", "y", "z"};
+    char text[200];
+    std::snprintf(text, sizeof(text),
+                  "LiDAR range offset: %+.1f ± %.1f mm, correlation %.2f with the translation "
+                  "along camera %s (boards over a wider range of distances, angles and "
+                  "directions from the LiDAR separate them)",
+                  offset.value_m * 1e3, offset.sigma_m * 1e3,
+                  offset.correlation_with_translation[axis], kAxisNames[axis]);
+    result.observability.weak_directions.push_back(text);
+    result.observability.well_constrained = false;
+  }
+  if (redundancy <= 0) {
+    result.observability.well_constrained = false;
+    result.observability.weak_directions.push_back(
+        "fewer than 2 redundant residuals: at least 2 pairs are needed, 3 for all six degrees of "
+        "freedom");
+  }
+  return result;
+}
+
+}  // namespace calibench

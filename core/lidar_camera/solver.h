@@ -1,0 +1,225 @@
+// Extrinsic from plane correspondences: the closed-form initial guess and Ca²Lib's joint
+// Gauss-Newton on SE(3) with a Huber kernel (Eq. (13)–(14)), as a steppable object so that a GUI
+// can show every iteration.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/estimation/uncertainty.h"
+#include "core/geometry/geometry.h"
+#include "core/target/board_edges.h"
+
+namespace calibench {
+
+// One accepted pair: the board plane seen by both sensors.
+struct PlanePair {
+  std::string id;
+  Plane lidar_plane;   // LiDAR frame, normal towards the LiDAR (d > 0)
+  Plane camera_plane;  // camera frame, normal towards the camera (d > 0)
+  // Covariances of (n, d) (rank 3). Used by the weighted method; zero = unknown.
+  Mat4 lidar_covariance = Mat4::Zero();
+  Mat4 camera_covariance = Mat4::Zero();
+  // d(n, d)/db of the LiDAR plane for a range offset b (LidarPlaneFit::range_offset_jacobian);
+  // zero = unknown (the pair then says nothing about b).
+  Vec4 lidar_range_offset_jacobian = Vec4::Zero();
+  // Board-edge constraint (SolverOptions::use_board_edges): the rings' crossings of the sheet's
+  // edge (LiDAR frame), the camera's board pose and the sheet's half size; zero size = none.
+  std::vector<LidarEdgePoint> lidar_edges = {};
+  Pose camera_from_board = Pose::Identity();
+  Vec2 sheet_half_size_m = Vec2::Zero();
+};
+
+enum class SolverMethod {
+  kCa2libGn,    // the paper: unweighted plane-to-plane error, Eq. (6), Huber on |e|
+  kWeightedMl,  // residuals whitened by both planes' covariances, Huber on the Mahalanobis norm
+  kKim,         // Kim et al. 2020, the paper's baseline: InitialGuessFromPlanes, no refinement
+};
+std::string SolverMethodName(SolverMethod method);  // "ca2lib-gn", "weighted-ml", "kim"
+std::optional<SolverMethod> ParseSolverMethod(const std::string& name);
+
+struct SolverOptions {
+  SolverMethod method = SolverMethod::kWeightedMl;
+  double huber_delta = 0.1;  // Huber threshold on |e_p| (Eq. (6) mixes unitless and metres)
+  // kWeightedMl: Huber threshold on the whitened residual, in standard deviations.
+  double whitened_huber_delta = 3.0;
+  // kWeightedMl: once converged, the worst pair whose Mahalanobis residual exceeds outlier_gate
+  // robust scales is given weight 0 and the solve continues (up to three rounds; a gated pair
+  // whose residual falls back inside the gate returns). The robust scale is the median
+  // Mahalanobis norm over its χ(3) expectation (1.54), at least 1: on real sensors, whose plane
+  // residuals exceed the propagated noise, the gate widens with them. 0 = no gating.
+  double outlier_gate = 4.0;
+  // kWeightedMl: also estimate a LiDAR range offset b (metres; measured range = true range + b),
+  // a constant error of the sensor's range calibration, from how each pair's plane moves with it.
+  bool estimate_range_offset = false;
+  // kWeightedMl: each ring's crossing of the sheet's edge must lie on the edge the camera sees
+  // (pairs with a known sheet size), whitened by the crossing's uncertainty along the ring and
+  // edge_floor_sigma_m (cut accuracy, beam width), with the Huber kernel of the planes.
+  bool use_board_edges = true;
+  double edge_floor_sigma_m = 0.003;
+  // With board edges: also estimate, per pair, how much larger than the sheet the LiDAR sees it
+  // (metres per side). A beam whose footprint only partly covers the board still returns the
+  // board's range, so a real sensor's ring ends reach past the edge by about half the footprint,
+  // which grows with the range (7 mm on average for the VLP-16 in acfr-vlp16-chessboard);
+  // unmodelled, it pushes every edge point outwards. Each pair's dilation is eliminated in closed
+  // form (variable projection), so it costs one edge residual per pair.
+  bool estimate_edge_dilation = true;
+  // kWeightedMl: report the larger of the model's covariance and the pairs' cluster-robust
+  // (sandwich) covariance along every direction (see SolverResult::covariance_inflation).
+  bool sandwich_covariance = true;
+  // Above this standard deviation (metres) the offset is reported as not determined by the data
+  // (a weak direction).
+  double range_offset_max_sigma_m = 0.01;
+  // kWeightedMl without estimate_range_offset: a score test at the solution asks whether the data
+  // shows a range offset all the same; one beyond this many standard deviations (and determined
+  // within range_offset_max_sigma_m) is reported (SolverResult::unmodelled_range_offset).
+  double range_offset_significance = 3.0;
+  int max_iterations = 50;       // Gauss-Newton iterations
+  double step_tolerance = 1e-9;  // stop when |delta| (m, rad) falls below this
+  // A direction of the information matrix whose eigenvalue is below this fraction of the largest
+  // is reported weak (about 2 degrees of spread of the board normals around it).
+  double weak_eigenvalue_ratio = 1e-3;
+  bool Check(std::string* why) const;
+};
+
+// The estimated LiDAR range offset with what the data says about it: its standard deviation and
+// its correlation with the camera-frame translation (b and the translation both move the planes'
+// distances; boards at one distance and angle cannot tell them apart).
+struct RangeOffsetEstimate {
+  double value_m = 0.0;
+  double sigma_m = 0.0;
+  Vec3 correlation_with_translation = Vec3::Zero();  // camera x, y, z
+  // sigma below SolverOptions::range_offset_max_sigma_m. A high correlation alone is no failure:
+  // it shows in the translation's (marginal) standard deviation.
+  bool well_determined = false;
+  bool operator==(const RangeOffsetEstimate&) const = default;
+};
+
+// How much larger than the sheet the LiDAR sees it, per side (SolverOptions::
+// estimate_edge_dilation): the mean over the pairs, its standard error and the pairs' spread.
+struct EdgeDilationEstimate {
+  double value_m = 0.0;
+  double sigma_m = 0.0;
+  double spread_m = 0.0;
+  bool operator==(const EdgeDilationEstimate&) const = default;
+};
+
+struct SolverResult {
+  SolverMethod method = SolverMethod::kWeightedMl;  // the method that produced it
+  Pose cam_from_lidar = Pose::Identity();
+  Mat6 covariance = Mat6::Zero();  // right perturbation of cam_from_lidar, [rho; phi]
+  bool converged = false;
+  int iterations = 0;
+  std::vector<double> cost_history;    // one entry per iteration, the initial cost first
+  std::vector<Vec4> residuals;         // per pair, Eq. (6) at the solution
+  std::vector<double> robust_weights;  // per pair, Huber IRLS weight at the solution (0 = gated)
+  ObservabilityReport observability;
+  std::optional<RangeOffsetEstimate> range_offset;  // SolverOptions::estimate_range_offset
+  // Not estimated, yet significant in the data (SolverOptions::range_offset_significance): the
+  // offset one Gauss-Newton step from the solution would estimate, with its standard deviation.
+  // The pose above does not include it; estimating it would move the pose.
+  std::optional<RangeOffsetEstimate> unmodelled_range_offset;
+  int num_edge_residuals = 0;                         // board-edge points used (use_board_edges)
+  std::optional<EdgeDilationEstimate> edge_dilation;  // estimate_edge_dilation, with edges
+  // A-posteriori variance factors of the planes' and the edges' residuals (kWeightedMl; 1 = their
+  // noise models held; for ca2lib-gn the planes' noise variance itself).
+  double plane_variance_factor = 1.0;
+  double edge_variance_factor = 1.0;
+  // How much the pairs' spread widened the model's covariance (the largest variance ratio, ≥ 1;
+  // SolverOptions::sandwich_covariance). Near 1: the noise models hold.
+  double covariance_inflation = 1.0;
+};
+
+// Closed form from the planes alone: rotation aligning the normals (Kabsch/SVD), then the
+// translation from n_c·t = d_l − d_c by least squares (minimum-norm along unobservable
+// directions). nullopt with *why when fewer than two pairs or all normals parallel.
+std::optional<Pose> InitialGuessFromPlanes(const std::vector<PlanePair>& pairs, std::string* why);
+
+// Σ Jᵢᵀ Sᵢ⁻¹ Jᵢ of the weighted residual (SolverMethod::kWeightedMl) at cam_from_lidar, with each
+// pair's own covariances, no robust weights and no variance factor. With noise-free planes and the
+// features' Cramér–Rao covariances this is the Fisher information of the extrinsic.
+Mat6 WeightedPlaneInformation(const std::vector<PlanePair>& pairs, const Pose& cam_from_lidar);
+
+// Eq. (14) solved by Gauss-Newton with iteratively reweighted Huber weights.
+class PlaneAlignmentSolver {
+ public:
+  // initial_range_offset_m: where the range offset starts (SolverOptions::estimate_range_offset),
+  // or its fixed value otherwise.
+  PlaneAlignmentSolver(std::vector<PlanePair> pairs, const SolverOptions& options,
+                       const Pose& initial_cam_from_lidar, double initial_range_offset_m = 0.0);
+
+  // One Gauss-Newton iteration; false once converged or out of iterations.
+  bool Step();
+  bool Done() const { return done_; }
+  const Pose& Estimate() const { return cam_from_lidar_; }
+  double RangeOffset() const { return range_offset_m_; }
+  const std::vector<IterationReport>& History() const { return history_; }
+
+  // Iterates to the end, calling on_iteration after each step (and once for the start).
+  SolverResult Run(const std::function<void(const IterationReport&)>& on_iteration = {});
+  // Covariance, residuals, weights and observability at the current estimate.
+  SolverResult Summarize() const;
+  // Starts from known variance factors of the planes and the edges (a finished solve's
+  // SolverResult::plane_variance_factor / edge_variance_factor), so that Summarize at its
+  // estimate weighs the residuals as that solve did.
+  void SetVarianceFactors(double plane_variance_factor, double edge_variance_factor);
+
+ private:
+  // Parameters [rho; phi; b]: the pose's right perturbation and the range offset. The offset's
+  // row and column are always filled (kWeightedMl), so that an offset left out can be tested;
+  // it moves only when estimated.
+  static constexpr int kNumParameters = 7;
+  static constexpr int kRangeOffset = 6;
+  using Mat7 = Eigen::Matrix<double, kNumParameters, kNumParameters>;
+  using Vec7 = Eigen::Matrix<double, kNumParameters, 1>;
+  struct Linearization {
+    Mat7 information = Mat7::Zero();  // JᵀWJ
+    Vec7 gradient = Vec7::Zero();     // JᵀWe
+    double cost = 0.0;
+    double weighted_squared_error = 0.0;
+    int num_residuals = 0;  // scalar residuals (3 per weighted pair, 4 per paper pair, 1 per edge)
+    int num_edge_residuals = 0;
+    int num_edge_dilations = 0;  // pairs whose edge dilation was eliminated (one residual each)
+    std::vector<double> pair_dilations_m;  // those pairs' dilations
+    Mat7 edge_information = Mat7::Zero();  // the edges' part of `information`
+    std::vector<Vec7> pair_gradients;      // kWeightedMl: each used pair's share of `gradient`
+    std::vector<double> pair_weights;      // per pair, its planes' robust weight (0 = gated)
+    double edge_weighted_squared_error = 0.0;
+  };
+  Linearization Linearize(const Pose& cam_from_lidar, double range_offset_m) const;
+  Linearization LinearizeHere() const { return Linearize(cam_from_lidar_, range_offset_m_); }
+  // Indices of the estimated parameters: the pose's six, then b when estimated.
+  std::vector<int> ActiveParameters() const;
+  // Adds one pair's board-edge residuals to `lin`.
+  void LinearizeEdges(const Pose& cam_from_lidar, double range_offset_m, const PlanePair& pair,
+                      Linearization* lin) const;
+  double HuberDelta() const;  // huber_delta or whitened_huber_delta, by method
+  double RobustWeight(double error_norm) const;
+  double RobustCost(double error_norm) const;
+
+  // One round of outlier gating (SolverOptions::outlier_gate); true when the gated set changed.
+  bool GateOutliers();
+  // One round of variance component estimation for planes and edges; true when the weights
+  // changed enough to solve again.
+  bool EstimateVarianceComponents();
+
+  std::vector<PlanePair> pairs_;
+  std::vector<char> gated_;  // per pair: dropped as an outlier
+  int gating_rounds_ = 0;
+  int iteration_budget_ = 0;  // history size at which Step stops
+  SolverOptions options_;
+  Pose cam_from_lidar_;
+  double range_offset_m_ = 0.0;
+  // Variance components (EstimateVarianceComponents): the planes' covariances and the edges'
+  // variances are multiplied by these.
+  double plane_variance_scale_ = 1.0;
+  double edge_variance_scale_ = 1.0;
+  int variance_component_rounds_ = 0;
+  std::vector<IterationReport> history_;
+  bool done_ = false;
+  bool converged_ = false;
+};
+
+}  // namespace calibench

@@ -1,0 +1,28 @@
+// The calibench.result.v1 file (DESIGN.md "Result") of both methods: what every result holds in
+// the same form (both directions of the transform, covariance, standard deviations,
+// observability, one entry per pair), and its reader. Each method adds its own solver figures
+// (core/lidar_camera/result_io.h, core/lrf/result_io.h).
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "core/base/types.h"
+
+namespace calibench {
+
+// The transform's frames: <target>_from_<source>.
+struct ResultNames {
+  std::string target = "cam";    // cam_from_<source>
+  std::string source = "lidar";  // "lidar" or "lrf"
+};
+
+struct LoadedResult {
+  Pose cam_from_source = Pose::Identity();  // cam_from_lidar (or cam_from_lrf)
+  Mat6 covariance = Mat6::Zero();
+  bool well_constrained = false;
+};
+// Reads cam_from_lidar (or cam_from_lrf) and the covariance. Throws IoError naming the file.
+LoadedResult LoadResult(const std::filesystem::path& path);
+
+}  // namespace calibench

@@ -1,0 +1,160 @@
+// Session data helpers, file load/save, undo/redo history and the autosaver. The JSON form is in
+// session_json.cpp.
+#include "core/session/session.h"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+#include <utility>
+
+#include "core/base/atomic_file.h"
+
+namespace calibench {
+
+bool BrushFitsImage(const BrushMask& mask, int rows, int columns, std::string* why) {
+  if (mask.rows == rows && mask.columns == columns) return true;
+  if (why)
+    *why = "the brush mask was painted on a " + std::to_string(mask.rows) + "x" +
+           std::to_string(mask.columns) + " LiDAR image, but this cloud gives " +
+           std::to_string(rows) + "x" + std::to_string(columns) + "; paint the board again";
+  return false;
+}
+
+bool SessionResult::operator==(const SessionResult& other) const {
+  return cam_from_lidar.matrix() == other.cam_from_lidar.matrix() &&
+         covariance == other.covariance && iterations == other.iterations &&
+         converged == other.converged && cost_history == other.cost_history &&
+         weak_directions == other.weak_directions && well_constrained == other.well_constrained &&
+         step_history == other.step_history && range_offset == other.range_offset &&
+         unmodelled_range_offset == other.unmodelled_range_offset &&
+         num_edge_residuals == other.num_edge_residuals && edge_dilation == other.edge_dilation &&
+         covariance_inflation == other.covariance_inflation &&
+         plane_variance_factor == other.plane_variance_factor &&
+         edge_variance_factor == other.edge_variance_factor &&
+         std::equal(estimate_history.begin(), estimate_history.end(),
+                    other.estimate_history.begin(), other.estimate_history.end(),
+                    [](const Pose& a, const Pose& b) { return a.matrix() == b.matrix(); });
+}
+
+SessionResult SessionResultFromSolver(const SolverResult& solver) {
+  return {solver.cam_from_lidar,
+          solver.covariance,
+          solver.iterations,
+          solver.converged,
+          solver.cost_history,
+          solver.observability.weak_directions,
+          solver.observability.well_constrained,
+          {},
+          {},
+          solver.range_offset,
+          solver.unmodelled_range_offset,
+          solver.num_edge_residuals,
+          solver.edge_dilation,
+          solver.covariance_inflation,
+          solver.plane_variance_factor,
+          solver.edge_variance_factor};
+}
+
+SolverResult SolverResultFromSession(const SessionResult& session, SolverMethod method) {
+  SolverResult r;
+  r.method = method;
+  r.cam_from_lidar = session.cam_from_lidar;
+  r.covariance = session.covariance;
+  r.iterations = session.iterations;
+  r.converged = session.converged;
+  r.cost_history = session.cost_history;
+  r.observability.weak_directions = session.weak_directions;
+  r.observability.well_constrained = session.well_constrained;
+  r.range_offset = session.range_offset;
+  r.unmodelled_range_offset = session.unmodelled_range_offset;
+  r.num_edge_residuals = session.num_edge_residuals;
+  r.edge_dilation = session.edge_dilation;
+  r.covariance_inflation = session.covariance_inflation;
+  r.plane_variance_factor = session.plane_variance_factor;
+  r.edge_variance_factor = session.edge_variance_factor;
+  return r;
+}
+
+std::filesystem::path NormalizeSessionPath(const std::filesystem::path& path) {
+  std::filesystem::path p = std::filesystem::absolute(path).lexically_normal();
+  // Without a trailing separator, so that "a/b/." and "a/b" compare equal.
+  if (!p.has_filename() && p != p.root_path()) p = p.parent_path();
+  return p;
+}
+
+Session NewSession(const Dataset& dataset) {
+  Session session;
+  session.dataset = NormalizeSessionPath(dataset.manifest);
+  for (const PairEntry& entry : dataset.pairs) {
+    PairState pair;
+    pair.id = entry.id;
+    session.pairs.push_back(pair);
+  }
+  if (!session.pairs.empty()) session.view.selected_pair = session.pairs.front().id;
+  return session;
+}
+
+void ApplySessionOptions(const Session& session, PipelineOptions* options) {
+  options->solver.method = session.method;
+  options->solver.huber_delta = session.huber_delta;
+  options->solver.max_iterations = session.max_iterations;
+  options->lidar_plane.ransac_threshold_m = session.ransac_threshold_m;
+}
+
+Session LoadSession(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path.string() + ": cannot open session file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw IoError(path.string() + ": read failed");
+  return SessionFromJson(text.str(), path);
+}
+
+void SaveSession(const std::filesystem::path& path, const Session& session) {
+  WriteFileAtomically(path, SessionToJson(session, path));
+}
+
+SessionHistory::SessionHistory(std::size_t max_depth) : max_depth_(max_depth) {
+  CALIBENCH_CHECK(max_depth >= 1);
+}
+
+void SessionHistory::Reset(const Session& state) {
+  states_.assign(1, state);
+  cursor_ = 0;
+}
+
+void SessionHistory::Push(const Session& state) {
+  if (states_.empty()) return Reset(state);
+  if (state == states_[cursor_]) return;
+  states_.erase(states_.begin() + static_cast<std::ptrdiff_t>(cursor_) + 1, states_.end());
+  states_.push_back(state);
+  ++cursor_;
+  if (states_.size() > max_depth_ + 1) {
+    states_.pop_front();
+    --cursor_;
+  }
+}
+
+std::optional<Session> SessionHistory::Undo() {
+  if (!CanUndo()) return std::nullopt;
+  return states_[--cursor_];
+}
+
+std::optional<Session> SessionHistory::Redo() {
+  if (!CanRedo()) return std::nullopt;
+  return states_[++cursor_];
+}
+
+Autosaver::Autosaver(std::filesystem::path path) : path_(std::move(path)) {}
+
+bool Autosaver::Save(const Session& session) {
+  std::string text = SessionToJson(session, path_);
+  if (has_written_ && text == last_text_) return false;
+  WriteFileAtomically(path_, text);
+  last_text_ = std::move(text);
+  has_written_ = true;
+  ++writes_;
+  return true;
+}
+
+}  // namespace calibench

@@ -1,0 +1,193 @@
+// The workbench's editable state as plain data and a file (calibench.session.v1): per-pair
+// status and brush masks, solver options, what the views showed, and the last solve; undo/redo
+// history and an autosaver. Reopening a saved session restores exactly what was on screen.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <deque>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/base/types.h"
+#include "core/io/dataset.h"
+#include "core/lidar/colormap.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/solver.h"
+
+namespace calibench {
+
+// The board region the user brushed on one pair's LiDAR image (projection by ID, lidar_image.h).
+struct BrushMask {
+  // Layout of the LiDAR image it was painted on (rings x azimuth bins). A mask only applies to
+  // an image of the same layout; BrushFitsImage says why not.
+  int rows = 0;
+  int columns = 0;
+  std::vector<int> pixels;  // sorted, unique pixel indices row * columns + col
+
+  bool operator==(const BrushMask&) const = default;
+};
+
+// False (with *why naming both layouts) when the mask was painted on another image layout.
+bool BrushFitsImage(const BrushMask& mask, int rows, int columns, std::string* why);
+
+struct PairState {
+  std::string id;  // the dataset's pair id
+  PairStatus status = PairStatus::kPending;
+  std::string reason;  // why rejected / failed, human-readable; empty otherwise
+  std::optional<BrushMask> brush;
+  bool brush_from_seed = false;  // brush generated from the manifest's lidar_seed, not painted
+
+  bool operator==(const PairState&) const = default;
+};
+
+enum class CameraImageMode { kRaw, kUndistorted };
+// How LiDAR points hidden from the camera are removed in the camera view.
+enum class VisibilityMode { kHpr, kZBuffer, kNone };
+
+// What the three views showed. Angles radians, distances metres, sizes pixels.
+struct ViewState {
+  std::string selected_pair;  // pair id; empty = none selected
+  LidarChannel lidar_channel = LidarChannel::kIntensity;
+  CameraImageMode camera_image = CameraImageMode::kUndistorted;
+  VisibilityMode visibility = VisibilityMode::kHpr;
+  double hpr_radius_exponent = 2.5;  // Katz R = max_dist * 10^x; HprOptions' default
+  double point_size_px = 2.0;        // rendered point diameter, pixels
+  double point_opacity = 1.0;        // [0, 1]
+  // 3D view: orbit camera about `orbit_target` (LiDAR frame, metres).
+  double orbit_yaw_rad = 0.0;     // about the LiDAR z axis, 0 = looking along +x
+  double orbit_pitch_rad = 0.35;  // elevation above the xy plane (about 20 degrees)
+  double orbit_distance_m = 5.0;  // close enough to see the boards and both sensor frames
+  std::array<double, 3> orbit_target = {1.5, 0.0, 0.0};  // in front of the LiDAR
+  double brush_radius_px = 6.0;                          // circle brush on the LiDAR image, pixels
+
+  bool operator==(const ViewState&) const = default;
+};
+
+// "intensity" / "range" / "ring", "raw" / "undistorted", "hpr" / "zbuffer" / "none".
+std::string LidarChannelName(LidarChannel channel);
+std::string CameraImageModeName(CameraImageMode mode);
+std::string VisibilityModeName(VisibilityMode mode);
+
+// The part of a SolverResult the session keeps. Per-pair residuals and weights are not kept: they
+// follow from the pairs' planes at cam_from_lidar.
+struct SessionResult {
+  Pose cam_from_lidar = Pose::Identity();  // x_in_cam = cam_from_lidar * x_in_lidar
+  Mat6 covariance = Mat6::Zero();          // right perturbation, [rho (m); phi (rad)]
+  int iterations = 0;
+  bool converged = false;
+  std::vector<double> cost_history;  // Eq. (14) cost per iteration, the initial cost first
+  std::vector<std::string> weak_directions;
+  bool well_constrained = false;
+  // Per iteration (same length as cost_history when recorded): |delta| and the estimate, so that
+  // a reopened session shows and replays the same convergence. May be empty.
+  std::vector<double> step_history;
+  std::vector<Pose> estimate_history;
+  // What the solve said beyond the pose (optional in the file): the range offset when estimated,
+  // the board edges used, the edge dilation and how far the pairs' spread widened the covariance.
+  std::optional<RangeOffsetEstimate> range_offset;
+  std::optional<RangeOffsetEstimate> unmodelled_range_offset;  // SolverResult's
+  int num_edge_residuals = 0;
+  std::optional<EdgeDilationEstimate> edge_dilation;
+  double covariance_inflation = 1.0;
+  double plane_variance_factor = 1.0;
+  double edge_variance_factor = 1.0;
+
+  // Exact value comparison (no tolerance), so a file round trip can be checked with ==.
+  bool operator==(const SessionResult& other) const;
+};
+SessionResult SessionResultFromSolver(const SolverResult& solver);
+// The reverse, for a reopened session: what the file keeps of a solve (no per-pair residuals,
+// no observability eigenvalues); `method` is the session's solver method.
+SolverResult SolverResultFromSession(const SessionResult& session, SolverMethod method);
+
+struct Session {
+  int version = 1;  // of the file format; this build reads and writes 1
+  // The manifest (or shorthand folder); absolute and lexically normal in memory.
+  std::filesystem::path dataset;
+  std::vector<PairState> pairs;                      // in the dataset's order
+  SolverMethod method = SolverOptions{}.method;      // solver (see SolverOptions)
+  double huber_delta = SolverOptions{}.huber_delta;  // Huber threshold (see SolverOptions)
+  bool estimate_range_offset = false;  // weighted-ml: LiDAR range offset (see SolverOptions)
+  int max_iterations = SolverOptions{}.max_iterations;                 // Gauss-Newton iterations
+  double ransac_threshold_m = LidarPlaneOptions{}.ransac_threshold_m;  // LiDAR plane inliers
+  ViewState view;
+  std::optional<SessionResult> result;  // the last solve, if any
+
+  bool operator==(const Session&) const = default;
+};
+
+// The form Session::dataset is kept in: absolute (against the working directory), lexically
+// normal, no trailing separator. Use it when setting Session::dataset from a user's path.
+std::filesystem::path NormalizeSessionPath(const std::filesystem::path& path);
+
+// One pending PairState per dataset pair, the first pair selected, default options.
+Session NewSession(const Dataset& dataset);
+
+// Copies the session's solver and RANSAC options into pipeline options.
+void ApplySessionOptions(const Session& session, PipelineOptions* options);
+
+// The session as JSON text for a file at session_path: the dataset path is written relative to
+// the session file's folder when it lies under it, absolute otherwise. Doubles round-trip
+// exactly; non-finite ones are written as the strings "nan", "inf", "-inf".
+// An empty session_path writes the dataset path absolute. Requires a non-empty session.dataset,
+// version 1, and brush masks whose pixels are sorted, unique and inside their image.
+std::string SessionToJson(const Session& session, const std::filesystem::path& session_path = {});
+
+// Parses session text read from source_path (named in errors; relative dataset paths resolve
+// against its folder). Throws IoError naming source_path and the problem for invalid JSON, a
+// wrong format or version, missing or mistyped fields, unknown status/mode names, duplicate
+// pair ids, or brush masks that are unsorted or outside their image.
+Session SessionFromJson(const std::string& text, const std::filesystem::path& source_path);
+
+// Reads a session file; never writes it. Throws IoError naming the file and the problem.
+Session LoadSession(const std::filesystem::path& path);
+
+// Writes atomically (temporary + rename); throws IoError naming the file.
+void SaveSession(const std::filesystem::path& path, const Session& session);
+
+// Undo/redo over whole session states. Push the state after every edit that should be
+// undoable; Undo/Redo return the state to restore (nullopt when there is none). The view is part
+// of each state: a caller that should not undo camera moves keeps its current view on restore.
+class SessionHistory {
+ public:
+  explicit SessionHistory(std::size_t max_depth = 100);  // undo steps kept, >= 1
+
+  // Forgets everything; `state` becomes the current state with nothing to undo.
+  void Reset(const Session& state);
+  // Records the state after an edit and drops the redo branch. A state equal to the current one
+  // is ignored (no empty undo steps). The first Push after construction acts as Reset.
+  void Push(const Session& state);
+  std::optional<Session> Undo();
+  std::optional<Session> Redo();
+  bool CanUndo() const { return cursor_ > 0; }
+  bool CanRedo() const { return cursor_ + 1 < states_.size(); }
+  std::size_t UndoDepth() const { return cursor_; }
+
+ private:
+  std::size_t max_depth_;
+  std::deque<Session> states_;  // oldest first; states_[cursor_] is the current state
+  std::size_t cursor_ = 0;
+};
+
+// Saves a session to one file whenever its text changed, so it can be called after every edit.
+class Autosaver {
+ public:
+  explicit Autosaver(std::filesystem::path path);
+
+  // Writes atomically unless the text equals the last one written; true when it wrote. Throws
+  // IoError naming the file; a failed write is retried on the next call.
+  bool Save(const Session& session);
+  const std::filesystem::path& path() const { return path_; }
+  int writes() const { return writes_; }  // files actually written
+
+ private:
+  std::filesystem::path path_;
+  std::string last_text_;
+  bool has_written_ = false;
+  int writes_ = 0;
+};
+
+}  // namespace calibench

@@ -1,0 +1,167 @@
+// Synthetic LiDAR + camera scenes with ground truth, written as real dataset files
+// (PCD clouds, PNG images, a calibench.dataset.v1 manifest). Deterministic for a seed.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/base/image.h"
+#include "core/base/types.h"
+#include "core/camera/camera.h"
+#include "core/io/dataset.h"
+#include "core/lidar/cloud.h"
+
+namespace calibench {
+
+enum class LidarModel { kHdl64, kVlp16, kOs0_128 };
+std::string LidarModelName(LidarModel model);  // "hdl64", "vlp16", "os0-128"
+std::optional<LidarModel> ParseLidarModelName(const std::string& name);
+
+// A spinning LiDAR's beam table: elevation per ring (radians, ring 0 = lowest) and azimuth bins.
+struct BeamTable {
+  std::vector<double> elevations_rad;
+  int azimuth_steps = 0;
+  double max_range_m = 100.0;
+};
+BeamTable MakeBeamTable(LidarModel model);
+
+struct SimOptions {
+  LidarModel lidar = LidarModel::kVlp16;
+  CameraModel camera;    // empty width = a default 1440x1080 pinhole-radtan (or fisheye)
+  bool fisheye = false;  // used only when `camera` is empty
+  BoardSpec board;       // cols == 0 = A3 checkerboard (7x5 inner corners, 40 mm squares)
+  int num_pairs = 20;
+  double min_distance_m = 1.5;  // board centre distance from the camera
+  double max_distance_m = 4.0;
+  double max_tilt_deg = 40.0;        // board normal vs. the camera viewing ray
+  double lidar_range_noise_m = 0.0;  // Gaussian, along each ray
+  // Constant error of the LiDAR's range calibration: measured range = true range + offset (m).
+  double lidar_range_offset_m = 0.0;
+  double image_noise = 0.0;  // Gaussian pixel noise, in [0,1] intensity units (Gazebo)
+  bool clutter = true;       // floor and walls
+  Pose cam_from_lidar = Pose::Identity();  // ground truth; Identity() = the default mount below
+  double seed_radius_m = 0.0;              // lidar_seed radius; 0 = 0.4 * the smaller board side
+  std::uint64_t seed = 1;
+
+  bool Check(std::string* why) const;
+};
+
+// The simulator's cameras, 1440x1080: pinhole rad-tan (fx = 1000 px) or Kannala-Brandt fisheye
+// (fx = 450 px).
+CameraModel DefaultSimCamera(bool fisheye);
+
+// The default mount: LiDAR x forward, z up; camera z forward, y down; camera 10 cm below and
+// 5 cm left of the LiDAR with a small rotation, so that the solver cannot get lucky with axes.
+Pose DefaultCamFromLidar();
+
+// Presets: "default" (VLP-16, pinhole, A3 checkerboard), "paper" (Ca²Lib Section 4.1:
+// HDL-64, 6x8-square checkerboard with 0.2 m squares, 1440x1080 camera), "demo" (OS0-128,
+// A3 checkerboard, 16 pairs at 1.2-3 m).
+// Throws std::invalid_argument naming the known presets for any other name.
+SimOptions SimPreset(const std::string& name);
+
+// The printed sheet as a reflectance map in the board frame (BoardSpec): 0 = black ink,
+// 1 = white paper. Checkerboards are analytic (top-left square black, like OpenCV's ChArUco);
+// ChArUco boards sample OpenCV 4.6's CharucoBoard::draw() texture (nearest texel, so that square
+// edges stay exact). Throws std::invalid_argument for an unknown ChArUco dictionary.
+class BoardPrint {
+ public:
+  explicit BoardPrint(const BoardSpec& board);
+  const BoardSpec& board() const { return board_; }
+  // Whether a board-frame point (metres, z = 0) lies on the sheet.
+  bool InSheet(const Vec2& xy) const {
+    return std::abs(xy.x()) <= half_sheet_.x() && std::abs(xy.y()) <= half_sheet_.y();
+  }
+  // Reflectance at a point of the sheet (board frame, metres); 1 on the white margin.
+  double Reflectance(const Vec2& xy) const;
+
+ private:
+  BoardSpec board_;
+  Vec2 half_sheet_;                    // metres
+  Vec2 half_pattern_;                  // metres
+  std::vector<std::uint8_t> texture_;  // ChArUco only: grey, row 0 at y = -pattern height / 2
+  int texture_width_ = 0;
+  int texture_height_ = 0;
+  double texels_per_metre_ = 0.0;
+};
+
+// What a simulated sweep can hit, in the LiDAR frame: one board and, with clutter, a floor and the
+// four walls of a square room centred on the LiDAR (walls and floor unbounded).
+struct LidarScene {
+  Pose lidar_from_board = Pose::Identity();
+  bool clutter = true;
+  double floor_z_m = -1.5;       // floor plane z = floor_z_m (metres, LiDAR frame)
+  double wall_distance_m = 6.0;  // walls at x = ±d and y = ±d (metres, LiDAR frame)
+};
+
+struct LidarScanOptions {
+  double range_noise_m = 0.0;       // Gaussian, along each ray (metres)
+  double range_offset_m = 0.0;      // added to every range (metres)
+  double azimuth_offset_rad = 0.0;  // azimuth of step 0 (the firing phase of this sweep)
+  std::uint64_t seed = 1;           // range and intensity noise
+};
+
+enum class SimSurface : std::uint8_t { kBoard, kFloor, kWall };
+
+// One sweep in double precision (the PCD file stores floats). Intensities: white paper ~200,
+// black ink ~20, walls ~90, floor ~60 (0..255, with small Gaussian noise).
+struct LidarScan {
+  std::vector<Vec3> points;         // metres, LiDAR frame
+  std::vector<float> intensity;     // 0..255
+  std::vector<int> ring;            // 0 = lowest beam
+  std::vector<SimSurface> surface;  // what each return hit
+
+  size_t size() const { return points.size(); }
+  // Unorganized cloud (height 1) with intensity and ring.
+  LidarCloud ToCloud() const;
+};
+
+// Casts every beam × azimuth step (firing order: azimuth outer, rings inner) and keeps the nearest
+// hit among the board sheet and, with clutter, the floor and walls; rays without a hit within
+// [0.3 m, max_range_m] give no point. Range noise moves each point along its ray.
+LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
+                            const LidarScene& scene, const LidarScanOptions& options);
+
+// The board poses SimulateDataset uses, pair by pair (camera frame, the print facing the camera).
+// Throws std::runtime_error when a pair cannot be placed under the options' constraints.
+std::vector<Pose> SampleBoardPoses(const SimOptions& options);
+
+// Rendering of one board into a camera image (used by the simulator and by the camera-side
+// bias tests). The print faces the camera: board frame as in BoardSpec (origin at the pattern
+// centre, x along columns, y along rows, z away from the viewer). White sheet margin up to the
+// sheet size, then a mid-grey background (no clutter). Anti-aliased by supersampling.
+struct RenderOptions {
+  int supersampling = 4;     // samples per pixel along each axis
+  double image_noise = 0.0;  // Gaussian, [0,1] intensity units
+  std::uint8_t background = 100;
+  std::uint64_t seed = 1;
+};
+ImageU8 RenderBoardImage(const CameraModel& camera, const BoardSpec& board,
+                         const Pose& cam_from_board, const RenderOptions& options);
+
+// The options with every default filled in (camera, board with its sheet size, mount, seed
+// radius), as the simulator uses them.
+SimOptions ResolveSimOptions(const SimOptions& options);
+
+// Each pair's noise-free geometry as SimulateDataset places it: the board pose and the board's
+// returns without range noise (LiDAR frame, the board alone). For the Cramér–Rao bound.
+struct SimPairTruth {
+  Pose cam_from_board = Pose::Identity();
+  std::vector<Vec3> lidar_board_points;
+};
+std::vector<SimPairTruth> SimulatePairTruth(const SimOptions& options);
+
+// The simulator's options as recorded in a dataset it wrote (Dataset::simulation); throws
+// IoError naming the manifest when the dataset carries no simulation record.
+SimOptions SimOptionsFromDataset(const Dataset& dataset);
+
+// Writes dataset.json, clouds/NNNN.pcd and images/NNNN.png under out_dir and returns the dataset
+// as written (absolute paths, ground truth set). Throws IoError on write failures,
+// std::invalid_argument for options that fail Check, std::runtime_error as SampleBoardPoses.
+Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& out_dir);
+
+}  // namespace calibench

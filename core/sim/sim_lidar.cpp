@@ -1,0 +1,185 @@
+// Spinning-LiDAR beam tables and the ray caster of the simulator (core/sim.h).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "core/sim/sim.h"
+
+namespace calibench {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+constexpr double kMinRangeM = 0.3;  // closer returns are suppressed, as real sensors do
+
+// Return intensities (0..255): retro-reflective-free paper and ink, painted walls, concrete floor.
+constexpr double kPaperIntensity = 200.0;
+constexpr double kInkIntensity = 20.0;
+constexpr double kWallIntensity = 90.0;
+constexpr double kFloorIntensity = 60.0;
+constexpr double kIntensityNoise = 3.0;
+
+// n angles from first_deg to last_deg inclusive, in radians.
+std::vector<double> LinspaceDeg(double first_deg, double last_deg, int n) {
+  std::vector<double> out(n);
+  for (int i = 0; i < n; ++i) {
+    out[i] = (first_deg + (last_deg - first_deg) * i / (n - 1)) * kDegToRad;
+  }
+  return out;
+}
+
+// The nearest hit of one ray from the LiDAR origin.
+struct RayHit {
+  double range = std::numeric_limits<double>::infinity();
+  SimSurface surface = SimSurface::kWall;
+  Vec2 board_xy = Vec2::Zero();
+};
+
+// The board sheet as a plane n·x = offset with in-plane axes, all in the LiDAR frame.
+struct BoardGeometry {
+  Vec3 normal, axis_x, axis_y, origin;
+  double offset = 0.0;
+};
+
+BoardGeometry MakeBoardGeometry(const Pose& lidar_from_board) {
+  BoardGeometry g;
+  g.axis_x = lidar_from_board.linear().col(0);
+  g.axis_y = lidar_from_board.linear().col(1);
+  g.normal = lidar_from_board.linear().col(2);
+  g.origin = lidar_from_board.translation();
+  g.offset = g.normal.dot(g.origin);
+  return g;
+}
+
+void IntersectBoard(const Vec3& dir, const BoardGeometry& g, const BoardPrint& print, RayHit* hit) {
+  const double denom = g.normal.dot(dir);
+  if (std::abs(denom) < 1e-12) return;
+  const double range = g.offset / denom;
+  if (range <= 0.0 || range >= hit->range) return;
+  const Vec3 local = range * dir - g.origin;
+  const Vec2 xy(g.axis_x.dot(local), g.axis_y.dot(local));
+  if (!print.InSheet(xy)) return;
+  *hit = RayHit{range, SimSurface::kBoard, xy};
+}
+
+// The room: floor z = floor_z (below the sensor) and walls |x| = d, |y| = d around it.
+void IntersectRoom(const Vec3& dir, const LidarScene& scene, RayHit* hit) {
+  const double d = scene.wall_distance_m;
+  double wall = std::numeric_limits<double>::infinity();
+  if (dir.x() != 0.0) wall = std::min(wall, d / std::abs(dir.x()));
+  if (dir.y() != 0.0) wall = std::min(wall, d / std::abs(dir.y()));
+  if (wall < hit->range) *hit = RayHit{wall, SimSurface::kWall, Vec2::Zero()};
+  if (dir.z() < 0.0) {
+    const double floor = scene.floor_z_m / dir.z();
+    if (floor > 0.0 && floor < hit->range) *hit = RayHit{floor, SimSurface::kFloor, Vec2::Zero()};
+  }
+}
+
+double SurfaceIntensity(const RayHit& hit, const BoardPrint& print) {
+  switch (hit.surface) {
+    case SimSurface::kBoard:
+      return kInkIntensity + (kPaperIntensity - kInkIntensity) * print.Reflectance(hit.board_xy);
+    case SimSurface::kFloor:
+      return kFloorIntensity;
+    case SimSurface::kWall:
+      return kWallIntensity;
+  }
+  return kWallIntensity;
+}
+
+}  // namespace
+
+std::string LidarModelName(LidarModel model) {
+  switch (model) {
+    case LidarModel::kHdl64:
+      return "hdl64";
+    case LidarModel::kVlp16:
+      return "vlp16";
+    case LidarModel::kOs0_128:
+      return "os0-128";
+  }
+  return "unknown";
+}
+
+std::optional<LidarModel> ParseLidarModelName(const std::string& name) {
+  for (LidarModel model : {LidarModel::kHdl64, LidarModel::kVlp16, LidarModel::kOs0_128}) {
+    if (LidarModelName(model) == name) return model;
+  }
+  return std::nullopt;
+}
+
+BeamTable MakeBeamTable(LidarModel model) {
+  BeamTable table;
+  switch (model) {
+    case LidarModel::kHdl64: {
+      // HDL-64E S2: lower block of 32 lasers at 1/2 deg, upper block of 32 at ~1/3 deg;
+      // 0.1728 deg azimuth resolution at 10 Hz.
+      table.elevations_rad = LinspaceDeg(-24.33, -8.83, 32);
+      const std::vector<double> upper = LinspaceDeg(-8.33, 2.0, 32);
+      table.elevations_rad.insert(table.elevations_rad.end(), upper.begin(), upper.end());
+      table.azimuth_steps = 2083;
+      table.max_range_m = 120.0;
+      break;
+    }
+    case LidarModel::kVlp16:
+      table.elevations_rad = LinspaceDeg(-15.0, 15.0, 16);
+      table.azimuth_steps = 1800;  // 0.2 deg at 10 Hz
+      table.max_range_m = 100.0;
+      break;
+    case LidarModel::kOs0_128:
+      table.elevations_rad = LinspaceDeg(-45.0, 45.0, 128);
+      table.azimuth_steps = 1024;
+      table.max_range_m = 50.0;
+      break;
+  }
+  return table;
+}
+
+LidarCloud LidarScan::ToCloud() const {
+  LidarCloud cloud;
+  cloud.points.reserve(points.size());
+  for (const Vec3& p : points) cloud.points.push_back(p.cast<float>());
+  cloud.intensity = intensity;
+  cloud.ring = ring;
+  cloud.width = static_cast<int>(points.size());
+  cloud.height = 1;
+  return cloud;
+}
+
+LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
+                            const LidarScene& scene, const LidarScanOptions& options) {
+  CALIBENCH_CHECK(beams.azimuth_steps > 0 && !beams.elevations_rad.empty());
+  CALIBENCH_CHECK(options.range_noise_m >= 0.0);
+  const BoardGeometry board = MakeBoardGeometry(scene.lidar_from_board);
+  const int rings = static_cast<int>(beams.elevations_rad.size());
+  std::vector<double> cos_el(rings), sin_el(rings);
+  for (int r = 0; r < rings; ++r) {
+    cos_el[r] = std::cos(beams.elevations_rad[r]);
+    sin_el[r] = std::sin(beams.elevations_rad[r]);
+  }
+  std::mt19937_64 rng(options.seed);
+  std::normal_distribution<double> unit_normal(0.0, 1.0);
+  LidarScan scan;
+  for (int step = 0; step < beams.azimuth_steps; ++step) {
+    const double azimuth = options.azimuth_offset_rad + 2.0 * M_PI * step / beams.azimuth_steps;
+    const double cos_az = std::cos(azimuth), sin_az = std::sin(azimuth);
+    for (int r = 0; r < rings; ++r) {
+      const Vec3 dir(cos_el[r] * cos_az, cos_el[r] * sin_az, sin_el[r]);
+      RayHit hit;
+      hit.range = beams.max_range_m;
+      IntersectBoard(dir, board, print, &hit);
+      if (scene.clutter) IntersectRoom(dir, scene, &hit);
+      if (hit.range >= beams.max_range_m || hit.range < kMinRangeM) continue;
+      double range = hit.range + options.range_offset_m;
+      if (options.range_noise_m > 0.0) range += options.range_noise_m * unit_normal(rng);
+      const double intensity = SurfaceIntensity(hit, print) + kIntensityNoise * unit_normal(rng);
+      scan.points.push_back(range * dir);
+      scan.intensity.push_back(static_cast<float>(std::clamp(intensity, 0.0, 255.0)));
+      scan.ring.push_back(r);
+      scan.surface.push_back(hit.surface);
+    }
+  }
+  return scan;
+}
+
+}  // namespace calibench

@@ -1,0 +1,65 @@
+// Camera side of a pair: find the board in the image, solve planar PnP through the camera model,
+// and express the board plane in the camera frame with its covariance.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/base/image.h"
+#include "core/base/types.h"
+#include "core/camera/camera.h"
+#include "core/geometry/geometry.h"
+#include "core/target/board.h"
+
+namespace calibench {
+
+struct BoardDetectionOptions {
+  // cornerSubPix refinement after findChessboardCornersSB removes its ~0.06–0.10 px bias at small
+  // squares (measured on rendered boards). Half window in pixels; 0 = choose from square size.
+  int subpix_half_window_px = 0;
+  // OpenCV 4.6 ChArUco corner interpolation is offset by +0.5 px in x and y (OpenCV issue 25539).
+  bool correct_charuco_offset = true;
+  int min_corners = 6;  // fewer detected corners = failed detection
+  // Smallest ArUco marker perimeter as a fraction of the larger image side. OpenCV's default
+  // (0.03, i.e. ~11 px markers on a 1440 px image) drops the markers of small boards at range.
+  double min_marker_perimeter_rate = 0.01;
+  bool Check(std::string* why) const;
+};
+
+struct BoardDetection {
+  std::vector<Vec2> pixels;        // detected corner positions (pixels)
+  std::vector<Vec3> board_points;  // the same corners in the board frame (metres, z = 0)
+  std::vector<int> ids;            // corner ids (index into BoardCornerPoints)
+};
+
+// nullopt with *why set when the board is not found (too few corners, no markers, ...).
+std::optional<BoardDetection> DetectBoard(const ImageU8& image, const BoardSpec& board,
+                                          const BoardDetectionOptions& options, std::string* why);
+
+struct CameraBoardObservation {
+  Pose cam_from_board;
+  Mat6 pose_covariance;   // of cam_from_board, right perturbation, [rho; phi]
+  Plane plane;            // in the camera frame, oriented towards the camera (d > 0)
+  Mat4 plane_covariance;  // of (n, d); rank 3 (n is unit)
+  double reprojection_rms_px = 0.0;
+  double corner_sigma_px = 0.0;  // estimated from the residuals (floored), used for covariances
+  int num_corners = 0;
+};
+
+struct PnpOptions {
+  double min_corner_sigma_px = 0.05;  // floor for the residual-based corner noise estimate
+  int max_iterations = 20;            // Gauss-Newton refinement in pixel space
+  double max_rms_px = 3.0;            // larger reprojection RMS = failed pose
+  bool Check(std::string* why) const;
+};
+
+// Planar PnP through the camera model (pinhole or fisheye, on the raw image): initialised with
+// IPPE on undistorted bearings, refined by Gauss-Newton on pixel residuals. Covariances follow
+// from the refined Jacobian and the corner noise. nullopt with *why on failure.
+std::optional<CameraBoardObservation> EstimateBoardPose(const CameraModel& camera,
+                                                        const BoardDetection& detection,
+                                                        const PnpOptions& options,
+                                                        std::string* why);
+
+}  // namespace calibench

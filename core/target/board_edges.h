@@ -1,0 +1,55 @@
+// Where the LiDAR's rings leave the board: points on the sheet's boundary that constrain the
+// extrinsic within the board plane (issue 5, board-edge constraints). Planes fix a board's tilt
+// and distance only; its in-plane position comes from other poses, so with few pairs the
+// translation along the boards is weak. The sheet's edges, seen by the camera through the board
+// pose and by the LiDAR as the ends of each ring's run of board returns, tie it down.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/geometry/geometry.h"
+#include "core/lidar/cloud.h"
+
+namespace calibench {
+
+// One crossing of a ring over the sheet's edge, on the fitted board plane (LiDAR frame).
+struct LidarEdgePoint {
+  Vec3 point = Vec3::Zero();        // the crossing: midway between the last board return and
+                                    // the first return beyond the board, on the plane
+  Vec3 along_ring = Vec3::UnitX();  // unit, LiDAR frame: the ring's direction there, outwards
+  // The crossing lies somewhere in the gap between those two returns: its standard deviation
+  // along the ring is the gap's length / √12 (uniform).
+  double sigma_along_m = 0.0;
+};
+
+struct BoardEdgeOptions {
+  // The return beyond the board must lie at least this far behind the board plane along its ray
+  // (metres): a return in front is an occluder, one on the plane a coplanar neighbour (a hand,
+  // the stand), and neither shows where the sheet ends.
+  double min_background_gap_m = 0.15;
+  // Neighbouring returns further apart than this (degrees of azimuth) leave the crossing too
+  // uncertain (a dropped return): no edge point there.
+  double max_azimuth_gap_deg = 0.6;
+  bool Check(std::string* why) const;
+};
+
+// Ring ends of the inliers of a fitted board plane (n·x + d = 0, LiDAR frame). Uses the cloud's
+// rings (or infers them); a ring whose neighbouring return is missing, occluding or coplanar
+// gives no point at that end.
+std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
+                                                   const std::vector<int>& inliers,
+                                                   const Plane& plane,
+                                                   const BoardEdgeOptions& options);
+
+// Residual of one edge point against the sheet (half sizes in metres, board frame as BoardSpec):
+// the signed distance, in the board plane, from the point to the sheet edge nearest to it
+// (positive outside). `camera_from_board` is the PnP pose. With `jacobian`, d/d(delta) for the
+// right perturbation cam_from_lidar·Exp(delta), [rho; phi]; with `sigma_m`, the residual's
+// standard deviation from the crossing's uncertainty along the ring and `floor_sigma_m`.
+double BoardEdgeResidual(const Pose& cam_from_lidar, const Pose& camera_from_board,
+                         const Vec2& sheet_half_size_m, const LidarEdgePoint& edge,
+                         double floor_sigma_m, Eigen::Matrix<double, 1, 6>* jacobian,
+                         double* sigma_m);
+
+}  // namespace calibench

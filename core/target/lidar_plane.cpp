@@ -1,0 +1,358 @@
+#include "core/target/lidar_plane.h"
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/sample_consensus/ransac.h>
+#include <pcl/sample_consensus/sac_model_plane.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace calibench {
+
+bool LidarPlaneOptions::Check(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (!(ransac_threshold_m > 0)) return fail("ransac_threshold_m must be > 0 (metres)");
+  if (ransac_iterations < 1) return fail("ransac_iterations must be >= 1");
+  if (min_inliers < 4) return fail("min_inliers must be >= 4");
+  if (!(min_inlier_fraction >= 0 && min_inlier_fraction <= 1))
+    return fail("min_inlier_fraction must be in [0, 1]");
+  if (!(grow_radius_m >= 0) || !std::isfinite(grow_radius_m))
+    return fail("grow_radius_m must be >= 0 (metres; 0 = no growing)");
+  if (!(sheet_size_m.minCoeff() >= 0) || !sheet_size_m.allFinite())
+    return fail("sheet_size_m must be >= 0 (metres; 0 = unknown)");
+  if (!edges.Check(why)) return false;
+  return true;
+}
+
+double BoardGrowRadius(const BoardSpec& board) {
+  return 1.05 * 0.5 * std::hypot(board.SheetWidth(), board.SheetHeight()) + 0.02;
+}
+
+namespace {
+
+// Range residual r − r̂ of a return against a plane (r̂ where its ray meets the plane); nullopt
+// for rays within ~1° of the plane.
+std::optional<double> RangeResidual(const Plane& plane, const Vec3& x) {
+  const auto on_plane = RangeOnPlane(plane, x);
+  if (!on_plane) return std::nullopt;
+  return x.norm() - *on_plane;
+}
+
+// The range band for inliers: 3σ̂ of the fit, at least the RANSAC threshold and at most five
+// times it (see FitBoardPlane).
+double RangeBand(const LidarPlaneOptions& options, double rms_m) {
+  return std::min(5.0 * options.ransac_threshold_m,
+                  std::max(options.ransac_threshold_m, 3.0 * rms_m));
+}
+
+// Maximum-likelihood refit with the band re-drawn around each new plane, over `candidates`.
+std::optional<LidarPlaneFit> RefineRangeMl(const LidarCloud& cloud,
+                                           const std::vector<int>& candidates,
+                                           const LidarPlaneFit& start,
+                                           const LidarPlaneOptions& options) {
+  std::optional<LidarPlaneFit> fit;
+  std::vector<int> inliers = start.inliers;
+  Plane plane = start.plane;
+  for (int round = 0; round < 4; ++round) {
+    auto ml = FitPlaneRangeMl(cloud, inliers, plane);
+    if (!ml) break;
+    fit = ml;
+    const double band_m = RangeBand(options, ml->rms_m);
+    std::vector<int> reselected;
+    for (int i : candidates) {
+      const auto residual = RangeResidual(ml->plane, cloud.points[i].cast<double>());
+      if (residual && std::abs(*residual) <= band_m) reselected.push_back(i);
+    }
+    if (reselected == inliers || reselected.size() < 4) break;
+    inliers = std::move(reselected);
+    plane = ml->plane;
+  }
+  return fit;
+}
+
+// Where the inliers' rays meet the plane, averaged: the board centre when the inliers cover it.
+Vec3 InlierCentre(const LidarCloud& cloud, const LidarPlaneFit& fit) {
+  Vec3 sum = Vec3::Zero();
+  int count = 0;
+  for (int i : fit.inliers) {
+    const Vec3 x = cloud.points[i].cast<double>();
+    if (const auto range = RangeOnPlane(fit.plane, x)) {
+      sum += x.normalized() * *range;
+      ++count;
+    }
+  }
+  return sum / std::max(1, count);
+}
+
+// FitBoardPlane's growing step (LidarPlaneOptions::grow_radius_m): candidates are the returns in
+// the band whose ray meets the plane inside the disc around the current centre; the centre moves
+// to the grown inliers' mean and the disc is drawn again until it settles. Selection is by ray
+// direction and the band only, as for the seed region, so that it does not bias the plane.
+LidarPlaneFit GrowToBoard(const LidarCloud& cloud, LidarPlaneFit fit,
+                          const LidarPlaneOptions& options) {
+  Vec3 centre = InlierCentre(cloud, fit);
+  for (int round = 0; round < 4; ++round) {
+    const double gate_m = 2.0 * RangeBand(options, fit.rms_m);
+    std::vector<int> candidates;
+    for (size_t i = 0; i < cloud.size(); ++i) {
+      const Vec3 x = cloud.points[i].cast<double>();
+      const auto residual = RangeResidual(fit.plane, x);
+      if (!residual || std::abs(*residual) > gate_m) continue;
+      const Vec3 on_plane = x - x.normalized() * *residual;
+      if ((on_plane - centre).norm() <= options.grow_radius_m)
+        candidates.push_back(static_cast<int>(i));
+    }
+    auto grown = RefineRangeMl(cloud, candidates, fit, options);
+    if (!grown || grown->inliers.size() < fit.inliers.size()) break;
+    fit = *grown;
+    fit.grown = true;
+    const Vec3 next_centre = InlierCentre(cloud, fit);
+    const bool settled = (next_centre - centre).norm() < 0.005;
+    centre = next_centre;
+    if (settled) break;
+  }
+  return fit;
+}
+
+}  // namespace
+
+std::vector<int> SelectSeedRegion(const LidarCloud& cloud, const LidarSeed& seed) {
+  // A cone of rays around the seed's direction (the disc of `radius` seen from the LiDAR) and a
+  // range gate, not a ball: a ball keeps or drops a return depending on its range noise, and on a
+  // tilted board that selection biases the plane (near-side returns pushed away stay in, those
+  // pulled closer drop out). Directions carry no range noise, like the brush on the LiDAR image.
+  std::vector<int> indices;
+  const double seed_range = seed.point.norm();
+  if (!(seed_range > 0)) return indices;
+  const Vec3 axis = seed.point / seed_range;
+  const double cos_cone = std::cos(std::asin(std::min(1.0, seed.radius / seed_range)));
+  const double range_gate = std::max(3.0 * seed.radius, 0.3);
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Vec3 x = cloud.points[i].cast<double>();
+    const double range = x.norm();
+    if (range <= 0 || std::abs(range - seed_range) > range_gate) continue;
+    if (axis.dot(x) >= cos_cone * range) indices.push_back(static_cast<int>(i));
+  }
+  return indices;
+}
+
+std::vector<int> SelectBrushRegion(const LidarImage& image, const std::vector<int>& pixels) {
+  std::vector<int> indices;
+  for (int pixel : pixels) {
+    if (pixel < 0 || pixel >= static_cast<int>(image.point_index.size())) continue;
+    if (image.point_index[pixel] >= 0) indices.push_back(image.point_index[pixel]);
+  }
+  std::sort(indices.begin(), indices.end());
+  indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
+  return indices;
+}
+
+std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
+                                                  const std::vector<int>& indices) {
+  if (indices.size() < 4) return std::nullopt;
+  Vec3 centroid = Vec3::Zero();
+  for (int i : indices) centroid += cloud.points[i].cast<double>();
+  centroid /= static_cast<double>(indices.size());
+  Mat3 scatter = Mat3::Zero();
+  for (int i : indices) {
+    const Vec3 p = cloud.points[i].cast<double>() - centroid;
+    scatter += p * p.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen(scatter);
+  // Points on a line (or a single ring) do not define a plane.
+  if (eigen.eigenvalues()[1] < 1e-6 * eigen.eigenvalues()[2] || eigen.eigenvalues()[1] <= 0)
+    return std::nullopt;
+  LidarPlaneFit fit;
+  fit.plane = OrientTowardsOrigin(
+      Plane{eigen.eigenvectors().col(0), -eigen.eigenvectors().col(0).dot(centroid)});
+  fit.inliers = indices;
+  fit.num_candidates = static_cast<int>(indices.size());
+  double sum_sq = 0.0;
+  for (int i : indices)
+    sum_sq += std::pow(fit.plane.SignedDistance(cloud.points[i].cast<double>()), 2);
+  fit.rms_m = std::sqrt(sum_sq / indices.size());
+  // Covariance: residual r_i = n·x_i + d, with n perturbed in its tangent plane (basis B):
+  // J_i = [x_iᵀ B, 1], Σ = σ² (JᵀJ)⁻¹ with σ² from the residuals (3 parameters).
+  Eigen::Matrix<double, 3, 2> tangent;
+  tangent.col(0) = fit.plane.normal.unitOrthogonal();
+  tangent.col(1) = fit.plane.normal.cross(tangent.col(0));
+  Mat3 normal_matrix = Mat3::Zero();
+  for (int i : indices) {
+    Eigen::RowVector3d j;
+    j << cloud.points[i].cast<double>().transpose() * tangent, 1.0;
+    normal_matrix += j.transpose() * j;
+  }
+  const double dof = std::max<double>(1.0, static_cast<double>(indices.size()) - 3.0);
+  const Mat3 local_cov = (sum_sq / dof) * normal_matrix.inverse();
+  Eigen::Matrix<double, 4, 3> to_coefficients = Eigen::Matrix<double, 4, 3>::Zero();
+  to_coefficients.topLeftCorner<3, 2>() = tangent;
+  to_coefficients(3, 2) = 1.0;
+  fit.covariance = to_coefficients * local_cov * to_coefficients.transpose();
+  return fit;
+}
+
+std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
+                                             const std::vector<int>& indices,
+                                             const Plane& initial) {
+  if (indices.size() < 4) return std::nullopt;
+  std::vector<Vec3> rays;
+  std::vector<double> ranges;
+  rays.reserve(indices.size());
+  ranges.reserve(indices.size());
+  for (int i : indices) {
+    const Vec3 x = cloud.points[i].cast<double>();
+    const double r = x.norm();
+    if (r <= 0) return std::nullopt;
+    rays.push_back(x / r);
+    ranges.push_back(r);
+  }
+  Plane plane = OrientTowardsOrigin(initial);
+  auto tangent_of = [](const Vec3& n) {
+    Eigen::Matrix<double, 3, 2> b;
+    b.col(0) = n.unitOrthogonal();
+    b.col(1) = n.cross(b.col(0));
+    return b;
+  };
+  // Residual e_i = r_i − r̂_i, r̂_i = −d/(n·u_i). With n ← n + B δ and d ← d + δ_d:
+  // ∂r̂/∂δ = d (u_iᵀ B)/(n·u_i)², ∂r̂/∂δ_d = −1/(n·u_i); ∂e/∂· = −∂r̂/∂·.
+  Vec3 sum_jacobian = Vec3::Zero();  // Σ ∂e_i/∂θ at the last linearisation
+  auto linearize = [&](const Plane& p, Mat3* normal_matrix, Vec3* gradient, double* sum_sq) {
+    const Eigen::Matrix<double, 3, 2> b = tangent_of(p.normal);
+    *normal_matrix = Mat3::Zero();
+    *gradient = Vec3::Zero();
+    *sum_sq = 0.0;
+    sum_jacobian.setZero();
+    for (size_t k = 0; k < rays.size(); ++k) {
+      const double cos_incidence = p.normal.dot(rays[k]);
+      // A ray grazing the plane (|cos| < 0.02, beyond 88.9°) has no finite predicted range.
+      if (std::abs(cos_incidence) < 0.02) return false;
+      const double predicted = -p.distance / cos_incidence;
+      const double e = ranges[k] - predicted;
+      Eigen::RowVector3d j;
+      j.head<2>() = -p.distance * rays[k].transpose() * b / (cos_incidence * cos_incidence);
+      j(2) = 1.0 / cos_incidence;
+      *normal_matrix += j.transpose() * j;
+      *gradient += j.transpose() * e;
+      *sum_sq += e * e;
+      sum_jacobian += j.transpose();
+    }
+    return true;
+  };
+  Mat3 normal_matrix;
+  Vec3 gradient;
+  double sum_sq = 0.0;
+  bool converged = false;
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    if (!linearize(plane, &normal_matrix, &gradient, &sum_sq)) return std::nullopt;
+    const Vec3 step = normal_matrix.ldlt().solve(-gradient);
+    if (!step.allFinite()) return std::nullopt;
+    const Eigen::Matrix<double, 3, 2> b = tangent_of(plane.normal);
+    plane.normal = (plane.normal + b * step.head<2>()).normalized();
+    plane.distance += step(2);
+    if (step.norm() < 1e-12) {
+      converged = true;
+      break;
+    }
+  }
+  if (!converged || !linearize(plane, &normal_matrix, &gradient, &sum_sq)) return std::nullopt;
+  LidarPlaneFit fit;
+  fit.plane = OrientTowardsOrigin(plane);
+  fit.inliers = indices;
+  fit.num_candidates = static_cast<int>(indices.size());
+  fit.rms_m = std::sqrt(sum_sq / indices.size());
+  const double dof = std::max<double>(1.0, static_cast<double>(indices.size()) - 3.0);
+  const Mat3 local_cov = (sum_sq / dof) * normal_matrix.inverse();
+  Eigen::Matrix<double, 4, 3> to_coefficients = Eigen::Matrix<double, 4, 3>::Zero();
+  to_coefficients.topLeftCorner<3, 2>() = tangent_of(plane.normal);
+  to_coefficients(3, 2) = 1.0;
+  fit.covariance = to_coefficients * local_cov * to_coefficients.transpose();
+  // A range offset b adds b to every residual; the Gauss-Newton solution then moves by
+  // −(JᵀJ)⁻¹ Jᵀ 1 per metre of b.
+  fit.range_offset_jacobian = to_coefficients * (-normal_matrix.ldlt().solve(sum_jacobian));
+  return fit;
+}
+
+std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
+                                           const std::vector<int>& candidates,
+                                           const LidarPlaneOptions& options, std::string* why) {
+  auto fail = [&](const std::string& m) -> std::optional<LidarPlaneFit> {
+    if (why) *why = m;
+    return std::nullopt;
+  };
+  if (candidates.empty()) return fail("the selected LiDAR region holds no points");
+  if (static_cast<int>(candidates.size()) < options.min_inliers)
+    return fail("the selected LiDAR region holds only " + std::to_string(candidates.size()) +
+                " points (need " + std::to_string(options.min_inliers) + ")");
+
+  // PCL's RANSAC draws from a fixed internal seed; shuffling the candidates with our own seed
+  // makes the sampling depend on options.seed and on nothing else.
+  std::vector<int> order = candidates;
+  std::mt19937_64 rng(options.seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
+  points->reserve(order.size());
+  for (int i : order)
+    points->push_back(pcl::PointXYZ(cloud.points[i].x(), cloud.points[i].y(), cloud.points[i].z()));
+  pcl::SampleConsensusModelPlane<pcl::PointXYZ>::Ptr model(
+      new pcl::SampleConsensusModelPlane<pcl::PointXYZ>(points, false));
+  pcl::RandomSampleConsensus<pcl::PointXYZ> ransac(model, options.ransac_threshold_m);
+  ransac.setMaxIterations(options.ransac_iterations);
+  if (!ransac.computeModel()) return fail("RANSAC found no plane in the selected LiDAR region");
+  std::vector<int> local_inliers;
+  ransac.getInliers(local_inliers);
+
+  // Least-squares refit on the inliers, then one re-selection with the refined plane.
+  std::vector<int> inliers;
+  for (int k : local_inliers) inliers.push_back(order[k]);
+  std::optional<LidarPlaneFit> fit = FitPlaneLeastSquares(cloud, inliers);
+  if (!fit) return fail("the RANSAC inliers lie on a line (a single ring?): no plane");
+  // Re-selection with an inlier band that adapts to the sensor: max(threshold, 3σ̂) with σ̂ the
+  // RMS of the current inliers. A fixed band narrower than ~3σ truncates the noise (a 30 mm band
+  // keeps 87% of 20 mm noise and shrinks its RMS by a quarter), which biases the covariance low;
+  // the band grows until it holds the noise, capped at 5x the RANSAC threshold.
+  double band = options.ransac_threshold_m;
+  for (int round = 0; round < 4; ++round) {
+    std::vector<int> refined;
+    for (int i : candidates)
+      if (std::abs(fit->plane.SignedDistance(cloud.points[i].cast<double>())) <= band)
+        refined.push_back(i);
+    if (refined.size() < 4) break;
+    auto again = FitPlaneLeastSquares(cloud, refined);
+    if (!again) break;
+    fit = again;
+    const double next_band = std::min(5.0 * options.ransac_threshold_m,
+                                      std::max(options.ransac_threshold_m, 3.0 * fit->rms_m));
+    if (next_band <= band * 1.05) break;
+    band = next_band;
+  }
+  if (options.fit_ranges_ml) {
+    // The unbiased estimate (see LidarPlaneOptions::fit_ranges_ml). The inlier band is re-drawn
+    // around the maximum-likelihood plane in range units (|r − r̂| ≤ max(threshold, 3σ̂_r)): a
+    // band around the biased least-squares plane would truncate the range noise on one side and
+    // carry the bias into the ML fit.
+    if (auto ml = RefineRangeMl(cloud, candidates, *fit, options)) fit = ml;
+  }
+  fit->num_candidates = static_cast<int>(candidates.size());
+  const int n = static_cast<int>(fit->inliers.size());
+  if (n < options.min_inliers)
+    return fail("plane has only " + std::to_string(n) + " inliers (need " +
+                std::to_string(options.min_inliers) + ")");
+  if (n < options.min_inlier_fraction * candidates.size())
+    return fail("plane explains only " + std::to_string(n) + " of " +
+                std::to_string(candidates.size()) + " selected points");
+  if (options.grow_radius_m > 0 && options.fit_ranges_ml) fit = GrowToBoard(cloud, *fit, options);
+  // Edge points need the whole board's returns: the ends of a brushed patch are not its edges.
+  if (fit->grown && options.sheet_size_m.minCoeff() > 0) {
+    fit->edge_points = ExtractBoardEdgePoints(cloud, fit->inliers, fit->plane, options.edges);
+    fit->sheet_size_m = options.sheet_size_m;
+  }
+  return fit;
+}
+
+}  // namespace calibench

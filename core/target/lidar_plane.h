@@ -1,0 +1,86 @@
+// LiDAR side of a pair: pick the board region (a brush on the LiDAR image or a seed point with a
+// radius), fit a plane by RANSAC (PCL), refit by least squares on the inliers, with covariance.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/geometry/geometry.h"
+#include "core/lidar/cloud.h"
+#include "core/lidar/lidar_image.h"
+#include "core/target/board.h"
+#include "core/target/board_edges.h"
+
+namespace calibench {
+
+struct LidarPlaneOptions {
+  double ransac_threshold_m = 0.03;  // inlier distance; ~3σ of typical spinning-LiDAR range noise
+  int ransac_iterations = 500;       // enough for > 50% inliers with a 1e-9 failure chance
+  int min_inliers = 20;              // fewer inliers = no plane (a board needs a few rings)
+  double min_inlier_fraction = 0.3;  // of the candidate points
+  std::uint64_t seed = 1;            // RANSAC sampling order; same seed, same plane
+  // Final fit by maximum likelihood on the ranges along the rays (FitPlaneRangeMl). LiDAR noise
+  // lies along each ray, so the total-least-squares plane of a tilted board is biased (the bias
+  // grows with σ² and the tilt); false keeps the total-least-squares refit.
+  bool fit_ranges_ml = true;
+  // Grow the fit from the selected region to the whole board: every return within the range band
+  // of the plane whose ray meets the plane within this radius (metres) of the board centre found
+  // from those returns. A brush or seed disc usually covers a third of the board; the returns it
+  // leaves out carry the rest of the plane's information (the far boards' tilt above all).
+  // 0 = keep the selected region. Set from the target by BoardGrowRadius.
+  double grow_radius_m = 0.0;
+  // The sheet's [width, height] in metres when known: the grown fit then also finds the rings'
+  // crossings of the sheet's edges (LidarPlaneFit::edge_points). 0 = unknown, no edge points.
+  Vec2 sheet_size_m = Vec2::Zero();
+  BoardEdgeOptions edges;
+  bool Check(std::string* why) const;
+};
+
+// The grow radius for a target: half the sheet's diagonal, 5% and 2 cm more so that the corners'
+// returns stay in while the centre estimate settles.
+double BoardGrowRadius(const BoardSpec& board);
+
+struct LidarPlaneFit {
+  Plane plane;                     // LiDAR frame, normal towards the LiDAR (d > 0)
+  Mat4 covariance = Mat4::Zero();  // of (n, d) from the least-squares refit; rank 3
+  std::vector<int> inliers;        // indices into the cloud
+  int num_candidates = 0;          // points in the brushed / seeded region
+  bool grown = false;              // inliers extend beyond the region (grow_radius_m)
+  // How the fitted (n, d) moves per metre of a range offset added to every return (FitPlaneRangeMl
+  // only; zero = unknown): the solver's handle on a LiDAR range offset.
+  Vec4 range_offset_jacobian = Vec4::Zero();
+  // Where the rings leave the board (LidarPlaneOptions::sheet_size_m), with that sheet size.
+  std::vector<LidarEdgePoint> edge_points;
+  Vec2 sheet_size_m = Vec2::Zero();
+  double rms_m = 0.0;  // point-to-plane RMS of the inliers
+};
+
+// Points on rays within the cone that a disc of `seed.radius` (metres) around `seed.point`
+// subtends from the LiDAR, and within max(3 radius, 0.3 m) of its range.
+std::vector<int> SelectSeedRegion(const LidarCloud& cloud, const LidarSeed& seed);
+
+// Points under brushed LiDAR-image pixels (indices into image.point_index).
+std::vector<int> SelectBrushRegion(const LidarImage& image, const std::vector<int>& pixels);
+
+// RANSAC + least-squares refit over the candidate points. nullopt with *why when the region is
+// empty, too small, or holds no plane with enough inliers.
+std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
+                                           const std::vector<int>& candidates,
+                                           const LidarPlaneOptions& options, std::string* why);
+
+// Least-squares (total least squares) plane through points with its (n, d) covariance, the
+// residual variance estimated from the fit. Needs >= 4 points not on a line.
+std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
+                                                  const std::vector<int>& indices);
+
+// Maximum likelihood plane under range noise along the rays from the LiDAR origin: minimises
+// Σ (r_i − r̂_i)², r_i = |x_i|, r̂_i = −d / (n·u_i) the range at which ray u_i = x_i/|x_i| meets
+// the plane (Gauss-Newton on n's tangent plane and d, started at `initial`). Covariance
+// σ̂² (JᵀJ)⁻¹ with σ̂² from the range residuals; rms_m is the range RMS. nullopt when fewer than 4
+// points, a ray parallel to the plane, or no convergence.
+std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
+                                             const std::vector<int>& indices, const Plane& initial);
+
+}  // namespace calibench

@@ -1,0 +1,595 @@
+#include "ui/lidar_camera/controller.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/io/cloud_io.h"
+#include "core/io/image_io.h"
+#include "core/lidar_camera/result_io.h"
+
+namespace calibench::ui {
+namespace {
+
+constexpr int kThumbnailWidth = 160;  // pixels
+
+std::vector<int> SeedBrush(const LidarCloud& cloud, const LidarImage& image,
+                           const LidarSeed& seed) {
+  std::vector<int> pixels;
+  for (int i : SelectSeedRegion(cloud, seed))
+    if (image.pixel_of_point[i] >= 0) pixels.push_back(image.pixel_of_point[i]);
+  std::sort(pixels.begin(), pixels.end());
+  pixels.erase(std::unique(pixels.begin(), pixels.end()), pixels.end());
+  return pixels;
+}
+
+// Pixels of a circle on the LiDAR image; columns wrap around (azimuth is periodic).
+std::vector<int> CirclePixels(int rows, int columns, int row, int column, float radius) {
+  std::vector<int> pixels;
+  const int r = static_cast<int>(std::ceil(radius));
+  for (int dr = -r; dr <= r; ++dr) {
+    const int y = row + dr;
+    if (y < 0 || y >= rows) continue;
+    for (int dc = -r; dc <= r; ++dc) {
+      if (dr * dr + dc * dc > radius * radius) continue;
+      const int x = ((column + dc) % columns + columns) % columns;
+      pixels.push_back(y * columns + x);
+    }
+  }
+  std::sort(pixels.begin(), pixels.end());
+  return pixels;
+}
+
+}  // namespace
+
+Controller::Controller(PipelineOptions options)
+    : pipeline_(std::move(options)), worker_([this](const std::string& message) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        SetStatus("error: " + message, true);
+      }) {}
+
+Controller::~Controller() = default;
+
+void Controller::WaitIdle() { worker_.WaitIdle(); }
+
+Snapshot Controller::GetSnapshot() const {
+  Snapshot copy;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    copy = state_;
+  }
+  copy.busy = worker_.Busy();
+  return copy;
+}
+
+void Controller::SetStatus(const std::string& message, bool error) {
+  state_.status_line = message;
+  state_.status_is_error = error;
+  ++state_.generation;
+}
+
+void Controller::OpenDataset(const std::filesystem::path& dataset_path,
+                             std::filesystem::path session_path) {
+  const Dataset dataset = LoadDataset(dataset_path);
+  if (session_path.empty()) {
+    const auto folder = std::filesystem::is_directory(dataset.manifest)
+                            ? dataset.manifest
+                            : dataset.manifest.parent_path();
+    session_path = folder / "calibench.session.json";
+  }
+  Session session = NewSession(dataset);
+  session.dataset = dataset.manifest;
+  Open(dataset, std::move(session), session_path);
+}
+
+void Controller::OpenSession(const std::filesystem::path& session_path) {
+  Session session = LoadSession(session_path);  // throws IoError; never rewrites the file
+  const Dataset dataset = LoadDataset(session.dataset);
+  if (session.pairs.size() != dataset.pairs.size())
+    throw IoError(session_path.string() + ": the session has " +
+                  std::to_string(session.pairs.size()) + " pairs but " + dataset.manifest.string() +
+                  " has " + std::to_string(dataset.pairs.size()));
+  for (size_t i = 0; i < dataset.pairs.size(); ++i)
+    if (session.pairs[i].id != dataset.pairs[i].id)
+      throw IoError(session_path.string() + ": pair " + std::to_string(i) + " is '" +
+                    session.pairs[i].id + "' in the session but '" + dataset.pairs[i].id +
+                    "' in the dataset");
+  Open(dataset, std::move(session), session_path);
+}
+
+void Controller::Open(const Dataset& dataset, Session session, std::filesystem::path session_path) {
+  WaitIdle();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_ = Snapshot{};
+    state_.dataset = dataset;
+    state_.dataset_path = dataset.manifest;
+    state_.session_path = session_path;
+    state_.pairs.resize(dataset.pairs.size());
+    for (size_t i = 0; i < dataset.pairs.size(); ++i) state_.pairs[i].id = dataset.pairs[i].id;
+    state_.loading_total = static_cast<int>(dataset.pairs.size());
+    session_ = std::move(session);
+    ApplySessionToState(session_);
+    history_.Reset(session_);
+    autosaver_ = std::make_unique<Autosaver>(session_path);
+    SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
+                  dataset.manifest.string(),
+              false);
+  }
+  for (int i = 0; i < static_cast<int>(dataset.pairs.size()); ++i)
+    worker_.Enqueue([this, i] { LoadPair(i); });
+  worker_.Enqueue([this] { EnsureSelectedImage(); });
+}
+
+void Controller::ApplySessionToState(const Session& session) {
+  ApplySessionOptions(session, &pipeline_);
+  state_.view = session.view;
+  state_.method = session.method;
+  state_.huber_delta = session.huber_delta;
+  state_.max_iterations = session.max_iterations;
+  state_.estimate_range_offset = session.estimate_range_offset;
+  for (size_t i = 0; i < session.pairs.size() && i < state_.pairs.size(); ++i) {
+    PairView& pair = state_.pairs[i];
+    pair.status = session.pairs[i].status;
+    pair.reason = session.pairs[i].reason;
+    if (session.pairs[i].brush) pair.brush_pixels = session.pairs[i].brush->pixels;
+    pair.brush_from_seed = session.pairs[i].brush_from_seed;
+  }
+  state_.selected = -1;
+  for (size_t i = 0; i < state_.pairs.size(); ++i)
+    if (state_.pairs[i].id == session.view.selected_pair) state_.selected = static_cast<int>(i);
+  if (state_.selected < 0 && !state_.pairs.empty()) state_.selected = 0;
+  state_.solver = SolverView{};
+  if (session.result) {
+    state_.solver.result = SolverResultFromSession(*session.result, session.method);
+    // The recorded convergence, so that the solver panel and the replay look as they did.
+    const auto& costs = session.result->cost_history;
+    const auto& steps = session.result->step_history;
+    const auto& estimates = session.result->estimate_history;
+    if (steps.size() == costs.size() && estimates.size() == costs.size())
+      for (size_t i = 0; i < costs.size(); ++i)
+        state_.solver.iterations.push_back({static_cast<int>(i), costs[i], steps[i], estimates[i]});
+  }
+  state_.can_undo = history_.CanUndo();
+  state_.can_redo = history_.CanRedo();
+  ++state_.generation;
+}
+
+void Controller::CommitEdit() {
+  const bool had_selected =
+      state_.selected >= 0 && state_.selected < static_cast<int>(state_.pairs.size());
+  state_.view.selected_pair = had_selected ? state_.pairs[state_.selected].id : "";
+  session_.view = state_.view;
+  session_.method = state_.method;
+  session_.huber_delta = state_.huber_delta;
+  session_.max_iterations = state_.max_iterations;
+  session_.estimate_range_offset = state_.estimate_range_offset;
+  for (size_t i = 0; i < state_.pairs.size(); ++i) {
+    PairState& p = session_.pairs[i];
+    const PairView& v = state_.pairs[i];
+    p.status = v.status;
+    p.reason = v.reason;
+    if (v.lidar_image) {
+      BrushMask mask{v.lidar_image->rows, v.lidar_image->columns, v.brush_pixels};
+      p.brush = mask;
+      p.brush_from_seed = v.brush_from_seed;
+    }
+  }
+  session_.result.reset();
+  if (state_.solver.result) {
+    session_.result = SessionResultFromSolver(*state_.solver.result);
+    for (const IterationReport& it : state_.solver.iterations) {
+      session_.result->step_history.push_back(it.step_norm);
+      session_.result->estimate_history.push_back(it.cam_from_lidar);
+    }
+  }
+  history_.Push(session_);
+  state_.can_undo = history_.CanUndo();
+  state_.can_redo = history_.CanRedo();
+  try {
+    if (autosaver_) autosaver_->Save(session_);
+  } catch (const IoError& e) {
+    SetStatus(std::string("autosave failed: ") + e.what(), true);
+  }
+  ++state_.generation;
+}
+
+void Controller::LoadPair(int index) {
+  PairEntry entry;
+  Dataset dataset;
+  PairView saved;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    entry = state_.dataset->pairs[index];
+    dataset = *state_.dataset;
+    saved = state_.pairs[index];
+  }
+  // The pipeline's own steps (core/lidar_camera/pipeline.h), as `calibench calibrate` runs them.
+  PairView loaded;
+  std::string why;
+  auto inputs = LoadPairInputs(dataset, entry, &why);
+  if (inputs) {
+    auto cloud = std::make_shared<LidarCloud>(std::move(inputs->cloud));
+    auto lidar_image = std::make_shared<LidarImage>(ProjectById(*cloud, LidarImageOptions{}));
+    loaded.thumbnail = std::make_shared<ImageU8>(ResizeImage(inputs->image, kThumbnailWidth));
+    CameraFeatures camera = ExtractCameraFeatures(dataset, inputs->image, pipeline_);
+    loaded.detection = std::move(camera.detection);
+    loaded.camera = std::move(camera.observation);
+    loaded.camera_failure = camera.failure;
+    loaded.brush_pixels = saved.brush_pixels;
+    loaded.brush_from_seed = saved.brush_from_seed;
+    // A brush derived from the seed is only its picture: the seed itself selects the region.
+    if ((loaded.brush_pixels.empty() || loaded.brush_from_seed) && entry.lidar_seed) {
+      loaded.brush_pixels = SeedBrush(*cloud, *lidar_image, *entry.lidar_seed);
+      loaded.brush_from_seed = true;
+    }
+    loaded.cloud = cloud;
+    loaded.lidar_image = lidar_image;
+  } else {
+    loaded.camera_failure = why;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  PairView& pair = state_.pairs[index];
+  pair.loaded = true;
+  pair.cloud = loaded.cloud;
+  pair.lidar_image = loaded.lidar_image;
+  pair.thumbnail = loaded.thumbnail;
+  pair.detection = loaded.detection;
+  pair.camera = loaded.camera;
+  pair.camera_failure = loaded.camera_failure;
+  pair.brush_pixels = loaded.brush_pixels;
+  pair.brush_from_seed = loaded.brush_from_seed;
+  ++state_.loading_done;
+  ++state_.generation;
+  if (pair.cloud) worker_.Enqueue([this, index] { RefitLidar(index); });
+  if (!pair.cloud) {
+    pair.status = PairStatus::kFailed;
+    pair.reason = pair.camera_failure;
+  }
+  if (state_.loading_done == state_.loading_total) {
+    SetStatus("loaded " + std::to_string(state_.loading_total) + " pairs", false);
+    // A reopened session with a result shows its reprojection again.
+    const int selected = state_.selected;
+    if (state_.solver.result) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
+  }
+}
+
+void Controller::RefitLidar(int index) {
+  std::shared_ptr<const LidarCloud> cloud;
+  std::shared_ptr<const LidarImage> image;
+  std::vector<int> brush;
+  bool brush_from_seed = false;
+  Dataset dataset;
+  std::optional<LidarSeed> seed;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    dataset = *state_.dataset;
+    seed = dataset.pairs[index].lidar_seed;
+    cloud = state_.pairs[index].cloud;
+    image = state_.pairs[index].lidar_image;
+    brush = state_.pairs[index].brush_pixels;
+    brush_from_seed = state_.pairs[index].brush_from_seed;
+  }
+  if (!cloud || !image) return;
+  // The same choice of region as `calibench calibrate`: the seed itself while the brush only
+  // pictures it; once painted (or erased), the brush.
+  BoardHint hint;
+  hint.image = image.get();
+  if (brush_from_seed)
+    hint.seed = seed;
+  else
+    hint.brush_pixels = &brush;
+  std::string why;
+  const std::optional<LidarPlaneFit> fit =
+      ExtractLidarFeatures(dataset, *cloud, hint, pipeline_, &why);
+  std::lock_guard<std::mutex> lock(mutex_);
+  PairView& pair = state_.pairs[index];
+  if (pair.brush_pixels != brush) return;  // a newer stroke queued its own refit
+  pair.lidar = fit;
+  pair.lidar_failure = fit ? "" : why;
+  // A pair with both planes is usable and accepted unless the user rejected it; one that lost a
+  // plane fails with the reason.
+  if (pair.status != PairStatus::kRejected) {
+    PairFeatures features = FeaturesOf(pair);
+    SetStatusFromFeatures(&features, pair.lidar_failure, pair.camera_failure);
+    pair.status = features.status;
+    pair.reason = features.reason;
+  }
+  ++state_.generation;
+  if (state_.loading_done == state_.loading_total) {
+    RecomputeResiduals();
+    CommitEdit();
+  }
+}
+
+void Controller::RecomputeResiduals() {
+  for (PairView& pair : state_.pairs) pair.residual.reset();
+  if (!state_.solver.result) return;
+  // The solver's own residuals and robust weights at the shown estimate, over the pairs that
+  // are accepted now (after a reload, or after accept/reject since the last solve).
+  std::vector<PairFeatures> features;
+  for (const PairView& pair : state_.pairs) features.push_back(FeaturesOf(pair));
+  SolverResult at_estimate = *state_.solver.result;
+  EvaluateAtSolution(features, SolverOptionsFromState(), &at_estimate);
+  size_t solved = 0;
+  for (PairView& pair : state_.pairs) {
+    if (pair.status != PairStatus::kAccepted || !pair.lidar || !pair.camera) continue;
+    pair.residual = at_estimate.residuals[solved];
+    pair.robust_weight = at_estimate.robust_weights[solved];
+    ++solved;
+  }
+}
+
+PairFeatures Controller::FeaturesOf(const PairView& pair) {
+  PairFeatures features;
+  features.id = pair.id;
+  features.status = pair.status;
+  features.reason = pair.reason;
+  features.lidar = pair.lidar;
+  features.camera = pair.camera;
+  // An accepted pair that lost a plane cannot be solved with.
+  if (features.status == PairStatus::kAccepted && !(features.lidar && features.camera))
+    features.status = PairStatus::kFailed;
+  return features;
+}
+
+PipelineOptions Controller::PipelineOptionsFromState() const {
+  PipelineOptions options = pipeline_;
+  options.solver = SolverOptionsFromState();
+  return options;
+}
+
+SolverOptions Controller::SolverOptionsFromState() const {
+  SolverOptions options = pipeline_.solver;
+  options.method = state_.method;
+  options.huber_delta = state_.huber_delta;
+  options.max_iterations = state_.max_iterations;
+  // The offset belongs to the weighted method; the checkbox keeps its value across methods.
+  options.estimate_range_offset =
+      state_.estimate_range_offset && state_.method == SolverMethod::kWeightedMl;
+  return options;
+}
+
+void Controller::Solve() {
+  std::vector<PairFeatures> features;
+  PipelineOptions options;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const PairView& pair : state_.pairs) features.push_back(FeaturesOf(pair));
+    options = PipelineOptionsFromState();
+    state_.solver = SolverView{};
+    state_.solver.running = true;
+    ++state_.generation;
+  }
+  // The CLI's solve (SolveFromFeatures), watched iteration by iteration.
+  const CalibrationOutcome outcome =
+      SolveFromFeatures(std::move(features), options, [this](const IterationReport& it) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        state_.solver.iterations.push_back(it);
+        ++state_.generation;
+      });
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_.solver.running = false;
+  if (!outcome.solution) {
+    state_.solver.iterations.clear();
+    state_.solver.failure = outcome.failure;
+    SetStatus("no calibration: " + outcome.failure, true);
+    return;
+  }
+  const SolverResult& result = *outcome.solution;
+  state_.solver.result = result;
+  state_.solver.solved_pair_ids.clear();
+  for (const PairFeatures& p : outcome.pairs)
+    if (p.status == PairStatus::kAccepted) state_.solver.solved_pair_ids.push_back(p.id);
+  RecomputeResiduals();
+  SetStatus("solved with " + std::to_string(state_.solver.solved_pair_ids.size()) + " pairs in " +
+                std::to_string(result.iterations) + " iterations" +
+                (result.observability.well_constrained ? "" : " (NOT well constrained)"),
+            !result.observability.well_constrained);
+  CommitEdit();
+  const int selected = state_.selected;
+  if (selected >= 0) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
+}
+
+void Controller::ComputeReprojection(int index) {
+  std::shared_ptr<const LidarCloud> cloud;
+  std::optional<Pose> cam_from_lidar;
+  CameraModel camera;
+  ViewState view;
+  std::string id;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (index < 0 || index >= static_cast<int>(state_.pairs.size()) || !state_.solver.result)
+      return;
+    cloud = state_.pairs[index].cloud;
+    cam_from_lidar = state_.solver.result->cam_from_lidar;
+    camera = state_.dataset->camera;
+    view = state_.view;
+    id = state_.pairs[index].id;
+  }
+  if (!cloud) return;
+  auto reprojection = std::make_shared<Reprojection>();
+  reprojection->pair_id = id;
+  reprojection->points = ProjectCloud(camera, *cam_from_lidar, *cloud);
+  if (view.visibility == VisibilityMode::kHpr) {
+    std::vector<Vec3> in_cam;
+    in_cam.reserve(reprojection->points.size());
+    for (const ProjectedPoint& p : reprojection->points)
+      in_cam.push_back(*cam_from_lidar * cloud->points[p.index].cast<double>());
+    HprOptions options;
+    options.radius_exponent = view.hpr_radius_exponent;
+    reprojection->visible = HiddenPointRemoval(in_cam, options);
+  } else if (view.visibility == VisibilityMode::kZBuffer) {
+    reprojection->visible = ZBufferVisibility(camera, reprojection->points, ZBufferOptions{});
+  } else {
+    reprojection->visible.assign(reprojection->points.size(), true);
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_.reprojection = reprojection;
+  ++state_.generation;
+}
+
+void Controller::EnsureSelectedImage() {
+  std::filesystem::path path;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (state_.selected < 0 || !state_.dataset) return;
+    path = state_.dataset->pairs[state_.selected].image;
+  }
+  std::shared_ptr<const ImageU8> image;
+  std::shared_ptr<const UndistortedView> undistorted;
+  try {
+    image = std::make_shared<ImageU8>(LoadImage(path));
+    CameraModel camera;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      camera = state_.dataset->camera;
+    }
+    undistorted = std::make_shared<UndistortedView>(Undistort(camera, *image));
+  } catch (const IoError& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    SetStatus(e.what(), true);
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (state_.selected >= 0 && state_.dataset->pairs[state_.selected].image == path) {
+    state_.selected_image = image;
+    state_.selected_undistorted = undistorted;
+    ++state_.generation;
+  }
+}
+
+void Controller::Apply(const Intent& intent) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!state_.dataset) return;
+  const int num_pairs = static_cast<int>(state_.pairs.size());
+  auto valid = [&](int index) { return index >= 0 && index < num_pairs; };
+  if (const auto* select = std::get_if<SelectPair>(&intent)) {
+    if (!valid(select->index) || select->index == state_.selected) return;
+    state_.selected = select->index;
+    state_.selected_image.reset();
+    state_.selected_undistorted.reset();
+    state_.reprojection.reset();
+    CommitEdit();
+    worker_.Enqueue([this] { EnsureSelectedImage(); });
+    const int index = select->index;
+    worker_.Enqueue([this, index] { ComputeReprojection(index); });
+  } else if (const auto* status = std::get_if<SetPairStatus>(&intent)) {
+    if (!valid(status->index)) return;
+    PairView& pair = state_.pairs[status->index];
+    if (status->status == PairStatus::kAccepted && !(pair.lidar && pair.camera)) {
+      SetStatus("pair " + pair.id + " cannot be accepted: " +
+                    (!pair.camera ? "no camera plane (" + pair.camera_failure + ")"
+                                  : "no LiDAR plane (" + pair.lidar_failure + ")"),
+                true);
+      return;
+    }
+    pair.status = status->status;
+    pair.reason = status->status == PairStatus::kRejected ? "rejected by the user" : "";
+    SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
+                  (state_.solver.result ? "; press Run to re-solve" : ""),
+              false);
+    CommitEdit();
+  } else if (const auto* stroke = std::get_if<BrushStroke>(&intent)) {
+    if (!valid(stroke->index)) return;
+    PairView& pair = state_.pairs[stroke->index];
+    if (!pair.lidar_image) return;
+    const auto circle = CirclePixels(pair.lidar_image->rows, pair.lidar_image->columns, stroke->row,
+                                     stroke->column, stroke->radius_px);
+    std::vector<int> merged;
+    if (stroke->erase) {
+      std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), circle.begin(),
+                          circle.end(), std::back_inserter(merged));
+    } else {
+      std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), circle.begin(),
+                     circle.end(), std::back_inserter(merged));
+    }
+    if (merged == pair.brush_pixels) return;
+    pair.brush_pixels = std::move(merged);
+    pair.brush_from_seed = false;  // painted: the brush replaces the seed from now on
+    CommitEdit();
+    const int index = stroke->index;
+    worker_.Enqueue([this, index] { RefitLidar(index); });
+  } else if (const auto* clear = std::get_if<ClearBrush>(&intent)) {
+    if (!valid(clear->index)) return;
+    state_.pairs[clear->index].brush_pixels.clear();
+    state_.pairs[clear->index].brush_from_seed = false;
+    CommitEdit();
+    const int index = clear->index;
+    worker_.Enqueue([this, index] { RefitLidar(index); });
+  } else if (std::holds_alternative<RunSolver>(intent)) {
+    worker_.Enqueue([this] { Solve(); });
+  } else if (std::holds_alternative<ResetSolver>(intent)) {
+    state_.solver = SolverView{};
+    state_.reprojection.reset();
+    RecomputeResiduals();
+    CommitEdit();
+  } else if (const auto* options = std::get_if<SetSolverOptions>(&intent)) {
+    SolverOptions check;
+    check.huber_delta = options->huber_delta;
+    check.max_iterations = options->max_iterations;
+    std::string why;
+    if (!check.Check(&why)) {
+      SetStatus("solver options: " + why, true);
+      return;
+    }
+    const bool method_changed = state_.method != options->method ||
+                                state_.estimate_range_offset != options->estimate_range_offset;
+    state_.method = options->method;
+    state_.estimate_range_offset = options->estimate_range_offset;
+    state_.huber_delta = options->huber_delta;
+    state_.max_iterations = options->max_iterations;
+    // Residuals and weights shown for the current estimate depend on the method.
+    if (method_changed) RecomputeResiduals();
+    CommitEdit();
+  } else if (const auto* view = std::get_if<SetView>(&intent)) {
+    const bool visibility_changed =
+        view->view.visibility != state_.view.visibility ||
+        view->view.hpr_radius_exponent != state_.view.hpr_radius_exponent;
+    state_.view = view->view;
+    CommitEdit();
+    if (visibility_changed) {
+      const int index = state_.selected;
+      worker_.Enqueue([this, index] { ComputeReprojection(index); });
+    }
+  } else if (const auto* export_result = std::get_if<ExportResult>(&intent)) {
+    if (!state_.solver.result) {
+      SetStatus("nothing to export: run the solver first", true);
+      return;
+    }
+    // What `calibench calibrate` writes: the pairs as they stand, the solution with the solver's
+    // residuals at it for the accepted ones.
+    CalibrationOutcome outcome;
+    for (const PairView& pair : state_.pairs) outcome.pairs.push_back(FeaturesOf(pair));
+    const SolverOptions options = SolverOptionsFromState();
+    outcome.solution = state_.solver.result;
+    EvaluateAtSolution(outcome.pairs, options, &*outcome.solution);
+    try {
+      WriteResult(export_result->path, outcome, options);
+      SetStatus("exported " + export_result->path.string(), false);
+    } catch (const IoError& e) {
+      SetStatus(e.what(), true);
+    }
+  } else if (const auto* save = std::get_if<SaveSessionAs>(&intent)) {
+    try {
+      SaveSession(save->path, session_);
+      autosaver_ = std::make_unique<Autosaver>(save->path);
+      state_.session_path = save->path;
+      SetStatus("saved session " + save->path.string(), false);
+    } catch (const IoError& e) {
+      SetStatus(e.what(), true);
+    }
+  } else if (std::holds_alternative<Undo>(intent) || std::holds_alternative<Redo>(intent)) {
+    const auto restored = std::holds_alternative<Undo>(intent) ? history_.Undo() : history_.Redo();
+    if (!restored) return;
+    std::vector<std::vector<int>> before;
+    for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
+    session_ = *restored;
+    ApplySessionToState(session_);
+    RecomputeResiduals();
+    if (autosaver_) autosaver_->Save(session_);
+    for (int i = 0; i < num_pairs; ++i)
+      if (state_.pairs[i].brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });
+  }
+}
+
+}  // namespace calibench::ui

@@ -1,0 +1,176 @@
+// The workbench's state and the only place that changes it. Panels read a Snapshot and return
+// Intents; the controller applies them, runs the slow work (loading, plane fits, detection,
+// solving, visibility) on a worker thread, and autosaves the session after every edit.
+// No GL, GLFW or ImGui here: the controller is driven by tests without a window.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/base/image.h"
+#include "core/camera/undistort.h"
+#include "core/io/dataset.h"
+#include "core/lidar/cloud.h"
+#include "core/lidar/lidar_image.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/solver.h"
+#include "core/reproject/reproject.h"
+#include "core/session/session.h"
+#include "core/target/board_camera.h"
+#include "core/target/lidar_plane.h"
+#include "ui/state/work_queue.h"
+
+namespace calibench::ui {
+
+// Everything the panels show about one pair. Heavy members are shared, immutable buffers.
+struct PairView {
+  std::string id;
+  PairStatus status = PairStatus::kPending;
+  std::string reason;
+  bool loaded = false;
+  std::shared_ptr<const LidarCloud> cloud;
+  std::shared_ptr<const LidarImage> lidar_image;
+  std::shared_ptr<const ImageU8> thumbnail;  // small BGR picture of the camera image
+  std::vector<int> brush_pixels;             // sorted LiDAR-image pixel indices
+  bool brush_from_seed = false;  // brush_pixels picture the manifest's lidar_seed (not painted)
+  std::optional<LidarPlaneFit> lidar;
+  std::string lidar_failure;
+  std::optional<BoardDetection> detection;
+  std::optional<CameraBoardObservation> camera;
+  std::string camera_failure;
+  std::optional<Vec4> residual;  // after a solve
+  double robust_weight = 1.0;
+};
+
+struct SolverView {
+  bool running = false;
+  std::vector<IterationReport> iterations;  // recorded by the solver's callback
+  std::optional<SolverResult> result;
+  std::vector<std::string> solved_pair_ids;  // the pairs behind result->residuals, in order
+  std::string failure;
+};
+
+// The camera-side reprojection of the selected pair after a solve.
+struct Reprojection {
+  std::string pair_id;
+  std::vector<ProjectedPoint> points;
+  std::vector<bool> visible;
+};
+
+struct Snapshot {
+  std::uint64_t generation = 0;  // increases with every change
+  std::filesystem::path dataset_path;
+  std::filesystem::path session_path;
+  std::optional<Dataset> dataset;
+  std::vector<PairView> pairs;
+  int selected = -1;
+  std::shared_ptr<const ImageU8> selected_image;  // full-resolution camera image of `selected`
+  std::shared_ptr<const UndistortedView> selected_undistorted;  // the same, distortion removed
+  SolverView solver;
+  std::shared_ptr<const Reprojection> reprojection;
+  ViewState view;
+  SolverMethod method = SolverOptions{}.method;
+  double huber_delta = SolverOptions{}.huber_delta;
+  int max_iterations = SolverOptions{}.max_iterations;
+  bool estimate_range_offset = false;  // weighted-ml only
+  bool can_undo = false, can_redo = false;
+  int loading_done = 0, loading_total = 0;
+  bool busy = false;        // worker has queued or running jobs
+  std::string status_line;  // the last message for the user (errors included)
+  bool status_is_error = false;
+};
+
+// What the user asked for. Panels return these; Controller::Apply carries them out.
+struct SelectPair {
+  int index;
+};
+struct SetPairStatus {
+  int index;
+  PairStatus status;
+};
+struct BrushStroke {
+  int index;
+  int row;
+  int column;
+  float radius_px;
+  bool erase;
+};
+struct ClearBrush {
+  int index;
+};
+struct RunSolver {};
+struct ResetSolver {};
+struct SetSolverOptions {
+  double huber_delta;
+  int max_iterations;
+  SolverMethod method = SolverOptions{}.method;
+  bool estimate_range_offset = false;
+};
+struct SetView {
+  ViewState view;
+};
+struct ExportResult {
+  std::filesystem::path path;
+};
+struct SaveSessionAs {
+  std::filesystem::path path;
+};
+struct Undo {};
+struct Redo {};
+using Intent =
+    std::variant<SelectPair, SetPairStatus, BrushStroke, ClearBrush, RunSolver, ResetSolver,
+                 SetSolverOptions, SetView, ExportResult, SaveSessionAs, Undo, Redo>;
+
+class Controller {
+ public:
+  // options: the pipeline's (as `calibench calibrate` takes them); a session's choices override
+  // its solver settings.
+  explicit Controller(PipelineOptions options = {});
+  ~Controller();
+  Controller(const Controller&) = delete;
+  Controller& operator=(const Controller&) = delete;
+
+  // Opens a dataset (new session saved next to it as <dataset folder>/calibench.session.json
+  // unless session_path is given) or a saved session. The manifest / session is read here and
+  // throws IoError; the pairs load on the worker thread (see loading_done / loading_total).
+  void OpenDataset(const std::filesystem::path& dataset, std::filesystem::path session_path = {});
+  void OpenSession(const std::filesystem::path& session);
+
+  void Apply(const Intent& intent);
+  Snapshot GetSnapshot() const;
+  // Blocks until the worker has no queued or running job (tests, headless renders).
+  void WaitIdle();
+
+ private:
+  void LoadAllPairs();
+  void LoadPair(int index);
+  void RefitLidar(int index);
+  void Solve();
+  SolverOptions SolverOptionsFromState() const;          // the user's choices over pipeline_.solver
+  PipelineOptions PipelineOptionsFromState() const;      // pipeline_ with those solver choices
+  static PairFeatures FeaturesOf(const PairView& pair);  // the pipeline's view of a pair
+  void ComputeReprojection(int index);
+  void EnsureSelectedImage();
+  void RecomputeResiduals();  // call with mutex_ held
+  void CommitEdit();          // session <- state, history + autosave; call with mutex_ held
+  void SetStatus(const std::string& message, bool error);  // call with mutex_ held
+  void ApplySessionToState(const Session& session);        // call with mutex_ held
+  void Open(const Dataset& dataset, Session session, std::filesystem::path session_path);
+
+  mutable std::mutex mutex_;
+  Snapshot state_;
+  Session session_;  // the editable state as saved; state_ mirrors it plus derived data
+  SessionHistory history_;
+  std::unique_ptr<Autosaver> autosaver_;
+  PipelineOptions pipeline_;
+
+  WorkQueue worker_;  // last member: jobs may touch everything above
+};
+
+}  // namespace calibench::ui

@@ -1,0 +1,303 @@
+#include "ui/lrf/controller.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/estimation/uncertainty.h"
+#include "core/io/image_io.h"
+#include "core/lrf/result_io.h"
+
+namespace calibench::ui {
+namespace {
+
+// Both sides of the pair gave what the solver needs.
+bool HasFeatures(const LrfPairFeatures& features) {
+  if (features.three_face) return features.three_face->scan.ok && features.three_face->depth.ok;
+  return features.board_scan && features.board_scan->ok && features.camera.has_value();
+}
+
+std::string FeatureFailure(const LrfPairFeatures& features) {
+  if (!features.reason.empty()) return features.reason;
+  if (features.three_face) {
+    if (!features.three_face->scan.ok) return "scan: " + features.three_face->scan.reason;
+    if (!features.three_face->depth.ok) return "depth: " + features.three_face->depth.reason;
+  }
+  if (features.board_scan && !features.board_scan->ok)
+    return "scan: " + features.board_scan->reason;
+  if (!features.camera) return "camera: no board pose";
+  return "no features";
+}
+
+// RMS distance of the pair's scan points, moved into the camera frame, to their planes.
+double PointToPlaneRms(const LrfPairFeatures& features, const Pose& cam_from_lrf) {
+  double sum = 0.0;
+  size_t count = 0;
+  auto add = [&](const Vec2& point, const Plane& plane) {
+    const double r = plane.SignedDistance(cam_from_lrf * Vec3(point.x(), point.y(), 0.0));
+    sum += r * r;
+    ++count;
+  };
+  if (features.three_face) {
+    for (int face = 0; face < 3; ++face)
+      for (const Vec2& p : features.three_face->scan.face_points[face])
+        add(p, features.three_face->depth.planes[face]);
+  } else if (features.board_scan && features.camera) {
+    for (const Vec2& p : features.board_scan->points) add(p, features.camera->plane);
+  }
+  return count ? std::sqrt(sum / count) : 0.0;
+}
+
+}  // namespace
+
+LrfController::LrfController(LrfPipelineOptions options)
+    : options_(std::move(options)), worker_([this](const std::string& message) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        state_.solver.running = false;
+        SetStatus("error: " + message, true);
+      }) {
+  state_.solver.method = options_.solver.method;
+  state_.status_line = "open an LRF dataset manifest";
+}
+
+LrfController::~LrfController() = default;
+
+void LrfController::WaitIdle() { worker_.WaitIdle(); }
+
+LrfSnapshot LrfController::GetSnapshot() const {
+  LrfSnapshot copy;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    copy = state_;
+  }
+  copy.busy = worker_.Busy();
+  return copy;
+}
+
+void LrfController::SetStatus(const std::string& message, bool error) {
+  state_.status_line = message;
+  state_.status_is_error = error;
+  ++state_.generation;
+}
+
+bool LrfController::Open(const std::filesystem::path& manifest) {
+  std::string why;
+  std::shared_ptr<const LrfDataset> dataset;
+  try {
+    if (!options_.Check(&why)) throw IoError("LRF pipeline options: " + why);
+    dataset = std::make_shared<const LrfDataset>(LoadLrfDataset(manifest));
+  } catch (const IoError& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    SetStatus(std::string("cannot open: ") + e.what(), true);
+    return false;
+  }
+  // Jobs of the previous dataset are dropped; one still running discards its result.
+  worker_.DropQueued();
+  std::uint64_t open_count;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    open_count = ++open_count_;
+    const std::uint64_t generation = state_.generation;
+    state_ = LrfSnapshot{};
+    state_.generation = generation;
+    state_.solver.method = options_.solver.method;
+    state_.manifest = dataset->manifest;
+    state_.dataset = dataset;
+    for (const LrfPairEntry& entry : dataset->pairs) state_.pairs.emplace_back().id = entry.id;
+    state_.selected = state_.pairs.empty() ? -1 : 0;
+    state_.extracted_total = static_cast<int>(state_.pairs.size());
+    outcome_.reset();
+    SetStatus("extracting features of " + std::to_string(state_.pairs.size()) + " pairs from " +
+                  dataset->manifest.string(),
+              false);
+  }
+  for (int i = 0; i < static_cast<int>(dataset->pairs.size()); ++i)
+    worker_.Enqueue([this, open_count, i] { Extract(open_count, i); });
+  if (dataset->target_type == LrfTargetType::kCheckerboard)
+    worker_.Enqueue([this] { LoadSelectedImage(); });
+  return true;
+}
+
+void LrfController::Extract(std::uint64_t open_count, int index) {
+  std::shared_ptr<const LrfDataset> dataset;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (open_count != open_count_) return;
+    dataset = state_.dataset;
+  }
+  auto features = std::make_shared<const LrfPairFeatures>(
+      ExtractLrfPairFeatures(*dataset, dataset->pairs[index], options_));
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (open_count != open_count_) return;
+  LrfPairView& pair = state_.pairs[index];
+  pair.features = features;
+  pair.extracted = true;
+  // Usable pairs are accepted unless the user rejected them; the others fail with the reason.
+  if (pair.status != PairStatus::kRejected) {
+    const bool usable = HasFeatures(*features);
+    pair.status = usable ? PairStatus::kAccepted : PairStatus::kFailed;
+    pair.reason = usable ? "" : FeatureFailure(*features);
+  }
+  if (++state_.extracted_done == state_.extracted_total) {
+    const int accepted = static_cast<int>(
+        std::count_if(state_.pairs.begin(), state_.pairs.end(),
+                      [](const LrfPairView& p) { return p.status == PairStatus::kAccepted; }));
+    SetStatus("extracted " + std::to_string(state_.extracted_total) +
+                  " pairs: " + std::to_string(accepted) + " accepted, " +
+                  std::to_string(state_.extracted_total - accepted) + " not",
+              false);
+  } else {
+    ++state_.generation;
+  }
+}
+
+void LrfController::Solve() {
+  std::vector<LrfPairFeatures> pairs;
+  std::shared_ptr<const LrfDataset> dataset;
+  LrfPipelineOptions options = options_;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!state_.dataset) return;
+    dataset = state_.dataset;
+    options.solver.method = state_.solver.method;
+    for (const LrfPairView& view : state_.pairs) {
+      if (!view.features) continue;
+      pairs.push_back(*view.features);
+      pairs.back().status = view.status;
+      pairs.back().reason = view.reason;
+    }
+    state_.solver = LrfSolverView{};
+    state_.solver.method = options.solver.method;
+    state_.solver.running = true;
+    outcome_.reset();
+    UpdatePairFigures();
+    SetStatus("solving (" + LrfMethodName(options.solver.method) + ") ...", false);
+  }
+  auto outcome = std::make_shared<LrfCalibrationOutcome>(
+      SolveLrfFromFeatures(std::move(pairs), *dataset, options));
+  std::lock_guard<std::mutex> lock(mutex_);
+  LrfSolverView& solver = state_.solver;
+  solver.running = false;
+  if (!outcome->solution || !outcome->solution->ok) {
+    solver.failure = !outcome->failure.empty() ? outcome->failure
+                     : outcome->solution       ? outcome->solution->reason
+                                               : "no calibration";
+    SetStatus("no calibration: " + solver.failure, true);
+    return;
+  }
+  const LrfSolution& solution = *outcome->solution;
+  solver.solution = solution;
+  // The refinement's recorded iterations drive the cost plot, Step and Replay.
+  solver.iterations = solution.history;
+  for (const LrfPairFeatures& p : outcome->pairs)
+    if (p.status == PairStatus::kAccepted) solver.solved_pair_ids.push_back(p.id);
+  solver.std_translation_mm = TranslationStd(solution.covariance, solution.cam_from_lrf) * 1e3;
+  solver.std_rotation_deg = RotationStdDeg(solution.covariance, solution.cam_from_lrf);
+  outcome_ = outcome;
+  UpdatePairFigures();
+  const bool well = solution.observability.well_constrained;
+  char line[256];
+  std::snprintf(line, sizeof(line), "solved (%s) with %zu pairs: %s%s",
+                LrfMethodName(solution.method).c_str(), solver.solved_pair_ids.size(),
+                LrfResidualText(solution, state_.dataset ? state_.dataset->target_type
+                                                         : LrfTargetType::kThreeFace)
+                    .c_str(),
+                well ? "" : " (NOT well constrained)");
+  SetStatus(line, !well);
+}
+
+void LrfController::UpdatePairFigures() {
+  const LrfSolution* solution = state_.solver.solution ? &*state_.solver.solution : nullptr;
+  for (LrfPairView& pair : state_.pairs) {
+    pair.point_to_line_m.reset();
+    pair.point_to_plane_rms_m.reset();
+    if (!solution || !pair.features || !HasFeatures(*pair.features)) continue;
+    if (pair.features->three_face)
+      pair.point_to_line_m = PointToLineError(*pair.features->three_face, solution->cam_from_lrf);
+    pair.point_to_plane_rms_m = PointToPlaneRms(*pair.features, solution->cam_from_lrf);
+  }
+  ++state_.generation;
+}
+
+void LrfController::LoadSelectedImage() {
+  std::filesystem::path path;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (state_.selected < 0 || !state_.dataset) return;
+    path = state_.dataset->pairs[state_.selected].image;
+  }
+  if (path.empty()) return;
+  std::shared_ptr<const ImageU8> image;
+  try {
+    image = std::make_shared<const ImageU8>(LoadImage(path));
+  } catch (const IoError& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    SetStatus(e.what(), true);
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (state_.selected >= 0 && state_.dataset->pairs[state_.selected].image == path) {
+    state_.selected_image = image;
+    ++state_.generation;
+  }
+}
+
+void LrfController::Apply(const LrfIntent& intent) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!state_.dataset) return;
+  const int num_pairs = static_cast<int>(state_.pairs.size());
+  auto valid = [&](int index) { return index >= 0 && index < num_pairs; };
+  if (const auto* select = std::get_if<LrfSelectPair>(&intent)) {
+    if (!valid(select->index) || select->index == state_.selected) return;
+    state_.selected = select->index;
+    state_.selected_image.reset();
+    ++state_.generation;
+    if (state_.dataset->target_type == LrfTargetType::kCheckerboard)
+      worker_.Enqueue([this] { LoadSelectedImage(); });
+  } else if (const auto* status = std::get_if<LrfSetPairStatus>(&intent)) {
+    if (!valid(status->index)) return;
+    LrfPairView& pair = state_.pairs[status->index];
+    if (status->status == PairStatus::kAccepted &&
+        !(pair.features && HasFeatures(*pair.features))) {
+      SetStatus("pair " + pair.id + " cannot be accepted: " +
+                    (pair.features ? FeatureFailure(*pair.features) : "features not extracted yet"),
+                true);
+      return;
+    }
+    pair.status = status->status;
+    pair.reason = status->status == PairStatus::kRejected ? "rejected by the user" : "";
+    SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
+                  (state_.solver.solution ? "; press Run to re-solve" : ""),
+              false);
+  } else if (std::holds_alternative<LrfRunSolver>(intent)) {
+    if (state_.solver.running) return;
+    state_.solver.running = true;  // until the queued solve starts and reports
+    ++state_.generation;
+    worker_.Enqueue([this] { Solve(); });
+  } else if (std::holds_alternative<LrfResetSolver>(intent)) {
+    const LrfMethod method = state_.solver.method;
+    state_.solver = LrfSolverView{};
+    state_.solver.method = method;
+    outcome_.reset();
+    UpdatePairFigures();
+  } else if (const auto* method = std::get_if<LrfSetMethod>(&intent)) {
+    if (method->method == state_.solver.method) return;
+    state_.solver.method = method->method;
+    SetStatus("method " + LrfMethodName(method->method) + "; press Run to solve with it", false);
+  } else if (const auto* export_result = std::get_if<LrfExportResult>(&intent)) {
+    if (!outcome_ || !outcome_->solution) {
+      SetStatus("nothing to export: run the solver first", true);
+      return;
+    }
+    LrfPipelineOptions options = options_;
+    options.solver.method = outcome_->solution->method;
+    try {
+      WriteLrfResult(export_result->path, *outcome_, options);
+      SetStatus("exported " + export_result->path.string(), false);
+    } catch (const IoError& e) {
+      SetStatus(e.what(), true);
+    }
+  }
+}
+
+}  // namespace calibench::ui

@@ -1,0 +1,112 @@
+// The 2D LRF workbench's state and the only place that changes it (the LRF counterpart of
+// ui/controller.h). Panels read an LrfSnapshot and return LrfIntents; the controller applies
+// them and runs feature extraction and solving on a worker thread.
+// No GL, GLFW or ImGui here: the controller is driven by tests without a window.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/base/image.h"
+#include "core/lrf/pipeline.h"
+#include "ui/state/work_queue.h"
+
+namespace calibench::ui {
+
+// Everything the panels show about one pair. The features are a shared, immutable buffer.
+struct LrfPairView {
+  std::string id;
+  PairStatus status = PairStatus::kPending;
+  std::string reason;
+  bool extracted = false;
+  std::shared_ptr<const LrfPairFeatures> features;
+  // At the solver's estimate (after a solve): Eq. (12) mean corner-to-line distance (three-face
+  // only) and the RMS point-to-plane distance of the pair's face / board scan points. Metres.
+  std::optional<double> point_to_line_m;
+  std::optional<double> point_to_plane_rms_m;
+};
+
+struct LrfSolverView {
+  LrfMethod method = LrfMethod::kRefined;
+  bool running = false;
+  // Gauss-Newton iterations of the refined method (cost and cam_from_lrf in cam_from_lidar);
+  // empty for paper-linear, which is closed form.
+  std::vector<IterationReport> iterations;
+  std::optional<LrfSolution> solution;  // ok solutions only; failures go to `failure`
+  std::vector<std::string> solved_pair_ids;
+  Vec3 std_translation_mm = Vec3::Zero();  // camera axes
+  Vec3 std_rotation_deg = Vec3::Zero();    // camera axes
+  std::string failure;
+};
+
+struct LrfSnapshot {
+  std::uint64_t generation = 0;  // increases with every change
+  std::filesystem::path manifest;
+  std::shared_ptr<const LrfDataset> dataset;  // null until a manifest opened
+  std::vector<LrfPairView> pairs;
+  int selected = -1;
+  std::shared_ptr<const ImageU8> selected_image;  // checkerboard case: the RGB image of `selected`
+  LrfSolverView solver;
+  int extracted_done = 0, extracted_total = 0;
+  bool busy = false;  // worker has queued or running jobs
+  std::string status_line;
+  bool status_is_error = false;
+};
+
+struct LrfSelectPair {
+  int index;
+};
+struct LrfSetPairStatus {
+  int index;
+  PairStatus status;  // kAccepted or kRejected
+};
+struct LrfRunSolver {};
+struct LrfResetSolver {};
+struct LrfSetMethod {
+  LrfMethod method;
+};
+struct LrfExportResult {
+  std::filesystem::path path;
+};
+using LrfIntent = std::variant<LrfSelectPair, LrfSetPairStatus, LrfRunSolver, LrfResetSolver,
+                               LrfSetMethod, LrfExportResult>;
+
+class LrfController {
+ public:
+  explicit LrfController(LrfPipelineOptions options = {});
+  ~LrfController();
+  LrfController(const LrfController&) = delete;
+  LrfController& operator=(const LrfController&) = delete;
+
+  // Loads the manifest and queues feature extraction of every pair. A manifest that cannot be
+  // read leaves the open dataset as it was and shows the error in the status line (false).
+  bool Open(const std::filesystem::path& manifest);
+  void Apply(const LrfIntent& intent);
+  LrfSnapshot GetSnapshot() const;
+  // Blocks until the worker has no queued or running job (tests, headless renders).
+  void WaitIdle();
+
+ private:
+  void Extract(std::uint64_t open_count, int index);
+  void Solve();
+  void LoadSelectedImage();
+  void UpdatePairFigures();                                // call with mutex_ held
+  void SetStatus(const std::string& message, bool error);  // call with mutex_ held
+
+  LrfPipelineOptions options_;
+  mutable std::mutex mutex_;
+  LrfSnapshot state_;
+  std::shared_ptr<const LrfCalibrationOutcome> outcome_;  // of the shown solution, for export
+  std::uint64_t open_count_ = 0;  // a job of an earlier Open() discards its result
+
+  WorkQueue worker_;  // last member: jobs may touch everything above
+};
+
+}  // namespace calibench::ui

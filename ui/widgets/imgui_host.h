@@ -1,0 +1,54 @@
+// Dear ImGui set-up shared by the window and the headless renderer: context, theme, font,
+// OpenGL3 backend (and the GLFW backend for a window). The headless host feeds display size, time
+// and input itself, so tests can drive the panels frame by frame without a window.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "core/base/image.h"
+
+struct GLFWwindow;
+
+namespace calibench::ui {
+
+class ImGuiHost {
+ public:
+  // Requires a current GL context. window == nullptr: headless (no platform backend).
+  explicit ImGuiHost(GLFWwindow* window);
+  ~ImGuiHost();
+  ImGuiHost(const ImGuiHost&) = delete;
+  ImGuiHost& operator=(const ImGuiHost&) = delete;
+
+  // Starts a frame. Headless: display size and delta time come from the arguments.
+  void NewFrame(int width, int height, double delta_seconds);
+  // Renders the frame's draw data into the currently bound framebuffer.
+  void Render();
+
+ private:
+  bool windowed_ = false;
+};
+
+// The dark theme and DejaVu Sans (from fonts-dejavu-core; ImGui's built-in font otherwise).
+void ApplyThemeAndFont();
+
+// Runs `frames` ImGui frames headless, each built by build_frame(), into an offscreen framebuffer
+// and returns the last one as a picture: exactly what the window would show.
+ImageU8 RenderFramesHeadless(ImGuiHost& host, int width, int height, int frames,
+                             const std::function<void()>& build_frame);
+
+// A workbench (either method's) driven headless against its controller, waiting for the
+// controller's worker before each frame and applying the intents the panels return.
+template <typename Controller, typename Workbench, typename Layout>
+ImageU8 RenderWorkbenchHeadless(Controller& controller, Workbench& workbench, ImGuiHost& host,
+                                Layout layout, int width, int height, int frames) {
+  return RenderFramesHeadless(host, width, height, frames, [&] {
+    controller.WaitIdle();
+    const auto snapshot = controller.GetSnapshot();
+    for (const auto& intent : workbench.Frame(snapshot, width, height, layout, 1.0 / 60.0))
+      controller.Apply(intent);
+  });
+}
+
+}  // namespace calibench::ui
