@@ -4,6 +4,7 @@
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "core/io/dataset.h"
+#include "core/session/session.h"
 
 namespace calibench::app {
 
@@ -12,8 +13,12 @@ int RunCalibrate(int argc, char** argv) {
       "Calibrate a 3D LiDAR to a camera from board planes (Ca²Lib plane-to-plane "
       "Gauss-Newton with a Huber kernel).",
       "calibench calibrate"};
-  std::string dataset_path, out_path;
-  app.add_option("--dataset,-d", dataset_path, "dataset.json or dataset folder")->required();
+  std::string dataset_path, session_path, out_path;
+  app.add_option("--dataset,-d", dataset_path, "dataset.json or dataset folder");
+  app.add_option("--session", session_path,
+                 "a workbench session (calibench.session.json): its brushes, rejections and "
+                 "solver choices are used, so the result is the workbench's; its dataset unless "
+                 "--dataset is given");
   app.add_option("--out,-o", out_path, "result file (calibench.result.v1)");
   PipelineFlags flags;
   AddPipelineFlags(app, flags);
@@ -27,8 +32,19 @@ int RunCalibrate(int argc, char** argv) {
     std::fprintf(stderr, "calibench calibrate: %s\n", why.c_str());
     return kUsage;
   }
+  PairEdits edits;
+  if (!session_path.empty()) {
+    const Session session = LoadSession(session_path);
+    if (dataset_path.empty()) dataset_path = session.dataset.string();
+    ApplySessionOptions(session, &flags.options);
+    edits = EditsFromSession(session);
+  }
+  if (dataset_path.empty()) {
+    std::fprintf(stderr, "calibench calibrate: give --dataset or --session\n");
+    return kUsage;
+  }
   const Dataset dataset = LoadDataset(dataset_path);
-  return CalibrateAndReport(dataset, flags.options, out_path);
+  return CalibrateAndReport(dataset, flags.options, out_path, nullptr, edits);
 }
 
 }  // namespace calibench::app

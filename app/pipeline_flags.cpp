@@ -101,8 +101,10 @@ ProgressCallback StderrProgress(const std::string& verb) {
 }
 
 int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
-                       const std::string& out_path, CalibrationOutcome* outcome_out) {
-  CalibrationOutcome outcome = CalibrateDataset(dataset, options, StderrProgress("extracted"));
+                       const std::string& out_path, CalibrationOutcome* outcome_out,
+                       const PairEdits& edits) {
+  CalibrationOutcome outcome =
+      CalibrateDataset(dataset, options, StderrProgress("extracted"), edits);
   std::printf("%s", FormatSummary(outcome).c_str());
   bool input_error = false;
   for (const PairFeatures& p : outcome.pairs) input_error |= p.input_error;

@@ -28,6 +28,7 @@ ProgressCallback StderrProgress(const std::string& verb);
 // exit code (kOk, kInputError when any pair file was unreadable, kNoCalibration,
 // kNotConstrained).
 int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
-                       const std::string& out_path, CalibrationOutcome* outcome_out = nullptr);
+                       const std::string& out_path, CalibrationOutcome* outcome_out = nullptr,
+                       const PairEdits& edits = {});
 
 }  // namespace calibench::app

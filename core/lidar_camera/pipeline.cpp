@@ -120,8 +120,27 @@ void SetStatusFromFeatures(PairFeatures* features, const std::string& lidar_fail
   features->reason = usable ? "" : (!features->lidar ? lidar_failure : "camera: " + camera_failure);
 }
 
+namespace {
+
+// The region hint for a pair: the user's brush where one was painted (checked against the
+// image layout it was painted on), else the manifest's seed. nullopt with *why for a brush that
+// does not fit this cloud's image.
+std::optional<BoardHint> HintFor(const PairEntry& pair, const PairEdit& edit,
+                                 const LidarImage* image, std::string* why) {
+  if (!edit.brush_pixels) return BoardHint{.seed = pair.lidar_seed};
+  if (image->rows != edit.brush_rows || image->columns != edit.brush_columns) {
+    *why = "the brush was painted on a " + std::to_string(edit.brush_rows) + "x" +
+           std::to_string(edit.brush_columns) + " LiDAR image but " + pair.cloud.string() +
+           " gives " + std::to_string(image->rows) + "x" + std::to_string(image->columns);
+    return std::nullopt;
+  }
+  return BoardHint{&*edit.brush_pixels, image, std::nullopt};
+}
+
+}  // namespace
+
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
-                                 const PipelineOptions& options) {
+                                 const PipelineOptions& options, const PairEdit& edit) {
   PairFeatures features;
   features.id = pair.id;
   std::string why;
@@ -131,17 +150,24 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
     SetStatusFromFeatures(&features, why, why);
     return features;
   }
+  // The brush's pixels index the image the workbench shows (ProjectById, default options).
+  std::optional<LidarImage> image;
+  if (edit.brush_pixels) image = ProjectById(inputs->cloud, LidarImageOptions{});
   std::string lidar_failure;
-  features.lidar = ExtractLidarFeatures(dataset, inputs->cloud, {.seed = pair.lidar_seed}, options,
-                                        &lidar_failure);
+  if (const auto hint = HintFor(pair, edit, image ? &*image : nullptr, &lidar_failure))
+    features.lidar = ExtractLidarFeatures(dataset, inputs->cloud, *hint, options, &lidar_failure);
   CameraFeatures camera = ExtractCameraFeatures(dataset, inputs->image, options);
   features.camera = std::move(camera.observation);
   SetStatusFromFeatures(&features, lidar_failure, camera.failure);
+  if (edit.rejected) {
+    features.status = PairStatus::kRejected;
+    features.reason = kRejectedByUser;
+  }
   return features;
 }
 
 CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,
-                                    const ProgressCallback& progress) {
+                                    const ProgressCallback& progress, const PairEdits& edits) {
   std::vector<const PairEntry*> selected;
   const std::set<std::string> wanted(options.pair_ids.begin(), options.pair_ids.end());
   for (const PairEntry& pair : dataset.pairs)
@@ -150,7 +176,11 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
   std::vector<PairFeatures> features(selected.size());
   ParallelFor(
       selected.size(), options.threads,
-      [&](size_t i) { features[i] = ExtractPairFeatures(dataset, *selected[i], options); },
+      [&](size_t i) {
+        const auto edit = edits.find(selected[i]->id);
+        features[i] = ExtractPairFeatures(dataset, *selected[i], options,
+                                          edit == edits.end() ? PairEdit{} : edit->second);
+      },
       [&](int finished, size_t i) {
         if (progress) progress(finished, static_cast<int>(selected.size()), selected[i]->id);
       });

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -98,11 +99,24 @@ std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const 
 void SetStatusFromFeatures(PairFeatures* features, const std::string& lidar_failure,
                            const std::string& camera_failure);
 
-// Loads the pair's files and extracts both planes (the steps above, the seed as the hint). Never
-// throws for bad data: the pair comes back kFailed with the reason (unreadable files name the
-// file).
+// What the workbench's user decided for a pair, as a session keeps it (core/session turns a
+// session into these): a painted brush replaces the manifest's seed, a rejection keeps the pair
+// out of the solve.
+struct PairEdit {
+  // LiDAR-image pixels (ProjectById with default LidarImageOptions) painted by the user; absent =
+  // the manifest's seed. Present but empty = the user erased the board.
+  std::optional<std::vector<int>> brush_pixels;
+  int brush_rows = 0;  // the image layout the brush was painted on
+  int brush_columns = 0;
+  bool rejected = false;
+};
+using PairEdits = std::map<std::string, PairEdit>;  // by pair id
+
+// Loads the pair's files and extracts both planes (the steps above; the hint is the pair's edited
+// brush, else its seed). Never throws for bad data: the pair comes back kFailed with the reason
+// (unreadable files name the file); a rejected pair comes back kRejected with its features.
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
-                                 const PipelineOptions& options);
+                                 const PipelineOptions& options, const PairEdit& edit = {});
 
 struct CalibrationOutcome {
   std::vector<PairFeatures> pairs;
@@ -113,7 +127,8 @@ struct CalibrationOutcome {
 
 // Extracts every selected pair (in parallel with options.threads) and solves.
 CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,
-                                    const ProgressCallback& progress = {});
+                                    const ProgressCallback& progress = {},
+                                    const PairEdits& edits = {});
 
 using IterationCallback = std::function<void(const IterationReport&)>;
 

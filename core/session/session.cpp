@@ -99,6 +99,23 @@ void ApplySessionOptions(const Session& session, PipelineOptions* options) {
   options->solver.huber_delta = session.huber_delta;
   options->solver.max_iterations = session.max_iterations;
   options->lidar_plane.ransac_threshold_m = session.ransac_threshold_m;
+  options->solver.estimate_range_offset =
+      session.estimate_range_offset && session.method == SolverMethod::kWeightedMl;
+}
+
+PairEdits EditsFromSession(const Session& session) {
+  PairEdits edits;
+  for (const PairState& pair : session.pairs) {
+    PairEdit edit;
+    edit.rejected = pair.status == PairStatus::kRejected;
+    if (pair.brush && !pair.brush_from_seed) {
+      edit.brush_pixels = pair.brush->pixels;
+      edit.brush_rows = pair.brush->rows;
+      edit.brush_columns = pair.brush->columns;
+    }
+    if (edit.rejected || edit.brush_pixels) edits[pair.id] = edit;
+  }
+  return edits;
 }
 
 Session LoadSession(const std::filesystem::path& path) {

@@ -126,8 +126,14 @@ std::filesystem::path NormalizeSessionPath(const std::filesystem::path& path);
 // One pending PairState per dataset pair, the first pair selected, default options.
 Session NewSession(const Dataset& dataset);
 
-// Copies the session's solver and RANSAC options into pipeline options.
+// Copies the session's solver and RANSAC options into pipeline options (the range offset only
+// for the weighted method, as the workbench solves).
 void ApplySessionOptions(const Session& session, PipelineOptions* options);
+
+// The user's decisions in the session as the pipeline takes them: painted brushes (not those
+// pictured from a seed) and rejections, by pair id. `calibench calibrate --session` and the
+// workbench then compute the same calibration.
+PairEdits EditsFromSession(const Session& session);
 
 // The session as JSON text for a file at session_path: the dataset path is written relative to
 // the session file's folder when it lies under it, absolute otherwise. Doubles round-trip

@@ -196,12 +196,15 @@ void Controller::CommitEdit() {
 void Controller::LoadPair(int index) {
   PairEntry entry;
   Dataset dataset;
-  PairView saved;
+  std::vector<int> saved_brush;
+  bool painted = false;  // the session holds a brush the user painted (or erased)
   {
     std::lock_guard<std::mutex> lock(mutex_);
     entry = state_.dataset->pairs[index];
     dataset = *state_.dataset;
-    saved = state_.pairs[index];
+    saved_brush = state_.pairs[index].brush_pixels;
+    const PairState& saved = session_.pairs[index];
+    painted = saved.brush.has_value() && !saved.brush_from_seed;
   }
   // The pipeline's own steps (core/lidar_camera/pipeline.h), as `calibench calibrate` runs them.
   PairView loaded;
@@ -215,10 +218,11 @@ void Controller::LoadPair(int index) {
     loaded.detection = std::move(camera.detection);
     loaded.camera = std::move(camera.observation);
     loaded.camera_failure = camera.failure;
-    loaded.brush_pixels = saved.brush_pixels;
-    loaded.brush_from_seed = saved.brush_from_seed;
-    // A brush derived from the seed is only its picture: the seed itself selects the region.
-    if ((loaded.brush_pixels.empty() || loaded.brush_from_seed) && entry.lidar_seed) {
+    // A painted brush replaces the seed; otherwise the seed selects the region and the brush
+    // only pictures it (as EditsFromSession tells `calibench calibrate --session`).
+    if (painted) {
+      loaded.brush_pixels = saved_brush;
+    } else if (entry.lidar_seed) {
       loaded.brush_pixels = SeedBrush(*cloud, *lidar_image, *entry.lidar_seed);
       loaded.brush_from_seed = true;
     }
@@ -301,18 +305,30 @@ void Controller::RefitLidar(int index) {
   }
 }
 
+SolverResult Controller::ResultForCurrentPairs() const {
+  SolverResult result = *state_.solver.result;
+  std::vector<PairFeatures> features;
+  std::vector<std::string> accepted;
+  for (const PairView& pair : state_.pairs) {
+    features.push_back(FeaturesOf(pair));
+    if (features.back().status == PairStatus::kAccepted) accepted.push_back(pair.id);
+  }
+  // The solve's own figures while its pairs are still the accepted ones (they include the
+  // outliers it gated); after accept/reject since, or after a reload, the solver's residuals at
+  // the shown estimate over the pairs accepted now.
+  if (accepted == state_.solver.solved_pair_ids && result.residuals.size() == accepted.size())
+    return result;
+  EvaluateAtSolution(features, SolverOptionsFromState(), &result);
+  return result;
+}
+
 void Controller::RecomputeResiduals() {
   for (PairView& pair : state_.pairs) pair.residual.reset();
   if (!state_.solver.result) return;
-  // The solver's own residuals and robust weights at the shown estimate, over the pairs that
-  // are accepted now (after a reload, or after accept/reject since the last solve).
-  std::vector<PairFeatures> features;
-  for (const PairView& pair : state_.pairs) features.push_back(FeaturesOf(pair));
-  SolverResult at_estimate = *state_.solver.result;
-  EvaluateAtSolution(features, SolverOptionsFromState(), &at_estimate);
+  const SolverResult at_estimate = ResultForCurrentPairs();
   size_t solved = 0;
   for (PairView& pair : state_.pairs) {
-    if (pair.status != PairStatus::kAccepted || !pair.lidar || !pair.camera) continue;
+    if (FeaturesOf(pair).status != PairStatus::kAccepted) continue;
     pair.residual = at_estimate.residuals[solved];
     pair.robust_weight = at_estimate.robust_weights[solved];
     ++solved;
@@ -484,7 +500,7 @@ void Controller::Apply(const Intent& intent) {
       return;
     }
     pair.status = status->status;
-    pair.reason = status->status == PairStatus::kRejected ? "rejected by the user" : "";
+    pair.reason = status->status == PairStatus::kRejected ? kRejectedByUser : "";
     SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
                   (state_.solver.result ? "; press Run to re-solve" : ""),
               false);
@@ -561,8 +577,7 @@ void Controller::Apply(const Intent& intent) {
     CalibrationOutcome outcome;
     for (const PairView& pair : state_.pairs) outcome.pairs.push_back(FeaturesOf(pair));
     const SolverOptions options = SolverOptionsFromState();
-    outcome.solution = state_.solver.result;
-    EvaluateAtSolution(outcome.pairs, options, &*outcome.solution);
+    outcome.solution = ResultForCurrentPairs();
     try {
       WriteResult(export_result->path, outcome, options);
       SetStatus("exported " + export_result->path.string(), false);

@@ -157,6 +157,9 @@ class Controller {
   static PairFeatures FeaturesOf(const PairView& pair);  // the pipeline's view of a pair
   void ComputeReprojection(int index);
   void EnsureSelectedImage();
+  // The solve's result with residuals and robust weights for the pairs accepted now, in order
+  // (state_.solver.result must be set); call with mutex_ held.
+  SolverResult ResultForCurrentPairs() const;
   void RecomputeResiduals();  // call with mutex_ held
   void CommitEdit();          // session <- state, history + autosave; call with mutex_ held
   void SetStatus(const std::string& message, bool error);  // call with mutex_ held

@@ -265,7 +265,7 @@ void LrfController::Apply(const LrfIntent& intent) {
       return;
     }
     pair.status = status->status;
-    pair.reason = status->status == PairStatus::kRejected ? "rejected by the user" : "";
+    pair.reason = status->status == PairStatus::kRejected ? kRejectedByUser : "";
     SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
                   (state_.solver.solution ? "; press Run to re-solve" : ""),
               false);

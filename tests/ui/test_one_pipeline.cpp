@@ -1,0 +1,150 @@
+// One pipeline: the workbench's controller and `calibench calibrate` compute the same calibration
+// from the same dataset and the same user decisions (a painted brush, a rejected pair), bit for
+// bit, because both run core/lidar_camera/pipeline.h's steps.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "core/io/dataset.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/result_io.h"
+#include "core/results/result_file.h"
+#include "core/session/session.h"
+#include "tests/test_support.h"
+#include "tests/ui/ui_fixture.h"
+#include "ui/lidar_camera/controller.h"
+
+namespace calibench::ui {
+namespace {
+
+Snapshot Loaded(Controller& controller) {
+  controller.WaitIdle();
+  return controller.GetSnapshot();
+}
+
+std::string ReadText(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Bit for bit: the same doubles, not merely close ones.
+template <typename A, typename B>
+void ExpectIdentical(const A& a, const B& b, const char* what) {
+  ASSERT_EQ(a.rows(), b.rows());
+  ASSERT_EQ(a.cols(), b.cols());
+  for (int r = 0; r < a.rows(); ++r)
+    for (int c = 0; c < a.cols(); ++c)
+      EXPECT_EQ(a(r, c), b(r, c)) << what << "(" << r << ", " << c << ")";
+}
+
+// Brushes pair 1 anew (its seed cleared, a disc painted at the board's centre) and rejects pair 2:
+// the session then holds one painted brush, one rejection and two seeded pairs.
+void BrushOneAndRejectOne(Controller& controller) {
+  const Snapshot before = Loaded(controller);
+  const PairView& pair = before.pairs[1];
+  ASSERT_TRUE(pair.lidar) << pair.lidar_failure;
+  const int inlier = pair.lidar->inliers[pair.lidar->inliers.size() / 2];
+  const int pixel = pair.lidar_image->pixel_of_point[inlier];
+  const int columns = pair.lidar_image->columns;
+  controller.Apply(ClearBrush{1});
+  controller.Apply(BrushStroke{1, pixel / columns, pixel % columns, 6.0f, false});
+  controller.Apply(SetPairStatus{2, PairStatus::kRejected});
+  controller.Apply(RunSolver{});
+}
+
+TEST(OnePipeline, WorkbenchAndCalibrateAgreeBitForBit) {
+  const auto dir = test::TempDir("one_pipeline");
+  const auto session_path = dir / "calibench.session.json";
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), session_path);
+  BrushOneAndRejectOne(controller);
+  const Snapshot gui = Loaded(controller);
+  ASSERT_TRUE(gui.solver.result) << gui.solver.failure;
+  EXPECT_FALSE(gui.pairs[1].brush_from_seed);
+  EXPECT_EQ(gui.pairs[2].status, PairStatus::kRejected);
+
+  // The CLI's path over what the workbench autosaved: `calibench calibrate --session`.
+  const Session session = LoadSession(session_path);
+  PipelineOptions options;
+  ApplySessionOptions(session, &options);
+  const PairEdits edits = EditsFromSession(session);
+  ASSERT_EQ(edits.size(), 2u);  // the painted brush and the rejection
+  const CalibrationOutcome cli = CalibrateDataset(LoadDataset(session.dataset), options, {}, edits);
+  ASSERT_TRUE(cli.solution) << cli.failure;
+
+  ExpectIdentical(gui.solver.result->cam_from_lidar.matrix(), cli.solution->cam_from_lidar.matrix(),
+                  "cam_from_lidar");
+  ExpectIdentical(gui.solver.result->covariance, cli.solution->covariance, "covariance");
+  EXPECT_EQ(gui.solver.result->iterations, cli.solution->iterations);
+  ASSERT_EQ(gui.pairs.size(), cli.pairs.size());
+  for (size_t i = 0; i < gui.pairs.size(); ++i) {
+    EXPECT_EQ(gui.pairs[i].status, cli.pairs[i].status) << gui.pairs[i].id;
+    EXPECT_EQ(gui.pairs[i].reason, cli.pairs[i].reason) << gui.pairs[i].id;
+  }
+
+  // The workbench's Export and `calibrate --out` write the same file.
+  const auto exported = dir / "exported.json";
+  controller.Apply(ExportResult{exported});
+  controller.WaitIdle();
+  const auto written = dir / "calibrated.json";
+  WriteResult(written, cli, options.solver);
+  EXPECT_EQ(ReadText(exported), ReadText(written));
+}
+
+TEST(OnePipeline, CalibrateWithTheSessionFlagMatchesTheWorkbench) {
+  const auto dir = test::TempDir("one_pipeline_cli");
+  const auto session_path = dir / "calibench.session.json";
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), session_path);
+  BrushOneAndRejectOne(controller);
+  const Snapshot gui = Loaded(controller);
+  ASSERT_TRUE(gui.solver.result) << gui.solver.failure;
+
+  const auto out = dir / "result.json";
+  std::string output;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --session " +
+                                 session_path.string() + " --out " + out.string(),
+                             &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("rejected"), std::string::npos) << output;
+  const LoadedResult cli = LoadResult(out);
+  // Through the result file's text: the JSON writer keeps every double exactly.
+  ExpectIdentical(cli.cam_from_source.matrix(), gui.solver.result->cam_from_lidar.matrix(),
+                  "cam_from_lidar");
+  ExpectIdentical(cli.covariance, gui.solver.result->covariance, "covariance");
+}
+
+TEST(OnePipeline, RenderSolveAndCalibrateWriteTheSameTransform) {
+  const auto dir = test::TempDir("one_pipeline_render");
+  // A copy of the dataset's manifest in its own folder: render --solve autosaves its session
+  // next to the dataset.
+  const Dataset dataset = LoadDataset(test::UiDataset());
+  const auto manifest = dir / "dataset.json";
+  SaveDataset(manifest, dataset);
+  std::string output;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " render --dataset " + manifest.string() +
+                                 " --solve --view camera --size 320x240 --out " +
+                                 (dir / "camera.png").string(),
+                             &output),
+            0)
+      << output;
+  const Session session = LoadSession(dir / "calibench.session.json");
+  ASSERT_TRUE(session.result);
+  const auto out = dir / "result.json";
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " + manifest.string() +
+                                 " --out " + out.string(),
+                             &output),
+            0)
+      << output;
+  const LoadedResult cli = LoadResult(out);
+  ExpectIdentical(cli.cam_from_source.matrix(), session.result->cam_from_lidar.matrix(),
+                  "cam_from_lidar");
+  ExpectIdentical(cli.covariance, session.result->covariance, "covariance");
+}
+
+}  // namespace
+}  // namespace calibench::ui
