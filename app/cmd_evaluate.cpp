@@ -28,10 +28,6 @@ void PrintError(const PoseError& error, const Mat6& covariance, const Pose& cam_
               st.norm(), sr.norm());
 }
 
-}  // namespace
-
-namespace {
-
 // The corner noise of a simulated dataset, measured as the mean of the PnP residual-based
 // estimates over its pairs (the renderer's noise has no closed-form pixel σ).
 double MeasureCornerSigma(const Dataset& dataset) {
@@ -47,17 +43,15 @@ double MeasureCornerSigma(const Dataset& dataset) {
   return count > 0 ? sum / count : 0.0;
 }
 
-}  // namespace
-
-int RunEvaluate(int argc, char** argv) {
-  // LRF results (cam_from_lrf) and the stereo-baseline check live in cmd_lrf.cpp.
+// `evaluate` of an LRF result or the stereo check (cmd_lrf.cpp), or `evaluate --sweep` (the Table 1
+// protocol under the name issue 5 uses); nullopt for the 3D LiDAR evaluation itself.
+std::optional<int> RunOtherEvaluation(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--stereo") return RunEvaluateLrf(argc, argv);
     if ((arg == "--dataset" || arg == "-d") && i + 1 < argc && IsLrfManifest(argv[i + 1]))
       return RunEvaluateLrf(argc, argv);
   }
-  // `evaluate --sweep ...` is the Table 1 protocol (cmd_sweep.cpp) under the name issue 5 uses.
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--sweep") {
       std::vector<char*> rest;
@@ -66,6 +60,50 @@ int RunEvaluate(int argc, char** argv) {
       return RunSweep(static_cast<int>(rest.size()), rest.data());
     }
   }
+  return std::nullopt;
+}
+
+// Prints the Cramér–Rao bound of a simulated dataset into *bound; an exit code on failure.
+int PrintCramerRaoBound(const Dataset& dataset, double corner_sigma_px,
+                        std::optional<CramerRaoBound>* bound) {
+  const SimOptions sim = SimOptionsFromDataset(dataset);
+  if (!(sim.lidar_range_noise_m > 0)) {
+    std::fprintf(stderr,
+                 "calibench evaluate: %s: the simulation has no LiDAR range noise, so the "
+                 "bound is zero\n",
+                 dataset.manifest.string().c_str());
+    return kInputError;
+  }
+  if (corner_sigma_px <= 0) corner_sigma_px = MeasureCornerSigma(dataset);
+  if (!(corner_sigma_px > 0)) {
+    std::fprintf(stderr,
+                 "calibench evaluate: no board found to measure the corner noise; "
+                 "give --corner-sigma-px\n");
+    return kInputError;
+  }
+  const SimulationBoundInput input = MakeSimulationBoundInput(sim, corner_sigma_px);
+  if (dataset.cam_from_lidar_ground_truth &&
+      !dataset.cam_from_lidar_ground_truth->isApprox(input.cam_from_lidar, 1e-9)) {
+    std::fprintf(stderr,
+                 "calibench evaluate: %s: the simulation record does not reproduce "
+                 "the ground truth\n",
+                 dataset.manifest.string().c_str());
+    return kInputError;
+  }
+  *bound = SimulationBound(input);
+  const Vec3 st = TranslationStd((*bound)->covariance, input.cam_from_lidar) * 1000.0;
+  std::printf(
+      "Cramér–Rao bound (%zu pairs, range noise %.1f mm, corner noise %.3f px): translation "
+      "%.2f mm RMS (std x/y/z %.2f / %.2f / %.2f mm, camera axes), rotation %.3f deg RMS\n",
+      input.pairs.size(), sim.lidar_range_noise_m * 1e3, corner_sigma_px,
+      (*bound)->translation_rms_m * 1e3, st.x(), st.y(), st.z(), (*bound)->rotation_rms_deg);
+  return kOk;
+}
+
+}  // namespace
+
+int RunEvaluate(int argc, char** argv) {
+  if (const auto code = RunOtherEvaluation(argc, argv)) return *code;
   CLI::App app{
       "Score a calibench.result.v1 file against a dataset's ground_truth, and/or print "
       "the Cramér–Rao bound of a simulated dataset.",
@@ -97,39 +135,8 @@ int RunEvaluate(int argc, char** argv) {
   const Dataset dataset = LoadDataset(dataset_path);
   std::optional<CramerRaoBound> bound;
   if (crlb) {
-    const SimOptions sim = SimOptionsFromDataset(dataset);
-    if (!(sim.lidar_range_noise_m > 0)) {
-      std::fprintf(stderr,
-                   "calibench evaluate: %s: the simulation has no LiDAR range noise, so the "
-                   "bound is zero\n",
-                   dataset.manifest.string().c_str());
-      return kInputError;
-    }
-    if (corner_sigma_px <= 0) corner_sigma_px = MeasureCornerSigma(dataset);
-    if (!(corner_sigma_px > 0)) {
-      std::fprintf(stderr,
-                   "calibench evaluate: no board found to measure the corner noise; "
-                   "give --corner-sigma-px\n");
-      return kInputError;
-    }
-    const SimulationBoundInput input = MakeSimulationBoundInput(sim, corner_sigma_px);
-    if (dataset.cam_from_lidar_ground_truth &&
-        !dataset.cam_from_lidar_ground_truth->isApprox(input.cam_from_lidar, 1e-9)) {
-      std::fprintf(stderr,
-                   "calibench evaluate: %s: the simulation record does not reproduce "
-                   "the ground truth\n",
-                   dataset.manifest.string().c_str());
-      return kInputError;
-    }
-    bound = SimulationBound(input);
-    const Vec3 st = TranslationStd(bound->covariance, input.cam_from_lidar) * 1000.0;
-    const Vec3 sr = RotationStdDeg(bound->covariance, input.cam_from_lidar);
-    std::printf(
-        "Cramér–Rao bound (%zu pairs, range noise %.1f mm, corner noise %.3f px): translation "
-        "%.2f mm RMS (std x/y/z %.2f / %.2f / %.2f mm, camera axes), rotation %.3f deg RMS\n",
-        input.pairs.size(), sim.lidar_range_noise_m * 1e3, corner_sigma_px,
-        bound->translation_rms_m * 1e3, st.x(), st.y(), st.z(), bound->rotation_rms_deg);
-    (void)sr;
+    const int code = PrintCramerRaoBound(dataset, corner_sigma_px, &bound);
+    if (code != kOk) return code;
   }
   if (result_path.empty()) return kOk;
   const LoadedResult result = LoadResult(result_path);

@@ -87,8 +87,10 @@ void WriteResult(const std::filesystem::path& path, const CalibrationOutcome& ou
   WriteResultJson(path, ResultToJson(outcome, options, names));
 }
 
-std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& names) {
-  std::ostringstream out;
+namespace {
+
+// One line per pair: its status, both sides' figures and, when solved with, its residual.
+void PrintPairs(const CalibrationOutcome& outcome, std::ostringstream& out) {
   char line[256];
   int accepted = 0, failed = 0;
   for (const PairFeatures& p : outcome.pairs) {
@@ -120,37 +122,11 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
     }
     out << "\n";
   }
-  if (!outcome.solution) {
-    out << "no calibration: " << outcome.failure << "\n";
-    return out.str();
-  }
-  const SolverResult& s = *outcome.solution;
-  const std::string fwd = names.target + "_from_" + names.source;
-  const std::string bwd = names.source + "_from_" + names.target;
-  auto print_pose = [&](const std::string& name, const std::string& words, const Pose& pose) {
-    out << name << "  (" << words << ")\n";
-    for (int r = 0; r < 3; ++r) {
-      std::snprintf(line, sizeof(line), "  [% .6f % .6f % .6f | % .6f]\n", pose.matrix()(r, 0),
-                    pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3));
-      out << line;
-    }
-  };
-  print_pose(fwd,
-             "maps points from the " + names.source + " frame into the " + names.target + " frame",
-             s.cam_from_lidar);
-  print_pose(bwd,
-             "maps points from the " + names.target + " frame into the " + names.source +
-                 " frame; "
-                 "its translation is the " +
-                 names.target + " position in the " + names.source + " frame",
-             s.cam_from_lidar.inverse());
-  const Vec3 st = TranslationStd(s.covariance, s.cam_from_lidar) * 1000.0;
-  const Vec3 sr = RotationStdDeg(s.covariance, s.cam_from_lidar);
-  std::snprintf(
-      line, sizeof(line),
-      "std (camera axes x/y/z) translation [mm]: %.2f %.2f %.2f   rotation [deg]: %.3f %.3f %.3f\n",
-      st.x(), st.y(), st.z(), sr.x(), sr.y(), sr.z());
-  out << line;
+}
+
+// What the weighted model estimated besides the pose: board edges, range offset, widening.
+void PrintModelFigures(const SolverResult& s, std::ostringstream& out) {
+  char line[256];
   if (s.num_edge_residuals > 0) {
     std::snprintf(line, sizeof(line), "board edges: %d ring crossings of the sheet's edges used",
                   s.num_edge_residuals);
@@ -189,6 +165,11 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
                   s.covariance_inflation);
     out << line;
   }
+}
+
+// Iterations, convergence and the observability verdict.
+void PrintConvergence(const SolverResult& s, std::ostringstream& out) {
+  char line[256];
   std::snprintf(line, sizeof(line), "solver: %d iterations, %s, cost %.3e -> %.3e\n", s.iterations,
                 s.converged ? "converged" : "NOT converged", s.cost_history.front(),
                 s.cost_history.back());
@@ -199,6 +180,21 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
     out << "observability: NOT well constrained; weak directions:\n";
     for (const auto& d : s.observability.weak_directions) out << "  - " << d << "\n";
   }
+}
+
+}  // namespace
+
+std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& names) {
+  std::ostringstream out;
+  PrintPairs(outcome, out);
+  if (!outcome.solution) {
+    out << "no calibration: " << outcome.failure << "\n";
+    return out.str();
+  }
+  const SolverResult& s = *outcome.solution;
+  out << FormatTransform(names, s.cam_from_lidar, s.covariance);
+  PrintModelFigures(s, out);
+  PrintConvergence(s, out);
   return out.str();
 }
 

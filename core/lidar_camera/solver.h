@@ -132,6 +132,10 @@ struct SolverResult {
   double covariance_inflation = 1.0;
 };
 
+// The LiDAR plane the board really has under a range offset b: the fitted one moved back by
+// b · d(n, d)/db (first order; the offset is centimetres against metres of range).
+Plane CorrectedLidarPlane(const PlanePair& pair, double range_offset_m);
+
 // Closed form from the planes alone: rotation aligning the normals (Kabsch/SVD), then the
 // translation from n_c·t = d_l − d_c by least squares (minimum-norm along unobservable
 // directions). nullopt with *why when fewer than two pairs or all normals parallel.
@@ -198,6 +202,19 @@ class PlaneAlignmentSolver {
   double HuberDelta() const;  // huber_delta or whitened_huber_delta, by method
   double RobustWeight(double error_norm) const;
   double RobustCost(double error_norm) const;
+
+  // Summarize's parts (solver_summary.cpp). The pose's covariance (and the offset's, when
+  // estimated) from the information scaled by the variance factor, widened to the pairs' spread
+  // (sandwich) where that is larger; *inflation gets the widening (1 = none).
+  Mat7 Covariance(const Linearization& lin, const std::vector<int>& active, double variance_factor,
+                  double* inflation) const;
+  // The offset's correlation with the camera-frame translation R ρ (right perturbation).
+  Vec3 OffsetCorrelation(const Mat7& joint_covariance) const;
+  // The estimated range offset, or (not estimated) the score test's significant one.
+  void ReportRangeOffset(const Linearization& lin, const Mat7& covariance, double variance_factor,
+                         SolverResult* result) const;
+  // Eigenvalues and weak directions of the geometry, plus what the offset and the redundancy say.
+  ObservabilityReport Observability(const SolverResult& result, int redundancy) const;
 
   // One round of outlier gating (SolverOptions::outlier_gate); true when the gated set changed.
   bool GateOutliers();

@@ -1,5 +1,6 @@
 #include "core/results/result_file.h"
 
+#include <cstdio>
 #include <fstream>
 
 #include "core/base/atomic_file.h"
@@ -43,6 +44,35 @@ json ResultHeaderJson(const ResultNames& names, const Pose& target_from_source,
 
 json PairEntryJson(const std::string& id, PairStatus status, const std::string& reason) {
   return {{"id", id}, {"status", PairStatusName(status)}, {"reason", reason}};
+}
+
+std::string FormatTransform(const ResultNames& names, const Pose& target_from_source,
+                            const Mat6& covariance) {
+  std::string out;
+  char line[256];
+  auto print_pose = [&](const std::string& name, const std::string& words, const Pose& pose) {
+    out += name + "  (" + words + ")\n";
+    for (int r = 0; r < 3; ++r) {
+      std::snprintf(line, sizeof(line), "  [% .6f % .6f % .6f | % .6f]\n", pose.matrix()(r, 0),
+                    pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3));
+      out += line;
+    }
+  };
+  print_pose(names.target + "_from_" + names.source,
+             "maps points from the " + names.source + " frame into the " + names.target + " frame",
+             target_from_source);
+  print_pose(names.source + "_from_" + names.target,
+             "maps points from the " + names.target + " frame into the " + names.source +
+                 " frame; its translation is the " + names.target + " position in the " +
+                 names.source + " frame",
+             target_from_source.inverse());
+  const Vec3 st = TranslationStd(covariance, target_from_source) * 1000.0;
+  const Vec3 sr = RotationStdDeg(covariance, target_from_source);
+  std::snprintf(
+      line, sizeof(line),
+      "std (camera axes x/y/z) translation [mm]: %.2f %.2f %.2f   rotation [deg]: %.3f %.3f %.3f\n",
+      st.x(), st.y(), st.z(), sr.x(), sr.y(), sr.z());
+  return out + line;
 }
 
 void WriteResultJson(const std::filesystem::path& path, const json& root) {

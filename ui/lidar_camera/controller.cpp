@@ -477,134 +477,158 @@ void Controller::EnsureSelectedImage() {
 void Controller::Apply(const Intent& intent) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!state_.dataset) return;
-  const int num_pairs = static_cast<int>(state_.pairs.size());
-  auto valid = [&](int index) { return index >= 0 && index < num_pairs; };
-  if (const auto* select = std::get_if<SelectPair>(&intent)) {
-    if (!valid(select->index) || select->index == state_.selected) return;
-    state_.selected = select->index;
-    state_.selected_image.reset();
-    state_.selected_undistorted.reset();
-    state_.reprojection.reset();
-    CommitEdit();
-    worker_.Enqueue([this] { EnsureSelectedImage(); });
-    const int index = select->index;
-    worker_.Enqueue([this, index] { ComputeReprojection(index); });
-  } else if (const auto* status = std::get_if<SetPairStatus>(&intent)) {
-    if (!valid(status->index)) return;
-    PairView& pair = state_.pairs[status->index];
-    if (status->status == PairStatus::kAccepted && !(pair.lidar && pair.camera)) {
-      SetStatus("pair " + pair.id + " cannot be accepted: " +
-                    (!pair.camera ? "no camera plane (" + pair.camera_failure + ")"
-                                  : "no LiDAR plane (" + pair.lidar_failure + ")"),
-                true);
-      return;
-    }
-    pair.status = status->status;
-    pair.reason = status->status == PairStatus::kRejected ? kRejectedByUser : "";
-    SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
-                  (state_.solver.result ? "; press Run to re-solve" : ""),
-              false);
-    CommitEdit();
-  } else if (const auto* stroke = std::get_if<BrushStroke>(&intent)) {
-    if (!valid(stroke->index)) return;
-    PairView& pair = state_.pairs[stroke->index];
-    if (!pair.lidar_image) return;
-    const auto circle = CirclePixels(pair.lidar_image->rows, pair.lidar_image->columns, stroke->row,
-                                     stroke->column, stroke->radius_px);
-    std::vector<int> merged;
-    if (stroke->erase) {
-      std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), circle.begin(),
-                          circle.end(), std::back_inserter(merged));
-    } else {
-      std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), circle.begin(),
-                     circle.end(), std::back_inserter(merged));
-    }
-    if (merged == pair.brush_pixels) return;
-    pair.brush_pixels = std::move(merged);
-    pair.brush_from_seed = false;  // painted: the brush replaces the seed from now on
-    CommitEdit();
-    const int index = stroke->index;
-    worker_.Enqueue([this, index] { RefitLidar(index); });
-  } else if (const auto* clear = std::get_if<ClearBrush>(&intent)) {
-    if (!valid(clear->index)) return;
-    state_.pairs[clear->index].brush_pixels.clear();
-    state_.pairs[clear->index].brush_from_seed = false;
-    CommitEdit();
-    const int index = clear->index;
-    worker_.Enqueue([this, index] { RefitLidar(index); });
-  } else if (std::holds_alternative<RunSolver>(intent)) {
-    worker_.Enqueue([this] { Solve(); });
-  } else if (std::holds_alternative<ResetSolver>(intent)) {
-    state_.solver = SolverView{};
-    state_.reprojection.reset();
-    RecomputeResiduals();
-    CommitEdit();
-  } else if (const auto* options = std::get_if<SetSolverOptions>(&intent)) {
-    SolverOptions check;
-    check.huber_delta = options->huber_delta;
-    check.max_iterations = options->max_iterations;
-    std::string why;
-    if (!check.Check(&why)) {
-      SetStatus("solver options: " + why, true);
-      return;
-    }
-    const bool method_changed = state_.method != options->method ||
-                                state_.estimate_range_offset != options->estimate_range_offset;
-    state_.method = options->method;
-    state_.estimate_range_offset = options->estimate_range_offset;
-    state_.huber_delta = options->huber_delta;
-    state_.max_iterations = options->max_iterations;
-    // Residuals and weights shown for the current estimate depend on the method.
-    if (method_changed) RecomputeResiduals();
-    CommitEdit();
-  } else if (const auto* view = std::get_if<SetView>(&intent)) {
-    const bool visibility_changed =
-        view->view.visibility != state_.view.visibility ||
-        view->view.hpr_radius_exponent != state_.view.hpr_radius_exponent;
-    state_.view = view->view;
-    CommitEdit();
-    if (visibility_changed) {
-      const int index = state_.selected;
-      worker_.Enqueue([this, index] { ComputeReprojection(index); });
-    }
-  } else if (const auto* export_result = std::get_if<ExportResult>(&intent)) {
-    if (!state_.solver.result) {
-      SetStatus("nothing to export: run the solver first", true);
-      return;
-    }
-    // What `calibench calibrate` writes: the pairs as they stand, the solution with the solver's
-    // residuals at it for the accepted ones.
-    CalibrationOutcome outcome;
-    for (const PairView& pair : state_.pairs) outcome.pairs.push_back(FeaturesOf(pair));
-    const SolverOptions options = SolverOptionsFromState();
-    outcome.solution = ResultForCurrentPairs();
-    try {
-      WriteResult(export_result->path, outcome, options);
-      SetStatus("exported " + export_result->path.string(), false);
-    } catch (const IoError& e) {
-      SetStatus(e.what(), true);
-    }
-  } else if (const auto* save = std::get_if<SaveSessionAs>(&intent)) {
-    try {
-      SaveSession(save->path, session_);
-      autosaver_ = std::make_unique<Autosaver>(save->path);
-      state_.session_path = save->path;
-      SetStatus("saved session " + save->path.string(), false);
-    } catch (const IoError& e) {
-      SetStatus(e.what(), true);
-    }
-  } else if (std::holds_alternative<Undo>(intent) || std::holds_alternative<Redo>(intent)) {
-    const auto restored = std::holds_alternative<Undo>(intent) ? history_.Undo() : history_.Redo();
-    if (!restored) return;
-    std::vector<std::vector<int>> before;
-    for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
-    session_ = *restored;
-    ApplySessionToState(session_);
-    RecomputeResiduals();
-    if (autosaver_) autosaver_->Save(session_);
-    for (int i = 0; i < num_pairs; ++i)
-      if (state_.pairs[i].brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });
+  std::visit([this](const auto& what) { Handle(what); }, intent);
+}
+
+bool Controller::ValidPair(int index) const {
+  return index >= 0 && index < static_cast<int>(state_.pairs.size());
+}
+
+void Controller::Handle(const SelectPair& select) {
+  if (!ValidPair(select.index) || select.index == state_.selected) return;
+  state_.selected = select.index;
+  state_.selected_image.reset();
+  state_.selected_undistorted.reset();
+  state_.reprojection.reset();
+  CommitEdit();
+  worker_.Enqueue([this] { EnsureSelectedImage(); });
+  const int index = select.index;
+  worker_.Enqueue([this, index] { ComputeReprojection(index); });
+}
+
+void Controller::Handle(const SetPairStatus& status) {
+  if (!ValidPair(status.index)) return;
+  PairView& pair = state_.pairs[status.index];
+  if (status.status == PairStatus::kAccepted && !(pair.lidar && pair.camera)) {
+    SetStatus("pair " + pair.id + " cannot be accepted: " +
+                  (!pair.camera ? "no camera plane (" + pair.camera_failure + ")"
+                                : "no LiDAR plane (" + pair.lidar_failure + ")"),
+              true);
+    return;
   }
+  pair.status = status.status;
+  pair.reason = status.status == PairStatus::kRejected ? kRejectedByUser : "";
+  SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
+                (state_.solver.result ? "; press Run to re-solve" : ""),
+            false);
+  CommitEdit();
+}
+
+void Controller::Handle(const BrushStroke& stroke) {
+  if (!ValidPair(stroke.index)) return;
+  PairView& pair = state_.pairs[stroke.index];
+  if (!pair.lidar_image) return;
+  const auto circle = CirclePixels(pair.lidar_image->rows, pair.lidar_image->columns, stroke.row,
+                                   stroke.column, stroke.radius_px);
+  std::vector<int> merged;
+  if (stroke.erase) {
+    std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), circle.begin(),
+                        circle.end(), std::back_inserter(merged));
+  } else {
+    std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), circle.begin(), circle.end(),
+                   std::back_inserter(merged));
+  }
+  if (merged == pair.brush_pixels) return;
+  pair.brush_pixels = std::move(merged);
+  pair.brush_from_seed = false;  // painted: the brush replaces the seed from now on
+  CommitEdit();
+  const int index = stroke.index;
+  worker_.Enqueue([this, index] { RefitLidar(index); });
+}
+
+void Controller::Handle(const ClearBrush& clear) {
+  if (!ValidPair(clear.index)) return;
+  state_.pairs[clear.index].brush_pixels.clear();
+  state_.pairs[clear.index].brush_from_seed = false;
+  CommitEdit();
+  const int index = clear.index;
+  worker_.Enqueue([this, index] { RefitLidar(index); });
+}
+
+void Controller::Handle(const RunSolver&) {
+  worker_.Enqueue([this] { Solve(); });
+}
+
+void Controller::Handle(const ResetSolver&) {
+  state_.solver = SolverView{};
+  state_.reprojection.reset();
+  RecomputeResiduals();
+  CommitEdit();
+}
+
+void Controller::Handle(const SetSolverOptions& options) {
+  SolverOptions check;
+  check.huber_delta = options.huber_delta;
+  check.max_iterations = options.max_iterations;
+  std::string why;
+  if (!check.Check(&why)) {
+    SetStatus("solver options: " + why, true);
+    return;
+  }
+  const bool method_changed = state_.method != options.method ||
+                              state_.estimate_range_offset != options.estimate_range_offset;
+  state_.method = options.method;
+  state_.estimate_range_offset = options.estimate_range_offset;
+  state_.huber_delta = options.huber_delta;
+  state_.max_iterations = options.max_iterations;
+  // Residuals and weights shown for the current estimate depend on the method.
+  if (method_changed) RecomputeResiduals();
+  CommitEdit();
+}
+
+void Controller::Handle(const SetView& view) {
+  const bool visibility_changed = view.view.visibility != state_.view.visibility ||
+                                  view.view.hpr_radius_exponent != state_.view.hpr_radius_exponent;
+  state_.view = view.view;
+  CommitEdit();
+  if (visibility_changed) {
+    const int index = state_.selected;
+    worker_.Enqueue([this, index] { ComputeReprojection(index); });
+  }
+}
+
+void Controller::Handle(const ExportResult& export_result) {
+  if (!state_.solver.result) {
+    SetStatus("nothing to export: run the solver first", true);
+    return;
+  }
+  // What `calibench calibrate` writes: the pairs as they stand, the solution with the solver's
+  // residuals at it for the accepted ones.
+  CalibrationOutcome outcome;
+  for (const PairView& pair : state_.pairs) outcome.pairs.push_back(FeaturesOf(pair));
+  outcome.solution = ResultForCurrentPairs();
+  try {
+    WriteResult(export_result.path, outcome, SolverOptionsFromState());
+    SetStatus("exported " + export_result.path.string(), false);
+  } catch (const IoError& e) {
+    SetStatus(e.what(), true);
+  }
+}
+
+void Controller::Handle(const SaveSessionAs& save) {
+  try {
+    SaveSession(save.path, session_);
+    autosaver_ = std::make_unique<Autosaver>(save.path);
+    state_.session_path = save.path;
+    SetStatus("saved session " + save.path.string(), false);
+  } catch (const IoError& e) {
+    SetStatus(e.what(), true);
+  }
+}
+
+void Controller::Handle(const Undo&) { Restore(history_.Undo()); }
+void Controller::Handle(const Redo&) { Restore(history_.Redo()); }
+
+void Controller::Restore(const std::optional<Session>& restored) {
+  if (!restored) return;
+  std::vector<std::vector<int>> before;
+  for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
+  session_ = *restored;
+  ApplySessionToState(session_);
+  RecomputeResiduals();
+  if (autosaver_) autosaver_->Save(session_);
+  for (int i = 0; i < static_cast<int>(state_.pairs.size()); ++i)
+    if (state_.pairs[i].brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });
 }
 
 }  // namespace calibench::ui

@@ -166,6 +166,22 @@ class Controller {
   void ApplySessionToState(const Session& session);        // call with mutex_ held
   void Open(const Dataset& dataset, Session session, std::filesystem::path session_path);
 
+  // One handler per intent (Apply visits them with mutex_ held).
+  bool ValidPair(int index) const;
+  void Handle(const SelectPair& select);
+  void Handle(const SetPairStatus& status);
+  void Handle(const BrushStroke& stroke);
+  void Handle(const ClearBrush& clear);
+  void Handle(const RunSolver&);
+  void Handle(const ResetSolver&);
+  void Handle(const SetSolverOptions& options);
+  void Handle(const SetView& view);
+  void Handle(const ExportResult& export_result);
+  void Handle(const SaveSessionAs& save);
+  void Handle(const Undo&);
+  void Handle(const Redo&);
+  void Restore(const std::optional<Session>& restored);  // undo / redo
+
   mutable std::mutex mutex_;
   Snapshot state_;
   Session session_;  // the editable state as saved; state_ mirrors it plus derived data
