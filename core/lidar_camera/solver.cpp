@@ -1,3 +1,4 @@
+#include "core/base/names.h"
 #include "core/lidar_camera/solver.h"
 
 #include <Eigen/Eigenvalues>
@@ -10,23 +11,16 @@
 
 namespace calibench {
 
-std::string SolverMethodName(SolverMethod method) {
-  switch (method) {
-    case SolverMethod::kCa2libGn:
-      return "ca2lib-gn";
-    case SolverMethod::kWeightedMl:
-      return "weighted-ml";
-    case SolverMethod::kKim:
-      return "kim";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<SolverMethod> kSolverMethodNames[] = {{SolverMethod::kCa2libGn, "ca2lib-gn"},
+                                                         {SolverMethod::kWeightedMl, "weighted-ml"},
+                                                         {SolverMethod::kKim, "kim"}};
+}  // namespace
+
+std::string SolverMethodName(SolverMethod method) { return NameIn(kSolverMethodNames, method); }
 
 std::optional<SolverMethod> ParseSolverMethod(const std::string& name) {
-  if (name == "ca2lib-gn") return SolverMethod::kCa2libGn;
-  if (name == "weighted-ml") return SolverMethod::kWeightedMl;
-  if (name == "kim") return SolverMethod::kKim;
-  return std::nullopt;
+  return ValueIn(kSolverMethodNames, name);
 }
 
 bool SolverOptions::Check(std::string* why) const {

@@ -1,26 +1,19 @@
 #include "core/results/pair_status.h"
 
-namespace calibench {
+#include "core/base/names.h"
 
-std::string PairStatusName(PairStatus status) {
-  switch (status) {
-    case PairStatus::kPending:
-      return "pending";
-    case PairStatus::kAccepted:
-      return "accepted";
-    case PairStatus::kRejected:
-      return "rejected";
-    case PairStatus::kFailed:
-      return "failed";
-  }
-  return "unknown";
-}
+namespace calibench {
+namespace {
+constexpr EnumName<PairStatus> kPairStatusNames[] = {{PairStatus::kPending, "pending"},
+                                                     {PairStatus::kAccepted, "accepted"},
+                                                     {PairStatus::kRejected, "rejected"},
+                                                     {PairStatus::kFailed, "failed"}};
+}  // namespace
+
+std::string PairStatusName(PairStatus status) { return NameIn(kPairStatusNames, status); }
 
 std::optional<PairStatus> ParsePairStatus(const std::string& name) {
-  for (PairStatus status :
-       {PairStatus::kPending, PairStatus::kAccepted, PairStatus::kRejected, PairStatus::kFailed})
-    if (PairStatusName(status) == name) return status;
-  return std::nullopt;
+  return ValueIn(kPairStatusNames, name);
 }
 
 }  // namespace calibench

@@ -4,6 +4,7 @@
 #include <limits>
 #include <random>
 
+#include "core/base/names.h"
 #include "core/sim/sim.h"
 
 namespace calibench {
@@ -89,23 +90,15 @@ double SurfaceIntensity(const RayHit& hit, const BoardPrint& print) {
 
 }  // namespace
 
-std::string LidarModelName(LidarModel model) {
-  switch (model) {
-    case LidarModel::kHdl64:
-      return "hdl64";
-    case LidarModel::kVlp16:
-      return "vlp16";
-    case LidarModel::kOs0_128:
-      return "os0-128";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<LidarModel> kLidarModelNames[] = {
+    {LidarModel::kHdl64, "hdl64"}, {LidarModel::kVlp16, "vlp16"}, {LidarModel::kOs0_128, "os0-128"}};
+}  // namespace
+
+std::string LidarModelName(LidarModel model) { return NameIn(kLidarModelNames, model); }
 
 std::optional<LidarModel> ParseLidarModelName(const std::string& name) {
-  for (LidarModel model : {LidarModel::kHdl64, LidarModel::kVlp16, LidarModel::kOs0_128}) {
-    if (LidarModelName(model) == name) return model;
-  }
-  return std::nullopt;
+  return ValueIn(kLidarModelNames, name);
 }
 
 BeamTable MakeBeamTable(LidarModel model) {

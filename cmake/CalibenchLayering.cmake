@@ -1,0 +1,73 @@
+# Who may include whom, enforced at configure time from the target graph: a source file in a
+# library may include headers of that library and of the libraries it links (transitively), no
+# others; core/ includes nothing from ui/, OpenGL, GLFW or ImGui. A violation stops the configure
+# step with the file and the include named.
+
+# The target a project header (or source file) belongs to: core/<x>/ -> calibench_<x>; ui/gfx,
+# ui/widgets, ui/state; ui/<method>/controller.* -> calibench_<method>_controller, the rest of
+# ui/<method>/ -> calibench_<method>_workbench.
+function(calibench_owner_target path out)
+  set(owner "")
+  if(path MATCHES "^core/([a-z_]+)/")
+    set(owner "calibench_${CMAKE_MATCH_1}")
+  elseif(path MATCHES "^ui/gfx/")
+    set(owner calibench_gfx)
+  elseif(path MATCHES "^ui/widgets/")
+    set(owner calibench_widgets)
+  elseif(path MATCHES "^ui/state/")
+    set(owner calibench_ui_state)
+  elseif(path MATCHES "^ui/([a-z_]+)/controller\\.")
+    set(owner "calibench_${CMAKE_MATCH_1}_controller")
+  elseif(path MATCHES "^ui/([a-z_]+)/")
+    set(owner "calibench_${CMAKE_MATCH_1}_workbench")
+  endif()
+  set(${out} "${owner}" PARENT_SCOPE)
+endfunction()
+
+# The calibench_* targets `target` links, directly or through others.
+function(calibench_link_closure target out)
+  set(closure "")
+  set(queue ${target})
+  while(queue)
+    list(POP_FRONT queue current)
+    get_target_property(links ${current} LINK_LIBRARIES)
+    get_target_property(interface ${current} INTERFACE_LINK_LIBRARIES)
+    foreach(link IN LISTS links interface)
+      if(link MATCHES "^calibench_" AND TARGET ${link} AND NOT link IN_LIST closure)
+        list(APPEND closure ${link})
+        list(APPEND queue ${link})
+      endif()
+    endforeach()
+  endwhile()
+  set(${out} "${closure}" PARENT_SCOPE)
+endfunction()
+
+function(calibench_check_layering)
+  file(GLOB_RECURSE files RELATIVE ${PROJECT_SOURCE_DIR} CONFIGURE_DEPENDS
+       ${PROJECT_SOURCE_DIR}/core/*.h ${PROJECT_SOURCE_DIR}/core/*.cpp
+       ${PROJECT_SOURCE_DIR}/ui/*.h ${PROJECT_SOURCE_DIR}/ui/*.cpp)
+  set(problems "")
+  foreach(file IN LISTS files)
+    calibench_owner_target(${file} owner)
+    if(NOT owner OR NOT TARGET ${owner})
+      continue()
+    endif()
+    calibench_link_closure(${owner} allowed)
+    list(APPEND allowed ${owner})
+    file(STRINGS ${PROJECT_SOURCE_DIR}/${file} includes REGEX "^#include")
+    foreach(line IN LISTS includes)
+      if(file MATCHES "^core/" AND line MATCHES "[<\"](ui/|GL/|GLFW/|EGL/|imgui|backends/)")
+        list(APPEND problems "${file}: ${line} (core/ must not include the UI, OpenGL or ImGui)")
+      elseif(line MATCHES "#include \"((core|ui)/[a-z_/]+\\.h)\"")
+        calibench_owner_target(${CMAKE_MATCH_1} included)
+        if(included AND NOT included IN_LIST allowed)
+          list(APPEND problems "${file}: ${line} (${owner} does not link ${included})")
+        endif()
+      endif()
+    endforeach()
+  endforeach()
+  if(problems)
+    list(JOIN problems "\n  " text)
+    message(FATAL_ERROR "Layering: includes that point past the target graph:\n  ${text}")
+  endif()
+endfunction()
