@@ -1,24 +1,33 @@
-// LoadCameraFile (core/dataset.h): intrinsics from OpenCV FileStorage, ROS camera_calibration /
-// CameraInfo YAML and Kalibr camchain files. Every file is first turned into a YamlNode tree
-// (cv::FileStorage for what OpenCV reads, the YAML subset reader for the rest), then one
-// interpreter picks the format by its keys.
+// LoadCameraFile (core/io/camera_file.h): intrinsics from OpenCV FileStorage, ROS
+// camera_calibration / CameraInfo YAML and Kalibr camchain files. Every file becomes one
+// YAML::Node tree (yaml-cpp for all YAML, OpenCV's %YAML:1.0 files included: it ignores the
+// unknown directive and keeps the !!opencv-matrix tags; cv::FileStorage for XML), then one
+// interpreter picks the format by its keys. Both parsers recurse, so the nesting of the text is
+// measured before either sees it.
+#include "core/io/camera_file.h"
+
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 
-#include "core/io/dataset.h"
-#include "core/io/camera_file.h"
-#include "core/io/yaml_lite.h"
+#include "core/base/types.h"
 
 namespace calibench {
 namespace {
 
 // Camera files are a few kilobytes; anything far larger is not one.
 constexpr std::uintmax_t kMaxFileBytes = 16 << 20;
+// Camera files nest four levels; deeper text is refused before a recursive parser sees it.
+constexpr int kMaxNesting = 64;
 
 // A problem with the file's content; LoadCameraFile adds the file name.
 class Problem : public std::runtime_error {
@@ -28,48 +37,248 @@ class Problem : public std::runtime_error {
 
 std::string Quote(const std::string& s) { return "'" + s + "'"; }
 
-YamlNode FromFileNode(const cv::FileNode& node) {
-  YamlNode out;
+Problem TooDeep(int line) {
+  return Problem("nested deeper than " + std::to_string(kMaxNesting) + " levels (line " +
+                 std::to_string(line) + "); not a camera file");
+}
+
+// An upper bound on the nesting of YAML text, measured line by line without parsing: block
+// collections by indentation (plus "- ", "? " and ": " indicators, and sequences written at
+// their key's indentation), flow collections by unclosed brackets. Quoted text, comments and
+// block scalars (| and >) are skipped. Throws at the first line nested deeper than kMaxNesting.
+class YamlNesting {
+ public:
+  // The line of a quote still open at the end of the text; 0 when none is.
+  int OpenQuoteLine() const { return quote_ ? quote_line_ : 0; }
+
+  void Line(std::string_view line, int number) {
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (quote_ || flow_ > 0) {
+      Scan(line, 0, flow_base_, number);  // a flow collection or quoted text going on
+      return;
+    }
+    const size_t indent = line.find_first_not_of(' ');
+    if (indent == std::string_view::npos || line[indent] == '#') return;
+    if (block_scalar_owner_ >= 0 && static_cast<int>(indent) > block_scalar_owner_) return;
+    block_scalar_owner_ = -1;
+    if (indent == 0 && line[0] == '%') return;  // a directive
+    if (indent == 0 && (line.starts_with("---") || line.starts_with("...")) &&
+        (line.size() == 3 || line[3] == ' ')) {
+      levels_.clear();  // a document marker; what follows it is at column 4
+      Line(std::string(3, ' ') + std::string(line.substr(3)), number);
+      return;
+    }
+    const Block block = EnterBlock(line, indent);
+    const size_t end = Scan(line, block.content, block.depth, number);
+    if (!quote_ && flow_ == 0) NoteBlockScalar(line, block, end);
+  }
+
+ private:
+  struct Level {
+    int indent = 0;
+    int base = 0;          // the depth this line's collections nest in
+    int depth = 0;         // the depth of its innermost collection
+    int sibling_base = 0;  // the base of map keys that follow at this indentation
+    bool dash = false;     // a sequence entry
+  };
+  struct Block {
+    int depth = 0;
+    size_t content = 0;  // where the text after the indicators starts
+    int owner = 0;       // the column a block scalar starting here must be indented beyond
+  };
+
+  Block EnterBlock(std::string_view line, size_t indent) {
+    Block block{0, indent, static_cast<int>(indent)};
+    int indicators = 0;
+    while (block.content < line.size() &&
+           std::string_view("-?:").find(line[block.content]) != std::string_view::npos &&
+           (block.content + 1 == line.size() || line[block.content + 1] == ' ')) {
+      ++indicators;
+      block.owner = static_cast<int>(block.content);
+      block.content = std::min(line.size(), line.find_first_not_of(' ', block.content + 1));
+    }
+    while (!levels_.empty() && levels_.back().indent > static_cast<int>(indent)) levels_.pop_back();
+    std::optional<Level> sibling;
+    if (!levels_.empty() && levels_.back().indent == static_cast<int>(indent)) {
+      sibling = levels_.back();
+      levels_.pop_back();
+    }
+    Level level{static_cast<int>(indent), 0, 0, 0, indicators > 0 && line[indent] == '-'};
+    level.sibling_base = sibling           ? sibling->sibling_base
+                         : levels_.empty() ? 0
+                                           : levels_.back().depth;
+    level.base = level.sibling_base;
+    // "key:" then "- item" at the same indentation: the sequence is the key's value.
+    if (sibling && level.dash) level.base = sibling->dash ? sibling->base : sibling->depth;
+    level.depth = level.base + 1 + indicators;
+    levels_.push_back(level);
+    block.depth = level.depth;
+    return block;
+  }
+
+  // Follows quotes and brackets from line[from]; returns where the content ends (a comment).
+  size_t Scan(std::string_view line, size_t from, int depth, int number) {
+    if (depth > kMaxNesting) throw TooDeep(number);
+    char previous = 0;  // the last character outside quotes that was not a space
+    for (size_t i = from; i < line.size(); ++i) {
+      const char c = line[i];
+      if (quote_) {
+        if (quote_ == '"' && c == '\\') {
+          ++i;
+        } else if (quote_ == '\'' && c == '\'' && i + 1 < line.size() && line[i + 1] == '\'') {
+          ++i;  // '' is a quote inside single quotes
+        } else if (c == quote_) {
+          quote_ = 0;
+          previous = c;
+        }
+        continue;
+      }
+      if (c == '#' && (i == from || line[i - 1] == ' ' || line[i - 1] == '\t')) return i;
+      // A quote opens a scalar only where one can start: first on the line (after "- "), after
+      // ": ", or after [ { , : in a flow collection; the apostrophe in "don't" is text.
+      const bool scalar_start =
+          !previous || (previous == ':' && line[i - 1] == ' ') ||
+          (flow_ > 0 && std::string_view(":[{,").find(previous) != std::string_view::npos);
+      if ((c == '"' || c == '\'') && scalar_start) {
+        quote_ = c;
+        quote_line_ = number;
+      } else if (c == '[' || c == '{') {
+        if (depth + ++flow_ > kMaxNesting) throw TooDeep(number);
+      } else if ((c == ']' || c == '}') && flow_ > 0) {
+        --flow_;
+      }
+      if (c != ' ' && c != '\t') previous = c;
+    }
+    flow_base_ = depth;
+    return line.size();
+  }
+
+  // After "key: |" or "- >-", the more indented lines are text.
+  void NoteBlockScalar(std::string_view line, const Block& block, size_t end) {
+    const std::string_view content = line.substr(0, line.find_last_not_of(" \t", end - 1) + 1);
+    const size_t space = content.find_last_of(' ');
+    const size_t start = space == std::string_view::npos ? 0 : space + 1;
+    if (start < block.content || start >= content.size()) return;
+    if (content[start] != '|' && content[start] != '>') return;
+    if (content.find_first_not_of("+-0123456789", start + 1) != std::string_view::npos) return;
+    block_scalar_owner_ = start == block.content ? block.owner : static_cast<int>(block.content);
+  }
+
+  std::vector<Level> levels_;
+  int flow_ = 0;        // unclosed [ and {
+  char quote_ = 0;      // the open quote, across lines
+  int quote_line_ = 0;  // where it opened
+  int flow_base_ = 0;   // the block depth the open flow collection or quote is in
+  int block_scalar_owner_ = -1;
+};
+
+// Refuses YAML nested deeper than kMaxNesting, and quoted text left open at the end of the file
+// (which yaml-cpp 0.7 takes as running to the end when the file ends in a line break).
+void CheckYamlText(std::string_view text) {
+  YamlNesting nesting;
+  int number = 0;
+  for (size_t start = 0; start <= text.size();) {
+    const size_t end = std::min(text.size(), text.find('\n', start));
+    nesting.Line(text.substr(start, end - start), ++number);
+    start = end + 1;
+  }
+  if (const int line = nesting.OpenQuoteLine()) {
+    throw Problem("not valid YAML: line " + std::to_string(line) + ": the quote is never closed");
+  }
+}
+
+// Where the markup starting at text[i] ('<') ends: its '>' (quotes respected), or the end of a
+// comment or CDATA section; npos when it does not end.
+size_t MarkupEnd(std::string_view text, size_t i) {
+  if (text.substr(i).starts_with("<!--")) return text.find("-->", i);
+  if (text.substr(i).starts_with("<![CDATA[")) return text.find("]]>", i);
+  char quote = 0;
+  for (size_t end = i + 1; end < text.size(); ++end) {
+    const char c = text[end];
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '>') {
+      return end;
+    }
+  }
+  return std::string_view::npos;
+}
+
+// Element nesting of XML text, as cv::FileStorage's recursive XML parser would meet it.
+void CheckXmlNesting(std::string_view text) {
+  int depth = 0;
+  for (size_t i = text.find('<'); i != std::string_view::npos; i = text.find('<', i + 1)) {
+    const size_t end = MarkupEnd(text, i);
+    if (end == std::string_view::npos) return;  // unclosed: the parser will say so
+    const char kind = text[i + 1];
+    if (kind == '/') {
+      depth = std::max(0, depth - 1);
+    } else if (kind != '?' && kind != '!' && text[end - 1] != '/' && ++depth > kMaxNesting) {
+      throw TooDeep(1 + static_cast<int>(std::count(text.begin(), text.begin() + i, '\n')));
+    }
+    i = end;
+  }
+}
+
+// " (line N)" for a node read from YAML text; nothing for nodes built from OpenCV's XML.
+std::string LineOf(const YAML::Node& node) {
+  const YAML::Mark mark = node.Mark();
+  return mark.is_null() ? "" : " (line " + std::to_string(mark.line + 1) + ")";
+}
+
+// How a value that was not what a field needs looks, for the message.
+std::string Shown(const YAML::Node& node) {
+  if (node.IsScalar()) return Quote(node.Scalar());
+  return node.IsSequence() ? "a list" : node.IsMap() ? "a map" : "nothing";
+}
+
+YAML::Node ParseYaml(const std::string& text) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    if (e.mark.is_null()) throw Problem("not valid YAML: " + e.msg);
+    throw Problem("not valid YAML: line " + std::to_string(e.mark.line + 1) + ", column " +
+                  std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+}
+
+YAML::Node FromFileNode(const cv::FileNode& node) {
   if (node.isMap() || node.isSeq()) {
-    out.kind = node.isMap() ? YamlNode::Kind::kMap : YamlNode::Kind::kSequence;
+    YAML::Node out(node.isMap() ? YAML::NodeType::Map : YAML::NodeType::Sequence);
     for (cv::FileNodeIterator it = node.begin(); it != node.end(); ++it) {
       const cv::FileNode child = *it;
       if (node.isMap()) {
-        out.entries.emplace_back(child.name(), FromFileNode(child));
+        out.force_insert(child.name(), FromFileNode(child));  // keeps a repeated key visible
       } else {
-        out.items.push_back(FromFileNode(child));
+        out.push_back(FromFileNode(child));
       }
     }
-  } else if (node.isInt() || node.isReal()) {
+    return out;
+  }
+  if (node.isInt() || node.isReal()) {
     char buffer[64];
     // Shortest text that reads back as the same double: no digits lost on the way.
     const double value =
         node.isInt() ? static_cast<double>(static_cast<int>(node)) : static_cast<double>(node);
     const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-    out.kind = YamlNode::Kind::kScalar;
-    out.scalar.assign(buffer, result.ptr);
-  } else if (node.isString()) {
-    out.kind = YamlNode::Kind::kScalar;
-    out.scalar = static_cast<std::string>(node);
-    out.quoted = true;
+    return YAML::Node(std::string(buffer, result.ptr));
   }
-  return out;
+  if (node.isString()) return YAML::Node(static_cast<std::string>(node));
+  return YAML::Node();
 }
 
-// The file read by cv::FileStorage (OpenCV's YAML with its %YAML:1.0 header, XML, JSON);
-// nullopt with OpenCV's reason when it does not take it.
-std::optional<YamlNode> ReadWithOpenCv(const std::filesystem::path& path, std::string* why) {
+// An XML file read by cv::FileStorage.
+YAML::Node ReadXmlWithOpenCv(const std::filesystem::path& path) {
   try {
     cv::FileStorage storage(path.string(), cv::FileStorage::READ);
-    if (!storage.isOpened()) {
-      *why = "OpenCV could not open it";
-      return std::nullopt;
-    }
+    if (!storage.isOpened()) throw Problem("OpenCV cannot read this XML file");
     return FromFileNode(storage.root());
   } catch (const cv::Exception& e) {
     // OpenCV's parsers put "file(line): problem" in `func` and their own name in `err`.
-    *why = e.code == cv::Error::StsParseError ? e.func : e.err;
-    return std::nullopt;
+    throw Problem("OpenCV cannot read this XML file: " +
+                  (e.code == cv::Error::StsParseError ? e.func : e.err));
   }
 }
 
@@ -84,50 +293,103 @@ std::string ReadText(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (!in) throw Problem("cannot be read");
+  // YAML and XML allow no control characters but tab and line breaks.
+  const auto binary = std::find_if(text.view().begin(), text.view().end(), [](char c) {
+    const auto byte = static_cast<unsigned char>(c);
+    return (byte < 0x20 && c != '\t' && c != '\n' && c != '\r') || byte == 0x7f;
+  });
+  if (binary != text.view().end()) throw Problem("binary data, not a text file");
   return text.str();
 }
 
-// A list of numbers: a sequence, or a matrix map with `data` (and rows x cols matching).
-std::vector<double> Numbers(const YamlNode& node, const std::string& what) {
-  if (node.kind == YamlNode::Kind::kMap) {
-    const YamlNode* data = node.Find("data");
-    if (!data) throw Problem(what + " is a map without 'data'");
-    std::vector<double> values = Numbers(*data, what + ".data");
-    const YamlNode* rows = node.Find("rows");
-    const YamlNode* cols = node.Find("cols");
-    if (rows && cols && rows->AsDouble() && cols->AsDouble() &&
-        *rows->AsDouble() * *cols->AsDouble() != static_cast<double>(values.size())) {
-      throw Problem(what + " says " + rows->scalar + "x" + cols->scalar + " but has " +
-                    std::to_string(values.size()) + " values");
-    }
-    return values;
+// The value under `key` in a map; nullopt when absent. yaml-cpp keeps both entries of a key
+// given twice, which no camera file means: an error.
+std::optional<YAML::Node> Find(const YAML::Node& map, const std::string& key) {
+  std::optional<YAML::Node> found;
+  if (!map.IsMap()) return found;
+  for (const auto& entry : map) {
+    if (!entry.first.IsScalar() || entry.first.Scalar() != key) continue;
+    if (found) throw Problem(Quote(key) + " is given twice" + LineOf(entry.first));
+    found.emplace(entry.second);  // emplace: assigning a YAML::Node would overwrite its target
   }
-  if (node.kind != YamlNode::Kind::kSequence) {
-    throw Problem(what + " must be a list of numbers (line " + std::to_string(node.line) + ")");
+  return found;
+}
+
+// A scalar read as a number: decimal or exponent notation, an optional sign, .inf / .nan;
+// nullopt for anything else ("1.0abc", "0x10", empty text, lists).
+std::optional<double> AsNumber(const YAML::Node& node) {
+  if (!node.IsScalar() || node.Scalar().empty()) return std::nullopt;
+  const std::string& text = node.Scalar();
+  const bool negative = text[0] == '-';
+  const std::string body = text[0] == '-' || text[0] == '+' ? text.substr(1) : text;
+  if (body.empty() || body[0] == '-' || body[0] == '+') return std::nullopt;
+  double value = 0;
+  if (body == ".inf" || body == ".Inf" || body == ".INF") {
+    value = std::numeric_limits<double>::infinity();
+  } else if (body == ".nan" || body == ".NaN" || body == ".NAN") {
+    value = std::numeric_limits<double>::quiet_NaN();
+  } else {
+    const char* end = body.data() + body.size();
+    const auto [ptr, error] = std::from_chars(body.data(), end, value);
+    if (error != std::errc() || ptr != end) return std::nullopt;
+  }
+  return negative ? -value : value;
+}
+
+int WholeNumber(const YAML::Node& node, const std::string& what) {
+  const std::optional<double> value = AsNumber(node);
+  if (!value || !(*value >= 0 && *value <= 1e6) || std::floor(*value) != *value) {
+    throw Problem(what + " must be a whole number, got " + Shown(node) + LineOf(node));
+  }
+  return static_cast<int>(*value);
+}
+
+std::vector<double> Numbers(const YAML::Node& node, const std::string& what);
+
+// An OpenCV / ROS matrix map: `data`, with `rows` x `cols` matching when both are stated.
+std::vector<double> MatrixNumbers(const YAML::Node& node, const std::string& what) {
+  const std::optional<YAML::Node> data = Find(node, "data");
+  if (!data) throw Problem(what + " is a map without 'data'" + LineOf(node));
+  std::vector<double> values = Numbers(*data, what + ".data");
+  const std::optional<YAML::Node> rows = Find(node, "rows");
+  const std::optional<YAML::Node> cols = Find(node, "cols");
+  if (rows && cols) {
+    const int r = WholeNumber(*rows, what + ".rows");
+    const int c = WholeNumber(*cols, what + ".cols");
+    if (static_cast<size_t>(r) * static_cast<size_t>(c) != values.size()) {
+      throw Problem(what + " says " + std::to_string(r) + "x" + std::to_string(c) + " but has " +
+                    std::to_string(values.size()) + " values" + LineOf(node));
+    }
+  }
+  return values;
+}
+
+// A list of numbers: a sequence, or a matrix map.
+std::vector<double> Numbers(const YAML::Node& node, const std::string& what) {
+  if (node.IsMap()) return MatrixNumbers(node, what);
+  if (!node.IsSequence()) {
+    throw Problem(what + " must be a list of numbers, got " + Shown(node) + LineOf(node));
   }
   std::vector<double> values;
-  for (const YamlNode& item : node.items) {
-    const std::optional<double> value = item.AsDouble();
+  for (const YAML::Node& item : node) {
+    const std::optional<double> value = AsNumber(item);
     if (!value) {
-      throw Problem(what + " must contain numbers only, found " + Quote(item.scalar) + " (line " +
-                    std::to_string(item.line) + ")");
+      throw Problem(what + " must contain numbers only, found " + Shown(item) + LineOf(item));
     }
     values.push_back(*value);
   }
   return values;
 }
 
-const YamlNode& Require(const YamlNode& map, const std::string& key, const std::string& format) {
-  const YamlNode* node = map.Find(key);
-  if (!node || node->kind == YamlNode::Kind::kNull) {
-    throw Problem("'" + key + "' is missing (" + format + ")");
-  }
+YAML::Node Require(const YAML::Node& map, const std::string& key, const std::string& format) {
+  const std::optional<YAML::Node> node = Find(map, key);
+  if (!node || node->IsNull()) throw Problem(Quote(key) + " is missing (" + format + ")");
   return *node;
 }
 
-std::string Text(const YamlNode& node, const std::string& what) {
-  if (node.kind != YamlNode::Kind::kScalar) throw Problem(what + " must be a text");
-  return node.scalar;
+std::string Text(const YAML::Node& node, const std::string& what) {
+  if (!node.IsScalar()) throw Problem(what + " must be a text, got " + Shown(node) + LineOf(node));
+  return node.Scalar();
 }
 
 int PixelCount(double value, const std::string& what) {
@@ -140,10 +402,12 @@ int PixelCount(double value, const std::string& what) {
 }
 
 // Image size in pixels; 0 when the file does not state it.
-int Size(const YamlNode* node, const std::string& what) {
+int Size(const std::optional<YAML::Node>& node, const std::string& what) {
   if (!node) return 0;
-  const std::optional<double> value = node->AsDouble();
-  if (!value) throw Problem(what + " must be a number of pixels, got " + Quote(node->scalar));
+  const std::optional<double> value = AsNumber(*node);
+  if (!value) {
+    throw Problem(what + " must be a number of pixels, got " + Shown(*node) + LineOf(*node));
+  }
   return PixelCount(*value, what);
 }
 
@@ -200,15 +464,14 @@ void SetModel(const std::string& name, std::vector<double> coefficients, CameraM
 }
 
 // OpenCV FileStorage and ROS camera_calibration: camera_matrix + distortion_coefficients.
-CameraModel FromCameraMatrix(const YamlNode& root, bool opencv_file) {
+CameraModel FromCameraMatrix(const YAML::Node& root, bool opencv_file) {
   const std::string format = "OpenCV / ROS camera_calibration";
   CameraModel camera;
   SetIntrinsics(Numbers(Require(root, "camera_matrix", format), "camera_matrix"), "camera_matrix",
                 &camera);
   const std::vector<double> coefficients =
       Numbers(Require(root, "distortion_coefficients", format), "distortion_coefficients");
-  const YamlNode* model = root.Find("distortion_model");
-  if (model) {
+  if (const std::optional<YAML::Node> model = Find(root, "distortion_model")) {
     SetModel(Text(*model, "distortion_model"), coefficients, &camera);
   } else if (opencv_file) {
     SetModel("pinhole-radtan", coefficients, &camera);  // what cv::calibrateCamera writes
@@ -217,26 +480,41 @@ CameraModel FromCameraMatrix(const YamlNode& root, bool opencv_file) {
         "'distortion_model' is missing; only OpenCV FileStorage files (with their "
         "%YAML:1.0 header) imply pinhole-radtan");
   }
-  camera.width = Size(root.Find("image_width"), "image_width");
-  camera.height = Size(root.Find("image_height"), "image_height");
+  camera.width = Size(Find(root, "image_width"), "image_width");
+  camera.height = Size(Find(root, "image_height"), "image_height");
   return camera;
 }
 
 // The ROS sensor_msgs/CameraInfo fields (ROS 1 upper case, ROS 2 lower case).
-CameraModel FromCameraInfo(const YamlNode& root) {
+CameraModel FromCameraInfo(const YAML::Node& root) {
   const std::string format = "ROS CameraInfo";
-  const bool upper = root.Find("K") != nullptr;
+  const bool upper = Find(root, "K").has_value();
   CameraModel camera;
   SetIntrinsics(Numbers(Require(root, upper ? "K" : "k", format), "K"), "K", &camera);
   SetModel(Text(Require(root, "distortion_model", format), "distortion_model"),
            Numbers(Require(root, upper ? "D" : "d", format), "D"), &camera);
-  camera.width = Size(root.Find("width"), "width");
-  camera.height = Size(root.Find("height"), "height");
+  camera.width = Size(Find(root, "width"), "width");
+  camera.height = Size(Find(root, "height"), "height");
   return camera;
 }
 
+// Kalibr's distortion: radtan / equidistant with distortion_coeffs, or none without them.
+void SetKalibrDistortion(const YAML::Node& cam, const std::string& format, CameraModel* camera) {
+  const std::string model = Text(Require(cam, "distortion_model", format), "distortion_model");
+  const std::optional<YAML::Node> coefficients_node = Find(cam, "distortion_coeffs");
+  std::vector<double> coefficients;
+  if (coefficients_node) coefficients = Numbers(*coefficients_node, "distortion_coeffs");
+  if (model == "none") {
+    if (!coefficients.empty()) throw Problem("distortion_model none with distortion_coeffs");
+    SetModel("radtan", {0, 0, 0, 0}, camera);
+  } else {
+    if (!coefficients_node) throw Problem("'distortion_coeffs' is missing (" + format + ")");
+    SetModel(model, coefficients, camera);
+  }
+}
+
 // A Kalibr camchain camera: pinhole intrinsics [fu fv pu pv], radtan / equidistant / none.
-CameraModel FromKalibr(const YamlNode& cam, const std::string& name) {
+CameraModel FromKalibr(const YAML::Node& cam, const std::string& name) {
   const std::string format = "Kalibr " + name;
   const std::string projection = Text(Require(cam, "camera_model", format), "camera_model");
   if (projection != "pinhole") {
@@ -253,18 +531,8 @@ CameraModel FromKalibr(const YamlNode& cam, const std::string& name) {
   camera.fy = intrinsics[1];
   camera.cx = intrinsics[2];
   camera.cy = intrinsics[3];
-  const std::string model = Text(Require(cam, "distortion_model", format), "distortion_model");
-  const YamlNode* coefficients_node = cam.Find("distortion_coeffs");
-  std::vector<double> coefficients;
-  if (coefficients_node) coefficients = Numbers(*coefficients_node, "distortion_coeffs");
-  if (model == "none") {
-    if (!coefficients.empty()) throw Problem("distortion_model none with distortion_coeffs");
-    SetModel("radtan", {0, 0, 0, 0}, &camera);
-  } else {
-    if (!coefficients_node) throw Problem("'distortion_coeffs' is missing (" + format + ")");
-    SetModel(model, coefficients, &camera);
-  }
-  if (const YamlNode* resolution = cam.Find("resolution")) {
+  SetKalibrDistortion(cam, format, &camera);
+  if (const std::optional<YAML::Node> resolution = Find(cam, "resolution")) {
     const std::vector<double> size = Numbers(*resolution, "resolution");
     if (size.size() != 2) throw Problem("resolution must be [width, height]");
     camera.width = PixelCount(size[0], "resolution width");
@@ -273,18 +541,18 @@ CameraModel FromKalibr(const YamlNode& cam, const std::string& name) {
   return camera;
 }
 
-CameraModel Interpret(const YamlNode& root, bool opencv_file) {
-  if (root.kind != YamlNode::Kind::kMap) {
+CameraModel Interpret(const YAML::Node& root, bool opencv_file) {
+  if (!root.IsMap()) {
     throw Problem("not a camera file: expected a map of named parameters at the top level");
   }
   CameraModel camera;
-  if (const YamlNode* cam0 = root.Find("cam0")) {
+  if (const std::optional<YAML::Node> cam0 = Find(root, "cam0")) {
     camera = FromKalibr(*cam0, "cam0");
-  } else if (root.Find("camera_model") && root.Find("intrinsics")) {
+  } else if (Find(root, "camera_model") && Find(root, "intrinsics")) {
     camera = FromKalibr(root, "camera");
-  } else if (root.Find("camera_matrix")) {
+  } else if (Find(root, "camera_matrix")) {
     camera = FromCameraMatrix(root, opencv_file);
-  } else if (root.Find("K") || root.Find("k")) {
+  } else if (Find(root, "K") || Find(root, "k")) {
     camera = FromCameraInfo(root);
   } else {
     throw Problem(
@@ -305,18 +573,15 @@ CameraModel Interpret(const YamlNode& root, bool opencv_file) {
 CameraModel LoadCameraFile(const std::filesystem::path& path) {
   try {
     const std::string text = ReadText(path);
-    std::string opencv_why;
-    if (std::optional<YamlNode> root = ReadWithOpenCv(path, &opencv_why)) {
-      return Interpret(*root, /*opencv_file=*/true);
-    }
     const size_t first = text.find_first_not_of(" \t\r\n");
     if (first != std::string::npos && text[first] == '<') {
-      throw Problem("OpenCV cannot read this XML file: " + opencv_why);
+      CheckXmlNesting(text);
+      return Interpret(ReadXmlWithOpenCv(path), /*opencv_file=*/true);
     }
-    std::string yaml_why;
-    const std::optional<YamlNode> root = ParseYamlLite(text, &yaml_why);
-    if (!root) throw Problem("not valid YAML: " + yaml_why);
-    return Interpret(*root, /*opencv_file=*/false);
+    CheckYamlText(text);
+    // OpenCV's FileStorage writes this header (not valid YAML 1.x; yaml-cpp skips it).
+    const bool opencv_file = text.starts_with("%YAML:1.");
+    return Interpret(ParseYaml(text), opencv_file);
   } catch (const Problem& problem) {
     throw IoError("camera file '" + path.string() + "': " + problem.what());
   }

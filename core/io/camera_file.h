@@ -12,6 +12,9 @@ namespace calibench {
 // message fields K/D), or a Kalibr camchain (cam0). The model must be stated by the file
 // (plumb_bob / rational_polynomial / radtan -> pinhole-radtan; equidistant / fisheye ->
 // kannala-brandt); OpenCV FileStorage files without a model are pinhole-radtan by definition.
+// Throws IoError naming the file and the problem (with its line where the YAML parser gives one):
+// a missing or mistyped field, a key given twice, invalid YAML/XML, binary data, or text nested
+// deeper than 64 levels (refused before any parser sees it).
 CameraModel LoadCameraFile(const std::filesystem::path& path);
 
 }  // namespace calibench

@@ -1,12 +1,13 @@
 // LoadCameraFile on every supported format (written here, and the real files in ../shared), and
-// on bad inputs, which must throw IoError naming the file.
+// on bad inputs, which must throw IoError naming the file (and the line, where there is one),
+// deeply nested ones included.
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <opencv2/core.hpp>
 
-#include "core/io/dataset.h"
 #include "core/io/camera_file.h"
+#include "core/io/dataset.h"
 #include "tests/test_support.h"
 
 namespace calibench {
@@ -153,6 +154,54 @@ TEST(CameraFileTest, KalibrCamchain) {
                {0, 0, 0, 0});
 }
 
+// The YAML that real camera files use beyond the plain shapes above: CRLF, comments, quotes
+// holding ':' and '#', anchors and aliases, block scalars, lists of maps, a YAML 1.2 header.
+TEST(CameraFileTest, YamlSyntaxInCameraFiles) {
+  const std::filesystem::path dir = test::TempDir("camera_file_yaml_syntax");
+  const auto ros = Write(dir / "info.yaml",
+                         "%YAML 1.2\r\n"
+                         "---\r\n"
+                         "# a CameraInfo, hand-edited\r\n"
+                         "header: {frame_id: \"cam #1: left\", stamp: {sec: 0}}\r\n"
+                         "note: |\r\n"
+                         "  don't [parse { this\r\n"
+                         "    - as: structure\r\n"
+                         "roi:\r\n"
+                         "- name: 'it''s full'\r\n"
+                         "  size: &size [640, 480]\r\n"
+                         "- same: *size\r\n"
+                         "width: 640  # pixels\r\n"
+                         "height: 480\r\n"
+                         "distortion_model: 'plumb_bob'\r\n"
+                         "D: [-0.1, 0.05,\r\n"
+                         "    0.001, -0.002, 0.0]\r\n"
+                         "K: [500, 0, 320,\r\n"
+                         "    0, 501, 240,\r\n"
+                         "    0, 0, 1]\r\n"
+                         "extra: " +
+                             std::string(60, '[') + std::string(60, ']') + "\r\n");
+  ExpectCamera(LoadCameraFile(ros), CameraModelType::kPinholeRadTan, 640, 480, 500, 501, 320, 240,
+               {-0.1, 0.05, 0.001, -0.002, 0.0});
+  // OpenCV's own header, tags and line-wrapped matrices, written by hand: the model is implied.
+  const auto opencv = Write(dir / "opencv.yml",
+                            "%YAML:1.0\n"
+                            "---\n"
+                            "calibration_time: \"Wed 08 Dec 2021 05:13:09 PM MSK\"\n"
+                            "camera_matrix: !!opencv-matrix\n"
+                            "   rows: 3\n"
+                            "   cols: 3\n"
+                            "   dt: d\n"
+                            "   data: [ 4.5251072219637672e+02, 0., 3.1770297317353277e+02, 0.,\n"
+                            "       4.5676707935146891e+02, 2.7775155919135995e+02, 0., 0., 1. ]\n"
+                            "distortion_coefficients: !!opencv-matrix\n"
+                            "   rows: 1\n"
+                            "   cols: 4\n"
+                            "   dt: d\n"
+                            "   data: [ .5, -.25, 0., 0. ]\n");
+  ExpectCamera(LoadCameraFile(opencv), CameraModelType::kPinholeRadTan, 0, 0, 452.51072219637672,
+               456.76707935146891, 317.70297317353277, 277.75155919135995, {0.5, -0.25, 0, 0});
+}
+
 TEST(CameraFileTest, SharedDatasetFiles) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
   const std::filesystem::path datasets = shared / "datasets";
@@ -247,6 +296,90 @@ TEST(CameraFileTest, BadInputsThrowIoErrorNamingTheFile) {
   WriteOpenCv(dir / "opencv_unknown.yml", CharucoK(), cv::Mat(std::vector<double>(4, 0.0)), "mei",
               640, 480);
   ExpectRejected(dir / "opencv_unknown.yml", "'mei' is unknown");
+}
+
+TEST(CameraFileTest, ErrorsNameTheLine) {
+  const std::filesystem::path dir = test::TempDir("camera_file_lines");
+  const std::string k = "K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n";
+  const std::string model = "distortion_model: plumb_bob\n";
+  ExpectRejected(Write(dir / "indent.yaml", k + "width: 640\n  height: 480\n"),
+                 "not valid YAML: line 3");
+  ExpectRejected(Write(dir / "tab.yaml", "header:\n\tseq: 0\n" + k), "not valid YAML: line 2");
+  // yaml-cpp 0.7 would let an unclosed quote run to the end of the file.
+  ExpectRejected(Write(dir / "quote.yaml", k + "distortion_model: \"plumb_bob\nD: [0, 0]\n"),
+                 "not valid YAML: line 2: the quote is never closed");
+  ExpectRejected(Write(dir / "quote1.yaml", k + "distortion_model: 'plumb_bob\nD: [0, 0]\n"),
+                 "not valid YAML: line 2: the quote is never closed");
+  ExpectRejected(Write(dir / "bracket.yaml", k + model + "D: [0, 0, 0, 0, 0\nwidth: 640\n"),
+                 "not valid YAML: line 4");
+  ExpectRejected(Write(dir / "alias.yaml", k + model + "D: *coefficients\n"),
+                 "not valid YAML: line 3");
+  ExpectRejected(Write(dir / "twice.yaml", k + model + "D: [0, 0, 0, 0, 0]\n" + k),
+                 "'K' is given twice (line 4)");
+  ExpectRejected(
+      Write(dir / "twice_inner.yaml", "cam0:\n  camera_model: pinhole\n  camera_model: omni\n"),
+      "'camera_model' is given twice (line 3)");
+  ExpectRejected(Write(dir / "text_value.yaml", k + model + "D: [0, a, 0, 0, 0]\n"),
+                 "D must contain numbers only, found 'a' (line 3)");
+  for (const char* number : {"0x10", "1.0abc", "--1", "1e", "~", "", "[1]"}) {
+    ExpectRejected(Write(dir / "number.yaml", k + model + "D: [0, " + number + ", 0, 0, 0]\n"),
+                   "D must contain numbers only");
+  }
+  ExpectRejected(Write(dir / "width_list.yaml", k + model + "D: [0, 0, 0, 0, 0]\nwidth: [640]\n"),
+                 "width must be a number of pixels, got a list (line 4)");
+  ExpectRejected(Write(dir / "model_list.yaml", k + "distortion_model: [a]\nD: [0, 0, 0, 0, 0]\n"),
+                 "distortion_model must be a text, got a list (line 2)");
+  ExpectRejected(Write(dir / "d_text.yaml", k + model + "D: none\n"),
+                 "D must be a list of numbers, got 'none' (line 3)");
+  ExpectRejected(Write(dir / "rows.yaml",
+                       "camera_matrix:\n  rows: three\n  cols: 3\n"
+                       "  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n" +
+                           model + "distortion_coefficients: [0, 0, 0, 0, 0]\n"),
+                 "camera_matrix.rows must be a whole number, got 'three' (line 2)");
+  ExpectRejected(Write(dir / "opencv_broken.yml",
+                       "%YAML:1.0\n---\ncamera_matrix: !!opencv-matrix\n   rows: 3\n"
+                       "   data: [ 1., 0.,\n"),
+                 "not valid YAML: line 6");
+  ExpectRejected(Write(dir / "control.yaml", k + "note: bell\a\n"), "binary data");
+}
+
+// Both parsers recurse; nesting is measured on the text first, so even 100,000 levels end in an
+// IoError, not a stack overflow.
+TEST(CameraFileTest, DeepNestingIsRefusedBeforeParsing) {
+  const std::filesystem::path dir = test::TempDir("camera_file_nesting");
+  const std::string k = "K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n";
+  const std::string deep = "nested deeper than 64 levels";
+  const int n = 100000;
+  const auto repeat = [](const std::string& s, int times) {
+    std::string out;
+    for (int i = 0; i < times; ++i) out += s;
+    return out;
+  };
+  ExpectRejected(Write(dir / "flow.yaml", k + "x: " + repeat("[", n) + repeat("]", n) + "\n"),
+                 deep + " (line 2)");
+  ExpectRejected(Write(dir / "flow_map.yaml", repeat("{a: ", n) + "1" + repeat("}", n)), deep);
+  ExpectRejected(Write(dir / "flow_lines.yaml", "x:\n" + repeat("  [\n", n)), deep);
+  ExpectRejected(Write(dir / "compact.yaml", repeat("- ", n) + "x\n"), deep);
+  ExpectRejected(Write(dir / "opencv.yml", "%YAML:1.0\n---\nx: " + repeat("[", n)), deep);
+  std::string indented;
+  for (int i = 0; i < 70; ++i) indented += std::string(i, ' ') + "k" + std::to_string(i) + ":\n";
+  ExpectRejected(Write(dir / "indented.yaml", indented), deep + " (line 65)");
+  std::string sequences = "k:\n";  // sequences at their key's indentation nest too
+  for (int i = 0; i < 40; ++i) sequences += std::string(2 * i, ' ') + "- k:\n";
+  ExpectRejected(Write(dir / "sequences.yaml", sequences), deep);
+  ExpectRejected(Write(dir / "deep.xml", "<?xml version=\"1.0\"?>\n<opencv_storage>\n" +
+                                             repeat("<a x=\"/>\">", n) + repeat("</a>", n) +
+                                             "\n</opencv_storage>\n"),
+                 deep + " (line 3)");
+  // Brackets in quotes, comments and block scalars are text, not nesting.
+  const std::string text = repeat("[", 100);
+  ExpectCamera(LoadCameraFile(
+                   Write(dir / "text.yaml", k +
+                                                "distortion_model: plumb_bob\nD: [0, 0, 0, 0, 0]\n"
+                                                "a: '" +
+                                                text + "'\nb: \"" + text + "\"\n# " + text +
+                                                "\nc: |\n  " + text + "\n  " + text + "\n")),
+               CameraModelType::kPinholeRadTan, 0, 0, 500, 500, 320, 240, {0, 0, 0, 0, 0});
 }
 
 }  // namespace
