@@ -41,31 +41,9 @@ std::vector<int> CirclePixels(int rows, int columns, int row, int column, float 
 
 }  // namespace
 
-Controller::Controller(PipelineOptions options)
-    : pipeline_(std::move(options)), worker_([this](const std::string& message) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        SetStatus("error: " + message, true);
-      }) {}
+Controller::Controller(PipelineOptions options) : pipeline_(std::move(options)) {}
 
-Controller::~Controller() = default;
-
-void Controller::WaitIdle() { worker_.WaitIdle(); }
-
-Snapshot Controller::GetSnapshot() const {
-  Snapshot copy;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    copy = state_;
-  }
-  copy.busy = worker_.Busy();
-  return copy;
-}
-
-void Controller::SetStatus(const std::string& message, bool error) {
-  state_.status_line = message;
-  state_.status_is_error = error;
-  ++state_.generation;
-}
+Controller::~Controller() { StopWorker(); }
 
 void Controller::OpenDataset(const std::filesystem::path& dataset_path,
                              std::filesystem::path session_path) {
@@ -474,16 +452,11 @@ void Controller::EnsureSelectedImage() {
   }
 }
 
-void Controller::Apply(const Intent& intent) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!state_.dataset) return;
-  std::visit([this](const auto& what) { Handle(what); }, intent);
-}
-
 bool Controller::ValidPair(int index) const {
   return index >= 0 && index < static_cast<int>(state_.pairs.size());
 }
 
+template <>
 void Controller::Handle(const SelectPair& select) {
   if (!ValidPair(select.index) || select.index == state_.selected) return;
   state_.selected = select.index;
@@ -496,6 +469,7 @@ void Controller::Handle(const SelectPair& select) {
   worker_.Enqueue([this, index] { ComputeReprojection(index); });
 }
 
+template <>
 void Controller::Handle(const SetPairStatus& status) {
   if (!ValidPair(status.index)) return;
   PairView& pair = state_.pairs[status.index];
@@ -514,6 +488,7 @@ void Controller::Handle(const SetPairStatus& status) {
   CommitEdit();
 }
 
+template <>
 void Controller::Handle(const BrushStroke& stroke) {
   if (!ValidPair(stroke.index)) return;
   PairView& pair = state_.pairs[stroke.index];
@@ -536,6 +511,7 @@ void Controller::Handle(const BrushStroke& stroke) {
   worker_.Enqueue([this, index] { RefitLidar(index); });
 }
 
+template <>
 void Controller::Handle(const ClearBrush& clear) {
   if (!ValidPair(clear.index)) return;
   state_.pairs[clear.index].brush_pixels.clear();
@@ -545,10 +521,12 @@ void Controller::Handle(const ClearBrush& clear) {
   worker_.Enqueue([this, index] { RefitLidar(index); });
 }
 
+template <>
 void Controller::Handle(const RunSolver&) {
   worker_.Enqueue([this] { Solve(); });
 }
 
+template <>
 void Controller::Handle(const ResetSolver&) {
   state_.solver = SolverView{};
   state_.reprojection.reset();
@@ -556,6 +534,7 @@ void Controller::Handle(const ResetSolver&) {
   CommitEdit();
 }
 
+template <>
 void Controller::Handle(const SetSolverOptions& options) {
   SolverOptions check;
   check.huber_delta = options.huber_delta;
@@ -576,6 +555,7 @@ void Controller::Handle(const SetSolverOptions& options) {
   CommitEdit();
 }
 
+template <>
 void Controller::Handle(const SetView& view) {
   const bool visibility_changed = view.view.visibility != state_.view.visibility ||
                                   view.view.hpr_radius_exponent != state_.view.hpr_radius_exponent;
@@ -587,6 +567,7 @@ void Controller::Handle(const SetView& view) {
   }
 }
 
+template <>
 void Controller::Handle(const ExportResult& export_result) {
   if (!state_.solver.result) {
     SetStatus("nothing to export: run the solver first", true);
@@ -605,6 +586,7 @@ void Controller::Handle(const ExportResult& export_result) {
   }
 }
 
+template <>
 void Controller::Handle(const SaveSessionAs& save) {
   try {
     SaveSession(save.path, session_);
@@ -616,8 +598,14 @@ void Controller::Handle(const SaveSessionAs& save) {
   }
 }
 
-void Controller::Handle(const Undo&) { Restore(history_.Undo()); }
-void Controller::Handle(const Redo&) { Restore(history_.Redo()); }
+template <>
+void Controller::Handle(const Undo&) {
+  Restore(history_.Undo());
+}
+template <>
+void Controller::Handle(const Redo&) {
+  Restore(history_.Redo());
+}
 
 void Controller::Restore(const std::optional<Session>& restored) {
   if (!restored) return;
@@ -629,6 +617,12 @@ void Controller::Restore(const std::optional<Session>& restored) {
   if (autosaver_) autosaver_->Save(session_);
   for (int i = 0; i < static_cast<int>(state_.pairs.size()); ++i)
     if (state_.pairs[i].brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });
+}
+
+void Controller::Apply(const Intent& intent) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!state_.dataset) return;
+  std::visit([this](const auto& what) { Handle(what); }, intent);
 }
 
 }  // namespace calibench::ui

@@ -24,15 +24,12 @@
 #include "core/session/session.h"
 #include "core/target/board_camera.h"
 #include "core/target/lidar_plane.h"
-#include "ui/state/work_queue.h"
+#include "ui/state/controller_state.h"
 
 namespace calibench::ui {
 
 // Everything the panels show about one pair. Heavy members are shared, immutable buffers.
-struct PairView {
-  std::string id;
-  PairStatus status = PairStatus::kPending;
-  std::string reason;
+struct PairView : PairHeader {
   bool loaded = false;
   std::shared_ptr<const LidarCloud> cloud;
   std::shared_ptr<const LidarImage> lidar_image;
@@ -63,8 +60,7 @@ struct Reprojection {
   std::vector<bool> visible;
 };
 
-struct Snapshot {
-  std::uint64_t generation = 0;  // increases with every change
+struct Snapshot : SnapshotHeader {
   std::filesystem::path dataset_path;
   std::filesystem::path session_path;
   std::optional<Dataset> dataset;
@@ -81,9 +77,6 @@ struct Snapshot {
   bool estimate_range_offset = false;  // weighted-ml only
   bool can_undo = false, can_redo = false;
   int loading_done = 0, loading_total = 0;
-  bool busy = false;        // worker has queued or running jobs
-  std::string status_line;  // the last message for the user (errors included)
-  bool status_is_error = false;
 };
 
 // What the user asked for. Panels return these; Controller::Apply carries them out.
@@ -127,7 +120,7 @@ using Intent =
     std::variant<SelectPair, SetPairStatus, BrushStroke, ClearBrush, RunSolver, ResetSolver,
                  SetSolverOptions, SetView, ExportResult, SaveSessionAs, Undo, Redo>;
 
-class Controller {
+class Controller : public ControllerState<Snapshot> {
  public:
   // options: the pipeline's (as `calibench calibrate` takes them); a session's choices override
   // its solver settings.
@@ -143,9 +136,6 @@ class Controller {
   void OpenSession(const std::filesystem::path& session);
 
   void Apply(const Intent& intent);
-  Snapshot GetSnapshot() const;
-  // Blocks until the worker has no queued or running job (tests, headless renders).
-  void WaitIdle();
 
  private:
   void LoadAllPairs();
@@ -162,34 +152,20 @@ class Controller {
   SolverResult ResultForCurrentPairs() const;
   void RecomputeResiduals();  // call with mutex_ held
   void CommitEdit();          // session <- state, history + autosave; call with mutex_ held
-  void SetStatus(const std::string& message, bool error);  // call with mutex_ held
-  void ApplySessionToState(const Session& session);        // call with mutex_ held
+  void ApplySessionToState(const Session& session);  // call with mutex_ held
   void Open(const Dataset& dataset, Session session, std::filesystem::path session_path);
 
-  // One handler per intent (Apply visits them with mutex_ held).
+  // One handler per intent type, each an explicit specialization in controller.cpp (Apply visits
+  // them with mutex_ held).
+  template <typename IntentType>
+  void Handle(const IntentType& intent);
   bool ValidPair(int index) const;
-  void Handle(const SelectPair& select);
-  void Handle(const SetPairStatus& status);
-  void Handle(const BrushStroke& stroke);
-  void Handle(const ClearBrush& clear);
-  void Handle(const RunSolver&);
-  void Handle(const ResetSolver&);
-  void Handle(const SetSolverOptions& options);
-  void Handle(const SetView& view);
-  void Handle(const ExportResult& export_result);
-  void Handle(const SaveSessionAs& save);
-  void Handle(const Undo&);
-  void Handle(const Redo&);
   void Restore(const std::optional<Session>& restored);  // undo / redo
 
-  mutable std::mutex mutex_;
-  Snapshot state_;
   Session session_;  // the editable state as saved; state_ mirrors it plus derived data
   SessionHistory history_;
   std::unique_ptr<Autosaver> autosaver_;
   PipelineOptions pipeline_;
-
-  WorkQueue worker_;  // last member: jobs may touch everything above
 };
 
 }  // namespace calibench::ui

@@ -50,35 +50,14 @@ double PointToPlaneRms(const LrfPairFeatures& features, const Pose& cam_from_lrf
 
 }  // namespace
 
-LrfController::LrfController(LrfPipelineOptions options)
-    : options_(std::move(options)), worker_([this](const std::string& message) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        state_.solver.running = false;
-        SetStatus("error: " + message, true);
-      }) {
+LrfController::LrfController(LrfPipelineOptions options) : options_(std::move(options)) {
   state_.solver.method = options_.solver.method;
   state_.status_line = "open an LRF dataset manifest";
 }
 
-LrfController::~LrfController() = default;
+LrfController::~LrfController() { StopWorker(); }
 
-void LrfController::WaitIdle() { worker_.WaitIdle(); }
-
-LrfSnapshot LrfController::GetSnapshot() const {
-  LrfSnapshot copy;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    copy = state_;
-  }
-  copy.busy = worker_.Busy();
-  return copy;
-}
-
-void LrfController::SetStatus(const std::string& message, bool error) {
-  state_.status_line = message;
-  state_.status_is_error = error;
-  ++state_.generation;
-}
+void LrfController::OnJobError() { state_.solver.running = false; }
 
 bool LrfController::Open(const std::filesystem::path& manifest) {
   std::string why;

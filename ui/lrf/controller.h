@@ -16,15 +16,12 @@
 
 #include "core/base/image.h"
 #include "core/lrf/pipeline.h"
-#include "ui/state/work_queue.h"
+#include "ui/state/controller_state.h"
 
 namespace calibench::ui {
 
 // Everything the panels show about one pair. The features are a shared, immutable buffer.
-struct LrfPairView {
-  std::string id;
-  PairStatus status = PairStatus::kPending;
-  std::string reason;
+struct LrfPairView : PairHeader {
   bool extracted = false;
   std::shared_ptr<const LrfPairFeatures> features;
   // At the solver's estimate (after a solve): Eq. (12) mean corner-to-line distance (three-face
@@ -46,8 +43,7 @@ struct LrfSolverView {
   std::string failure;
 };
 
-struct LrfSnapshot {
-  std::uint64_t generation = 0;  // increases with every change
+struct LrfSnapshot : SnapshotHeader {
   std::filesystem::path manifest;
   std::shared_ptr<const LrfDataset> dataset;  // null until a manifest opened
   std::vector<LrfPairView> pairs;
@@ -55,9 +51,6 @@ struct LrfSnapshot {
   std::shared_ptr<const ImageU8> selected_image;  // checkerboard case: the RGB image of `selected`
   LrfSolverView solver;
   int extracted_done = 0, extracted_total = 0;
-  bool busy = false;  // worker has queued or running jobs
-  std::string status_line;
-  bool status_is_error = false;
 };
 
 struct LrfSelectPair {
@@ -78,7 +71,7 @@ struct LrfExportResult {
 using LrfIntent = std::variant<LrfSelectPair, LrfSetPairStatus, LrfRunSolver, LrfResetSolver,
                                LrfSetMethod, LrfExportResult>;
 
-class LrfController {
+class LrfController : public ControllerState<LrfSnapshot> {
  public:
   explicit LrfController(LrfPipelineOptions options = {});
   ~LrfController();
@@ -89,24 +82,17 @@ class LrfController {
   // read leaves the open dataset as it was and shows the error in the status line (false).
   bool Open(const std::filesystem::path& manifest);
   void Apply(const LrfIntent& intent);
-  LrfSnapshot GetSnapshot() const;
-  // Blocks until the worker has no queued or running job (tests, headless renders).
-  void WaitIdle();
 
  private:
+  void OnJobError() override;
   void Extract(std::uint64_t open_count, int index);
   void Solve();
   void LoadSelectedImage();
-  void UpdatePairFigures();                                // call with mutex_ held
-  void SetStatus(const std::string& message, bool error);  // call with mutex_ held
+  void UpdatePairFigures();  // call with mutex_ held
 
   LrfPipelineOptions options_;
-  mutable std::mutex mutex_;
-  LrfSnapshot state_;
   std::shared_ptr<const LrfCalibrationOutcome> outcome_;  // of the shown solution, for export
   std::uint64_t open_count_ = 0;  // a job of an earlier Open() discards its result
-
-  WorkQueue worker_;  // last member: jobs may touch everything above
 };
 
 }  // namespace calibench::ui

@@ -7,19 +7,23 @@ namespace calibench::ui {
 WorkQueue::WorkQueue(std::function<void(const std::string&)> on_error)
     : on_error_(std::move(on_error)), worker_([this] { Loop(); }) {}
 
-WorkQueue::~WorkQueue() {
+WorkQueue::~WorkQueue() { Stop(); }
+
+void WorkQueue::Stop() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
     queue_.clear();
   }
   queue_cv_.notify_all();
-  worker_.join();
+  if (worker_.joinable()) worker_.join();
+  idle_cv_.notify_all();
 }
 
 void WorkQueue::Enqueue(std::function<void()> job) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (stop_) return;
     queue_.push_back(std::move(job));
   }
   queue_cv_.notify_one();

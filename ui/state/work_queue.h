@@ -15,11 +15,14 @@ class WorkQueue {
  public:
   // on_error(message) is called on the worker thread when a job throws; the queue goes on.
   explicit WorkQueue(std::function<void(const std::string&)> on_error);
-  // Drops the jobs not yet started and waits for the running one.
+  // Stop()s.
   ~WorkQueue();
   WorkQueue(const WorkQueue&) = delete;
   WorkQueue& operator=(const WorkQueue&) = delete;
 
+  // Drops the jobs not yet started, waits for the running one and ends the thread; jobs enqueued
+  // afterwards are dropped. Idempotent.
+  void Stop();
   void Enqueue(std::function<void()> job);
   // Drops the jobs not yet started (a running one finishes).
   void DropQueued();

@@ -1,0 +1,72 @@
+// What both workbench controllers keep the same way: the snapshot the panels read, behind a
+// mutex, with its status line and change counter, and the worker that runs the slow jobs.
+// No GL, no ImGui.
+#pragma once
+
+#include <cstdint>
+#include <mutex>
+#include <string>
+
+#include "core/results/pair_status.h"
+#include "ui/state/work_queue.h"
+
+namespace calibench::ui {
+
+// The part of a pair every workbench lists: which pair, where it stands and why.
+struct PairHeader {
+  std::string id;
+  PairStatus status = PairStatus::kPending;
+  std::string reason;  // why failed / rejected, human-readable
+};
+
+// The part of a snapshot every workbench shows: the status line and whether work is running.
+struct SnapshotHeader {
+  std::uint64_t generation = 0;  // increases with every change
+  bool busy = false;             // the worker has queued or running jobs
+  std::string status_line;       // the last message for the user (errors included)
+  bool status_is_error = false;
+};
+
+// Snapshot derives from SnapshotHeader. A derived controller must call StopWorker() first in its
+// destructor: queued jobs touch the derived controller's members.
+template <typename Snapshot>
+class ControllerState {
+ public:
+  // A copy of the state for the panels (taken under the lock).
+  Snapshot GetSnapshot() const {
+    Snapshot copy;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      copy = state_;
+    }
+    copy.busy = worker_.Busy();
+    return copy;
+  }
+  // Blocks until the worker has no queued or running job (tests, headless renders).
+  void WaitIdle() { worker_.WaitIdle(); }
+
+ protected:
+  ControllerState()
+      : worker_([this](const std::string& message) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          OnJobError();
+          SetStatus("error: " + message, true);
+        }) {}
+  ~ControllerState() = default;
+
+  void StopWorker() { worker_.Stop(); }
+  // The user's message; call with mutex_ held.
+  void SetStatus(const std::string& message, bool error) {
+    state_.status_line = message;
+    state_.status_is_error = error;
+    ++state_.generation;
+  }
+  // What else a failed job resets (with mutex_ held), before its message is shown.
+  virtual void OnJobError() {}
+
+  mutable std::mutex mutex_;
+  Snapshot state_;
+  WorkQueue worker_;
+};
+
+}  // namespace calibench::ui
