@@ -15,6 +15,9 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat3 = Eigen::Matrix3d;
 using Mat4 = Eigen::Matrix4d;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
 // A rigid transform named b_from_a maps points: x_in_b = b_from_a * x_in_a.
 using Pose = Eigen::Isometry3d;
 

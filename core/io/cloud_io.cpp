@@ -44,32 +44,33 @@ T LoadAs(const char* data, bool big_endian) {
 
 }  // namespace
 
+namespace {
+
+// An integer of 1, 2, 4 or 8 bytes as the matching type of the family (signed or unsigned).
+template <typename T8, typename T16, typename T32, typename T64>
+double ReadInteger(const char* data, int bytes, bool big_endian) {
+  switch (bytes) {
+    case 1:
+      return LoadAs<T8>(data, big_endian);
+    case 2:
+      return LoadAs<T16>(data, big_endian);
+    case 4:
+      return LoadAs<T32>(data, big_endian);
+    default:
+      return static_cast<double>(LoadAs<T64>(data, big_endian));
+  }
+}
+
+}  // namespace
+
 double ReadScalar(const char* data, ScalarType type, bool big_endian) {
   switch (type.kind) {
     case ScalarKind::kFloat:
       return type.bytes == 4 ? LoadAs<float>(data, big_endian) : LoadAs<double>(data, big_endian);
     case ScalarKind::kSigned:
-      switch (type.bytes) {
-        case 1:
-          return LoadAs<int8_t>(data, big_endian);
-        case 2:
-          return LoadAs<int16_t>(data, big_endian);
-        case 4:
-          return LoadAs<int32_t>(data, big_endian);
-        default:
-          return static_cast<double>(LoadAs<int64_t>(data, big_endian));
-      }
+      return ReadInteger<int8_t, int16_t, int32_t, int64_t>(data, type.bytes, big_endian);
     case ScalarKind::kUnsigned:
-      switch (type.bytes) {
-        case 1:
-          return LoadAs<uint8_t>(data, big_endian);
-        case 2:
-          return LoadAs<uint16_t>(data, big_endian);
-        case 4:
-          return LoadAs<uint32_t>(data, big_endian);
-        default:
-          return static_cast<double>(LoadAs<uint64_t>(data, big_endian));
-      }
+      return ReadInteger<uint8_t, uint16_t, uint32_t, uint64_t>(data, type.bytes, big_endian);
   }
   throw std::logic_error("ReadScalar: unknown scalar kind");
 }

@@ -41,6 +41,24 @@ struct RawHeader {
   std::string_view width, height, points, data;
 };
 
+// The RawHeader member a keyword that takes a list of words (FIELDS, SIZE, ...) fills; null for
+// other keywords.
+std::vector<std::string_view>* ListKeyword(RawHeader* raw, std::string_view key) {
+  if (key == "FIELDS" || key == "COLUMNS") return &raw->fields;
+  if (key == "SIZE") return &raw->sizes;
+  if (key == "TYPE") return &raw->types;
+  if (key == "COUNT") return &raw->counts;
+  return nullptr;
+}
+
+// The member a keyword that takes one word (WIDTH, HEIGHT, POINTS) fills; null for others.
+std::string_view* WordKeyword(RawHeader* raw, std::string_view key) {
+  if (key == "WIDTH") return &raw->width;
+  if (key == "HEIGHT") return &raw->height;
+  if (key == "POINTS") return &raw->points;
+  return nullptr;
+}
+
 std::string Joined(const std::vector<std::string_view>& words) {
   std::string text;
   for (const auto& w : words) text += (text.empty() ? "" : " ") + std::string(w);
@@ -63,21 +81,15 @@ RawHeader ReadRawHeader(const std::filesystem::path& path, const std::string& by
     const std::vector<std::string_view> values(words.begin() + 1, words.end());
     const std::string_view first = values.empty() ? std::string_view() : values[0];
     if (key == "VERSION" || key == "VIEWPOINT") continue;
-    if (key == "FIELDS" || key == "COLUMNS")
-      raw.fields = values;
-    else if (key == "SIZE")
-      raw.sizes = values;
-    else if (key == "TYPE")
-      raw.types = values;
-    else if (key == "COUNT")
-      raw.counts = values;
-    else if (key == "WIDTH")
-      raw.width = first;
-    else if (key == "HEIGHT")
-      raw.height = first;
-    else if (key == "POINTS")
-      raw.points = first;
-    else if (key == "DATA") {
+    if (auto* list = ListKeyword(&raw, key)) {
+      *list = values;
+      continue;
+    }
+    if (auto* word = WordKeyword(&raw, key)) {
+      *word = first;
+      continue;
+    }
+    if (key == "DATA") {
       raw.data = first;
       header->data_start = pos;
       header->data_line = line_number + 1;

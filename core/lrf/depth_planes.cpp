@@ -20,8 +20,6 @@ namespace calibench {
 
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // ---------------------------------------------------------------------------------------------
 // The depth image as points on the subsampled pixel grid.
@@ -61,7 +59,6 @@ DepthCloud BackProject(const DepthImage& depth, const DepthRegion& region, int s
 double PlaneThreshold(const DepthFeatureOptions& options, double z) {
   return options.plane_threshold_m + options.plane_threshold_per_m2 * z * z;
 }
-
 
 // Calls visit(n) for each cell n of the 3×3 block around `cell` (itself included) inside the
 // grid: 8-connectivity on the subsampled pixel grid.
@@ -153,7 +150,6 @@ std::vector<int> LargestComponent(const DepthCloud& cloud, const std::vector<int
   }
   return best;
 }
-
 
 // ---------------------------------------------------------------------------------------------
 // Planes in the cloud (paper Eq. (6): one plane equation per face).
@@ -318,7 +314,6 @@ std::optional<std::array<int, 3>> ChooseTriple(const DepthCloud& cloud,
   return best;
 }
 
-
 // Each point of the three patches goes to the one plane it is an inlier of (distance and local
 // normal); points that fit two (along the edges AB, AC, AD) are left out, since they would pull
 // the planes towards each other. Then the planes are fitted again.
@@ -350,7 +345,6 @@ bool ReassignAndRefit(const DepthCloud& cloud, const DepthFeatureOptions& option
   *faces = std::move(refit);
   return true;
 }
-
 
 // ---------------------------------------------------------------------------------------------
 // Sequential plane extraction (Fig. 7 (c)).
@@ -518,8 +512,7 @@ bool CheckFaceAngles(const std::array<PlanePatch, 3>& faces, const DepthFeatureO
     const double angle = UnsignedAngleDeg(faces[a].plane.normal, faces[b].plane.normal);
     out->min_face_angle_deg = std::min(out->min_face_angle_deg, angle);
     if (angle < options.min_face_angle_deg) {
-      out->reason =
-          NearParallelReason(FaceName(a), FaceName(b), options.min_face_angle_deg, angle);
+      out->reason = NearParallelReason(FaceName(a), FaceName(b), options.min_face_angle_deg, angle);
       return false;
     }
   }
@@ -587,8 +580,7 @@ bool DepthFeatureOptions::Check(std::string* why) const {
   if (!(plane_threshold_per_m2 >= 0))
     return FailCheck(why, "plane_threshold_per_m2 must be >= 0 (1/m)");
   if (min_inliers_per_face < 4) return FailCheck(why, "min_inliers_per_face must be >= 4");
-  if (max_planes < 3)
-    return FailCheck(why, "max_planes must be >= 3 (the target has three faces)");
+  if (max_planes < 3) return FailCheck(why, "max_planes must be >= 3 (the target has three faces)");
   if (!(min_face_angle_deg >= 0 && min_face_angle_deg < 90))
     return FailCheck(why, "min_face_angle_deg must be in [0, 90)");
   return true;

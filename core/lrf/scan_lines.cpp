@@ -319,8 +319,8 @@ std::optional<std::array<std::vector<Vec2>, 3>> PointsBetweenCorners(
                                                       IntersectLines(lines[2], lines[0])};
   for (int k = 0; k < 3; ++k) {
     if (corners[k]) continue;
-    *reason = std::string("lines ") + kLineNames[k] + " and " + kLineNames[(k + 1) % 3] +
-              " are parallel";
+    *reason =
+        std::string("lines ") + kLineNames[k] + " and " + kLineNames[(k + 1) % 3] + " are parallel";
     return std::nullopt;
   }
   const double reference = std::atan2(corners[1]->y(), corners[1]->x());
@@ -407,8 +407,7 @@ bool ScanFeatureOptions::Check(std::string* why) const {
   if (!(break_angle_factor >= 0)) return FailCheck(why, "break_angle_factor must be >= 0");
   if (!(line_threshold_m > 0)) return FailCheck(why, "line_threshold_m must be > 0 (metres)");
   if (min_points_per_face < 2) return FailCheck(why, "min_points_per_face must be >= 2");
-  if (!(min_face_length_m >= 0))
-    return FailCheck(why, "min_face_length_m must be >= 0 (metres)");
+  if (!(min_face_length_m >= 0)) return FailCheck(why, "min_face_length_m must be >= 0 (metres)");
   if (!(min_line_angle_deg >= 0 && min_line_angle_deg < 90))
     return FailCheck(why, "min_line_angle_deg must be in [0, 90)");
   if (ransac_iterations < 1) return FailCheck(why, "ransac_iterations must be >= 1");

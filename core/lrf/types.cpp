@@ -1,14 +1,10 @@
 #include "core/lrf/types.h"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace calibench {
 namespace {
-
-bool Fail(std::string* why, const std::string& message) {
-  if (why) *why = message;
-  return false;
-}
 
 // Unit normal of triangle (p, q, r), turned towards +z of the target frame (the sensors' side).
 Plane TrianglePlane(const Vec3& p, const Vec3& q, const Vec3& r) {
@@ -21,40 +17,48 @@ Plane TrianglePlane(const Vec3& p, const Vec3& q, const Vec3& r) {
 // Eq. (7) and the scan corners F, G, H are then ill-defined.
 constexpr double kMinFaceAngleDeg = 5.0;
 
+
 }  // namespace
 
+bool FailCheck(std::string* why, const std::string& message) {
+  if (why) *why = message;
+  return false;
+}
+
 bool DepthIntrinsics::Check(std::string* why) const {
-  if (width <= 0 || height <= 0) return Fail(why, "depth camera width and height must be > 0");
+  if (width <= 0 || height <= 0) return FailCheck(why, "depth camera width and height must be > 0");
   if (!(std::isfinite(fx) && std::isfinite(fy) && fx > 0 && fy > 0))
-    return Fail(why, "depth camera fx and fy must be finite and > 0 (pixels)");
+    return FailCheck(why, "depth camera fx and fy must be finite and > 0 (pixels)");
   if (!(std::isfinite(cx) && std::isfinite(cy)))
-    return Fail(why, "depth camera cx and cy must be finite (pixels)");
+    return FailCheck(why, "depth camera cx and cy must be finite (pixels)");
   if (!(std::isfinite(depth_scale) && depth_scale > 0))
-    return Fail(why, "depth_scale must be finite and > 0 (metres per PNG unit)");
+    return FailCheck(why, "depth_scale must be finite and > 0 (metres per PNG unit)");
   return true;
 }
 
 bool ThreeFaceTarget::Check(std::string* why) const {
   const double values[] = {base_width, base_height, tent_half_width, apex_y, foot_y, ridge_height};
   if (!std::all_of(std::begin(values), std::end(values), [](double v) { return std::isfinite(v); }))
-    return Fail(why, "three-face target sizes must be finite");
+    return FailCheck(why, "three-face target sizes must be finite");
   if (!(base_width > 0 && base_height > 0))
-    return Fail(why, "three-face target base_width and base_height must be > 0 (metres)");
-  if (!(tent_half_width > 0)) return Fail(why, "three-face target tent_half_width must be > 0");
-  if (!(ridge_height > 0)) return Fail(why, "three-face target ridge_height must be > 0");
-  if (!(apex_y > foot_y)) return Fail(why, "three-face target apex_y must be above foot_y");
+    return FailCheck(why, "three-face target base_width and base_height must be > 0 (metres)");
+  if (!(tent_half_width > 0))
+    return FailCheck(why, "three-face target tent_half_width must be > 0");
+  if (!(ridge_height > 0)) return FailCheck(why, "three-face target ridge_height must be > 0");
+  if (!(apex_y > foot_y)) return FailCheck(why, "three-face target apex_y must be above foot_y");
   // The scan must cross the base on both sides of the tent (segments E…F and H…I).
   if (!(tent_half_width < 0.5 * base_width))
-    return Fail(why, "three-face target tent_half_width must be < base_width / 2 (tent on base)");
+    return FailCheck(why,
+                     "three-face target tent_half_width must be < base_width / 2 (tent on base)");
   if (apex_y > 0.5 * base_height || foot_y < -0.5 * base_height)
-    return Fail(why, "three-face target apex_y and foot_y must lie within ±base_height / 2");
+    return FailCheck(why, "three-face target apex_y and foot_y must lie within ±base_height / 2");
   const auto planes = FacePlanes();
   for (int i = 0; i < 3; ++i) {
     for (int j = i + 1; j < 3; ++j) {
       const double cosine = std::clamp(planes[i].normal.dot(planes[j].normal), -1.0, 1.0);
       if (std::acos(cosine) * 180.0 / M_PI < kMinFaceAngleDeg)
-        return Fail(why, "three-face target faces " + std::to_string(i) + " and " +
-                             std::to_string(j) + " are nearly parallel (< 5 degrees)");
+        return FailCheck(why, "three-face target faces " + std::to_string(i) + " and " +
+                                  std::to_string(j) + " are nearly parallel (< 5 degrees)");
     }
   }
   return true;
@@ -62,6 +66,24 @@ bool ThreeFaceTarget::Check(std::string* why) const {
 
 std::array<Plane, 3> ThreeFaceTarget::FacePlanes() const {
   return {Plane{Vec3::UnitZ(), 0.0}, TrianglePlane(A(), B(), C()), TrianglePlane(A(), C(), D())};
+}
+
+const char* FaceName(int face) {
+  static const char* const kNames[3] = {"base PBDQ", "face ABC", "face ACD"};
+  CALIBENCH_CHECK(face >= 0 && face < 3);
+  return kNames[face];
+}
+
+double UnsignedAngleDeg(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return std::acos(std::clamp(std::abs(a.dot(b)), 0.0, 1.0)) * kRadToDeg;
+}
+
+std::string NearParallelReason(const std::string& a, const std::string& b, double limit_deg,
+                               double angle_deg) {
+  char limit[32], angle[32];
+  std::snprintf(limit, sizeof(limit), "%.1f", limit_deg);
+  std::snprintf(angle, sizeof(angle), "%.1f", angle_deg);
+  return a + " and " + b + " are within " + limit + "° of parallel (" + angle + "°)";
 }
 
 }  // namespace calibench

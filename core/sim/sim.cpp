@@ -14,7 +14,6 @@
 namespace calibench {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kImageMarginFraction = 0.05;  // of the image width, around the whole sheet
 constexpr int kMinBoardRings = 4;
 constexpr int kMinBoardPoints = 60;

@@ -10,7 +10,6 @@
 namespace calibench {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kMinRangeM = 0.3;  // closer returns are suppressed, as real sensors do
 
 // Return intensities (0..255): retro-reflective-free paper and ink, painted walls, concrete floor.

@@ -41,12 +41,7 @@ double BoardPrint::Reflectance(const Vec2& xy) const {
   if (std::abs(xy.x()) > half_pattern_.x() || std::abs(xy.y()) > half_pattern_.y()) return 1.0;
   if (board_.type == BoardType::kCheckerboard) {
     // Square (0, 0), top left, is black, as on OpenCV's ChArUco drawing.
-    const int i =
-        std::clamp(static_cast<int>(std::floor((xy.x() + half_pattern_.x()) / board_.square_size)),
-                   0, board_.SquaresX() - 1);
-    const int j =
-        std::clamp(static_cast<int>(std::floor((xy.y() + half_pattern_.y()) / board_.square_size)),
-                   0, board_.SquaresY() - 1);
+    const auto [i, j] = PatternSquareAt(board_, xy);
     return (i + j) % 2 == 0 ? 0.0 : 1.0;
   }
   const int col =
@@ -183,12 +178,7 @@ class BoardShader {
     const int band_pattern = Band(xy, half_pattern_);
     if (band_pattern != 4) return 10 + band_pattern;  // margin bands
     const BoardSpec& board = print_.board();
-    const int i =
-        std::clamp(static_cast<int>(std::floor((xy.x() + half_pattern_.x()) / board.square_size)),
-                   0, board.SquaresX() - 1);
-    const int j =
-        std::clamp(static_cast<int>(std::floor((xy.y() + half_pattern_.y()) / board.square_size)),
-                   0, board.SquaresY() - 1);
+    const auto [i, j] = PatternSquareAt(board, xy);
     const int square = j * board.SquaresX() + i;
     return uniform_square_[square] ? 100 + square : -1;
   }

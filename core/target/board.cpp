@@ -1,5 +1,7 @@
 #include "core/target/board.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "core/target/charuco_board.h"
@@ -90,40 +92,52 @@ std::vector<Vec3> BoardCornerPoints(const BoardSpec& board) {
   return points;
 }
 
+std::pair<int, int> PatternSquareAt(const BoardSpec& board, const Vec2& xy) {
+  const double half_width = 0.5 * board.PatternWidth(), half_height = 0.5 * board.PatternHeight();
+  const int i = std::clamp(static_cast<int>(std::floor((xy.x() + half_width) / board.square_size)),
+                           0, board.SquaresX() - 1);
+  const int j = std::clamp(static_cast<int>(std::floor((xy.y() + half_height) / board.square_size)),
+                           0, board.SquaresY() - 1);
+  return {i, j};
+}
+
+namespace {
+
+// Printable boards by name. ChArUco: few, large squares, so that 4x4 markers stay decodable
+// (> ~12 px) at 3-4 m. "paper": Ca²Lib Section 4.1, 8x6 squares of 0.2 m printed edge to edge.
+struct NamedBoard {
+  const char* name;
+  BoardType type;
+  int cols, rows;        // inner corners (checkerboard) or squares (ChArUco)
+  double square_size;    // metres
+  double marker_size;    // metres, ChArUco only
+  double width, height;  // the sheet, metres
+};
+constexpr NamedBoard kNamedBoards[] = {
+    {"a3", BoardType::kCheckerboard, 7, 5, 0.04, 0.0, 0.42, 0.297},
+    {"a4", BoardType::kCheckerboard, 5, 4, 0.035, 0.0, 0.297, 0.21},
+    {"charuco-a3", BoardType::kCharuco, 6, 4, 0.065, 0.05, 0.42, 0.297},
+    {"charuco-a4", BoardType::kCharuco, 5, 3, 0.055, 0.042, 0.297, 0.21},
+    {"paper", BoardType::kCheckerboard, 7, 5, 0.2, 0.0, 1.6, 1.2}};
+
+}  // namespace
+
 BoardSpec BoardPreset(const std::string& name) {
-  BoardSpec b;
-  if (name == "a3" || name == "a4") {
-    const bool a3 = name == "a3";
-    b.type = BoardType::kCheckerboard;
-    b.cols = a3 ? 7 : 5;
-    b.rows = a3 ? 5 : 4;
-    b.square_size = a3 ? 0.04 : 0.035;
-    b.board_width = a3 ? 0.42 : 0.297;
-    b.board_height = a3 ? 0.297 : 0.21;
-  } else if (name == "charuco-a3" || name == "charuco-a4") {
-    const bool a3 = name == "charuco-a3";
-    // Few, large squares: 4x4 markers must stay decodable (> ~12 px) at 3-4 m.
-    b.type = BoardType::kCharuco;
-    b.cols = a3 ? 6 : 5;
-    b.rows = a3 ? 4 : 3;
-    b.square_size = a3 ? 0.065 : 0.055;
-    b.marker_size = a3 ? 0.05 : 0.042;
-    b.dictionary = "DICT_4X4_50";
-    b.board_width = a3 ? 0.42 : 0.297;
-    b.board_height = a3 ? 0.297 : 0.21;
-  } else if (name == "paper") {
-    // Ca²Lib Section 4.1: 8x6 squares of 0.2 m (7x5 inner corners) printed edge to edge.
-    b.type = BoardType::kCheckerboard;
-    b.cols = 7;
-    b.rows = 5;
-    b.square_size = 0.2;
-    b.board_width = 1.6;
-    b.board_height = 1.2;
-  } else {
-    throw std::invalid_argument("unknown board '" + name +
-                                "' (known: a3, a4, charuco-a3, charuco-a4, paper)");
+  for (const NamedBoard& named : kNamedBoards) {
+    if (name != named.name) continue;
+    BoardSpec board;
+    board.type = named.type;
+    board.cols = named.cols;
+    board.rows = named.rows;
+    board.square_size = named.square_size;
+    board.marker_size = named.marker_size;
+    if (named.type == BoardType::kCharuco) board.dictionary = "DICT_4X4_50";
+    board.board_width = named.width;
+    board.board_height = named.height;
+    return board;
   }
-  return b;
+  throw std::invalid_argument("unknown board '" + name +
+                              "' (known: a3, a4, charuco-a3, charuco-a4, paper)");
 }
 
 }  // namespace calibench

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/base/types.h"
@@ -45,6 +46,10 @@ struct LidarSeed {
 // The board's corner points in the board frame (metres) in detection order: checkerboard inner
 // corners row-major (x fastest); ChArUco chessboard corners by id (OpenCV's id order).
 std::vector<Vec3> BoardCornerPoints(const BoardSpec& board);
+
+// The pattern square (column i, row j; (0, 0) top left) under a board-frame point (metres),
+// clamped to the pattern.
+std::pair<int, int> PatternSquareAt(const BoardSpec& board, const Vec2& xy);
 
 // Named printable boards: "a3", "a4" (checkerboards), "charuco-a3", "charuco-a4" (few, large
 // squares so that 4x4 markers decode at 3-4 m) and "paper" (Ca²Lib's 8x6 squares of 0.2 m).

@@ -211,15 +211,10 @@ void Controller::LoadPair(int index) {
   }
   std::lock_guard<std::mutex> lock(mutex_);
   PairView& pair = state_.pairs[index];
-  pair.loaded = true;
-  pair.cloud = loaded.cloud;
-  pair.lidar_image = loaded.lidar_image;
-  pair.thumbnail = loaded.thumbnail;
-  pair.detection = loaded.detection;
-  pair.camera = loaded.camera;
-  pair.camera_failure = loaded.camera_failure;
-  pair.brush_pixels = loaded.brush_pixels;
-  pair.brush_from_seed = loaded.brush_from_seed;
+  // Loading is the pair's first job after Open: besides its header nothing was derived yet.
+  static_cast<PairHeader&>(loaded) = pair;
+  loaded.loaded = true;
+  pair = std::move(loaded);
   ++state_.loading_done;
   ++state_.generation;
   if (pair.cloud) worker_.Enqueue([this, index] { RefitLidar(index); });
