@@ -22,11 +22,7 @@ int RunCalibrate(int argc, char** argv) {
   app.add_option("--out,-o", out_path, "result file (calibench.result.v1)");
   PipelineFlags flags;
   AddPipelineFlags(app, flags);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
   std::string why;
   if (!FinalizePipelineFlags(flags, &why)) {
     std::fprintf(stderr, "calibench calibrate: %s\n", why.c_str());

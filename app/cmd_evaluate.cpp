@@ -123,11 +123,7 @@ int RunEvaluate(int argc, char** argv) {
                  "corner noise the bound assumes [px]; default: measured from the dataset's "
                  "PnP residuals");
   app.add_flag("--sweep", sweep, "run the Table 1 sweep instead (see `calibench sweep --help`)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
   if (result_path.empty() && !crlb) {
     std::fprintf(stderr, "calibench evaluate: --result is required (unless --crlb)\n");
     return kUsage;
@@ -170,11 +166,7 @@ int RunDemo(int argc, char** argv) {
   bool no_gui = false;
   app.add_flag("--no-gui", no_gui,
                "never open the workbench window (the views are rendered to PNG instead)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
   SimOptions sim;
   std::string why;
   if (!BuildSimOptions(sim_flags, &sim, &why)) {

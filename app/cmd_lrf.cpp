@@ -69,11 +69,7 @@ int RunLrfCalibrate(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--pairs", pairs_text, "comma-separated pair ids (default: all)");
   app.add_option("--threads", options.threads, "feature extraction workers")->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
   const auto parsed = ParseLrfMethod(method);
   if (!parsed) {
     std::fprintf(stderr,
@@ -129,11 +125,7 @@ int RunSimulateLrf(int argc, char** argv) {
                "also a right depth camera 0.12 m to the right (right.json), for "
                "`evaluate --stereo`");
   app.add_flag("--no-clutter", no_clutter, "no walls or floor");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
   if (kind != "lrf") {
     std::fprintf(stderr, "calibench simulate: --kind must be lrf (or absent for the 3D LiDAR)\n");
     return kUsage;
@@ -182,11 +174,7 @@ int RunEvaluateLrf(int argc, char** argv) {
   app.add_flag("--stereo", stereo, "the stereo-baseline check");
   app.add_option("--max-translation-mm", max_translation_mm, "fail (exit 5) above this error");
   app.add_option("--max-rotation-deg", max_rotation_deg, "fail (exit 5) above this error");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
   const LrfDataset dataset = LoadLrfDataset(dataset_path);
   const LoadedResult left = LoadResult(result_path);
   Pose estimate, reference;
@@ -240,11 +228,7 @@ int RunSweepLrf(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--preset", preset, "paper | ideal")->capture_default_str();
   app.add_option("--table", table_path, "also write the markdown table here");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
   auto sim = LrfSimPreset(preset);
   if (kind != "lrf" || !sim || options.seeds < 1) {
     std::fprintf(stderr, "calibench sweep: --kind lrf, --preset paper|ideal, --seeds >= 1\n");

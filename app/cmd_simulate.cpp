@@ -79,11 +79,7 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--out,-o", out_dir, "output folder")->required();
   SimFlags flags;
   AddSimFlags(app, flags);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
   SimOptions options;
   std::string why;
   if (!BuildSimOptions(flags, &options, &why)) {

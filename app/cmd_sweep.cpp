@@ -49,11 +49,7 @@ int RunSweep(int argc, char** argv) {
   AddSimFlags(app, sim_flags);
   PipelineFlags flags;
   AddPipelineFlags(app, flags, /*with_selection=*/false);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
   PlaneSweepOptions sweep;
   sweep.subsets = subsets;
   sweep.work_dir = work_dir;

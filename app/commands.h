@@ -2,7 +2,12 @@
 // returns the process exit code (see ExitCode).
 #pragma once
 
+#include <optional>
 #include <string>
+
+namespace CLI {
+class App;
+}
 
 namespace calibench::app {
 
@@ -15,6 +20,10 @@ enum ExitCode : int {
   kNotConstrained = 4,  // a result was written but the planes do not fix all six dof
   kAccuracyFailed = 5,  // evaluate: error above the given bounds
 };
+
+// Parses a subcommand's flags; the exit code when parsing ends the command (--help printed: kOk;
+// a bad flag, reported: kUsage), nullopt when the command goes on.
+std::optional<int> ParseFlags(CLI::App& app, int argc, char** argv);
 
 int RunCalibrate(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
