@@ -419,32 +419,19 @@ void Controller::ComputeReprojection(int index) {
 
 void Controller::EnsureSelectedImage() {
   std::filesystem::path path;
+  const std::shared_ptr<const ImageU8> image = LoadSelectedImageFile(&path);
+  if (!image) return;
+  CameraModel camera;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (state_.selected < 0 || !state_.dataset) return;
-    path = state_.dataset->pairs[state_.selected].image;
+    camera = state_.dataset->camera;
   }
-  std::shared_ptr<const ImageU8> image;
-  std::shared_ptr<const UndistortedView> undistorted;
-  try {
-    image = std::make_shared<ImageU8>(LoadImage(path));
-    CameraModel camera;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      camera = state_.dataset->camera;
-    }
-    undistorted = std::make_shared<UndistortedView>(Undistort(camera, *image));
-  } catch (const IoError& e) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    SetStatus(e.what(), true);
-    return;
-  }
+  auto undistorted = std::make_shared<const UndistortedView>(Undistort(camera, *image));
   std::lock_guard<std::mutex> lock(mutex_);
-  if (state_.selected >= 0 && state_.dataset->pairs[state_.selected].image == path) {
-    state_.selected_image = image;
-    state_.selected_undistorted = undistorted;
-    ++state_.generation;
-  }
+  if (!StillSelected(path)) return;
+  state_.selected_image = image;
+  state_.selected_undistorted = undistorted;
+  ++state_.generation;
 }
 
 bool Controller::ValidPair(int index) const {

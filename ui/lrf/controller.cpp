@@ -200,25 +200,12 @@ void LrfController::UpdatePairFigures() {
 
 void LrfController::LoadSelectedImage() {
   std::filesystem::path path;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (state_.selected < 0 || !state_.dataset) return;
-    path = state_.dataset->pairs[state_.selected].image;
-  }
-  if (path.empty()) return;
-  std::shared_ptr<const ImageU8> image;
-  try {
-    image = std::make_shared<const ImageU8>(LoadImage(path));
-  } catch (const IoError& e) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    SetStatus(e.what(), true);
-    return;
-  }
+  const std::shared_ptr<const ImageU8> image = LoadSelectedImageFile(&path);
+  if (!image) return;
   std::lock_guard<std::mutex> lock(mutex_);
-  if (state_.selected >= 0 && state_.dataset->pairs[state_.selected].image == path) {
-    state_.selected_image = image;
-    ++state_.generation;
-  }
+  if (!StillSelected(path)) return;
+  state_.selected_image = image;
+  ++state_.generation;
 }
 
 void LrfController::Apply(const LrfIntent& intent) {

@@ -4,9 +4,13 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
+#include <memory>
 #include <mutex>
 #include <string>
 
+#include "core/base/image.h"
+#include "core/io/image_io.h"
 #include "core/results/pair_status.h"
 #include "ui/state/work_queue.h"
 
@@ -60,6 +64,28 @@ class ControllerState {
     state_.status_line = message;
     state_.status_is_error = error;
     ++state_.generation;
+  }
+  // The selected pair's image, read on the worker: *path gets its file (empty when nothing with
+  // an image is selected); nullptr with the status line set when the file cannot be read.
+  std::shared_ptr<const ImageU8> LoadSelectedImageFile(std::filesystem::path* path) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (state_.selected < 0 || !state_.dataset) return nullptr;
+      *path = state_.dataset->pairs[state_.selected].image;
+    }
+    if (path->empty()) return nullptr;
+    try {
+      return std::make_shared<const ImageU8>(LoadImage(*path));
+    } catch (const IoError& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      SetStatus(e.what(), true);
+      return nullptr;
+    }
+  }
+  // True while `path` is still the selected pair's image (a newer selection drops the old
+  // image); call with mutex_ held.
+  bool StillSelected(const std::filesystem::path& path) const {
+    return state_.selected >= 0 && state_.dataset->pairs[state_.selected].image == path;
   }
   // What else a failed job resets (with mutex_ held), before its message is shown.
   virtual void OnJobError() {}
