@@ -1,28 +1,22 @@
-// `calibench gui` (the workbench window) and `calibench render` (the same views, headless).
-
-// clang-format off
-// gl_api.h first: it declares GL for everything below (and sets GLFW_INCLUDE_NONE).
-#include "ui/gfx/gl_api.h"
-#include <GLFW/glfw3.h>
-// clang-format on
-
+// `calibench gui` (the workbench window) and `calibench render` (the same views, headless): flags
+// in, calls to ui/widgets (window_loop.h, headless_render.h) out.
 #include <CLI/CLI.hpp>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <memory>
+#include <optional>
 
 #include "app/commands.h"
 #include "core/base/image.h"
 #include "core/io/image_io.h"
 #include "ui/gfx/context.h"
-#include "ui/gfx/framebuffer.h"
 #include "ui/lidar_camera/controller.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/lrf/controller.h"
 #include "ui/lrf/workbench.h"
+#include "ui/widgets/headless_render.h"
 #include "ui/widgets/imgui_host.h"
+#include "ui/widgets/window_loop.h"
 
 namespace calibench::app {
 namespace {
@@ -30,6 +24,22 @@ namespace {
 bool ParseSize(const std::string& text, int* width, int* height) {
   return std::sscanf(text.c_str(), "%dx%d", width, height) == 2 && *width >= 64 && *height >= 64 &&
          *width <= 8192 && *height <= 8192;
+}
+
+// Parses the command line, then `size` (bound to --size) into *width x *height: nullopt to go
+// on, else the exit code (kOk after --help).
+std::optional<int> ParseFlags(CLI::App& app, int argc, char** argv, const std::string& size,
+                              const char* command, int* width, int* height) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kOk : kUsage;
+  }
+  if (!ParseSize(size, width, height)) {
+    std::fprintf(stderr, "calibench %s: --size must be WxH, e.g. 1600x900\n", command);
+    return kUsage;
+  }
+  return std::nullopt;
 }
 
 // Opens the dataset or session the flags name; false (message printed) when neither is given.
@@ -46,76 +56,63 @@ bool OpenInput(ui::Controller& controller, const std::string& dataset, const std
   return true;
 }
 
-// Opens the window or prints why not.
-std::unique_ptr<gfx::WindowContext> OpenWindow(int width, int height, const char* title) {
-  std::string why;
-  auto context = gfx::WindowContext::Create(width, height, title, &why);
-  if (!context)
+// The window the gui flags ask for; with --screenshot its last frame is kept.
+ui::WindowOptions WindowOptionsOf(int width, int height, const char* title,
+                                  const std::string& screenshot, int quit_after_frames) {
+  return {width, height, title, quit_after_frames, !screenshot.empty()};
+}
+
+// The exit code of a window run; writes the screenshot it captured.
+int FinishWindow(const ui::WindowRun& run, const std::string& screenshot) {
+  if (!run.opened) {
     std::fprintf(stderr,
                  "calibench gui: cannot open a window: %s\n"
                  "(no display? `calibench render` draws the same views to PNG)\n",
-                 why.c_str());
-  return context;
-}
-
-// The window's frame loop, shared by both workbenches: ui_frame(width, height, dt) issues the
-// ImGui calls of one frame and applies their intents. The frame is drawn offscreen, then blitted
-// (so that --screenshot reads exactly what is shown).
-void RunWindowLoop(gfx::WindowContext& context, ui::ImGuiHost& host,
-                   const std::function<void(int, int, double)>& ui_frame,
-                   const std::string& screenshot, int quit_after_frames) {
-  gfx::Framebuffer frame_target;
-  auto last = std::chrono::steady_clock::now();
-  for (int frame = 0; !glfwWindowShouldClose(context.window()); ++frame) {
-    glfwPollEvents();
-    int fb_width = 0, fb_height = 0;
-    glfwGetFramebufferSize(context.window(), &fb_width, &fb_height);
-    if (fb_width <= 0 || fb_height <= 0) continue;
-    const auto now = std::chrono::steady_clock::now();
-    const double dt = std::chrono::duration<double>(now - last).count();
-    last = now;
-    host.NewFrame(fb_width, fb_height, dt);
-    ui_frame(fb_width, fb_height, dt);
-    frame_target.Resize(fb_width, fb_height);
-    frame_target.Bind();
-    frame_target.Clear(0.06f, 0.06f, 0.07f, 1.0f);
-    host.Render();
-    const bool last_frame = quit_after_frames > 0 && frame + 1 >= quit_after_frames;
-    if (last_frame && !screenshot.empty()) {
-      SaveImage(screenshot, frame_target.ReadPixels());
-      std::printf("wrote %s\n", screenshot.c_str());
-    }
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, frame_target.framebuffer());
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-    glBlitFramebuffer(0, 0, fb_width, fb_height, 0, 0, fb_width, fb_height, GL_COLOR_BUFFER_BIT,
-                      GL_NEAREST);
-    glfwSwapBuffers(context.window());
-    if (last_frame) break;
+                 run.why.c_str());
+    return kInputError;
   }
-}
-
-// The LRF workbench in a window (a calibench.lrf-dataset.v1 manifest).
-int RunLrfGuiWindow(const std::string& dataset, int width, int height,
-                    const std::string& screenshot, int quit_after_frames) {
-  auto context = OpenWindow(width, height, "Calibench (2D LRF)");
-  if (!context) return kInputError;
-  ui::LrfController controller;
-  controller.Open(dataset);  // a bad manifest shows its error in the window's status line
-  ui::ImGuiHost host(context->window());
-  ui::LrfWorkbench workbench;
-  RunWindowLoop(
-      *context, host,
-      [&](int w, int h, double dt) {
-        for (const ui::LrfIntent& intent :
-             workbench.Frame(controller.GetSnapshot(), w, h, ui::LrfLayout::kWorkbench, dt))
-          controller.Apply(intent);
-      },
-      screenshot, quit_after_frames);
+  if (run.last_frame) {
+    SaveImage(screenshot, *run.last_frame);
+    std::printf("wrote %s\n", screenshot.c_str());
+  }
   return kOk;
 }
 
-int RenderLrfHeadless(const std::string& dataset, const std::string& pair, bool solve,
-                      const std::string& view, int width, int height, const std::string& out,
+// The LRF workbench in a window (a calibench.lrf-dataset.v1 manifest).
+int RunLrfGuiWindow(const std::string& dataset, const ui::WindowOptions& window,
+                    const std::string& screenshot) {
+  ui::LrfController controller;
+  controller.Open(dataset);  // a bad manifest shows its error in the window's status line
+  return FinishWindow(
+      ui::RunWorkbenchWindow<ui::LrfWorkbench>(window, controller, ui::LrfLayout::kWorkbench),
+      screenshot);
+}
+
+// The headless GL context of a render, or nullptr after printing `failure`: why.
+std::unique_ptr<gfx::GlContext> OpenHeadless(gfx::HeadlessBackend backend, const char* failure) {
+  std::string why;
+  auto context = gfx::CreateHeadlessContext(backend, &why);
+  if (!context) std::fprintf(stderr, "%s: %s\n", failure, why.c_str());
+  return context;
+}
+
+// Writes a render of `view` (nullopt: the pair was not found in `where`).
+int SaveShot(const std::optional<ImageU8>& picture, const ui::HeadlessShot& shot,
+             const std::string& view, const std::string& out, const std::string& where,
+             const gfx::GlContext& context) {
+  if (!picture) {
+    std::fprintf(stderr, "calibench render: no pair '%s' in %s\n", shot.pair_id.c_str(),
+                 where.c_str());
+    return kInputError;
+  }
+  SaveImage(out, *picture);
+  std::printf("wrote %s (%dx%d, %s, %s)\n", out.c_str(), shot.width, shot.height, view.c_str(),
+              context.Description().c_str());
+  return kOk;
+}
+
+int RenderLrfHeadless(const std::string& dataset, const ui::HeadlessShot& shot,
+                      const std::string& view, const std::string& out,
                       gfx::HeadlessBackend backend) {
   ui::LrfLayout layout;
   if (!ui::ParseLrfLayout(view, &layout)) {
@@ -124,59 +121,29 @@ int RenderLrfHeadless(const std::string& dataset, const std::string& pair, bool 
                  "workbench\n");
     return kUsage;
   }
-  std::string why;
-  auto context = gfx::CreateHeadlessContext(backend, &why);
-  if (!context) {
-    std::fprintf(stderr, "calibench render: no headless OpenGL: %s\n", why.c_str());
-    return kInputError;
-  }
+  const auto context = OpenHeadless(backend, "calibench render: no headless OpenGL");
+  if (!context) return kInputError;
   ui::LrfController controller;
   if (!controller.Open(dataset)) {
     std::fprintf(stderr, "calibench render: %s\n", controller.GetSnapshot().status_line.c_str());
     return kInputError;
   }
-  controller.WaitIdle();
-  if (!pair.empty()) {
-    const ui::LrfSnapshot s = controller.GetSnapshot();
-    int index = -1;
-    for (size_t i = 0; i < s.pairs.size(); ++i)
-      if (s.pairs[i].id == pair) index = static_cast<int>(i);
-    if (index < 0) {
-      std::fprintf(stderr, "calibench render: no pair '%s' in %s\n", pair.c_str(), dataset.c_str());
-      return kInputError;
-    }
-    controller.Apply(ui::LrfSelectPair{index});
-  }
-  if (solve) controller.Apply(ui::LrfRunSolver{});
-  controller.WaitIdle();
-  ui::ImGuiHost host(nullptr);
-  ui::LrfWorkbench workbench;
-  SaveImage(out, ui::RenderWorkbenchHeadless(controller, workbench, host, layout, width, height,
-                                             /*frames=*/4));
-  std::printf("wrote %s (%dx%d, %s, %s)\n", out.c_str(), width, height, view.c_str(),
-              context->Description().c_str());
-  return kOk;
+  const auto picture = ui::RenderShot<ui::LrfWorkbench, ui::LrfSelectPair, ui::LrfRunSolver>(
+      controller, layout, shot);
+  return SaveShot(picture, shot, view, out, dataset, *context);
 }
 
 }  // namespace
 
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
                  const std::string& screenshot, int quit_after_frames) {
-  auto context = OpenWindow(width, height, "Calibench");
-  if (!context) return kInputError;
   ui::Controller controller;
   if (!OpenInput(controller, dataset, session, "gui")) return kUsage;
-  ui::ImGuiHost host(context->window());
-  ui::Workbench workbench;
-  RunWindowLoop(
-      *context, host,
-      [&](int w, int h, double dt) {
-        for (const ui::Intent& intent :
-             workbench.Frame(controller.GetSnapshot(), w, h, ui::Layout::kWorkbench, dt))
-          controller.Apply(intent);
-      },
-      screenshot, quit_after_frames);
-  return kOk;
+  return FinishWindow(
+      ui::RunWorkbenchWindow<ui::Workbench>(
+          WindowOptionsOf(width, height, "Calibench", screenshot, quit_after_frames), controller,
+          ui::Layout::kWorkbench),
+      screenshot);
 }
 
 int RunGui(int argc, char** argv) {
@@ -192,34 +159,24 @@ int RunGui(int argc, char** argv) {
   app.add_option("--size", size, "window size WxH")->capture_default_str();
   app.add_option("--screenshot", screenshot, "write the last frame to this PNG");
   app.add_option("--quit-after-frames", quit_after_frames, "close after N frames (tests)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
   int width = 0, height = 0;
-  if (!ParseSize(size, &width, &height)) {
-    std::fprintf(stderr, "calibench gui: --size must be WxH, e.g. 1600x900\n");
-    return kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv, size, "gui", &width, &height)) return *code;
   if (!dataset.empty() && IsLrfManifest(dataset))
-    return RunLrfGuiWindow(dataset, width, height, screenshot, quit_after_frames);
+    return RunLrfGuiWindow(
+        dataset,
+        WindowOptionsOf(width, height, "Calibench (2D LRF)", screenshot, quit_after_frames),
+        screenshot);
   return RunGuiWindow(dataset, session, width, height, screenshot, quit_after_frames);
 }
 
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
                    bool solve, const std::string& view, int width, int height,
                    const std::string& out, const std::string& backend_name) {
-  ui::Layout layout;
   gfx::HeadlessBackend backend;
-  if (!dataset.empty() && IsLrfManifest(dataset)) {
-    if (!gfx::ParseHeadlessBackend(backend_name, &backend)) {
-      std::fprintf(stderr, "calibench render: --gl must be auto, egl or osmesa\n");
-      return kUsage;
-    }
-    return RenderLrfHeadless(dataset, pair, solve, view, width, height, out, backend);
-  }
-  if (!ui::ParseLayout(view, &layout)) {
+  const ui::HeadlessShot shot{pair, solve, width, height};
+  const bool lrf = !dataset.empty() && IsLrfManifest(dataset);
+  ui::Layout layout;
+  if (!lrf && !ui::ParseLayout(view, &layout)) {
     std::fprintf(stderr, "calibench render: --view must be lidar, camera, 3d or workbench\n");
     return kUsage;
   }
@@ -227,48 +184,21 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
     std::fprintf(stderr, "calibench render: --gl must be auto, egl or osmesa\n");
     return kUsage;
   }
-  std::string why;
-  auto context = gfx::CreateHeadlessContext(backend, &why);
-  if (!context) {
-    std::fprintf(stderr, "calibench render: no headless OpenGL: %s\n", why.c_str());
-    return kInputError;
-  }
+  if (lrf) return RenderLrfHeadless(dataset, shot, view, out, backend);
+  const auto context = OpenHeadless(backend, "calibench render: no headless OpenGL");
+  if (!context) return kInputError;
   ui::Controller controller;
   if (!OpenInput(controller, dataset, session, "render")) return kUsage;
-  controller.WaitIdle();
-  if (!pair.empty()) {
-    const ui::Snapshot s = controller.GetSnapshot();
-    int index = -1;
-    for (size_t i = 0; i < s.pairs.size(); ++i)
-      if (s.pairs[i].id == pair) index = static_cast<int>(i);
-    if (index < 0) {
-      std::fprintf(stderr, "calibench render: no pair '%s' in %s\n", pair.c_str(),
-                   s.dataset_path.string().c_str());
-      return kInputError;
-    }
-    controller.Apply(ui::SelectPair{index});
-  }
-  if (solve) controller.Apply(ui::RunSolver{});
-  controller.WaitIdle();
-  ui::ImGuiHost host(nullptr);
-  ui::Workbench workbench;
-  // A few frames: ImGui sizes tables and windows on the first ones.
-  const ImageU8 picture =
-      ui::RenderWorkbenchHeadless(controller, workbench, host, layout, width, height, /*frames=*/4);
-  SaveImage(out, picture);
-  std::printf("wrote %s (%dx%d, %s, %s)\n", out.c_str(), width, height, view.c_str(),
-              context->Description().c_str());
-  return kOk;
+  const auto picture =
+      ui::RenderShot<ui::Workbench, ui::SelectPair, ui::RunSolver>(controller, layout, shot);
+  return SaveShot(picture, shot, view, out, controller.GetSnapshot().dataset_path.string(),
+                  *context);
 }
 
 int RenderDemoViews(const std::string& dataset, const std::string& out_dir) {
-  std::string why;
-  auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &why);
-  if (!context) {
-    std::fprintf(stderr, "calibench demo: no headless OpenGL to render the views: %s\n",
-                 why.c_str());
-    return kInputError;
-  }
+  const auto context = OpenHeadless(gfx::HeadlessBackend::kAuto,
+                                    "calibench demo: no headless OpenGL to render the views");
+  if (!context) return kInputError;
   ui::Controller controller;
   controller.OpenDataset(dataset, std::filesystem::path(out_dir) / "calibench.session.json");
   controller.WaitIdle();
@@ -312,16 +242,8 @@ int RunRender(int argc, char** argv) {
   app.add_option("--size", size, "WxH")->capture_default_str();
   app.add_option("--out,-o", out, "PNG file")->required();
   app.add_option("--gl", gl, "auto | egl | osmesa")->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? kOk : kUsage;
-  }
   int width = 0, height = 0;
-  if (!ParseSize(size, &width, &height)) {
-    std::fprintf(stderr, "calibench render: --size must be WxH, e.g. 1600x900\n");
-    return kUsage;
-  }
+  if (const auto code = ParseFlags(app, argc, argv, size, "render", &width, &height)) return *code;
   return RenderHeadless(dataset, session, pair, solve, view, width, height, out, gl);
 }
 

@@ -3,9 +3,10 @@
 #include <stdexcept>
 
 #include "ui/gfx/context_internal.h"
+#include "ui/gfx/framebuffer.h"
 #include "ui/gfx/gl_loader.h"
 
-// No GL header from GLFW: this file makes no GL call (LoadGl does them).
+// No GL header from GLFW: this file makes no GL call (LoadGl and Framebuffer do them).
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
@@ -54,6 +55,22 @@ std::unique_ptr<GlContext> CreateHeadlessContext(HeadlessBackend backend, std::s
   }
   context = internal::CreateOsMesaContext(&osmesa_why);
   if (!context && why) *why = egl_why.empty() ? osmesa_why : egl_why + "; " + osmesa_why;
+  return context;
+}
+
+void internal::HeadlessContext::MakeCurrent() {
+  std::string why;
+  if (!TryMakeCurrent(&why)) throw std::runtime_error(description_ + ": " + why);
+}
+
+std::unique_ptr<GlContext> internal::HeadlessContext::Activate(
+    std::unique_ptr<HeadlessContext> context, const std::string& label, std::string* why) {
+  std::string reason;
+  if (!context->TryMakeCurrent(&reason)) {
+    *why = label + ": " + reason;
+    return nullptr;
+  }
+  context->description_ = label + ": " + CurrentGlSummary();
   return context;
 }
 
@@ -106,5 +123,18 @@ void WindowContext::MakeCurrent() {
 }
 
 std::string WindowContext::Description() const { return description_; }
+
+void WindowContext::PollEvents() { glfwPollEvents(); }
+
+bool WindowContext::ShouldClose() const { return glfwWindowShouldClose(window_); }
+
+void WindowContext::FramebufferSize(int* width, int* height) const {
+  glfwGetFramebufferSize(window_, width, height);
+}
+
+void WindowContext::Present(const Framebuffer& frame) {
+  frame.BlitToDefault();
+  glfwSwapBuffers(window_);
+}
 
 }  // namespace calibench::gfx

@@ -10,6 +10,8 @@ struct GLFWwindow;
 
 namespace calibench::gfx {
 
+class Framebuffer;
+
 enum class HeadlessBackend { kAuto, kEgl, kOsMesa };
 // "auto", "egl", "osmesa"; false for anything else.
 bool ParseHeadlessBackend(const std::string& name, HeadlessBackend* backend);
@@ -36,6 +38,16 @@ class WindowContext : public GlContext {
   void MakeCurrent() override;
   std::string Description() const override;
   GLFWwindow* window() const { return window_; }
+
+  // The window's frame loop: handles pending events (input goes to the callbacks, ImGui's
+  // included), tells whether the user asked to close the window, and its framebuffer size
+  // (pixels; 0 while minimised).
+  void PollEvents();
+  bool ShouldClose() const;
+  void FramebufferSize(int* width, int* height) const;
+  // Shows `frame`, drawn offscreen at the framebuffer size: copies it into the back buffer and
+  // swaps (waiting for vsync).
+  void Present(const Framebuffer& frame);
 
  private:
   explicit WindowContext(GLFWwindow* window) : window_(window) {}

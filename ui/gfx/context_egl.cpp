@@ -2,7 +2,6 @@
 #include <map>
 #include <mutex>
 #include <sstream>
-#include <stdexcept>
 #include <string_view>
 #include <vector>
 
@@ -80,7 +79,7 @@ void ReleaseDisplay(EGLDisplay display) {
   }
 }
 
-class EglContext final : public GlContext {
+class EglContext final : public HeadlessContext {
  public:
   // Takes over one AcquireDisplay() reference and the context.
   EglContext(EGLDisplay display, EGLContext context) : display_(display), context_(context) {}
@@ -92,9 +91,7 @@ class EglContext final : public GlContext {
     ReleaseDisplay(display_);
   }
 
-  // false with *why; MakeCurrent() throws instead because a context that worked once and then
-  // cannot be made current is a broken driver, not bad input.
-  bool TryMakeCurrent(std::string* why) {
+  bool TryMakeCurrent(std::string* why) override {
     // The bound client API is per thread: another library may have bound GLES in between.
     eglBindAPI(EGL_OPENGL_API);
     // If EGL believes the context is current already, eglMakeCurrent does nothing; but an OSMesa
@@ -109,17 +106,10 @@ class EglContext final : public GlContext {
     }
     return LoadGl(EglProc, why);
   }
-  void MakeCurrent() override {
-    std::string why;
-    if (!TryMakeCurrent(&why)) throw std::runtime_error("EGL context: " + why);
-  }
-  std::string Description() const override { return description_; }
-  void set_description(std::string description) { description_ = std::move(description); }
 
  private:
   EGLDisplay display_;
   EGLContext context_;
-  std::string description_;
 };
 
 EGLConfig ChooseConfig(EGLDisplay display, const char* display_extensions, bool* ok) {
@@ -176,13 +166,7 @@ std::unique_ptr<GlContext> TryDisplay(EGLDisplay display, const std::string& lab
     *why = label + ": " + reason;
     return nullptr;
   }
-  auto result = std::make_unique<EglContext>(display, context);
-  if (!result->TryMakeCurrent(&reason)) {
-    *why = label + ": " + reason;
-    return nullptr;
-  }
-  result->set_description(label + ": " + CurrentGlSummary());
-  return result;
+  return HeadlessContext::Activate(std::make_unique<EglContext>(display, context), label, why);
 }
 
 }  // namespace

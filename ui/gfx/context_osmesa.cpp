@@ -4,7 +4,6 @@
 #include <GL/osmesa.h>
 
 #include <array>
-#include <stdexcept>
 
 #include "ui/gfx/context_internal.h"
 #include "ui/gfx/gl_loader.h"
@@ -14,12 +13,12 @@ namespace {
 
 void* OsMesaProc(const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); }
 
-class OsMesaGlContext final : public GlContext {
+class OsMesaGlContext final : public HeadlessContext {
  public:
   explicit OsMesaGlContext(OSMesaContext context) : context_(context) {}
   ~OsMesaGlContext() override { OSMesaDestroyContext(context_); }
 
-  bool TryMakeCurrent(std::string* why) {
+  bool TryMakeCurrent(std::string* why) override {
     // OSMesa always needs a colour buffer to be current; we never draw into it (views render
     // into gfx::Framebuffer objects), so a tiny one does.
     if (!OSMesaMakeCurrent(context_, dummy_buffer_.data(), GL_UNSIGNED_BYTE, kDummySize,
@@ -29,18 +28,11 @@ class OsMesaGlContext final : public GlContext {
     }
     return LoadGl(OsMesaProc, why);
   }
-  void MakeCurrent() override {
-    std::string why;
-    if (!TryMakeCurrent(&why)) throw std::runtime_error("OSMesa context: " + why);
-  }
-  std::string Description() const override { return description_; }
-  void set_description(std::string description) { description_ = std::move(description); }
 
  private:
   static constexpr int kDummySize = 4;  // pixels
   OSMesaContext context_;
   std::array<unsigned char, kDummySize * kDummySize * 4> dummy_buffer_{};  // RGBA8
-  std::string description_;
 };
 
 }  // namespace
@@ -59,14 +51,7 @@ std::unique_ptr<GlContext> CreateOsMesaContext(std::string* why) {
     *why = "OSMesa: OSMesaCreateContextAttribs gave no GL 3.3 core context";
     return nullptr;
   }
-  auto result = std::make_unique<OsMesaGlContext>(context);
-  std::string reason;
-  if (!result->TryMakeCurrent(&reason)) {
-    *why = "OSMesa: " + reason;
-    return nullptr;
-  }
-  result->set_description("OSMesa: " + CurrentGlSummary());
-  return result;
+  return HeadlessContext::Activate(std::make_unique<OsMesaGlContext>(context), "OSMesa", why);
 }
 
 }  // namespace calibench::gfx::internal

@@ -149,6 +149,13 @@ ImageU8 Framebuffer::ReadPixels() const {
   return ReadBgrTopRowFirst(framebuffer_, GL_COLOR_ATTACHMENT0, width_, height_);
 }
 
+void Framebuffer::BlitToDefault() const {
+  if (!framebuffer_) throw std::logic_error("Framebuffer::BlitToDefault before Resize");
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer_);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+}
+
 ImageU8 Framebuffer::ReadDefaultPixels(int window_width, int window_height) {
   return ReadBgrTopRowFirst(0, GL_BACK, window_width, window_height);
 }

@@ -28,6 +28,9 @@ class Framebuffer {
   // The same from the window's default framebuffer (its back buffer: call before swapping), for
   // screenshots of the whole window, ImGui included. Sizes in framebuffer pixels.
   static ImageU8 ReadDefaultPixels(int window_width, int window_height);
+  // Copies the colour into the window's default framebuffer (its back buffer), pixel for pixel
+  // from the lower-left corner: how a window shows a frame drawn offscreen.
+  void BlitToDefault() const;
   // The colour texture, bottom row first as GL stores it: show it with ImGui::Image(texture,
   // size, ImVec2(0, 1), ImVec2(1, 0)) to see it upright.
   std::uint32_t color_texture() const { return color_texture_; }

@@ -13,61 +13,58 @@
 #include "ui/gfx/shader_sources.h"
 
 namespace calibench::gfx {
-namespace {
 
 // Positions go to GL straight from the std::vector, so the element layouts must be packed.
 static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
 static_assert(sizeof(Rgba) == 4);
 
-// The vertex layout shared by points, lines and triangles: location 0 = vec3 position,
-// location 1 = RGBA8 colour normalized to [0, 1].
-void CreateColoredVertexArray(std::uint32_t* vao, std::uint32_t* vbo_positions,
-                              std::uint32_t* vbo_colors) {
-  glGenVertexArrays(1, vao);
-  glBindVertexArray(*vao);
-  glGenBuffers(1, vbo_positions);
-  glBindBuffer(GL_ARRAY_BUFFER, *vbo_positions);
+ColoredVertices::ColoredVertices(const char* name, const char* vertex_shader,
+                                 const char* fragment_shader, size_t group)
+    : name_(name), group_(group) {
+  program_ = BuildProgram(name, vertex_shader, fragment_shader);
+  // Location 0 = vec3 position, location 1 = RGBA8 colour normalized to [0, 1].
+  glGenVertexArrays(1, &vao_);
+  glBindVertexArray(vao_);
+  glGenBuffers(1, &vbo_positions_);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo_positions_);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Eigen::Vector3f), nullptr);
   glEnableVertexAttribArray(0);
-  glGenBuffers(1, vbo_colors);
-  glBindBuffer(GL_ARRAY_BUFFER, *vbo_colors);
+  glGenBuffers(1, &vbo_colors_);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo_colors_);
   glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(Rgba), nullptr);
   glEnableVertexAttribArray(1);
   glBindVertexArray(0);
 }
 
-// Returns the vertex count. `group` is 1 (points), 2 (line segments) or 3 (triangles).
-size_t UploadColored(std::uint32_t vbo_positions, std::uint32_t vbo_colors,
-                     const std::vector<Eigen::Vector3f>& positions, const std::vector<Rgba>& colors,
-                     size_t group, const char* what) {
-  if (positions.size() != colors.size() || positions.size() % group != 0) {
-    throw std::invalid_argument(std::string(what) + ": " + std::to_string(positions.size()) +
+ColoredVertices::~ColoredVertices() {
+  if (program_) glDeleteProgram(program_);
+  if (vao_) glDeleteVertexArrays(1, &vao_);
+  if (vbo_positions_) glDeleteBuffers(1, &vbo_positions_);
+  if (vbo_colors_) glDeleteBuffers(1, &vbo_colors_);
+}
+
+void ColoredVertices::Upload(const std::vector<Eigen::Vector3f>& positions,
+                             const std::vector<Rgba>& colors) {
+  if (positions.size() != colors.size() || positions.size() % group_ != 0) {
+    throw std::invalid_argument(std::string(name_) + ": " + std::to_string(positions.size()) +
                                 " vertices and " + std::to_string(colors.size()) +
                                 " colours; need equal counts, a multiple of " +
-                                std::to_string(group));
+                                std::to_string(group_));
   }
-  glBindBuffer(GL_ARRAY_BUFFER, vbo_positions);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo_positions_);
   glBufferData(GL_ARRAY_BUFFER, positions.size() * sizeof(Eigen::Vector3f), positions.data(),
                GL_STATIC_DRAW);
-  glBindBuffer(GL_ARRAY_BUFFER, vbo_colors);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo_colors_);
   glBufferData(GL_ARRAY_BUFFER, colors.size() * sizeof(Rgba), colors.data(), GL_STATIC_DRAW);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
-  return positions.size();
+  count_ = positions.size();
 }
 
-void DeleteColored(std::uint32_t program, std::uint32_t vao, std::uint32_t vbo_positions,
-                   std::uint32_t vbo_colors) {
-  if (program) glDeleteProgram(program);
-  if (vao) glDeleteVertexArrays(1, &vao);
-  if (vbo_positions) glDeleteBuffers(1, &vbo_positions);
-  if (vbo_colors) glDeleteBuffers(1, &vbo_colors);
-}
-
-// Sets all the state a colour draw depends on (ImGui and other views leave theirs behind).
-// Depth writes off lets translucent surfaces show what lies behind them whatever the draw order.
-void PrepareColoredDraw(std::uint32_t program, const Matrix4f& view_projection, bool depth_write) {
-  glUseProgram(program);
-  glUniformMatrix4fv(glGetUniformLocation(program, "view_projection"), 1, GL_FALSE,
+bool ColoredVertices::Prepare(const Matrix4f& view_projection, bool depth_write) const {
+  if (count_ == 0) return false;
+  // ImGui and other views leave their state behind: set all of it.
+  glUseProgram(program_);
+  glUniformMatrix4fv(glGetUniformLocation(program_, "view_projection"), 1, GL_FALSE,
                      view_projection.data());
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);  // lines drawn over a quad at the same depth stay visible
@@ -78,56 +75,35 @@ void PrepareColoredDraw(std::uint32_t program, const Matrix4f& view_projection, 
   glEnable(GL_BLEND);
   glBlendEquation(GL_FUNC_ADD);
   glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  return true;
 }
 
-void FinishDraw() {
+void ColoredVertices::DrawAll(std::uint32_t mode) const {
+  glBindVertexArray(vao_);
+  glDrawArrays(mode, 0, static_cast<GLsizei>(count_));
   glBindVertexArray(0);
   glUseProgram(0);
   glDepthMask(GL_TRUE);
 }
 
-}  // namespace
-
-PointRenderer::PointRenderer() {
-  program_ = BuildProgram("points", shader_sources::kPointsVert, shader_sources::kPointsFrag);
-  CreateColoredVertexArray(&vao_, &vbo_positions_, &vbo_colors_);
-}
-
-PointRenderer::~PointRenderer() { DeleteColored(program_, vao_, vbo_positions_, vbo_colors_); }
-
-void PointRenderer::Upload(const std::vector<Eigen::Vector3f>& positions,
-                           const std::vector<Rgba>& colors) {
-  count_ = UploadColored(vbo_positions_, vbo_colors_, positions, colors, 1, "PointRenderer");
-}
+PointRenderer::PointRenderer()
+    : ColoredVertices("points", shader_sources::kPointsVert, shader_sources::kPointsFrag, 1) {}
 
 void PointRenderer::Draw(const Matrix4f& view_projection, float point_size_px,
                          float opacity) const {
-  if (count_ == 0) return;
   // Translucent points must not hide each other, opaque ones must.
-  PrepareColoredDraw(program_, view_projection, opacity >= 1.0f);
-  glUniform1f(glGetUniformLocation(program_, "point_size_px"), point_size_px);
-  glUniform1f(glGetUniformLocation(program_, "opacity"), std::clamp(opacity, 0.0f, 1.0f));
+  if (!Prepare(view_projection, opacity >= 1.0f)) return;
+  glUniform1f(glGetUniformLocation(program(), "point_size_px"), point_size_px);
+  glUniform1f(glGetUniformLocation(program(), "opacity"), std::clamp(opacity, 0.0f, 1.0f));
   glEnable(GL_PROGRAM_POINT_SIZE);  // size from gl_PointSize in the vertex shader
-  glBindVertexArray(vao_);
-  glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(count_));
-  FinishDraw();
+  DrawAll(GL_POINTS);
 }
 
-LineRenderer::LineRenderer() {
-  program_ = BuildProgram("lines", shader_sources::kColoredVert, shader_sources::kColoredFrag);
-  CreateColoredVertexArray(&vao_, &vbo_positions_, &vbo_colors_);
-}
-
-LineRenderer::~LineRenderer() { DeleteColored(program_, vao_, vbo_positions_, vbo_colors_); }
-
-void LineRenderer::Upload(const std::vector<Eigen::Vector3f>& vertices,
-                          const std::vector<Rgba>& colors) {
-  count_ = UploadColored(vbo_positions_, vbo_colors_, vertices, colors, 2, "LineRenderer");
-}
+LineRenderer::LineRenderer()
+    : ColoredVertices("lines", shader_sources::kColoredVert, shader_sources::kColoredFrag, 2) {}
 
 void LineRenderer::Draw(const Matrix4f& view_projection, float width_px) const {
-  if (count_ == 0) return;
-  PrepareColoredDraw(program_, view_projection, true);
+  if (!Prepare(view_projection, true)) return;
   // Wide lines are deprecated in core profile: a forward-compatible context (macOS) rejects
   // widths above 1 and drivers clamp to GL_ALIASED_LINE_WIDTH_RANGE (Mesa: up to 255, NVIDIA:
   // about 10). So width_px is a wish that may be ignored; views must not rely on it.
@@ -137,34 +113,49 @@ void LineRenderer::Draw(const Matrix4f& view_projection, float width_px) const {
   glGetFloatv(GL_ALIASED_LINE_WIDTH_RANGE, range);
   const bool forward_compatible = (flags & GL_CONTEXT_FLAG_FORWARD_COMPATIBLE_BIT) != 0;
   glLineWidth(forward_compatible ? 1.0f : std::clamp(width_px, range[0], range[1]));
-  glBindVertexArray(vao_);
-  glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(count_));
+  DrawAll(GL_LINES);
   glLineWidth(1.0f);
-  FinishDraw();
 }
 
-TriangleRenderer::TriangleRenderer() {
-  program_ = BuildProgram("triangles", shader_sources::kColoredVert, shader_sources::kColoredFrag);
-  CreateColoredVertexArray(&vao_, &vbo_positions_, &vbo_colors_);
-}
-
-TriangleRenderer::~TriangleRenderer() {
-  DeleteColored(program_, vao_, vbo_positions_, vbo_colors_);
-}
-
-void TriangleRenderer::Upload(const std::vector<Eigen::Vector3f>& vertices,
-                              const std::vector<Rgba>& colors) {
-  count_ = UploadColored(vbo_positions_, vbo_colors_, vertices, colors, 3, "TriangleRenderer");
-}
+TriangleRenderer::TriangleRenderer()
+    : ColoredVertices("triangles", shader_sources::kColoredVert, shader_sources::kColoredFrag, 3) {}
 
 void TriangleRenderer::Draw(const Matrix4f& view_projection) const {
-  if (count_ == 0) return;
   // Depth test on (points behind a board quad are tinted by it), depth write off (the quad hides
   // nothing drawn after it, and two quads blend whatever their order).
-  PrepareColoredDraw(program_, view_projection, false);
-  glBindVertexArray(vao_);
-  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(count_));
-  FinishDraw();
+  if (!Prepare(view_projection, false)) return;
+  DrawAll(GL_TRIANGLES);
+}
+
+void LineBatch::Add(const Eigen::Vector3d& a, const Eigen::Vector3d& b, Rgba color) {
+  vertices.push_back(a.cast<float>());
+  vertices.push_back(b.cast<float>());
+  colors.push_back(color);
+  colors.push_back(color);
+}
+
+void LineBatch::AddAxes(const Eigen::Isometry3d& world_from_frame, double length) {
+  const Rgba axis_colors[3] = {{255, 60, 60, 255}, {60, 230, 60, 255}, {80, 120, 255, 255}};
+  for (int a = 0; a < 3; ++a)
+    Add(world_from_frame.translation(), world_from_frame * (Eigen::Vector3d::Unit(a) * length),
+        axis_colors[a]);
+}
+
+void TriangleBatch::AddQuad(const std::array<Eigen::Vector3d, 4>& corners, Rgba color) {
+  for (int k : {0, 1, 2, 0, 2, 3}) {
+    vertices.push_back(corners[k].cast<float>());
+    colors.push_back(color);
+  }
+}
+
+void TriangleBatch::AddRectangle(const Eigen::Isometry3d& world_from_frame, double width,
+                                 double height, Rgba color) {
+  const double hw = width / 2, hh = height / 2;
+  AddQuad({world_from_frame * Eigen::Vector3d(-hw, -hh, 0),
+           world_from_frame * Eigen::Vector3d(hw, -hh, 0),
+           world_from_frame * Eigen::Vector3d(hw, hh, 0),
+           world_from_frame * Eigen::Vector3d(-hw, hh, 0)},
+          color);
 }
 
 Matrix4f Perspective(float fovy_rad, float aspect, float near_m, float far_m) {

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -16,44 +18,76 @@ struct Rgba {
   std::uint8_t r = 255, g = 255, b = 255, a = 255;
 };
 
-// Round, depth-tested points with per-point colour; size in pixels.
-class PointRenderer {
+// What points, lines and triangles share: a program and a vertex array of positions with one
+// RGBA colour each, uploaded whole. Not copyable (it owns GL names).
+class ColoredVertices {
  public:
-  PointRenderer();
-  ~PointRenderer();
+  ColoredVertices(const ColoredVertices&) = delete;
+  ColoredVertices& operator=(const ColoredVertices&) = delete;
+  // Equal counts, a multiple of the primitive's vertex count (1, 2 or 3); std::invalid_argument
+  // otherwise.
   void Upload(const std::vector<Eigen::Vector3f>& positions, const std::vector<Rgba>& colors);
-  void Draw(const Matrix4f& view_projection, float point_size_px, float opacity = 1.0f) const;
   size_t size() const { return count_; }
 
+ protected:
+  // name: for messages; group: vertices per primitive. Requires a current context.
+  ColoredVertices(const char* name, const char* vertex_shader, const char* fragment_shader,
+                  size_t group);
+  ~ColoredVertices();
+  // Sets the program, its view_projection and all the state a draw depends on; false when there
+  // is nothing to draw. depth_write: whether the primitives hide what is drawn after them (off
+  // lets translucent surfaces show what lies behind them whatever the draw order).
+  bool Prepare(const Matrix4f& view_projection, bool depth_write) const;
+  // Draws every vertex as `mode` primitives (GL_POINTS, ...) and restores the state.
+  void DrawAll(std::uint32_t mode) const;
+  std::uint32_t program() const { return program_; }
+
  private:
+  const char* name_;
+  size_t group_;
   std::uint32_t program_ = 0, vao_ = 0, vbo_positions_ = 0, vbo_colors_ = 0;
   size_t count_ = 0;
+};
+
+// Round, depth-tested points with per-point colour; size in pixels.
+class PointRenderer : public ColoredVertices {
+ public:
+  PointRenderer();
+  void Draw(const Matrix4f& view_projection, float point_size_px, float opacity = 1.0f) const;
 };
 
 // Line segments (pairs of vertices) with per-vertex colour.
-class LineRenderer {
+class LineRenderer : public ColoredVertices {
  public:
   LineRenderer();
-  ~LineRenderer();
-  void Upload(const std::vector<Eigen::Vector3f>& vertices, const std::vector<Rgba>& colors);
   void Draw(const Matrix4f& view_projection, float width_px = 1.0f) const;
-
- private:
-  std::uint32_t program_ = 0, vao_ = 0, vbo_positions_ = 0, vbo_colors_ = 0;
-  size_t count_ = 0;
 };
 
 // Triangles (triples of vertices) with per-vertex colour and alpha blending; for board quads.
-class TriangleRenderer {
+class TriangleRenderer : public ColoredVertices {
  public:
   TriangleRenderer();
-  ~TriangleRenderer();
-  void Upload(const std::vector<Eigen::Vector3f>& vertices, const std::vector<Rgba>& colors);
   void Draw(const Matrix4f& view_projection) const;
+};
 
- private:
-  std::uint32_t program_ = 0, vao_ = 0, vbo_positions_ = 0, vbo_colors_ = 0;
-  size_t count_ = 0;
+// Line segments gathered for a LineRenderer: two vertices and two colours per segment.
+struct LineBatch {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<Rgba> colors;
+  void Add(const Eigen::Vector3d& a, const Eigen::Vector3d& b, Rgba color);
+  // The frame's x, y and z axes (red, green, blue), `length` long from its origin.
+  void AddAxes(const Eigen::Isometry3d& world_from_frame, double length);
+};
+
+// Triangles gathered for a TriangleRenderer: three vertices and three colours per triangle.
+struct TriangleBatch {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<Rgba> colors;
+  // The quadrilateral c0 c1 c2 c3 as the triangles (c0, c1, c2) and (c0, c2, c3).
+  void AddQuad(const std::array<Eigen::Vector3d, 4>& corners, Rgba color);
+  // A width x height rectangle centred on the frame's origin, in its xy plane.
+  void AddRectangle(const Eigen::Isometry3d& world_from_frame, double width, double height,
+                    Rgba color);
 };
 
 // A texture from an ImageU8 (grey or BGR), drawn as a screen-aligned rectangle given in

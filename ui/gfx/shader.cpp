@@ -1,5 +1,6 @@
 #include "ui/gfx/shader.h"
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -8,34 +9,31 @@
 namespace calibench::gfx {
 namespace {
 
-std::string ShaderLog(GLuint shader) {
+// The info log of a shader (glGetShaderiv, glGetShaderInfoLog; status GL_COMPILE_STATUS) or a
+// program (the glGetProgram pair; GL_LINK_STATUS) when its status is not GL_TRUE: the compiler's
+// or the linker's messages. nullopt when the status is GL_TRUE.
+std::optional<std::string> FailureLog(GLuint object, GLenum status,
+                                      PFNGLGETSHADERIVPROC get_parameter,
+                                      PFNGLGETSHADERINFOLOGPROC get_log) {
+  GLint ok = GL_FALSE;
+  get_parameter(object, status, &ok);
+  if (ok == GL_TRUE) return std::nullopt;
   GLint length = 0;
-  glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+  get_parameter(object, GL_INFO_LOG_LENGTH, &length);
   std::string log(static_cast<size_t>(length > 0 ? length : 1), '\0');
-  glGetShaderInfoLog(shader, length, nullptr, log.data());
-  return log.c_str();
-}
-
-std::string ProgramLog(GLuint program) {
-  GLint length = 0;
-  glGetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
-  std::string log(static_cast<size_t>(length > 0 ? length : 1), '\0');
-  glGetProgramInfoLog(program, length, nullptr, log.data());
-  return log.c_str();
+  get_log(object, length, nullptr, log.data());
+  return std::string(log.c_str());
 }
 
 GLuint Compile(const char* name, GLenum stage, const char* source) {
   const GLuint shader = glCreateShader(stage);
   glShaderSource(shader, 1, &source, nullptr);
   glCompileShader(shader);
-  GLint ok = GL_FALSE;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (ok != GL_TRUE) {
-    const std::string log = ShaderLog(shader);
+  if (const auto log = FailureLog(shader, GL_COMPILE_STATUS, glGetShaderiv, glGetShaderInfoLog)) {
     glDeleteShader(shader);
     throw std::runtime_error(std::string("GLSL ") +
                              (stage == GL_VERTEX_SHADER ? "vertex" : "fragment") + " shader of '" +
-                             name + "' does not compile: " + log);
+                             name + "' does not compile: " + *log);
   }
   return shader;
 }
@@ -61,12 +59,9 @@ std::uint32_t BuildProgram(const char* name, const char* vertex_source,
   glDetachShader(program, fragment);
   glDeleteShader(vertex);
   glDeleteShader(fragment);
-  GLint ok = GL_FALSE;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (ok != GL_TRUE) {
-    const std::string log = ProgramLog(program);
+  if (const auto log = FailureLog(program, GL_LINK_STATUS, glGetProgramiv, glGetProgramInfoLog)) {
     glDeleteProgram(program);
-    throw std::runtime_error(std::string("GLSL program '") + name + "' does not link: " + log);
+    throw std::runtime_error(std::string("GLSL program '") + name + "' does not link: " + *log);
   }
   return program;
 }

@@ -1,33 +1,33 @@
-// One frame of the workbench: the three views side by side on top (LiDAR image, camera frame,
-// 3D), the measurements list and the solver panel below, a status line at the bottom. Reads a
-// controller Snapshot, issues ImGui calls, returns the user's Intents. Owns only GL resources
-// and view-local state (zoom, pan, replay position). Used identically by the window and by the
-// headless renderer, which is what makes `calibench render` show what the window shows.
+// One frame of the workbench (WorkbenchFrame): the three views side by side on top (LiDAR image,
+// camera frame, 3D), the measurements list and the solver panel below, a status line at the
+// bottom. Reads a controller Snapshot, issues ImGui calls, returns the user's Intents. Owns only GL
+// resources and view-local state (zoom, pan, replay position). Used identically by the window and
+// by the headless renderer, which is what makes `calibench render` show what the window shows.
 #pragma once
 
-#include <map>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "ui/gfx/framebuffer.h"
 #include "ui/gfx/renderers.h"
 #include "ui/lidar_camera/controller.h"
+#include "ui/widgets/view_window.h"
+#include "ui/widgets/workbench_frame.h"
+#include "ui/widgets/zoom_pan_image.h"
 
 namespace calibench::ui {
+
+struct CameraShown;  // what the camera view shows in a frame (workbench_gl.h)
 
 enum class Layout { kWorkbench, kLidarOnly, kCameraOnly, kSceneOnly };
 // "workbench", "lidar", "camera", "3d"; false for others.
 bool ParseLayout(const std::string& name, Layout* layout);
 
-class Workbench {
+class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
  public:
   Workbench();
-  ~Workbench();
-  // Call between ImGui::NewFrame() and ImGui::Render(); width/height of the display in pixels.
-  // replay_seconds advances the solver replay (seconds since the last frame).
-  std::vector<Intent> Frame(const Snapshot& snapshot, int width, int height, Layout layout,
-                            double seconds_since_last_frame);
+  ~Workbench() override;
 
   // Where the last frame drew the LiDAR image (screen pixels) and which horizontal texture range
   // [u0, u1] it showed: lets tests (and tools) aim the brush at a LiDAR pixel.
@@ -37,33 +37,44 @@ class Workbench {
   const ImageRect& lidar_image_rect() const { return lidar_image_rect_; }
 
  private:
-  struct ViewRect {
-    float x, y, w, h;
-  };
-  void LidarView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
-  void CameraView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
-  void SceneView(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
+  // LiDAR view (workbench_lidar.cpp).
+  void LidarView(const Snapshot& s, const Rect& r, std::vector<Intent>* intents);
+  void LidarToolbar(const Snapshot& s, const PairView& pair, std::vector<Intent>* intents);
+  void CenterLidarOnBrush(const PairView& pair);
+  void LidarPicture(const Snapshot& s, const PairView& pair, std::vector<Intent>* intents);
+  // Camera view (workbench_camera.cpp).
+  void CameraView(const Snapshot& s, const Rect& r, std::vector<Intent>* intents);
+  // Returns the view settings as edited this frame.
+  ViewState CameraToolbar(const Snapshot& s, const PairView& pair, std::vector<Intent>* intents);
+  // The image and the reprojected points into gl_->camera_target, when they changed.
+  void DrawCameraTarget(const Snapshot& s, const PairView& pair, const CameraShown& shown,
+                        const ViewState& view);
+  // 3D view (workbench_scene.cpp).
+  void SceneView(const Snapshot& s, const Rect& r, std::vector<Intent>* intents);
+  void UploadSceneCloud(const Snapshot& s, const PairView& pair, bool camera_colors);
   // Draws the 3D scene (grid, axes, cloud, board quads) into gl_->scene_target.
   void DrawScene(const Snapshot& s, const PairView& pair, const gfx::Matrix4f& view_projection,
                  const Pose* estimate, int width, int height);
-  void MeasurementsPanel(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
-  void SolverPanel(const Snapshot& s, const ViewRect& r, std::vector<Intent>* intents);
-  void StatusLine(const Snapshot& s, const ViewRect& r);
-  void HandleKeys(const Snapshot& s, std::vector<Intent>* intents);
+  // Panels (workbench_panels.cpp).
+  void MeasurementsPanel(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) override;
+  void PairRow(const Snapshot& s, int index, std::vector<Intent>* intents);
+  void SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) override;
+  void SolutionReadouts(const SolverResult& result, std::vector<Intent>* intents);
+  // workbench.cpp
+  void View(int index, const Snapshot& s, const Rect& r, std::vector<Intent>* intents) override;
+  std::string Opened(const Snapshot& s) const override;
+  void HandleKeys(const Snapshot& s, std::vector<Intent>* intents) override;
+  // The estimate shown: the replayed iteration, else the solution; null before a solve.
   const Pose* DisplayedEstimate(const Snapshot& s) const;
 
-  // GL resources, created lazily inside a current context.
+  // GL resources, made by the constructor: construct a workbench with a GL context current.
   struct Gl;
   std::unique_ptr<Gl> gl_;
   // View-local state.
-  float lidar_zoom_ = 3.0f;        // horizontal zoom of the LiDAR image (1 = all 360 degrees)
-  float lidar_center_ = 0.5f;      // centre column as a fraction of the image width
-  std::string lidar_centered_on_;  // pair whose brush the LiDAR view was last centred on
-  float camera_zoom_ = 1.0f;       // 1 = the whole image; wheel zooms about the mouse
-  float camera_center_x_ = 0.5f;   // visible centre, fractions of the image
-  float camera_center_y_ = 0.5f;
-  double replay_position_ = -1;  // iteration shown; < 0 = the last one
-  bool replaying_ = false;
+  float lidar_zoom_ = 3.0f;          // horizontal zoom of the LiDAR image (1 = all 360 degrees)
+  float lidar_center_ = 0.5f;        // centre column as a fraction of the image width
+  std::string lidar_centered_on_;    // pair whose brush the LiDAR view was last centred on
+  ZoomPanImage camera_image_;        // zoom and pan of the camera view
   bool scene_camera_colors_ = true;  // 3D cloud coloured from the image once a solve exists
   std::string export_path_ = "result.json";
   std::string session_path_ = "session.json";

@@ -1,13 +1,17 @@
-// GL resources of the workbench (private to ui/workbench*.cpp).
+// GL resources of the workbench (private to ui/lidar_camera/workbench*.cpp).
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "ui/gfx/framebuffer.h"
 #include "ui/gfx/renderers.h"
 #include "ui/lidar_camera/workbench.h"
+#include "ui/widgets/zoom_pan_image.h"
 
 namespace calibench::ui {
 
@@ -24,5 +28,27 @@ struct Workbench::Gl {
   gfx::TriangleRenderer scene_quads;
   std::map<std::string, std::unique_ptr<gfx::ImageTexture>> thumbnails;
 };
+
+// What the camera view shows in a frame: the raw image with the real lens, or the undistorted one
+// with its pinhole, and where.
+struct CameraShown {
+  const ImageU8* image = nullptr;
+  bool undistorted = false;
+  const CameraModel* lens = nullptr;   // the camera's
+  const CameraModel* model = nullptr;  // what `image` was taken with: `lens` or the pinhole
+  ZoomPanImage::Placement at;
+
+  // A raw-image pixel as shown (through the pinhole when undistorted).
+  std::optional<Vec2> FromRaw(const Vec2& raw) const {
+    if (!undistorted) return raw;
+    const auto ray = lens->Unproject(raw);
+    return ray ? model->Project(*ray) : std::nullopt;
+  }
+};
+
+// A colour map's RGB with an alpha.
+inline gfx::Rgba ToRgba(const std::array<std::uint8_t, 3>& rgb, std::uint8_t alpha = 255) {
+  return {rgb[0], rgb[1], rgb[2], alpha};
+}
 
 }  // namespace calibench::ui

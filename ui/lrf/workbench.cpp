@@ -1,22 +1,20 @@
 #include "ui/lrf/workbench.h"
 
-// clang-format off
-// gl_api.h first: it declares GL for everything below.
-#include "core/lrf/result_io.h"
-#include "ui/gfx/gl_api.h"
-// clang-format on
-
 #include <imgui.h>
 
 #include <algorithm>
-#include <cfloat>
 #include <cmath>
 #include <cstdio>
 
 #include "core/geometry/geometry.h"
-#include "core/lidar_camera/result_io.h"
+#include "core/lrf/result_io.h"
 #include "ui/gfx/framebuffer.h"
 #include "ui/gfx/renderers.h"
+#include "ui/widgets/frame_key.h"
+#include "ui/widgets/pair_review.h"
+#include "ui/widgets/path_field.h"
+#include "ui/widgets/solution_readouts.h"
+#include "ui/widgets/workbench_layout.h"
 
 namespace calibench::ui {
 
@@ -33,14 +31,6 @@ struct LrfWorkbench::Gl {
 
 namespace {
 
-constexpr ImGuiWindowFlags kViewFlags =
-    ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
-    ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse |
-    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus;
-constexpr ImGuiWindowFlags kPanelFlags =
-    ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
-    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus;
-
 // Faces 0 (base), 1 (ABC), 2 (ACD): the same colours in every view. RGB.
 constexpr std::uint8_t kFaceRgb[3][3] = {{80, 150, 255}, {240, 90, 200}, {70, 215, 120}};
 constexpr const char* kFaceNames[3] = {"base", "ABC", "ACD"};
@@ -54,27 +44,23 @@ ImVec4 FaceColorVec(int face) {
   return {kFaceRgb[face][0] / 255.f, kFaceRgb[face][1] / 255.f, kFaceRgb[face][2] / 255.f, 1};
 }
 
-bool BeginView(const char* title, float x, float y, float w, float h) {
-  ImGui::SetNextWindowPos({x, y});
-  ImGui::SetNextWindowSize({w, h});
-  return ImGui::Begin(title, nullptr, kViewFlags);
-}
-
-ImTextureID TextureId(std::uint32_t texture) {
-  return reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(texture));
-}
-
 const LrfPairFeatures* SelectedFeatures(const LrfSnapshot& s) {
   if (s.selected < 0 || s.selected >= static_cast<int>(s.pairs.size())) return nullptr;
   return s.pairs[s.selected].features.get();
 }
 
-void Waiting(const LrfSnapshot& s) {
+// Begins a view of the selected pair: its features, or nullptr after saying what the view waits
+// for. Call ImGui::End() either way.
+const LrfPairFeatures* BeginPairView(const char* title, const LrfSnapshot& s, const Rect& r) {
+  if (!BeginView(title, r)) return nullptr;
+  const LrfPairFeatures* pair = SelectedFeatures(s);
+  if (pair) return pair;
   if (!s.dataset)
     ImGui::TextDisabled("no dataset open");
   else
     ImGui::TextDisabled("extracting features: %d / %d pairs ...", s.extracted_done,
                         s.extracted_total);
+  return nullptr;
 }
 
 // Scan points on the target, with their face (0..2; 3 = checkerboard).
@@ -131,6 +117,13 @@ std::optional<Vec2> ProjectToImage(const LrfDataset& dataset, const Vec3& x) {
 
 Vec3 OnScanPlane(const Vec2& p) { return Vec3(p.x(), p.y(), 0.0); }
 
+// Corner `c` (0..2: F, G, H) of the three-face target as a white ring with its name.
+void DrawCornerRing(ImDrawList* draw, ImVec2 q, int c) {
+  constexpr const char* kCorners[3] = {"F", "G", "H"};
+  draw->AddCircle(q, 6.0f, IM_COL32(255, 255, 255, 255), 16, 2.0f);
+  draw->AddText({q.x + 8, q.y - 8}, IM_COL32(255, 255, 255, 255), kCorners[c]);
+}
+
 // Constructs the intent in place (a moved temporary variant trips GCC 12's
 // -Wmaybe-uninitialized).
 template <typename T, typename... Args>
@@ -138,107 +131,28 @@ void Emit(std::vector<LrfIntent>* intents, Args&&... args) {
   intents->emplace_back(std::in_place_type<T>, T{std::forward<Args>(args)...});
 }
 
-}  // namespace
+// ---- The scan view: the LRF frame seen from above, screen right = LRF -y, screen up = LRF +x.
 
-bool ParseLrfLayout(const std::string& name, LrfLayout* layout) {
-  if (name == "workbench")
-    *layout = LrfLayout::kWorkbench;
-  else if (name == "scan")
-    *layout = LrfLayout::kScanOnly;
-  else if (name == "depth")
-    *layout = LrfLayout::kDepthOnly;
-  else if (name == "3d")
-    *layout = LrfLayout::kSceneOnly;
-  else
-    return false;
-  return true;
-}
+struct ScanCanvas {
+  ImVec2 origin, size;  // screen pixels
+  Vec2 center;          // the LRF-frame point at the canvas's centre, metres
+  double scale = 1;     // pixels per metre
 
-LrfWorkbench::LrfWorkbench() : gl_(std::make_unique<Gl>()) {}
-LrfWorkbench::~LrfWorkbench() = default;
+  ImVec2 end() const { return ImVec2(origin.x + size.x, origin.y + size.y); }
+  ImVec2 ToScreen(const Vec2& p) const {
+    const ImVec2 mid(origin.x + size.x / 2, origin.y + size.y / 2);
+    return ImVec2(mid.x - static_cast<float>((p.y() - center.y()) * scale),
+                  mid.y - static_cast<float>((p.x() - center.x()) * scale));
+  }
+  bool Inside(const ImVec2& q) const {
+    return q.x >= origin.x && q.x <= end().x && q.y >= origin.y && q.y <= end().y;
+  }
+};
 
-const Pose* LrfWorkbench::DisplayedEstimate(const LrfSnapshot& s) const {
-  const auto& iterations = s.solver.iterations;
-  if (!iterations.empty()) {
-    const int last = static_cast<int>(iterations.size()) - 1;
-    const int index =
-        replay_position_ < 0 ? last : std::min(last, static_cast<int>(replay_position_));
-    return &iterations[index].cam_from_lidar;  // IterationReport names it for the 3D method
-  }
-  return s.solver.solution ? &s.solver.solution->cam_from_lrf : nullptr;
-}
-
-std::vector<LrfIntent> LrfWorkbench::Frame(const LrfSnapshot& s, int width, int height,
-                                           LrfLayout layout, double seconds_since_last_frame) {
-  std::vector<LrfIntent> intents;
-  if (replaying_ && !s.solver.iterations.empty()) {
-    replay_position_ = std::max(0.0, replay_position_) + 2.0 * seconds_since_last_frame;  // 2 it/s
-    if (replay_position_ >= static_cast<double>(s.solver.iterations.size()) - 1) {
-      replay_position_ = -1;
-      replaying_ = false;
-    }
-  }
-  const float w = static_cast<float>(width), h = static_cast<float>(height);
-  switch (layout) {
-    case LrfLayout::kScanOnly:
-      ScanView(s, {0, 0, w, h});
-      return intents;
-    case LrfLayout::kDepthOnly:
-      ImageView(s, {0, 0, w, h});
-      return intents;
-    case LrfLayout::kSceneOnly:
-      SceneView(s, {0, 0, w, h});
-      return intents;
-    case LrfLayout::kWorkbench:
-      break;
-  }
-  const float status_h = ImGui::GetFrameHeightWithSpacing() + 8;
-  const float top_h = std::floor((h - status_h) * 0.58f);
-  const float third = std::floor(w / 3);
-  ScanView(s, {0, 0, third, top_h});
-  ImageView(s, {third, 0, third, top_h});
-  SceneView(s, {2 * third, 0, w - 2 * third, top_h});
-  const float bottom_h = h - status_h - top_h, left_w = std::floor(w * 0.5f);
-  MeasurementsPanel(s, {0, top_h, left_w, bottom_h}, &intents);
-  SolverPanel(s, {left_w, top_h, w - left_w, bottom_h}, &intents);
-  StatusLine(s, {0, h - status_h, w, status_h});
-  HandleKeys(s, &intents);
-  return intents;
-}
-
-void LrfWorkbench::ScanView(const LrfSnapshot& s, const ViewRect& r) {
-  if (!BeginView("Scan (LRF frame, top-down)", r.x, r.y, r.w, r.h)) return ImGui::End();
-  const LrfPairFeatures* pair = SelectedFeatures(s);
-  if (!pair) {
-    Waiting(s);
-    return ImGui::End();
-  }
-  const LaserScan& scan = pair->scan;
-  const auto target = TargetPoints(*pair);
-  if (pair->three_face && pair->three_face->scan.ok) {
-    ImGui::Text("%zu rays, %zu on the target, line RMS %.1f mm", scan.ranges.size(), target.size(),
-                pair->three_face->scan.rms_m * 1e3);
-  } else if (pair->board_scan && pair->board_scan->ok) {
-    ImGui::Text("%zu rays, %zu on the board, line RMS %.1f mm", scan.ranges.size(), target.size(),
-                pair->board_scan->rms_m * 1e3);
-  } else {
-    const std::string why = pair->three_face   ? pair->three_face->scan.reason
-                            : pair->board_scan ? pair->board_scan->reason
-                                               : pair->reason;
-    ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "no target: %s", why.c_str());
-  }
-  for (int face = 0; face < 3 && pair->three_face; ++face) {
-    ImGui::TextColored(FaceColorVec(face), "%s", kFaceNames[face]);
-    ImGui::SameLine();
-  }
-  ImGui::TextDisabled("rings: F G H   wheel: zoom about the target");
-
-  const ImVec2 origin = ImGui::GetCursorScreenPos();
-  const ImVec2 avail = ImGui::GetContentRegionAvail();
-  if (avail.x < 10 || avail.y < 10) return ImGui::End();
-  ImGui::InvisibleButton("scan_canvas", avail);
-  const bool hovered = ImGui::IsItemHovered();
-  // Fit the LRF origin and the target (margin 0.4 m); the wheel zooms about the target's centre.
+// Fits the LRF origin and the target (margin 0.3 m and a fifth of their extent); `zoom` about the
+// target's centre.
+ScanCanvas FitScanCanvas(ImVec2 origin, ImVec2 size,
+                         const std::vector<std::pair<Vec2, int>>& target, float zoom) {
   Vec2 lo(0, 0), hi(0, 0), target_center(1, 0);
   if (!target.empty()) {
     target_center.setZero();
@@ -251,131 +165,332 @@ void LrfWorkbench::ScanView(const LrfSnapshot& s, const ViewRect& r) {
   }
   const Vec2 margin = Vec2::Constant(0.3) + 0.2 * (hi - lo);
   lo -= margin, hi += margin;
-  // Screen right = LRF -y, screen up = LRF +x.
-  const double fit = std::min(avail.x / (hi.y() - lo.y()), avail.y / (hi.x() - lo.x()));
-  const double scale = fit * scan_zoom_;  // pixels per metre
-  const Vec2 center = target_center + ((lo + hi) / 2 - target_center) / scan_zoom_;
-  const ImVec2 mid(origin.x + avail.x / 2, origin.y + avail.y / 2);
-  auto to_screen = [&](const Vec2& p) {
-    return ImVec2(mid.x - static_cast<float>((p.y() - center.y()) * scale),
-                  mid.y - static_cast<float>((p.x() - center.x()) * scale));
-  };
-  const ImVec2 end(origin.x + avail.x, origin.y + avail.y);
-  auto inside = [&](const ImVec2& q) {
-    return q.x >= origin.x && q.x <= end.x && q.y >= origin.y && q.y <= end.y;
-  };
-  ImDrawList* draw = ImGui::GetWindowDrawList();
-  draw->PushClipRect(origin, end, true);
-  draw->AddRectFilled(origin, end, IM_COL32(22, 22, 27, 255));
-  // Metre grid: the smallest of 0.1 / 0.2 / 0.5 / 1 / 2 / 5 m at least 45 px apart.
+  const double fit = std::min(size.x / (hi.y() - lo.y()), size.y / (hi.x() - lo.x()));
+  ScanCanvas canvas{origin, size, target_center + ((lo + hi) / 2 - target_center) / zoom};
+  canvas.scale = fit * zoom;
+  return canvas;
+}
+
+// Metre grid lines labelled with their x and y: the smallest of 0.1 / 0.2 / 0.5 / 1 / 2 / 5 m at
+// least 45 px apart.
+void DrawScanGrid(ImDrawList* draw, const ScanCanvas& canvas) {
   double spacing = 5.0;
   for (double candidate : {0.1, 0.2, 0.5, 1.0, 2.0, 5.0})
-    if (candidate * scale >= 45) {
+    if (candidate * canvas.scale >= 45) {
       spacing = candidate;
       break;
     }
-  const double half_x = avail.y / 2 / scale, half_y = avail.x / 2 / scale;
-  for (int k = static_cast<int>(std::floor((center.x() - half_x) / spacing));
-       k * spacing <= center.x() + half_x; ++k) {
-    const float y = to_screen(Vec2(k * spacing, 0)).y;
-    draw->AddLine({origin.x, y}, {end.x, y},
-                  k == 0 ? IM_COL32(95, 95, 105, 255) : IM_COL32(50, 50, 58, 255));
-    char label[32];
+  const ImVec2 origin = canvas.origin, end = canvas.end();
+  const double half_x = canvas.size.y / 2 / canvas.scale, half_y = canvas.size.x / 2 / canvas.scale;
+  auto line_color = [](int k) {
+    return k == 0 ? IM_COL32(95, 95, 105, 255) : IM_COL32(50, 50, 58, 255);
+  };
+  char label[32];
+  for (int k = static_cast<int>(std::floor((canvas.center.x() - half_x) / spacing));
+       k * spacing <= canvas.center.x() + half_x; ++k) {
+    const float y = canvas.ToScreen(Vec2(k * spacing, 0)).y;
+    draw->AddLine({origin.x, y}, {end.x, y}, line_color(k));
     std::snprintf(label, sizeof(label), "x %g m", k * spacing);
     draw->AddText({origin.x + 3, y - 15}, IM_COL32(120, 120, 130, 255), label);
   }
-  for (int k = static_cast<int>(std::floor((center.y() - half_y) / spacing));
-       k * spacing <= center.y() + half_y; ++k) {
-    const float x = to_screen(Vec2(0, k * spacing)).x;
-    draw->AddLine({x, origin.y}, {x, end.y},
-                  k == 0 ? IM_COL32(95, 95, 105, 255) : IM_COL32(50, 50, 58, 255));
-    char label[32];
+  for (int k = static_cast<int>(std::floor((canvas.center.y() - half_y) / spacing));
+       k * spacing <= canvas.center.y() + half_y; ++k) {
+    const float x = canvas.ToScreen(Vec2(0, k * spacing)).x;
+    draw->AddLine({x, origin.y}, {x, end.y}, line_color(k));
     std::snprintf(label, sizeof(label), "y %g", k * spacing);
     draw->AddText({x + 3, end.y - 16}, IM_COL32(120, 120, 130, 255), label);
   }
-  // Every return in grey, the target's points coloured by face.
+}
+
+// A fitted line as a segment over its points' extent (plus 5 cm).
+void DrawFittedLine(ImDrawList* draw, const ScanCanvas& canvas, const Line2& line,
+                    const std::vector<Vec2>& points, ImU32 color) {
+  if (points.empty()) return;
+  const Vec2 direction(-line.normal.y(), line.normal.x());
+  const Vec2 foot = -line.normal * line.offset;
+  double t0 = 1e9, t1 = -1e9;
+  for (const Vec2& p : points)
+    t0 = std::min(t0, (p - foot).dot(direction)), t1 = std::max(t1, (p - foot).dot(direction));
+  draw->AddLine(canvas.ToScreen(foot + (t0 - 0.05) * direction),
+                canvas.ToScreen(foot + (t1 + 0.05) * direction), color, 1.5f);
+}
+
+// Every return in grey, the target's points coloured by face, the fitted lines and corners.
+void DrawScanPoints(ImDrawList* draw, const ScanCanvas& canvas, const LrfPairFeatures& pair,
+                    const std::vector<std::pair<Vec2, int>>& target) {
+  const LaserScan& scan = pair.scan;
   for (size_t i = 0; i < scan.ranges.size(); ++i) {
     if (!scan.Valid(i)) continue;
-    const ImVec2 q = to_screen(scan.Point(i));
-    if (inside(q))
+    const ImVec2 q = canvas.ToScreen(scan.Point(i));
+    if (canvas.Inside(q))
       draw->AddRectFilled({q.x - 1, q.y - 1}, {q.x + 1, q.y + 1}, IM_COL32(150, 150, 158, 255));
   }
   for (const auto& [p, face] : target)
-    draw->AddCircleFilled(to_screen(p), 2.5f, face < 3 ? FaceColor(face) : kBoardColor, 8);
-  // The fitted lines as segments over their points' extent (plus 5 cm).
-  auto draw_line = [&](const Line2& line, const std::vector<Vec2>& points, ImU32 color) {
-    if (points.empty()) return;
-    const Vec2 direction(-line.normal.y(), line.normal.x());
-    const Vec2 foot = -line.normal * line.offset;
-    double t0 = 1e9, t1 = -1e9;
-    for (const Vec2& p : points)
-      t0 = std::min(t0, (p - foot).dot(direction)), t1 = std::max(t1, (p - foot).dot(direction));
-    draw->AddLine(to_screen(foot + (t0 - 0.05) * direction),
-                  to_screen(foot + (t1 + 0.05) * direction), color, 1.5f);
-  };
-  if (pair->three_face && pair->three_face->scan.ok) {
-    const ScanFeatures& features = pair->three_face->scan;
+    draw->AddCircleFilled(canvas.ToScreen(p), 2.5f, face < 3 ? FaceColor(face) : kBoardColor, 8);
+  if (pair.three_face && pair.three_face->scan.ok) {
+    const ScanFeatures& features = pair.three_face->scan;
     for (int face = 0; face < 3; ++face)
-      draw_line(features.lines[face], features.face_points[face], FaceColor(face, 200));
-    constexpr const char* kCorners[3] = {"F", "G", "H"};
-    for (int c = 0; c < 3; ++c) {
-      const ImVec2 q = to_screen(features.corners[c]);
-      draw->AddCircle(q, 6.0f, IM_COL32(255, 255, 255, 255), 16, 2.0f);
-      draw->AddText({q.x + 8, q.y - 8}, IM_COL32(255, 255, 255, 255), kCorners[c]);
-    }
+      DrawFittedLine(draw, canvas, features.lines[face], features.face_points[face],
+                     FaceColor(face, 200));
+    for (int c = 0; c < 3; ++c) DrawCornerRing(draw, canvas.ToScreen(features.corners[c]), c);
   }
-  if (pair->board_scan && pair->board_scan->ok)
-    draw_line(pair->board_scan->line, pair->board_scan->points, kBoardColor);
-  // The LRF: x forward (red, up the screen), y left (green).
-  const ImVec2 o = to_screen(Vec2::Zero());
+  if (pair.board_scan && pair.board_scan->ok)
+    DrawFittedLine(draw, canvas, pair.board_scan->line, pair.board_scan->points, kBoardColor);
+}
+
+// The LRF's axes (x forward: red, up the screen; y left: green) and, with an estimate, the
+// camera's centre and optical axis seen from above.
+void DrawScanSensors(ImDrawList* draw, const ScanCanvas& canvas, const Pose* estimate) {
+  const ImVec2 o = canvas.ToScreen(Vec2::Zero());
   draw->AddLine(o, {o.x, o.y - 40}, IM_COL32(255, 70, 70, 255), 2.0f);
   draw->AddLine(o, {o.x - 40, o.y}, IM_COL32(70, 230, 70, 255), 2.0f);
   draw->AddCircleFilled(o, 4.0f, IM_COL32(235, 235, 235, 255), 12);
   draw->AddText({o.x + 6, o.y + 2}, IM_COL32(235, 235, 235, 255), "LRF");
-  // After a solve: the camera's centre and optical axis seen from above.
-  if (const Pose* estimate = DisplayedEstimate(s)) {
-    const Pose lrf_from_cam = estimate->inverse();
-    const Vec3 c = lrf_from_cam.translation(), axis = lrf_from_cam.linear().col(2);
-    const ImVec2 q = to_screen(c.head<2>());
-    draw->AddLine(q, to_screen(c.head<2>() + 0.3 * axis.head<2>()), IM_COL32(80, 220, 255, 255),
-                  2.0f);
-    draw->AddCircleFilled(q, 4.0f, IM_COL32(80, 220, 255, 255), 12);
-    draw->AddText({q.x + 6, q.y - 16}, IM_COL32(80, 220, 255, 255), "camera");
+  if (!estimate) return;
+  const Pose lrf_from_cam = estimate->inverse();
+  const Vec3 c = lrf_from_cam.translation(), axis = lrf_from_cam.linear().col(2);
+  const ImVec2 q = canvas.ToScreen(c.head<2>());
+  draw->AddLine(q, canvas.ToScreen(c.head<2>() + 0.3 * axis.head<2>()), IM_COL32(80, 220, 255, 255),
+                2.0f);
+  draw->AddCircleFilled(q, 4.0f, IM_COL32(80, 220, 255, 255), 12);
+  draw->AddText({q.x + 6, q.y - 16}, IM_COL32(80, 220, 255, 255), "camera");
+}
+
+// Rays, target points and line RMS (or why there is no target); the face colours.
+void ScanReadouts(const LrfPairFeatures& pair, size_t target_points) {
+  const size_t rays = pair.scan.ranges.size();
+  if (pair.three_face && pair.three_face->scan.ok) {
+    ImGui::Text("%zu rays, %zu on the target, line RMS %.1f mm", rays, target_points,
+                pair.three_face->scan.rms_m * 1e3);
+  } else if (pair.board_scan && pair.board_scan->ok) {
+    ImGui::Text("%zu rays, %zu on the board, line RMS %.1f mm", rays, target_points,
+                pair.board_scan->rms_m * 1e3);
+  } else {
+    const std::string why = pair.three_face   ? pair.three_face->scan.reason
+                            : pair.board_scan ? pair.board_scan->reason
+                                              : pair.reason;
+    ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "no target: %s", why.c_str());
   }
+  for (int face = 0; face < 3 && pair.three_face; ++face) {
+    ImGui::TextColored(FaceColorVec(face), "%s", kFaceNames[face]);
+    ImGui::SameLine();
+  }
+  ImGui::TextDisabled("rings: F G H   wheel: zoom about the target");
+}
+
+// ---- The image view: the depth picture (three-face) or the camera image (checkerboard).
+
+// What the image shows of the pair, in words; the picture's source (the camera image, or the
+// pair for its depth frame), nullptr when there is none.
+const void* ImageReadouts(const LrfSnapshot& s, const LrfPairFeatures& pair, bool board_case) {
+  if (board_case) {
+    if (pair.camera)
+      ImGui::Text("board: %d corners, reprojection RMS %.2f px, %.2f m away",
+                  pair.camera->num_corners, pair.camera->reprojection_rms_px,
+                  pair.camera->plane.distance);
+    else
+      ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "board not found: %s", pair.reason.c_str());
+    return s.selected_image.get();
+  }
+  if (!pair.three_face) return nullptr;
+  const DepthFeatures& d = pair.three_face->depth;
+  if (d.ok)
+    ImGui::Text("faces %d / %d / %d px, plane RMS %.1f mm, smallest angle %.0f deg",
+                d.inlier_counts[0], d.inlier_counts[1], d.inlier_counts[2], d.rms_m * 1e3,
+                d.min_face_angle_deg);
+  else
+    ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "no faces: %s", d.reason.c_str());
+  return pair.depth ? &pair : nullptr;
+}
+
+// The checkerboard sheet's outline, edges subdivided (lenses bend them).
+void DrawSheetOutline(ImDrawList* draw, const LrfDataset& dataset, const Pose& cam_from_board,
+                      const ZoomPanImage::Placement& at) {
+  const double hw = dataset.board.SheetWidth() / 2, hh = dataset.board.SheetHeight() / 2;
+  const Vec3 corners[4] = {{-hw, -hh, 0}, {hw, -hh, 0}, {hw, hh, 0}, {-hw, hh, 0}};
+  std::vector<ImVec2> outline;
+  for (int e = 0; e < 4; ++e)
+    for (int k = 0; k < 16; ++k)
+      if (const auto px = ProjectToImage(
+              dataset,
+              cam_from_board * (corners[e] + (corners[(e + 1) % 4] - corners[e]) * (k / 16.0))))
+        outline.push_back(at.ToScreen(*px));
+  if (outline.size() > 2)
+    draw->AddPolyline(outline.data(), static_cast<int>(outline.size()), IM_COL32(80, 200, 255, 255),
+                      ImDrawFlags_Closed, 2.0f);
+}
+
+// Every return moved into the camera by the estimate, the target's larger and outlined, and the
+// corners F G H.
+void DrawScanInImage(ImDrawList* draw, const LrfDataset& dataset, const LrfPairFeatures& pair,
+                     const Pose& estimate, const ZoomPanImage::Placement& at) {
+  const LaserScan& scan = pair.scan;
+  for (size_t i = 0; i < scan.ranges.size(); ++i)
+    if (scan.Valid(i))
+      if (const auto px = ProjectToImage(dataset, estimate * OnScanPlane(scan.Point(i))))
+        draw->AddCircleFilled(at.ToScreen(*px), 1.5f, kScanInCamera, 6);
+  // Outlines first, then the fills: the target's returns are dense.
+  std::vector<ImVec2> on_target;
+  for (const auto& [p, face] : TargetPoints(pair))
+    if (const auto px = ProjectToImage(dataset, estimate * OnScanPlane(p)))
+      on_target.push_back(at.ToScreen(*px));
+  for (const ImVec2& q : on_target) draw->AddCircleFilled(q, 3.2f, IM_COL32(0, 0, 0, 255), 8);
+  for (const ImVec2& q : on_target) draw->AddCircleFilled(q, 2.0f, kScanInCamera, 8);
+  if (!pair.three_face || !pair.three_face->scan.ok) return;
+  for (int c = 0; c < 3; ++c)
+    if (const auto px =
+            ProjectToImage(dataset, estimate * OnScanPlane(pair.three_face->scan.corners[c])))
+      DrawCornerRing(draw, at.ToScreen(*px), c);
+}
+
+// ---- The 3D view, in the camera frame.
+
+// The depth frame back-projected (every stride-th pixel, at most ~40k points), faces coloured,
+// the rest grey by distance.
+struct DepthCloud {
+  std::vector<Eigen::Vector3f> positions;
+  std::vector<gfx::Rgba> colors;
+  Vec3 face_sum = Vec3::Zero(), all_sum = Vec3::Zero();
+  int face_count = 0;
+  std::vector<double> heights;  // camera y of each point
+};
+
+DepthCloud BackProject(const LrfPairFeatures& pair) {
+  DepthCloud cloud;
+  if (!pair.depth) return cloud;
+  const DepthImage& depth = *pair.depth;
+  const DepthIntrinsics& k = depth.intrinsics;
+  const auto* faces =
+      pair.three_face && pair.three_face->depth.face_of_pixel.size() == depth.depth_m.size()
+          ? &pair.three_face->depth.face_of_pixel
+          : nullptr;
+  const int stride =
+      std::max(1, static_cast<int>(std::ceil(std::sqrt(k.width * k.height / 40000.0))));
+  for (int v = 0; v < k.height; v += stride)
+    for (int u = 0; u < k.width; u += stride) {
+      const double z = depth.At(u, v);
+      if (z <= 0) continue;
+      const Vec3 x((u - k.cx) / k.fx * z, (v - k.cy) / k.fy * z, z);
+      const int face = faces ? (*faces)[static_cast<size_t>(v) * k.width + u] : -1;
+      cloud.positions.push_back(x.cast<float>());
+      cloud.all_sum += x;
+      cloud.heights.push_back(x.y());
+      if (face >= 0 && face < 3) {
+        cloud.colors.push_back({kFaceRgb[face][0], kFaceRgb[face][1], kFaceRgb[face][2], 255});
+        cloud.face_sum += x;
+        ++cloud.face_count;
+      } else {
+        const auto g = static_cast<std::uint8_t>(std::clamp(190.0 - 15.0 * z, 90.0, 190.0));
+        cloud.colors.push_back({g, g, g, 255});
+      }
+    }
+  return cloud;
+}
+
+// `text` next to the camera-frame point x, when it is in front of the camera and in the view.
+void LabelAt(const gfx::Matrix4f& view_projection, ImVec2 origin, ImVec2 size, const Vec3& x,
+             const char* text) {
+  const Eigen::Vector4f clip = view_projection * Eigen::Vector4f(x.x(), x.y(), x.z(), 1.0f);
+  if (clip.w() <= 0) return;
+  const float u = (clip.x() / clip.w() + 1) / 2, v = (1 - clip.y() / clip.w()) / 2;
+  if (u < 0 || u > 1 || v < 0 || v > 1) return;
+  ImGui::GetWindowDrawList()->AddText({origin.x + u * size.x + 4, origin.y + v * size.y + 2},
+                                      IM_COL32(220, 220, 220, 255), text);
+}
+
+// ---- The panels.
+
+void TextMm(const std::optional<double>& metres) {
+  if (metres) ImGui::Text("%.1f", *metres * 1e3);
+}
+
+// Id (selects the pair), status, scan and depth (or PnP) RMS, Eq. 12 and plane residuals (mm),
+// what the pair gave.
+void PairRow(const LrfSnapshot& s, int index, std::vector<LrfIntent>* intents) {
+  const LrfPairView& pair = s.pairs[index];
+  const LrfPairFeatures* f = pair.features.get();
+  ImGui::TableNextRow();
+  ImGui::TableNextColumn();
+  if (PairSelectable(index, pair.id, index == s.selected)) Emit<LrfSelectPair>(intents, index);
+  ImGui::TableNextColumn();
+  PairStatusText(pair.status, pair.extracted ? PairStatusName(pair.status) : "extracting");
+  ImGui::TableNextColumn();
+  if (f && f->three_face && f->three_face->scan.ok) TextMm(f->three_face->scan.rms_m);
+  if (f && f->board_scan && f->board_scan->ok) TextMm(f->board_scan->rms_m);
+  ImGui::TableNextColumn();
+  if (f && f->three_face && f->three_face->depth.ok) TextMm(f->three_face->depth.rms_m);
+  if (f && f->camera) ImGui::Text("%.2f", f->camera->reprojection_rms_px);
+  ImGui::TableNextColumn();
+  TextMm(pair.point_to_line_m);
+  ImGui::TableNextColumn();
+  TextMm(pair.point_to_plane_rms_m);
+  ImGui::TableNextColumn();
+  if (!pair.reason.empty())
+    ImGui::TextWrapped("%s", pair.reason.c_str());
+  else if (f && f->three_face)
+    ImGui::TextDisabled(
+        "%zu scan points, faces %d / %d / %d px", f->three_face->scan.target_indices.size(),
+        f->three_face->depth.inlier_counts[0], f->three_face->depth.inlier_counts[1],
+        f->three_face->depth.inlier_counts[2]);
+  else if (f && f->board_scan && f->camera)
+    ImGui::TextDisabled("%zu board points, %d corners", f->board_scan->points.size(),
+                        f->camera->num_corners);
+}
+
+}  // namespace
+
+bool ParseLrfLayout(const std::string& name, LrfLayout* layout) {
+  return ParseLayoutName(name, {"workbench", "scan", "depth", "3d"}, layout);
+}
+
+LrfWorkbench::LrfWorkbench() : WorkbenchFrame(0.5f), gl_(std::make_unique<Gl>()) {}
+
+LrfWorkbench::~LrfWorkbench() = default;
+
+void LrfWorkbench::View(int index, const LrfSnapshot& s, const Rect& r,
+                        std::vector<LrfIntent>* /*intents: the views return none*/) {
+  if (index == 0) ScanView(s, r);
+  if (index == 1) ImageView(s, r);
+  if (index == 2) SceneView(s, r);
+}
+
+std::string LrfWorkbench::Opened(const LrfSnapshot& s) const {
+  return "dataset: " + s.manifest.filename().string();
+}
+
+const Pose* LrfWorkbench::DisplayedEstimate(const LrfSnapshot& s) const {
+  return replay().ShownEstimate(s.solver.iterations,
+                                s.solver.solution ? &s.solver.solution->cam_from_lrf : nullptr);
+}
+
+void LrfWorkbench::ScanView(const LrfSnapshot& s, const Rect& r) {
+  const LrfPairFeatures* pair = BeginPairView("Scan (LRF frame, top-down)", s, r);
+  if (!pair) return ImGui::End();
+  const auto target = TargetPoints(*pair);
+  ScanReadouts(*pair, target.size());
+  const ImVec2 origin = ImGui::GetCursorScreenPos();
+  const ImVec2 avail = ImGui::GetContentRegionAvail();
+  if (avail.x < 10 || avail.y < 10) return ImGui::End();
+  ImGui::InvisibleButton("scan_canvas", avail);
+  const bool hovered = ImGui::IsItemHovered();
+  const ScanCanvas canvas = FitScanCanvas(origin, avail, target, scan_zoom_);
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  draw->PushClipRect(origin, canvas.end(), true);
+  draw->AddRectFilled(origin, canvas.end(), IM_COL32(22, 22, 27, 255));
+  DrawScanGrid(draw, canvas);
+  DrawScanPoints(draw, canvas, *pair, target);
+  DrawScanSensors(draw, canvas, DisplayedEstimate(s));
   draw->PopClipRect();
   if (hovered && ImGui::GetIO().MouseWheel != 0)
     scan_zoom_ = std::clamp(scan_zoom_ * std::pow(1.25f, ImGui::GetIO().MouseWheel), 1.0f, 60.0f);
   ImGui::End();
 }
 
-void LrfWorkbench::ImageView(const LrfSnapshot& s, const ViewRect& r) {
+void LrfWorkbench::ImageView(const LrfSnapshot& s, const Rect& r) {
   const bool board_case = s.dataset && s.dataset->target_type == LrfTargetType::kCheckerboard;
-  if (!BeginView(board_case ? "Camera image" : "Depth image", r.x, r.y, r.w, r.h))
-    return ImGui::End();
-  const LrfPairFeatures* pair = SelectedFeatures(s);
-  if (!pair) {
-    Waiting(s);
-    return ImGui::End();
-  }
-  const void* source = nullptr;
-  if (board_case) {
-    if (pair->camera)
-      ImGui::Text("board: %d corners, reprojection RMS %.2f px, %.2f m away",
-                  pair->camera->num_corners, pair->camera->reprojection_rms_px,
-                  pair->camera->plane.distance);
-    else
-      ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "board not found: %s", pair->reason.c_str());
-    source = s.selected_image.get();
-  } else if (pair->three_face) {
-    const DepthFeatures& d = pair->three_face->depth;
-    if (d.ok)
-      ImGui::Text("faces %d / %d / %d px, plane RMS %.1f mm, smallest angle %.0f deg",
-                  d.inlier_counts[0], d.inlier_counts[1], d.inlier_counts[2], d.rms_m * 1e3,
-                  d.min_face_angle_deg);
-    else
-      ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "no faces: %s", d.reason.c_str());
-    if (pair->depth) source = pair;
-  }
+  const LrfPairFeatures* pair = BeginPairView(board_case ? "Camera image" : "Depth image", s, r);
+  if (!pair) return ImGui::End();
+  const void* source = ImageReadouts(s, *pair, board_case);
   const Pose* estimate = DisplayedEstimate(s);
   ImGui::TextDisabled(estimate ? "yellow: the scan moved into the camera; rings: F G H"
                                : "run the solver to project the scan into this image");
@@ -384,497 +499,201 @@ void LrfWorkbench::ImageView(const LrfSnapshot& s, const ViewRect& r) {
                         pair->reason.c_str());
     return ImGui::End();
   }
-  if (reinterpret_cast<std::uintptr_t>(source) != image_key_) {
-    image_key_ = reinterpret_cast<std::uintptr_t>(source);
-    if (board_case)
-      gl_->picture.Upload(*s.selected_image, true);
-    else
-      gl_->picture.Upload(ComposeDepthPicture(*pair->depth, pair->three_face->depth), false);
-  }
-  const int iw = gl_->picture.width(), ih = gl_->picture.height();
-  const ImVec2 avail = ImGui::GetContentRegionAvail();
-  const float fit = std::min(avail.x / iw, avail.y / ih);
-  const float tw = std::max(1.0f, std::floor(iw * fit)), th = std::max(1.0f, std::floor(ih * fit));
-  // Zoom and pan: the visible part is [u0, u0 + span] x [v0, v0 + span] (fractions of the image).
-  const float span = 1.0f / image_zoom_;
-  image_center_x_ = std::clamp(image_center_x_, span / 2, 1 - span / 2);
-  image_center_y_ = std::clamp(image_center_y_, span / 2, 1 - span / 2);
-  const float u0 = image_center_x_ - span / 2, v0 = image_center_y_ - span / 2;
-  const ImVec2 origin = ImGui::GetCursorScreenPos();
-  ImGui::Image(TextureId(gl_->picture.texture()), ImVec2(tw, th), ImVec2(u0, v0),
-               ImVec2(u0 + span, v0 + span));
+  UploadPicture(s, *pair, source);
+  const ZoomPanImage::Placement at = image_.Place(gl_->picture.width(), gl_->picture.height());
+  ZoomPanImage::Show(at, gl_->picture.texture());
   const bool hovered = ImGui::IsItemHovered();
-  auto to_screen = [&](const Vec2& px) {
-    return ImVec2(origin.x + static_cast<float>(((px.x() + 0.5) / iw - u0) / span * tw),
-                  origin.y + static_cast<float>(((px.y() + 0.5) / ih - v0) / span * th));
-  };
   ImDrawList* draw = ImGui::GetWindowDrawList();
-  draw->PushClipRect(origin, ImVec2(origin.x + tw, origin.y + th), true);
-  if (board_case && pair->camera) {
-    const double hw = s.dataset->board.SheetWidth() / 2, hh = s.dataset->board.SheetHeight() / 2;
-    const Vec3 corners[4] = {{-hw, -hh, 0}, {hw, -hh, 0}, {hw, hh, 0}, {-hw, hh, 0}};
-    std::vector<ImVec2> outline;
-    for (int e = 0; e < 4; ++e)
-      for (int k = 0; k < 16; ++k)
-        if (const auto px = ProjectToImage(
-                *s.dataset, pair->camera->cam_from_board *
-                                (corners[e] + (corners[(e + 1) % 4] - corners[e]) * (k / 16.0))))
-          outline.push_back(to_screen(*px));
-    if (outline.size() > 2)
-      draw->AddPolyline(outline.data(), static_cast<int>(outline.size()),
-                        IM_COL32(80, 200, 255, 255), ImDrawFlags_Closed, 2.0f);
-  }
-  if (estimate) {
-    // Every return moved into the camera by the estimate, the target's larger and outlined.
-    const LaserScan& scan = pair->scan;
-    for (size_t i = 0; i < scan.ranges.size(); ++i)
-      if (scan.Valid(i))
-        if (const auto px = ProjectToImage(*s.dataset, *estimate * OnScanPlane(scan.Point(i))))
-          draw->AddCircleFilled(to_screen(*px), 1.5f, kScanInCamera, 6);
-    // Outlines first, then the fills: the target's returns are dense.
-    std::vector<ImVec2> on_target;
-    for (const auto& [p, face] : TargetPoints(*pair))
-      if (const auto px = ProjectToImage(*s.dataset, *estimate * OnScanPlane(p)))
-        on_target.push_back(to_screen(*px));
-    for (const ImVec2& q : on_target) draw->AddCircleFilled(q, 3.2f, IM_COL32(0, 0, 0, 255), 8);
-    for (const ImVec2& q : on_target) draw->AddCircleFilled(q, 2.0f, kScanInCamera, 8);
-    if (pair->three_face && pair->three_face->scan.ok) {
-      constexpr const char* kCorners[3] = {"F", "G", "H"};
-      for (int c = 0; c < 3; ++c)
-        if (const auto px = ProjectToImage(
-                *s.dataset, *estimate * OnScanPlane(pair->three_face->scan.corners[c]))) {
-          const ImVec2 q = to_screen(*px);
-          draw->AddCircle(q, 6.0f, IM_COL32(255, 255, 255, 255), 16, 2.0f);
-          draw->AddText({q.x + 8, q.y - 8}, IM_COL32(255, 255, 255, 255), kCorners[c]);
-        }
-    }
-  }
+  draw->PushClipRect(at.origin, ImVec2(at.origin.x + at.size.x, at.origin.y + at.size.y), true);
+  if (board_case && pair->camera)
+    DrawSheetOutline(draw, *s.dataset, pair->camera->cam_from_board, at);
+  if (estimate) DrawScanInImage(draw, *s.dataset, *pair, *estimate, at);
   draw->PopClipRect();
-  if (hovered) {
-    const ImGuiIO& io = ImGui::GetIO();
-    if (io.MouseWheel != 0) {
-      // Zoom about the pixel under the mouse.
-      const float mx = u0 + (io.MousePos.x - origin.x) / tw * span;
-      const float my = v0 + (io.MousePos.y - origin.y) / th * span;
-      image_zoom_ = std::clamp(image_zoom_ * std::pow(1.25f, io.MouseWheel), 1.0f, 32.0f);
-      const float new_span = 1.0f / image_zoom_;
-      image_center_x_ = mx - (io.MousePos.x - origin.x) / tw * new_span + new_span / 2;
-      image_center_y_ = my - (io.MousePos.y - origin.y) / th * new_span + new_span / 2;
-    }
-    if (ImGui::IsMouseDragging(ImGuiMouseButton_Right)) {
-      image_center_x_ -= io.MouseDelta.x / tw * span;
-      image_center_y_ -= io.MouseDelta.y / th * span;
-    }
-  }
+  if (hovered) image_.HandleMouse(at);
   ImGui::End();
+}
+
+void LrfWorkbench::UploadPicture(const LrfSnapshot& s, const LrfPairFeatures& pair,
+                                 const void* source) {
+  if (reinterpret_cast<std::uintptr_t>(source) == image_key_) return;
+  image_key_ = reinterpret_cast<std::uintptr_t>(source);
+  if (source == s.selected_image.get())
+    gl_->picture.Upload(*s.selected_image, true);
+  else
+    gl_->picture.Upload(ComposeDepthPicture(*pair.depth, pair.three_face->depth), false);
+}
+
+void LrfWorkbench::UploadDepthCloud(const LrfPairFeatures& pair) {
+  if (gl_->cloud_source == &pair) return;
+  gl_->cloud_source = &pair;
+  DepthCloud cloud = BackProject(pair);
+  gl_->cloud_points.Upload(cloud.positions, cloud.colors);
+  // Orbit about the target's faces, else the board, else the whole cloud.
+  if (cloud.face_count)
+    gl_->scene_center = cloud.face_sum / cloud.face_count;
+  else if (pair.camera)
+    gl_->scene_center = pair.camera->cam_from_board.translation();
+  else if (!cloud.positions.empty())
+    gl_->scene_center = cloud.all_sum / static_cast<double>(cloud.positions.size());
+  // The grid goes on the floor: a high percentile of the heights (y down).
+  std::vector<double>& heights = cloud.heights;
+  if (!heights.empty()) {
+    std::nth_element(heights.begin(), heights.begin() + heights.size() * 49 / 50, heights.end());
+    gl_->floor_y = heights[heights.size() * 49 / 50];
+  } else {
+    gl_->floor_y = gl_->scene_center.y() + 1.0;
+  }
 }
 
 void LrfWorkbench::DrawScene(const LrfSnapshot& s, const LrfPairFeatures& pair,
                              const gfx::Matrix4f& view_projection, const Pose* estimate, int tw,
                              int th) {
-  std::vector<Eigen::Vector3f> lines;
-  std::vector<gfx::Rgba> line_colors;
-  auto add_line = [&](const Vec3& a, const Vec3& b, gfx::Rgba c) {
-    lines.push_back(a.cast<float>());
-    lines.push_back(b.cast<float>());
-    line_colors.push_back(c);
-    line_colors.push_back(c);
-  };
+  gfx::LineBatch lines;
   // A 0.5 m grid on the floor (camera y points down), around and behind the target.
   const Vec3& c = gl_->scene_center;
   const double x0 = std::round(c.x()) - 4, z1 = std::ceil(c.z()) + 3, y = gl_->floor_y;
   const gfx::Rgba grid{62, 62, 70, 255};
-  for (int k = 0; k <= 16; ++k) add_line({x0 + 0.5 * k, y, 0}, {x0 + 0.5 * k, y, z1}, grid);
-  for (int k = 0; k <= 2 * z1; ++k) add_line({x0, y, 0.5 * k}, {x0 + 8, y, 0.5 * k}, grid);
-  auto add_axes = [&](const Pose& cam_from_frame, double length) {
-    const gfx::Rgba colors[3] = {{255, 60, 60, 255}, {60, 230, 60, 255}, {80, 120, 255, 255}};
-    for (int a = 0; a < 3; ++a)
-      add_line(cam_from_frame.translation(), cam_from_frame * (Vec3::Unit(a) * length), colors[a]);
-  };
-  add_axes(Pose::Identity(), 0.3);         // the camera
-  if (estimate) add_axes(*estimate, 0.3);  // the LRF at the estimate
-  std::vector<Eigen::Vector3f> quad;
-  std::vector<gfx::Rgba> quad_colors;
-  if (pair.camera) {
-    const double hw = s.dataset->board.SheetWidth() / 2, hh = s.dataset->board.SheetHeight() / 2;
-    const Vec3 corners[4] = {{-hw, -hh, 0}, {hw, -hh, 0}, {hw, hh, 0}, {-hw, hh, 0}};
-    for (int k : {0, 1, 2, 0, 2, 3}) {
-      quad.push_back((pair.camera->cam_from_board * corners[k]).cast<float>());
-      quad_colors.push_back({255, 150, 40, 110});
-    }
-  }
+  for (int k = 0; k <= 16; ++k) lines.Add({x0 + 0.5 * k, y, 0}, {x0 + 0.5 * k, y, z1}, grid);
+  for (int k = 0; k <= 2 * z1; ++k) lines.Add({x0, y, 0.5 * k}, {x0 + 8, y, 0.5 * k}, grid);
+  lines.AddAxes(Pose::Identity(), 0.3);         // the camera
+  if (estimate) lines.AddAxes(*estimate, 0.3);  // the LRF at the estimate
+  gfx::TriangleBatch board;
+  if (pair.camera)
+    board.AddRectangle(pair.camera->cam_from_board, s.dataset->board.SheetWidth(),
+                       s.dataset->board.SheetHeight(), {255, 150, 40, 110});
   std::vector<Eigen::Vector3f> scan;
   if (estimate)
     for (size_t i = 0; i < pair.scan.ranges.size(); ++i)
       if (pair.scan.Valid(i) && pair.scan.ranges[i] < 15.0)
         scan.push_back((*estimate * OnScanPlane(pair.scan.Point(i))).cast<float>());
   gl_->scene_target.Resize(tw, th);
-  gl_->scene_target.Bind();
   gl_->scene_target.Clear(0.08f, 0.08f, 0.1f, 1.0f);
-  gl_->scene_lines.Upload(lines, line_colors);
+  gl_->scene_lines.Upload(lines.vertices, lines.colors);
   gl_->scene_lines.Draw(view_projection);
   gl_->cloud_points.Draw(view_projection, 2.0f);
   gl_->scan_points.Upload(scan, std::vector<gfx::Rgba>(scan.size(), gfx::Rgba{255, 225, 40, 255}));
   gl_->scan_points.Draw(view_projection, 4.0f);
-  gl_->scene_board.Upload(quad, quad_colors);
+  gl_->scene_board.Upload(board.vertices, board.colors);
   gl_->scene_board.Draw(view_projection);
 }
 
-void LrfWorkbench::SceneView(const LrfSnapshot& s, const ViewRect& r) {
-  if (!BeginView("3D (camera frame)", r.x, r.y, r.w, r.h)) return ImGui::End();
-  const LrfPairFeatures* pair = SelectedFeatures(s);
-  if (!pair) {
-    Waiting(s);
-    return ImGui::End();
-  }
+void LrfWorkbench::SceneView(const LrfSnapshot& s, const Rect& r) {
+  const LrfPairFeatures* pair = BeginPairView("3D (camera frame)", s, r);
+  if (!pair) return ImGui::End();
   const Pose* estimate = DisplayedEstimate(s);
   ImGui::TextDisabled(estimate ? "cloud by face; yellow: the scan at the estimate. drag: orbit, "
                                  "wheel: zoom"
                                : "cloud by face; run the solver to move the scan in. drag: orbit");
-  if (gl_->cloud_source != pair) {
-    // The depth frame back-projected (every stride-th pixel, at most ~40k points).
-    gl_->cloud_source = pair;
-    std::vector<Eigen::Vector3f> positions;
-    std::vector<gfx::Rgba> colors;
-    Vec3 face_sum = Vec3::Zero(), all_sum = Vec3::Zero();
-    int face_count = 0;
-    std::vector<double> heights;
-    if (pair->depth) {
-      const DepthImage& depth = *pair->depth;
-      const DepthIntrinsics& k = depth.intrinsics;
-      const auto* faces =
-          pair->three_face && pair->three_face->depth.face_of_pixel.size() == depth.depth_m.size()
-              ? &pair->three_face->depth.face_of_pixel
-              : nullptr;
-      const int stride =
-          std::max(1, static_cast<int>(std::ceil(std::sqrt(k.width * k.height / 40000.0))));
-      for (int v = 0; v < k.height; v += stride)
-        for (int u = 0; u < k.width; u += stride) {
-          const double z = depth.At(u, v);
-          if (z <= 0) continue;
-          const Vec3 x((u - k.cx) / k.fx * z, (v - k.cy) / k.fy * z, z);
-          const int face = faces ? (*faces)[static_cast<size_t>(v) * k.width + u] : -1;
-          positions.push_back(x.cast<float>());
-          all_sum += x;
-          heights.push_back(x.y());
-          if (face >= 0 && face < 3) {
-            colors.push_back({kFaceRgb[face][0], kFaceRgb[face][1], kFaceRgb[face][2], 255});
-            face_sum += x;
-            ++face_count;
-          } else {
-            const auto g = static_cast<std::uint8_t>(std::clamp(190.0 - 15.0 * z, 90.0, 190.0));
-            colors.push_back({g, g, g, 255});
-          }
-        }
-    }
-    gl_->cloud_points.Upload(positions, colors);
-    if (face_count)
-      gl_->scene_center = face_sum / face_count;
-    else if (pair->camera)
-      gl_->scene_center = pair->camera->cam_from_board.translation();
-    else if (!positions.empty())
-      gl_->scene_center = all_sum / static_cast<double>(positions.size());
-    if (!heights.empty()) {
-      std::nth_element(heights.begin(), heights.begin() + heights.size() * 49 / 50, heights.end());
-      gl_->floor_y = heights[heights.size() * 49 / 50];
-    } else {
-      gl_->floor_y = gl_->scene_center.y() + 1.0;
-    }
-  }
+  UploadDepthCloud(*pair);
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const int tw = std::max(1, static_cast<int>(avail.x)),
             th = std::max(1, static_cast<int>(avail.y));
   // Orbit about a point between the camera and the target, so that both stay in view.
-  const Eigen::Vector3f target = (0.65 * gl_->scene_center).cast<float>();
-  const float distance =
-      orbit_distance_scale_ * std::max(0.5f, static_cast<float>(gl_->scene_center.norm()));
-  const Eigen::Vector3f forward(std::cos(orbit_pitch_rad_) * std::sin(orbit_yaw_rad_),
-                                std::sin(orbit_pitch_rad_),
-                                std::cos(orbit_pitch_rad_) * std::cos(orbit_yaw_rad_));
+  const Vec3& center = gl_->scene_center;
   const gfx::Matrix4f view_projection =
-      gfx::Perspective(0.9f, static_cast<float>(tw) / th, 0.05f, 200.0f) *
-      gfx::LookAt(target - distance * forward, target, -Eigen::Vector3f::UnitY());
+      orbit_.ViewProjection((0.65 * center).cast<float>(),
+                            orbit_.distance * std::max(0.5f, static_cast<float>(center.norm())),
+                            static_cast<float>(tw) / th, 200.0f, WorldUp::kYDown);
   // Redraw only when something shown changed: the pair, the view or the estimate.
-  std::uint64_t key = reinterpret_cast<std::uintptr_t>(pair) ^ 0xcbf29ce484222325ull;
-  auto mix = [&key](const void* data, size_t bytes) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < bytes; ++i) key = (key ^ p[i]) * 0x100000001b3ull;
-  };
-  mix(view_projection.data(), sizeof(float) * 16);
-  if (estimate) mix(estimate->matrix().data(), sizeof(double) * 16);
-  if (key != scene_key_ || gl_->scene_target.width() != tw || gl_->scene_target.height() != th) {
-    scene_key_ = key;
+  FrameKey key(reinterpret_cast<std::uintptr_t>(pair));
+  key.Mix(view_projection.data(), sizeof(float) * 16);
+  if (estimate) key.Mix(estimate->matrix().data(), sizeof(double) * 16);
+  if (key.value() != scene_key_ || gl_->scene_target.width() != tw ||
+      gl_->scene_target.height() != th) {
+    scene_key_ = key.value();
     DrawScene(s, *pair, view_projection, estimate, tw, th);
   }
   const ImVec2 origin = ImGui::GetCursorScreenPos();
-  ImGui::Image(TextureId(gl_->scene_target.color_texture()), ImVec2(tw, th), ImVec2(0, 1),
-               ImVec2(1, 0));
+  FramebufferImage(gl_->scene_target, ImVec2(tw, th));
   // Frame names next to their axes.
-  auto label = [&](const Vec3& x, const char* text) {
-    const Eigen::Vector4f clip = view_projection * Eigen::Vector4f(x.x(), x.y(), x.z(), 1.0f);
-    if (clip.w() <= 0) return;
-    const float u = (clip.x() / clip.w() + 1) / 2, v = (1 - clip.y() / clip.w()) / 2;
-    if (u < 0 || u > 1 || v < 0 || v > 1) return;
-    ImGui::GetWindowDrawList()->AddText({origin.x + u * tw + 4, origin.y + v * th + 2},
-                                        IM_COL32(220, 220, 220, 255), text);
-  };
-  label(Vec3::Zero(), "camera");
-  if (estimate) label(estimate->translation(), "LRF");
-  if (ImGui::IsItemHovered()) {
-    const ImGuiIO& io = ImGui::GetIO();
-    if (ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
-      orbit_yaw_rad_ += io.MouseDelta.x * 0.01f;
-      orbit_pitch_rad_ = std::clamp(orbit_pitch_rad_ + io.MouseDelta.y * 0.01f, -1.5f, 1.5f);
-    }
-    if (io.MouseWheel != 0)
-      orbit_distance_scale_ =
-          std::clamp(orbit_distance_scale_ * std::pow(0.85f, io.MouseWheel), 0.2f, 20.0f);
-  }
+  LabelAt(view_projection, origin, ImVec2(tw, th), Vec3::Zero(), "camera");
+  if (estimate) LabelAt(view_projection, origin, ImVec2(tw, th), estimate->translation(), "LRF");
+  if (ImGui::IsItemHovered()) orbit_.HandleMouse(/*drag_turns_right=*/true, 0.2f, 20.0f);
   ImGui::End();
 }
 
-namespace {
-
-ImVec4 StatusColor(PairStatus status) {
-  switch (status) {
-    case PairStatus::kAccepted:
-      return {0.45f, 0.85f, 0.45f, 1};
-    case PairStatus::kRejected:
-      return {0.95f, 0.65f, 0.3f, 1};
-    case PairStatus::kFailed:
-      return {1.0f, 0.4f, 0.35f, 1};
-    case PairStatus::kPending:
-      return {0.7f, 0.7f, 0.7f, 1};
-  }
-  return {1, 1, 1, 1};
-}
-
-void TextMm(const std::optional<double>& metres) {
-  if (metres) ImGui::Text("%.1f", *metres * 1e3);
-}
-
-}  // namespace
-
-void LrfWorkbench::MeasurementsPanel(const LrfSnapshot& s, const ViewRect& r,
+void LrfWorkbench::MeasurementsPanel(const LrfSnapshot& s, const Rect& r,
                                      std::vector<LrfIntent>* intents) {
-  ImGui::SetNextWindowPos({r.x, r.y});
-  ImGui::SetNextWindowSize({r.w, r.h});
-  if (!ImGui::Begin("Measurements", nullptr, kPanelFlags)) return ImGui::End();
-  if (s.extracted_done < s.extracted_total) {
-    char label[64];
-    std::snprintf(label, sizeof(label), "extracting %d / %d pairs", s.extracted_done,
-                  s.extracted_total);
-    ImGui::ProgressBar(static_cast<float>(s.extracted_done) / std::max(1, s.extracted_total),
-                       {-1, 0}, label);
-  }
-  ImGui::BeginDisabled(s.selected < 0);
-  if (ImGui::Button("Accept (A)"))
-    Emit<LrfSetPairStatus>(intents, s.selected, PairStatus::kAccepted);
-  ImGui::SameLine();
-  if (ImGui::Button("Reject (R)"))
-    Emit<LrfSetPairStatus>(intents, s.selected, PairStatus::kRejected);
-  ImGui::EndDisabled();
-  ImGui::SameLine();
-  ImGui::TextDisabled("arrows: previous / next; figures in mm");
+  if (!BeginPanel("Measurements", r)) return ImGui::End();
+  PairProgress("extracting", s.extracted_done, s.extracted_total);
+  if (const auto status = ReviewButtons(s.selected >= 0, "arrows: previous / next; figures in mm"))
+    Emit<LrfSetPairStatus>(intents, s.selected, *status);
   const bool board_case = s.dataset && s.dataset->target_type == LrfTargetType::kCheckerboard;
-  if (ImGui::BeginTable(
-          "pairs", 7,
-          ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_BordersInnerV,
-          ImVec2(0, ImGui::GetContentRegionAvail().y))) {
-    ImGui::TableSetupScrollFreeze(0, 1);
-    ImGui::TableSetupColumn("pair", ImGuiTableColumnFlags_WidthFixed, 60);
-    ImGui::TableSetupColumn("status", ImGuiTableColumnFlags_WidthFixed, 70);
-    ImGui::TableSetupColumn("scan", ImGuiTableColumnFlags_WidthFixed, 45);
-    ImGui::TableSetupColumn(board_case ? "PnP px" : "depth", ImGuiTableColumnFlags_WidthFixed, 50);
-    ImGui::TableSetupColumn("Eq.12", ImGuiTableColumnFlags_WidthFixed, 50);
-    ImGui::TableSetupColumn("plane", ImGuiTableColumnFlags_WidthFixed, 45);
-    ImGui::TableSetupColumn("details", ImGuiTableColumnFlags_WidthStretch);
-    ImGui::TableHeadersRow();
-    for (int i = 0; i < static_cast<int>(s.pairs.size()); ++i) {
-      const LrfPairView& pair = s.pairs[i];
-      const LrfPairFeatures* f = pair.features.get();
-      ImGui::TableNextRow();
-      ImGui::TableNextColumn();
-      ImGui::PushID(i);
-      if (ImGui::Selectable(
-              pair.id.c_str(), i == s.selected,
-              ImGuiSelectableFlags_SpanAllColumns | ImGuiSelectableFlags_AllowItemOverlap))
-        Emit<LrfSelectPair>(intents, i);
-      ImGui::PopID();
-      ImGui::TableNextColumn();
-      ImGui::TextColored(StatusColor(pair.status), "%s",
-                         pair.extracted ? PairStatusName(pair.status).c_str() : "extracting");
-      ImGui::TableNextColumn();
-      if (f && f->three_face && f->three_face->scan.ok) TextMm(f->three_face->scan.rms_m);
-      if (f && f->board_scan && f->board_scan->ok) TextMm(f->board_scan->rms_m);
-      ImGui::TableNextColumn();
-      if (f && f->three_face && f->three_face->depth.ok) TextMm(f->three_face->depth.rms_m);
-      if (f && f->camera) ImGui::Text("%.2f", f->camera->reprojection_rms_px);
-      ImGui::TableNextColumn();
-      TextMm(pair.point_to_line_m);
-      ImGui::TableNextColumn();
-      TextMm(pair.point_to_plane_rms_m);
-      ImGui::TableNextColumn();
-      if (!pair.reason.empty())
-        ImGui::TextWrapped("%s", pair.reason.c_str());
-      else if (f && f->three_face)
-        ImGui::TextDisabled(
-            "%zu scan points, faces %d / %d / %d px", f->three_face->scan.target_indices.size(),
-            f->three_face->depth.inlier_counts[0], f->three_face->depth.inlier_counts[1],
-            f->three_face->depth.inlier_counts[2]);
-      else if (f && f->board_scan && f->camera)
-        ImGui::TextDisabled("%zu board points, %d corners", f->board_scan->points.size(),
-                            f->camera->num_corners);
-    }
+  if (BeginPairsTable({{"pair", 60},
+                       {"status", 70},
+                       {"scan", 45},
+                       {board_case ? "PnP px" : "depth", 50},
+                       {"Eq.12", 50},
+                       {"plane", 45},
+                       {"details"}})) {
+    for (int i = 0; i < static_cast<int>(s.pairs.size()); ++i) PairRow(s, i, intents);
     ImGui::EndTable();
   }
   ImGui::End();
 }
 
-void LrfWorkbench::SolverPanel(const LrfSnapshot& s, const ViewRect& r,
+void LrfWorkbench::SolverPanel(const LrfSnapshot& s, const Rect& r,
                                std::vector<LrfIntent>* intents) {
-  ImGui::SetNextWindowPos({r.x, r.y});
-  ImGui::SetNextWindowSize({r.w, r.h});
-  if (!ImGui::Begin("Solver", nullptr, kPanelFlags)) return ImGui::End();
+  if (!BeginPanel("Solver", r)) return ImGui::End();
   static const char* kMethods[] = {"paper-linear (Eq. 9-11)", "refined (point-to-plane GN)"};
   int method = s.solver.method == LrfMethod::kPaperLinear ? 0 : 1;
   ImGui::SetNextItemWidth(230);
   if (ImGui::Combo("method", &method, kMethods, 2))
     Emit<LrfSetMethod>(intents, method == 0 ? LrfMethod::kPaperLinear : LrfMethod::kRefined);
-  const bool solved = !s.solver.iterations.empty();
-  ImGui::BeginDisabled(s.solver.running);
-  if (ImGui::Button("Run (F5)")) {
-    Emit<LrfRunSolver>(intents);
-    replay_position_ = -1;
-    replaying_ = false;
-  }
-  ImGui::SameLine();
-  if (ImGui::Button("Step")) {
-    if (!solved) {
-      Emit<LrfRunSolver>(intents);
-      replay_position_ = 0;
-    } else {
-      replay_position_ = replay_position_ < 0 ? 0 : replay_position_ + 1;
-      if (replay_position_ >= static_cast<double>(s.solver.iterations.size()) - 1)
-        replay_position_ = -1;
-    }
-    replaying_ = false;
-  }
-  ImGui::SameLine();
-  if (ImGui::Button("Replay") && solved) {
-    replay_position_ = 0;
-    replaying_ = true;
-  }
-  ImGui::SameLine();
-  if (ImGui::Button("Reset")) {
-    Emit<LrfResetSolver>(intents);
-    replay_position_ = -1;
-  }
-  ImGui::EndDisabled();
+  const SolverReplay::Request request =
+      replay().Buttons(s.solver.iterations.size(), s.solver.running);
+  if (request.run) Emit<LrfRunSolver>(intents);
+  if (request.reset) Emit<LrfResetSolver>(intents);
   if (s.solver.running) {
     ImGui::SameLine();
     ImGui::TextColored({0.95f, 0.8f, 0.3f, 1}, "solving ...");
   }
-  if (solved) {
-    std::vector<float> log_cost;
-    for (const IterationReport& it : s.solver.iterations)
-      log_cost.push_back(static_cast<float>(std::log10(std::max(it.cost, 1e-30))));
-    const int shown = replay_position_ < 0 ? static_cast<int>(log_cost.size()) - 1
-                                           : static_cast<int>(replay_position_);
-    char overlay[96];
-    std::snprintf(overlay, sizeof(overlay), "log10 cost; iteration %d of %zu: %.4e", shown,
-                  log_cost.size() - 1, s.solver.iterations[shown].cost);
-    ImGui::PlotLines("##cost", log_cost.data(), static_cast<int>(log_cost.size()), 0, overlay,
-                     FLT_MAX, FLT_MAX, ImVec2(r.w * 0.55f, 60));
-  } else if (s.solver.solution) {
+  if (!s.solver.iterations.empty())
+    replay().CostPlot(s.solver.iterations, ImVec2(r.w * 0.55f, 60));
+  else if (s.solver.solution)
     ImGui::TextDisabled("closed form (Eq. 11): no iterations to replay");
-  }
   if (!s.solver.failure.empty())
     ImGui::TextColored({1.0f, 0.4f, 0.35f, 1}, "%s", s.solver.failure.c_str());
-  if (s.solver.solution) {
-    const LrfSolution& solution = *s.solver.solution;
-    const Pose& pose = solution.cam_from_lrf;
-    ImGui::Text("cam_from_lrf");
-    ImGui::SameLine();
-    ImGui::TextDisabled("(x_cam = cam_from_lrf * x_lrf)");
-    for (int row = 0; row < 3; ++row)
-      ImGui::Text("  % .5f % .5f % .5f | % .4f", pose.matrix()(row, 0), pose.matrix()(row, 1),
-                  pose.matrix()(row, 2), pose.matrix()(row, 3));
-    const Vec3& st = s.solver.std_translation_mm;
-    const Vec3& sr = s.solver.std_rotation_deg;
-    ImGui::Text("std (camera x/y/z): %.1f %.1f %.1f mm, %.3f %.3f %.3f deg", st.x(), st.y(), st.z(),
-                sr.x(), sr.y(), sr.z());
-    ImGui::Text(
-        "%s over %zu pairs",
-        LrfResidualText(solution, s.dataset ? s.dataset->target_type : LrfTargetType::kThreeFace)
-            .c_str(),
-        s.solver.solved_pair_ids.size());
-    if (s.dataset && s.dataset->cam_from_lrf_ground_truth) {
-      const Pose& truth = *s.dataset->cam_from_lrf_ground_truth;
-      ImGui::TextDisabled("vs ground truth: %.1f mm, %.3f deg",
-                          (pose.translation() - truth.translation()).norm() * 1e3,
-                          RotationAngle(pose.linear(), truth.linear()) * 180.0 / M_PI);
-    }
-    if (solution.observability.well_constrained) {
-      ImGui::TextColored({0.45f, 0.85f, 0.45f, 1}, "well constrained (%s, %d iterations%s)",
-                         LrfMethodName(solution.method).c_str(), solution.iterations,
-                         solution.method == LrfMethod::kRefined
-                             ? (solution.converged ? ", converged" : ", not converged")
-                             : "");
-    } else {
-      ImGui::TextColored({1.0f, 0.45f, 0.3f, 1},
-                         "NOT well constrained: add observations with other target poses");
-      for (const std::string& d : solution.observability.weak_directions)
-        ImGui::TextColored({1.0f, 0.6f, 0.4f, 1}, "  weak: %s", d.c_str());
-    }
-    char path[512];
-    std::snprintf(path, sizeof(path), "%s", export_path_.c_str());
-    ImGui::SetNextItemWidth(220);
-    if (ImGui::InputText("##export", path, sizeof(path))) export_path_ = path;
-    ImGui::SameLine();
-    if (ImGui::Button("Export result")) Emit<LrfExportResult>(intents, export_path_);
-  }
+  if (s.solver.solution) SolutionReadouts(s, intents);
   ImGui::End();
 }
 
-void LrfWorkbench::StatusLine(const LrfSnapshot& s, const ViewRect& r) {
-  ImGui::SetNextWindowPos({r.x, r.y});
-  ImGui::SetNextWindowSize({r.w, r.h});
-  ImGui::Begin("##status", nullptr,
-               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
-                   ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus);
-  if (s.busy) {
-    ImGui::TextColored({0.95f, 0.8f, 0.3f, 1}, "working");
-    ImGui::SameLine();
+void LrfWorkbench::SolutionReadouts(const LrfSnapshot& s, std::vector<LrfIntent>* intents) {
+  const LrfSolution& solution = *s.solver.solution;
+  const Pose& pose = solution.cam_from_lrf;
+  PoseReadout("cam_from_lrf", "x_cam = cam_from_lrf * x_lrf", pose);
+  StdReadout(s.solver.std_translation_mm, s.solver.std_rotation_deg);
+  ImGui::Text(
+      "%s over %zu pairs",
+      LrfResidualText(solution, s.dataset ? s.dataset->target_type : LrfTargetType::kThreeFace)
+          .c_str(),
+      s.solver.solved_pair_ids.size());
+  if (s.dataset && s.dataset->cam_from_lrf_ground_truth) {
+    const Pose& truth = *s.dataset->cam_from_lrf_ground_truth;
+    ImGui::TextDisabled("vs ground truth: %.1f mm, %.3f deg",
+                        (pose.translation() - truth.translation()).norm() * 1e3,
+                        RotationAngle(pose.linear(), truth.linear()) * 180.0 / M_PI);
   }
-  if (s.status_is_error)
-    ImGui::TextColored({1.0f, 0.4f, 0.35f, 1}, "%s", s.status_line.c_str());
-  else
-    ImGui::TextUnformatted(s.status_line.c_str());
-  ImGui::SameLine(std::max(ImGui::GetCursorPosX() + 20, r.w - 420));
-  ImGui::TextDisabled("dataset: %s", s.manifest.filename().string().c_str());
-  ImGui::End();
+  const char* convergence = solution.method != LrfMethod::kRefined ? ""
+                            : solution.converged                   ? ", converged"
+                                                                   : ", not converged";
+  ObservabilityReadout(solution.observability,
+                       LrfMethodName(solution.method) + ", " + std::to_string(solution.iterations) +
+                           " iterations" + convergence,
+                       "NOT well constrained: add observations with other target poses");
+  if (PathField("##export", &export_path_, "Export result"))
+    Emit<LrfExportResult>(intents, export_path_);
 }
-
-// Dear ImGui 1.86 keys are the platform backend's codes: GLFW uses ASCII for letters, and the
-// headless host maps the same codes (as in workbench.cpp).
-namespace {
-constexpr int kKeyF5 = 294;  // GLFW_KEY_F5
-bool KeyPressed(int key) { return key >= 0 && ImGui::IsKeyPressed(key, false); }
-bool NamedKeyPressed(ImGuiKey key) { return KeyPressed(ImGui::GetKeyIndex(key)); }
-}  // namespace
 
 void LrfWorkbench::HandleKeys(const LrfSnapshot& s, std::vector<LrfIntent>* intents) {
   if (ImGui::GetIO().WantTextInput || s.selected < 0) return;
   const int n = static_cast<int>(s.pairs.size());
-  const bool ctrl = ImGui::GetIO().KeyCtrl;
-  if (!ctrl && KeyPressed('A')) Emit<LrfSetPairStatus>(intents, s.selected, PairStatus::kAccepted);
-  if (!ctrl && KeyPressed('R')) Emit<LrfSetPairStatus>(intents, s.selected, PairStatus::kRejected);
-  if (NamedKeyPressed(ImGuiKey_DownArrow) || NamedKeyPressed(ImGuiKey_RightArrow))
-    Emit<LrfSelectPair>(intents, std::min(n - 1, s.selected + 1));
-  if (NamedKeyPressed(ImGuiKey_UpArrow) || NamedKeyPressed(ImGuiKey_LeftArrow))
-    Emit<LrfSelectPair>(intents, std::max(0, s.selected - 1));
-  if (NamedKeyPressed(ImGuiKey_Enter) || KeyPressed(kKeyF5)) Emit<LrfRunSolver>(intents);
+  const ReviewKeys keys = ReadReviewKeys();
+  if (keys.accept) Emit<LrfSetPairStatus>(intents, s.selected, PairStatus::kAccepted);
+  if (keys.reject) Emit<LrfSetPairStatus>(intents, s.selected, PairStatus::kRejected);
+  if (keys.next) Emit<LrfSelectPair>(intents, std::min(n - 1, s.selected + 1));
+  if (keys.previous) Emit<LrfSelectPair>(intents, std::max(0, s.selected - 1));
+  if (keys.run) Emit<LrfRunSolver>(intents);
 }
 
 }  // namespace calibench::ui

@@ -78,17 +78,21 @@ void ImGuiHost::Render() {
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 }
 
+void ImGuiHost::DrawFrame(gfx::Framebuffer& target, int width, int height, double delta_seconds,
+                          const std::function<void()>& build_frame) {
+  NewFrame(width, height, delta_seconds);
+  build_frame();
+  target.Resize(width, height);
+  target.Bind();
+  target.Clear(0.06f, 0.06f, 0.07f, 1.0f);
+  Render();
+}
+
 ImageU8 RenderFramesHeadless(ImGuiHost& host, int width, int height, int frames,
                              const std::function<void()>& build_frame) {
   gfx::Framebuffer target;
-  target.Resize(width, height);
-  for (int frame = 0; frame < frames; ++frame) {
-    host.NewFrame(width, height, 1.0 / 60.0);
-    build_frame();
-    target.Bind();
-    target.Clear(0.06f, 0.06f, 0.07f, 1.0f);
-    host.Render();
-  }
+  for (int frame = 0; frame < frames; ++frame)
+    host.DrawFrame(target, width, height, 1.0 / 60.0, build_frame);
   glFinish();
   return target.ReadPixels();
 }

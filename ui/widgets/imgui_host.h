@@ -1,15 +1,18 @@
 // Dear ImGui set-up shared by the window and the headless renderer: context, theme, font,
 // OpenGL3 backend (and the GLFW backend for a window). The headless host feeds display size, time
-// and input itself, so tests can drive the panels frame by frame without a window.
+// and input itself, so tests can drive the panels frame by frame without a window
+// (RenderWorkbenchHeadless below; headless_render.h prepares what such a render shows).
 #pragma once
 
 #include <functional>
-#include <memory>
-#include <string>
 
 #include "core/base/image.h"
 
 struct GLFWwindow;
+
+namespace calibench::gfx {
+class Framebuffer;
+}
 
 namespace calibench::ui {
 
@@ -25,6 +28,10 @@ class ImGuiHost {
   void NewFrame(int width, int height, double delta_seconds);
   // Renders the frame's draw data into the currently bound framebuffer.
   void Render();
+  // One whole frame drawn into `target` (resized to width x height): NewFrame, build_frame()
+  // (the frame's ImGui calls), then the draw data over the workbench's background.
+  void DrawFrame(gfx::Framebuffer& target, int width, int height, double delta_seconds,
+                 const std::function<void()>& build_frame);
 
  private:
   bool windowed_ = false;

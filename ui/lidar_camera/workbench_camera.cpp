@@ -1,0 +1,184 @@
+// The camera view of the workbench: the camera frame (raw or undistorted) with the detected
+// corners, the board's outline and axes, and after a solve the LiDAR points projected into it.
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/lidar/colormap.h"
+#include "ui/lidar_camera/workbench.h"
+#include "ui/lidar_camera/workbench_gl.h"
+
+namespace calibench::ui {
+namespace {
+
+// What the camera framebuffer depends on.
+std::uint64_t CameraTargetKey(const CameraShown& shown, const Reprojection* points,
+                              const ViewState& view, std::uint64_t zoom_key) {
+  return reinterpret_cast<std::uintptr_t>(shown.image) ^
+         (points ? reinterpret_cast<std::uintptr_t>(points) << 1 : 0) ^
+         (static_cast<std::uint64_t>(shown.at.size.x) << 48) ^
+         (static_cast<std::uint64_t>(shown.at.size.y) << 36) ^
+         static_cast<std::uint64_t>(view.point_size_px * 1000) * 7919 ^
+         static_cast<std::uint64_t>(view.point_opacity * 1000) * 104729 ^ zoom_key;
+}
+
+// The visible LiDAR points of the reprojection at the solution, coloured by depth, into `points`.
+void UploadReprojection(const Snapshot& s, const PairView& pair, const CameraShown& shown,
+                        gfx::PointRenderer* points) {
+  std::vector<Eigen::Vector3f> positions;
+  std::vector<gfx::Rgba> colors;
+  const Reprojection& rp = *s.reprojection;
+  const Pose& cam_from_lidar = s.solver.result->cam_from_lidar;
+  for (size_t i = 0; i < rp.points.size(); ++i) {
+    if (!rp.visible.empty() && !rp.visible[i]) continue;
+    std::optional<Vec2> px = rp.points[i].pixel;
+    if (shown.undistorted)
+      px = shown.model->Project(cam_from_lidar *
+                                pair.cloud->points[rp.points[i].index].cast<double>());
+    if (!px) continue;
+    positions.push_back(shown.at.ToNdc(*px));
+    colors.push_back(ToRgba(MapColor(Colormap::kTurbo, rp.points[i].depth_m / 20.0)));
+  }
+  points->Upload(positions, colors);
+}
+
+// The sheet's outline (edges subdivided: lenses bend them) and the board's axes.
+void DrawBoard(ImDrawList* draw, const BoardSpec& board, const Pose& cam_from_board,
+               const CameraShown& shown) {
+  const double hw = board.SheetWidth() / 2, hh = board.SheetHeight() / 2;
+  const Vec3 corners[4] = {{-hw, -hh, 0}, {hw, -hh, 0}, {hw, hh, 0}, {-hw, hh, 0}};
+  std::vector<ImVec2> outline;
+  for (int e = 0; e < 4; ++e)
+    for (int k = 0; k < 16; ++k) {
+      const Vec3 p = corners[e] + (corners[(e + 1) % 4] - corners[e]) * (k / 16.0);
+      if (const auto px = shown.model->Project(cam_from_board * p))
+        outline.push_back(shown.at.ToScreen(*px));
+    }
+  if (outline.size() > 2)
+    draw->AddPolyline(outline.data(), static_cast<int>(outline.size()), IM_COL32(80, 200, 255, 255),
+                      ImDrawFlags_Closed, 2.0f);
+  const double axis = 0.5 * std::min(hw, hh);
+  const auto o = shown.model->Project(cam_from_board * Vec3::Zero());
+  const ImU32 axis_colors[3] = {IM_COL32(255, 60, 60, 255), IM_COL32(60, 255, 60, 255),
+                                IM_COL32(80, 120, 255, 255)};
+  for (int a = 0; a < 3 && o; ++a) {
+    const Vec3 tip = cam_from_board * (Vec3::Unit(a) * (a == 2 ? -axis : axis));
+    if (const auto px = shown.model->Project(tip))
+      draw->AddLine(shown.at.ToScreen(*o), shown.at.ToScreen(*px), axis_colors[a], 2.0f);
+  }
+}
+
+// Over the picture: the detected corners, the board or why there is none.
+void DrawCameraOverlays(const Snapshot& s, const PairView& pair, const CameraShown& shown) {
+  const ImVec2 origin = shown.at.origin;
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  draw->PushClipRect(origin, ImVec2(origin.x + shown.at.size.x, origin.y + shown.at.size.y), true);
+  if (pair.detection)
+    for (const Vec2& corner : pair.detection->pixels)
+      if (const auto px = shown.FromRaw(corner))
+        draw->AddCircle(shown.at.ToScreen(*px), 3.0f, IM_COL32(255, 220, 0, 255));
+  if (pair.camera)
+    DrawBoard(draw, s.dataset->target, pair.camera->cam_from_board, shown);
+  else
+    draw->AddText(ImVec2(origin.x + 12, origin.y + 12), IM_COL32(255, 90, 80, 255),
+                  ("board not found: " + pair.camera_failure).c_str());
+  draw->PopClipRect();
+}
+
+}  // namespace
+
+void Workbench::CameraView(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) {
+  if (!BeginView("Camera", r)) return ImGui::End();
+  const PairView* pair = s.selected >= 0 ? &s.pairs[s.selected] : nullptr;
+  if (!pair || !s.selected_image || !s.dataset) {
+    ImGui::TextDisabled("loading image ...");
+    return ImGui::End();
+  }
+  const ViewState view = CameraToolbar(s, *pair, intents);
+  CameraShown shown;
+  shown.undistorted =
+      s.view.camera_image == CameraImageMode::kUndistorted && s.selected_undistorted;
+  shown.image = shown.undistorted ? &s.selected_undistorted->image : s.selected_image.get();
+  shown.lens = &s.dataset->camera;
+  shown.model = shown.undistorted ? &s.selected_undistorted->pinhole : shown.lens;
+  shown.at = camera_image_.Place(shown.image->width, shown.image->height);
+  DrawCameraTarget(s, *pair, shown, view);
+  FramebufferImage(gl_->camera_target, shown.at.size);
+  const bool hovered = ImGui::IsItemHovered();
+  DrawCameraOverlays(s, *pair, shown);
+  if (hovered) {
+    camera_image_.HandleMouse(shown.at);
+    if (!s.solver.result)
+      ImGui::SetTooltip("run the solver to project the LiDAR points into this image");
+  }
+  ImGui::End();
+}
+
+// Image mode, visibility, point size and opacity (HPR radius); the board found in the image.
+ViewState Workbench::CameraToolbar(const Snapshot& s, const PairView& pair,
+                                   std::vector<Intent>* intents) {
+  ViewState view = s.view;
+  static const char* kModes[] = {"raw", "undistorted"};
+  int mode = static_cast<int>(view.camera_image);
+  ImGui::SetNextItemWidth(110);
+  if (ImGui::Combo("##mode", &mode, kModes, 2))
+    view.camera_image = static_cast<CameraImageMode>(mode);
+  static const char* kVisibility[] = {"hidden-point removal", "z-buffer", "no occlusion"};
+  int visibility = static_cast<int>(view.visibility);
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(150);
+  if (ImGui::Combo("##visibility", &visibility, kVisibility, 3))
+    view.visibility = static_cast<VisibilityMode>(visibility);
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(70);
+  float size = static_cast<float>(view.point_size_px),
+        opacity = static_cast<float>(view.point_opacity);
+  if (ImGui::SliderFloat("size", &size, 1.0f, 8.0f, "%.1f")) view.point_size_px = size;
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(70);
+  if (ImGui::SliderFloat("opacity", &opacity, 0.1f, 1.0f, "%.2f")) view.point_opacity = opacity;
+  if (view.visibility == VisibilityMode::kHpr) {
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(70);
+    float exponent = static_cast<float>(view.hpr_radius_exponent);
+    if (ImGui::SliderFloat("HPR 10^", &exponent, 1.0f, 4.0f, "%.1f"))
+      view.hpr_radius_exponent = exponent;
+  }
+  if (!(view == s.view)) intents->push_back(SetView{view});
+  if (pair.camera) {
+    ImGui::Text("board: %d corners, reprojection RMS %.2f px, %.2f m away",
+                pair.camera->num_corners, pair.camera->reprojection_rms_px,
+                pair.camera->plane.distance);
+  } else {
+    ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "board not found: %s", pair.camera_failure.c_str());
+  }
+  return view;
+}
+
+void Workbench::DrawCameraTarget(const Snapshot& s, const PairView& pair, const CameraShown& shown,
+                                 const ViewState& view) {
+  const bool show_points = s.reprojection && s.reprojection->pair_id == pair.id && s.solver.result;
+  const std::uint64_t key = CameraTargetKey(shown, show_points ? s.reprojection.get() : nullptr,
+                                            view, camera_image_.Key());
+  if (key == camera_key_) return;
+  camera_key_ = key;
+  if (gl_->camera_image_source != shown.image) {
+    gl_->camera_image.Upload(*shown.image, true);
+    gl_->camera_image_source = shown.image;
+  }
+  const int tw = static_cast<int>(shown.at.size.x), th = static_cast<int>(shown.at.size.y);
+  gl_->camera_target.Resize(tw, th);
+  gl_->camera_target.Bind();
+  gl_->camera_target.Clear(0.1f, 0.1f, 0.1f, 1.0f);
+  const Eigen::Vector3f top_left = shown.at.ToNdc({-0.5, -0.5});
+  const Eigen::Vector3f bottom_right =
+      shown.at.ToNdc({shown.image->width - 0.5, shown.image->height - 0.5});
+  gl_->camera_image.Draw(top_left.x(), bottom_right.y(), bottom_right.x(), top_left.y());
+  if (!show_points) return;
+  UploadReprojection(s, pair, shown, &gl_->camera_points);
+  gl_->camera_points.Draw(gfx::Matrix4f::Identity(), static_cast<float>(view.point_size_px),
+                          static_cast<float>(view.point_opacity));
+}
+
+}  // namespace calibench::ui

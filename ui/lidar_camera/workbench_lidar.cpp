@@ -1,0 +1,146 @@
+// The LiDAR view of the workbench: the LiDAR image (intensity, range or ring) with the brush that
+// marks the board, zoomed horizontally.
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/lidar/colormap.h"
+#include "ui/lidar_camera/workbench.h"
+#include "ui/lidar_camera/workbench_gl.h"
+
+namespace calibench::ui {
+namespace {
+
+// The LiDAR picture with the brush (white veil) and the plane inliers (magenta: no perceptual
+// colour map uses it) composed in.
+ImageU8 ComposeLidarPicture(const PairView& pair, LidarChannel channel) {
+  ImageU8 picture = RenderLidarImage(*pair.lidar_image, channel, Colormap::kTurbo);
+  auto blend = [&](int pixel, int r, int g, int b, float alpha) {
+    std::uint8_t* p = picture.data.data() + static_cast<size_t>(pixel) * picture.channels;
+    p[0] = static_cast<std::uint8_t>(p[0] * (1 - alpha) + b * alpha);
+    p[1] = static_cast<std::uint8_t>(p[1] * (1 - alpha) + g * alpha);
+    p[2] = static_cast<std::uint8_t>(p[2] * (1 - alpha) + r * alpha);
+  };
+  for (int pixel : pair.brush_pixels) blend(pixel, 255, 255, 255, 0.45f);
+  if (pair.lidar)
+    for (int i : pair.lidar->inliers)
+      if (pair.lidar_image->pixel_of_point[i] >= 0)
+        blend(pair.lidar_image->pixel_of_point[i], 255, 40, 220, 0.9f);
+  return picture;
+}
+
+// What the composed picture depends on.
+std::uint64_t LidarPictureKey(const PairView& pair, LidarChannel channel) {
+  return reinterpret_cast<std::uintptr_t>(pair.lidar_image.get()) ^
+         (pair.brush_pixels.size() * 2654435761ull) ^
+         ((pair.lidar ? pair.lidar->inliers.size() + 1 : 0) << 20) ^
+         (static_cast<std::uint64_t>(channel) << 40);
+}
+
+void DrawEllipse(ImDrawList* draw, ImVec2 centre, float rx, float ry, ImU32 color) {
+  constexpr int kSegments = 48;
+  ImVec2 points[kSegments];
+  for (int i = 0; i < kSegments; ++i) {
+    const float a = 2.0f * static_cast<float>(M_PI) * i / kSegments;
+    points[i] = ImVec2(centre.x + rx * std::cos(a), centre.y + ry * std::sin(a));
+  }
+  draw->AddPolyline(points, kSegments, color, ImDrawFlags_Closed, 1.5f);
+}
+
+}  // namespace
+
+void Workbench::LidarView(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) {
+  if (!BeginView("LiDAR image", r)) return ImGui::End();
+  const PairView* pair = s.selected >= 0 ? &s.pairs[s.selected] : nullptr;
+  if (!pair || !pair->lidar_image) {
+    ImGui::TextDisabled(s.loading_total ? "loading %d / %d pairs ..." : "no dataset open",
+                        s.loading_done, s.loading_total);
+    return ImGui::End();
+  }
+  LidarToolbar(s, *pair, intents);
+  const std::uint64_t key = LidarPictureKey(*pair, s.view.lidar_channel);
+  if (key != lidar_key_) {
+    gl_->lidar_picture.Upload(ComposeLidarPicture(*pair, s.view.lidar_channel), false);
+    lidar_key_ = key;
+  }
+  CenterLidarOnBrush(*pair);
+  LidarPicture(s, *pair, intents);
+  ImGui::End();
+}
+
+// Channel, brush radius, clear; the plane fitted to the brush.
+void Workbench::LidarToolbar(const Snapshot& s, const PairView& pair,
+                             std::vector<Intent>* intents) {
+  static const char* kChannels[] = {"intensity", "range", "ring"};
+  int channel = static_cast<int>(s.view.lidar_channel);
+  ImGui::SetNextItemWidth(110);
+  if (ImGui::Combo("##channel", &channel, kChannels, 3)) {
+    ViewState view = s.view;
+    view.lidar_channel = static_cast<LidarChannel>(channel);
+    intents->push_back(SetView{view});
+  }
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(110);
+  float radius = static_cast<float>(s.view.brush_radius_px);
+  if (ImGui::SliderFloat("brush [ ]", &radius, 1.0f, 60.0f, "%.0f px")) {
+    ViewState view = s.view;
+    view.brush_radius_px = radius;
+    intents->push_back(SetView{view});
+  }
+  ImGui::SameLine();
+  if (ImGui::SmallButton("clear")) intents->push_back(ClearBrush{s.selected});
+  if (pair.lidar) {
+    ImGui::Text("plane: %zu inliers of %d, RMS %.1f mm", pair.lidar->inliers.size(),
+                pair.lidar->num_candidates, pair.lidar->rms_m * 1e3);
+  } else {
+    ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "no plane: %s", pair.lidar_failure.c_str());
+  }
+}
+
+// A newly selected pair opens centred on its brush (the board), not on a fixed azimuth.
+void Workbench::CenterLidarOnBrush(const PairView& pair) {
+  if (lidar_centered_on_ == pair.id || pair.brush_pixels.empty()) return;
+  // Circular mean: the brush may straddle the image's left/right seam.
+  const int columns = pair.lidar_image->columns;
+  double sx = 0, sy = 0;
+  for (int pixel : pair.brush_pixels) {
+    const double a = 2 * M_PI * ((pixel % columns) + 0.5) / columns;
+    sx += std::cos(a), sy += std::sin(a);
+  }
+  const double mean = std::atan2(sy, sx);
+  lidar_center_ = static_cast<float>((mean < 0 ? mean + 2 * M_PI : mean) / (2 * M_PI));
+  lidar_centered_on_ = pair.id;
+}
+
+// The picture zoomed horizontally about lidar_center_, rows stretched to the view height. Over
+// it: the brush outline (a circle in LiDAR pixels, an ellipse on screen); left drag paints (shift
+// erases), the wheel zooms, a right drag pans.
+void Workbench::LidarPicture(const Snapshot& s, const PairView& pair,
+                             std::vector<Intent>* intents) {
+  const LidarImage& image = *pair.lidar_image;
+  const ImVec2 avail = ImGui::GetContentRegionAvail();
+  const float span = 1.0f / std::max(1.0f, lidar_zoom_);
+  lidar_center_ = std::clamp(lidar_center_, span / 2, 1 - span / 2);
+  const ImVec2 uv0(lidar_center_ - span / 2, 0), uv1(lidar_center_ + span / 2, 1);
+  const ImVec2 origin = ImGui::GetCursorScreenPos();
+  ImGui::Image(TextureId(gl_->lidar_picture.texture()), avail, uv0, uv1);
+  lidar_image_rect_ = {origin.x, origin.y, avail.x, avail.y, uv0.x, uv1.x};
+  if (!ImGui::IsItemHovered()) return;
+  const ImGuiIO& io = ImGui::GetIO();
+  const float col = (uv0.x + (io.MousePos.x - origin.x) / avail.x * span) * image.columns;
+  const float row = (io.MousePos.y - origin.y) / avail.y * image.rows;
+  const float rad = static_cast<float>(s.view.brush_radius_px);
+  const float px_per_col = avail.x / (span * image.columns), px_per_row = avail.y / image.rows;
+  DrawEllipse(ImGui::GetWindowDrawList(), io.MousePos, rad * px_per_col, rad * px_per_row,
+              io.KeyShift ? IM_COL32(255, 120, 90, 255) : IM_COL32(255, 255, 255, 220));
+  if (ImGui::IsMouseDown(ImGuiMouseButton_Left))
+    intents->push_back(
+        BrushStroke{s.selected, static_cast<int>(row), static_cast<int>(col), rad, io.KeyShift});
+  if (io.MouseWheel != 0)
+    lidar_zoom_ = std::clamp(lidar_zoom_ * std::pow(1.25f, io.MouseWheel), 1.0f, 40.0f);
+  if (ImGui::IsMouseDragging(ImGuiMouseButton_Right))
+    lidar_center_ -= io.MouseDelta.x / avail.x * span;
+}
+
+}  // namespace calibench::ui

@@ -1,0 +1,200 @@
+// The 3D view of the workbench: the LiDAR cloud (coloured by a LiDAR channel, or from the camera
+// image after a solve), the board planes and both sensor frames, in the LiDAR frame.
+#include <imgui.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/lidar/colormap.h"
+#include "core/reproject/reproject.h"
+#include "ui/lidar_camera/workbench.h"
+#include "ui/lidar_camera/workbench_gl.h"
+#include "ui/widgets/frame_key.h"
+#include "ui/widgets/orbit_camera.h"
+
+namespace calibench::ui {
+namespace {
+
+// The cloud coloured from the camera image at the solution; grey where the camera sees nothing.
+std::vector<gfx::Rgba> ImageColors(const Snapshot& s, const LidarCloud& cloud) {
+  std::vector<gfx::Rgba> colors(cloud.size());
+  const CloudColors from_image =
+      ColorizeCloud(s.dataset->camera, s.solver.result->cam_from_lidar, cloud, *s.selected_image,
+                    s.reprojection->visible, s.reprojection->points);
+  for (size_t i = 0; i < cloud.size(); ++i)
+    colors[i] = from_image.has_color[i]
+                    ? gfx::Rgba{from_image.bgr[3 * i + 2], from_image.bgr[3 * i + 1],
+                                from_image.bgr[3 * i], 255}
+                    : gfx::Rgba{70, 70, 76, 255};
+  return colors;
+}
+
+// The cloud coloured by a LiDAR channel (0 intensity, 1 range, 2 ring), the 2nd to 98th
+// percentile spread over the colour map.
+std::vector<gfx::Rgba> ChannelColors(const LidarCloud& cloud, int channel) {
+  std::vector<float> values(cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    if (channel == 0)
+      values[i] = cloud.HasIntensity() ? cloud.intensity[i] : cloud.points[i].norm();
+    else if (channel == 1)
+      values[i] = cloud.points[i].norm();
+    else
+      values[i] = cloud.HasRing() ? static_cast<float>(cloud.ring[i]) : cloud.points[i].z();
+  }
+  std::vector<float> sorted = values;
+  std::sort(sorted.begin(), sorted.end());
+  const float lo = sorted.empty() ? 0 : sorted[sorted.size() / 50];
+  const float hi = sorted.empty() ? 1 : sorted[sorted.size() - 1 - sorted.size() / 50];
+  std::vector<gfx::Rgba> colors(cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i)
+    colors[i] = ToRgba(MapColor(Colormap::kTurbo, (values[i] - lo) / std::max(1e-6f, hi - lo)));
+  return colors;
+}
+
+// The LiDAR board: the inliers' extent in the fitted plane, as a rectangle's corners.
+std::array<Vec3, 4> InlierExtent(const LidarCloud& cloud, const LidarPlaneFit& fit) {
+  const Vec3 n = fit.plane.normal;
+  Vec3 centroid = Vec3::Zero();
+  for (int i : fit.inliers) centroid += cloud.points[i].cast<double>();
+  centroid /= std::max<size_t>(1, fit.inliers.size());
+  const Vec3 u = n.unitOrthogonal(), w = n.cross(u);
+  double u0 = 1e9, u1 = -1e9, w0 = 1e9, w1 = -1e9;
+  for (int i : fit.inliers) {
+    const Vec3 d = cloud.points[i].cast<double>() - centroid;
+    u0 = std::min(u0, d.dot(u)), u1 = std::max(u1, d.dot(u));
+    w0 = std::min(w0, d.dot(w)), w1 = std::max(w1, d.dot(w));
+  }
+  return {centroid + u0 * u + w0 * w, centroid + u1 * u + w0 * w, centroid + u1 * u + w1 * w,
+          centroid + u0 * u + w1 * w};
+}
+
+// "camera colours" and what the view shows otherwise; the mouse's use.
+void SceneToolbar(const Snapshot& s, bool* camera_colors) {
+  static const char* kColorings[] = {"intensity", "range", "ring"};
+  ImGui::Checkbox("camera colours", camera_colors);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("colour the cloud from the camera image (after a solve)");
+  ImGui::SameLine();
+  ImGui::TextDisabled(
+      "else %s (LiDAR view); magenta: plane inliers. drag: orbit, right: pan, wheel: zoom",
+      kColorings[static_cast<int>(s.view.lidar_channel)]);
+}
+
+// Left drag orbits, right drag pans the target in the ground plane and up, the wheel zooms: the
+// view state after this frame's mouse over the hovered view.
+ViewState OrbitByMouse(const ViewState& v) {
+  OrbitCamera<double> orbit{v.orbit_yaw_rad, v.orbit_pitch_rad, v.orbit_distance_m};
+  orbit.HandleMouse(/*drag_turns_right=*/false, 0.5, 200.0);
+  ViewState next = v;
+  next.orbit_yaw_rad = orbit.yaw_rad;
+  next.orbit_pitch_rad = orbit.pitch_rad;
+  next.orbit_distance_m = orbit.distance;
+  if (ImGui::IsMouseDragging(ImGuiMouseButton_Right)) {
+    const ImGuiIO& io = ImGui::GetIO();
+    const double k = v.orbit_distance_m * 0.002;
+    const Vec3 right(-std::sin(v.orbit_yaw_rad), std::cos(v.orbit_yaw_rad), 0);
+    for (int a = 0; a < 3; ++a) next.orbit_target[a] -= k * io.MouseDelta.x * -right[a];
+    next.orbit_target[2] += k * io.MouseDelta.y;
+  }
+  return next;
+}
+
+}  // namespace
+
+void Workbench::SceneView(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) {
+  if (!BeginView("3D", r)) return ImGui::End();
+  const PairView* pair = s.selected >= 0 ? &s.pairs[s.selected] : nullptr;
+  if (!pair || !pair->cloud || !s.dataset) {
+    ImGui::TextDisabled("loading ...");
+    return ImGui::End();
+  }
+  const bool can_use_camera =
+      s.reprojection && s.reprojection->pair_id == pair->id && s.selected_image && s.solver.result;
+  SceneToolbar(s, &scene_camera_colors_);
+  const ImVec2 avail = ImGui::GetContentRegionAvail();
+  const int tw = std::max(1, static_cast<int>(avail.x)),
+            th = std::max(1, static_cast<int>(avail.y));
+  UploadSceneCloud(s, *pair, scene_camera_colors_ && can_use_camera);
+  // Orbit camera about the target (LiDAR frame, z up).
+  const ViewState& v = s.view;
+  const OrbitCamera<double> orbit{v.orbit_yaw_rad, v.orbit_pitch_rad, v.orbit_distance_m};
+  const gfx::Matrix4f view_projection = orbit.ViewProjection(
+      Eigen::Vector3d(v.orbit_target[0], v.orbit_target[1], v.orbit_target[2]).cast<float>(),
+      static_cast<float>(v.orbit_distance_m), static_cast<float>(tw) / th, 500.0f, WorldUp::kZUp);
+  const Pose* estimate = DisplayedEstimate(s);
+  // Redraw only when something shown changed: the cloud and its colours, the view, the point
+  // size or the estimate (131k points on llvmpipe cost most of a frame).
+  FrameKey frame_key(scene_key_);
+  frame_key.Mix(view_projection.data(), sizeof(float) * 16);
+  frame_key.Mix(&v.point_size_px, sizeof(double));
+  if (estimate) frame_key.Mix(estimate->matrix().data(), sizeof(double) * 16);
+  if (frame_key.value() != scene_frame_key_ || gl_->scene_target.width() != tw ||
+      gl_->scene_target.height() != th) {
+    scene_frame_key_ = frame_key.value();
+    DrawScene(s, *pair, view_projection, estimate, tw, th);
+  }
+  FramebufferImage(gl_->scene_target, ImVec2(tw, th));
+  if (ImGui::IsItemHovered())
+    if (const ViewState next = OrbitByMouse(v); !(next == v)) intents->push_back(SetView{next});
+  ImGui::End();
+}
+
+// The cloud's colours (plane inliers magenta) into gl_->scene_points and the grid's height,
+// when the cloud, the colouring or the inliers changed.
+void Workbench::UploadSceneCloud(const Snapshot& s, const PairView& pair, bool camera_colors) {
+  const LidarCloud& cloud = *pair.cloud;
+  const int coloring = static_cast<int>(s.view.lidar_channel);
+  const std::uint64_t key =
+      reinterpret_cast<std::uintptr_t>(&cloud) ^ (static_cast<std::uint64_t>(coloring) << 56) ^
+      (camera_colors ? reinterpret_cast<std::uintptr_t>(s.reprojection.get()) << 3 : 0) ^
+      ((pair.lidar ? pair.lidar->inliers.size() + 1 : 0) << 36);
+  if (key == scene_key_) return;
+  scene_key_ = key;
+  std::vector<gfx::Rgba> colors =
+      camera_colors ? ImageColors(s, cloud) : ChannelColors(cloud, coloring);
+  if (pair.lidar)
+    for (int i : pair.lidar->inliers) colors[i] = {255, 40, 220, 255};
+  gl_->scene_points.Upload(cloud.points, colors);
+  // The grid goes on the floor: a low percentile of the heights, robust to a few stray returns.
+  std::vector<float> heights(cloud.size());
+  for (size_t i = 0; i < cloud.size(); ++i) heights[i] = cloud.points[i].z();
+  if (!heights.empty()) {
+    std::nth_element(heights.begin(), heights.begin() + heights.size() / 50, heights.end());
+    gl_->scene_floor_z = heights[heights.size() / 50];
+  }
+}
+
+void Workbench::DrawScene(const Snapshot& s, const PairView& pair,
+                          const gfx::Matrix4f& view_projection, const Pose* estimate, int tw,
+                          int th) {
+  const LidarCloud& cloud = *pair.cloud;
+  // Lines: ground grid, LiDAR axes, camera axes at the displayed estimate.
+  gfx::LineBatch lines;
+  const double floor_z = gl_->scene_floor_z;
+  for (int k = -10; k <= 10; ++k) {
+    const gfx::Rgba grid{70, 70, 78, 255};
+    lines.Add({k * 1.0, -10, floor_z}, {k * 1.0, 10, floor_z}, grid);
+    lines.Add({-10, k * 1.0, floor_z}, {10, k * 1.0, floor_z}, grid);
+  }
+  lines.AddAxes(Pose::Identity(), 0.5);
+  gfx::TriangleBatch quads;
+  if (pair.lidar) quads.AddQuad(InlierExtent(cloud, *pair.lidar), {60, 140, 255, 110});
+  if (estimate) {
+    const Pose lidar_from_cam = estimate->inverse();
+    lines.AddAxes(lidar_from_cam, 0.3);
+    if (pair.camera)
+      quads.AddRectangle(lidar_from_cam * pair.camera->cam_from_board,
+                         s.dataset->target.SheetWidth(), s.dataset->target.SheetHeight(),
+                         {255, 150, 40, 110});
+  }
+  gl_->scene_target.Resize(tw, th);
+  gl_->scene_target.Clear(0.08f, 0.08f, 0.1f, 1.0f);
+  gl_->scene_lines.Upload(lines.vertices, lines.colors);
+  gl_->scene_lines.Draw(view_projection);
+  gl_->scene_points.Draw(view_projection, static_cast<float>(s.view.point_size_px));
+  gl_->scene_quads.Upload(quads.vertices, quads.colors);
+  gl_->scene_quads.Draw(view_projection);
+}
+
+}  // namespace calibench::ui
