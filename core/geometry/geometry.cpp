@@ -1,6 +1,8 @@
 #include "core/geometry/geometry.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 
 namespace calibench {
@@ -91,6 +93,85 @@ std::optional<double> RangeOnPlane(const Plane& plane, const Vec3& point) {
 Plane OrientTowardsOrigin(const Plane& plane) {
   if (plane.distance >= 0) return plane;
   return Plane{-plane.normal, -plane.distance};
+}
+
+namespace {
+
+// Point k of a plane fit's input is point_at(k): an Eigen 3-vector of doubles or an expression of
+// one (single-precision LiDAR points cast on the fly); its weight is weight_at(k). Templates, so
+// that each kind of input is evaluated as its own expressions.
+
+// Σ = s² (Jᵀ W J)⁻¹ over the tangent-plane parameters (δ_n ∈ ℝ², δ_d) of fit->plane, mapped to
+// (n, d) by n = n₀ + B δ_n; s² = Σ w r² / (N − 3). Also sets the unweighted RMS residual.
+template <typename PointAt, typename WeightAt>
+void SetPlaneCovariance(size_t count, const PointAt& point_at, const WeightAt& weight_at,
+                        PlaneFit* fit) {
+  Eigen::Matrix<double, 3, 2> tangent;
+  tangent.col(0) = fit->plane.normal.unitOrthogonal();
+  tangent.col(1) = fit->plane.normal.cross(tangent.col(0));
+  Mat3 normal_matrix = Mat3::Zero();
+  double weighted_sq = 0.0, sum_sq = 0.0;
+  for (size_t k = 0; k < count; ++k) {
+    const double r = fit->plane.SignedDistance(point_at(k));
+    weighted_sq += weight_at(k) * r * r;
+    sum_sq += r * r;
+    Eigen::RowVector3d j;
+    j << point_at(k).transpose() * tangent, 1.0;
+    normal_matrix += weight_at(k) * j.transpose() * j;
+  }
+  fit->rms_m = std::sqrt(sum_sq / count);
+  const double dof = std::max<double>(1.0, static_cast<double>(count) - 3.0);
+  const Mat3 local_cov = (weighted_sq / dof) * normal_matrix.inverse();
+  Eigen::Matrix<double, 4, 3> to_coefficients = Eigen::Matrix<double, 4, 3>::Zero();
+  to_coefficients.topLeftCorner<3, 2>() = tangent;
+  to_coefficients(3, 2) = 1.0;
+  fit->covariance = to_coefficients * local_cov * to_coefficients.transpose();
+}
+
+// Weighted total least squares: the plane through the weighted centroid normal to the smallest
+// eigenvector of the weighted scatter.
+template <typename PointAt, typename WeightAt>
+std::optional<PlaneFit> FitPlaneTls(size_t count, const PointAt& point_at,
+                                    const WeightAt& weight_at) {
+  if (count < 4) return std::nullopt;
+  double weight_sum = 0.0;
+  Vec3 centroid = Vec3::Zero();
+  for (size_t k = 0; k < count; ++k) {
+    weight_sum += weight_at(k);
+    centroid += weight_at(k) * point_at(k);
+  }
+  centroid /= weight_sum;
+  Mat3 scatter = Mat3::Zero();
+  for (size_t k = 0; k < count; ++k) {
+    const Vec3 p = point_at(k) - centroid;
+    scatter += weight_at(k) * p * p.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen(scatter);
+  // Points on a line (e.g. a single LiDAR ring) leave two eigenvalues near zero.
+  if (eigen.eigenvalues()[1] < 1e-6 * eigen.eigenvalues()[2] || eigen.eigenvalues()[1] <= 0)
+    return std::nullopt;
+  PlaneFit fit;
+  fit.plane = OrientTowardsOrigin(
+      Plane{eigen.eigenvectors().col(0), -eigen.eigenvectors().col(0).dot(centroid)});
+  SetPlaneCovariance(count, point_at, weight_at, &fit);
+  return fit;
+}
+
+}  // namespace
+
+std::optional<PlaneFit> FitPlaneWeighted(const std::vector<Vec3>& points,
+                                         const std::vector<double>& weights) {
+  CALIBENCH_CHECK(weights.empty() || weights.size() == points.size());
+  return FitPlaneTls(
+      points.size(), [&](size_t k) -> const Vec3& { return points[k]; },
+      [&](size_t k) { return weights.empty() ? 1.0 : weights[k]; });
+}
+
+std::optional<PlaneFit> FitPlane(const std::vector<Eigen::Vector3f>& points,
+                                 const std::vector<int>& indices) {
+  return FitPlaneTls(
+      indices.size(), [&](size_t k) { return points[indices[k]].cast<double>(); },
+      [](size_t) { return 1.0; });
 }
 
 Vec4 PlaneToPlaneError(const Plane& plane_i, const Plane& plane_j) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include "core/base/types.h"
 
@@ -54,6 +55,23 @@ Plane OrientTowardsOrigin(const Plane& plane);
 // −d / (n·u) with u the ray's unit direction; nullopt at the origin and for rays within ~1° of
 // the plane (|n·u| < 0.02), whose range is unbounded.
 std::optional<double> RangeOnPlane(const Plane& plane, const Vec3& point);
+
+// A total-least-squares plane with the covariance of its coefficients.
+struct PlaneFit {
+  Plane plane;                     // normal towards the frame's origin (d > 0)
+  Mat4 covariance = Mat4::Zero();  // of (n, d); rank 3 (n moves in its tangent plane only)
+  double rms_m = 0.0;              // unweighted RMS point-to-plane distance (metres)
+};
+
+// Weighted total least squares through `points` (metres, any frame) with weights w_i (empty: all
+// 1), and the (n, d) covariance: residual r_i = n·x_i + d with n perturbed in its tangent plane
+// (basis B), J_i = [x_iᵀ B, 1], Σ = s² (Jᵀ W J)⁻¹ with s² = Σ w r² / (N − 3) from the residuals.
+// nullopt for fewer than 4 points, or points on a line (they do not define a plane).
+std::optional<PlaneFit> FitPlaneWeighted(const std::vector<Vec3>& points,
+                                         const std::vector<double>& weights = {});
+// The same, unweighted, over points[indices] of single-precision points (a LiDAR cloud's).
+std::optional<PlaneFit> FitPlane(const std::vector<Eigen::Vector3f>& points,
+                                 const std::vector<int>& indices);
 
 // Eq. (6): e = [n_i - n_j ; n_j·(p(pi_j) - p(pi_i))], 4-vector, first three unitless, last metres.
 Vec4 PlaneToPlaneError(const Plane& plane_i, const Plane& plane_j);

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "core/base/atomic_file.h"
 #include "core/geometry/geometry.h"
@@ -16,73 +17,66 @@ using nlohmann::json;
 
 using json_io::Fail;
 using json_io::Get;
-using json_io::MatrixToJson;
-using json_io::ParseInlineCamera;
-using json_io::ParseTarget;
-using json_io::PoseFromJson;
-using json_io::ReadJson;
-using json_io::Resolve;
-using json_io::TargetToJson;
 
 namespace {
 
-Dataset LoadManifest(const fs::path& manifest) {
-  const json root = ReadJson(manifest);
+constexpr char kFormat[] = "calibench.dataset.v1";
+
+PairEntry ParsePair(const json& p, const fs::path& manifest, std::set<std::string>* seen) {
   const fs::path base = manifest.parent_path();
+  PairEntry pair;
+  pair.id = Get<std::string>(p, "id", manifest, "pairs[].");
+  json_io::CheckUniquePairId(pair.id, seen, manifest);
+  const std::string where = "pairs[" + pair.id + "].";
+  pair.cloud = json_io::Resolve(base, Get<std::string>(p, "cloud", manifest, where));
+  pair.image = json_io::Resolve(base, Get<std::string>(p, "image", manifest, where));
+  if (p.contains("lidar_seed")) {
+    const json& s = p.at("lidar_seed");
+    const auto point = Get<std::vector<double>>(s, "point", manifest, "lidar_seed.");
+    if (point.size() != 3)
+      Fail(manifest, "pair " + pair.id + ": lidar_seed.point must be [x, y, z]");
+    LidarSeed seed{Vec3(point[0], point[1], point[2]),
+                   Get<double>(s, "radius", manifest, "lidar_seed.")};
+    if (!(seed.radius > 0) || !seed.point.allFinite())
+      Fail(manifest, "pair " + pair.id + ": lidar_seed needs a finite point and a radius > 0");
+    pair.lidar_seed = seed;
+  }
+  return pair;
+}
+
+SimulationRecord ParseSimulation(const json& sim, const fs::path& manifest) {
+  const std::string where = "simulation.";
+  SimulationRecord record;
+  record.lidar_model = Get<std::string>(sim, "lidar_model", manifest, where);
+  record.num_pairs = Get<int>(sim, "num_pairs", manifest, where);
+  record.min_distance_m = Get<double>(sim, "min_distance_m", manifest, where);
+  record.max_distance_m = Get<double>(sim, "max_distance_m", manifest, where);
+  record.max_tilt_deg = Get<double>(sim, "max_tilt_deg", manifest, where);
+  record.lidar_range_noise_m = Get<double>(sim, "lidar_range_noise_m", manifest, where);
+  // Manifests written before the offset existed have none.
+  record.lidar_range_offset_m = json_io::GetOr(sim, "lidar_range_offset_m", 0.0, manifest, where);
+  record.image_noise = Get<double>(sim, "image_noise", manifest, where);
+  record.clutter = Get<bool>(sim, "clutter", manifest, where);
+  record.seed_radius_m = Get<double>(sim, "seed_radius_m", manifest, where);
+  record.seed = Get<std::uint64_t>(sim, "seed", manifest, where);
+  return record;
+}
+
+Dataset LoadManifest(const fs::path& manifest) {
+  const json root = json_io::ReadJson(manifest);
   Dataset dataset;
   dataset.manifest = manifest;
-  const std::string format = root.value("format", "");
-  if (format != "calibench.dataset.v1")
-    Fail(manifest, "format is '" + format + "', expected 'calibench.dataset.v1'");
+  json_io::CheckFormat(root, kFormat, manifest);
   dataset.camera = json_io::ParseManifestCamera(root, manifest);
-  if (!root.contains("target")) Fail(manifest, "missing field 'target'");
-  dataset.target = ParseTarget(root.at("target"), manifest);
+  dataset.target = json_io::ParseTarget(json_io::Field(root, "target", manifest), manifest);
   if (root.contains("lidar")) dataset.lidar_rings = root.at("lidar").value("rings", 0);
-  if (!root.contains("pairs") || !root.at("pairs").is_array())
-    Fail(manifest, "missing array 'pairs'");
-  std::map<std::string, int> seen;
-  for (const json& p : root.at("pairs")) {
-    PairEntry pair;
-    pair.id = Get<std::string>(p, "id", manifest, "pairs[].");
-    if (seen[pair.id]++) Fail(manifest, "pair id '" + pair.id + "' appears twice");
-    pair.cloud = Resolve(base, Get<std::string>(p, "cloud", manifest, "pairs[" + pair.id + "]."));
-    pair.image = Resolve(base, Get<std::string>(p, "image", manifest, "pairs[" + pair.id + "]."));
-    if (p.contains("lidar_seed")) {
-      const json& s = p.at("lidar_seed");
-      const auto point = Get<std::vector<double>>(s, "point", manifest, "lidar_seed.");
-      if (point.size() != 3)
-        Fail(manifest, "pair " + pair.id + ": lidar_seed.point must be [x, y, z]");
-      LidarSeed seed{Vec3(point[0], point[1], point[2]),
-                     Get<double>(s, "radius", manifest, "lidar_seed.")};
-      if (!(seed.radius > 0) || !seed.point.allFinite())
-        Fail(manifest, "pair " + pair.id + ": lidar_seed needs a finite point and a radius > 0");
-      pair.lidar_seed = seed;
-    }
-    dataset.pairs.push_back(pair);
-  }
-  if (root.contains("ground_truth") && root.at("ground_truth").contains("cam_from_lidar"))
-    dataset.cam_from_lidar_ground_truth = PoseFromJson(root.at("ground_truth").at("cam_from_lidar"),
-                                                       manifest, "ground_truth.cam_from_lidar");
-  if (root.contains("simulation")) {
-    const json& sim = root.at("simulation");
-    SimulationRecord record;
-    record.lidar_model = Get<std::string>(sim, "lidar_model", manifest, "simulation.");
-    record.num_pairs = Get<int>(sim, "num_pairs", manifest, "simulation.");
-    record.min_distance_m = Get<double>(sim, "min_distance_m", manifest, "simulation.");
-    record.max_distance_m = Get<double>(sim, "max_distance_m", manifest, "simulation.");
-    record.max_tilt_deg = Get<double>(sim, "max_tilt_deg", manifest, "simulation.");
-    record.lidar_range_noise_m = Get<double>(sim, "lidar_range_noise_m", manifest, "simulation.");
-    // Manifests written before the offset existed have none.
-    record.lidar_range_offset_m =
-        sim.contains("lidar_range_offset_m")
-            ? Get<double>(sim, "lidar_range_offset_m", manifest, "simulation.")
-            : 0.0;
-    record.image_noise = Get<double>(sim, "image_noise", manifest, "simulation.");
-    record.clutter = Get<bool>(sim, "clutter", manifest, "simulation.");
-    record.seed_radius_m = Get<double>(sim, "seed_radius_m", manifest, "simulation.");
-    record.seed = Get<std::uint64_t>(sim, "seed", manifest, "simulation.");
-    dataset.simulation = record;
-  }
+  std::set<std::string> seen;
+  for (const json& p : json_io::PairsArray(root, manifest))
+    dataset.pairs.push_back(ParsePair(p, manifest, &seen));
+  dataset.cam_from_lidar_ground_truth =
+      json_io::OptionalPose(root, "ground_truth", "cam_from_lidar", manifest);
+  if (root.contains("simulation"))
+    dataset.simulation = ParseSimulation(root.at("simulation"), manifest);
   return dataset;
 }
 
@@ -97,9 +91,9 @@ Dataset LoadFolder(const fs::path& dir) {
   if (!fs::exists(target_file))
     Fail(dir, "folder dataset has no target.json (and no dataset.json)");
   dataset.camera = LoadCameraFile(camera_file);
-  json target = ReadJson(target_file);
+  json target = json_io::ReadJson(target_file);
   dataset.target =
-      ParseTarget(target.contains("target") ? target.at("target") : target, target_file);
+      json_io::ParseTarget(target.contains("target") ? target.at("target") : target, target_file);
   auto list = [&](const char* sub) {
     std::map<std::string, fs::path> by_stem;
     if (!fs::is_directory(dir / sub)) Fail(dir, std::string("folder dataset has no ") + sub + "/");
@@ -132,9 +126,9 @@ Dataset LoadDataset(const fs::path& path) {
 void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
   auto relative = [&](const fs::path& p) { return json_io::PathForManifest(p, manifest_path); };
   json root;
-  root["format"] = "calibench.dataset.v1";
+  root["format"] = kFormat;
   root["camera"] = json_io::CameraToJson(dataset.camera);
-  root["target"] = TargetToJson(dataset.target);
+  root["target"] = json_io::TargetToJson(dataset.target);
   if (dataset.lidar_rings > 0) root["lidar"] = {{"rings", dataset.lidar_rings}};
   json pairs = json::array();
   for (const PairEntry& p : dataset.pairs) {
@@ -148,7 +142,7 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
   root["pairs"] = pairs;
   if (dataset.cam_from_lidar_ground_truth)
     root["ground_truth"] = {
-        {"cam_from_lidar", MatrixToJson(dataset.cam_from_lidar_ground_truth->matrix())},
+        {"cam_from_lidar", json_io::MatrixToJson(dataset.cam_from_lidar_ground_truth->matrix())},
         {"direction", "x_in_cam = cam_from_lidar * x_in_lidar"}};
   if (dataset.simulation) {
     const SimulationRecord& r = *dataset.simulation;

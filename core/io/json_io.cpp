@@ -24,6 +24,35 @@ json ReadJson(const fs::path& path) {
   }
 }
 
+const json& Field(const json& node, const char* key, const fs::path& file,
+                  const std::string& where) {
+  if (!node.is_object() || !node.contains(key)) Fail(file, "missing field '" + where + key + "'");
+  return node.at(key);
+}
+
+void CheckFormat(const json& root, const std::string& expected, const fs::path& manifest) {
+  const std::string format = root.value("format", "");
+  if (format != expected) Fail(manifest, "format is '" + format + "', expected '" + expected + "'");
+}
+
+const json& PairsArray(const json& root, const fs::path& manifest) {
+  if (!root.contains("pairs") || !root.at("pairs").is_array())
+    Fail(manifest, "missing array 'pairs'");
+  return root.at("pairs");
+}
+
+void CheckUniquePairId(const std::string& id, std::set<std::string>* seen,
+                       const fs::path& manifest) {
+  if (!seen->insert(id).second) Fail(manifest, "pair id '" + id + "' appears twice");
+}
+
+std::optional<Pose> OptionalPose(const json& root, const char* group, const char* key,
+                                 const fs::path& manifest) {
+  if (!root.contains(group) || !root.at(group).is_object() || !root.at(group).contains(key))
+    return std::nullopt;
+  return PoseFromJson(root.at(group).at(key), manifest, std::string(group) + "." + key);
+}
+
 fs::path Resolve(const fs::path& base_dir, const std::string& p) {
   const fs::path path(p);
   return path.is_absolute() ? path : (base_dir / path).lexically_normal();
@@ -36,12 +65,7 @@ CameraModel ParseInlineCamera(const json& node, const fs::path& file) {
   if (!type)
     Fail(file, "camera.model '" + model + "' is unknown (use pinhole-radtan or kannala-brandt)");
   camera.type = *type;
-  camera.width = Get<int>(node, "width", file, "camera.");
-  camera.height = Get<int>(node, "height", file, "camera.");
-  camera.fx = Get<double>(node, "fx", file, "camera.");
-  camera.fy = Get<double>(node, "fy", file, "camera.");
-  camera.cx = Get<double>(node, "cx", file, "camera.");
-  camera.cy = Get<double>(node, "cy", file, "camera.");
+  GetPinhole(node, file, "camera.", &camera);
   camera.distortion = Get<std::vector<double>>(node, "distortion", file, "camera.");
   return camera;
 }
@@ -73,8 +97,7 @@ BoardSpec ParseTarget(const json& node, const fs::path& file) {
     board.board_width = size[0];
     board.board_height = size[1];
   }
-  std::string why;
-  if (!board.Check(&why)) Fail(file, "target: " + why);
+  CheckOrFail(board, file, "target");
   return board;
 }
 
@@ -149,20 +172,15 @@ CameraModel ParseManifestCamera(const json& root, const fs::path& manifest) {
   } else {
     Fail(manifest, "neither 'camera' nor 'camera_file' is given");
   }
-  std::string why;
-  if (!camera.Check(&why)) Fail(manifest, "camera: " + why);
+  CheckOrFail(camera, manifest, "camera");
   return camera;
 }
 
 json CameraToJson(const CameraModel& c) {
-  return {{"model", CameraModelName(c.type)},
-          {"width", c.width},
-          {"height", c.height},
-          {"fx", c.fx},
-          {"fy", c.fy},
-          {"cx", c.cx},
-          {"cy", c.cy},
-          {"distortion", c.distortion}};
+  json camera = PinholeToJson(c);
+  camera["model"] = CameraModelName(c.type);
+  camera["distortion"] = c.distortion;
+  return camera;
 }
 
 std::string PathForManifest(const fs::path& path, const fs::path& manifest) {

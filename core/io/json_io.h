@@ -1,10 +1,12 @@
-// JSON helpers shared by the manifest readers (dataset.cpp, lrf_dataset.cpp) and the result
-// writers (result_io.cpp, lrf_pipeline.cpp). Internal: include it from .cpp files only (it pulls
+// JSON helpers shared by the manifest readers (io/dataset.cpp, lrf/dataset.cpp) and the result
+// writer (results/result_file.cpp). Internal: include it from .cpp files only (it pulls
 // in nlohmann/json). Every reader throws IoError naming the file and the problem.
 #pragma once
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
 #include <string>
 
 #include "core/base/types.h"
@@ -31,6 +33,55 @@ T Get(const json& node, const char* key, const std::filesystem::path& file,
     Fail(file, "field '" + where + key + "' has the wrong type: " + e.what());
   }
 }
+
+// node[key] as T when present, else `fallback`; IoError as Get when present with the wrong type.
+template <typename T>
+T GetOr(const json& node, const char* key, T fallback, const std::filesystem::path& file,
+        const std::string& where) {
+  return node.contains(key) ? Get<T>(node, key, file, where) : fallback;
+}
+
+// node[key] itself; IoError "missing field '<where><key>'".
+const json& Field(const json& node, const char* key, const std::filesystem::path& file,
+                  const std::string& where = "");
+
+// IoError "<what>: <why>" naming the file unless spec.Check(&why) passes (targets, intrinsics).
+template <typename Spec>
+void CheckOrFail(const Spec& spec, const std::filesystem::path& file, const std::string& what) {
+  std::string why;
+  if (!spec.Check(&why)) Fail(file, what + ": " + why);
+}
+
+// The pinhole fields of an intrinsics object (CameraModel, DepthIntrinsics): width and height
+// (pixels), fx, fy, cx, cy (pixels), read from node (named `where` in messages) and written back.
+template <typename Intrinsics>
+void GetPinhole(const json& node, const std::filesystem::path& file, const std::string& where,
+                Intrinsics* in) {
+  in->width = Get<int>(node, "width", file, where);
+  in->height = Get<int>(node, "height", file, where);
+  in->fx = Get<double>(node, "fx", file, where);
+  in->fy = Get<double>(node, "fy", file, where);
+  in->cx = Get<double>(node, "cx", file, where);
+  in->cy = Get<double>(node, "cy", file, where);
+}
+template <typename Intrinsics>
+json PinholeToJson(const Intrinsics& in) {
+  return {{"width", in.width}, {"height", in.height}, {"fx", in.fx},
+          {"fy", in.fy},       {"cx", in.cx},         {"cy", in.cy}};
+}
+
+// A manifest's "format"; IoError "format is '<found>', expected '<expected>'".
+void CheckFormat(const json& root, const std::string& expected,
+                 const std::filesystem::path& manifest);
+// A manifest's "pairs"; IoError "missing array 'pairs'".
+const json& PairsArray(const json& root, const std::filesystem::path& manifest);
+// Records a pair id; IoError "pair id '<id>' appears twice" when `seen` holds it already.
+void CheckUniquePairId(const std::string& id, std::set<std::string>* seen,
+                       const std::filesystem::path& manifest);
+// root[group][key] as a rigid transform (PoseFromJson, named "<group>.<key>"); nullopt when
+// either is absent.
+std::optional<Pose> OptionalPose(const json& root, const char* group, const char* key,
+                                 const std::filesystem::path& manifest);
 
 // An absolute path, or one relative to base_dir.
 std::filesystem::path Resolve(const std::filesystem::path& base_dir, const std::string& path);

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <fstream>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <set>
 
 #include "core/base/atomic_file.h"
 #include "core/geometry/geometry.h"
@@ -18,27 +18,13 @@ using nlohmann::json;
 
 using json_io::Fail;
 using json_io::Get;
-using json_io::MatrixToJson;
-using json_io::ParseInlineCamera;
-using json_io::ParseTarget;
-using json_io::PoseFromJson;
-using json_io::ReadJson;
-using json_io::Resolve;
-using json_io::TargetToJson;
+using json_io::GetOr;
 
 namespace {
 
 constexpr char kFormat[] = "calibench.lrf-dataset.v1";
 constexpr double kDeg = M_PI / 180.0;
 
-template <typename T>
-T GetOr(const json& node, const char* key, T fallback, const fs::path& file,
-        const std::string& where) {
-  return node.contains(key) ? Get<T>(node, key, file, where) : fallback;
-}
-
-// The next three mirror the file-static helpers of core/dataset.cpp (same field names and
-// messages) so that the checkerboard variant reads exactly like calibench.dataset.v1.
 ThreeFaceTarget ParseThreeFace(const json& node, const fs::path& file) {
   ThreeFaceTarget t;
   t.base_width = GetOr(node, "base_width", t.base_width, file, "target.");
@@ -47,23 +33,32 @@ ThreeFaceTarget ParseThreeFace(const json& node, const fs::path& file) {
   t.apex_y = GetOr(node, "apex_y", t.apex_y, file, "target.");
   t.foot_y = GetOr(node, "foot_y", t.foot_y, file, "target.");
   t.ridge_height = GetOr(node, "ridge_height", t.ridge_height, file, "target.");
-  std::string why;
-  if (!t.Check(&why)) Fail(file, "target: " + why);
+  json_io::CheckOrFail(t, file, "target");
   return t;
+}
+
+json ThreeFaceToJson(const ThreeFaceTarget& t) {
+  return {{"type", "three-face"},
+          {"base_width", t.base_width},
+          {"base_height", t.base_height},
+          {"tent_half_width", t.tent_half_width},
+          {"apex_y", t.apex_y},
+          {"foot_y", t.foot_y},
+          {"ridge_height", t.ridge_height}};
 }
 
 DepthIntrinsics ParseDepthCamera(const json& node, const fs::path& file) {
   DepthIntrinsics in;
-  in.width = Get<int>(node, "width", file, "depth_camera.");
-  in.height = Get<int>(node, "height", file, "depth_camera.");
-  in.fx = Get<double>(node, "fx", file, "depth_camera.");
-  in.fy = Get<double>(node, "fy", file, "depth_camera.");
-  in.cx = Get<double>(node, "cx", file, "depth_camera.");
-  in.cy = Get<double>(node, "cy", file, "depth_camera.");
+  json_io::GetPinhole(node, file, "depth_camera.", &in);
   in.depth_scale = GetOr(node, "depth_scale", in.depth_scale, file, "depth_camera.");
-  std::string why;
-  if (!in.Check(&why)) Fail(file, "depth_camera: " + why);
+  json_io::CheckOrFail(in, file, "depth_camera");
   return in;
+}
+
+json DepthCameraToJson(const DepthIntrinsics& in) {
+  json camera = json_io::PinholeToJson(in);
+  camera["depth_scale"] = in.depth_scale;
+  return camera;
 }
 
 ScanRegion ParseScanRegion(const json& node, const fs::path& file, const std::string& where) {
@@ -82,7 +77,7 @@ ScanRegion ParseScanRegion(const json& node, const fs::path& file, const std::st
 // loaded, so that one missing file fails its pair (named) and keeps the others.
 fs::path PairFile(const json& p, const char* key, const fs::path& manifest,
                   const std::string& where) {
-  return Resolve(manifest.parent_path(), Get<std::string>(p, key, manifest, where));
+  return json_io::Resolve(manifest.parent_path(), Get<std::string>(p, key, manifest, where));
 }
 
 LrfPairEntry ParsePair(const json& p, LrfTargetType type, const fs::path& manifest) {
@@ -103,11 +98,11 @@ LrfPairEntry ParsePair(const json& p, LrfTargetType type, const fs::path& manife
   return pair;
 }
 
-std::optional<Pose> OptionalPose(const json& root, const char* group, const char* key,
-                                 const fs::path& manifest) {
-  if (!root.contains(group) || !root.at(group).is_object() || !root.at(group).contains(key))
-    return std::nullopt;
-  return PoseFromJson(root.at(group).at(key), manifest, std::string(group) + "." + key);
+json ScanRegionToJson(const ScanRegion& region) {
+  return {{"angle_min_deg", region.angle_min / kDeg},
+          {"angle_max_deg", region.angle_max / kDeg},
+          {"range_min", region.range_min},
+          {"range_max", region.range_max}};
 }
 
 // Scan files ------------------------------------------------------------------------------------
@@ -128,7 +123,7 @@ double RangeFromJson(const json& value, const fs::path& file, size_t index) {
 }
 
 LaserScan LoadScanJson(const fs::path& path) {
-  const json root = ReadJson(path);
+  const json root = json_io::ReadJson(path);
   if (!root.is_object()) Fail(path, "a LaserScan JSON must be an object");
   LaserScan scan;
   scan.angle_min = Get<double>(root, "angle_min", path, "");
@@ -202,62 +197,50 @@ LaserScan LoadScanPcd(const fs::path& path) {
 
 LrfDataset LoadLrfDataset(const fs::path& manifest_path) {
   const fs::path manifest = fs::absolute(manifest_path);
-  const json root = ReadJson(manifest);
+  const json root = json_io::ReadJson(manifest);
   if (!root.is_object()) Fail(manifest, "the manifest must be a JSON object");
-  const std::string format = root.value("format", "");
-  if (format != kFormat)
-    Fail(manifest, "format is '" + format + "', expected '" + std::string(kFormat) + "'");
+  json_io::CheckFormat(root, kFormat, manifest);
   LrfDataset dataset;
   dataset.manifest = manifest;
-  if (!root.contains("target")) Fail(manifest, "missing field 'target'");
-  const json& target = root.at("target");
+  const json& target = json_io::Field(root, "target", manifest);
   const std::string type = Get<std::string>(target, "type", manifest, "target.");
   if (type == "three-face") {
     dataset.target_type = LrfTargetType::kThreeFace;
     dataset.three_face = ParseThreeFace(target, manifest);
-    if (!root.contains("depth_camera")) Fail(manifest, "missing field 'depth_camera'");
-    dataset.depth_camera = ParseDepthCamera(root.at("depth_camera"), manifest);
+    dataset.depth_camera =
+        ParseDepthCamera(json_io::Field(root, "depth_camera", manifest), manifest);
   } else if (type == "checkerboard" || type == "charuco") {
     dataset.target_type = LrfTargetType::kCheckerboard;
-    dataset.board = ParseTarget(target, manifest);
+    dataset.board = json_io::ParseTarget(target, manifest);
     dataset.camera = json_io::ParseManifestCamera(root, manifest);
   } else {
     Fail(manifest, "target.type '" + type + "' is unknown (use three-face or checkerboard)");
   }
-  if (!root.contains("pairs") || !root.at("pairs").is_array())
-    Fail(manifest, "missing array 'pairs'");
-  std::map<std::string, int> seen;
-  for (const json& p : root.at("pairs")) {
+  std::set<std::string> seen;
+  for (const json& p : json_io::PairsArray(root, manifest)) {
     LrfPairEntry pair = ParsePair(p, dataset.target_type, manifest);
-    if (seen[pair.id]++) Fail(manifest, "pair id '" + pair.id + "' appears twice");
+    json_io::CheckUniquePairId(pair.id, &seen, manifest);
     dataset.pairs.push_back(std::move(pair));
   }
-  dataset.cam_from_lrf_ground_truth = OptionalPose(root, "ground_truth", "cam_from_lrf", manifest);
-  dataset.initial_cam_from_lrf = OptionalPose(root, "initial_guess", "cam_from_lrf", manifest);
-  dataset.right_from_left = OptionalPose(root, "stereo", "right_from_left", manifest);
+  dataset.cam_from_lrf_ground_truth =
+      json_io::OptionalPose(root, "ground_truth", "cam_from_lrf", manifest);
+  dataset.initial_cam_from_lrf =
+      json_io::OptionalPose(root, "initial_guess", "cam_from_lrf", manifest);
+  dataset.right_from_left = json_io::OptionalPose(root, "stereo", "right_from_left", manifest);
   return dataset;
 }
 
 void SaveLrfDataset(const fs::path& manifest_path, const LrfDataset& dataset) {
   auto relative = [&](const fs::path& p) { return json_io::PathForManifest(p, manifest_path); };
+  auto matrix = [](const Pose& pose) { return json_io::MatrixToJson(pose.matrix()); };
   json root;
   root["format"] = kFormat;
   if (dataset.target_type == LrfTargetType::kThreeFace) {
-    const DepthIntrinsics& d = dataset.depth_camera;
-    root["depth_camera"] = {
-        {"width", d.width}, {"height", d.height},          {"fx", d.fx}, {"fy", d.fy}, {"cx", d.cx},
-        {"cy", d.cy},       {"depth_scale", d.depth_scale}};
-    const ThreeFaceTarget& t = dataset.three_face;
-    root["target"] = {{"type", "three-face"},
-                      {"base_width", t.base_width},
-                      {"base_height", t.base_height},
-                      {"tent_half_width", t.tent_half_width},
-                      {"apex_y", t.apex_y},
-                      {"foot_y", t.foot_y},
-                      {"ridge_height", t.ridge_height}};
+    root["depth_camera"] = DepthCameraToJson(dataset.depth_camera);
+    root["target"] = ThreeFaceToJson(dataset.three_face);
   } else {
     root["camera"] = json_io::CameraToJson(dataset.camera);
-    root["target"] = TargetToJson(dataset.board);
+    root["target"] = json_io::TargetToJson(dataset.board);
   }
   json pairs = json::array();
   for (const LrfPairEntry& p : dataset.pairs) {
@@ -265,23 +248,17 @@ void SaveLrfDataset(const fs::path& manifest_path, const LrfDataset& dataset) {
     if (!p.depth.empty()) entry["depth"] = relative(p.depth);
     if (!p.depth_cloud.empty()) entry["cloud"] = relative(p.depth_cloud);
     if (!p.image.empty()) entry["image"] = relative(p.image);
-    if (p.scan_region)
-      entry["scan_region"] = {{"angle_min_deg", p.scan_region->angle_min / kDeg},
-                              {"angle_max_deg", p.scan_region->angle_max / kDeg},
-                              {"range_min", p.scan_region->range_min},
-                              {"range_max", p.scan_region->range_max}};
+    if (p.scan_region) entry["scan_region"] = ScanRegionToJson(*p.scan_region);
     pairs.push_back(entry);
   }
   root["pairs"] = pairs;
   if (dataset.cam_from_lrf_ground_truth)
-    root["ground_truth"] = {
-        {"cam_from_lrf", MatrixToJson(dataset.cam_from_lrf_ground_truth->matrix())},
-        {"direction", "x_in_cam = cam_from_lrf * x_in_lrf"}};
+    root["ground_truth"] = {{"cam_from_lrf", matrix(*dataset.cam_from_lrf_ground_truth)},
+                            {"direction", "x_in_cam = cam_from_lrf * x_in_lrf"}};
   if (dataset.initial_cam_from_lrf)
-    root["initial_guess"] = {
-        {"cam_from_lrf", MatrixToJson(dataset.initial_cam_from_lrf->matrix())}};
+    root["initial_guess"] = {{"cam_from_lrf", matrix(*dataset.initial_cam_from_lrf)}};
   if (dataset.right_from_left)
-    root["stereo"] = {{"right_from_left", MatrixToJson(dataset.right_from_left->matrix())},
+    root["stereo"] = {{"right_from_left", matrix(*dataset.right_from_left)},
                       {"direction", "x_in_right = right_from_left * x_in_left"}};
   WriteFileAtomically(manifest_path, root.dump(2) + "\n");
 }
@@ -312,8 +289,7 @@ void SaveLaserScanJson(const fs::path& path, const LaserScan& scan) {
 
 DepthImage LoadDepthPng(const fs::path& path, const DepthIntrinsics& intrinsics) {
   if (!fs::exists(path)) Fail(path, "no such file");
-  std::string why;
-  if (!intrinsics.Check(&why)) Fail(path, "depth intrinsics: " + why);
+  json_io::CheckOrFail(intrinsics, path, "depth intrinsics");
   cv::Mat image;
   try {
     image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
@@ -357,8 +333,7 @@ DepthImage LoadDepthPng(const fs::path& path, const DepthIntrinsics& intrinsics)
 
 void SaveDepthPng(const fs::path& path, const DepthImage& depth) {
   const DepthIntrinsics& in = depth.intrinsics;
-  std::string why;
-  if (!in.Check(&why)) Fail(path, "depth intrinsics: " + why);
+  json_io::CheckOrFail(in, path, "depth intrinsics");
   if (depth.depth_m.size() != static_cast<size_t>(in.width) * in.height)
     Fail(path, "depth image has " + std::to_string(depth.depth_m.size()) +
                    " values, the intrinsics say " + std::to_string(in.width) + "x" +
@@ -379,8 +354,7 @@ void SaveDepthPng(const fs::path& path, const DepthImage& depth) {
 }
 
 DepthImage LoadDepthCloud(const fs::path& path, const DepthIntrinsics& intrinsics) {
-  std::string why;
-  if (!intrinsics.Check(&why)) Fail(path, "depth intrinsics: " + why);
+  json_io::CheckOrFail(intrinsics, path, "depth intrinsics");
   const LidarCloud cloud = LoadCloud(path);
   DepthImage depth;
   depth.intrinsics = intrinsics;

@@ -20,9 +20,9 @@ namespace calibench {
 
 namespace {
 
-
 // ---------------------------------------------------------------------------------------------
 // The depth image as points on the subsampled pixel grid.
+
 // Every stride-th pixel back-projected, with its cell in the subsampled grid (for connectivity).
 struct DepthCloud {
   std::vector<Vec3> points;   // camera frame, metres

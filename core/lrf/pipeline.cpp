@@ -24,14 +24,9 @@ bool LrfPipelineOptions::Check(std::string* why) const {
   if (!scan.Check(why) || !depth.Check(why) || !board_scan.Check(why) || !pnp.Check(why) ||
       !solver.Check(why))
     return false;
-  if (!(adaptive_error_threshold_m >= 0) || !std::isfinite(adaptive_error_threshold_m)) {
-    if (why) *why = "the adaptive error threshold must be >= 0 metres";
-    return false;
-  }
-  if (threads < 1) {
-    if (why) *why = "threads must be >= 1";
-    return false;
-  }
+  if (!(adaptive_error_threshold_m >= 0) || !std::isfinite(adaptive_error_threshold_m))
+    return FailCheck(why, "the adaptive error threshold must be >= 0 metres");
+  if (threads < 1) return FailCheck(why, "threads must be >= 1");
   return true;
 }
 

@@ -7,11 +7,16 @@
 #include <limits>
 #include <sstream>
 
+#include "core/base/names.h"
+
 namespace calibench {
 
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+constexpr EnumName<LrfMethod> kLrfMethodNames[] = {{LrfMethod::kPaperLinear, "paper-linear"},
+                                                   {LrfMethod::kRefined, "refined"}};
 
 // Eq. (10)–(11) is declared rank-deficient when its condition number exceeds 1e7: exact
 // degeneracies (parallel faces, a single pose, board normals without a component along one axis)
@@ -186,28 +191,41 @@ LrfSolution LinearSolution(const std::vector<PointOnPlane>& corner_constraints,
   return solution;
 }
 
-}  // namespace
-
-std::string LrfMethodName(LrfMethod method) {
-  return method == LrfMethod::kPaperLinear ? "paper-linear" : "refined";
+// The paper-linear answer (Eq. (10)–(11) over `linear_constraints`), or the refinement over
+// `refine_constraints` seeded by it, or by `initial` when the linear system is rank-deficient.
+LrfSolution SolveLinearThenRefine(const std::vector<PointOnPlane>& linear_constraints,
+                                  const std::vector<PointOnPlane>& refine_constraints,
+                                  const LrfSolverOptions& options,
+                                  const std::optional<Pose>& initial, size_t num_observations) {
+  std::string why;
+  const std::optional<Pose> linear = SolveLinearPointOnPlane(linear_constraints, &why);
+  if (options.method == LrfMethod::kPaperLinear) {
+    if (!linear) return Failure(options.method, why);
+    return LinearSolution(linear_constraints, refine_constraints, options, *linear,
+                          num_observations);
+  }
+  if (!linear && !initial)
+    return Failure(options.method, why + "; no initial estimate was given to refine from");
+  LrfSolution solution =
+      PointPlaneSolver(refine_constraints, options, linear ? *linear : *initial).Run();
+  ResizePerObservation(num_observations, &solution);
+  return solution;
 }
 
+}  // namespace
+
+std::string LrfMethodName(LrfMethod method) { return NameIn(kLrfMethodNames, method); }
+
 std::optional<LrfMethod> ParseLrfMethod(const std::string& name) {
-  if (name == "paper-linear") return LrfMethod::kPaperLinear;
-  if (name == "refined") return LrfMethod::kRefined;
-  return std::nullopt;
+  return ValueIn(kLrfMethodNames, name);
 }
 
 bool LrfSolverOptions::Check(std::string* why) const {
-  auto fail = [&](const std::string& message) {
-    if (why) *why = message;
-    return false;
-  };
-  if (!(huber_delta_m > 0)) return fail("huber_delta_m must be > 0 (metres)");
-  if (max_iterations < 1) return fail("max_iterations must be >= 1");
-  if (!(step_tolerance > 0)) return fail("step_tolerance must be > 0");
+  if (!(huber_delta_m > 0)) return FailCheck(why, "huber_delta_m must be > 0 (metres)");
+  if (max_iterations < 1) return FailCheck(why, "max_iterations must be >= 1");
+  if (!(step_tolerance > 0)) return FailCheck(why, "step_tolerance must be > 0");
   if (!(weak_eigenvalue_ratio > 0 && weak_eigenvalue_ratio < 1))
-    return fail("weak_eigenvalue_ratio must be in (0, 1)");
+    return FailCheck(why, "weak_eigenvalue_ratio must be in (0, 1)");
   return true;
 }
 
@@ -381,18 +399,10 @@ LrfSolution SolveLrf(const std::vector<LrfObservation>& observations,
   if (points.size() < 7)
     return Failure(options.method, "the usable observations have only " +
                                        std::to_string(points.size()) + " face scan points");
-  const std::optional<Pose> linear = SolveLinearPointOnPlane(corners, &why);
-  LrfSolution solution;
-  if (options.method == LrfMethod::kPaperLinear) {
-    if (!linear) return Failure(options.method, why);
-    solution = LinearSolution(corners, points, options, *linear, observations.size());
-  } else {
-    if (!linear && !initial)
-      return Failure(options.method, why + "; no initial estimate was given to refine from");
-    // Refinement over every scan point of every face, seeded by Eq. (11).
-    solution = PointPlaneSolver(points, options, linear ? *linear : *initial).Run();
-    ResizePerObservation(observations.size(), &solution);
-  }
+  // Eq. (11) from the corners; the refinement runs over every scan point of every face.
+  LrfSolution solution =
+      SolveLinearThenRefine(corners, points, options, initial, observations.size());
+  if (!solution.ok) return solution;
   FillPointToLine(observations, &solution);
   return solution;
 }
@@ -447,18 +457,7 @@ LrfSolution SolveLrfBoard(const std::vector<LrfBoardObservation>& observations,
                                        " had at least two board points)");
   // Zhang & Pless's linear step is Eq. (10) with one row per board scan point.
   const std::vector<PointOnPlane> constraints = BoardConstraints(observations);
-  const std::optional<Pose> linear = SolveLinearPointOnPlane(constraints, &why);
-  LrfSolution solution;
-  if (options.method == LrfMethod::kPaperLinear) {
-    if (!linear) return Failure(options.method, why);
-    solution = LinearSolution(constraints, constraints, options, *linear, observations.size());
-  } else {
-    if (!linear && !initial)
-      return Failure(options.method, why + "; no initial estimate was given to refine from");
-    solution = PointPlaneSolver(constraints, options, linear ? *linear : *initial).Run();
-    ResizePerObservation(observations.size(), &solution);
-  }
-  return solution;
+  return SolveLinearThenRefine(constraints, constraints, options, initial, observations.size());
 }
 
 }  // namespace calibench

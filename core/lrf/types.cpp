@@ -17,7 +17,6 @@ Plane TrianglePlane(const Vec3& p, const Vec3& q, const Vec3& r) {
 // Eq. (7) and the scan corners F, G, H are then ill-defined.
 constexpr double kMinFaceAngleDeg = 5.0;
 
-
 }  // namespace
 
 bool FailCheck(std::string* why, const std::string& message) {

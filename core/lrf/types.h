@@ -27,6 +27,10 @@
 
 namespace calibench {
 
+// For the Check(std::string* why) methods of options and specs: sets *why (when given) to
+// `message` and returns false.
+bool FailCheck(std::string* why, const std::string& message);
+
 // A ROS-LaserScan-like scan. ranges[i] is at angle angle_min + i * angle_increment (radians,
 // counter-clockwise from +x about +z); NaN or outside [range_min, range_max] = no return.
 struct LaserScan {
@@ -135,5 +139,26 @@ struct LrfBoardObservation {
   Plane camera_plane;              // camera frame, normal towards the camera (d > 0)
   Mat4 camera_plane_covariance = Mat4::Zero();
 };
+
+// Shared by the two feature extractors (scan_lines.h, depth_planes.h).
+
+// The face's name in reasons: "base PBDQ", "face ABC", "face ACD" for faces 0, 1, 2.
+const char* FaceName(int face);
+// The angle between two unit normals (of lines or planes), ignoring their sign (degrees).
+double UnsignedAngleDeg(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+// "<a> and <b> are within <limit_deg>° of parallel (<angle_deg>°)": why two lines or two faces
+// are refused as near parallel (their intersection would be ill-conditioned).
+std::string NearParallelReason(const std::string& a, const std::string& b, double limit_deg,
+                               double angle_deg);
+// Why an extractor's options (called `what` in the reason) or the target cannot be used, in
+// words; empty when both pass their Check.
+template <typename Options>
+std::string InputProblem(const Options& options, const std::string& what,
+                         const ThreeFaceTarget& target) {
+  std::string why;
+  if (!options.Check(&why)) return "bad " + what + ": " + why;
+  if (!target.Check(&why)) return "bad target: " + why;
+  return "";
+}
 
 }  // namespace calibench

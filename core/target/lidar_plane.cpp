@@ -155,45 +155,15 @@ std::vector<int> SelectBrushRegion(const LidarImage& image, const std::vector<in
 
 std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
                                                   const std::vector<int>& indices) {
-  if (indices.size() < 4) return std::nullopt;
-  Vec3 centroid = Vec3::Zero();
-  for (int i : indices) centroid += cloud.points[i].cast<double>();
-  centroid /= static_cast<double>(indices.size());
-  Mat3 scatter = Mat3::Zero();
-  for (int i : indices) {
-    const Vec3 p = cloud.points[i].cast<double>() - centroid;
-    scatter += p * p.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Mat3> eigen(scatter);
-  // Points on a line (or a single ring) do not define a plane.
-  if (eigen.eigenvalues()[1] < 1e-6 * eigen.eigenvalues()[2] || eigen.eigenvalues()[1] <= 0)
-    return std::nullopt;
+  // Unweighted: every return counts alike (FitPlaneRangeMl models the range noise instead).
+  const std::optional<PlaneFit> plane_fit = FitPlane(cloud.points, indices);
+  if (!plane_fit) return std::nullopt;
   LidarPlaneFit fit;
-  fit.plane = OrientTowardsOrigin(
-      Plane{eigen.eigenvectors().col(0), -eigen.eigenvectors().col(0).dot(centroid)});
+  fit.plane = plane_fit->plane;
+  fit.covariance = plane_fit->covariance;
+  fit.rms_m = plane_fit->rms_m;
   fit.inliers = indices;
   fit.num_candidates = static_cast<int>(indices.size());
-  double sum_sq = 0.0;
-  for (int i : indices)
-    sum_sq += std::pow(fit.plane.SignedDistance(cloud.points[i].cast<double>()), 2);
-  fit.rms_m = std::sqrt(sum_sq / indices.size());
-  // Covariance: residual r_i = n·x_i + d, with n perturbed in its tangent plane (basis B):
-  // J_i = [x_iᵀ B, 1], Σ = σ² (JᵀJ)⁻¹ with σ² from the residuals (3 parameters).
-  Eigen::Matrix<double, 3, 2> tangent;
-  tangent.col(0) = fit.plane.normal.unitOrthogonal();
-  tangent.col(1) = fit.plane.normal.cross(tangent.col(0));
-  Mat3 normal_matrix = Mat3::Zero();
-  for (int i : indices) {
-    Eigen::RowVector3d j;
-    j << cloud.points[i].cast<double>().transpose() * tangent, 1.0;
-    normal_matrix += j.transpose() * j;
-  }
-  const double dof = std::max<double>(1.0, static_cast<double>(indices.size()) - 3.0);
-  const Mat3 local_cov = (sum_sq / dof) * normal_matrix.inverse();
-  Eigen::Matrix<double, 4, 3> to_coefficients = Eigen::Matrix<double, 4, 3>::Zero();
-  to_coefficients.topLeftCorner<3, 2>() = tangent;
-  to_coefficients(3, 2) = 1.0;
-  fit.covariance = to_coefficients * local_cov * to_coefficients.transpose();
   return fit;
 }
 

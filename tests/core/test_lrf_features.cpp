@@ -9,7 +9,9 @@
 #include <random>
 #include <sstream>
 
-#include "core/lrf/features.h"
+#include "core/lrf/board_in_scan.h"
+#include "core/lrf/depth_planes.h"
+#include "core/lrf/scan_lines.h"
 #include "core/sim/lrf_sim.h"
 #include "tests/test_support.h"
 
