@@ -35,7 +35,8 @@ std::optional<Enum> ValueIn(const EnumName<Enum> (&table)[N], const std::string&
 template <typename Enum, size_t N>
 std::string NamesIn(const EnumName<Enum> (&table)[N]) {
   std::string names;
-  for (const EnumName<Enum>& entry : table) names += (names.empty() ? "" : ", ") + std::string(entry.name);
+  for (const EnumName<Enum>& entry : table)
+    names += (names.empty() ? "" : ", ") + std::string(entry.name);
   return names;
 }
 

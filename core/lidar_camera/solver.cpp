@@ -1,4 +1,3 @@
-#include "core/base/names.h"
 #include "core/lidar_camera/solver.h"
 
 #include <Eigen/Eigenvalues>
@@ -8,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+
+#include "core/base/names.h"
 
 namespace calibench {
 

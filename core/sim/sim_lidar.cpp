@@ -90,8 +90,9 @@ double SurfaceIntensity(const RayHit& hit, const BoardPrint& print) {
 }  // namespace
 
 namespace {
-constexpr EnumName<LidarModel> kLidarModelNames[] = {
-    {LidarModel::kHdl64, "hdl64"}, {LidarModel::kVlp16, "vlp16"}, {LidarModel::kOs0_128, "os0-128"}};
+constexpr EnumName<LidarModel> kLidarModelNames[] = {{LidarModel::kHdl64, "hdl64"},
+                                                     {LidarModel::kVlp16, "vlp16"},
+                                                     {LidarModel::kOs0_128, "os0-128"}};
 }  // namespace
 
 std::string LidarModelName(LidarModel model) { return NameIn(kLidarModelNames, model); }

@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "core/lidar_camera/pipeline.h"
 #include "core/estimation/uncertainty.h"
+#include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/sim/sim.h"
 #include "tests/test_support.h"

@@ -9,8 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/lidar_camera/pipeline.h"
 #include "core/estimation/uncertainty.h"
+#include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/result_io.h"
 #include "tests/acfr_manifest.h"
 #include "tests/test_support.h"

@@ -55,13 +55,18 @@ void BrushOneAndRejectOne(Controller& controller) {
   controller.Apply(RunSolver{});
 }
 
+// Opens the UI dataset with its session at session_path, edits it as above and solves.
+Snapshot EditedAndSolved(Controller& controller, const std::filesystem::path& session_path) {
+  controller.OpenDataset(test::UiDataset(), session_path);
+  BrushOneAndRejectOne(controller);
+  return Loaded(controller);
+}
+
 TEST(OnePipeline, WorkbenchAndCalibrateAgreeBitForBit) {
   const auto dir = test::TempDir("one_pipeline");
   const auto session_path = dir / "calibench.session.json";
   Controller controller;
-  controller.OpenDataset(test::UiDataset(), session_path);
-  BrushOneAndRejectOne(controller);
-  const Snapshot gui = Loaded(controller);
+  const Snapshot gui = EditedAndSolved(controller, session_path);
   ASSERT_TRUE(gui.solver.result) << gui.solver.failure;
   EXPECT_FALSE(gui.pairs[1].brush_from_seed);
   EXPECT_EQ(gui.pairs[2].status, PairStatus::kRejected);
@@ -98,9 +103,7 @@ TEST(OnePipeline, CalibrateWithTheSessionFlagMatchesTheWorkbench) {
   const auto dir = test::TempDir("one_pipeline_cli");
   const auto session_path = dir / "calibench.session.json";
   Controller controller;
-  controller.OpenDataset(test::UiDataset(), session_path);
-  BrushOneAndRejectOne(controller);
-  const Snapshot gui = Loaded(controller);
+  const Snapshot gui = EditedAndSolved(controller, session_path);
   ASSERT_TRUE(gui.solver.result) << gui.solver.failure;
 
   const auto out = dir / "result.json";

@@ -278,19 +278,22 @@ void Controller::RefitLidar(int index) {
   }
 }
 
+bool Controller::SolvesWith(const PairView& pair) {
+  return pair.status == PairStatus::kAccepted && pair.lidar && pair.camera;
+}
+
 SolverResult Controller::ResultForCurrentPairs() const {
   SolverResult result = *state_.solver.result;
-  std::vector<PairFeatures> features;
   std::vector<std::string> accepted;
-  for (const PairView& pair : state_.pairs) {
-    features.push_back(FeaturesOf(pair));
-    if (features.back().status == PairStatus::kAccepted) accepted.push_back(pair.id);
-  }
+  for (const PairView& pair : state_.pairs)
+    if (SolvesWith(pair)) accepted.push_back(pair.id);
   // The solve's own figures while its pairs are still the accepted ones (they include the
   // outliers it gated); after accept/reject since, or after a reload, the solver's residuals at
   // the shown estimate over the pairs accepted now.
   if (accepted == state_.solver.solved_pair_ids && result.residuals.size() == accepted.size())
     return result;
+  std::vector<PairFeatures> features;
+  for (const PairView& pair : state_.pairs) features.push_back(FeaturesOf(pair));
   EvaluateAtSolution(features, SolverOptionsFromState(), &result);
   return result;
 }
@@ -301,7 +304,7 @@ void Controller::RecomputeResiduals() {
   const SolverResult at_estimate = ResultForCurrentPairs();
   size_t solved = 0;
   for (PairView& pair : state_.pairs) {
-    if (FeaturesOf(pair).status != PairStatus::kAccepted) continue;
+    if (!SolvesWith(pair)) continue;
     pair.residual = at_estimate.residuals[solved];
     pair.robust_weight = at_estimate.robust_weights[solved];
     ++solved;
@@ -316,7 +319,7 @@ PairFeatures Controller::FeaturesOf(const PairView& pair) {
   features.lidar = pair.lidar;
   features.camera = pair.camera;
   // An accepted pair that lost a plane cannot be solved with.
-  if (features.status == PairStatus::kAccepted && !(features.lidar && features.camera))
+  if (features.status == PairStatus::kAccepted && !SolvesWith(pair))
     features.status = PairStatus::kFailed;
   return features;
 }

@@ -145,6 +145,7 @@ class Controller : public ControllerState<Snapshot> {
   SolverOptions SolverOptionsFromState() const;          // the user's choices over pipeline_.solver
   PipelineOptions PipelineOptionsFromState() const;      // pipeline_ with those solver choices
   static PairFeatures FeaturesOf(const PairView& pair);  // the pipeline's view of a pair
+  static bool SolvesWith(const PairView& pair);          // accepted, with both planes
   void ComputeReprojection(int index);
   void EnsureSelectedImage();
   // The solve's result with residuals and robust weights for the pairs accepted now, in order
