@@ -16,67 +16,63 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 using json_io::Fail;
-using json_io::Get;
 
 namespace {
 
 constexpr char kFormat[] = "calibench.dataset.v1";
 
-PairEntry ParsePair(const json& p, const fs::path& manifest, std::set<std::string>* seen) {
-  const fs::path base = manifest.parent_path();
+PairEntry ParsePair(const json_io::Fields& p, std::set<std::string>* seen) {
+  const fs::path base = p.file().parent_path();
   PairEntry pair;
-  pair.id = Get<std::string>(p, "id", manifest, "pairs[].");
-  json_io::CheckUniquePairId(pair.id, seen, manifest);
-  const std::string where = "pairs[" + pair.id + "].";
-  pair.cloud = json_io::Resolve(base, Get<std::string>(p, "cloud", manifest, where));
-  pair.image = json_io::Resolve(base, Get<std::string>(p, "image", manifest, where));
-  if (p.contains("lidar_seed")) {
-    const json& s = p.at("lidar_seed");
-    const auto point = Get<std::vector<double>>(s, "point", manifest, "lidar_seed.");
-    if (point.size() != 3)
-      Fail(manifest, "pair " + pair.id + ": lidar_seed.point must be [x, y, z]");
-    LidarSeed seed{Vec3(point[0], point[1], point[2]),
-                   Get<double>(s, "radius", manifest, "lidar_seed.")};
+  pair.id = p.String("id");
+  json_io::CheckUniquePairId(pair.id, seen, p.file());
+  pair.cloud = json_io::Resolve(base, p.String("cloud"));
+  pair.image = json_io::Resolve(base, p.String("image"));
+  if (p.Has("lidar_seed")) {
+    const json_io::Fields s = p.Object("lidar_seed");
+    const auto point = s.Get<std::vector<double>>("point");
+    if (point.size() != 3) s.Fail("point", "must be [x, y, z]");
+    LidarSeed seed{Vec3(point[0], point[1], point[2]), s.Number("radius")};
     if (!(seed.radius > 0) || !seed.point.allFinite())
-      Fail(manifest, "pair " + pair.id + ": lidar_seed needs a finite point and a radius > 0");
+      p.Fail("lidar_seed", "needs a finite point and a radius > 0");
     pair.lidar_seed = seed;
   }
   return pair;
 }
 
-SimulationRecord ParseSimulation(const json& sim, const fs::path& manifest) {
-  const std::string where = "simulation.";
+SimulationRecord ParseSimulation(const json_io::Fields& sim) {
   SimulationRecord record;
-  record.lidar_model = Get<std::string>(sim, "lidar_model", manifest, where);
-  record.num_pairs = Get<int>(sim, "num_pairs", manifest, where);
-  record.min_distance_m = Get<double>(sim, "min_distance_m", manifest, where);
-  record.max_distance_m = Get<double>(sim, "max_distance_m", manifest, where);
-  record.max_tilt_deg = Get<double>(sim, "max_tilt_deg", manifest, where);
-  record.lidar_range_noise_m = Get<double>(sim, "lidar_range_noise_m", manifest, where);
+  record.lidar_model = sim.String("lidar_model");
+  record.num_pairs = sim.Int("num_pairs");
+  record.min_distance_m = sim.Number("min_distance_m");
+  record.max_distance_m = sim.Number("max_distance_m");
+  record.max_tilt_deg = sim.Number("max_tilt_deg");
+  record.lidar_range_noise_m = sim.Number("lidar_range_noise_m");
   // Manifests written before the offset existed have none.
-  record.lidar_range_offset_m = json_io::GetOr(sim, "lidar_range_offset_m", 0.0, manifest, where);
-  record.image_noise = Get<double>(sim, "image_noise", manifest, where);
-  record.clutter = Get<bool>(sim, "clutter", manifest, where);
-  record.seed_radius_m = Get<double>(sim, "seed_radius_m", manifest, where);
-  record.seed = Get<std::uint64_t>(sim, "seed", manifest, where);
+  record.lidar_range_offset_m = sim.GetOr("lidar_range_offset_m", 0.0);
+  record.image_noise = sim.Number("image_noise");
+  record.clutter = sim.Bool("clutter");
+  record.seed_radius_m = sim.Number("seed_radius_m");
+  record.seed = sim.Get<std::uint64_t>("seed");
   return record;
 }
 
 Dataset LoadManifest(const fs::path& manifest) {
-  const json root = json_io::ReadJson(manifest);
+  const json document = json_io::ReadJson(manifest);
+  const json_io::Fields root(document, manifest);
   Dataset dataset;
   dataset.manifest = manifest;
-  json_io::CheckFormat(root, kFormat, manifest);
-  dataset.camera = json_io::ParseManifestCamera(root, manifest);
-  dataset.target = json_io::ParseTarget(json_io::Field(root, "target", manifest), manifest);
-  if (root.contains("lidar")) dataset.lidar_rings = root.at("lidar").value("rings", 0);
+  json_io::CheckFormat(root, kFormat);
+  dataset.camera = json_io::ParseManifestCamera(root);
+  dataset.target = json_io::ParseTarget(root.Object("target"));
+  if (root.Has("lidar")) dataset.lidar_rings = root.Object("lidar").GetOr("rings", 0);
   std::set<std::string> seen;
-  for (const json& p : json_io::PairsArray(root, manifest))
-    dataset.pairs.push_back(ParsePair(p, manifest, &seen));
-  dataset.cam_from_lidar_ground_truth =
-      json_io::OptionalPose(root, "ground_truth", "cam_from_lidar", manifest);
-  if (root.contains("simulation"))
-    dataset.simulation = ParseSimulation(root.at("simulation"), manifest);
+  const json& pairs = json_io::PairsArray(root);
+  for (size_t i = 0; i < pairs.size(); ++i)
+    dataset.pairs.push_back(
+        ParsePair(json_io::Fields(pairs[i], manifest, "pairs[" + std::to_string(i) + "]"), &seen));
+  dataset.cam_from_lidar_ground_truth = json_io::OptionalPose(root, "ground_truth", "cam_from_lidar");
+  if (root.Has("simulation")) dataset.simulation = ParseSimulation(root.Object("simulation"));
   return dataset;
 }
 
@@ -91,9 +87,9 @@ Dataset LoadFolder(const fs::path& dir) {
   if (!fs::exists(target_file))
     Fail(dir, "folder dataset has no target.json (and no dataset.json)");
   dataset.camera = LoadCameraFile(camera_file);
-  json target = json_io::ReadJson(target_file);
-  dataset.target =
-      json_io::ParseTarget(target.contains("target") ? target.at("target") : target, target_file);
+  const json target_document = json_io::ReadJson(target_file);
+  const json_io::Fields target(target_document, target_file);
+  dataset.target = json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
   auto list = [&](const char* sub) {
     std::map<std::string, fs::path> by_stem;
     if (!fs::is_directory(dir / sub)) Fail(dir, std::string("folder dataset has no ") + sub + "/");

@@ -24,33 +24,26 @@ json ReadJson(const fs::path& path) {
   }
 }
 
-const json& Field(const json& node, const char* key, const fs::path& file,
-                  const std::string& where) {
-  if (!node.is_object() || !node.contains(key)) Fail(file, "missing field '" + where + key + "'");
-  return node.at(key);
+void CheckFormat(const Fields& root, const std::string& expected) {
+  const std::string format = root.Has("format") && root.At("format").is_string()
+                                 ? root.String("format")
+                                 : std::string("missing");
+  if (format != expected)
+    Fail(root.file(), "format is '" + format + "', expected '" + expected + "'");
 }
 
-void CheckFormat(const json& root, const std::string& expected, const fs::path& manifest) {
-  const std::string format = root.value("format", "");
-  if (format != expected) Fail(manifest, "format is '" + format + "', expected '" + expected + "'");
-}
-
-const json& PairsArray(const json& root, const fs::path& manifest) {
-  if (!root.contains("pairs") || !root.at("pairs").is_array())
-    Fail(manifest, "missing array 'pairs'");
-  return root.at("pairs");
-}
+const json& PairsArray(const Fields& root) { return root.Array("pairs"); }
 
 void CheckUniquePairId(const std::string& id, std::set<std::string>* seen,
                        const fs::path& manifest) {
   if (!seen->insert(id).second) Fail(manifest, "pair id '" + id + "' appears twice");
 }
 
-std::optional<Pose> OptionalPose(const json& root, const char* group, const char* key,
-                                 const fs::path& manifest) {
-  if (!root.contains(group) || !root.at(group).is_object() || !root.at(group).contains(key))
-    return std::nullopt;
-  return PoseFromJson(root.at(group).at(key), manifest, std::string(group) + "." + key);
+std::optional<Pose> OptionalPose(const Fields& root, const char* group, const char* key) {
+  if (!root.Has(group)) return std::nullopt;
+  const Fields poses = root.Object(group);
+  if (!poses.Has(key)) return std::nullopt;
+  return PoseFromJson(poses.At(key), root.file(), poses.Path(key));
 }
 
 fs::path Resolve(const fs::path& base_dir, const std::string& p) {
@@ -58,46 +51,49 @@ fs::path Resolve(const fs::path& base_dir, const std::string& p) {
   return path.is_absolute() ? path : (base_dir / path).lexically_normal();
 }
 
-CameraModel ParseInlineCamera(const json& node, const fs::path& file) {
+CameraModel ParseInlineCamera(const Fields& node) {
   CameraModel camera;
-  const std::string model = Get<std::string>(node, "model", file, "camera.");
+  const std::string model = node.String("model");
   const auto type = ParseCameraModelName(model);
   if (!type)
-    Fail(file, "camera.model '" + model + "' is unknown (use pinhole-radtan or kannala-brandt)");
+    node.Fail("model", "'" + model + "' is unknown (use pinhole-radtan or kannala-brandt)");
   camera.type = *type;
-  GetPinhole(node, file, "camera.", &camera);
-  camera.distortion = Get<std::vector<double>>(node, "distortion", file, "camera.");
+  GetPinhole(node, &camera);
+  camera.distortion = node.Get<std::vector<double>>("distortion");
   return camera;
 }
 
-BoardSpec ParseTarget(const json& node, const fs::path& file) {
+BoardSpec ParseTarget(const Fields& node) {
   BoardSpec board;
-  const std::string type = Get<std::string>(node, "type", file, "target.");
+  const std::string type = node.String("type");
+  auto pair_of_ints = [&](const char* key) {
+    const auto values = node.Get<std::vector<int>>(key);
+    if (values.size() != 2) node.Fail(key, "must be [cols, rows]");
+    return values;
+  };
   if (type == "checkerboard") {
     board.type = BoardType::kCheckerboard;
-    const auto corners = Get<std::vector<int>>(node, "inner_corners", file, "target.");
-    if (corners.size() != 2) Fail(file, "target.inner_corners must be [cols, rows]");
+    const auto corners = pair_of_ints("inner_corners");
     board.cols = corners[0];
     board.rows = corners[1];
   } else if (type == "charuco") {
     board.type = BoardType::kCharuco;
-    const auto squares = Get<std::vector<int>>(node, "squares", file, "target.");
-    if (squares.size() != 2) Fail(file, "target.squares must be [cols, rows]");
+    const auto squares = pair_of_ints("squares");
     board.cols = squares[0];
     board.rows = squares[1];
-    board.marker_size = Get<double>(node, "marker_size", file, "target.");
-    board.dictionary = Get<std::string>(node, "dictionary", file, "target.");
+    board.marker_size = node.Number("marker_size");
+    board.dictionary = node.String("dictionary");
   } else {
-    Fail(file, "target.type '" + type + "' is unknown (use checkerboard or charuco)");
+    node.Fail("type", "'" + type + "' is unknown (use checkerboard or charuco)");
   }
-  board.square_size = Get<double>(node, "square_size", file, "target.");
-  if (node.contains("board_size")) {
-    const auto size = Get<std::vector<double>>(node, "board_size", file, "target.");
-    if (size.size() != 2) Fail(file, "target.board_size must be [width, height] in metres");
+  board.square_size = node.Number("square_size");
+  if (node.Has("board_size")) {
+    const auto size = node.Get<std::vector<double>>("board_size");
+    if (size.size() != 2) node.Fail("board_size", "must be [width, height] in metres");
     board.board_width = size[0];
     board.board_height = size[1];
   }
-  CheckOrFail(board, file, "target");
+  CheckOrFail(board, node.file(), "target");
   return board;
 }
 
@@ -123,7 +119,7 @@ json MatrixToJson(const Mat4& m) {
   return rows;
 }
 
-Pose PoseFromJson(const json& node, const fs::path& file, const std::string& name) {
+Mat4 RigidMatrixFromJson(const json& node, const fs::path& file, const std::string& name) {
   std::vector<std::vector<double>> rows;
   try {
     rows = node.get<std::vector<std::vector<double>>>();
@@ -141,8 +137,13 @@ Pose PoseFromJson(const json& node, const fs::path& file, const std::string& nam
       rotation.determinant() < 0 || (m.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9)
     Fail(file,
          name + " is not a rigid transform (rotation not orthonormal or last row not 0 0 0 1)");
+  return m;
+}
+
+Pose PoseFromJson(const json& node, const fs::path& file, const std::string& name) {
+  const Mat4 m = RigidMatrixFromJson(node, file, name);
   Pose pose = Pose::Identity();
-  pose.linear() = NearestRotation(rotation);
+  pose.linear() = NearestRotation(m.topLeftCorner<3, 3>());
   pose.translation() = m.topRightCorner<3, 1>();
   return pose;
 }
@@ -159,20 +160,19 @@ json PoseToResultJson(const Pose& pose) {
       {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
 }
 
-CameraModel ParseManifestCamera(const json& root, const fs::path& manifest) {
-  const fs::path base = manifest.parent_path();
+CameraModel ParseManifestCamera(const Fields& root) {
+  const fs::path base = root.file().parent_path();
   CameraModel camera;
-  if (root.contains("camera_file")) {
-    camera = LoadCameraFile(Resolve(base, Get<std::string>(root, "camera_file", manifest, "")));
-  } else if (root.contains("camera")) {
-    const json& cam = root.at("camera");
-    camera = cam.contains("file")
-                 ? LoadCameraFile(Resolve(base, Get<std::string>(cam, "file", manifest, "camera.")))
-                 : ParseInlineCamera(cam, manifest);
+  if (root.Has("camera_file")) {
+    camera = LoadCameraFile(Resolve(base, root.String("camera_file")));
+  } else if (root.Has("camera")) {
+    const Fields cam = root.Object("camera");
+    camera = cam.Has("file") ? LoadCameraFile(Resolve(base, cam.String("file")))
+                             : ParseInlineCamera(cam);
   } else {
-    Fail(manifest, "neither 'camera' nor 'camera_file' is given");
+    Fail(root.file(), "neither 'camera' nor 'camera_file' is given");
   }
-  CheckOrFail(camera, manifest, "camera");
+  CheckOrFail(camera, root.file(), "camera");
   return camera;
 }
 

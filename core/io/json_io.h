@@ -1,5 +1,5 @@
 // JSON helpers shared by the manifest readers (io/dataset.cpp, lrf/dataset.cpp) and the result
-// writer (results/result_file.cpp). Internal: include it from .cpp files only (it pulls
+// writer (results/result_file.cpp); fields are read with json_fields.h. Internal: include it from .cpp files only (it pulls
 // in nlohmann/json). Every reader throws IoError naming the file and the problem.
 #pragma once
 
@@ -12,6 +12,7 @@
 #include "core/base/types.h"
 #include "core/camera/camera.h"
 #include "core/io/dataset.h"
+#include "core/io/json_fields.h"
 
 namespace calibench::json_io {
 
@@ -22,29 +23,6 @@ using nlohmann::json;
 // Parses a JSON file; IoError when missing, unreadable or not JSON.
 json ReadJson(const std::filesystem::path& path);
 
-// node[key] as T; IoError "missing field '<where><key>'" or "has the wrong type".
-template <typename T>
-T Get(const json& node, const char* key, const std::filesystem::path& file,
-      const std::string& where) {
-  if (!node.is_object() || !node.contains(key)) Fail(file, "missing field '" + where + key + "'");
-  try {
-    return node.at(key).get<T>();
-  } catch (const json::exception& e) {
-    Fail(file, "field '" + where + key + "' has the wrong type: " + e.what());
-  }
-}
-
-// node[key] as T when present, else `fallback`; IoError as Get when present with the wrong type.
-template <typename T>
-T GetOr(const json& node, const char* key, T fallback, const std::filesystem::path& file,
-        const std::string& where) {
-  return node.contains(key) ? Get<T>(node, key, file, where) : fallback;
-}
-
-// node[key] itself; IoError "missing field '<where><key>'".
-const json& Field(const json& node, const char* key, const std::filesystem::path& file,
-                  const std::string& where = "");
-
 // IoError "<what>: <why>" naming the file unless spec.Check(&why) passes (targets, intrinsics).
 template <typename Spec>
 void CheckOrFail(const Spec& spec, const std::filesystem::path& file, const std::string& what) {
@@ -53,16 +31,15 @@ void CheckOrFail(const Spec& spec, const std::filesystem::path& file, const std:
 }
 
 // The pinhole fields of an intrinsics object (CameraModel, DepthIntrinsics): width and height
-// (pixels), fx, fy, cx, cy (pixels), read from node (named `where` in messages) and written back.
+// (pixels), fx, fy, cx, cy (pixels), read from `node` and written back.
 template <typename Intrinsics>
-void GetPinhole(const json& node, const std::filesystem::path& file, const std::string& where,
-                Intrinsics* in) {
-  in->width = Get<int>(node, "width", file, where);
-  in->height = Get<int>(node, "height", file, where);
-  in->fx = Get<double>(node, "fx", file, where);
-  in->fy = Get<double>(node, "fy", file, where);
-  in->cx = Get<double>(node, "cx", file, where);
-  in->cy = Get<double>(node, "cy", file, where);
+void GetPinhole(const Fields& node, Intrinsics* in) {
+  in->width = node.Int("width");
+  in->height = node.Int("height");
+  in->fx = node.Number("fx");
+  in->fy = node.Number("fy");
+  in->cx = node.Number("cx");
+  in->cy = node.Number("cy");
 }
 template <typename Intrinsics>
 json PinholeToJson(const Intrinsics& in) {
@@ -71,27 +48,25 @@ json PinholeToJson(const Intrinsics& in) {
 }
 
 // A manifest's "format"; IoError "format is '<found>', expected '<expected>'".
-void CheckFormat(const json& root, const std::string& expected,
-                 const std::filesystem::path& manifest);
+void CheckFormat(const Fields& root, const std::string& expected);
 // A manifest's "pairs"; IoError "missing array 'pairs'".
-const json& PairsArray(const json& root, const std::filesystem::path& manifest);
+const json& PairsArray(const Fields& root);
 // Records a pair id; IoError "pair id '<id>' appears twice" when `seen` holds it already.
 void CheckUniquePairId(const std::string& id, std::set<std::string>* seen,
                        const std::filesystem::path& manifest);
 // root[group][key] as a rigid transform (PoseFromJson, named "<group>.<key>"); nullopt when
 // either is absent.
-std::optional<Pose> OptionalPose(const json& root, const char* group, const char* key,
-                                 const std::filesystem::path& manifest);
+std::optional<Pose> OptionalPose(const Fields& root, const char* group, const char* key);
 
 // An absolute path, or one relative to base_dir.
 std::filesystem::path Resolve(const std::filesystem::path& base_dir, const std::string& path);
 
 // The inline "camera" object of a manifest (model, size, focal lengths, centre, distortion).
-CameraModel ParseInlineCamera(const json& node, const std::filesystem::path& file);
+CameraModel ParseInlineCamera(const Fields& camera);
 
 // The manifest's camera: "camera_file" (OpenCV / ROS / Kalibr file), "camera": {"file": ...}, or
 // an inline "camera" object; validated with CameraModel::Check.
-CameraModel ParseManifestCamera(const json& root, const std::filesystem::path& manifest);
+CameraModel ParseManifestCamera(const Fields& root);
 // The inline form ParseInlineCamera reads.
 json CameraToJson(const CameraModel& camera);
 
@@ -102,11 +77,14 @@ std::string PathForManifest(const std::filesystem::path& path,
 
 // A "target" object: checkerboard (inner_corners) or charuco (squares, marker_size,
 // dictionary), square_size, optional board_size; validated with BoardSpec::Check.
-BoardSpec ParseTarget(const json& node, const std::filesystem::path& file);
+BoardSpec ParseTarget(const Fields& target);
 json TargetToJson(const BoardSpec& board);
 
-// A 4x4 rigid transform as rows; PoseFromJson checks orthonormality and the last row.
+// A 4x4 rigid transform as rows. RigidMatrixFromJson checks orthonormality (1e-4) and the last
+// row and returns the numbers as written; PoseFromJson also projects onto the nearest rotation.
 json MatrixToJson(const Mat4& m);
+Mat4 RigidMatrixFromJson(const json& node, const std::filesystem::path& file,
+                         const std::string& name);
 Pose PoseFromJson(const json& node, const std::filesystem::path& file, const std::string& name);
 
 // The result file's form of a transform: matrix, translation_m, quaternion_xyzw.

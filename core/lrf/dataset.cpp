@@ -17,23 +17,22 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 using json_io::Fail;
-using json_io::Get;
-using json_io::GetOr;
+using json_io::Fields;
 
 namespace {
 
 constexpr char kFormat[] = "calibench.lrf-dataset.v1";
 constexpr double kDeg = M_PI / 180.0;
 
-ThreeFaceTarget ParseThreeFace(const json& node, const fs::path& file) {
+ThreeFaceTarget ParseThreeFace(const Fields& node) {
   ThreeFaceTarget t;
-  t.base_width = GetOr(node, "base_width", t.base_width, file, "target.");
-  t.base_height = GetOr(node, "base_height", t.base_height, file, "target.");
-  t.tent_half_width = GetOr(node, "tent_half_width", t.tent_half_width, file, "target.");
-  t.apex_y = GetOr(node, "apex_y", t.apex_y, file, "target.");
-  t.foot_y = GetOr(node, "foot_y", t.foot_y, file, "target.");
-  t.ridge_height = GetOr(node, "ridge_height", t.ridge_height, file, "target.");
-  json_io::CheckOrFail(t, file, "target");
+  t.base_width = node.GetOr("base_width", t.base_width);
+  t.base_height = node.GetOr("base_height", t.base_height);
+  t.tent_half_width = node.GetOr("tent_half_width", t.tent_half_width);
+  t.apex_y = node.GetOr("apex_y", t.apex_y);
+  t.foot_y = node.GetOr("foot_y", t.foot_y);
+  t.ridge_height = node.GetOr("ridge_height", t.ridge_height);
+  json_io::CheckOrFail(t, node.file(), "target");
   return t;
 }
 
@@ -47,11 +46,11 @@ json ThreeFaceToJson(const ThreeFaceTarget& t) {
           {"ridge_height", t.ridge_height}};
 }
 
-DepthIntrinsics ParseDepthCamera(const json& node, const fs::path& file) {
+DepthIntrinsics ParseDepthCamera(const Fields& node) {
   DepthIntrinsics in;
-  json_io::GetPinhole(node, file, "depth_camera.", &in);
-  in.depth_scale = GetOr(node, "depth_scale", in.depth_scale, file, "depth_camera.");
-  json_io::CheckOrFail(in, file, "depth_camera");
+  json_io::GetPinhole(node, &in);
+  in.depth_scale = node.GetOr("depth_scale", in.depth_scale);
+  json_io::CheckOrFail(in, node.file(), "depth_camera");
   return in;
 }
 
@@ -61,40 +60,38 @@ json DepthCameraToJson(const DepthIntrinsics& in) {
   return camera;
 }
 
-ScanRegion ParseScanRegion(const json& node, const fs::path& file, const std::string& where) {
+ScanRegion ParseScanRegion(const Fields& node) {
   ScanRegion region;
-  region.angle_min = GetOr(node, "angle_min_deg", -180.0, file, where) * kDeg;
-  region.angle_max = GetOr(node, "angle_max_deg", 180.0, file, where) * kDeg;
-  region.range_min = GetOr(node, "range_min", region.range_min, file, where);
-  region.range_max = GetOr(node, "range_max", region.range_max, file, where);
+  region.angle_min = node.GetOr("angle_min_deg", -180.0) * kDeg;
+  region.angle_max = node.GetOr("angle_max_deg", 180.0) * kDeg;
+  region.range_min = node.GetOr("range_min", region.range_min);
+  region.range_max = node.GetOr("range_max", region.range_max);
   if (!(region.angle_min < region.angle_max && region.range_min >= 0 &&
         region.range_min < region.range_max))
-    Fail(file, where + " needs angle_min_deg < angle_max_deg and 0 <= range_min < range_max");
+    json_io::FailAt(node.file(), node.where(),
+                    "needs angle_min_deg < angle_max_deg and 0 <= range_min < range_max");
   return region;
 }
 
 // A pair's file, resolved against the manifest's folder. Existence is checked when the pair is
 // loaded, so that one missing file fails its pair (named) and keeps the others.
-fs::path PairFile(const json& p, const char* key, const fs::path& manifest,
-                  const std::string& where) {
-  return json_io::Resolve(manifest.parent_path(), Get<std::string>(p, key, manifest, where));
+fs::path PairFile(const Fields& p, const char* key) {
+  return json_io::Resolve(p.file().parent_path(), p.String(key));
 }
 
-LrfPairEntry ParsePair(const json& p, LrfTargetType type, const fs::path& manifest) {
+LrfPairEntry ParsePair(const Fields& p, LrfTargetType type) {
   LrfPairEntry pair;
-  pair.id = Get<std::string>(p, "id", manifest, "pairs[].");
-  const std::string where = "pairs[" + pair.id + "].";
-  pair.scan = PairFile(p, "scan", manifest, where);
+  pair.id = p.String("id");
+  pair.scan = PairFile(p, "scan");
   if (type == LrfTargetType::kThreeFace) {
-    if (p.contains("depth") == p.contains("cloud"))
-      Fail(manifest, "pair " + pair.id + " needs exactly one of 'depth' (PNG) or 'cloud' (PCD)");
-    if (p.contains("depth")) pair.depth = PairFile(p, "depth", manifest, where);
-    if (p.contains("cloud")) pair.depth_cloud = PairFile(p, "cloud", manifest, where);
+    if (p.Has("depth") == p.Has("cloud"))
+      Fail(p.file(), "pair " + pair.id + " needs exactly one of 'depth' (PNG) or 'cloud' (PCD)");
+    if (p.Has("depth")) pair.depth = PairFile(p, "depth");
+    if (p.Has("cloud")) pair.depth_cloud = PairFile(p, "cloud");
   } else {
-    pair.image = PairFile(p, "image", manifest, where);
+    pair.image = PairFile(p, "image");
   }
-  if (p.contains("scan_region"))
-    pair.scan_region = ParseScanRegion(p.at("scan_region"), manifest, where + "scan_region.");
+  if (p.Has("scan_region")) pair.scan_region = ParseScanRegion(p.Object("scan_region"));
   return pair;
 }
 
@@ -123,16 +120,14 @@ double RangeFromJson(const json& value, const fs::path& file, size_t index) {
 }
 
 LaserScan LoadScanJson(const fs::path& path) {
-  const json root = json_io::ReadJson(path);
-  if (!root.is_object()) Fail(path, "a LaserScan JSON must be an object");
+  const json document = json_io::ReadJson(path);
+  const Fields root(document, path);
   LaserScan scan;
-  scan.angle_min = Get<double>(root, "angle_min", path, "");
-  scan.angle_increment = Get<double>(root, "angle_increment", path, "");
-  scan.range_min = Get<double>(root, "range_min", path, "");
-  scan.range_max = Get<double>(root, "range_max", path, "");
-  if (!root.contains("ranges") || !root.at("ranges").is_array())
-    Fail(path, "missing array 'ranges'");
-  const json& ranges = root.at("ranges");
+  scan.angle_min = root.Number("angle_min");
+  scan.angle_increment = root.Number("angle_increment");
+  scan.range_min = root.Number("range_min");
+  scan.range_max = root.Number("range_max");
+  const json& ranges = root.Array("ranges");
   if (ranges.empty()) Fail(path, "'ranges' is empty");
   for (size_t i = 0; i < ranges.size(); ++i)
     scan.ranges.push_back(RangeFromJson(ranges[i], path, i));
@@ -197,36 +192,35 @@ LaserScan LoadScanPcd(const fs::path& path) {
 
 LrfDataset LoadLrfDataset(const fs::path& manifest_path) {
   const fs::path manifest = fs::absolute(manifest_path);
-  const json root = json_io::ReadJson(manifest);
-  if (!root.is_object()) Fail(manifest, "the manifest must be a JSON object");
-  json_io::CheckFormat(root, kFormat, manifest);
+  const json document = json_io::ReadJson(manifest);
+  const Fields root(document, manifest);
+  json_io::CheckFormat(root, kFormat);
   LrfDataset dataset;
   dataset.manifest = manifest;
-  const json& target = json_io::Field(root, "target", manifest);
-  const std::string type = Get<std::string>(target, "type", manifest, "target.");
+  const Fields target = root.Object("target");
+  const std::string type = target.String("type");
   if (type == "three-face") {
     dataset.target_type = LrfTargetType::kThreeFace;
-    dataset.three_face = ParseThreeFace(target, manifest);
-    dataset.depth_camera =
-        ParseDepthCamera(json_io::Field(root, "depth_camera", manifest), manifest);
+    dataset.three_face = ParseThreeFace(target);
+    dataset.depth_camera = ParseDepthCamera(root.Object("depth_camera"));
   } else if (type == "checkerboard" || type == "charuco") {
     dataset.target_type = LrfTargetType::kCheckerboard;
-    dataset.board = json_io::ParseTarget(target, manifest);
-    dataset.camera = json_io::ParseManifestCamera(root, manifest);
+    dataset.board = json_io::ParseTarget(target);
+    dataset.camera = json_io::ParseManifestCamera(root);
   } else {
-    Fail(manifest, "target.type '" + type + "' is unknown (use three-face or checkerboard)");
+    target.Fail("type", "'" + type + "' is unknown (use three-face or checkerboard)");
   }
   std::set<std::string> seen;
-  for (const json& p : json_io::PairsArray(root, manifest)) {
-    LrfPairEntry pair = ParsePair(p, dataset.target_type, manifest);
+  const json& pairs = json_io::PairsArray(root);
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    LrfPairEntry pair = ParsePair(Fields(pairs[i], manifest, "pairs[" + std::to_string(i) + "]"),
+                                  dataset.target_type);
     json_io::CheckUniquePairId(pair.id, &seen, manifest);
     dataset.pairs.push_back(std::move(pair));
   }
-  dataset.cam_from_lrf_ground_truth =
-      json_io::OptionalPose(root, "ground_truth", "cam_from_lrf", manifest);
-  dataset.initial_cam_from_lrf =
-      json_io::OptionalPose(root, "initial_guess", "cam_from_lrf", manifest);
-  dataset.right_from_left = json_io::OptionalPose(root, "stereo", "right_from_left", manifest);
+  dataset.cam_from_lrf_ground_truth = json_io::OptionalPose(root, "ground_truth", "cam_from_lrf");
+  dataset.initial_cam_from_lrf = json_io::OptionalPose(root, "initial_guess", "cam_from_lrf");
+  dataset.right_from_left = json_io::OptionalPose(root, "stereo", "right_from_left");
   return dataset;
 }
 

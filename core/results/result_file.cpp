@@ -1,7 +1,6 @@
 #include "core/results/result_file.h"
 
 #include <cstdio>
-#include <fstream>
 
 #include "core/base/atomic_file.h"
 #include "core/io/json_io.h"
@@ -80,39 +79,27 @@ void WriteResultJson(const std::filesystem::path& path, const json& root) {
 }
 
 LoadedResult LoadResult(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw IoError(path.string() + ": cannot open result file");
-  json root;
-  try {
-    root = json::parse(in);
-  } catch (const json::exception& e) {
-    throw IoError(path.string() + ": not valid JSON: " + e.what());
-  }
-  if (root.value("format", "") != "calibench.result.v1")
-    throw IoError(path.string() + ": format is not calibench.result.v1");
-  const char* key = root.contains("cam_from_lidar") ? "cam_from_lidar" : "cam_from_lrf";
-  if (!root.contains(key))
-    throw IoError(path.string() + ": has neither cam_from_lidar nor cam_from_lrf");
+  const json document = json_io::ReadJson(path);
+  const json_io::Fields root(document, path);
+  json_io::CheckFormat(root, "calibench.result.v1");
+  const char* key = root.Has("cam_from_lidar") ? "cam_from_lidar" : "cam_from_lrf";
+  if (!root.Has(key)) json_io::Fail(path, "has neither cam_from_lidar nor cam_from_lrf");
   LoadedResult result;
-  try {
-    const auto rows = root.at(key).at("matrix").get<std::vector<std::vector<double>>>();
-    if (rows.size() != 4) throw IoError(path.string() + ": " + key + ".matrix must be 4x4");
-    Mat4 m;
-    for (int r = 0; r < 4; ++r) {
-      if (rows[r].size() != 4) throw IoError(path.string() + ": " + key + ".matrix must be 4x4");
-      for (int c = 0; c < 4; ++c) m(r, c) = rows[r][c];
+  const json_io::Fields pose = root.Object(key);
+  // As written, bit for bit: a result read back equals the one the solver returned.
+  result.cam_from_source.matrix() =
+      json_io::RigidMatrixFromJson(pose.At("matrix"), path, pose.Path("matrix"));
+  // The uncertainty is optional, so that a hand-written transform can serve as --initial-guess.
+  if (root.Has("covariance_6x6")) {
+    const json& covariance = root.Array("covariance_6x6", 6);
+    for (int r = 0; r < 6; ++r) {
+      const std::string where = "covariance_6x6[" + std::to_string(r) + "]";
+      const json& row = json_io::ArrayAt(covariance[r], 6, path, where);
+      for (int c = 0; c < 6; ++c) result.covariance(r, c) = json_io::NumberAt(row[c], path, where);
     }
-    result.cam_from_source.matrix() = m;
-    if (root.contains("covariance_6x6")) {
-      const auto cov = root.at("covariance_6x6").get<std::vector<std::vector<double>>>();
-      for (int r = 0; r < 6 && r < static_cast<int>(cov.size()); ++r)
-        for (int c = 0; c < 6 && c < static_cast<int>(cov[r].size()); ++c)
-          result.covariance(r, c) = cov[r][c];
-    }
-    result.well_constrained = root.at("observability").value("well_constrained", false);
-  } catch (const json::exception& e) {
-    throw IoError(path.string() + ": malformed result: " + e.what());
   }
+  if (root.Has("observability"))
+    result.well_constrained = root.Object("observability").Bool("well_constrained");
   return result;
 }
 

@@ -120,7 +120,7 @@ TEST(Dataset, BadManifestsNameTheFileAndTheProblem) {
   ExpectRejected(m, "three_coefficients", "4, 5 or 8");
   m = good;
   m["camera"].erase("fx");
-  ExpectRejected(m, "no_fx", "missing field 'camera.fx'");
+  ExpectRejected(m, "no_fx", "camera.fx: missing");
   m = good;
   m["pairs"][1]["id"] = "p0";
   ExpectRejected(m, "duplicate_id", "appears twice");
