@@ -43,12 +43,11 @@ int IntAt(const json& value, const fs::path& file, const std::string& path) {
   FailAt(file, path, "must be an integer, found " + Shown(value));
 }
 
-const json& ArrayAt(const json& value, size_t size, const fs::path& file,
-                    const std::string& path) {
+const json& ArrayAt(const json& value, size_t size, const fs::path& file, const std::string& path) {
   if (!value.is_array() || (size > 0 && value.size() != size))
     FailAt(file, path,
-           "must be an array" + (size > 0 ? " of " + std::to_string(size) + " entries"
-                                          : std::string()));
+           "must be an array" +
+               (size > 0 ? " of " + std::to_string(size) + " entries" : std::string()));
   return value;
 }
 

@@ -91,8 +91,16 @@ class BoardPrint {
 
 // What a simulated sweep can hit, in the LiDAR frame: one board and, with clutter, a floor and the
 // four walls of a square room centred on the LiDAR (walls and floor unbounded).
+// A flat rectangle in the scene that is not the board: a panel on a wall, a door, a second board.
+// Its plane is its frame's xy plane, centred on the origin.
+struct ScenePanel {
+  Pose lidar_from_panel = Pose::Identity();
+  Vec2 size_m = Vec2::Zero();  // [x, y] extent, metres
+};
+
 struct LidarScene {
   Pose lidar_from_board = Pose::Identity();
+  std::vector<ScenePanel> panels;  // hit as walls are (SimSurface::kWall)
   bool clutter = true;
   double floor_z_m = -1.5;       // floor plane z = floor_z_m (metres, LiDAR frame)
   double wall_distance_m = 6.0;  // walls at x = ±d and y = ±d (metres, LiDAR frame)
@@ -121,8 +129,8 @@ struct LidarScan {
 };
 
 // Casts every beam × azimuth step (firing order: azimuth outer, rings inner) and keeps the nearest
-// hit among the board sheet and, with clutter, the floor and walls; rays without a hit within
-// [0.3 m, max_range_m] give no point. Range noise moves each point along its ray.
+// hit among the board sheet, the panels and, with clutter, the floor and walls; rays without a hit
+// within [0.3 m, max_range_m] give no point. Range noise moves each point along its ray.
 LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
                             const LidarScene& scene, const LidarScanOptions& options);
 

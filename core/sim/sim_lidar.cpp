@@ -62,6 +62,19 @@ void IntersectBoard(const Vec3& dir, const BoardGeometry& g, const BoardPrint& p
   *hit = RayHit{range, SimSurface::kBoard, xy};
 }
 
+void IntersectPanel(const Vec3& dir, const ScenePanel& panel, RayHit* hit) {
+  const BoardGeometry g = MakeBoardGeometry(panel.lidar_from_panel);
+  const double denom = g.normal.dot(dir);
+  if (std::abs(denom) < 1e-12) return;
+  const double range = g.offset / denom;
+  if (range <= 0.0 || range >= hit->range) return;
+  const Vec3 local = range * dir - g.origin;
+  if (std::abs(g.axis_x.dot(local)) > panel.size_m.x() / 2 ||
+      std::abs(g.axis_y.dot(local)) > panel.size_m.y() / 2)
+    return;
+  *hit = RayHit{range, SimSurface::kWall, Vec2::Zero()};
+}
+
 // The room: floor z = floor_z (below the sensor) and walls |x| = d, |y| = d around it.
 void IntersectRoom(const Vec3& dir, const LidarScene& scene, RayHit* hit) {
   const double d = scene.wall_distance_m;
@@ -161,6 +174,7 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
       RayHit hit;
       hit.range = beams.max_range_m;
       IntersectBoard(dir, board, print, &hit);
+      for (const ScenePanel& panel : scene.panels) IntersectPanel(dir, panel, &hit);
       if (scene.clutter) IntersectRoom(dir, scene, &hit);
       if (hit.range >= beams.max_range_m || hit.range < kMinRangeM) continue;
       double range = hit.range + options.range_offset_m;

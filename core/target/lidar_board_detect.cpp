@@ -1,0 +1,519 @@
+#include "core/target/lidar_board_detect.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <map>
+
+#include "core/target/lidar_board_grid.h"
+
+namespace calibench {
+namespace {
+
+using board_grid::AngularGrid;
+
+struct LocalPlane {
+  Vec3 normal = Vec3::Zero();
+  bool planar = false;
+};
+
+Vec3 PointAt(const LidarCloud& cloud, int index) { return cloud.points[index].cast<double>(); }
+
+// How far apart two neighbouring returns on one surface may be: a ring step at this range on a
+// surface tilted up to ~65 degrees, plus noise.
+double LinkDistance(const AngularGrid& grid, double range) {
+  return 2.5 * range * std::max(grid.row_step_rad, grid.column_step_rad) + 0.05;
+}
+
+// The plane of each return's neighbourhood (one ring step around it in every direction). Flat
+// where the neighbourhood spans two rings and hugs its plane; the returns near a sheet's border,
+// whose neighbourhoods take in what lies behind, come out not planar.
+std::vector<LocalPlane> LocalPlanes(const LidarCloud& cloud, const AngularGrid& grid,
+                                    const LidarBoardDetectionOptions& options) {
+  std::vector<LocalPlane> planes(grid.point.size());
+  std::vector<Vec3> near;
+  for (int row = 0; row < grid.rows; ++row) {
+    for (int column = 0; column < grid.columns; ++column) {
+      const int cell = grid.Cell(row, column);
+      if (grid.point[cell] < 0) continue;
+      const Vec3 centre = PointAt(cloud, grid.point[cell]);
+      const double link = LinkDistance(grid, grid.range[cell]);
+      const auto [half_rows, half_columns] =
+          grid.HalfWindow(grid.range[cell], options.neighbourhood_half_size_m);
+      near.clear();
+      int rows_seen = 0;
+      for (int r = std::max(0, row - half_rows); r <= std::min(grid.rows - 1, row + half_rows);
+           ++r) {
+        bool seen = false;
+        for (int dc = -half_columns; dc <= half_columns; ++dc) {
+          const int other = grid.point[grid.Cell(r, grid.Wrap(column + dc))];
+          if (other < 0) continue;
+          const Vec3 p = PointAt(cloud, other);
+          if ((p - centre).norm() > link) continue;
+          near.push_back(p);
+          seen = true;
+        }
+        rows_seen += seen ? 1 : 0;
+      }
+      if (near.size() < 6 || rows_seen < 2) continue;
+      Vec3 mean = Vec3::Zero();
+      for (const Vec3& p : near) mean += p;
+      mean /= double(near.size());
+      Mat3 scatter = Mat3::Zero();
+      for (const Vec3& p : near) scatter += (p - mean) * (p - mean).transpose();
+      Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+      eigen.computeDirect(scatter / double(near.size()));
+      planes[cell].normal = eigen.eigenvectors().col(0);
+      planes[cell].planar = std::sqrt(std::max(0.0, eigen.eigenvalues()(0))) < options.planar_rms_m;
+    }
+  }
+  return planes;
+}
+
+// A plane through accumulated moments, kept relative to the first point for precision.
+struct PlaneMoments {
+  Vec3 origin = Vec3::Zero();
+  Vec3 sum = Vec3::Zero();
+  Mat3 sum_outer = Mat3::Zero();
+  int count = 0;
+  void Add(const Vec3& p) {
+    if (count == 0) origin = p;
+    const Vec3 q = p - origin;
+    sum += q;
+    sum_outer += q * q.transpose();
+    ++count;
+  }
+  Vec3 Mean() const { return origin + sum / count; }
+  Vec3 Normal() const {
+    const Vec3 mean = sum / count;
+    Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+    eigen.computeDirect(sum_outer / count - mean * mean.transpose());
+    return eigen.eigenvectors().col(0);
+  }
+};
+
+// Region growing over the grid: seeds in order of flatness, neighbours join by distance to the
+// segment's plane (refitted as the segment doubles) and normal agreement. Returns that are not
+// planar join but do not spread the segment, so a tripod's mast or a wall behind the border stays
+// out. Returns segments as lists of cells.
+std::vector<std::vector<int>> GrowSegments(const LidarCloud& cloud, const AngularGrid& grid,
+                                           const std::vector<LocalPlane>& planes,
+                                           const LidarBoardDetectionOptions& options) {
+  const double cos_tolerance = std::cos(options.normal_tolerance_deg * M_PI / 180.0);
+  std::vector<int> label(grid.point.size(), -1);
+  std::vector<std::vector<int>> segments;
+  std::deque<int> queue;
+  for (int seed = 0; seed < static_cast<int>(grid.point.size()); ++seed) {
+    if (!planes[seed].planar || label[seed] >= 0) continue;
+    const double seed_range = grid.range[seed];
+    if (seed_range < options.min_range_m || seed_range > options.max_range_m) continue;
+    const int id = static_cast<int>(segments.size());
+    std::vector<int> cells = {seed};
+    label[seed] = id;
+    PlaneMoments moments;
+    moments.Add(PointAt(cloud, grid.point[seed]));
+    Vec3 normal = planes[seed].normal;
+    double offset = -normal.dot(PointAt(cloud, grid.point[seed]));
+    int refit_at = 40;  // a smaller patch's plane is no better than the seed's own
+    int min_row = seed / grid.columns, max_row = min_row;
+    queue.assign(1, seed);
+    while (!queue.empty()) {
+      const int cell = queue.front();
+      queue.pop_front();
+      const int row = cell / grid.columns, column = cell % grid.columns;
+      const Vec3 here = PointAt(cloud, grid.point[cell]);
+      const double link = LinkDistance(grid, grid.range[cell]);
+      const auto [half_rows, half_columns] =
+          grid.HalfWindow(grid.range[cell], options.neighbourhood_half_size_m);
+      for (int r = std::max(0, row - half_rows); r <= std::min(grid.rows - 1, row + half_rows); ++r)
+        for (int dc = -half_columns; dc <= half_columns; ++dc) {
+          const int other = grid.Cell(r, grid.Wrap(column + dc));
+          if (grid.point[other] < 0 || label[other] >= 0) continue;
+          const Vec3 p = PointAt(cloud, grid.point[other]);
+          if ((p - here).norm() > link ||
+              std::abs(normal.dot(p) + offset) > options.plane_tolerance_m)
+            continue;
+          // Only flat returns that agree spread the segment; the others (a border whose
+          // neighbourhood takes in what is behind) join without spreading it.
+          const bool spreads =
+              planes[other].planar && std::abs(planes[other].normal.dot(normal)) >= cos_tolerance;
+          label[other] = id;
+          cells.push_back(other);
+          moments.Add(p);
+          min_row = std::min(min_row, r);
+          max_row = std::max(max_row, r);
+          if (spreads) queue.push_back(other);
+        }
+      // Refit once the segment spans two rows (one row is a line: its plane is undetermined).
+      if (moments.count >= refit_at && max_row > min_row) {
+        normal = moments.Normal();
+        offset = -normal.dot(moments.Mean());
+        refit_at = 2 * moments.count;
+      }
+    }
+    segments.push_back(std::move(cells));
+  }
+  return segments;
+}
+
+// The sheet's [long, short] side bounds: the known sheet, or the pattern plus margins.
+struct SheetBounds {
+  Vec2 min = Vec2::Zero();
+  Vec2 max = Vec2::Zero();
+};
+SheetBounds BoundsFor(const BoardSpec& board, const LidarBoardDetectionOptions& options) {
+  SheetBounds bounds;
+  if (board.board_width > 0 && board.board_height > 0) {
+    bounds.min = bounds.max = Vec2(std::max(board.board_width, board.board_height),
+                                   std::min(board.board_width, board.board_height));
+  } else {
+    const Vec2 pattern(std::max(board.PatternWidth(), board.PatternHeight()),
+                       std::min(board.PatternWidth(), board.PatternHeight()));
+    bounds.min = pattern + Vec2::Constant(2 * options.min_unknown_margin_m);
+    bounds.max = pattern + Vec2::Constant(2 * options.max_unknown_margin_m);
+  }
+  return bounds;
+}
+
+enum class Border { kFree, kAttached, kOccluded };
+
+// What lies at `cell` seen from a segment with `plane`: nothing or something behind (free),
+// something on the plane (attached) or in front (occluded).
+Border Classify(const LidarCloud& cloud, const AngularGrid& grid, int cell, const Plane& plane,
+                double jump_m) {
+  if (grid.point[cell] < 0) return Border::kFree;
+  const Vec3 p = PointAt(cloud, grid.point[cell]);
+  const double range = p.norm();
+  const double along = plane.normal.dot(p / range);
+  if (along >= -1e-6) return Border::kFree;  // the ray never meets the plane's front
+  const double predicted = -plane.distance / along;
+  if (range > predicted + jump_m) return Border::kFree;
+  return range < predicted - jump_m ? Border::kOccluded : Border::kAttached;
+}
+
+// The fraction of a segment's border with nothing right behind it: the row ends (along rings) and
+// the column ends (across rings), each half of the answer.
+double FreeEdgeFraction(const LidarCloud& cloud, const AngularGrid& grid,
+                        const std::vector<int>& cells, const std::vector<char>& in_segment,
+                        const Plane& plane, double jump_m) {
+  std::map<int, std::pair<int, int>> row_ends;     // row -> columns unwrapped about the first cell
+  std::map<int, std::pair<int, int>> column_ends;  // column -> rows
+  const int reference = cells.front() % grid.columns;
+  for (int cell : cells) {
+    const int row = cell / grid.columns, column = cell % grid.columns;
+    int unwrapped = column - reference;
+    if (unwrapped > grid.columns / 2) unwrapped -= grid.columns;
+    if (unwrapped < -grid.columns / 2) unwrapped += grid.columns;
+    auto [it, fresh] = row_ends.try_emplace(row, unwrapped, unwrapped);
+    it->second = {std::min(it->second.first, unwrapped), std::max(it->second.second, unwrapped)};
+    auto [ct, cfresh] = column_ends.try_emplace(column, row, row);
+    ct->second = {std::min(ct->second.first, row), std::max(ct->second.second, row)};
+  }
+  // Walking outward, the first return off the plane decides; a fringe of the sheet's own returns
+  // that the segment left out (noise at its border) is stepped over, a wall is not (it stays on
+  // the plane for the whole reach).
+  const int reach = grid.HalfWindowColumns() + 3;
+  auto along_row = [&](int row, int from, int step) {
+    for (int k = 1; k <= reach; ++k) {
+      const int cell = grid.Cell(row, grid.Wrap(reference + from + step * k));
+      if (in_segment[cell] || grid.point[cell] < 0) continue;
+      const Border border = Classify(cloud, grid, cell, plane, jump_m);
+      if (border != Border::kAttached) return border;
+    }
+    return Border::kAttached;
+  };
+  auto along_column = [&](int column, int from, int step) {
+    for (int k = 1; k <= 3; ++k) {
+      const int row = from + step * k;
+      if (row < 0 || row >= grid.rows) return Border::kFree;
+      const int cell = grid.Cell(row, column);
+      if (in_segment[cell]) continue;
+      const Border border = Classify(cloud, grid, cell, plane, jump_m);
+      if (border != Border::kAttached) return border;
+    }
+    return Border::kAttached;
+  };
+  int free_h = 0, total_h = 0, free_v = 0, total_v = 0;
+  for (const auto& [row, ends] : row_ends) {
+    free_h += (along_row(row, ends.first, -1) == Border::kFree) +
+              (along_row(row, ends.second, +1) == Border::kFree);
+    total_h += 2;
+  }
+  for (const auto& [column, ends] : column_ends) {
+    free_v += (along_column(column, ends.first, -1) == Border::kFree) +
+              (along_column(column, ends.second, +1) == Border::kFree);
+    total_v += 2;
+  }
+  const double h = total_h ? double(free_h) / total_h : 0.0;
+  const double v = total_v ? double(free_v) / total_v : 0.0;
+  return 0.5 * (h + v);
+}
+
+std::string Format(const char* format, double a, double b = 0, double c = 0, double d = 0) {
+  char text[160];
+  std::snprintf(text, sizeof(text), format, a, b, c, d);
+  return text;
+}
+
+// Fits, measures and tests one segment. The candidate's `rejection` says why it is not the board.
+// The plane, centre, RMS and outline of a set of returns.
+void Measure(const LidarCloud& cloud, LidarBoardCandidate* c) {
+  PlaneMoments moments;
+  for (int index : c->indices) moments.Add(PointAt(cloud, index));
+  c->centre = moments.Mean();
+  Vec3 normal = moments.Normal();
+  if (normal.dot(c->centre) > 0) normal = -normal;
+  c->plane = Plane{normal, -normal.dot(c->centre)};
+  const Vec3 e1 = normal.unitOrthogonal(), e2 = normal.cross(e1);
+  std::vector<Vec2> flat;
+  double squares = 0.0;
+  for (int index : c->indices) {
+    const Vec3 q = PointAt(cloud, index) - c->centre;
+    flat.emplace_back(q.dot(e1), q.dot(e2));
+    squares += std::pow(q.dot(normal), 2);
+  }
+  c->rms_m = std::sqrt(squares / c->indices.size());
+  const std::vector<Vec2> hull = board_grid::ConvexHull(flat);
+  c->hull_area_m2 = board_grid::PolygonArea(hull);
+  c->extent_m = board_grid::MinAreaRectangle(hull);
+}
+
+// The chosen segment grown to the whole sheet: every return within the plane band and within the
+// sheet's reach of the centre, twice (the second pass about the completed centre). A segment that
+// noise split covers part of the sheet; its plane tilts with the part.
+void CompleteSheet(const LidarCloud& cloud, const SheetBounds& sheet,
+                   const LidarBoardDetectionOptions& options, LidarBoardCandidate* c) {
+  // The band follows the segment's own noise, so that a wall a few centimetres behind stays out.
+  const double band = std::clamp(3.0 * c->rms_m, 0.015, options.plane_tolerance_m);
+  for (double reach : {sheet.max.norm(), 0.5 * sheet.max.norm() + options.size_tolerance_m}) {
+    LidarBoardCandidate grown = *c;
+    grown.indices.clear();
+    for (size_t i = 0; i < cloud.size(); ++i) {
+      const Vec3 p = PointAt(cloud, static_cast<int>(i));
+      if (std::abs(c->plane.SignedDistance(p)) < band && (p - c->centre).norm() < reach)
+        grown.indices.push_back(static_cast<int>(i));
+    }
+    if (grown.indices.size() < c->indices.size()) return;  // never lose the segment's returns
+    Measure(cloud, &grown);
+    // Grown past the sheet: something else shares the plane there; keep the segment.
+    if ((grown.extent_m - sheet.max).maxCoeff() > options.size_tolerance_m) return;
+    *c = std::move(grown);
+  }
+}
+
+// Fits, measures and tests one segment. The candidate's `rejection` says why it is not the board.
+LidarBoardCandidate Evaluate(const LidarCloud& cloud, const AngularGrid& grid,
+                             const std::vector<int>& cells, std::vector<char>* in_segment,
+                             const SheetBounds& sheet, const LidarBoardDetectionOptions& options,
+                             const SceneBackground* background) {
+  LidarBoardCandidate c;
+  std::vector<int> rows;
+  for (int cell : cells) {
+    c.indices.push_back(grid.point[cell]);
+    rows.push_back(cell / grid.columns);
+  }
+  std::sort(rows.begin(), rows.end());
+  c.rings = static_cast<int>(std::unique(rows.begin(), rows.end()) - rows.begin());
+  Measure(cloud, &c);
+  const double fill_min = options.min_fill * sheet.min.prod();
+  const double fill_max = options.max_fill * sheet.max.prod();
+  const Vec2 too_long = c.extent_m - sheet.max - Vec2::Constant(options.size_tolerance_m);
+  const double size_score =
+      std::min(1.0, c.hull_area_m2 / (0.8 * sheet.min.prod())) *
+      std::max(0.0, 1.0 - std::max(0.0, c.hull_area_m2 - sheet.max.prod()) / sheet.max.prod());
+  c.score = 0.4 * size_score;
+  if (c.rings < 2) {
+    c.rejection = "spans a single ring";
+  } else if (too_long.maxCoeff() > 0 || c.hull_area_m2 > fill_max) {
+    c.rejection = "larger than the sheet";
+  } else if (c.hull_area_m2 < fill_min) {
+    c.rejection = "smaller than the sheet";
+  }
+  if (!c.rejection.empty()) return c;
+  for (int cell : cells) (*in_segment)[cell] = 1;
+  c.free_edge_fraction =
+      FreeEdgeFraction(cloud, grid, cells, *in_segment, c.plane, options.edge_jump_m);
+  for (int cell : cells) (*in_segment)[cell] = 0;
+  if (background && background->usable()) {
+    int on_background = 0;
+    for (int index : c.indices) on_background += background->IsStatic(cloud, index);
+    c.static_fraction = double(on_background) / c.indices.size();
+  }
+  const double flatness = std::clamp(1.0 - c.rms_m / options.plane_tolerance_m, 0.0, 1.0);
+  c.score =
+      (0.4 * size_score + 0.4 * c.free_edge_fraction + 0.2 * flatness) * (1.0 - c.static_fraction);
+  if (c.free_edge_fraction < options.min_free_edge_fraction)
+    c.rejection = Format("attached to what is behind it (%.0f%% of its border free)",
+                         100 * c.free_edge_fraction);
+  else if (c.static_fraction > options.max_static_fraction)
+    c.rejection = Format("part of the static scene (%.0f%% of its returns in every cloud)",
+                         100 * c.static_fraction);
+  return c;
+}
+
+}  // namespace
+
+bool LidarBoardDetectionOptions::Check(std::string* why) const {
+  auto fail = [&](const char* what) {
+    *why = what;
+    return false;
+  };
+  if (!(plane_tolerance_m > 0)) return fail("plane_tolerance_m must be > 0");
+  if (!(normal_tolerance_deg > 0 && normal_tolerance_deg < 90))
+    return fail("normal_tolerance_deg must lie in (0, 90)");
+  if (!(planar_rms_m > 0)) return fail("planar_rms_m must be > 0");
+  if (min_points < 6) return fail("min_points must be at least 6");
+  if (!(size_tolerance_m >= 0)) return fail("size_tolerance_m must be >= 0");
+  if (!(min_fill > 0 && min_fill < max_fill)) return fail("need 0 < min_fill < max_fill");
+  if (!(min_unknown_margin_m >= 0 && min_unknown_margin_m <= max_unknown_margin_m))
+    return fail("need 0 <= min_unknown_margin_m <= max_unknown_margin_m");
+  if (!(edge_jump_m > 0)) return fail("edge_jump_m must be > 0");
+  if (!(min_free_edge_fraction >= 0 && min_free_edge_fraction <= 1))
+    return fail("min_free_edge_fraction must lie in [0, 1]");
+  if (!(max_static_fraction >= 0 && max_static_fraction <= 1))
+    return fail("max_static_fraction must lie in [0, 1]");
+  if (!(ambiguity_ratio > 0 && ambiguity_ratio <= 1)) return fail("ambiguity_ratio in (0, 1]");
+  if (!(min_range_m >= 0 && min_range_m < max_range_m))
+    return fail("need 0 <= min_range_m < max_range_m");
+  if (!(angular_cell_deg >= 0)) return fail("angular_cell_deg must be >= 0");
+  return true;
+}
+
+std::string LidarBoardCandidate::Describe() const {
+  return Format("a %.2f x %.2f m plane at %.1f m, azimuth %.0f deg", extent_m.x(), extent_m.y(),
+                centre.norm(), std::atan2(centre.y(), centre.x()) * 180.0 / M_PI);
+}
+
+LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& board,
+                                     const LidarBoardDetectionOptions& options,
+                                     const SceneBackground* background) {
+  std::string why;
+  CALIBENCH_CHECK(options.Check(&why));
+  LidarBoardDetection result;
+  const AngularGrid grid = board_grid::BuildAngularGrid(cloud, options.angular_cell_deg);
+  const SheetBounds sheet = BoundsFor(board, options);
+  const std::vector<LocalPlane> planes = LocalPlanes(cloud, grid, options);
+  std::vector<char> in_segment(grid.point.size(), 0);
+  for (const std::vector<int>& cells : GrowSegments(cloud, grid, planes, options)) {
+    if (static_cast<int>(cells.size()) < options.min_points) continue;
+    LidarBoardCandidate c = Evaluate(cloud, grid, cells, &in_segment, sheet, options, background);
+    if (c.rejection.empty())
+      result.candidates.push_back(std::move(c));
+    else
+      result.near_misses.push_back(std::move(c));
+  }
+  auto by_score = [](const auto& a, const auto& b) { return a.score > b.score; };
+  std::sort(result.candidates.begin(), result.candidates.end(), by_score);
+  std::sort(result.near_misses.begin(), result.near_misses.end(), by_score);
+  if (result.near_misses.size() > 5) result.near_misses.resize(5);
+  const LidarBoardCandidate* near_miss =
+      result.near_misses.empty() ? nullptr : &result.near_misses.front();
+  const std::string wanted =
+      Format("no planar segment of %.2f x %.2f m standing free", sheet.max.y(), sheet.max.x());
+  if (result.candidates.empty()) {
+    result.reason = wanted + (near_miss ? "; best candidate: " + near_miss->Describe() + ", " +
+                                              near_miss->rejection
+                                        : "; no planar segment at all");
+    return result;
+  }
+  const LidarBoardCandidate& best = result.candidates.front();
+  // Pieces of one sheet (a segment split by noise) are not rivals: the plane fit grows the best
+  // piece to the whole sheet anyway.
+  const double sheet_diagonal = sheet.max.norm();
+  auto same_sheet = [&](const LidarBoardCandidate& other) {
+    return (other.centre - best.centre).norm() < 0.75 * sheet_diagonal &&
+           std::abs(other.plane.normal.dot(best.plane.normal)) > std::cos(10.0 * M_PI / 180.0);
+  };
+  const auto rival = std::find_if(result.candidates.begin() + 1, result.candidates.end(),
+                                  [&](const auto& other) { return !same_sheet(other); });
+  const double second = rival != result.candidates.end() ? rival->score : 0.0;
+  if (second > options.ambiguity_ratio * best.score) {
+    result.reason = "two board-like planes, too close to tell apart: " + best.Describe() + " and " +
+                    rival->Describe();
+    return result;
+  }
+  result.confidence =
+      best.score *
+      std::clamp((1.0 - second / best.score) / (1.0 - options.ambiguity_ratio) * 0.5 + 0.5, 0.0,
+                 1.0);
+  result.board = best;
+  CompleteSheet(cloud, sheet, options, &*result.board);
+  return result;
+}
+
+// ---- SceneBackground ----
+
+SceneBackground::SceneBackground(double cell_deg, double tolerance_m)
+    : cell_rad_(cell_deg * M_PI / 180.0), tolerance_m_(tolerance_m) {
+  CALIBENCH_CHECK(cell_deg > 0 && tolerance_m > 0);
+}
+
+std::int64_t SceneBackground::Key(const LidarCloud& cloud, int index) const {
+  const Eigen::Vector3f& p = cloud.points[index];
+  const auto azimuth =
+      static_cast<std::int64_t>(std::floor((std::atan2(p.y(), p.x()) + M_PI) / cell_rad_));
+  std::int64_t row;
+  if (cloud.HasRing())
+    row = cloud.ring[index];
+  else if (cloud.IsOrganized())
+    row = index / cloud.width;
+  else
+    row = 100000 +
+          static_cast<std::int64_t>(std::floor(
+              std::atan2(double(p.z()), std::hypot(double(p.x()), double(p.y()))) / cell_rad_));
+  return row * 1000000 + azimuth;
+}
+
+void SceneBackground::Add(const LidarCloud& cloud) {
+  std::unordered_map<std::int64_t, float> nearest;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
+    const std::int64_t key = Key(cloud, static_cast<int>(i));
+    auto [it, fresh] = nearest.try_emplace(key, p.norm());
+    if (!fresh) it->second = std::min(it->second, p.norm());
+  }
+  for (const auto& [key, range] : nearest) ranges_[key].push_back(range);
+  ++clouds_;
+  usable_ = false;
+}
+
+bool SceneBackground::Finish(std::string* why) {
+  median_.clear();
+  usable_ = false;
+  if (clouds_ < 3) {
+    *why = "a background needs at least 3 clouds, have " + std::to_string(clouds_);
+    return false;
+  }
+  long agree = 0, total = 0;
+  for (auto& [key, ranges] : ranges_) {
+    if (2 * static_cast<int>(ranges.size()) < clouds_) continue;
+    std::vector<float> sorted = ranges;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const float median = sorted[sorted.size() / 2];
+    median_[key] = median;
+    for (float r : ranges) agree += std::abs(r - median) < tolerance_m_;
+    total += static_cast<long>(ranges.size());
+  }
+  // A static sensor sees the same room in every cloud; most returns then sit on their medians.
+  if (total == 0 || agree < total / 2) {
+    *why = Format(
+        "the clouds do not share a static scene (%.0f%% of returns repeat): the sensor "
+        "moved between pairs, so no background model",
+        total ? 100.0 * agree / total : 0.0);
+    median_.clear();
+    return false;
+  }
+  usable_ = true;
+  return true;
+}
+
+bool SceneBackground::IsStatic(const LidarCloud& cloud, int index) const {
+  if (!usable_) return false;
+  const auto it = median_.find(Key(cloud, index));
+  return it != median_.end() && std::abs(cloud.points[index].norm() - it->second) < tolerance_m_;
+}
+
+}  // namespace calibench

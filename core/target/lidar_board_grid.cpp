@@ -1,0 +1,182 @@
+#include "core/target/lidar_board_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_set>
+
+#include "core/lidar/lidar_image.h"
+
+namespace calibench::board_grid {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+double Elevation(const Eigen::Vector3f& p) {
+  return std::atan2(double(p.z()), std::hypot(double(p.x()), double(p.y())));
+}
+
+// Spinning LiDARs without a ring field still come in clear elevation clusters; swept and
+// solid-state ones do not (many tiny "rings").
+bool HasRingStructure(const LidarCloud& cloud) {
+  if (cloud.HasRing() || cloud.IsOrganized()) return true;
+  const std::vector<int> rings = InferRings(cloud, LidarImageOptions{});
+  std::unordered_set<int> distinct(rings.begin(), rings.end());
+  return distinct.size() >= 8 && distinct.size() <= 256 && cloud.size() / distinct.size() >= 200;
+}
+
+AngularGrid FromRings(const LidarCloud& cloud) {
+  const LidarImage image = ProjectById(cloud, LidarImageOptions{});
+  AngularGrid grid;
+  grid.rows = image.rows;
+  grid.columns = image.columns;
+  grid.point = image.point_index;
+  grid.range = image.range;
+  grid.from_rings = true;
+  grid.column_step_rad = 2.0 * M_PI / std::max(1, image.columns);
+  // The rows' mean elevations; their median spacing is the ring spacing (uneven on some sensors,
+  // the median is the typical one).
+  std::vector<double> sum(image.rows, 0.0);
+  std::vector<int> count(image.rows, 0);
+  for (int cell = 0; cell < static_cast<int>(image.point_index.size()); ++cell) {
+    if (image.point_index[cell] < 0) continue;
+    sum[cell / image.columns] += Elevation(cloud.points[image.point_index[cell]]);
+    ++count[cell / image.columns];
+  }
+  std::vector<double> steps;
+  for (int row = 1; row < image.rows; ++row)
+    if (count[row] > 0 && count[row - 1] > 0)
+      steps.push_back(std::abs(sum[row] / count[row] - sum[row - 1] / count[row - 1]));
+  if (!steps.empty()) {
+    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+    grid.row_step_rad = std::max(steps[steps.size() / 2], grid.column_step_rad);
+  } else {
+    grid.row_step_rad = grid.column_step_rad;
+  }
+  return grid;
+}
+
+// One return per cell on average: the cell side from the solid angle the cloud covers (counted
+// on a 1 degree grid) and its number of returns.
+double AutoCellDeg(const LidarCloud& cloud) {
+  std::unordered_set<std::int64_t> occupied;
+  for (const Eigen::Vector3f& p : cloud.points) {
+    if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
+    const auto az = static_cast<std::int64_t>(std::floor(std::atan2(p.y(), p.x()) * 180.0 / M_PI));
+    const auto el = static_cast<std::int64_t>(std::floor(Elevation(p) * 180.0 / M_PI));
+    occupied.insert(el * 1000 + az);
+  }
+  if (occupied.empty()) return 1.0;
+  return std::clamp(std::sqrt(double(occupied.size()) / double(cloud.size())), 0.05, 2.0);
+}
+
+AngularGrid FromAngles(const LidarCloud& cloud, double cell_deg) {
+  AngularGrid grid;
+  const double cell = (cell_deg > 0 ? cell_deg : AutoCellDeg(cloud)) * M_PI / 180.0;
+  double top = -M_PI, bottom = M_PI;
+  for (const Eigen::Vector3f& p : cloud.points) {
+    if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
+    top = std::max(top, Elevation(p));
+    bottom = std::min(bottom, Elevation(p));
+  }
+  grid.columns = std::max(1, static_cast<int>(std::lround(2.0 * M_PI / cell)));
+  grid.rows = top >= bottom ? static_cast<int>((top - bottom) / cell) + 1 : 0;
+  grid.row_step_rad = cell;
+  grid.column_step_rad = 2.0 * M_PI / grid.columns;
+  grid.point.assign(static_cast<size_t>(grid.rows) * grid.columns, -1);
+  grid.range.assign(grid.point.size(), kNaN);
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
+    const int row = std::min(grid.rows - 1, static_cast<int>((top - Elevation(p)) / cell));
+    const int cell_index = grid.Cell(row, AzimuthColumn(p, grid.columns));
+    const float range = p.norm();
+    if (grid.point[cell_index] >= 0 && !(range < grid.range[cell_index])) continue;
+    grid.point[cell_index] = static_cast<int>(i);
+    grid.range[cell_index] = range;
+  }
+  return grid;
+}
+
+double Cross(const Vec2& o, const Vec2& a, const Vec2& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+
+}  // namespace
+
+int AngularGrid::HalfWindowColumns() const {
+  if (column_step_rad <= 0) return 1;
+  return std::clamp(static_cast<int>(std::lround(row_step_rad / column_step_rad)), 1, 16);
+}
+
+std::pair<int, int> AngularGrid::HalfWindow(double range_m, double half_size_m) const {
+  const double rows_needed = half_size_m / (std::max(range_m, 0.1) * row_step_rad);
+  const int half_rows = std::clamp(static_cast<int>(std::ceil(rows_needed)), 1, 3);
+  const double columns_needed = half_size_m / (std::max(range_m, 0.1) * column_step_rad);
+  const int half_columns =
+      std::max(static_cast<int>(std::lround(half_rows * row_step_rad / column_step_rad)),
+               static_cast<int>(std::ceil(columns_needed)));
+  return {half_rows, std::clamp(half_columns, 1, 24)};
+}
+
+AngularGrid BuildAngularGrid(const LidarCloud& cloud, double cell_deg) {
+  return HasRingStructure(cloud) ? FromRings(cloud) : FromAngles(cloud, cell_deg);
+}
+
+// Andrew's monotone chain.
+std::vector<Vec2> ConvexHull(std::vector<Vec2> points) {
+  std::sort(points.begin(), points.end(), [](const Vec2& a, const Vec2& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (points.size() < 3) return points;
+  std::vector<Vec2> hull(2 * points.size());
+  size_t k = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && Cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  for (size_t i = points.size() - 1, lower = k + 1; i > 0; --i) {
+    while (k >= lower && Cross(hull[k - 2], hull[k - 1], points[i - 1]) <= 0) --k;
+    hull[k++] = points[i - 1];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+double PolygonArea(const std::vector<Vec2>& polygon) {
+  double twice = 0.0;
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Vec2& a = polygon[i];
+    const Vec2& b = polygon[(i + 1) % polygon.size()];
+    twice += a.x() * b.y() - b.x() * a.y();
+  }
+  return std::abs(twice) / 2.0;
+}
+
+// The minimum-area rectangle has a side along one hull edge (Freeman & Shapira 1975).
+Vec2 MinAreaRectangle(const std::vector<Vec2>& hull) {
+  if (hull.size() < 3) return Vec2::Zero();
+  double best_area = std::numeric_limits<double>::infinity();
+  Vec2 best = Vec2::Zero();
+  for (size_t i = 0; i < hull.size(); ++i) {
+    const Vec2 edge = hull[(i + 1) % hull.size()] - hull[i];
+    if (edge.norm() < 1e-9) continue;
+    const Vec2 u = edge.normalized();
+    const Vec2 v(-u.y(), u.x());
+    double u_min = 1e300, u_max = -1e300, v_min = 1e300, v_max = -1e300;
+    for (const Vec2& p : hull) {
+      u_min = std::min(u_min, p.dot(u));
+      u_max = std::max(u_max, p.dot(u));
+      v_min = std::min(v_min, p.dot(v));
+      v_max = std::max(v_max, p.dot(v));
+    }
+    const double area = (u_max - u_min) * (v_max - v_min);
+    if (area < best_area) {
+      best_area = area;
+      best = Vec2(std::max(u_max - u_min, v_max - v_min), std::min(u_max - u_min, v_max - v_min));
+    }
+  }
+  return best;
+}
+
+}  // namespace calibench::board_grid
