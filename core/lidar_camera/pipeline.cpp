@@ -4,6 +4,7 @@
 #include <set>
 
 #include "core/base/image.h"
+#include "core/base/names.h"
 #include "core/base/parallel.h"
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
@@ -12,8 +13,13 @@
 namespace calibench {
 
 bool PipelineOptions::Check(std::string* why) const {
-  if (!lidar_plane.Check(why) || !detection.Check(why) || !pnp.Check(why) || !solver.Check(why))
+  if (!lidar_plane.Check(why) || !detection.Check(why) || !pnp.Check(why) || !solver.Check(why) ||
+      !board_detection.Check(why))
     return false;
+  if (!(guided_max_sigmas > 0 && guided_min_angle_deg >= 0 && guided_min_offset_m >= 0)) {
+    if (why) *why = "guided_max_sigmas must be > 0 and the guided floors >= 0";
+    return false;
+  }
   if (threads < 1) {
     if (why) *why = "threads must be >= 1";
     return false;
@@ -24,6 +30,16 @@ bool PipelineOptions::Check(std::string* why) const {
   }
   return true;
 }
+
+namespace {
+constexpr EnumName<BoardSource> kBoardSourceNames[] = {{BoardSource::kNone, "none"},
+                                                       {BoardSource::kBrush, "brush"},
+                                                       {BoardSource::kSeed, "seed"},
+                                                       {BoardSource::kDetected, "detected"},
+                                                       {BoardSource::kCameraGuided, "camera-guided"}};
+}  // namespace
+
+std::string BoardSourceName(BoardSource source) { return NameIn(kBoardSourceNames, source); }
 
 LidarPlaneOptions LidarPlaneOptionsFor(const PipelineOptions& options, const BoardSpec& target) {
   LidarPlaneOptions lidar = options.lidar_plane;
@@ -91,14 +107,44 @@ std::vector<int> SelectBoardRegion(const LidarCloud& cloud, const BoardHint& hin
   return {};
 }
 
+namespace {
+
+// The region of the hint (brush, else seed) or, without one, of the detected board.
+std::vector<int> RegionFor(const Dataset& dataset, const LidarCloud& cloud, const BoardHint& hint,
+                           const PipelineOptions& options, std::string* why,
+                           BoardOrigin* origin) {
+  const bool brushed = hint.brush_pixels && !hint.brush_pixels->empty();
+  if (brushed || hint.seed || !options.detect_board) {
+    *origin = {brushed      ? BoardSource::kBrush
+               : hint.seed_from_camera ? BoardSource::kCameraGuided
+               : hint.seed  ? BoardSource::kSeed
+                            : BoardSource::kNone,
+               1.0, ""};
+    return SelectBoardRegion(cloud, hint, why);
+  }
+  const LidarBoardDetection found =
+      DetectLidarBoard(cloud, dataset.target, options.board_detection, hint.background);
+  if (!found.board) {
+    *why = "LiDAR: " + found.reason;
+    *origin = {BoardSource::kDetected, 0.0, found.reason};
+    return {};
+  }
+  *origin = {BoardSource::kDetected, found.confidence, found.board->Describe()};
+  return found.board->indices;
+}
+
+}  // namespace
+
 std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const LidarCloud& cloud,
                                                   const BoardHint& hint,
-                                                  const PipelineOptions& options,
-                                                  std::string* why) {
-  std::string no_hint;
-  const std::vector<int> region = SelectBoardRegion(cloud, hint, &no_hint);
-  if (!no_hint.empty()) {
-    *why = no_hint;
+                                                  const PipelineOptions& options, std::string* why,
+                                                  BoardOrigin* origin) {
+  BoardOrigin found;
+  std::string no_region;
+  const std::vector<int> region = RegionFor(dataset, cloud, hint, options, &no_region, &found);
+  if (origin) *origin = found;
+  if (!no_region.empty()) {
+    *why = no_region;
     return std::nullopt;
   }
   std::string fit_failure;
@@ -106,10 +152,12 @@ std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const 
       FitBoardPlane(cloud, region, LidarPlaneOptionsFor(options, dataset.target), &fit_failure);
   if (fit) return fit;
   *why = "LiDAR: " + fit_failure;
-  const bool from_seed = hint.seed && !(hint.brush_pixels && !hint.brush_pixels->empty());
-  if (from_seed)
-    *why += " (seed at " + std::to_string(hint.seed->point.norm()).substr(0, 4) + " m, radius " +
+  if (found.source == BoardSource::kSeed || found.source == BoardSource::kCameraGuided)
+    *why += std::string(found.source == BoardSource::kSeed ? " (seed" : " (camera's prediction") +
+            " at " + std::to_string(hint.seed->point.norm()).substr(0, 4) + " m, radius " +
             std::to_string(hint.seed->radius).substr(0, 4) + " m)";
+  else if (found.source == BoardSource::kDetected)
+    *why += " (detected " + found.detail + ")";
   return std::nullopt;
 }
 
@@ -140,7 +188,8 @@ std::optional<BoardHint> HintFor(const PairEntry& pair, const PairEdit& edit,
 }  // namespace
 
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
-                                 const PipelineOptions& options, const PairEdit& edit) {
+                                 const PipelineOptions& options, const PairEdit& edit,
+                                 const SceneBackground* background) {
   PairFeatures features;
   features.id = pair.id;
   std::string why;
@@ -154,8 +203,11 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
   std::optional<LidarImage> image;
   if (edit.brush_pixels) image = ProjectById(inputs->cloud, LidarImageOptions{});
   std::string lidar_failure;
-  if (const auto hint = HintFor(pair, edit, image ? &*image : nullptr, &lidar_failure))
-    features.lidar = ExtractLidarFeatures(dataset, inputs->cloud, *hint, options, &lidar_failure);
+  if (auto hint = HintFor(pair, edit, image ? &*image : nullptr, &lidar_failure)) {
+    hint->background = background;
+    features.lidar = ExtractLidarFeatures(dataset, inputs->cloud, *hint, options, &lidar_failure,
+                                          &features.board_origin);
+  }
   CameraFeatures camera = ExtractCameraFeatures(dataset, inputs->image, options);
   features.camera = std::move(camera.observation);
   SetStatusFromFeatures(&features, lidar_failure, camera.failure);
@@ -166,6 +218,35 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
   return features;
 }
 
+namespace {
+
+// Whether some pair will need detection: no brush painted and no seed in the manifest.
+bool AnyPairToDetect(const std::vector<const PairEntry*>& pairs, const PairEdits& edits) {
+  return std::any_of(pairs.begin(), pairs.end(), [&](const PairEntry* pair) {
+    const auto edit = edits.find(pair->id);
+    const bool brushed = edit != edits.end() && edit->second.brush_pixels;
+    return !brushed && !pair->lidar_seed;
+  });
+}
+
+}  // namespace
+
+std::optional<SceneBackground> BuildSceneBackground(const std::vector<const PairEntry*>& pairs,
+                                                    int threads, std::string* why) {
+  std::vector<std::optional<LidarCloud>> clouds(pairs.size());
+  ParallelFor(pairs.size(), threads, [&](size_t i) {
+    try {
+      clouds[i] = LoadCloud(pairs[i]->cloud);
+    } catch (const IoError&) {  // the pair itself reports it when it is extracted
+    }
+  });
+  SceneBackground background;
+  for (const auto& cloud : clouds)
+    if (cloud) background.Add(*cloud);
+  if (!background.Finish(why)) return std::nullopt;
+  return background;
+}
+
 CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,
                                     const ProgressCallback& progress, const PairEdits& edits) {
   std::vector<const PairEntry*> selected;
@@ -173,18 +254,28 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
   for (const PairEntry& pair : dataset.pairs)
     if (wanted.empty() || wanted.count(pair.id)) selected.push_back(&pair);
 
+  std::optional<SceneBackground> background;
+  std::string background_note;
+  if (options.detect_board && options.background_model && AnyPairToDetect(selected, edits))
+    background = BuildSceneBackground(selected, options.threads, &background_note);
+
   std::vector<PairFeatures> features(selected.size());
   ParallelFor(
       selected.size(), options.threads,
       [&](size_t i) {
         const auto edit = edits.find(selected[i]->id);
-        features[i] = ExtractPairFeatures(dataset, *selected[i], options,
-                                          edit == edits.end() ? PairEdit{} : edit->second);
+        features[i] =
+            ExtractPairFeatures(dataset, *selected[i], options,
+                                edit == edits.end() ? PairEdit{} : edit->second,
+                                background ? &*background : nullptr);
       },
       [&](int finished, size_t i) {
         if (progress) progress(finished, static_cast<int>(selected.size()), selected[i]->id);
       });
-  return SolveFromFeatures(std::move(features), options);
+  CalibrationOutcome outcome = SolveFromFeatures(std::move(features), options);
+  outcome.background_note = background_note;
+  if (options.camera_guided) CompleteWithCamera(dataset, selected, options, edits, &outcome);
+  return outcome;
 }
 
 CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,

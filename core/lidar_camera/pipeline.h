@@ -15,6 +15,7 @@
 #include "core/lidar_camera/solver.h"
 #include "core/results/pair_status.h"
 #include "core/target/board_camera.h"
+#include "core/target/lidar_board_detect.h"
 #include "core/target/lidar_plane.h"
 
 namespace calibench {
@@ -31,7 +32,31 @@ struct PipelineOptions {
   // LiDAR: grow each brushed / seeded region to the whole board, limited by the target's sheet
   // size (LidarPlaneOptions::grow_radius_m = BoardGrowRadius(target)).
   bool grow_to_board = true;
+  // Pairs with neither a brush nor a seed: find the board in the cloud (DetectLidarBoard), with a
+  // background model over the selected pairs' clouds (SceneBackground), and check every board
+  // against the camera's once a first solution exists (camera-guided completion).
+  bool detect_board = true;
+  LidarBoardDetectionOptions board_detection;
+  bool background_model = true;
+  bool camera_guided = true;
+  // A LiDAR board whose plane disagrees with the camera's prediction by more than this many
+  // standard deviations (and more than the floors below) is not used.
+  double guided_max_sigmas = 4.0;
+  double guided_min_angle_deg = 2.0;
+  double guided_min_offset_m = 0.03;
   bool Check(std::string* why) const;
+};
+
+// Where a pair's LiDAR board region came from.
+enum class BoardSource { kNone, kBrush, kSeed, kDetected, kCameraGuided };
+std::string BoardSourceName(BoardSource source);  // "none", "brush", "seed", "detected", ...
+
+// How a pair's LiDAR board was found: the source, a confidence in [0, 1] (1 for a user's brush or
+// seed) and, for a detection, what was found.
+struct BoardOrigin {
+  BoardSource source = BoardSource::kNone;
+  double confidence = 0.0;
+  std::string detail;
 };
 
 struct PairFeatures {
@@ -41,6 +66,7 @@ struct PairFeatures {
   bool input_error = false;  // the pair's files could not be read
   std::optional<LidarPlaneFit> lidar;
   std::optional<CameraBoardObservation> camera;
+  BoardOrigin board_origin;
 };
 
 // options.lidar_plane for `target`: its grow radius (when options.grow_to_board) and its sheet size
@@ -82,17 +108,21 @@ struct BoardHint {
   const std::vector<int>* brush_pixels = nullptr;  // null or empty: no brush
   const LidarImage* image = nullptr;               // the image the brush was painted on
   std::optional<LidarSeed> seed;
+  bool seed_from_camera = false;                 // the seed is the camera's prediction
+  const SceneBackground* background = nullptr;  // for detection; may be null
 };
 // Candidate points (indices into the cloud); empty with *why when there is no hint.
 std::vector<int> SelectBoardRegion(const LidarCloud& cloud, const BoardHint& hint,
                                    std::string* why);
 
-// The LiDAR side: the board plane fitted to the hint's region (SelectBoardRegion), grown to the
-// sheet (LidarPlaneOptionsFor). nullopt with *why ("LiDAR: ...", or the missing hint) when no
-// plane is found.
+// The LiDAR side: the board plane fitted to the hint's region (SelectBoardRegion) or, without a
+// hint, to the board detected in the cloud (options.detect_board), grown to the sheet
+// (LidarPlaneOptionsFor). nullopt with *why ("LiDAR: ...", or the missing hint) when no plane is
+// found. *origin (optional) says where the region came from.
 std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const LidarCloud& cloud,
                                                   const BoardHint& hint,
-                                                  const PipelineOptions& options, std::string* why);
+                                                  const PipelineOptions& options, std::string* why,
+                                                  BoardOrigin* origin = nullptr);
 
 // The status of a pair from its two sides: kAccepted with both planes, else kFailed with the
 // first missing side's failure (LiDAR first; the camera's prefixed "camera: ").
@@ -112,18 +142,34 @@ struct PairEdit {
 };
 using PairEdits = std::map<std::string, PairEdit>;  // by pair id
 
-// Loads the pair's files and extracts both planes (the steps above; the hint is the pair's edited
-// brush, else its seed). Never throws for bad data: the pair comes back kFailed with the reason
-// (unreadable files name the file); a rejected pair comes back kRejected with its features.
-PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
-                                 const PipelineOptions& options, const PairEdit& edit = {});
-
 struct CalibrationOutcome {
   std::vector<PairFeatures> pairs;
   std::optional<SolverResult> solution;  // absent when no calibration could be computed
   std::string failure;                   // why `solution` is absent
   Pose initial_cam_from_lidar = Pose::Identity();
+  std::string background_note;  // why no background model was used, when one was wanted
 };
+
+// Loads the pair's files and extracts both planes (the steps above; the hint is the pair's edited
+// brush, else its seed). Never throws for bad data: the pair comes back kFailed with the reason
+// (unreadable files name the file); a rejected pair comes back kRejected with its features.
+PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
+                                 const PipelineOptions& options, const PairEdit& edit = {},
+                                 const SceneBackground* background = nullptr);
+
+// The background model over the selected pairs' clouds (for detection); nullopt with *why when it
+// cannot be built (fewer than 3 readable clouds, or the sensor moved between pairs).
+std::optional<SceneBackground> BuildSceneBackground(const std::vector<const PairEntry*>& pairs,
+                                                    int threads, std::string* why);
+
+// Camera-guided completion (options.camera_guided): with a first solution, predicts every pair's
+// board in the LiDAR frame from its camera pose, drops LiDAR boards that disagree with it (the
+// pair fails, saying by how much) and looks again for the board at the prediction where the LiDAR
+// side failed or disagreed; re-solves until no pair changes (at most 3 rounds). Pairs with a brush
+// are the user's word and are left alone.
+void CompleteWithCamera(const Dataset& dataset, const std::vector<const PairEntry*>& pairs,
+                        const PipelineOptions& options, const PairEdits& edits,
+                        CalibrationOutcome* outcome);
 
 // Extracts every selected pair (in parallel with options.threads) and solves.
 CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,

@@ -59,6 +59,11 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
   size_t solved_index = 0;
   for (const PairFeatures& p : outcome.pairs) {
     json entry = PairEntryJson(p.id, p.status, p.reason);
+    if (p.board_origin.source != BoardSource::kNone) {
+      entry["lidar_board"] = {{"source", BoardSourceName(p.board_origin.source)},
+                              {"confidence", p.board_origin.confidence}};
+      if (!p.board_origin.detail.empty()) entry["lidar_board"]["found"] = p.board_origin.detail;
+    }
     if (p.lidar) {
       entry["lidar_plane"] = Vec4ToJson(p.lidar->plane.Coefficients());
       entry["lidar_inliers"] = p.lidar->inliers.size();
@@ -107,10 +112,12 @@ void PrintPairs(const CalibrationOutcome& outcome, std::ostringstream& out) {
     }
     if (!p.lidar || !p.camera) continue;
     std::snprintf(line, sizeof(line),
-                  "  pair %-8s %-8s lidar %5zu inliers rms %5.1f mm | camera %3d corners rms "
-                  "%.2f px",
-                  p.id.c_str(), PairStatusName(p.status).c_str(), p.lidar->inliers.size(),
-                  p.lidar->rms_m * 1e3, p.camera->num_corners, p.camera->reprojection_rms_px);
+                  "  pair %-8s %-8s board %-13s %4.2f | lidar %5zu inliers rms %5.1f mm | camera "
+                  "%3d corners rms %.2f px",
+                  p.id.c_str(), PairStatusName(p.status).c_str(),
+                  BoardSourceName(p.board_origin.source).c_str(), p.board_origin.confidence,
+                  p.lidar->inliers.size(), p.lidar->rms_m * 1e3, p.camera->num_corners,
+                  p.camera->reprojection_rms_px);
     out << line;
     if (outcome.solution && p.status == PairStatus::kAccepted &&
         solved_index < outcome.solution->residuals.size()) {
@@ -187,6 +194,8 @@ void PrintConvergence(const SolverResult& s, std::ostringstream& out) {
 std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& names) {
   std::ostringstream out;
   PrintPairs(outcome, out);
+  if (!outcome.background_note.empty())
+    out << "board detection without a background model: " << outcome.background_note << "\n";
   if (!outcome.solution) {
     out << "no calibration: " << outcome.failure << "\n";
     return out.str();

@@ -357,7 +357,7 @@ LidarBoardCandidate Evaluate(const LidarCloud& cloud, const AngularGrid& grid,
 
 bool LidarBoardDetectionOptions::Check(std::string* why) const {
   auto fail = [&](const char* what) {
-    *why = what;
+    if (why) *why = what;
     return false;
   };
   if (!(plane_tolerance_m > 0)) return fail("plane_tolerance_m must be > 0");

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
+#include <map>
 #include <random>
 #include <utility>
 #include <vector>
@@ -190,6 +192,74 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
       EXPECT_LT(ratio, 2.0) << name << ", axis " << k;
     }
   }
+}
+
+// The ACFR files as a user lays them out: clouds/, images/, camera.yaml, target.json (with the
+// sheet size), no seeds anywhere. Links, not copies.
+std::filesystem::path WriteAcfrFolder(const std::filesystem::path& acfr,
+                                      const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  fs::remove_all(dir);
+  fs::create_directories(dir / "clouds");
+  fs::create_directories(dir / "images");
+  for (int n = 1; n <= 40; ++n) {
+    const std::string id = "pose" + std::to_string(n);
+    fs::create_symlink(acfr / "pcd" / (id + "_full.pcd"), dir / "clouds" / (id + ".pcd"));
+    fs::create_symlink(acfr / "images" / (id + ".png"), dir / "images" / (id + ".png"));
+  }
+  fs::create_symlink(acfr / "camera_info.yaml", dir / "camera.yaml");
+  std::ofstream(dir / "target.json") << R"({"type": "checkerboard", "inner_corners": [5, 7],
+    "square_size": 0.095, "board_size": [0.61, 0.85]})";
+  return dir;
+}
+
+TEST(RealVlp16, NoSeedsNoBrushingTheBoardIsDetectedInEveryCloud) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  const auto acfr = shared / "datasets/acfr-vlp16-chessboard";
+  const Dataset folder = LoadDataset(WriteAcfrFolder(acfr, test::TempDir("real_vlp16_folder")));
+  const Dataset seeded =
+      LoadDataset(test::WriteAcfrManifest(acfr, test::TempDir("real_vlp16_seeded")));
+  ASSERT_EQ(folder.pairs.size(), 40u);
+  for (const PairEntry& pair : folder.pairs) ASSERT_FALSE(pair.lidar_seed);
+
+  PipelineOptions options;
+  options.threads = 2;
+  const CalibrationOutcome detected = CalibrateDataset(folder, options);
+  const CalibrationOutcome reference = CalibrateDataset(seeded, options);
+  ASSERT_TRUE(detected.solution) << detected.failure;
+  ASSERT_TRUE(reference.solution) << reference.failure;
+  EXPECT_TRUE(detected.background_note.empty()) << detected.background_note;
+
+  std::map<std::string, const PairFeatures*> seeded_pairs;
+  for (const PairFeatures& p : reference.pairs) seeded_pairs[p.id] = &p;
+  int found = 0, wrong = 0;
+  std::printf("pair     source         conf  angle to seeded  offset\n");
+  for (const PairFeatures& p : detected.pairs) {
+    if (!p.lidar) {
+      std::printf("%-8s %s\n", p.id.c_str(), p.reason.c_str());
+      continue;
+    }
+    ++found;
+    const PairFeatures& s = *seeded_pairs.at(p.id);
+    ASSERT_TRUE(s.lidar) << p.id;
+    const double angle =
+        std::acos(std::min(1.0, std::abs(p.lidar->plane.normal.dot(s.lidar->plane.normal))));
+    const double offset = std::abs(p.lidar->plane.distance - s.lidar->plane.distance);
+    const bool false_detection = angle > 2.0 * kDegToRad || offset > 0.03;
+    wrong += false_detection;
+    std::printf("%-8s %-13s  %.2f  %6.3f deg       %5.1f mm%s\n", p.id.c_str(),
+                BoardSourceName(p.board_origin.source).c_str(), p.board_origin.confidence,
+                angle * kRadToDeg, offset * 1e3, false_detection ? "  FALSE" : "");
+    EXPECT_NE(p.board_origin.source, BoardSource::kSeed);
+  }
+  const PoseError apart =
+      ComputePoseError(detected.solution->cam_from_lidar, reference.solution->cam_from_lidar);
+  std::printf("%d of 40 detected, %d false; calibration %.2f mm / %.4f deg from the seeded one\n",
+              found, wrong, apart.translation_m * 1e3, apart.rotation_rad * kRadToDeg);
+  EXPECT_GE(found, 38);
+  EXPECT_EQ(wrong, 0);
+  EXPECT_LT(apart.translation_m, 0.002);
+  EXPECT_LT(apart.rotation_rad, 0.05 * kDegToRad);
 }
 
 }  // namespace

@@ -1,0 +1,173 @@
+// Camera-guided completion of the LiDAR boards (pipeline.h, CompleteWithCamera): the solution
+// predicts where each pair's board lies in the LiDAR frame; boards that disagree are not used,
+// and the board is looked for again at the prediction.
+#include <cmath>
+#include <cstdio>
+
+#include "core/base/parallel.h"
+#include "core/io/cloud_io.h"
+#include "core/lidar_camera/pipeline.h"
+
+namespace calibench {
+namespace {
+
+// The camera's board in the LiDAR frame: its plane (normal towards the LiDAR) and centre.
+struct PredictedBoard {
+  Plane plane;
+  Vec3 centre = Vec3::Zero();
+};
+
+PredictedBoard Predict(const CameraBoardObservation& camera, const Pose& cam_from_lidar) {
+  // x_c = R x_l + t, so n_c·x_c + d_c = (Rᵀ n_c)·x_l + (n_c·t + d_c).
+  const Mat3 rotation = cam_from_lidar.linear();
+  const Vec3 t = cam_from_lidar.translation();
+  PredictedBoard board;
+  board.plane.normal = rotation.transpose() * camera.plane.normal;
+  board.plane.distance = camera.plane.distance + camera.plane.normal.dot(t);
+  if (board.plane.distance < 0) {
+    board.plane.normal = -board.plane.normal;
+    board.plane.distance = -board.plane.distance;
+  }
+  board.centre = cam_from_lidar.inverse() * camera.cam_from_board.translation();
+  return board;
+}
+
+// Why the LiDAR board disagrees with the prediction, or "" when it agrees. Tolerances: the
+// options' sigmas of both planes' normal and offset uncertainty, floored.
+std::string Disagreement(const LidarPlaneFit& lidar, const Vec3& lidar_centre,
+                         const CameraBoardObservation& camera, const PredictedBoard& predicted,
+                         double sheet_diagonal_m, const PipelineOptions& options) {
+  const double angle =
+      std::acos(std::min(1.0, std::abs(lidar.plane.normal.dot(predicted.plane.normal))));
+  const double offset = std::abs(predicted.plane.SignedDistance(lidar_centre));
+  const double shift = (lidar_centre - predicted.centre).norm();
+  const double sigma_angle =
+      std::sqrt(lidar.covariance.topLeftCorner<3, 3>().trace() +
+                camera.plane_covariance.topLeftCorner<3, 3>().trace());
+  const double sigma_offset = std::sqrt(lidar.covariance(3, 3) + camera.plane_covariance(3, 3));
+  const double max_angle = std::max(options.guided_min_angle_deg * kDegToRad,
+                                    options.guided_max_sigmas * sigma_angle);
+  const double max_offset =
+      std::max(options.guided_min_offset_m, options.guided_max_sigmas * sigma_offset);
+  if (angle <= max_angle && offset <= max_offset && shift <= 0.5 * sheet_diagonal_m) return "";
+  char text[200];
+  std::snprintf(text, sizeof(text),
+                "LiDAR board disagrees with the camera's by %.1f deg, %.0f mm off its plane, "
+                "%.0f mm from its centre (allowed %.1f deg, %.0f mm)",
+                angle * kRadToDeg, offset * 1e3, shift * 1e3, max_angle * kRadToDeg,
+                max_offset * 1e3);
+  return text;
+}
+
+// The centroid of the plane's inliers in the pair's cloud.
+Vec3 CentreOf(const LidarCloud& cloud, const LidarPlaneFit& fit) {
+  Vec3 sum = Vec3::Zero();
+  for (int i : fit.inliers) sum += cloud.points[i].cast<double>();
+  return fit.inliers.empty() ? Vec3::Zero() : Vec3(sum / double(fit.inliers.size()));
+}
+
+struct Review {
+  bool changed = false;
+  std::optional<LidarPlaneFit> lidar;
+  BoardOrigin origin;
+  std::string failure;  // non-empty: the pair fails with it
+};
+
+// One pair against the prediction: keep an agreeing board, else look at the prediction.
+Review ReviewPair(const Dataset& dataset, const PairEntry& entry, const PairFeatures& pair,
+                  const Pose& cam_from_lidar, const PipelineOptions& options) {
+  Review review;
+  const PredictedBoard predicted = Predict(*pair.camera, cam_from_lidar);
+  const double diagonal = std::hypot(dataset.target.SheetWidth(), dataset.target.SheetHeight());
+  LidarCloud cloud;
+  try {
+    cloud = LoadCloud(entry.cloud);
+  } catch (const IoError&) {
+    return review;  // the pair already failed on its input
+  }
+  std::string disagreement;
+  if (pair.lidar) {
+    disagreement = Disagreement(*pair.lidar, CentreOf(cloud, *pair.lidar), *pair.camera,
+                                predicted, diagonal, options);
+    if (disagreement.empty()) return review;  // agrees: unchanged
+    if (pair.board_origin.source == BoardSource::kSeed) {  // the user's seed wins: flag only
+      review.changed = pair.status == PairStatus::kAccepted;
+      review.lidar = pair.lidar;
+      review.origin = pair.board_origin;
+      review.failure = disagreement;
+      return review;
+    }
+  }
+  BoardHint hint;
+  hint.seed = LidarSeed{predicted.centre,
+                        0.4 * std::min(dataset.target.SheetWidth(), dataset.target.SheetHeight())};
+  hint.seed_from_camera = true;
+  std::string why;
+  BoardOrigin origin;
+  auto fit = ExtractLidarFeatures(dataset, cloud, hint, options, &why, &origin);
+  if (fit) {
+    const std::string again =
+        Disagreement(*fit, CentreOf(cloud, *fit), *pair.camera, predicted, diagonal, options);
+    if (again.empty()) {
+      origin.detail = pair.board_origin.source == BoardSource::kDetected && pair.lidar
+                          ? "at the camera's prediction; detection had found " +
+                                pair.board_origin.detail + " (" + disagreement + ")"
+                          : "at the camera's prediction";
+      review.changed = true;
+      review.lidar = std::move(fit);
+      review.origin = origin;
+      return review;
+    }
+    why = again;
+  }
+  // Nothing agreeing at the prediction either: the pair fails with the first reason.
+  review.changed = pair.status == PairStatus::kAccepted;
+  review.failure = disagreement.empty() ? why : disagreement;
+  review.origin = pair.board_origin;
+  return review;
+}
+
+}  // namespace
+
+void CompleteWithCamera(const Dataset& dataset, const std::vector<const PairEntry*>& pairs,
+                        const PipelineOptions& options, const PairEdits& edits,
+                        CalibrationOutcome* outcome) {
+  CALIBENCH_CHECK(pairs.size() == outcome->pairs.size());
+  for (int round = 0; round < 3 && outcome->solution; ++round) {
+    const Pose cam_from_lidar = outcome->solution->cam_from_lidar;
+    std::vector<Review> reviews(pairs.size());
+    ParallelFor(pairs.size(), options.threads, [&](size_t i) {
+      const PairFeatures& pair = outcome->pairs[i];
+      const auto edit = edits.find(pair.id);
+      const bool brushed = edit != edits.end() && edit->second.brush_pixels;
+      if (pair.input_error || !pair.camera || brushed || pair.status == PairStatus::kRejected)
+        return;
+      reviews[i] = ReviewPair(dataset, *pairs[i], pair, cam_from_lidar, options);
+    });
+    bool changed = false;
+    std::vector<PairFeatures> features = outcome->pairs;
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      Review& review = reviews[i];
+      if (!review.changed && review.failure.empty()) continue;
+      PairFeatures& pair = features[i];
+      const PairStatus before = pair.status;
+      pair.lidar = std::move(review.lidar);
+      pair.board_origin = review.origin;
+      SetStatusFromFeatures(&pair, review.failure, "");
+      if (!review.failure.empty()) {
+        pair.status = PairStatus::kFailed;
+        pair.reason = review.failure;
+        pair.lidar.reset();
+      }
+      changed = changed || review.changed || pair.status != before;
+    }
+    if (!changed) return;
+    const std::string background_note = outcome->background_note;
+    CalibrationOutcome next = SolveFromFeatures(std::move(features), options);
+    if (!next.solution) return;  // keep the last solution rather than none
+    *outcome = std::move(next);
+    outcome->background_note = background_note;
+  }
+}
+
+}  // namespace calibench
