@@ -41,12 +41,11 @@ std::string Disagreement(const LidarPlaneFit& lidar, const Vec3& lidar_centre,
       std::acos(std::min(1.0, std::abs(lidar.plane.normal.dot(predicted.plane.normal))));
   const double offset = std::abs(predicted.plane.SignedDistance(lidar_centre));
   const double shift = (lidar_centre - predicted.centre).norm();
-  const double sigma_angle =
-      std::sqrt(lidar.covariance.topLeftCorner<3, 3>().trace() +
-                camera.plane_covariance.topLeftCorner<3, 3>().trace());
+  const double sigma_angle = std::sqrt(lidar.covariance.topLeftCorner<3, 3>().trace() +
+                                       camera.plane_covariance.topLeftCorner<3, 3>().trace());
   const double sigma_offset = std::sqrt(lidar.covariance(3, 3) + camera.plane_covariance(3, 3));
-  const double max_angle = std::max(options.guided_min_angle_deg * kDegToRad,
-                                    options.guided_max_sigmas * sigma_angle);
+  const double max_angle =
+      std::max(options.guided_min_angle_deg * kDegToRad, options.guided_max_sigmas * sigma_angle);
   const double max_offset =
       std::max(options.guided_min_offset_m, options.guided_max_sigmas * sigma_offset);
   if (angle <= max_angle && offset <= max_offset && shift <= 0.5 * sheet_diagonal_m) return "";
@@ -85,11 +84,13 @@ Review ReviewPair(const Dataset& dataset, const PairEntry& entry, const PairFeat
   } catch (const IoError&) {
     return review;  // the pair already failed on its input
   }
+  // A seed is the user's word: its board is checked, never replaced.
+  if (!pair.lidar && pair.board_origin.source == BoardSource::kSeed) return review;
   std::string disagreement;
   if (pair.lidar) {
-    disagreement = Disagreement(*pair.lidar, CentreOf(cloud, *pair.lidar), *pair.camera,
-                                predicted, diagonal, options);
-    if (disagreement.empty()) return review;  // agrees: unchanged
+    disagreement = Disagreement(*pair.lidar, CentreOf(cloud, *pair.lidar), *pair.camera, predicted,
+                                diagonal, options);
+    if (disagreement.empty()) return review;               // agrees: unchanged
     if (pair.board_origin.source == BoardSource::kSeed) {  // the user's seed wins: flag only
       review.changed = pair.status == PairStatus::kAccepted;
       review.lidar = pair.lidar;

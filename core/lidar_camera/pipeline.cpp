@@ -32,11 +32,12 @@ bool PipelineOptions::Check(std::string* why) const {
 }
 
 namespace {
-constexpr EnumName<BoardSource> kBoardSourceNames[] = {{BoardSource::kNone, "none"},
-                                                       {BoardSource::kBrush, "brush"},
-                                                       {BoardSource::kSeed, "seed"},
-                                                       {BoardSource::kDetected, "detected"},
-                                                       {BoardSource::kCameraGuided, "camera-guided"}};
+constexpr EnumName<BoardSource> kBoardSourceNames[] = {
+    {BoardSource::kNone, "none"},
+    {BoardSource::kBrush, "brush"},
+    {BoardSource::kSeed, "seed"},
+    {BoardSource::kDetected, "detected"},
+    {BoardSource::kCameraGuided, "camera-guided"}};
 }  // namespace
 
 std::string BoardSourceName(BoardSource source) { return NameIn(kBoardSourceNames, source); }
@@ -111,14 +112,13 @@ namespace {
 
 // The region of the hint (brush, else seed) or, without one, of the detected board.
 std::vector<int> RegionFor(const Dataset& dataset, const LidarCloud& cloud, const BoardHint& hint,
-                           const PipelineOptions& options, std::string* why,
-                           BoardOrigin* origin) {
+                           const PipelineOptions& options, std::string* why, BoardOrigin* origin) {
   const bool brushed = hint.brush_pixels && !hint.brush_pixels->empty();
-  if (brushed || hint.seed || !options.detect_board) {
-    *origin = {brushed      ? BoardSource::kBrush
+  if (brushed || hint.seed || !options.detect_board || !hint.detect) {
+    *origin = {brushed                 ? BoardSource::kBrush
                : hint.seed_from_camera ? BoardSource::kCameraGuided
-               : hint.seed  ? BoardSource::kSeed
-                            : BoardSource::kNone,
+               : hint.seed             ? BoardSource::kSeed
+                                       : BoardSource::kNone,
                1.0, ""};
     return SelectBoardRegion(cloud, hint, why);
   }
@@ -182,7 +182,9 @@ std::optional<BoardHint> HintFor(const PairEntry& pair, const PairEdit& edit,
            " gives " + std::to_string(image->rows) + "x" + std::to_string(image->columns);
     return std::nullopt;
   }
-  return BoardHint{&*edit.brush_pixels, image, std::nullopt};
+  BoardHint hint{&*edit.brush_pixels, image, std::nullopt};
+  hint.detect = false;  // the user's brush, even an erased one, is the word
+  return hint;
 }
 
 }  // namespace
@@ -264,10 +266,9 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
       selected.size(), options.threads,
       [&](size_t i) {
         const auto edit = edits.find(selected[i]->id);
-        features[i] =
-            ExtractPairFeatures(dataset, *selected[i], options,
-                                edit == edits.end() ? PairEdit{} : edit->second,
-                                background ? &*background : nullptr);
+        features[i] = ExtractPairFeatures(dataset, *selected[i], options,
+                                          edit == edits.end() ? PairEdit{} : edit->second,
+                                          background ? &*background : nullptr);
       },
       [&](int finished, size_t i) {
         if (progress) progress(finished, static_cast<int>(selected.size()), selected[i]->id);

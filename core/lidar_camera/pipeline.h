@@ -108,7 +108,8 @@ struct BoardHint {
   const std::vector<int>* brush_pixels = nullptr;  // null or empty: no brush
   const LidarImage* image = nullptr;               // the image the brush was painted on
   std::optional<LidarSeed> seed;
-  bool seed_from_camera = false;                 // the seed is the camera's prediction
+  bool seed_from_camera = false;  // the seed is the camera's prediction
+  bool detect = true;  // without brush or seed: detect the board (false: the user erased it)
   const SceneBackground* background = nullptr;  // for detection; may be null
 };
 // Candidate points (indices into the cloud); empty with *why when there is no hint.

@@ -17,6 +17,7 @@
 #include "core/sim/lrf_sim.h"
 #include "core/sim/sim.h"
 #include "core/target/board_camera.h"
+#include "core/target/lidar_board_detect.h"
 #include "core/target/lidar_plane.h"
 #include "tests/acfr_manifest.h"
 
@@ -93,6 +94,81 @@ BENCHMARK(BM_LidarPlaneExtraction)
     ->Arg(static_cast<int>(LidarModel::kVlp16))
     ->Arg(static_cast<int>(LidarModel::kOs0_128))
     ->Unit(benchmark::kMillisecond);
+
+// The board found without a seed in one cloud (one core): a real VLP-16 scan, a simulated
+// OS0-128 scan, and a ring-less swept copy of it.
+void BM_LidarBoardDetection(benchmark::State& state) {
+  LidarCloud cloud;
+  BoardSpec board = BoardPreset("a3");
+  std::string label;
+  if (state.range(0) == 0) {
+    const auto dir = AcfrDir();
+    if (!dir) {
+      state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
+      return;
+    }
+    cloud = LoadCloud(*dir / "pcd/pose20_full.pcd");
+    board.cols = 5;
+    board.rows = 7;
+    board.square_size = 0.095;
+    board.board_width = 0.61;
+    board.board_height = 0.85;
+    label = "real VLP-16";
+  } else {
+    const Dataset& dataset = SimulatedPair(LidarModel::kOs0_128);
+    cloud = LoadCloud(dataset.pairs[0].cloud);
+    label = "OS0-128";
+    if (state.range(0) == 2) {  // scatter the rings: each return turned by up to 0.35 deg
+      std::mt19937_64 rng(4);
+      std::uniform_real_distribution<float> jitter(-0.35f * M_PI / 180, 0.35f * M_PI / 180);
+      for (Eigen::Vector3f& p : cloud.points)
+        p = Eigen::AngleAxisf(jitter(rng), Eigen::Vector3f(p.y(), -p.x(), 0).normalized()) * p;
+      cloud.ring.clear();
+      label = "swept, ring-less";
+    }
+  }
+  state.SetLabel(label + ", " + std::to_string(cloud.size()) + " points");
+  for (auto _ : state)
+    benchmark::DoNotOptimize(DetectLidarBoard(cloud, board, LidarBoardDetectionOptions{}));
+}
+BENCHMARK(BM_LidarBoardDetection)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+
+// The dataset-level steps for the 40 real pairs: the background model over every cloud, and the
+// whole calibration without seeds (detection and camera-guided completion included), 2 threads.
+void BM_BackgroundModelReal40Clouds(benchmark::State& state) {
+  const auto dir = AcfrDir();
+  if (!dir) {
+    state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
+    return;
+  }
+  std::vector<LidarCloud> clouds;
+  for (int n = 1; n <= 40; ++n)
+    clouds.push_back(LoadCloud(*dir / ("pcd/pose" + std::to_string(n) + "_full.pcd")));
+  for (auto _ : state) {
+    SceneBackground background;
+    for (const LidarCloud& cloud : clouds) background.Add(cloud);
+    std::string why;
+    benchmark::DoNotOptimize(background.Finish(&why));
+  }
+}
+BENCHMARK(BM_BackgroundModelReal40Clouds)->Unit(benchmark::kMillisecond);
+
+void BM_CalibrateReal40PairsWithoutSeeds2Threads(benchmark::State& state) {
+  const auto dir = AcfrDir();
+  if (!dir) {
+    state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
+    return;
+  }
+  Dataset dataset = LoadDataset(test::WriteAcfrManifest(*dir, BenchDir("acfr")));
+  for (PairEntry& pair : dataset.pairs) pair.lidar_seed.reset();
+  PipelineOptions options;
+  options.threads = 2;
+  for (auto _ : state) benchmark::DoNotOptimize(CalibrateDataset(dataset, options));
+}
+BENCHMARK(BM_CalibrateReal40PairsWithoutSeeds2Threads)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
 
 void BM_BoardDetectionAndPnp1920x1208(benchmark::State& state) {
   const auto dir = AcfrDir();

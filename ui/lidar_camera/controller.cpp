@@ -111,6 +111,7 @@ void Controller::ApplySessionToState(const Session& session) {
     pair.reason = session.pairs[i].reason;
     if (session.pairs[i].brush) pair.brush_pixels = session.pairs[i].brush->pixels;
     pair.brush_from_seed = session.pairs[i].brush_from_seed;
+    pair.brush_edited = session.pairs[i].brush.has_value() && !pair.brush_from_seed;
   }
   state_.selected = -1;
   for (size_t i = 0; i < state_.pairs.size(); ++i)
@@ -146,10 +147,15 @@ void Controller::CommitEdit() {
     const PairView& v = state_.pairs[i];
     p.status = v.status;
     p.reason = v.reason;
-    if (v.lidar_image) {
+    // No brush for a pair left to detection: reopened (or calibrated with --session) it is
+    // detected again, while an erased brush stays erased.
+    if (v.lidar_image && (v.brush_edited || v.brush_from_seed)) {
       BrushMask mask{v.lidar_image->rows, v.lidar_image->columns, v.brush_pixels};
       p.brush = mask;
       p.brush_from_seed = v.brush_from_seed;
+    } else if (v.lidar_image) {
+      p.brush.reset();
+      p.brush_from_seed = false;
     }
   }
   session_.result.reset();
@@ -235,6 +241,7 @@ void Controller::RefitLidar(int index) {
   std::shared_ptr<const LidarImage> image;
   std::vector<int> brush;
   bool brush_from_seed = false;
+  bool brush_edited = false;
   Dataset dataset;
   std::optional<LidarSeed> seed;
   {
@@ -245,6 +252,7 @@ void Controller::RefitLidar(int index) {
     image = state_.pairs[index].lidar_image;
     brush = state_.pairs[index].brush_pixels;
     brush_from_seed = state_.pairs[index].brush_from_seed;
+    brush_edited = state_.pairs[index].brush_edited;
   }
   if (!cloud || !image) return;
   // The same choice of region as `calibench calibrate`: the seed itself while the brush only
@@ -255,14 +263,17 @@ void Controller::RefitLidar(int index) {
     hint.seed = seed;
   else
     hint.brush_pixels = &brush;
+  hint.detect = !brush_edited;  // an erased brush means "no board here", not "find it"
   std::string why;
+  BoardOrigin origin;
   const std::optional<LidarPlaneFit> fit =
-      ExtractLidarFeatures(dataset, *cloud, hint, pipeline_, &why);
+      ExtractLidarFeatures(dataset, *cloud, hint, pipeline_, &why, &origin);
   std::lock_guard<std::mutex> lock(mutex_);
   PairView& pair = state_.pairs[index];
   if (pair.brush_pixels != brush) return;  // a newer stroke queued its own refit
   pair.lidar = fit;
   pair.lidar_failure = fit ? "" : why;
+  pair.board_origin = origin;
   // A pair with both planes is usable and accepted unless the user rejected it; one that lost a
   // plane fails with the reason.
   if (pair.status != PairStatus::kRejected) {
@@ -318,6 +329,7 @@ PairFeatures Controller::FeaturesOf(const PairView& pair) {
   features.reason = pair.reason;
   features.lidar = pair.lidar;
   features.camera = pair.camera;
+  features.board_origin = pair.board_origin;
   // An accepted pair that lost a plane cannot be solved with.
   if (features.status == PairStatus::kAccepted && !SolvesWith(pair))
     features.status = PairStatus::kFailed;
@@ -491,6 +503,7 @@ void Controller::Handle(const BrushStroke& stroke) {
   if (merged == pair.brush_pixels) return;
   pair.brush_pixels = std::move(merged);
   pair.brush_from_seed = false;  // painted: the brush replaces the seed from now on
+  pair.brush_edited = true;
   CommitEdit();
   const int index = stroke.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });
@@ -501,6 +514,7 @@ void Controller::Handle(const ClearBrush& clear) {
   if (!ValidPair(clear.index)) return;
   state_.pairs[clear.index].brush_pixels.clear();
   state_.pairs[clear.index].brush_from_seed = false;
+  state_.pairs[clear.index].brush_edited = true;
   CommitEdit();
   const int index = clear.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });

@@ -36,7 +36,11 @@ struct PairView : PairHeader {
   std::shared_ptr<const ImageU8> thumbnail;  // small BGR picture of the camera image
   std::vector<int> brush_pixels;             // sorted LiDAR-image pixel indices
   bool brush_from_seed = false;  // brush_pixels picture the manifest's lidar_seed (not painted)
+  // The user painted or erased: the brush is the region. Neither edited nor seeded: the board is
+  // detected (BoardOrigin says so).
+  bool brush_edited = false;
   std::optional<LidarPlaneFit> lidar;
+  BoardOrigin board_origin;
   std::string lidar_failure;
   std::optional<BoardDetection> detection;
   std::optional<CameraBoardObservation> camera;
