@@ -288,7 +288,31 @@ LidarImage ProjectById(const LidarCloud& cloud, const LidarImageOptions& options
     image.range[pixel] = range;
     image.intensity[pixel] = cloud.HasIntensity() ? cloud.intensity[i] : range;
   }
+  std::vector<double> sum(image.rows, 0.0);
+  std::vector<int> count(image.rows, 0);
+  for (size_t pixel = 0; pixel < pixels; ++pixel) {
+    const int index = image.point_index[pixel];
+    if (index < 0) continue;
+    const Eigen::Vector3f& p = cloud.points[index];
+    sum[pixel / image.columns] += std::atan2(p.z(), std::hypot(p.x(), p.y()));
+    ++count[pixel / image.columns];
+  }
+  image.row_elevation_rad.resize(image.rows);
+  for (int row = 0; row < image.rows; ++row)
+    image.row_elevation_rad[row] = count[row] ? static_cast<float>(sum[row] / count[row]) : kNaN;
   return image;
+}
+
+double LidarImage::VerticalSpanRad() const {
+  std::vector<double> elevations;
+  for (float e : row_elevation_rad)
+    if (std::isfinite(e)) elevations.push_back(e);
+  if (elevations.size() < 2) return 0.0;
+  std::sort(elevations.begin(), elevations.end());
+  std::vector<double> steps;
+  for (size_t i = 1; i < elevations.size(); ++i) steps.push_back(elevations[i] - elevations[i - 1]);
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  return elevations.back() - elevations.front() + steps[steps.size() / 2];
 }
 
 }  // namespace calibench

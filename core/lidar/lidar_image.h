@@ -28,11 +28,17 @@ struct LidarImage {
   std::vector<float> intensity;  // NaN where empty; raw intensity (range when the cloud has none)
   std::vector<float> range;      // metres, NaN where empty
   std::vector<int> ring_of_row;  // ring id shown in each row
+  // Mean elevation of each row's returns (radians, NaN for an empty row): what the workbench
+  // needs to draw rows at the sensor's angular aspect.
+  std::vector<float> row_elevation_rad;
   // Per point: the pixel it landed in (row * columns + col), or -1 when another point won the
   // pixel.
   std::vector<int> pixel_of_point;
 
   int PixelIndex(int row, int col) const { return row * columns + col; }
+  // The elevation the rows span (highest minus lowest row, plus one median row step), radians;
+  // 0 when fewer than two rows hold returns.
+  double VerticalSpanRad() const;
 };
 
 // Builds the image; within a pixel the nearest point wins.

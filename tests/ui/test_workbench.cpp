@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 #include <imgui.h>
 
+#include <cmath>
 #include <cstdlib>
+#include <set>
 
 #include "core/base/image.h"
 #include "core/io/image_io.h"
@@ -83,8 +85,9 @@ TEST_F(WorkbenchRender, PanelsDrivenFrameByFrame) {
   FrameWithInput(controller, workbench, *host_, Layout::kLidarOnly, {-1, -1}, false, -1);
   const auto& rect = workbench.lidar_image_rect();
   const float u = (board_pixel % columns + 0.5f) / columns;
-  const ImVec2 aim(rect.x + (u - rect.u0) / (rect.u1 - rect.u0) * rect.w,
-                   rect.y + (board_pixel / columns + 0.5f) / rows * rect.h);
+  const ImVec2 aim(
+      rect.x + (u - rect.u0) / (rect.u1 - rect.u0) * rect.w,
+      rect.y + ((board_pixel / columns + 0.5f) / rows - rect.v0) / (rect.v1 - rect.v0) * rect.h);
   ASSERT_GT(aim.x, rect.x);
   ASSERT_LT(aim.x, rect.x + rect.w);
   // A brush stroke: the LiDAR view returns it, the controller fits the plane.
@@ -124,6 +127,54 @@ TEST_F(WorkbenchRender, PanelsDrivenFrameByFrame) {
   const Snapshot solved = controller.GetSnapshot();
   ASSERT_TRUE(solved.solver.result);
   EXPECT_TRUE(solved.solver.result->converged);
+}
+
+// The board painted in the 3D view: the stroke selects the board's returns (not the wall behind),
+// the plane refitted to them is the seeded one, and the view shows it (golden).
+TEST_F(WorkbenchRender, TheBoardPaintedInTheThreeDViewGivesItsPlane) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), test::TempDir("scene_brush_session") / "s.json");
+  controller.WaitIdle();
+  const PairView seeded = controller.GetSnapshot().pairs[0];
+  ASSERT_TRUE(seeded.lidar);
+  Vec3 board_centre = Vec3::Zero();
+  for (int i : seeded.lidar->inliers) board_centre += seeded.cloud->points[i].cast<double>();
+  board_centre /= double(seeded.lidar->inliers.size());
+  controller.Apply(ClearBrush{0});
+  // Look at the board from 2 m: the orbit target on its centre.
+  ViewState view = controller.GetSnapshot().view;
+  for (int a = 0; a < 3; ++a) view.orbit_target[a] = board_centre[a];
+  view.orbit_distance_m = 2.0;
+  view.orbit_yaw_rad = std::atan2(board_centre.y(), board_centre.x()) + M_PI;
+  controller.Apply(SetView{view});
+  controller.WaitIdle();
+  ASSERT_FALSE(controller.GetSnapshot().pairs[0].lidar);
+
+  Workbench workbench;
+  workbench.set_scene_brush(true);
+  FrameWithInput(controller, workbench, *host_, Layout::kSceneOnly, {-1, -1}, false, -1);
+  const auto& rect = workbench.scene_image_rect();
+  const ImVec2 aim(rect.x + rect.w / 2, rect.y + rect.h / 2);  // the target: the board centre
+  const auto stroke =
+      FrameWithInput(controller, workbench, *host_, Layout::kSceneOnly, aim, true, -1);
+  const PaintPoints* paint = nullptr;
+  for (const Intent& i : stroke)
+    if (const auto* p = std::get_if<PaintPoints>(&i)) paint = p;
+  ASSERT_TRUE(paint) << "the stroke painted nothing";
+  EXPECT_FALSE(paint->erase);
+  // Every painted pixel is a board return of the seeded fit.
+  std::set<int> board_pixels;
+  for (int i : seeded.lidar->inliers) board_pixels.insert(seeded.lidar_image->pixel_of_point[i]);
+  for (int pixel : paint->pixels) EXPECT_TRUE(board_pixels.count(pixel)) << pixel;
+  controller.Apply(*paint);
+  controller.WaitIdle();
+  const PairView painted = controller.GetSnapshot().pairs[0];
+  ASSERT_TRUE(painted.lidar) << painted.lidar_failure;
+  EXPECT_EQ(painted.board_origin.source, BoardSource::kBrush);
+  EXPECT_GT(std::abs(painted.lidar->plane.normal.dot(seeded.lidar->plane.normal)),
+            std::cos(1.0 * M_PI / 180));
+  EXPECT_NEAR(painted.lidar->plane.distance, seeded.lidar->plane.distance, 0.01);
+  ExpectMatchesGolden(Render(controller, Layout::kSceneOnly, 480, 300), "scene_brushed");
 }
 
 TEST_F(WorkbenchRender, ASavedAndReopenedSessionRendersIdentically) {

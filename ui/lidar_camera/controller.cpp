@@ -223,17 +223,49 @@ void Controller::LoadPair(int index) {
   pair = std::move(loaded);
   ++state_.loading_done;
   ++state_.generation;
-  if (pair.cloud) worker_.Enqueue([this, index] { RefitLidar(index); });
+  // Detection waits for every cloud: the background model over them keeps static board-sized
+  // panels out (as CalibrateDataset does).
+  const bool detects = !pair.brush_from_seed && !painted;
+  if (pair.cloud && !detects) worker_.Enqueue([this, index] { RefitLidar(index); });
+  if (pair.cloud && detects) pair.lidar_failure = "finding the board once every pair is loaded ...";
   if (!pair.cloud) {
     pair.status = PairStatus::kFailed;
     pair.reason = pair.camera_failure;
   }
   if (state_.loading_done == state_.loading_total) {
+    worker_.Enqueue([this] { DetectWithBackground(); });
     SetStatus("loaded " + std::to_string(state_.loading_total) + " pairs", false);
     // A reopened session with a result shows its reprojection again.
     const int selected = state_.selected;
     if (state_.solver.result) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
   }
+}
+
+void Controller::DetectWithBackground() {
+  std::vector<std::shared_ptr<const LidarCloud>> clouds;
+  std::vector<int> detect;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (size_t i = 0; i < state_.pairs.size(); ++i) {
+      const PairView& pair = state_.pairs[i];
+      if (!pair.cloud) continue;
+      clouds.push_back(pair.cloud);
+      if (!pair.brush_from_seed && !pair.brush_edited) detect.push_back(static_cast<int>(i));
+    }
+  }
+  background_.reset();
+  if (!detect.empty() && pipeline_.background_model) {
+    SceneBackground background;
+    for (const auto& cloud : clouds) background.Add(*cloud);
+    std::string why;
+    if (background.Finish(&why)) {
+      background_ = std::move(background);
+    } else {
+      std::lock_guard<std::mutex> lock(mutex_);
+      SetStatus("board detection without a background model: " + why, false);
+    }
+  }
+  for (int index : detect) RefitLidar(index);
 }
 
 void Controller::RefitLidar(int index) {
@@ -259,11 +291,13 @@ void Controller::RefitLidar(int index) {
   // pictures it; once painted (or erased), the brush.
   BoardHint hint;
   hint.image = image.get();
+  // Seed, else the user's brush (an erased one means "no board here"), else detection.
   if (brush_from_seed)
     hint.seed = seed;
-  else
+  else if (brush_edited)
     hint.brush_pixels = &brush;
-  hint.detect = !brush_edited;  // an erased brush means "no board here", not "find it"
+  hint.detect = !brush_edited;
+  hint.background = background_ ? &*background_ : nullptr;  // written on this thread only
   std::string why;
   BoardOrigin origin;
   const std::optional<LidarPlaneFit> fit =
@@ -274,6 +308,16 @@ void Controller::RefitLidar(int index) {
   pair.lidar = fit;
   pair.lidar_failure = fit ? "" : why;
   pair.board_origin = origin;
+  // A detected board shows as the brush (in its own colour) until the user edits it.
+  if (origin.source == BoardSource::kDetected) {
+    pair.brush_pixels.clear();
+    if (fit)
+      for (int i : fit->inliers)
+        if (pair.lidar_image->pixel_of_point[i] >= 0)
+          pair.brush_pixels.push_back(pair.lidar_image->pixel_of_point[i]);
+    std::sort(pair.brush_pixels.begin(), pair.brush_pixels.end());
+    pair.brush_detected = true;
+  }
   // A pair with both planes is usable and accepted unless the user rejected it; one that lost a
   // plane fails with the reason.
   if (pair.status != PairStatus::kRejected) {
@@ -504,6 +548,7 @@ void Controller::Handle(const BrushStroke& stroke) {
   pair.brush_pixels = std::move(merged);
   pair.brush_from_seed = false;  // painted: the brush replaces the seed from now on
   pair.brush_edited = true;
+  pair.brush_detected = false;
   CommitEdit();
   const int index = stroke.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });
@@ -515,8 +560,47 @@ void Controller::Handle(const ClearBrush& clear) {
   state_.pairs[clear.index].brush_pixels.clear();
   state_.pairs[clear.index].brush_from_seed = false;
   state_.pairs[clear.index].brush_edited = true;
+  state_.pairs[clear.index].brush_detected = false;
   CommitEdit();
   const int index = clear.index;
+  worker_.Enqueue([this, index] { RefitLidar(index); });
+}
+
+template <>
+void Controller::Handle(const DetectBoardAgain& again) {
+  if (!again.all && !ValidPair(again.index)) return;
+  for (size_t i = 0; i < state_.pairs.size(); ++i) {
+    if (!again.all && static_cast<int>(i) != again.index) continue;
+    PairView& pair = state_.pairs[i];
+    if (!pair.lidar_image) continue;
+    pair.brush_pixels.clear();
+    pair.brush_from_seed = false;
+    pair.brush_edited = false;
+    pair.brush_detected = false;
+    const int index = static_cast<int>(i);
+    worker_.Enqueue([this, index] { RefitLidar(index); });
+  }
+  CommitEdit();
+}
+
+template <>
+void Controller::Handle(const PaintPoints& paint) {
+  if (!ValidPair(paint.index) || paint.pixels.empty()) return;
+  PairView& pair = state_.pairs[paint.index];
+  std::vector<int> merged;
+  if (paint.erase)
+    std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), paint.pixels.begin(),
+                        paint.pixels.end(), std::back_inserter(merged));
+  else
+    std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), paint.pixels.begin(),
+                   paint.pixels.end(), std::back_inserter(merged));
+  if (merged == pair.brush_pixels) return;
+  pair.brush_pixels = std::move(merged);
+  pair.brush_from_seed = false;
+  pair.brush_edited = true;
+  pair.brush_detected = false;
+  CommitEdit();
+  const int index = paint.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });
 }
 

@@ -39,6 +39,7 @@ struct PairView : PairHeader {
   // The user painted or erased: the brush is the region. Neither edited nor seeded: the board is
   // detected (BoardOrigin says so).
   bool brush_edited = false;
+  bool brush_detected = false;  // brush_pixels picture the detected board (not painted)
   std::optional<LidarPlaneFit> lidar;
   BoardOrigin board_origin;
   std::string lidar_failure;
@@ -101,6 +102,17 @@ struct BrushStroke {
 struct ClearBrush {
   int index;
 };
+// Forget the pair's brush (and seed) and detect the board again; every pair when `all`.
+struct DetectBoardAgain {
+  int index;
+  bool all = false;
+};
+// LiDAR points painted in the 3D view, as the LiDAR-image pixels they landed in (sorted).
+struct PaintPoints {
+  int index;
+  std::vector<int> pixels;
+  bool erase;
+};
 struct RunSolver {};
 struct ResetSolver {};
 struct SetSolverOptions {
@@ -120,9 +132,9 @@ struct SaveSessionAs {
 };
 struct Undo {};
 struct Redo {};
-using Intent =
-    std::variant<SelectPair, SetPairStatus, BrushStroke, ClearBrush, RunSolver, ResetSolver,
-                 SetSolverOptions, SetView, ExportResult, SaveSessionAs, Undo, Redo>;
+using Intent = std::variant<SelectPair, SetPairStatus, BrushStroke, ClearBrush, DetectBoardAgain,
+                            PaintPoints, RunSolver, ResetSolver, SetSolverOptions, SetView,
+                            ExportResult, SaveSessionAs, Undo, Redo>;
 
 class Controller : public ControllerState<Snapshot> {
  public:
@@ -145,6 +157,9 @@ class Controller : public ControllerState<Snapshot> {
   void LoadAllPairs();
   void LoadPair(int index);
   void RefitLidar(int index);
+  // Once every pair is loaded: the background model over their clouds, then detection for the
+  // pairs without a seed or a brush (worker thread).
+  void DetectWithBackground();
   void Solve();
   SolverOptions SolverOptionsFromState() const;          // the user's choices over pipeline_.solver
   PipelineOptions PipelineOptionsFromState() const;      // pipeline_ with those solver choices
@@ -171,6 +186,7 @@ class Controller : public ControllerState<Snapshot> {
   SessionHistory history_;
   std::unique_ptr<Autosaver> autosaver_;
   PipelineOptions pipeline_;
+  std::optional<SceneBackground> background_;  // worker thread only (DetectWithBackground)
 };
 
 }  // namespace calibench::ui

@@ -29,12 +29,17 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   Workbench();
   ~Workbench() override;
 
-  // Where the last frame drew the LiDAR image (screen pixels) and which horizontal texture range
-  // [u0, u1] it showed: lets tests (and tools) aim the brush at a LiDAR pixel.
+  // Where the last frame drew the LiDAR image (screen pixels) and which texture ranges [u0, u1]
+  // and [v0, v1] it showed: lets tests (and tools) aim the brush at a LiDAR pixel.
   struct ImageRect {
-    float x = 0, y = 0, w = 0, h = 0, u0 = 0, u1 = 1;
+    float x = 0, y = 0, w = 0, h = 0, u0 = 0, u1 = 1, v0 = 0, v1 = 1;
   };
   const ImageRect& lidar_image_rect() const { return lidar_image_rect_; }
+  // Where the last frame drew the 3D view (screen pixels; u and v unused).
+  const ImageRect& scene_image_rect() const { return scene_image_rect_; }
+  // The 3D view's left drag paints the board on the points instead of orbiting (the "brush"
+  // checkbox of its toolbar).
+  void set_scene_brush(bool on) { scene_brush_ = on; }
 
  private:
   // LiDAR view (workbench_lidar.cpp).
@@ -71,14 +76,19 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   struct Gl;
   std::unique_ptr<Gl> gl_;
   // View-local state.
-  float lidar_zoom_ = 3.0f;          // horizontal zoom of the LiDAR image (1 = all 360 degrees)
+  // Horizontal zoom of the LiDAR image (1 = all 360 degrees); 0 = fit the rows, drawn at the
+  // sensor's angular aspect, to the view's height.
+  float lidar_zoom_ = 0.0f;
   float lidar_center_ = 0.5f;        // centre column as a fraction of the image width
+  float lidar_center_v_ = 0.5f;      // centre row as a fraction of the height, when cropped
   std::string lidar_centered_on_;    // pair whose brush the LiDAR view was last centred on
   ZoomPanImage camera_image_;        // zoom and pan of the camera view
   bool scene_camera_colors_ = true;  // 3D cloud coloured from the image once a solve exists
   std::string export_path_ = "result.json";
   std::string session_path_ = "session.json";
   ImageRect lidar_image_rect_;
+  ImageRect scene_image_rect_;
+  bool scene_brush_ = false;
   std::uint64_t scene_frame_key_ = 0;  // what the 3D framebuffer last showed
   std::uint64_t lidar_key_ = ~0ull, camera_key_ = ~0ull, scene_key_ = ~0ull;
 };

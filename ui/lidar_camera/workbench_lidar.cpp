@@ -22,7 +22,9 @@ ImageU8 ComposeLidarPicture(const PairView& pair, LidarChannel channel) {
     p[1] = static_cast<std::uint8_t>(p[1] * (1 - alpha) + g * alpha);
     p[2] = static_cast<std::uint8_t>(p[2] * (1 - alpha) + r * alpha);
   };
-  for (int pixel : pair.brush_pixels) blend(pixel, 255, 255, 255, 0.45f);
+  // A detected board's region in cyan until the user edits it; a painted or seeded one in white.
+  for (int pixel : pair.brush_pixels)
+    pair.brush_detected ? blend(pixel, 40, 220, 255, 0.55f) : blend(pixel, 255, 255, 255, 0.45f);
   if (pair.lidar)
     for (int i : pair.lidar->inliers)
       if (pair.lidar_image->pixel_of_point[i] >= 0)
@@ -35,6 +37,7 @@ std::uint64_t LidarPictureKey(const PairView& pair, LidarChannel channel) {
   return reinterpret_cast<std::uintptr_t>(pair.lidar_image.get()) ^
          (pair.brush_pixels.size() * 2654435761ull) ^
          ((pair.lidar ? pair.lidar->inliers.size() + 1 : 0) << 20) ^
+         (static_cast<std::uint64_t>(pair.brush_detected) << 36) ^
          (static_cast<std::uint64_t>(channel) << 40);
 }
 
@@ -90,9 +93,27 @@ void Workbench::LidarToolbar(const Snapshot& s, const PairView& pair,
   }
   ImGui::SameLine();
   if (ImGui::SmallButton("clear")) intents->push_back(ClearBrush{s.selected});
+  // Second row: the board found again, the view back on it.
+  if (ImGui::SmallButton("detect")) intents->push_back(DetectBoardAgain{s.selected, false});
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("forget this pair's brush and find the board in the cloud again");
+  ImGui::SameLine();
+  if (ImGui::SmallButton("detect all")) intents->push_back(DetectBoardAgain{s.selected, true});
+  ImGui::SameLine();
+  if (ImGui::SmallButton("zoom to board")) {
+    lidar_zoom_ = 0.0f;
+    lidar_centered_on_.clear();
+  }
   if (pair.lidar) {
-    ImGui::Text("plane: %zu inliers of %d, RMS %.1f mm", pair.lidar->inliers.size(),
-                pair.lidar->num_candidates, pair.lidar->rms_m * 1e3);
+    const BoardOrigin& origin = pair.board_origin;
+    ImGui::Text("plane: %zu inliers of %d, RMS %.1f mm | board: %s", pair.lidar->inliers.size(),
+                pair.lidar->num_candidates, pair.lidar->rms_m * 1e3,
+                BoardSourceName(origin.source).c_str());
+    if (origin.source == BoardSource::kDetected) {
+      ImGui::SameLine();
+      ImGui::TextColored({0.3f, 0.85f, 1.0f, 1}, "(confidence %.2f: %s)", origin.confidence,
+                         origin.detail.c_str());
+    }
   } else {
     ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "no plane: %s", pair.lidar_failure.c_str());
   }
@@ -103,35 +124,59 @@ void Workbench::CenterLidarOnBrush(const PairView& pair) {
   if (lidar_centered_on_ == pair.id || pair.brush_pixels.empty()) return;
   // Circular mean: the brush may straddle the image's left/right seam.
   const int columns = pair.lidar_image->columns;
-  double sx = 0, sy = 0;
+  double sx = 0, sy = 0, rows = 0;
   for (int pixel : pair.brush_pixels) {
     const double a = 2 * M_PI * ((pixel % columns) + 0.5) / columns;
     sx += std::cos(a), sy += std::sin(a);
+    rows += pixel / columns + 0.5;
   }
   const double mean = std::atan2(sy, sx);
   lidar_center_ = static_cast<float>((mean < 0 ? mean + 2 * M_PI : mean) / (2 * M_PI));
+  lidar_center_v_ = static_cast<float>(rows / pair.brush_pixels.size() / pair.lidar_image->rows);
   lidar_centered_on_ = pair.id;
 }
 
-// The picture zoomed horizontally about lidar_center_, rows stretched to the view height. Over
-// it: the brush outline (a circle in LiDAR pixels, an ellipse on screen); left drag paints (shift
-// erases), the wheel zooms, a right drag pans.
+// The picture zoomed horizontally about lidar_center_, its rows at the sensor's angular aspect
+// (a VLP-16's 16 rings span 30 degrees: each row is drawn as tall as 2 degrees of azimuth are
+// wide), cropped vertically about lidar_center_v_ when taller than the view. Over it: the brush
+// outline (a circle in LiDAR pixels, an ellipse on screen); left drag paints (shift erases), the
+// wheel zooms, a right drag pans.
 void Workbench::LidarPicture(const Snapshot& s, const PairView& pair,
                              std::vector<Intent>* intents) {
   const LidarImage& image = *pair.lidar_image;
   const ImVec2 avail = ImGui::GetContentRegionAvail();
+  const double vertical_rad = image.VerticalSpanRad();
+  if (lidar_zoom_ <= 0)  // fit: the rows fill the height
+    lidar_zoom_ =
+        vertical_rad > 0
+            ? std::clamp(static_cast<float>(2 * M_PI * avail.y / (avail.x * vertical_rad)), 1.0f,
+                         40.0f)
+            : 3.0f;
   const float span = 1.0f / std::max(1.0f, lidar_zoom_);
   lidar_center_ = std::clamp(lidar_center_, span / 2, 1 - span / 2);
-  const ImVec2 uv0(lidar_center_ - span / 2, 0), uv1(lidar_center_ + span / 2, 1);
+  float height = avail.y, v0 = 0.0f, v1 = 1.0f;
+  if (vertical_rad > 0) {
+    const float full = static_cast<float>(vertical_rad * avail.x / (2 * M_PI * span));
+    if (full <= avail.y) {
+      height = full;
+    } else {
+      const float shown = avail.y / full;
+      v0 = std::clamp(lidar_center_v_ - shown / 2, 0.0f, 1.0f - shown);
+      v1 = v0 + shown;
+    }
+  }
+  height = std::max(height, 1.0f);
+  const ImVec2 uv0(lidar_center_ - span / 2, v0), uv1(lidar_center_ + span / 2, v1);
   const ImVec2 origin = ImGui::GetCursorScreenPos();
-  ImGui::Image(TextureId(gl_->lidar_picture.texture()), avail, uv0, uv1);
-  lidar_image_rect_ = {origin.x, origin.y, avail.x, avail.y, uv0.x, uv1.x};
+  ImGui::Image(TextureId(gl_->lidar_picture.texture()), ImVec2(avail.x, height), uv0, uv1);
+  lidar_image_rect_ = {origin.x, origin.y, avail.x, height, uv0.x, uv1.x, v0, v1};
   if (!ImGui::IsItemHovered()) return;
   const ImGuiIO& io = ImGui::GetIO();
   const float col = (uv0.x + (io.MousePos.x - origin.x) / avail.x * span) * image.columns;
-  const float row = (io.MousePos.y - origin.y) / avail.y * image.rows;
+  const float row = (v0 + (io.MousePos.y - origin.y) / height * (v1 - v0)) * image.rows;
   const float rad = static_cast<float>(s.view.brush_radius_px);
-  const float px_per_col = avail.x / (span * image.columns), px_per_row = avail.y / image.rows;
+  const float px_per_col = avail.x / (span * image.columns);
+  const float px_per_row = height / ((v1 - v0) * image.rows);
   DrawEllipse(ImGui::GetWindowDrawList(), io.MousePos, rad * px_per_col, rad * px_per_row,
               io.KeyShift ? IM_COL32(255, 120, 90, 255) : IM_COL32(255, 255, 255, 220));
   if (ImGui::IsMouseDown(ImGuiMouseButton_Left))
@@ -139,8 +184,10 @@ void Workbench::LidarPicture(const Snapshot& s, const PairView& pair,
         BrushStroke{s.selected, static_cast<int>(row), static_cast<int>(col), rad, io.KeyShift});
   if (io.MouseWheel != 0)
     lidar_zoom_ = std::clamp(lidar_zoom_ * std::pow(1.25f, io.MouseWheel), 1.0f, 40.0f);
-  if (ImGui::IsMouseDragging(ImGuiMouseButton_Right))
+  if (ImGui::IsMouseDragging(ImGuiMouseButton_Right)) {
     lidar_center_ -= io.MouseDelta.x / avail.x * span;
+    lidar_center_v_ -= io.MouseDelta.y / height * (v1 - v0);
+  }
 }
 
 }  // namespace calibench::ui

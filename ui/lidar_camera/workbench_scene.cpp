@@ -69,16 +69,56 @@ std::array<Vec3, 4> InlierExtent(const LidarCloud& cloud, const LidarPlaneFit& f
           centroid + u0 * u + w1 * w};
 }
 
-// "camera colours" and what the view shows otherwise; the mouse's use.
-void SceneToolbar(const Snapshot& s, bool* camera_colors) {
+// "camera colours", the brush, and what the view shows otherwise; the mouse's use.
+void SceneToolbar(const Snapshot& s, bool* camera_colors, bool* brush) {
   static const char* kColorings[] = {"intensity", "range", "ring"};
   ImGui::Checkbox("camera colours", camera_colors);
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("colour the cloud from the camera image (after a solve)");
   ImGui::SameLine();
-  ImGui::TextDisabled(
-      "else %s (LiDAR view); magenta: plane inliers. drag: orbit, right: pan, wheel: zoom",
-      kColorings[static_cast<int>(s.view.lidar_channel)]);
+  ImGui::Checkbox("brush", brush);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "left drag paints the board on the points (shift erases); the same brush "
+        "as the LiDAR image's");
+  ImGui::SameLine();
+  ImGui::TextDisabled("else %s; magenta: plane inliers. %s, right: pan, wheel: zoom",
+                      kColorings[static_cast<int>(s.view.lidar_channel)],
+                      *brush ? "drag: paint" : "drag: orbit");
+}
+
+// The screen radius of the 3D brush: the LiDAR image brush's radius, scaled so that the default
+// covers a few rings of a board at 2-3 m.
+float SceneBrushRadiusPx(const ViewState& view) {
+  return static_cast<float>(4.0 * view.brush_radius_px);
+}
+
+// The LiDAR-image pixels of the points under a circle of the 3D view: those that project within
+// radius_px of `centre` (screen pixels; the view drawn at `origin`, w x h) and lie on the nearest
+// surface there (within 0.3 m of the nearest such point's depth), so that a stroke on the board
+// does not take the wall behind it. Sorted, unique.
+std::vector<int> PixelsUnderSceneBrush(const PairView& pair, const gfx::Matrix4f& view_projection,
+                                       const ImVec2& origin, float w, float h, const ImVec2& centre,
+                                       float radius_px) {
+  const LidarCloud& cloud = *pair.cloud;
+  std::vector<std::pair<float, int>> hits;  // (depth, point)
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector4f clip = view_projection * cloud.points[i].homogeneous();
+    if (clip.w() <= 1e-6f) continue;
+    const float x = origin.x + (clip.x() / clip.w() + 1.0f) * 0.5f * w;
+    const float y = origin.y + (1.0f - clip.y() / clip.w()) * 0.5f * h;
+    if (std::hypot(x - centre.x, y - centre.y) <= radius_px)
+      hits.emplace_back(clip.w(), static_cast<int>(i));
+  }
+  std::vector<int> pixels;
+  if (hits.empty()) return pixels;
+  const float nearest = std::min_element(hits.begin(), hits.end())->first;
+  for (const auto& [depth, point] : hits)
+    if (depth < nearest + 0.3f && pair.lidar_image->pixel_of_point[point] >= 0)
+      pixels.push_back(pair.lidar_image->pixel_of_point[point]);
+  std::sort(pixels.begin(), pixels.end());
+  pixels.erase(std::unique(pixels.begin(), pixels.end()), pixels.end());
+  return pixels;
 }
 
 // Left drag orbits, right drag pans the target in the ground plane and up, the wheel zooms: the
@@ -111,7 +151,7 @@ void Workbench::SceneView(const Snapshot& s, const Rect& r, std::vector<Intent>*
   }
   const bool can_use_camera =
       s.reprojection && s.reprojection->pair_id == pair->id && s.selected_image && s.solver.result;
-  SceneToolbar(s, &scene_camera_colors_);
+  SceneToolbar(s, &scene_camera_colors_, &scene_brush_);
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const int tw = std::max(1, static_cast<int>(avail.x)),
             th = std::max(1, static_cast<int>(avail.y));
@@ -134,9 +174,30 @@ void Workbench::SceneView(const Snapshot& s, const Rect& r, std::vector<Intent>*
     scene_frame_key_ = frame_key.value();
     DrawScene(s, *pair, view_projection, estimate, tw, th);
   }
+  const ImVec2 origin = ImGui::GetCursorScreenPos();
   FramebufferImage(gl_->scene_target, ImVec2(tw, th));
-  if (ImGui::IsItemHovered())
-    if (const ViewState next = OrbitByMouse(v); !(next == v)) intents->push_back(SetView{next});
+  scene_image_rect_ = {origin.x, origin.y, static_cast<float>(tw), static_cast<float>(th)};
+  if (ImGui::IsItemHovered()) {
+    const ImGuiIO& io = ImGui::GetIO();
+    if (scene_brush_ && pair->lidar_image) {
+      const float radius = SceneBrushRadiusPx(v);
+      ImGui::GetWindowDrawList()->AddCircle(
+          io.MousePos, radius,
+          io.KeyShift ? IM_COL32(255, 120, 90, 255) : IM_COL32(255, 255, 255, 220), 48, 1.5f);
+      if (ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+        std::vector<int> pixels =
+            PixelsUnderSceneBrush(*pair, view_projection, origin, tw, th, io.MousePos, radius);
+        if (!pixels.empty())
+          intents->push_back(PaintPoints{s.selected, std::move(pixels), io.KeyShift});
+      }
+    }
+    ViewState next = OrbitByMouse(v);
+    if (scene_brush_) {  // the left drag paints: keep the orbit angles, allow pan and zoom
+      next.orbit_yaw_rad = v.orbit_yaw_rad;
+      next.orbit_pitch_rad = v.orbit_pitch_rad;
+    }
+    if (!(next == v)) intents->push_back(SetView{next});
+  }
   ImGui::End();
 }
 
