@@ -152,6 +152,12 @@ void SessionHistory::Push(const Session& state) {
   }
 }
 
+void SessionHistory::Amend(const Session& state) {
+  if (cursor_ == 0) return Push(state);
+  states_.erase(states_.begin() + static_cast<std::ptrdiff_t>(cursor_) + 1, states_.end());
+  states_[cursor_] = state;
+}
+
 std::optional<Session> SessionHistory::Undo() {
   if (!CanUndo()) return std::nullopt;
   return states_[--cursor_];

@@ -166,6 +166,10 @@ class SessionHistory {
   // Records the state after an edit and drops the redo branch. A state equal to the current one
   // is ignored (no empty undo steps). The first Push after construction acts as Reset.
   void Push(const Session& state);
+  // Replaces the current state without a new undo step (and drops the redo branch): the rest of
+  // an edit already pushed, such as the later dabs of one brush stroke. Push when nothing is
+  // recorded yet or the current state is the first.
+  void Amend(const Session& state);
   std::optional<Session> Undo();
   std::optional<Session> Redo();
   bool CanUndo() const { return cursor_ > 0; }

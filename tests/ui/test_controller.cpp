@@ -67,6 +67,29 @@ TEST(Controller, BrushStrokesRefitThePlaneAndErasingRemovesIt) {
   EXPECT_TRUE(s.pairs[1].brush_pixels.empty());
 }
 
+// The dabs of one stroke (mouse held down, then released) are one undo step.
+TEST(Controller, OneBrushStrokeIsOneUndoStep) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), test::TempDir("controller_stroke") / "s.json");
+  Snapshot s = Loaded(controller);
+  const std::vector<int> seeded = s.pairs[1].brush_pixels;
+  const int columns = s.pairs[1].lidar_image->columns;
+  const int pixel = seeded[seeded.size() / 2];
+  for (int step = 0; step < 5; ++step)  // a drag along the row
+    controller.Apply(BrushStroke{1, pixel / columns, pixel % columns + 4 * step, 3.0f, false});
+  controller.Apply(EndStroke{});
+  s = Loaded(controller);
+  const std::vector<int> first_stroke = s.pairs[1].brush_pixels;
+  EXPECT_GT(first_stroke.size(), seeded.size());
+  controller.Apply(BrushStroke{1, pixel / columns, pixel % columns + 40, 3.0f, false});
+  controller.Apply(EndStroke{});
+  Loaded(controller);
+  controller.Apply(Undo{});  // the second stroke
+  EXPECT_EQ(Loaded(controller).pairs[1].brush_pixels, first_stroke);
+  controller.Apply(Undo{});  // the whole first stroke, all five dabs
+  EXPECT_EQ(Loaded(controller).pairs[1].brush_pixels, seeded);
+}
+
 TEST(Controller, RejectAcceptSolveAndUndo) {
   Controller controller;
   const auto dir = test::TempDir("controller_solve");

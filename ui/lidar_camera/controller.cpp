@@ -166,7 +166,10 @@ void Controller::CommitEdit() {
       session_.result->estimate_history.push_back(it.cam_from_lidar);
     }
   }
-  history_.Push(session_);
+  if (stroke_open_)
+    history_.Amend(session_);
+  else
+    history_.Push(session_);
   state_.can_undo = history_.CanUndo();
   state_.can_redo = history_.CanRedo();
   try {
@@ -550,6 +553,7 @@ void Controller::Handle(const BrushStroke& stroke) {
   pair.brush_edited = true;
   pair.brush_detected = false;
   CommitEdit();
+  stroke_open_ = true;  // the stroke's later dabs amend this undo step
   const int index = stroke.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });
 }
@@ -564,6 +568,11 @@ void Controller::Handle(const ClearBrush& clear) {
   CommitEdit();
   const int index = clear.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });
+}
+
+template <>
+void Controller::Handle(const EndStroke&) {
+  stroke_open_ = false;
 }
 
 template <>
@@ -600,6 +609,7 @@ void Controller::Handle(const PaintPoints& paint) {
   pair.brush_edited = true;
   pair.brush_detected = false;
   CommitEdit();
+  stroke_open_ = true;  // the stroke's later dabs amend this undo step
   const int index = paint.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });
 }
@@ -705,6 +715,9 @@ void Controller::Restore(const std::optional<Session>& restored) {
 void Controller::Apply(const Intent& intent) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!state_.dataset) return;
+  // A stroke is its dabs; anything else in between ends it.
+  if (!std::holds_alternative<BrushStroke>(intent) && !std::holds_alternative<PaintPoints>(intent))
+    stroke_open_ = false;
   std::visit([this](const auto& what) { Handle(what); }, intent);
 }
 

@@ -102,6 +102,8 @@ struct BrushStroke {
 struct ClearBrush {
   int index;
 };
+// The mouse button was released: the brush stroke (BrushStroke / PaintPoints dabs) is complete.
+struct EndStroke {};
 // Forget the pair's brush (and seed) and detect the board again; every pair when `all`.
 struct DetectBoardAgain {
   int index;
@@ -132,9 +134,9 @@ struct SaveSessionAs {
 };
 struct Undo {};
 struct Redo {};
-using Intent = std::variant<SelectPair, SetPairStatus, BrushStroke, ClearBrush, DetectBoardAgain,
-                            PaintPoints, RunSolver, ResetSolver, SetSolverOptions, SetView,
-                            ExportResult, SaveSessionAs, Undo, Redo>;
+using Intent = std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush,
+                            DetectBoardAgain, PaintPoints, RunSolver, ResetSolver, SetSolverOptions,
+                            SetView, ExportResult, SaveSessionAs, Undo, Redo>;
 
 class Controller : public ControllerState<Snapshot> {
  public:
@@ -171,7 +173,9 @@ class Controller : public ControllerState<Snapshot> {
   // (state_.solver.result must be set); call with mutex_ held.
   SolverResult ResultForCurrentPairs() const;
   void RecomputeResiduals();  // call with mutex_ held
-  void CommitEdit();          // session <- state, history + autosave; call with mutex_ held
+  // session <- state, history + autosave; call with mutex_ held. Within an open brush stroke the
+  // history's last step is amended, so that one stroke is one undo step.
+  void CommitEdit();
   void ApplySessionToState(const Session& session);  // call with mutex_ held
   void Open(const Dataset& dataset, Session session, std::filesystem::path session_path);
 
@@ -187,6 +191,7 @@ class Controller : public ControllerState<Snapshot> {
   std::unique_ptr<Autosaver> autosaver_;
   PipelineOptions pipeline_;
   std::optional<SceneBackground> background_;  // worker thread only (DetectWithBackground)
+  bool stroke_open_ = false;  // BrushStroke / PaintPoints dabs since the last EndStroke
 };
 
 }  // namespace calibench::ui

@@ -170,6 +170,7 @@ void Workbench::LidarPicture(const Snapshot& s, const PairView& pair,
   const ImVec2 origin = ImGui::GetCursorScreenPos();
   ImGui::Image(TextureId(gl_->lidar_picture.texture()), ImVec2(avail.x, height), uv0, uv1);
   lidar_image_rect_ = {origin.x, origin.y, avail.x, height, uv0.x, uv1.x, v0, v1};
+  if (ImGui::IsMouseReleased(ImGuiMouseButton_Left)) intents->push_back(EndStroke{});
   if (!ImGui::IsItemHovered()) return;
   const ImGuiIO& io = ImGui::GetIO();
   const float col = (uv0.x + (io.MousePos.x - origin.x) / avail.x * span) * image.columns;

@@ -177,6 +177,8 @@ void Workbench::SceneView(const Snapshot& s, const Rect& r, std::vector<Intent>*
   const ImVec2 origin = ImGui::GetCursorScreenPos();
   FramebufferImage(gl_->scene_target, ImVec2(tw, th));
   scene_image_rect_ = {origin.x, origin.y, static_cast<float>(tw), static_cast<float>(th)};
+  if (scene_brush_ && ImGui::IsMouseReleased(ImGuiMouseButton_Left))
+    intents->push_back(EndStroke{});
   if (ImGui::IsItemHovered()) {
     const ImGuiIO& io = ImGui::GetIO();
     if (scene_brush_ && pair->lidar_image) {
