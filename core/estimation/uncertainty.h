@@ -15,6 +15,9 @@ struct IterationReport {
   double step_norm = 0.0;  // |delta|
   Pose cam_from_lidar = Pose::Identity();
   double range_offset_m = 0.0;  // SolverOptions::estimate_range_offset
+  // The weights changed at this iteration (outliers gated, variance factors re-estimated): its
+  // cost is the one under the new weights, not comparable with the costs before it.
+  bool reweighted = false;
 };
 
 struct ObservabilityReport {

@@ -327,6 +327,7 @@ bool PlaneAlignmentSolver::Step() {
     // Continue from here without the gated pairs, with a fresh iteration budget; costs before
     // and after are not comparable.
     history_.back().cost = LinearizeHere().cost;
+    history_.back().reweighted = true;
     done_ = converged_ = false;
     iteration_budget_ = static_cast<int>(history_.size()) + options_.max_iterations;
   }

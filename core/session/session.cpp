@@ -25,7 +25,9 @@ bool SessionResult::operator==(const SessionResult& other) const {
          covariance == other.covariance && iterations == other.iterations &&
          converged == other.converged && cost_history == other.cost_history &&
          weak_directions == other.weak_directions && well_constrained == other.well_constrained &&
-         step_history == other.step_history && range_offset == other.range_offset &&
+         step_history == other.step_history &&
+         reweighted_iterations == other.reweighted_iterations &&
+         range_offset == other.range_offset &&
          unmodelled_range_offset == other.unmodelled_range_offset &&
          num_edge_residuals == other.num_edge_residuals && edge_dilation == other.edge_dilation &&
          covariance_inflation == other.covariance_inflation &&
@@ -44,6 +46,7 @@ SessionResult SessionResultFromSolver(const SolverResult& solver) {
           solver.cost_history,
           solver.observability.weak_directions,
           solver.observability.well_constrained,
+          {},
           {},
           {},
           solver.range_offset,

@@ -85,6 +85,7 @@ struct SessionResult {
   // a reopened session shows and replays the same convergence. May be empty.
   std::vector<double> step_history;
   std::vector<Pose> estimate_history;
+  std::vector<int> reweighted_iterations;  // where the weights changed (IterationReport)
   // What the solve said beyond the pose (optional in the file): the range offset when estimated,
   // the board edges used, the edge dilation and how far the pairs' spread widened the covariance.
   std::optional<RangeOffsetEstimate> range_offset;

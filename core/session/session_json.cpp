@@ -26,13 +26,13 @@ constexpr long long kMaxImagePixels = 1LL << 26;
 constexpr char kDirection[] = "x_in_cam = cam_from_lidar * x_in_lidar (camera from LiDAR)";
 
 constexpr EnumName<LidarChannel> kChannelNames[] = {{LidarChannel::kIntensity, "intensity"},
-                                                   {LidarChannel::kRange, "range"},
-                                                   {LidarChannel::kRing, "ring"}};
+                                                    {LidarChannel::kRange, "range"},
+                                                    {LidarChannel::kRing, "ring"}};
 constexpr EnumName<CameraImageMode> kImageModeNames[] = {
     {CameraImageMode::kRaw, "raw"}, {CameraImageMode::kUndistorted, "undistorted"}};
 constexpr EnumName<VisibilityMode> kVisibilityNames[] = {{VisibilityMode::kHpr, "hpr"},
-                                                        {VisibilityMode::kZBuffer, "zbuffer"},
-                                                        {VisibilityMode::kNone, "none"}};
+                                                         {VisibilityMode::kZBuffer, "zbuffer"},
+                                                         {VisibilityMode::kNone, "none"}};
 
 // ---- writing ----
 
@@ -116,6 +116,7 @@ Json ResultToJson(const SessionResult& r) {
       {"well_constrained", r.well_constrained},
       {"step_history", Numbers(r.step_history.data(), static_cast<int>(r.step_history.size()))},
       {"estimate_history", EstimateHistory(r.estimate_history)},
+      {"reweighted_iterations", r.reweighted_iterations},
       {"board_edge_points", r.num_edge_residuals},
       {"covariance_inflation", r.covariance_inflation},
       {"plane_variance_factor", r.plane_variance_factor},
@@ -243,8 +244,7 @@ ViewState ReadView(const Fields& f) {
 }
 
 template <int N>
-Eigen::Matrix<double, N, N> ReadSquare(const json& value, const Fields& f,
-                                       const std::string& key) {
+Eigen::Matrix<double, N, N> ReadSquare(const json& value, const Fields& f, const std::string& key) {
   const std::string what = f.Path(key) + " (" + std::to_string(N) + "x" + std::to_string(N) + ")";
   json_io::ArrayAt(value, N, f.file(), what);
   Eigen::Matrix<double, N, N> m;
@@ -317,6 +317,10 @@ SessionResult ReadResult(const Fields& f) {
       pose.matrix() = ReadSquare<4>(m, f, "estimate_history");
       r.estimate_history.push_back(pose);
     }
+  if (f.Has("reweighted_iterations"))  // written since the cost plot marks them
+    for (const json& k : f.Array("reweighted_iterations"))
+      r.reweighted_iterations.push_back(
+          json_io::IntAt(k, f.file(), f.Path("reweighted_iterations")));
   ReadResultExtras(f, &r);
   return r;
 }
@@ -346,8 +350,8 @@ void CheckFormatAndVersion(const Fields& f) {
   if (f.Int("version") != kVersion)
     json_io::FailAt(f.file(), "",
                     "session version " + std::to_string(f.Int("version")) +
-                        " is not supported (this build reads version " +
-                        std::to_string(kVersion) + ")");
+                        " is not supported (this build reads version " + std::to_string(kVersion) +
+                        ")");
 }
 
 Session ReadSession(const json& root, const std::filesystem::path& source_path) {
@@ -366,8 +370,7 @@ Session ReadSession(const json& root, const std::filesystem::path& source_path) 
     s.pairs.push_back(ReadPair(Fields(pairs[i], source_path, where)));
     for (size_t j = 0; j < i; ++j)
       if (s.pairs[j].id == s.pairs[i].id)
-        json_io::FailAt(source_path, where + ".id",
-                        "\"" + s.pairs[i].id + "\" appears twice");
+        json_io::FailAt(source_path, where + ".id", "\"" + s.pairs[i].id + "\" appears twice");
   }
   s.view = ReadView(f.Object("view"));
   if (!s.view.selected_pair.empty() &&

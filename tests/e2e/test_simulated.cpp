@@ -7,6 +7,7 @@
 #include <map>
 #include <tuple>
 
+#include "core/io/cloud_io.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/sim/sim.h"
 #include "tests/test_support.h"
@@ -130,6 +131,64 @@ TEST_P(SimulatedCalibration, RecoversTheGroundTruth) {
   EXPECT_GE(found, lidar_ok_seeded - 1);  // >= 98 % over the 12 combinations, asserted per set
   EXPECT_LT(detected_error.translation_m, std::max(0.0015, 1.1 * error.translation_m));
   EXPECT_LT(detected_error.rotation_rad, std::max(0.03 * kDegToRad, 1.1 * error.rotation_rad));
+}
+
+// A pair whose cloud holds a second, identical sheet: detection cannot tell the two apart and
+// fails naming both; the camera's prediction from the other pairs' solution finds the right one.
+TEST(CameraGuidedCompletion, ResolvesTwoBoardsInOneCloudWithTheCameraPrediction) {
+  SimOptions sim = SimPreset("default");
+  sim.lidar = LidarModel::kOs0_128;
+  sim.num_pairs = 10;
+  sim.lidar_range_noise_m = 0.005;
+  sim.seed = 23;
+  Dataset dataset = SimulateDataset(sim, test::TempDir("camera_guided"));
+  for (PairEntry& pair : dataset.pairs) pair.lidar_seed.reset();
+  const auto truth = TrueBoardPlanes(dataset);
+  // The decoy: a sheet of the board's size facing the LiDAR, away from the board (opposite
+  // azimuth), cast with the same beams and appended to pair 3's cloud.
+  const PairEntry& victim = dataset.pairs[3];
+  LidarCloud cloud = LoadCloud(victim.cloud);
+  Vec3 board_dir = -truth.at(victim.id).normal;
+  const double azimuth = std::atan2(board_dir.y(), board_dir.x()) + M_PI / 2;
+  ScenePanel decoy;
+  const Vec3 centre(2.2 * std::cos(azimuth), 2.2 * std::sin(azimuth), 0.0);
+  const Vec3 z = Vec3(centre.x(), centre.y(), 0).normalized(), y = -Vec3::UnitZ();
+  decoy.lidar_from_panel.linear() << y.cross(z), y, z;
+  decoy.lidar_from_panel.translation() = centre;
+  decoy.size_m = Vec2(dataset.target.SheetWidth(), dataset.target.SheetHeight());
+  LidarScene scene;
+  scene.clutter = false;
+  scene.lidar_from_board.translation() = Vec3(0, 0, 500);  // the print itself: out of reach
+  scene.panels.push_back(decoy);
+  LidarScanOptions scan_options;
+  scan_options.range_noise_m = 0.005;
+  const LidarCloud extra =
+      SimulateLidarScan(MakeBeamTable(sim.lidar), BoardPrint(dataset.target), scene, scan_options)
+          .ToCloud();
+  ASSERT_GT(extra.size(), 100u);
+  cloud.points.insert(cloud.points.end(), extra.points.begin(), extra.points.end());
+  cloud.intensity.insert(cloud.intensity.end(), extra.intensity.begin(), extra.intensity.end());
+  cloud.ring.insert(cloud.ring.end(), extra.ring.begin(), extra.ring.end());
+  cloud.width = static_cast<int>(cloud.size());
+  SavePcd(victim.cloud, cloud);
+
+  PipelineOptions without_guidance;
+  without_guidance.camera_guided = false;
+  const CalibrationOutcome alone = CalibrateDataset(dataset, without_guidance);
+  EXPECT_EQ(alone.pairs[3].status, PairStatus::kFailed);
+  EXPECT_NE(alone.pairs[3].reason.find("two board-like planes"), std::string::npos)
+      << alone.pairs[3].reason;
+
+  const CalibrationOutcome guided = CalibrateDataset(dataset, PipelineOptions{});
+  const PairFeatures& pair = guided.pairs[3];
+  ASSERT_EQ(pair.status, PairStatus::kAccepted) << pair.reason;
+  EXPECT_EQ(pair.board_origin.source, BoardSource::kCameraGuided);
+  ASSERT_TRUE(pair.lidar);
+  const Plane& board = truth.at(pair.id);
+  EXPECT_LT(std::acos(std::min(1.0, std::abs(pair.lidar->plane.normal.dot(board.normal)))),
+            2.0 * kDegToRad);
+  EXPECT_NEAR(pair.lidar->plane.distance, board.distance, 0.03);
+  for (const PairFeatures& p : guided.pairs) EXPECT_EQ(p.status, PairStatus::kAccepted) << p.id;
 }
 
 std::string ParamName(const ::testing::TestParamInfo<Param>& info) {

@@ -177,6 +177,35 @@ TEST_F(WorkbenchRender, TheBoardPaintedInTheThreeDViewGivesItsPlane) {
   ExpectMatchesGolden(Render(controller, Layout::kSceneOnly, 480, 300), "scene_brushed");
 }
 
+// The LiDAR colour selector draws the channel it shows, in one workbench across frames (it once
+// drew the previously chosen one).
+TEST_F(WorkbenchRender, TheLidarChannelShownIsTheOneChosen) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), test::TempDir("channel_session") / "s.json");
+  controller.WaitIdle();
+  Workbench workbench;  // one instance: its redraw check is what is tested
+  auto render = [&] {
+    return RenderWorkbenchHeadless(controller, workbench, *host_, Layout::kLidarOnly, 480, 300, 2);
+  };
+  auto fresh = [&] {  // a workbench that never saw another channel
+    Workbench other;
+    return RenderWorkbenchHeadless(controller, other, *host_, Layout::kLidarOnly, 480, 300, 2);
+  };
+  auto choose = [&](LidarChannel channel) {
+    ViewState view = controller.GetSnapshot().view;
+    view.lidar_channel = channel;
+    controller.Apply(SetView{view});
+  };
+  const ImageU8 intensity = render();
+  for (LidarChannel channel :
+       {LidarChannel::kRange, LidarChannel::kRing, LidarChannel::kIntensity}) {
+    choose(channel);
+    const ImageU8 shown = render();
+    EXPECT_EQ(shown.data, fresh().data) << LidarChannelName(channel);
+    if (channel != LidarChannel::kIntensity) EXPECT_NE(shown.data, intensity.data);
+  }
+}
+
 TEST_F(WorkbenchRender, ASavedAndReopenedSessionRendersIdentically) {
   const auto path = test::TempDir("reopen_session") / "work.session.json";
   ImageU8 before;

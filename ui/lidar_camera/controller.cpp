@@ -127,6 +127,9 @@ void Controller::ApplySessionToState(const Session& session) {
     if (steps.size() == costs.size() && estimates.size() == costs.size())
       for (size_t i = 0; i < costs.size(); ++i)
         state_.solver.iterations.push_back({static_cast<int>(i), costs[i], steps[i], estimates[i]});
+    for (int k : session.result->reweighted_iterations)
+      if (k >= 0 && k < static_cast<int>(state_.solver.iterations.size()))
+        state_.solver.iterations[k].reweighted = true;
   }
   state_.can_undo = history_.CanUndo();
   state_.can_redo = history_.CanRedo();
@@ -164,6 +167,7 @@ void Controller::CommitEdit() {
     for (const IterationReport& it : state_.solver.iterations) {
       session_.result->step_history.push_back(it.step_norm);
       session_.result->estimate_history.push_back(it.cam_from_lidar);
+      if (it.reweighted) session_.result->reweighted_iterations.push_back(it.iteration);
     }
   }
   if (stroke_open_)

@@ -8,6 +8,7 @@
 #include "core/lidar/colormap.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/lidar_camera/workbench_gl.h"
+#include "ui/widgets/toolbar.h"
 
 namespace calibench::ui {
 namespace {
@@ -126,20 +127,20 @@ ViewState Workbench::CameraToolbar(const Snapshot& s, const PairView& pair,
     view.camera_image = static_cast<CameraImageMode>(mode);
   static const char* kVisibility[] = {"hidden-point removal", "z-buffer", "no occlusion"};
   int visibility = static_cast<int>(view.visibility);
-  ImGui::SameLine();
+  SameLineIfFits(ToolbarItemWidth("##visibility", 150));
   ImGui::SetNextItemWidth(150);
   if (ImGui::Combo("##visibility", &visibility, kVisibility, 3))
     view.visibility = static_cast<VisibilityMode>(visibility);
-  ImGui::SameLine();
+  SameLineIfFits(ToolbarItemWidth("size", 70));
   ImGui::SetNextItemWidth(70);
   float size = static_cast<float>(view.point_size_px),
         opacity = static_cast<float>(view.point_opacity);
   if (ImGui::SliderFloat("size", &size, 1.0f, 8.0f, "%.1f")) view.point_size_px = size;
-  ImGui::SameLine();
+  SameLineIfFits(ToolbarItemWidth("opacity", 70));
   ImGui::SetNextItemWidth(70);
   if (ImGui::SliderFloat("opacity", &opacity, 0.1f, 1.0f, "%.2f")) view.point_opacity = opacity;
   if (view.visibility == VisibilityMode::kHpr) {
-    ImGui::SameLine();
+    SameLineIfFits(ToolbarItemWidth("HPR 10^", 70));
     ImGui::SetNextItemWidth(70);
     float exponent = static_cast<float>(view.hpr_radius_exponent);
     if (ImGui::SliderFloat("HPR 10^", &exponent, 1.0f, 4.0f, "%.1f"))

@@ -8,6 +8,7 @@
 #include "core/lidar/colormap.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/lidar_camera/workbench_gl.h"
+#include "ui/widgets/toolbar.h"
 
 namespace calibench::ui {
 namespace {
@@ -83,7 +84,7 @@ void Workbench::LidarToolbar(const Snapshot& s, const PairView& pair,
     view.lidar_channel = static_cast<LidarChannel>(channel);
     intents->push_back(SetView{view});
   }
-  ImGui::SameLine();
+  SameLineIfFits(ToolbarItemWidth("brush [ ]", 110));
   ImGui::SetNextItemWidth(110);
   float radius = static_cast<float>(s.view.brush_radius_px);
   if (ImGui::SliderFloat("brush [ ]", &radius, 1.0f, 60.0f, "%.0f px")) {
@@ -91,15 +92,15 @@ void Workbench::LidarToolbar(const Snapshot& s, const PairView& pair,
     view.brush_radius_px = radius;
     intents->push_back(SetView{view});
   }
-  ImGui::SameLine();
+  SameLineIfFits(ToolbarItemWidth("clear"));
   if (ImGui::SmallButton("clear")) intents->push_back(ClearBrush{s.selected});
   // Second row: the board found again, the view back on it.
   if (ImGui::SmallButton("detect")) intents->push_back(DetectBoardAgain{s.selected, false});
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("forget this pair's brush and find the board in the cloud again");
-  ImGui::SameLine();
+  SameLineIfFits(ToolbarItemWidth("detect all"));
   if (ImGui::SmallButton("detect all")) intents->push_back(DetectBoardAgain{s.selected, true});
-  ImGui::SameLine();
+  SameLineIfFits(ToolbarItemWidth("zoom to board"));
   if (ImGui::SmallButton("zoom to board")) {
     lidar_zoom_ = 0.0f;
     lidar_centered_on_.clear();

@@ -65,10 +65,17 @@ bool BeginPairsTable(std::initializer_list<PairColumn> columns) {
 
 bool PairSelectable(int index, const std::string& id, bool selected, float row_height) {
   ImGui::PushID(index);
+  // The selected row stands out more than the one under the mouse (ImGui's default is the
+  // reverse: hovering looked like selecting).
+  const ImVec4 accent = ImGui::GetStyleColorVec4(ImGuiCol_Header);
+  ImGui::PushStyleColor(ImGuiCol_Header, ImVec4(accent.x, accent.y, accent.z, 0.75f));
+  ImGui::PushStyleColor(ImGuiCol_HeaderHovered, ImVec4(accent.x, accent.y, accent.z, 0.25f));
+  ImGui::PushStyleColor(ImGuiCol_HeaderActive, ImVec4(accent.x, accent.y, accent.z, 0.9f));
   const bool clicked =
       ImGui::Selectable(id.c_str(), selected,
                         ImGuiSelectableFlags_SpanAllColumns | ImGuiSelectableFlags_AllowItemOverlap,
                         ImVec2(0, row_height));
+  ImGui::PopStyleColor(3);
   ImGui::PopID();
   return clicked;
 }

@@ -71,6 +71,27 @@ void SolverReplay::CostPlot(const std::vector<IterationReport>& iterations, ImVe
                 log_cost.size() - 1, iterations[shown].cost);
   ImGui::PlotLines("##cost", log_cost.data(), static_cast<int>(log_cost.size()), 0, overlay,
                    FLT_MAX, FLT_MAX, size);
+  // Where the weights changed the cost jumps with them: an orange mark says so, so that a solve
+  // that converged never looks like one that diverged.
+  const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+  const ImVec2 pad = ImGui::GetStyle().FramePadding;
+  const float inner = hi.x - lo.x - 2 * pad.x;
+  bool any = false;
+  for (size_t i = 1; i < iterations.size(); ++i) {
+    if (!iterations[i].reweighted) continue;
+    any = true;
+    const float x = lo.x + pad.x + inner * static_cast<float>(i) / (iterations.size() - 1);
+    ImGui::GetWindowDrawList()->AddLine(ImVec2(x, lo.y + pad.y), ImVec2(x, hi.y - pad.y),
+                                        IM_COL32(255, 150, 40, 220), 2.0f);
+  }
+  if (any) {
+    ImGui::GetWindowDrawList()->AddText(ImVec2(lo.x + pad.x, hi.y - pad.y - ImGui::GetFontSize()),
+                                        IM_COL32(255, 150, 40, 255), "| re-weighted");
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip(
+          "orange marks: the weights changed there (outliers gated or variance factors "
+          "re-estimated).\nThe cost jumps with the weights; the solve did not diverge.");
+  }
 }
 
 }  // namespace calibench::ui
