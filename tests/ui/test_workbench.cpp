@@ -10,6 +10,7 @@
 
 #include "core/base/image.h"
 #include "core/io/image_io.h"
+#include "tests/acfr_manifest.h"
 #include "tests/test_support.h"
 #include "tests/ui/golden.h"
 #include "tests/ui/ui_fixture.h"
@@ -175,6 +176,69 @@ TEST_F(WorkbenchRender, TheBoardPaintedInTheThreeDViewGivesItsPlane) {
             std::cos(1.0 * M_PI / 180));
   EXPECT_NEAR(painted.lidar->plane.distance, seeded.lidar->plane.distance, 0.01);
   ExpectMatchesGolden(Render(controller, Layout::kSceneOnly, 480, 300), "scene_brushed");
+}
+
+// The same on the real VLP-16 (16 rings: the 3D view is where the board is easiest to pick): a
+// drag across the board paints only its returns and gives the seeded plane. The frame is saved
+// for a look (test_tmp/real_3d_brush/workbench.png).
+TEST_F(WorkbenchRender, RealVlp16BoardPaintedInTheThreeDView) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  const auto dir = test::TempDir("real_3d_brush");
+  Controller controller;
+  controller.OpenDataset(test::WriteAcfrManifest(shared / "datasets/acfr-vlp16-chessboard", dir),
+                         dir / "s.json");
+  controller.WaitIdle();
+  int index = -1;
+  for (size_t i = 0; i < controller.GetSnapshot().pairs.size(); ++i)
+    if (controller.GetSnapshot().pairs[i].id == "pose16") index = static_cast<int>(i);
+  ASSERT_GE(index, 0);
+  const PairView seeded = controller.GetSnapshot().pairs[index];
+  ASSERT_TRUE(seeded.lidar);
+  Vec3 centre = Vec3::Zero();
+  for (int i : seeded.lidar->inliers) centre += seeded.cloud->points[i].cast<double>();
+  centre /= double(seeded.lidar->inliers.size());
+  controller.Apply(SelectPair{index});
+  controller.Apply(ClearBrush{index});
+  ViewState view = controller.GetSnapshot().view;
+  for (int a = 0; a < 3; ++a) view.orbit_target[a] = centre[a];
+  view.orbit_distance_m = 3.0;
+  view.orbit_yaw_rad = std::atan2(centre.y(), centre.x());  // from behind the LiDAR
+  view.orbit_pitch_rad = 0.3;
+  controller.Apply(SetView{view});
+  controller.WaitIdle();
+
+  Workbench workbench;
+  workbench.set_scene_brush(true);
+  FrameWithInput(controller, workbench, *host_, Layout::kSceneOnly, {-1, -1}, false, -1);
+  const auto& rect = workbench.scene_image_rect();
+  std::set<int> board_pixels;
+  for (int i : seeded.lidar->inliers) board_pixels.insert(seeded.lidar_image->pixel_of_point[i]);
+  int painted = 0, off_board = 0;
+  for (int dx = -30; dx <= 30; dx += 10) {  // one drag across the board's middle
+    const ImVec2 aim(rect.x + rect.w / 2 + dx, rect.y + rect.h / 2);
+    for (const Intent& intent :
+         FrameWithInput(controller, workbench, *host_, Layout::kSceneOnly, aim, true, -1)) {
+      if (const auto* paint = std::get_if<PaintPoints>(&intent)) {
+        painted += static_cast<int>(paint->pixels.size());
+        for (int pixel : paint->pixels) off_board += !board_pixels.count(pixel);
+      }
+      controller.Apply(intent);
+    }
+  }
+  for (const Intent& intent :
+       FrameWithInput(controller, workbench, *host_, Layout::kSceneOnly, {-1, -1}, false, -1))
+    controller.Apply(intent);  // the release ends the stroke
+  controller.WaitIdle();
+  EXPECT_GT(painted, 50);
+  EXPECT_EQ(off_board, 0);
+  const PairView brushed = controller.GetSnapshot().pairs[index];
+  ASSERT_TRUE(brushed.lidar) << brushed.lidar_failure;
+  EXPECT_EQ(brushed.board_origin.source, BoardSource::kBrush);
+  EXPECT_GT(std::abs(brushed.lidar->plane.normal.dot(seeded.lidar->plane.normal)),
+            std::cos(1.0 * M_PI / 180));
+  EXPECT_NEAR(brushed.lidar->plane.distance, seeded.lidar->plane.distance, 0.01);
+  SaveImage(dir / "workbench.png", RenderWorkbenchHeadless(controller, workbench, *host_,
+                                                           Layout::kWorkbench, 1600, 900, 4));
 }
 
 // The LiDAR colour selector draws the channel it shows, in one workbench across frames (it once
