@@ -14,7 +14,7 @@ namespace calibench::ui {
 namespace {
 
 // The LiDAR picture with the brush (white veil) and the plane inliers (magenta: no perceptual
-// colour map uses it) composed in.
+// colour map uses it; cyan for a detected board) composed in.
 ImageU8 ComposeLidarPicture(const PairView& pair, LidarChannel channel) {
   ImageU8 picture = RenderLidarImage(*pair.lidar_image, channel, Colormap::kTurbo);
   auto blend = [&](int pixel, int r, int g, int b, float alpha) {
@@ -26,10 +26,12 @@ ImageU8 ComposeLidarPicture(const PairView& pair, LidarChannel channel) {
   // A detected board's region in cyan until the user edits it; a painted or seeded one in white.
   for (int pixel : pair.brush_pixels)
     pair.brush_detected ? blend(pixel, 40, 220, 255, 0.55f) : blend(pixel, 255, 255, 255, 0.45f);
+  // Inliers magenta, or cyan while the region is the detected one (not yet edited by the user).
   if (pair.lidar)
     for (int i : pair.lidar->inliers)
       if (pair.lidar_image->pixel_of_point[i] >= 0)
-        blend(pair.lidar_image->pixel_of_point[i], 255, 40, 220, 0.9f);
+        pair.brush_detected ? blend(pair.lidar_image->pixel_of_point[i], 40, 220, 255, 0.9f)
+                            : blend(pair.lidar_image->pixel_of_point[i], 255, 40, 220, 0.9f);
   return picture;
 }
 

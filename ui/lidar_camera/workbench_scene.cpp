@@ -82,9 +82,9 @@ void SceneToolbar(const Snapshot& s, bool* camera_colors, bool* brush) {
         "left drag paints the board on the points (shift erases); the same brush "
         "as the LiDAR image's");
   ImGui::SameLine();
-  ImGui::TextDisabled("else %s; magenta: plane inliers. %s, right: pan, wheel: zoom",
-                      kColorings[static_cast<int>(s.view.lidar_channel)],
-                      *brush ? "drag: paint" : "drag: orbit");
+  ImGui::TextDisabled(
+      "else %s; magenta: plane inliers (cyan: detected). %s, right: pan, wheel: zoom",
+      kColorings[static_cast<int>(s.view.lidar_channel)], *brush ? "drag: paint" : "drag: orbit");
 }
 
 // The screen radius of the 3D brush: the LiDAR image brush's radius, scaled so that the default
@@ -211,13 +211,16 @@ void Workbench::UploadSceneCloud(const Snapshot& s, const PairView& pair, bool c
   const std::uint64_t key =
       reinterpret_cast<std::uintptr_t>(&cloud) ^ (static_cast<std::uint64_t>(coloring) << 56) ^
       (camera_colors ? reinterpret_cast<std::uintptr_t>(s.reprojection.get()) << 3 : 0) ^
-      ((pair.lidar ? pair.lidar->inliers.size() + 1 : 0) << 36);
+      ((pair.lidar ? pair.lidar->inliers.size() + 1 : 0) << 36) ^
+      (static_cast<std::uint64_t>(pair.brush_detected) << 60);
   if (key == scene_key_) return;
   scene_key_ = key;
   std::vector<gfx::Rgba> colors =
       camera_colors ? ImageColors(s, cloud) : ChannelColors(cloud, coloring);
+  const gfx::Rgba inlier = pair.brush_detected ? gfx::Rgba{40, 220, 255, 255}  // detected
+                                               : gfx::Rgba{255, 40, 220, 255};
   if (pair.lidar)
-    for (int i : pair.lidar->inliers) colors[i] = {255, 40, 220, 255};
+    for (int i : pair.lidar->inliers) colors[i] = inlier;
   gl_->scene_points.Upload(cloud.points, colors);
   // The grid goes on the floor: a low percentile of the heights, robust to a few stray returns.
   std::vector<float> heights(cloud.size());
