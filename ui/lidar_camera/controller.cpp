@@ -538,28 +538,11 @@ void Controller::Handle(const SetPairStatus& status) {
 
 template <>
 void Controller::Handle(const BrushStroke& stroke) {
-  if (!ValidPair(stroke.index)) return;
-  PairView& pair = state_.pairs[stroke.index];
-  if (!pair.lidar_image) return;
-  const auto circle = CirclePixels(pair.lidar_image->rows, pair.lidar_image->columns, stroke.row,
-                                   stroke.column, stroke.radius_px);
-  std::vector<int> merged;
-  if (stroke.erase) {
-    std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), circle.begin(),
-                        circle.end(), std::back_inserter(merged));
-  } else {
-    std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), circle.begin(), circle.end(),
-                   std::back_inserter(merged));
-  }
-  if (merged == pair.brush_pixels) return;
-  pair.brush_pixels = std::move(merged);
-  pair.brush_from_seed = false;  // painted: the brush replaces the seed from now on
-  pair.brush_edited = true;
-  pair.brush_detected = false;
-  CommitEdit();
-  stroke_open_ = true;  // the stroke's later dabs amend this undo step
-  const int index = stroke.index;
-  worker_.Enqueue([this, index] { RefitLidar(index); });
+  if (!ValidPair(stroke.index) || !state_.pairs[stroke.index].lidar_image) return;
+  const LidarImage& image = *state_.pairs[stroke.index].lidar_image;
+  Paint(stroke.index,
+        CirclePixels(image.rows, image.columns, stroke.row, stroke.column, stroke.radius_px),
+        stroke.erase);
 }
 
 template <>
@@ -598,23 +581,25 @@ void Controller::Handle(const DetectBoardAgain& again) {
 
 template <>
 void Controller::Handle(const PaintPoints& paint) {
-  if (!ValidPair(paint.index) || paint.pixels.empty()) return;
-  PairView& pair = state_.pairs[paint.index];
+  if (ValidPair(paint.index)) Paint(paint.index, paint.pixels, paint.erase);
+}
+
+void Controller::Paint(int index, const std::vector<int>& pixels, bool erase) {
+  PairView& pair = state_.pairs[index];
   std::vector<int> merged;
-  if (paint.erase)
-    std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), paint.pixels.begin(),
-                        paint.pixels.end(), std::back_inserter(merged));
+  if (erase)
+    std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), pixels.begin(),
+                        pixels.end(), std::back_inserter(merged));
   else
-    std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), paint.pixels.begin(),
-                   paint.pixels.end(), std::back_inserter(merged));
+    std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), pixels.begin(), pixels.end(),
+                   std::back_inserter(merged));
   if (merged == pair.brush_pixels) return;
   pair.brush_pixels = std::move(merged);
-  pair.brush_from_seed = false;
+  pair.brush_from_seed = false;  // painted: the brush replaces the seed from now on
   pair.brush_edited = true;
   pair.brush_detected = false;
   CommitEdit();
   stroke_open_ = true;  // the stroke's later dabs amend this undo step
-  const int index = paint.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });
 }
 

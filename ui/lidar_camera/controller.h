@@ -184,6 +184,9 @@ class Controller : public ControllerState<Snapshot> {
   template <typename IntentType>
   void Handle(const IntentType& intent);
   bool ValidPair(int index) const;
+  // Adds (or, erasing, removes) LiDAR-image pixels to a pair's brush and refits: both brushes'
+  // dabs. Call with mutex_ held.
+  void Paint(int index, const std::vector<int>& pixels, bool erase);
   void Restore(const std::optional<Session>& restored);  // undo / redo
 
   Session session_;  // the editable state as saved; state_ mirrors it plus derived data
