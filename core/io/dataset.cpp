@@ -71,7 +71,8 @@ Dataset LoadManifest(const fs::path& manifest) {
   for (size_t i = 0; i < pairs.size(); ++i)
     dataset.pairs.push_back(
         ParsePair(json_io::Fields(pairs[i], manifest, "pairs[" + std::to_string(i) + "]"), &seen));
-  dataset.cam_from_lidar_ground_truth = json_io::OptionalPose(root, "ground_truth", "cam_from_lidar");
+  dataset.cam_from_lidar_ground_truth =
+      json_io::OptionalPose(root, "ground_truth", "cam_from_lidar");
   if (root.Has("simulation")) dataset.simulation = ParseSimulation(root.Object("simulation"));
   return dataset;
 }

@@ -1,6 +1,7 @@
 // JSON helpers shared by the manifest readers (io/dataset.cpp, lrf/dataset.cpp) and the result
-// writer (results/result_file.cpp); fields are read with json_fields.h. Internal: include it from .cpp files only (it pulls
-// in nlohmann/json). Every reader throws IoError naming the file and the problem.
+// writer (results/result_file.cpp); fields are read with json_fields.h. Internal: include it from
+// .cpp files only (it pulls in nlohmann/json). Every reader throws IoError naming the file and the
+// problem.
 #pragma once
 
 #include <filesystem>

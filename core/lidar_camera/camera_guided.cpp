@@ -34,9 +34,10 @@ PredictedBoard Predict(const CameraBoardObservation& camera, const Pose& cam_fro
 
 // Why the LiDAR board disagrees with the prediction, or "" when it agrees. Tolerances: the
 // options' sigmas of both planes' normal and offset uncertainty, floored.
-std::string Disagreement(const LidarPlaneFit& lidar, const Vec3& lidar_centre,
-                         const CameraBoardObservation& camera, const PredictedBoard& predicted,
-                         double sheet_diagonal_m, const PipelineOptions& options) {
+std::string Disagreement(const LidarPlaneFit& lidar, const CameraBoardObservation& camera,
+                         const PredictedBoard& predicted, double sheet_diagonal_m,
+                         const PipelineOptions& options) {
+  const Vec3& lidar_centre = lidar.inlier_centroid;
   const double angle =
       std::acos(std::min(1.0, std::abs(lidar.plane.normal.dot(predicted.plane.normal))));
   const double offset = std::abs(predicted.plane.SignedDistance(lidar_centre));
@@ -58,13 +59,6 @@ std::string Disagreement(const LidarPlaneFit& lidar, const Vec3& lidar_centre,
   return text;
 }
 
-// The centroid of the plane's inliers in the pair's cloud.
-Vec3 CentreOf(const LidarCloud& cloud, const LidarPlaneFit& fit) {
-  Vec3 sum = Vec3::Zero();
-  for (int i : fit.inliers) sum += cloud.points[i].cast<double>();
-  return fit.inliers.empty() ? Vec3::Zero() : Vec3(sum / double(fit.inliers.size()));
-}
-
 struct Review {
   bool changed = false;
   std::optional<LidarPlaneFit> lidar;
@@ -78,18 +72,11 @@ Review ReviewPair(const Dataset& dataset, const PairEntry& entry, const PairFeat
   Review review;
   const PredictedBoard predicted = Predict(*pair.camera, cam_from_lidar);
   const double diagonal = std::hypot(dataset.target.SheetWidth(), dataset.target.SheetHeight());
-  LidarCloud cloud;
-  try {
-    cloud = LoadCloud(entry.cloud);
-  } catch (const IoError&) {
-    return review;  // the pair already failed on its input
-  }
   // A seed is the user's word: its board is checked, never replaced.
   if (!pair.lidar && pair.board_origin.source == BoardSource::kSeed) return review;
   std::string disagreement;
   if (pair.lidar) {
-    disagreement = Disagreement(*pair.lidar, CentreOf(cloud, *pair.lidar), *pair.camera, predicted,
-                                diagonal, options);
+    disagreement = Disagreement(*pair.lidar, *pair.camera, predicted, diagonal, options);
     if (disagreement.empty()) return review;               // agrees: unchanged
     if (pair.board_origin.source == BoardSource::kSeed) {  // the user's seed wins: flag only
       review.changed = pair.status == PairStatus::kAccepted;
@@ -99,6 +86,13 @@ Review ReviewPair(const Dataset& dataset, const PairEntry& entry, const PairFeat
       return review;
     }
   }
+  // Only now is the cloud needed: to look for the board where the camera says it is.
+  LidarCloud cloud;
+  try {
+    cloud = LoadCloud(entry.cloud);
+  } catch (const IoError&) {
+    return review;  // the pair already failed on its input
+  }
   BoardHint hint;
   hint.seed = LidarSeed{predicted.centre,
                         0.4 * std::min(dataset.target.SheetWidth(), dataset.target.SheetHeight())};
@@ -107,8 +101,7 @@ Review ReviewPair(const Dataset& dataset, const PairEntry& entry, const PairFeat
   BoardOrigin origin;
   auto fit = ExtractLidarFeatures(dataset, cloud, hint, options, &why, &origin);
   if (fit) {
-    const std::string again =
-        Disagreement(*fit, CentreOf(cloud, *fit), *pair.camera, predicted, diagonal, options);
+    const std::string again = Disagreement(*fit, *pair.camera, predicted, diagonal, options);
     if (again.empty()) {
       origin.detail = pair.board_origin.source == BoardSource::kDetected && pair.lidar
                           ? "at the camera's prediction; detection had found " +

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 
 #include "core/base/names.h"
@@ -51,28 +52,37 @@ BoardGeometry MakeBoardGeometry(const Pose& lidar_from_board) {
   return g;
 }
 
-void IntersectBoard(const Vec3& dir, const BoardGeometry& g, const BoardPrint& print, RayHit* hit) {
+// Where a ray from the LiDAR origin meets a rectangle's plane nearer than `nearer_than`: its
+// range and the point in the rectangle's axes; nullopt when parallel, behind or farther.
+struct PlaneHit {
+  double range;
+  Vec2 xy;
+};
+std::optional<PlaneHit> HitPlane(const Vec3& dir, const BoardGeometry& g, double nearer_than) {
   const double denom = g.normal.dot(dir);
-  if (std::abs(denom) < 1e-12) return;
+  if (std::abs(denom) < 1e-12) return std::nullopt;
   const double range = g.offset / denom;
-  if (range <= 0.0 || range >= hit->range) return;
+  if (range <= 0.0 || range >= nearer_than) return std::nullopt;
   const Vec3 local = range * dir - g.origin;
-  const Vec2 xy(g.axis_x.dot(local), g.axis_y.dot(local));
-  if (!print.InSheet(xy)) return;
-  *hit = RayHit{range, SimSurface::kBoard, xy};
+  return PlaneHit{range, Vec2(g.axis_x.dot(local), g.axis_y.dot(local))};
 }
 
-void IntersectPanel(const Vec3& dir, const ScenePanel& panel, RayHit* hit) {
-  const BoardGeometry g = MakeBoardGeometry(panel.lidar_from_panel);
-  const double denom = g.normal.dot(dir);
-  if (std::abs(denom) < 1e-12) return;
-  const double range = g.offset / denom;
-  if (range <= 0.0 || range >= hit->range) return;
-  const Vec3 local = range * dir - g.origin;
-  if (std::abs(g.axis_x.dot(local)) > panel.size_m.x() / 2 ||
-      std::abs(g.axis_y.dot(local)) > panel.size_m.y() / 2)
-    return;
-  *hit = RayHit{range, SimSurface::kWall, Vec2::Zero()};
+void IntersectBoard(const Vec3& dir, const BoardGeometry& g, const BoardPrint& print, RayHit* hit) {
+  const auto at = HitPlane(dir, g, hit->range);
+  if (at && print.InSheet(at->xy)) *hit = RayHit{at->range, SimSurface::kBoard, at->xy};
+}
+
+// A panel: its geometry (once per scan) and half extent.
+struct PanelGeometry {
+  BoardGeometry plane;
+  Vec2 half_size;
+};
+
+void IntersectPanel(const Vec3& dir, const PanelGeometry& panel, RayHit* hit) {
+  const auto at = HitPlane(dir, panel.plane, hit->range);
+  if (at && std::abs(at->xy.x()) <= panel.half_size.x() &&
+      std::abs(at->xy.y()) <= panel.half_size.y())
+    *hit = RayHit{at->range, SimSurface::kWall, Vec2::Zero()};
 }
 
 // The room: floor z = floor_z (below the sensor) and walls |x| = d, |y| = d around it.
@@ -157,6 +167,9 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
   CALIBENCH_CHECK(beams.azimuth_steps > 0 && !beams.elevations_rad.empty());
   CALIBENCH_CHECK(options.range_noise_m >= 0.0);
   const BoardGeometry board = MakeBoardGeometry(scene.lidar_from_board);
+  std::vector<PanelGeometry> panels;
+  for (const ScenePanel& panel : scene.panels)
+    panels.push_back({MakeBoardGeometry(panel.lidar_from_panel), panel.size_m / 2});
   const int rings = static_cast<int>(beams.elevations_rad.size());
   std::vector<double> cos_el(rings), sin_el(rings);
   for (int r = 0; r < rings; ++r) {
@@ -174,7 +187,7 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
       RayHit hit;
       hit.range = beams.max_range_m;
       IntersectBoard(dir, board, print, &hit);
-      for (const ScenePanel& panel : scene.panels) IntersectPanel(dir, panel, &hit);
+      for (const PanelGeometry& panel : panels) IntersectPanel(dir, panel, &hit);
       if (scene.clutter) IntersectRoom(dir, scene, &hit);
       if (hit.range >= beams.max_range_m || hit.range < kMinRangeM) continue;
       double range = hit.range + options.range_offset_m;

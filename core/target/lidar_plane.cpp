@@ -153,6 +153,14 @@ std::vector<int> SelectBrushRegion(const LidarImage& image, const std::vector<in
   return indices;
 }
 
+namespace {
+Vec3 Centroid(const LidarCloud& cloud, const std::vector<int>& indices) {
+  Vec3 sum = Vec3::Zero();
+  for (int i : indices) sum += cloud.points[i].cast<double>();
+  return indices.empty() ? sum : Vec3(sum / static_cast<double>(indices.size()));
+}
+}  // namespace
+
 std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
                                                   const std::vector<int>& indices) {
   // Unweighted: every return counts alike (FitPlaneRangeMl models the range noise instead).
@@ -163,6 +171,7 @@ std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
   fit.covariance = plane_fit->covariance;
   fit.rms_m = plane_fit->rms_m;
   fit.inliers = indices;
+  fit.inlier_centroid = Centroid(cloud, indices);
   fit.num_candidates = static_cast<int>(indices.size());
   return fit;
 }
@@ -234,6 +243,7 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
   LidarPlaneFit fit;
   fit.plane = OrientTowardsOrigin(plane);
   fit.inliers = indices;
+  fit.inlier_centroid = Centroid(cloud, indices);
   fit.num_candidates = static_cast<int>(indices.size());
   fit.rms_m = std::sqrt(sum_sq / indices.size());
   const double dof = std::max<double>(1.0, static_cast<double>(indices.size()) - 3.0);

@@ -43,11 +43,12 @@ struct LidarPlaneOptions {
 double BoardGrowRadius(const BoardSpec& board);
 
 struct LidarPlaneFit {
-  Plane plane;                     // LiDAR frame, normal towards the LiDAR (d > 0)
-  Mat4 covariance = Mat4::Zero();  // of (n, d) from the least-squares refit; rank 3
-  std::vector<int> inliers;        // indices into the cloud
-  int num_candidates = 0;          // points in the brushed / seeded region
-  bool grown = false;              // inliers extend beyond the region (grow_radius_m)
+  Plane plane;                          // LiDAR frame, normal towards the LiDAR (d > 0)
+  Mat4 covariance = Mat4::Zero();       // of (n, d) from the least-squares refit; rank 3
+  std::vector<int> inliers;             // indices into the cloud
+  Vec3 inlier_centroid = Vec3::Zero();  // mean of the inliers (LiDAR frame, metres)
+  int num_candidates = 0;               // points in the brushed / seeded region
+  bool grown = false;                   // inliers extend beyond the region (grow_radius_m)
   // How the fitted (n, d) moves per metre of a range offset added to every return (FitPlaneRangeMl
   // only; zero = unknown): the solver's handle on a LiDAR range offset.
   Vec4 range_offset_jacobian = Vec4::Zero();

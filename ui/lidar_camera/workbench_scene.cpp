@@ -55,9 +55,7 @@ std::vector<gfx::Rgba> ChannelColors(const LidarCloud& cloud, int channel) {
 // The LiDAR board: the inliers' extent in the fitted plane, as a rectangle's corners.
 std::array<Vec3, 4> InlierExtent(const LidarCloud& cloud, const LidarPlaneFit& fit) {
   const Vec3 n = fit.plane.normal;
-  Vec3 centroid = Vec3::Zero();
-  for (int i : fit.inliers) centroid += cloud.points[i].cast<double>();
-  centroid /= std::max<size_t>(1, fit.inliers.size());
+  const Vec3& centroid = fit.inlier_centroid;
   const Vec3 u = n.unitOrthogonal(), w = n.cross(u);
   double u0 = 1e9, u1 = -1e9, w0 = 1e9, w1 = -1e9;
   for (int i : fit.inliers) {
