@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <deque>
 #include <map>
 
 #include "core/target/lidar_board_grid.h"
@@ -27,44 +26,59 @@ double LinkDistance(const AngularGrid& grid, double range) {
   return 2.5 * range * std::max(grid.row_step_rad, grid.column_step_rad) + 0.05;
 }
 
+// Each grid cell's return in double precision (NaN where the cell is empty): the neighbourhood
+// loops below read it contiguously, without going through the cloud's index.
+std::vector<Vec3> CellPoints(const LidarCloud& cloud, const AngularGrid& grid) {
+  std::vector<Vec3> points(grid.point.size(), Vec3::Constant(std::nan("")));
+  for (size_t cell = 0; cell < grid.point.size(); ++cell)
+    if (grid.point[cell] >= 0) points[cell] = PointAt(cloud, grid.point[cell]);
+  return points;
+}
+
 // The plane of each return's neighbourhood (one ring step around it in every direction). Flat
 // where the neighbourhood spans two rings and hugs its plane; the returns near a sheet's border,
-// whose neighbourhoods take in what lies behind, come out not planar.
-std::vector<LocalPlane> LocalPlanes(const LidarCloud& cloud, const AngularGrid& grid,
+// whose neighbourhoods take in what lies behind, come out not planar. The scatter is accumulated
+// in one pass relative to the centre return (shift-invariant, and no list of neighbours).
+std::vector<LocalPlane> LocalPlanes(const AngularGrid& grid, const std::vector<Vec3>& cell_points,
                                     const LidarBoardDetectionOptions& options) {
   std::vector<LocalPlane> planes(grid.point.size());
-  std::vector<Vec3> near;
   for (int row = 0; row < grid.rows; ++row) {
     for (int column = 0; column < grid.columns; ++column) {
       const int cell = grid.Cell(row, column);
       if (grid.point[cell] < 0) continue;
-      const Vec3 centre = PointAt(cloud, grid.point[cell]);
+      const Vec3 centre = cell_points[cell];
       const double link = LinkDistance(grid, grid.range[cell]);
+      const double link_squared = link * link;
       const auto [half_rows, half_columns] =
           grid.HalfWindow(grid.range[cell], options.neighbourhood_half_size_m);
-      near.clear();
+      Vec3 sum = Vec3::Zero();
+      double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;  // the scatter's distinct entries
+      int count = 0;
       int rows_seen = 0;
+      const int first_column = grid.Wrap(column - half_columns);
+      const int width = std::min(2 * half_columns + 1, grid.columns);
       for (int r = std::max(0, row - half_rows); r <= std::min(grid.rows - 1, row + half_rows);
            ++r) {
-        bool seen = false;
-        for (int dc = -half_columns; dc <= half_columns; ++dc) {
-          const int other = grid.point[grid.Cell(r, grid.Wrap(column + dc))];
-          if (other < 0) continue;
-          const Vec3 p = PointAt(cloud, other);
-          if ((p - centre).norm() > link) continue;
-          near.push_back(p);
-          seen = true;
+        const int row_start = grid.Cell(r, 0);
+        const int count_before = count;
+        for (int k = 0, c = first_column; k < width; ++k, c = c + 1 == grid.columns ? 0 : c + 1) {
+          if (grid.point[row_start + c] < 0) continue;
+          const Vec3 q = cell_points[row_start + c] - centre;
+          if (q.squaredNorm() > link_squared) continue;
+          sum += q;
+          xx += q.x() * q.x(), xy += q.x() * q.y(), xz += q.x() * q.z();
+          yy += q.y() * q.y(), yz += q.y() * q.z(), zz += q.z() * q.z();
+          ++count;
         }
-        rows_seen += seen ? 1 : 0;
+        rows_seen += count > count_before ? 1 : 0;
       }
-      if (near.size() < 6 || rows_seen < 2) continue;
-      Vec3 mean = Vec3::Zero();
-      for (const Vec3& p : near) mean += p;
-      mean /= double(near.size());
-      Mat3 scatter = Mat3::Zero();
-      for (const Vec3& p : near) scatter += (p - mean) * (p - mean).transpose();
+      if (count < 6 || rows_seen < 2) continue;
+      const Vec3 mean = sum / count;
+      Mat3 sum_outer;
+      sum_outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+      const Mat3 scatter = sum_outer / count - mean * mean.transpose();
       Eigen::SelfAdjointEigenSolver<Mat3> eigen;
-      eigen.computeDirect(scatter / double(near.size()));
+      eigen.computeDirect(scatter);
       planes[cell].normal = eigen.eigenvectors().col(0);
       planes[cell].planar = std::sqrt(std::max(0.0, eigen.eigenvalues()(0))) < options.planar_rms_m;
     }
@@ -98,13 +112,14 @@ struct PlaneMoments {
 // segment's plane (refitted as the segment doubles) and normal agreement. Returns that are not
 // planar join but do not spread the segment, so a tripod's mast or a wall behind the border stays
 // out. Returns segments as lists of cells.
-std::vector<std::vector<int>> GrowSegments(const LidarCloud& cloud, const AngularGrid& grid,
+std::vector<std::vector<int>> GrowSegments(const AngularGrid& grid,
+                                           const std::vector<Vec3>& cell_points,
                                            const std::vector<LocalPlane>& planes,
                                            const LidarBoardDetectionOptions& options) {
   const double cos_tolerance = std::cos(options.normal_tolerance_deg * M_PI / 180.0);
   std::vector<int> label(grid.point.size(), -1);
   std::vector<std::vector<int>> segments;
-  std::deque<int> queue;
+  std::vector<int> queue;  // cells whose neighbours are still to visit, from `next` on
   for (int seed = 0; seed < static_cast<int>(grid.point.size()); ++seed) {
     if (!planes[seed].planar || label[seed] >= 0) continue;
     const double seed_range = grid.range[seed];
@@ -113,26 +128,26 @@ std::vector<std::vector<int>> GrowSegments(const LidarCloud& cloud, const Angula
     std::vector<int> cells = {seed};
     label[seed] = id;
     PlaneMoments moments;
-    moments.Add(PointAt(cloud, grid.point[seed]));
+    moments.Add(cell_points[seed]);
     Vec3 normal = planes[seed].normal;
-    double offset = -normal.dot(PointAt(cloud, grid.point[seed]));
+    double offset = -normal.dot(cell_points[seed]);
     int refit_at = 40;  // a smaller patch's plane is no better than the seed's own
     int min_row = seed / grid.columns, max_row = min_row;
     queue.assign(1, seed);
-    while (!queue.empty()) {
-      const int cell = queue.front();
-      queue.pop_front();
+    for (size_t next = 0; next < queue.size(); ++next) {
+      const int cell = queue[next];
       const int row = cell / grid.columns, column = cell % grid.columns;
-      const Vec3 here = PointAt(cloud, grid.point[cell]);
+      const Vec3 here = cell_points[cell];
       const double link = LinkDistance(grid, grid.range[cell]);
+      const double link_squared = link * link;
       const auto [half_rows, half_columns] =
           grid.HalfWindow(grid.range[cell], options.neighbourhood_half_size_m);
       for (int r = std::max(0, row - half_rows); r <= std::min(grid.rows - 1, row + half_rows); ++r)
         for (int dc = -half_columns; dc <= half_columns; ++dc) {
           const int other = grid.Cell(r, grid.Wrap(column + dc));
           if (grid.point[other] < 0 || label[other] >= 0) continue;
-          const Vec3 p = PointAt(cloud, grid.point[other]);
-          if ((p - here).norm() > link ||
+          const Vec3& p = cell_points[other];
+          if ((p - here).squaredNorm() > link_squared ||
               std::abs(normal.dot(p) + offset) > options.plane_tolerance_m)
             continue;
           // Only flat returns that agree spread the segment; the others (a border whose
@@ -394,9 +409,10 @@ LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& b
   LidarBoardDetection result;
   const AngularGrid grid = board_grid::BuildAngularGrid(cloud, options.angular_cell_deg);
   const SheetBounds sheet = BoundsFor(board, options);
-  const std::vector<LocalPlane> planes = LocalPlanes(cloud, grid, options);
+  const std::vector<Vec3> cell_points = CellPoints(cloud, grid);
+  const std::vector<LocalPlane> planes = LocalPlanes(grid, cell_points, options);
   std::vector<char> in_segment(grid.point.size(), 0);
-  for (const std::vector<int>& cells : GrowSegments(cloud, grid, planes, options)) {
+  for (const std::vector<int>& cells : GrowSegments(grid, cell_points, planes, options)) {
     if (static_cast<int>(cells.size()) < options.min_points) continue;
     LidarBoardCandidate c = Evaluate(cloud, grid, cells, &in_segment, sheet, options, background);
     if (c.rejection.empty())
