@@ -177,7 +177,6 @@ int RunDemo(int argc, char** argv) {
               LidarModelName(sim.lidar).c_str(), out_dir.c_str());
   const Dataset dataset = SimulateDataset(sim, out_dir);
   PipelineOptions options;
-  options.threads = 2;
   CalibrationOutcome outcome;
   const int code = CalibrateAndReport(dataset, options, out_dir + "/result.json", &outcome);
   if (outcome.solution && dataset.cam_from_lidar_ground_truth)

@@ -226,6 +226,8 @@ int RunSweepLrf(int argc, char** argv) {
   app.add_option("--sizes", sizes_text, "numbers of observations")->capture_default_str();
   app.add_option("--seeds", options.seeds, "independent simulations per size")
       ->capture_default_str();
+  app.add_option("--threads", options.pipeline.threads, "workers (seeds run in parallel)")
+      ->capture_default_str();
   app.add_option("--preset", preset, "paper | ideal")->capture_default_str();
   app.add_option("--table", table_path, "also write the markdown table here");
   if (const auto code = ParseFlags(app, argc, argv)) return *code;

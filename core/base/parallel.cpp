@@ -8,6 +8,8 @@
 
 namespace calibench {
 
+int DefaultThreads() { return std::max(1, static_cast<int>(std::thread::hardware_concurrency())); }
+
 void ParallelFor(size_t count, int threads, const std::function<void(size_t)>& body,
                  const std::function<void(int, size_t)>& on_done) {
   std::atomic<size_t> next{0};

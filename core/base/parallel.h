@@ -7,6 +7,10 @@
 
 namespace calibench {
 
+// The machine's hardware threads (at least 1): the default worker count everywhere. Results never
+// depend on it (every parallel loop writes per-index slots and reduces them in index order).
+int DefaultThreads();
+
 // Runs body(i) for i in [0, count) on up to `threads` threads (the caller's included), each
 // taking the next index when done. on_done(finished, i), if given, is called after each body
 // under a lock, with the number finished so far.

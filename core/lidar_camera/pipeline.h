@@ -27,7 +27,7 @@ struct PipelineOptions {
   SolverOptions solver;
   std::vector<std::string> pair_ids;           // empty = every pair of the dataset
   std::optional<Pose> initial_cam_from_lidar;  // user guess; else the closed form from planes
-  int threads = 1;                             // feature extraction workers
+  int threads = DefaultThreads();              // feature extraction workers
   int min_pairs = 3;                           // planes fix all 6 dof from 3 pairs on
   // LiDAR: grow each brushed / seeded region to the whole board, limited by the target's sheet
   // size (LidarPlaneOptions::grow_radius_m = BoardGrowRadius(target)).

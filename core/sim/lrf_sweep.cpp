@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
+
+#include "core/base/parallel.h"
 
 namespace calibench {
 
@@ -19,7 +22,18 @@ LrfSweepResult RunLrfSweep(const LrfSweepOptions& options,
       std::vector<std::vector<std::pair<double, double>>>(options.sizes.size()));
   std::vector<std::vector<int>> failures(options.methods.size(),
                                          std::vector<int>(options.sizes.size(), 0));
-  for (int s = 0; s < options.seeds; ++s) {
+  // One seed's outcome: per (method, size) its error, or nothing when the solve failed.
+  struct SeedRun {
+    std::vector<std::vector<std::optional<std::pair<double, double>>>> errors;
+    int observations_total = 0, observations_failed = 0;
+  };
+  std::vector<SeedRun> runs(static_cast<size_t>(options.seeds));
+  // Seeds run in parallel (options.pipeline.threads); each has its own simulation, and they are
+  // reduced in seed order, so the table does not depend on the thread count.
+  auto run_seed = [&](size_t s) {
+    SeedRun& run = runs[s];
+    run.errors.assign(options.methods.size(),
+                      std::vector<std::optional<std::pair<double, double>>>(options.sizes.size()));
     LrfSimOptions sim = options.sim;
     // A few extra poses, so that an observation whose features fail (reported below) does not
     // leave the seed short of max_size usable ones.
@@ -34,32 +48,39 @@ LrfSweepResult RunLrfSweep(const LrfSweepOptions& options,
       observation.id = std::to_string(k);
       observation.scan = ExtractScanFeatures(rendered.scan, sim.target, options.pipeline.scan);
       observation.depth = ExtractDepthFeatures(rendered.depth, sim.target, options.pipeline.depth);
-      ++result.observations_total;
+      ++run.observations_total;
       if (observation.scan.ok && observation.depth.ok)
         usable.push_back(std::move(observation));
       else
-        ++result.observations_failed;
+        ++run.observations_failed;
     }
     for (size_t m = 0; m < options.methods.size(); ++m) {
       LrfSolverOptions solver = options.pipeline.solver;
       solver.method = options.methods[m];
       for (size_t i = 0; i < options.sizes.size(); ++i) {
         const int n = options.sizes[i];
-        if (static_cast<int>(usable.size()) < n) {
-          ++failures[m][i];
-          continue;
-        }
+        if (static_cast<int>(usable.size()) < n) continue;
         const std::vector<LrfObservation> first(usable.begin(), usable.begin() + n);
         const LrfSolution solution = SolveLrf(first, solver);
-        if (!solution.ok) {
-          ++failures[m][i];
-          continue;
-        }
+        if (!solution.ok) continue;
         const PoseError e = ComputePoseError(solution.cam_from_lrf, sim.cam_from_lrf);
-        errors[m][i].push_back({e.rotation_rad * 180.0 / M_PI, e.translation_m * 1e3});
+        run.errors[m][i] = std::make_pair(e.rotation_rad * 180.0 / M_PI, e.translation_m * 1e3);
       }
     }
-    if (progress) progress(s + 1, options.seeds);
+  };
+  ParallelFor(runs.size(), options.pipeline.threads, run_seed, [&](int finished, size_t) {
+    if (progress) progress(finished, options.seeds);
+  });
+  for (const SeedRun& run : runs) {
+    result.observations_total += run.observations_total;
+    result.observations_failed += run.observations_failed;
+    for (size_t m = 0; m < options.methods.size(); ++m)
+      for (size_t i = 0; i < options.sizes.size(); ++i) {
+        if (run.errors[m][i])
+          errors[m][i].push_back(*run.errors[m][i]);
+        else
+          ++failures[m][i];
+      }
   }
   result.cells.assign(options.methods.size(), std::vector<LrfSweepCell>(options.sizes.size()));
   for (size_t m = 0; m < options.methods.size(); ++m) {

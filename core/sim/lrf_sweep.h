@@ -37,7 +37,7 @@ struct LrfSweepResult {
   int observations_total = 0;
 };
 
-// progress(seed index, seeds) after each seed.
+// progress(seeds finished, seeds) after each seed (seeds run on options.pipeline.threads).
 LrfSweepResult RunLrfSweep(const LrfSweepOptions& options,
                            const std::function<void(int, int)>& progress = {});
 

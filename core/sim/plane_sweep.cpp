@@ -3,9 +3,11 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <sstream>
 
+#include "core/base/parallel.h"
 #include "core/sim/crlb.h"
 
 namespace calibench {
@@ -65,18 +67,24 @@ PlaneSweepCell RunSubsets(const std::vector<Subset>& subsets, const Pose& truth,
   std::vector<double> t_err, r_err;
   double bound_t2 = 0, bound_r2 = 0;
   PlaneSweepCell cell;
-  for (const Subset& subset : subsets) {
-    const CalibrationOutcome outcome = SolveFromFeatures(subset.features, options);
-    if (!outcome.solution) {
+  // Solved in parallel, reduced in subset order: the cell does not depend on the thread count.
+  std::vector<std::optional<SolverResult>> solutions(subsets.size());
+  ParallelFor(subsets.size(), options.threads, [&](size_t s) {
+    solutions[s] = SolveFromFeatures(subsets[s].features, options).solution;
+  });
+  for (size_t s = 0; s < subsets.size(); ++s) {
+    const Subset& subset = subsets[s];
+    const std::optional<SolverResult>& solution = solutions[s];
+    if (!solution) {
       ++cell.failures;
       continue;
     }
-    const PoseError e = ComputePoseError(outcome.solution->cam_from_lidar, truth);
+    const PoseError e = ComputePoseError(solution->cam_from_lidar, truth);
     t_err.push_back(e.translation_m * 1000);
     r_err.push_back(e.rotation_rad * 180 / M_PI);
     bound_t2 += std::pow(subset.bound.translation_rms_m * 1000, 2);
     bound_r2 += std::pow(subset.bound.rotation_rms_deg, 2);
-    if (!outcome.solution->observability.well_constrained) ++cell.weak;
+    if (!solution->observability.well_constrained) ++cell.weak;
   }
   if (!t_err.empty()) Aggregate(t_err, r_err, bound_t2, bound_r2, &cell);
   return cell;
@@ -86,8 +94,12 @@ Pool ExtractPool(const Dataset& dataset, const PipelineOptions& options,
                  const std::function<void(const std::string&)>& log) {
   Pool pool;
   double corner_sigma_sum = 0.0;
+  std::vector<PairFeatures> extracted(dataset.pairs.size());
+  ParallelFor(dataset.pairs.size(), options.threads, [&](size_t p) {
+    extracted[p] = ExtractPairFeatures(dataset, dataset.pairs[p], options);
+  });
   for (size_t p = 0; p < dataset.pairs.size(); ++p) {
-    PairFeatures f = ExtractPairFeatures(dataset, dataset.pairs[p], options);
+    PairFeatures& f = extracted[p];
     if (f.status == PairStatus::kAccepted || (f.lidar && f.camera)) {
       corner_sigma_sum += f.camera->corner_sigma_px;
       pool.features.push_back(f);
