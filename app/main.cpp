@@ -5,6 +5,7 @@
 #include <string>
 
 #include "app/commands.h"
+#include "core/base/allocator.h"
 #include "core/base/types.h"
 
 namespace {
@@ -40,6 +41,7 @@ void PrintUsage() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  calibench::KeepFreedMemoryForReuse();
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
     PrintUsage();
     return argc < 2 ? calibench::app::kUsage : calibench::app::kOk;

@@ -131,8 +131,7 @@ void SetPlaneCovariance(size_t count, const PointAt& point_at, const WeightAt& w
 // Weighted total least squares: the plane through the weighted centroid normal to the smallest
 // eigenvector of the weighted scatter.
 template <typename PointAt, typename WeightAt>
-std::optional<PlaneFit> FitPlaneTls(size_t count, const PointAt& point_at,
-                                    const WeightAt& weight_at) {
+std::optional<Plane> TlsPlane(size_t count, const PointAt& point_at, const WeightAt& weight_at) {
   if (count < 4) return std::nullopt;
   double weight_sum = 0.0;
   Vec3 centroid = Vec3::Zero();
@@ -150,9 +149,17 @@ std::optional<PlaneFit> FitPlaneTls(size_t count, const PointAt& point_at,
   // Points on a line (e.g. a single LiDAR ring) leave two eigenvalues near zero.
   if (eigen.eigenvalues()[1] < 1e-6 * eigen.eigenvalues()[2] || eigen.eigenvalues()[1] <= 0)
     return std::nullopt;
-  PlaneFit fit;
-  fit.plane = OrientTowardsOrigin(
+  return OrientTowardsOrigin(
       Plane{eigen.eigenvectors().col(0), -eigen.eigenvectors().col(0).dot(centroid)});
+}
+
+template <typename PointAt, typename WeightAt>
+std::optional<PlaneFit> FitPlaneTls(size_t count, const PointAt& point_at,
+                                    const WeightAt& weight_at) {
+  const std::optional<Plane> plane = TlsPlane(count, point_at, weight_at);
+  if (!plane) return std::nullopt;
+  PlaneFit fit;
+  fit.plane = *plane;
   SetPlaneCovariance(count, point_at, weight_at, &fit);
   return fit;
 }
@@ -163,6 +170,14 @@ std::optional<PlaneFit> FitPlaneWeighted(const std::vector<Vec3>& points,
                                          const std::vector<double>& weights) {
   CALIBENCH_CHECK(weights.empty() || weights.size() == points.size());
   return FitPlaneTls(
+      points.size(), [&](size_t k) -> const Vec3& { return points[k]; },
+      [&](size_t k) { return weights.empty() ? 1.0 : weights[k]; });
+}
+
+std::optional<Plane> FitPlaneWeightedPlane(const std::vector<Vec3>& points,
+                                           const std::vector<double>& weights) {
+  CALIBENCH_CHECK(weights.empty() || weights.size() == points.size());
+  return TlsPlane(
       points.size(), [&](size_t k) -> const Vec3& { return points[k]; },
       [&](size_t k) { return weights.empty() ? 1.0 : weights[k]; });
 }

@@ -69,6 +69,10 @@ struct PlaneFit {
 // nullopt for fewer than 4 points, or points on a line (they do not define a plane).
 std::optional<PlaneFit> FitPlaneWeighted(const std::vector<Vec3>& points,
                                          const std::vector<double>& weights = {});
+// Its plane alone (bit for bit), without the covariance's pass over the points: for iterations that
+// only need the plane.
+std::optional<Plane> FitPlaneWeightedPlane(const std::vector<Vec3>& points,
+                                           const std::vector<double>& weights = {});
 // The same, unweighted, over points[indices] of single-precision points (a LiDAR cloud's).
 std::optional<PlaneFit> FitPlane(const std::vector<Eigen::Vector3f>& points,
                                  const std::vector<int>& indices);

@@ -2,12 +2,6 @@
 // Section 4.2 step 3, Fig. 7): the three-face target's faces and their intersection lines.
 #include "core/lrf/depth_planes.h"
 
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
-#include <pcl/sample_consensus/ransac.h>
-#include <pcl/sample_consensus/sac_model_normal_plane.h>
-#include <pcl/sample_consensus/sac_model_plane.h>
-
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
@@ -73,44 +67,192 @@ void ForEachCellAround(const DepthCloud& cloud, int cell, Visit visit) {
     }
 }
 
-// Local normals by PCA over grid neighbours: they tell the faces apart where the inlier distance
-// (several centimetres at 3 m) cannot, e.g. a plane slicing through the ridge of the tent. The
+// The half window (cells) of point x's normal and the reach of its neighbours (metres). The
 // window's spread must exceed the depth noise (σ ≈ threshold / 3) by about twice, else the
-// smallest eigenvector is noise: half-width ≈ 1.15 · threshold / cell, 2 to 8 cells.
-// Neighbours across a depth jump are left out.
+// smallest eigenvector is noise: half-width ≈ 1.15 · threshold / cell, 2 to 8 cells. The reach is
+// the window plus the noise (a jump to the wall behind is a metre or more).
+struct NormalWindow {
+  int half = 0;
+  double reach_sq = 0.0;
+};
+NormalWindow NormalWindowAt(const DepthIntrinsics& k, const DepthFeatureOptions& options,
+                            const Vec3& x) {
+  const double cell_m = options.stride_px * x.z() / k.fx;
+  NormalWindow window;
+  window.half = std::clamp(
+      static_cast<int>(std::lround(1.15 * PlaneThreshold(options, x.z()) / cell_m)), 2, 8);
+  window.reach_sq =
+      std::pow(std::sqrt(2.0) * window.half * cell_m + 2.0 * PlaneThreshold(options, x.z()), 2);
+  return window;
+}
+
+// The normal of a scatter matrix (smallest eigenvector, towards the camera at x) and the RMS
+// distance of the points from their plane.
+std::pair<Vec3, double> NormalOfScatter(const Mat3& scatter_over_n, const Vec3& x) {
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+  eigen.computeDirect(scatter_over_n);
+  Vec3 normal = eigen.eigenvectors().col(0);
+  if (normal.dot(x) > 0) normal = -normal;
+  return {normal, std::sqrt(std::max(0.0, eigen.eigenvalues()(0)))};
+}
+
+// The exact neighbourhood: the grid neighbours within the reach, so that a window across a depth
+// jump leaves the far side out. Zero when fewer than 6 neighbours.
+Vec3 NormalFromNeighbours(const DepthCloud& cloud, size_t i, const NormalWindow& window) {
+  const Vec3& x = cloud.points[i];
+  const int gu = cloud.cell[i] % cloud.grid_width, gv = cloud.cell[i] / cloud.grid_width;
+  Vec3 sum = Vec3::Zero();
+  Mat3 sum_sq = Mat3::Zero();
+  int n = 0;
+  const int half = window.half;
+  for (int nv = std::max(0, gv - half); nv <= std::min(cloud.grid_height - 1, gv + half); ++nv)
+    for (int nu = std::max(0, gu - half); nu <= std::min(cloud.grid_width - 1, gu + half); ++nu) {
+      const int j = cloud.point_of_cell[nv * cloud.grid_width + nu];
+      if (j < 0) continue;
+      const Vec3 d = cloud.points[j] - x;
+      if (d.squaredNorm() > window.reach_sq) continue;
+      sum += d;
+      sum_sq += d * d.transpose();
+      ++n;
+    }
+  if (n < 6) return Vec3::Zero();
+  return NormalOfScatter((sum_sq - sum * sum.transpose() / n) / n, x).first;
+}
+
+// Summed-area tables of the grid's point moments (count, Σp, Σp·pᵀ relative to an origin): the
+// moments of any window in constant time.
+class MomentTables {
+ public:
+  explicit MomentTables(const DepthCloud& cloud) : width_(cloud.grid_width + 1) {
+    if (!cloud.points.empty()) origin_ = cloud.points[cloud.points.size() / 2];
+    table_.assign(static_cast<size_t>(width_) * (cloud.grid_height + 1), Moments{});
+    for (int v = 0; v < cloud.grid_height; ++v) {
+      Moments row;
+      for (int u = 0; u < cloud.grid_width; ++u) {
+        const int j = cloud.point_of_cell[v * cloud.grid_width + u];
+        if (j >= 0) row.Add(cloud.points[j] - origin_);
+        table_[Index(u + 1, v + 1)] = table_[Index(u + 1, v)] + row;
+      }
+    }
+  }
+  // Count and scatter / count of the cells [u0, u1] × [v0, v1] (inclusive).
+  bool Window(int u0, int v0, int u1, int v1, int* n, Mat3* scatter) const {
+    const Moments m = table_[Index(u1 + 1, v1 + 1)] - table_[Index(u0, v1 + 1)] -
+                      table_[Index(u1 + 1, v0)] + table_[Index(u0, v0)];
+    *n = static_cast<int>(std::lround(m.values[0]));
+    if (*n < 6) return false;
+    const Vec3 local_mean = Vec3(m.values[1], m.values[2], m.values[3]) / *n;
+    Mat3 second;
+    second << m.values[4], m.values[5], m.values[6], m.values[5], m.values[7], m.values[8],
+        m.values[6], m.values[8], m.values[9];
+    *scatter = second / *n - local_mean * local_mean.transpose();
+    return true;
+  }
+
+ private:
+  struct Moments {
+    std::array<double, 10> values{};  // n, x, y, z, xx, xy, xz, yy, yz, zz
+    void Add(const Vec3& p) {
+      const double add[10] = {1,
+                              p.x(),
+                              p.y(),
+                              p.z(),
+                              p.x() * p.x(),
+                              p.x() * p.y(),
+                              p.x() * p.z(),
+                              p.y() * p.y(),
+                              p.y() * p.z(),
+                              p.z() * p.z()};
+      for (int k = 0; k < 10; ++k) values[k] += add[k];
+    }
+    Moments operator+(const Moments& o) const {
+      Moments r = *this;
+      for (int k = 0; k < 10; ++k) r.values[k] += o.values[k];
+      return r;
+    }
+    Moments operator-(const Moments& o) const {
+      Moments r = *this;
+      for (int k = 0; k < 10; ++k) r.values[k] -= o.values[k];
+      return r;
+    }
+  };
+  size_t Index(int u, int v) const { return static_cast<size_t>(v) * width_ + u; }
+  int width_;
+  Vec3 origin_ = Vec3::Zero();
+  std::vector<Moments> table_;
+};
+
+// Local normals by PCA over grid neighbours: they tell the faces apart where the inlier distance
+// (several centimetres at 3 m) cannot, e.g. a plane slicing through the ridge of the tent.
+// A window whose points all lie within half a threshold (~1.5σ) of their plane holds no depth
+// jump and no ridge: its normal comes from the summed-area tables in constant time. The others
+// (about one in six on the simulated target) take their neighbours one by one and leave those
+// across a depth jump out.
 void ComputeNormals(const DepthIntrinsics& k, const DepthFeatureOptions& options,
                     DepthCloud* cloud) {
-  const int stride = options.stride_px;
   cloud->normals.assign(cloud->points.size(), Vec3::Zero());
-  for (size_t i = 0; i < cloud->points.size(); ++i) {
+  const MomentTables tables(*cloud);
+  // Whether a point's normal came from a planar window (the summed-area path).
+  std::vector<char> planar(cloud->points.size(), 0);
+  auto compute = [&](size_t i) {
     const Vec3& x = cloud->points[i];
-    const double cell_m = stride * x.z() / k.fx;
-    const int half = std::clamp(
-        static_cast<int>(std::lround(1.15 * PlaneThreshold(options, x.z()) / cell_m)), 2, 8);
-    // Within the window plus the noise (a jump to the wall behind is a metre or more).
-    const double reach_sq =
-        std::pow(std::sqrt(2.0) * half * cell_m + 2.0 * PlaneThreshold(options, x.z()), 2);
+    const NormalWindow window = NormalWindowAt(k, options, x);
     const int gu = cloud->cell[i] % cloud->grid_width, gv = cloud->cell[i] / cloud->grid_width;
-    Vec3 sum = Vec3::Zero();
-    Mat3 sum_sq = Mat3::Zero();
-    int n = 0;
-    for (int nv = std::max(0, gv - half); nv <= std::min(cloud->grid_height - 1, gv + half); ++nv)
-      for (int nu = std::max(0, gu - half); nu <= std::min(cloud->grid_width - 1, gu + half);
-           ++nu) {
-        const int j = cloud->point_of_cell[nv * cloud->grid_width + nu];
-        if (j < 0 || (cloud->points[j] - x).squaredNorm() > reach_sq) continue;
-        const Vec3 d = cloud->points[j] - x;
-        sum += d;
-        sum_sq += d * d.transpose();
-        ++n;
+    const double cell_m = options.stride_px * x.z() / k.fx;
+    // The window, then (on a surface seen at a grazing angle, whose window corners lie beyond the
+    // reach on the plane, where the exact neighbourhood would leave them out) the window shrunk
+    // until its corners are within the reach.
+    int half = window.half;
+    for (int attempt = 0; attempt < 3 && half >= 1; ++attempt) {
+      int n = 0;
+      Mat3 scatter;
+      if (!tables.Window(std::max(0, gu - half), std::max(0, gv - half),
+                         std::min(cloud->grid_width - 1, gu + half),
+                         std::min(cloud->grid_height - 1, gv + half), &n, &scatter))
+        break;
+      const auto [normal, rms] = NormalOfScatter(scatter, x);
+      if (rms > 0.5 * PlaneThreshold(options, x.z())) break;
+      const double corner_m =
+          std::sqrt(2.0) * half * cell_m / std::max(1e-3, std::abs(normal.dot(x.normalized())));
+      if (corner_m * corner_m < window.reach_sq) {
+        cloud->normals[i] = normal;
+        planar[i] = 1;
+        return;
       }
-    if (n < 6) continue;
-    const Mat3 scatter = sum_sq - sum * sum.transpose() / n;
-    Eigen::SelfAdjointEigenSolver<Mat3> eigen;
-    eigen.computeDirect(scatter);
-    Vec3 normal = eigen.eigenvectors().col(0);
-    if (normal.dot(x) > 0) normal = -normal;
-    cloud->normals[i] = normal;
+      half =
+          std::min(half - 1, static_cast<int>(0.95 * half * std::sqrt(window.reach_sq) / corner_m));
+    }
+    cloud->normals[i] = NormalFromNeighbours(*cloud, i, window);
+  };
+  // Windows of neighbouring cells share most of their points: the normals are computed on the
+  // even cells, and a cell between even cells whose planar normals agree within a degree takes
+  // their mean (three in four cells, on surfaces); every other cell is computed.
+  const double agree = std::cos(6.0 * kDegToRad);
+  for (size_t i = 0; i < cloud->points.size(); ++i) {
+    const int gu = cloud->cell[i] % cloud->grid_width, gv = cloud->cell[i] / cloud->grid_width;
+    if (gu % 2 == 0 && gv % 2 == 0) compute(i);
+  }
+  for (size_t i = 0; i < cloud->points.size(); ++i) {
+    const int gu = cloud->cell[i] % cloud->grid_width, gv = cloud->cell[i] / cloud->grid_width;
+    if (gu % 2 == 0 && gv % 2 == 0) continue;
+    Vec3 sum = Vec3::Zero();
+    Vec3 first = Vec3::Zero();
+    bool usable = true;
+    for (int nv = gv - gv % 2; nv <= gv + gv % 2 && usable; nv += 2)
+      for (int nu = gu - gu % 2; nu <= gu + gu % 2 && usable; nu += 2) {
+        const int j = nu < cloud->grid_width && nv < cloud->grid_height
+                          ? cloud->point_of_cell[nv * cloud->grid_width + nu]
+                          : -1;
+        usable = j >= 0 && planar[j] && (first.isZero() || first.dot(cloud->normals[j]) >= agree);
+        if (!usable) break;
+        if (first.isZero()) first = cloud->normals[j];
+        sum += cloud->normals[j];
+      }
+    if (usable) {
+      cloud->normals[i] = sum.normalized();
+    } else {
+      compute(i);
+    }
   }
 }
 
@@ -161,16 +303,26 @@ struct PlanePatch {
   double rms_m = 0.0;
 };
 
-// The weighted plane fit with its (n, d) covariance (FitPlaneWeighted, core/geometry): the
-// weights w_i = 1 / t(z_i)², t the inlier threshold, follow the depth noise's growth with z².
+// The points of `indices` with their weights w_i = 1 / t(z_i)², t the inlier threshold: they
+// follow the depth noise's growth with z².
+void WeightedPoints(const DepthCloud& cloud, const std::vector<int>& indices,
+                    const DepthFeatureOptions& options, std::vector<Vec3>* points,
+                    std::vector<double>* weights) {
+  points->clear();
+  weights->clear();
+  for (int i : indices) {
+    points->push_back(cloud.points[i]);
+    const double threshold = PlaneThreshold(options, cloud.points[i].z());
+    weights->push_back(1.0 / (threshold * threshold));
+  }
+}
+
+// The weighted plane fit with its (n, d) covariance (FitPlaneWeighted, core/geometry).
 std::optional<PlanePatch> FitPatch(const DepthCloud& cloud, const std::vector<int>& indices,
                                    const DepthFeatureOptions& options) {
   std::vector<Vec3> points;
   std::vector<double> weights;
-  for (int i : indices) {
-    points.push_back(cloud.points[i]);
-    weights.push_back(1.0 / std::pow(PlaneThreshold(options, cloud.points[i].z()), 2));
-  }
+  WeightedPoints(cloud, indices, options, &points, &weights);
   const std::optional<PlaneFit> fit = FitPlaneWeighted(points, weights);
   if (!fit) return std::nullopt;
   PlanePatch patch;
@@ -181,49 +333,73 @@ std::optional<PlanePatch> FitPatch(const DepthCloud& cloud, const std::vector<in
   return patch;
 }
 
-// One PCL RANSAC plane over (a random subset of) the live points, with the subset's inliers
-// (cloud indices); nullopt when none.
+// Its plane alone.
+std::optional<Plane> FitPatchPlane(const DepthCloud& cloud, const std::vector<int>& indices,
+                                   const DepthFeatureOptions& options) {
+  std::vector<Vec3> points;
+  std::vector<double> weights;
+  WeightedPoints(cloud, indices, options, &points, &weights);
+  return FitPlaneWeightedPlane(points, weights);
+}
+
+// Points RANSAC looks at (a random subset of the live points): plenty to find a surface of the
+// min_inliers_per_face the target's faces have; the connected inliers among all points then
+// refine it (ConnectedInliers). RANSAC's cost is linear in it.
+constexpr size_t kRansacSamplePoints = 1500;
+constexpr int kRansacMaxIterations = 200;
+constexpr double kRansacConfidence = 0.999;
+
+// One plane by RANSAC over a random subset of the live points, with the subset's inliers (cloud
+// indices); nullopt when none. Each hypothesis is one point and its local normal (ComputeNormals),
+// so that one good draw suffices: log(1 - confidence) / log(1 - w) draws for an inlier share w
+// (16 at w = 0.35), against about 150 for three-point samples. Inliers are counted as everywhere
+// else here (IsInlier: the depth-dependent distance and the normal), which needs no acos per
+// point as PCL's normal-plane model does; the hypothesis with the most wins, the first on ties.
 std::optional<Plane> RansacPlane(const DepthCloud& cloud, std::vector<int> live,
                                  std::mt19937_64* rng, const DepthFeatureOptions& options,
                                  std::vector<int>* ransac_inliers) {
-  // PCL samples with a fixed internal seed; shuffling with ours makes the result depend on
-  // options.seed only. 4000 points are plenty to find a plane and keep each RANSAC fast.
   std::shuffle(live.begin(), live.end(), *rng);
-  live.resize(std::min<size_t>(live.size(), 4000));
+  live.resize(std::min(live.size(), kRansacSamplePoints));
+  std::vector<int> candidates;  // sample points with a normal
   std::vector<double> depths;
-  pcl::PointCloud<pcl::PointXYZ>::Ptr points(new pcl::PointCloud<pcl::PointXYZ>);
-  pcl::PointCloud<pcl::Normal>::Ptr normals(new pcl::PointCloud<pcl::Normal>);
   for (int i : live) {
-    const Vec3& p = cloud.points[i];
-    const Vec3& n = cloud.normals[i];
-    points->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-    normals->push_back(pcl::Normal(n.x(), n.y(), n.z()));  // curvature 0: full normal weight
-    depths.push_back(p.z());
+    if (!cloud.normals[i].isZero()) candidates.push_back(i);
+    depths.push_back(cloud.points[i].z());
   }
-  // The threshold of the nearer quarter: leftovers far away (where the threshold is wide) must
-  // not let RANSAC slice one plane through several near surfaces.
+  if (candidates.empty()) return std::nullopt;
+  // One threshold, that of the nearer quarter: leftovers far away (where the threshold is wide)
+  // must not let a plane slice through several near surfaces and win.
   const size_t quarter = depths.size() / 4;
   std::nth_element(depths.begin(), depths.begin() + quarter, depths.end());
   const double threshold = PlaneThreshold(options, depths[quarter]);
-  // PCL's distance is w·angle + (1 - w)·distance: a kNormalToleranceDeg difference in normal
-  // costs a whole threshold, as in IsInlier.
-  pcl::SampleConsensusModelNormalPlane<pcl::PointXYZ, pcl::Normal>::Ptr model(
-      new pcl::SampleConsensusModelNormalPlane<pcl::PointXYZ, pcl::Normal>(points, false));
-  model->setInputNormals(normals);
-  model->setNormalDistanceWeight(std::min(0.5, threshold / (kNormalToleranceDeg * kDegToRad)));
-  pcl::RandomSampleConsensus<pcl::PointXYZ> ransac(model, threshold);
-  ransac.setMaxIterations(300);
-  if (!ransac.computeModel()) return std::nullopt;
-  Eigen::VectorXf coefficients;
-  ransac.getModelCoefficients(coefficients);
-  if (coefficients.size() != 4) return std::nullopt;
-  const Vec3 normal = coefficients.head<3>().cast<double>();
-  if (normal.norm() < 1e-9) return std::nullopt;
-  std::vector<int> local;
-  ransac.getInliers(local);
+  const double min_cos = std::cos(kNormalToleranceDeg * kDegToRad);
+  auto inlier = [&](int i, const Plane& plane) {
+    return std::abs(plane.SignedDistance(cloud.points[i])) <= threshold &&
+           std::abs(cloud.normals[i].dot(plane.normal)) >= min_cos;
+  };
+  std::uniform_int_distribution<size_t> pick(0, candidates.size() - 1);
+  std::optional<Plane> best;
+  size_t best_count = 0;
+  int needed = kRansacMaxIterations;
+  for (int iteration = 0; iteration < needed; ++iteration) {
+    const int seed = candidates[pick(*rng)];
+    const Plane plane{cloud.normals[seed], -cloud.normals[seed].dot(cloud.points[seed])};
+    size_t count = 0;
+    for (int i : live) count += inlier(i, plane) ? 1 : 0;
+    if (count <= best_count) continue;
+    best = plane;
+    best_count = count;
+    const double share = static_cast<double>(count) / live.size();
+    if (share >= 1.0) break;
+    needed = std::min(
+        kRansacMaxIterations,
+        static_cast<int>(std::ceil(std::log(1.0 - kRansacConfidence) / std::log(1.0 - share))));
+  }
+  if (!best) return std::nullopt;
   ransac_inliers->clear();
-  for (int k : local) ransac_inliers->push_back(live[k]);
-  return Plane{normal.normalized(), coefficients[3] / normal.norm()};
+  for (int i : live)
+    if (inlier(i, *best)) ransac_inliers->push_back(i);
+  return best;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -369,9 +545,9 @@ std::vector<int> ConnectedInliers(const DepthCloud& cloud, const std::vector<int
       if (IsInlier(cloud, i, current, options)) inliers.push_back(i);
     component = LargestComponent(cloud, inliers);
     if (static_cast<int>(component.size()) < options.min_inliers_per_face) break;
-    const auto refit = FitPatch(cloud, component, options);
+    const auto refit = FitPatchPlane(cloud, component, options);
     if (!refit) break;
-    current = refit->plane;
+    current = *refit;
   }
   return component;
 }
