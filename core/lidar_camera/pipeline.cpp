@@ -66,10 +66,10 @@ PlanePair MakePlanePair(const std::string& id, const LidarPlaneFit& lidar,
 }
 
 std::optional<PairInputs> LoadPairInputs(const Dataset& dataset, const PairEntry& pair,
-                                         std::string* why) {
+                                         std::string* why, LidarCloud* preloaded) {
   PairInputs inputs;
   try {
-    inputs.cloud = LoadCloud(pair.cloud);
+    inputs.cloud = preloaded ? std::move(*preloaded) : LoadCloud(pair.cloud);
     inputs.image = LoadImage(pair.image);
   } catch (const IoError& e) {
     *why = e.what();
@@ -191,11 +191,11 @@ std::optional<BoardHint> HintFor(const PairEntry& pair, const PairEdit& edit,
 
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
                                  const PipelineOptions& options, const PairEdit& edit,
-                                 const SceneBackground* background) {
+                                 const SceneBackground* background, LidarCloud* preloaded_cloud) {
   PairFeatures features;
   features.id = pair.id;
   std::string why;
-  auto inputs = LoadPairInputs(dataset, pair, &why);
+  auto inputs = LoadPairInputs(dataset, pair, &why, preloaded_cloud);
   if (!inputs) {
     features.input_error = true;
     SetStatusFromFeatures(&features, why, why);
@@ -233,8 +233,9 @@ bool AnyPairToDetect(const std::vector<const PairEntry*>& pairs, const PairEdits
 
 }  // namespace
 
-std::optional<SceneBackground> BuildSceneBackground(const std::vector<const PairEntry*>& pairs,
-                                                    int threads, std::string* why) {
+std::optional<SceneBackground> BuildSceneBackground(
+    const std::vector<const PairEntry*>& pairs, int threads, std::string* why,
+    std::vector<std::optional<LidarCloud>>* kept) {
   std::vector<std::optional<LidarCloud>> clouds(pairs.size());
   ParallelFor(pairs.size(), threads, [&](size_t i) {
     try {
@@ -245,6 +246,7 @@ std::optional<SceneBackground> BuildSceneBackground(const std::vector<const Pair
   SceneBackground background;
   for (const auto& cloud : clouds)
     if (cloud) background.Add(*cloud);
+  if (kept) *kept = std::move(clouds);
   if (!background.Finish(why)) return std::nullopt;
   return background;
 }
@@ -258,17 +260,20 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
 
   std::optional<SceneBackground> background;
   std::string background_note;
+  std::vector<std::optional<LidarCloud>> clouds;  // read once, for the background and the pair
   if (options.detect_board && options.background_model && AnyPairToDetect(selected, edits))
-    background = BuildSceneBackground(selected, options.threads, &background_note);
+    background = BuildSceneBackground(selected, options.threads, &background_note, &clouds);
 
   std::vector<PairFeatures> features(selected.size());
   ParallelFor(
       selected.size(), options.threads,
       [&](size_t i) {
         const auto edit = edits.find(selected[i]->id);
+        LidarCloud* preloaded = i < clouds.size() && clouds[i] ? &*clouds[i] : nullptr;
         features[i] = ExtractPairFeatures(dataset, *selected[i], options,
                                           edit == edits.end() ? PairEdit{} : edit->second,
-                                          background ? &*background : nullptr);
+                                          background ? &*background : nullptr, preloaded);
+        if (preloaded) clouds[i].reset();  // its memory goes with the pair
       },
       [&](int finished, size_t i) {
         if (progress) progress(finished, static_cast<int>(selected.size()), selected[i]->id);

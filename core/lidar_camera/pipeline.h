@@ -87,9 +87,10 @@ struct PairInputs {
   ImageU8 image;
 };
 // nullopt with *why naming the file when a file cannot be read or the image is not the camera's
-// size.
+// size. A cloud already read (`preloaded`, e.g. by BuildSceneBackground) is moved in instead of
+// being read again.
 std::optional<PairInputs> LoadPairInputs(const Dataset& dataset, const PairEntry& pair,
-                                         std::string* why);
+                                         std::string* why, LidarCloud* preloaded = nullptr);
 
 // The camera side: the board detected in the image and its plane by PnP; `failure` says why
 // `observation` is absent. `detection` is kept even when PnP fails.
@@ -156,12 +157,16 @@ struct CalibrationOutcome {
 // (unreadable files name the file); a rejected pair comes back kRejected with its features.
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
                                  const PipelineOptions& options, const PairEdit& edit = {},
-                                 const SceneBackground* background = nullptr);
+                                 const SceneBackground* background = nullptr,
+                                 LidarCloud* preloaded_cloud = nullptr);
 
 // The background model over the selected pairs' clouds (for detection); nullopt with *why when it
-// cannot be built (fewer than 3 readable clouds, or the sensor moved between pairs).
-std::optional<SceneBackground> BuildSceneBackground(const std::vector<const PairEntry*>& pairs,
-                                                    int threads, std::string* why);
+// cannot be built (fewer than 3 readable clouds, or the sensor moved between pairs). `clouds`
+// (optional) receives the clouds it read, per pair (nullopt where unreadable), so that the
+// extraction does not read them again.
+std::optional<SceneBackground> BuildSceneBackground(
+    const std::vector<const PairEntry*>& pairs, int threads, std::string* why,
+    std::vector<std::optional<LidarCloud>>* clouds = nullptr);
 
 // Camera-guided completion (options.camera_guided): with a first solution, predicts every pair's
 // board in the LiDAR frame from its camera pose, drops LiDAR boards that disagree with it (the
