@@ -189,7 +189,7 @@ int RunDemo(int argc, char** argv) {
   if (!no_gui && display && *display) {
     std::printf("opening the workbench on %s (close the window to finish)\n",
                 dataset.manifest.string().c_str());
-    return RunGuiWindow(dataset.manifest.string(), "", 1600, 900, "", 0);
+    return RunGuiWindow(dataset.manifest.string(), "", 1600, 900, "");
   }
   return RenderDemoViews(dataset.manifest.string(), out_dir);
 }

@@ -58,8 +58,8 @@ bool OpenInput(ui::Controller& controller, const std::string& dataset, const std
 
 // The window the gui flags ask for; with --screenshot its last frame is kept.
 ui::WindowOptions WindowOptionsOf(int width, int height, const char* title,
-                                  const std::string& screenshot, int quit_after_frames) {
-  return {width, height, title, quit_after_frames, !screenshot.empty()};
+                                  const std::string& screenshot, const GuiQuit& quit) {
+  return {width, height, title, quit.after_frames, !screenshot.empty(), quit.after_seconds};
 }
 
 // The exit code of a window run; writes the screenshot it captured.
@@ -75,6 +75,8 @@ int FinishWindow(const ui::WindowRun& run, const std::string& screenshot) {
     SaveImage(screenshot, *run.last_frame);
     std::printf("wrote %s\n", screenshot.c_str());
   }
+  std::printf("frames drawn: %d (%d with nothing moving for a second)\n", run.stats.frames,
+              run.stats.quiet_frames);
   return kOk;
 }
 
@@ -136,14 +138,13 @@ int RenderLrfHeadless(const std::string& dataset, const ui::HeadlessShot& shot,
 }  // namespace
 
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
-                 const std::string& screenshot, int quit_after_frames) {
+                 const std::string& screenshot, const GuiQuit& quit) {
   ui::Controller controller;
   if (!OpenInput(controller, dataset, session, "gui")) return kUsage;
-  return FinishWindow(
-      ui::RunWorkbenchWindow<ui::Workbench>(
-          WindowOptionsOf(width, height, "Calibench", screenshot, quit_after_frames), controller,
-          ui::Layout::kWorkbench),
-      screenshot);
+  return FinishWindow(ui::RunWorkbenchWindow<ui::Workbench>(
+                          WindowOptionsOf(width, height, "Calibench", screenshot, quit), controller,
+                          ui::Layout::kWorkbench),
+                      screenshot);
 }
 
 int RunGui(int argc, char** argv) {
@@ -152,21 +153,23 @@ int RunGui(int argc, char** argv) {
       "reject pairs, solve and inspect.",
       "calibench gui"};
   std::string dataset, session, size = "1600x900", screenshot;
-  int quit_after_frames = 0;
+  GuiQuit quit;
   app.add_option("--dataset,-d", dataset,
                  "dataset.json or dataset folder, or an LRF manifest (calibench.lrf-dataset.v1)");
   app.add_option("--session,-s", session, "a saved session (calibench.session.v1)");
   app.add_option("--size", size, "window size WxH")->capture_default_str();
   app.add_option("--screenshot", screenshot, "write the last frame to this PNG");
-  app.add_option("--quit-after-frames", quit_after_frames, "close after N frames (tests)");
+  app.add_option("--quit-after-frames", quit.after_frames,
+                 "close after N frames, drawn back to back (tests)");
+  app.add_option("--quit-after-seconds", quit.after_seconds,
+                 "close after S seconds, drawing only on input or work as usual (tests)");
   int width = 0, height = 0;
   if (const auto code = ParseFlags(app, argc, argv, size, "gui", &width, &height)) return *code;
   if (!dataset.empty() && IsLrfManifest(dataset))
-    return RunLrfGuiWindow(
-        dataset,
-        WindowOptionsOf(width, height, "Calibench (2D LRF)", screenshot, quit_after_frames),
-        screenshot);
-  return RunGuiWindow(dataset, session, width, height, screenshot, quit_after_frames);
+    return RunLrfGuiWindow(dataset,
+                           WindowOptionsOf(width, height, "Calibench (2D LRF)", screenshot, quit),
+                           screenshot);
+  return RunGuiWindow(dataset, session, width, height, screenshot, quit);
 }
 
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,

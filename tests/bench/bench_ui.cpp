@@ -9,6 +9,8 @@
 
 #include "core/sim/sim.h"
 #include "ui/gfx/context.h"
+#include "ui/gfx/framebuffer.h"
+#include "ui/gfx/gl_api.h"
 #include "ui/lidar_camera/controller.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/widgets/imgui_host.h"
@@ -67,6 +69,60 @@ void BM_WorkbenchFrame1600x900(benchmark::State& state) {
                                                          ui::Layout::kWorkbench, 1600, 900, 1));
 }
 BENCHMARK(BM_WorkbenchFrame1600x900)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// One frame after an edit, drawn into the window's offscreen framebuffer and finished (glFinish),
+// without the headless readback: /0 the 3D view turned (an orbit drag: the 3D view redraws),
+// /1 the reprojected points' opacity changed (a slider: the camera view redraws), /2 a pair
+// rejected (the list changes; no view redraws).
+void BM_WorkbenchFrameAfterEdit1600x900(benchmark::State& state) {
+  std::string why;
+  auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &why);
+  if (!context) {
+    state.SkipWithError(why.c_str());
+    return;
+  }
+  ui::Controller controller;
+  controller.OpenDataset(SimulatedDemo(3),
+                         std::filesystem::temp_directory_path() / "bench_ui_edit.json");
+  controller.WaitIdle();
+  controller.Apply(ui::RunSolver{});
+  controller.WaitIdle();
+  ui::ImGuiHost host(nullptr);
+  ui::Workbench workbench;
+  ui::RenderWorkbenchHeadless(controller, workbench, host, ui::Layout::kWorkbench, 1600, 900, 3);
+  gfx::Framebuffer target;
+  int edit = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    ViewState view = controller.GetSnapshot().view;
+    ++edit;
+    if (state.range(0) == 0) {
+      view.orbit_yaw_rad += 0.05;
+      controller.Apply(ui::SetView{view});
+    } else if (state.range(0) == 1) {
+      view.point_opacity = edit % 2 ? 0.9 : 1.0;
+      controller.Apply(ui::SetView{view});
+    } else {
+      controller.Apply(
+          ui::SetPairStatus{2, edit % 2 ? PairStatus::kRejected : PairStatus::kAccepted});
+    }
+    controller.WaitIdle();
+    state.ResumeTiming();
+    host.DrawFrame(target, 1600, 900, 1.0 / 60.0, [&] {
+      for (const auto& intent :
+           workbench.Frame(controller.GetSnapshot(), 1600, 900, ui::Layout::kWorkbench, 1.0 / 60.0))
+        controller.Apply(intent);
+    });
+    glFinish();
+  }
+  state.SetLabel(context->Description());
+}
+BENCHMARK(BM_WorkbenchFrameAfterEdit1600x900)
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_Session40PairsMemory(benchmark::State& state) {
   const auto manifest = SimulatedDemo(40);

@@ -1,6 +1,8 @@
 // A real window: `calibench gui` under Xvfb for a few frames, with a screenshot of what it showed.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "core/base/image.h"
 #include "core/io/image_io.h"
 #include "tests/test_support.h"
@@ -55,6 +57,34 @@ TEST(GuiWindow, OpensUnderXvfbAndShowsTheThreeViews) {
     const std::uint8_t* p = image.Row(8) + 3 * x;
     EXPECT_GT(p[0], p[2]) << "no title bar at x = " << x << "; see " << shot;  // blue > red (BGR)
   }
+}
+
+// Left alone, the window draws nothing: after the pairs load it sleeps in the window system
+// until input or work arrives (a loop that redraws continuously draws hundreds of frames a
+// second under Xvfb, all of them "quiet").
+TEST(GuiWindow, IdleWindowDrawsNoFrames) {
+  std::string output;
+  if (test::RunCommand("command -v xvfb-run", &output) != 0) {
+    if (std::getenv("CALIBENCH_REQUIRE_SHARED")) FAIL() << "xvfb-run is not installed";
+    GTEST_SKIP() << "xvfb-run is not installed (apt-get install xvfb xauth)";
+  }
+  const auto dir = test::TempDir("gui_window_idle");
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " simulate --preset demo --pairs 3 --out " +
+                                 (dir / "data").string(),
+                             &output),
+            0)
+      << output;
+  const int code = test::RunCommand(
+      "xvfb-run -a -s '-screen 0 1600x900x24' " + test::CalibenchExe() + " gui --dataset " +
+          (dir / "data/dataset.json").string() + " --size 1600x900 --quit-after-seconds 6",
+      &output);
+  ASSERT_EQ(code, 0) << output;
+  int frames = -1, quiet = -1;
+  const auto at = output.find("frames drawn: ");
+  ASSERT_NE(at, std::string::npos) << output;
+  ASSERT_EQ(std::sscanf(output.c_str() + at, "frames drawn: %d (%d", &frames, &quiet), 2) << output;
+  EXPECT_GT(frames, 0) << output;  // it did draw while loading
+  EXPECT_EQ(quiet, 0) << output;
 }
 
 }  // namespace

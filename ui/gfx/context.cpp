@@ -98,8 +98,9 @@ std::unique_ptr<WindowContext> WindowContext::Create(int width, int height,
     return nullptr;
   }
   std::unique_ptr<WindowContext> context(new WindowContext(window));
+  context->InstallEventCounters();
   glfwMakeContextCurrent(window);
-  glfwSwapInterval(1);  // vsync: the workbench redraws every frame and need not outrun the screen
+  glfwSwapInterval(1);  // vsync: an animating workbench need not outrun the screen
   if (!LoadGl(GlfwProc, why)) {
     *why = "GLFW window: " + *why;
     return nullptr;
@@ -125,6 +126,33 @@ void WindowContext::MakeCurrent() {
 std::string WindowContext::Description() const { return description_; }
 
 void WindowContext::PollEvents() { glfwPollEvents(); }
+
+void WindowContext::WaitEvents(double timeout_s) {
+  if (timeout_s > 0)
+    glfwWaitEventsTimeout(timeout_s);
+  else
+    glfwPollEvents();
+}
+
+void WindowContext::CountEvent(GLFWwindow* window) {
+  ++static_cast<WindowContext*>(glfwGetWindowUserPointer(window))->events_;
+}
+
+void WindowContext::InstallEventCounters() {
+  glfwSetWindowUserPointer(window_, this);
+  // ImGui's GLFW backend (1.86) polls the pointer position and installs no cursor callback; it
+  // keeps the callbacks below that were set before it and calls them from its own.
+  glfwSetCursorPosCallback(window_, [](GLFWwindow* w, double, double) { CountEvent(w); });
+  glfwSetMouseButtonCallback(window_, [](GLFWwindow* w, int, int, int) { CountEvent(w); });
+  glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double) { CountEvent(w); });
+  glfwSetKeyCallback(window_, [](GLFWwindow* w, int, int, int, int) { CountEvent(w); });
+  glfwSetCharCallback(window_, [](GLFWwindow* w, unsigned int) { CountEvent(w); });
+  glfwSetCursorEnterCallback(window_, [](GLFWwindow* w, int) { CountEvent(w); });
+  glfwSetWindowFocusCallback(window_, [](GLFWwindow* w, int) { CountEvent(w); });
+  glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* w, int, int) { CountEvent(w); });
+  glfwSetWindowRefreshCallback(window_, [](GLFWwindow* w) { CountEvent(w); });
+  glfwSetWindowIconifyCallback(window_, [](GLFWwindow* w, int) { CountEvent(w); });
+}
 
 bool WindowContext::ShouldClose() const { return glfwWindowShouldClose(window_); }
 

@@ -3,6 +3,7 @@
 // per context through gl_api.h, so the same binary draws with any of them.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -43,6 +44,11 @@ class WindowContext : public GlContext {
   // included), tells whether the user asked to close the window, and its framebuffer size
   // (pixels; 0 while minimised).
   void PollEvents();
+  // Sleeps until an event arrives or `timeout_s` passes, then handles the events as PollEvents.
+  void WaitEvents(double timeout_s);
+  // How many input and window events (pointer, buttons, wheel, keys, text, resize, focus,
+  // expose) have arrived: the frame loop draws only when it moves, or while something animates.
+  std::uint64_t EventCount() const { return events_; }
   bool ShouldClose() const;
   void FramebufferSize(int* width, int* height) const;
   // Shows `frame`, drawn offscreen at the framebuffer size: copies it into the back buffer and
@@ -51,7 +57,11 @@ class WindowContext : public GlContext {
 
  private:
   explicit WindowContext(GLFWwindow* window) : window_(window) {}
+  // Counts events; installed before ImGui's backend, which chains to them.
+  void InstallEventCounters();
+  static void CountEvent(GLFWwindow* window);
   GLFWwindow* window_ = nullptr;
+  std::uint64_t events_ = 0;
   std::string description_;
 };
 

@@ -26,22 +26,30 @@ std::uint64_t CameraTargetKey(const CameraShown& shown, const Reprojection* poin
 
 // The visible LiDAR points of the reprojection at the solution, coloured by depth, into `points`.
 void UploadReprojection(const Snapshot& s, const PairView& pair, const CameraShown& shown,
-                        gfx::PointRenderer* points) {
-  std::vector<Eigen::Vector3f> positions;
-  std::vector<gfx::Rgba> colors;
-  const Reprojection& rp = *s.reprojection;
-  const Pose& cam_from_lidar = s.solver.result->cam_from_lidar;
-  for (size_t i = 0; i < rp.points.size(); ++i) {
-    if (!rp.visible.empty() && !rp.visible[i]) continue;
-    std::optional<Vec2> px = rp.points[i].pixel;
-    if (shown.undistorted)
-      px = shown.model->Project(cam_from_lidar *
-                                pair.cloud->points[rp.points[i].index].cast<double>());
-    if (!px) continue;
-    positions.push_back(shown.at.ToNdc(*px));
-    colors.push_back(ToRgba(MapColor(Colormap::kTurbo, rp.points[i].depth_m / 20.0)));
+                        ShownReprojection* shown_points, gfx::PointRenderer* renderer) {
+  ShownReprojection& cache = *shown_points;
+  if (cache.source != s.reprojection || cache.undistorted != shown.undistorted) {
+    cache.source = s.reprojection;
+    cache.undistorted = shown.undistorted;
+    cache.pixels.clear();
+    cache.colors.clear();
+    const Reprojection& rp = *s.reprojection;
+    const Pose& cam_from_lidar = s.solver.result->cam_from_lidar;
+    for (size_t i = 0; i < rp.points.size(); ++i) {
+      if (!rp.visible.empty() && !rp.visible[i]) continue;
+      std::optional<Vec2> px = rp.points[i].pixel;
+      if (shown.undistorted)
+        px = shown.model->Project(cam_from_lidar *
+                                  pair.cloud->points[rp.points[i].index].cast<double>());
+      if (!px) continue;
+      cache.pixels.push_back(*px);
+      cache.colors.push_back(ToRgba(MapColor(Colormap::kTurbo, rp.points[i].depth_m / 20.0)));
+    }
   }
-  points->Upload(positions, colors);
+  std::vector<Eigen::Vector3f> positions;
+  positions.reserve(cache.pixels.size());
+  for (const Vec2& px : cache.pixels) positions.push_back(shown.at.ToNdc(px));
+  renderer->Upload(positions, cache.colors);
 }
 
 // The sheet's outline (edges subdivided: lenses bend them) and the board's axes.
@@ -177,7 +185,7 @@ void Workbench::DrawCameraTarget(const Snapshot& s, const PairView& pair, const 
       shown.at.ToNdc({shown.image->width - 0.5, shown.image->height - 0.5});
   gl_->camera_image.Draw(top_left.x(), bottom_right.y(), bottom_right.x(), top_left.y());
   if (!show_points) return;
-  UploadReprojection(s, pair, shown, &gl_->camera_points);
+  UploadReprojection(s, pair, shown, &gl_->camera_points_shown, &gl_->camera_points);
   gl_->camera_points.Draw(gfx::Matrix4f::Identity(), static_cast<float>(view.point_size_px),
                           static_cast<float>(view.point_opacity));
 }

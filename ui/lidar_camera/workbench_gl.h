@@ -15,12 +15,23 @@
 
 namespace calibench::ui {
 
+// The reprojected points as shown (pixels of the image shown, turbo colours by range), kept for the
+// reprojection and the image mode they were made for: a zoom, a pan or a point style needs only
+// their placement again.
+struct ShownReprojection {
+  std::shared_ptr<const Reprojection> source;
+  bool undistorted = false;
+  std::vector<Vec2> pixels;
+  std::vector<gfx::Rgba> colors;
+};
+
 struct Workbench::Gl {
   gfx::ImageTexture lidar_picture;
   gfx::ImageTexture camera_image;
   const ImageU8* camera_image_source = nullptr;  // what camera_image holds
   gfx::Framebuffer camera_target;
   gfx::PointRenderer camera_points;
+  ShownReprojection camera_points_shown;
   gfx::Framebuffer scene_target;
   gfx::PointRenderer scene_points;
   float scene_floor_z = -1.5f;  // metres, LiDAR frame; from the shown cloud

@@ -21,6 +21,8 @@ class SolverReplay {
 
   // Moves a running replay on by 2 iterations per second; call once a frame.
   void Advance(size_t iterations, double seconds_since_last_frame);
+  // Whether a replay is running (the views change from frame to frame).
+  bool playing() const { return playing_; }
   // The index of the iteration shown: the replayed one, else the last; -1 when there is none.
   int Shown(size_t iterations) const;
   // The estimate the views show: the shown iteration's (IterationReport names it

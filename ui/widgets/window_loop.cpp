@@ -1,6 +1,10 @@
 #include "ui/widgets/window_loop.h"
 
+#include <imgui.h>
+
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 
 #include "ui/gfx/context.h"
 #include "ui/gfx/framebuffer.h"
@@ -21,22 +25,66 @@ Window::Window(const WindowOptions& options, std::unique_ptr<gfx::WindowContext>
 
 Window::~Window() = default;
 
-std::optional<ImageU8> Window::Run(const std::function<void(int, int, double)>& frame) {
+namespace {
+constexpr double kAnimationFrameS = 1.0 / 60;  // frame period while the workbench animates
+constexpr double kIdleWakeS = 1.0;             // wakes to check for close; draws nothing
+constexpr double kTypingFrameS = 0.25;         // redraws a focused text field's cursor
+constexpr int kSettleFrames = 3;  // after input or an animation: hover, popups and layout settle
+constexpr double kQuietS = 1.0;   // FrameStats::quiet_frames: nothing moved for this long
+}  // namespace
+
+std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& frame) {
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
   std::optional<ImageU8> last_picture;
   gfx::Framebuffer target;
-  auto last = std::chrono::steady_clock::now();
-  for (int count = 0; !context_->ShouldClose(); ++count) {
-    context_->PollEvents();
+  const auto start = Clock::now();
+  auto last_draw = start, last_change = start;
+  const bool back_to_back = options_.quit_after_frames > 0;
+  bool animating = true;  // the first frames lay the workbench out
+  int settle = kSettleFrames;
+  std::uint64_t seen_events = context_->EventCount();
+  while (!context_->ShouldClose()) {
+    const bool typing = ImGui::GetIO().WantTextInput;
+    if (back_to_back || settle > 0)
+      context_->PollEvents();
+    else if (animating)
+      context_->WaitEvents(std::max(1e-3, kAnimationFrameS - since(last_draw)));
+    else
+      context_->WaitEvents(typing ? std::max(1e-3, kTypingFrameS - since(last_draw)) : kIdleWakeS);
+    if (options_.quit_after_seconds > 0 && since(start) >= options_.quit_after_seconds) break;
+    if (context_->EventCount() != seen_events) {
+      seen_events = context_->EventCount();
+      settle = kSettleFrames;
+      last_change = Clock::now();
+    }
+    const bool due = back_to_back || settle > 0 ||
+                     (animating && since(last_draw) >= kAnimationFrameS - 1e-3) ||
+                     (typing && since(last_draw) >= kTypingFrameS);
+    if (!due) continue;
     int width = 0, height = 0;
     context_->FramebufferSize(&width, &height);
-    if (width <= 0 || height <= 0) continue;  // minimised
-    const auto now = std::chrono::steady_clock::now();
-    const double seconds = std::chrono::duration<double>(now - last).count();
-    last = now;
-    host_->DrawFrame(target, width, height, seconds, [&] { frame(width, height, seconds); });
-    const bool last_frame =
-        options_.quit_after_frames > 0 && count + 1 >= options_.quit_after_frames;
-    if (last_frame && options_.capture_last_frame) last_picture = target.ReadPixels();
+    if (width <= 0 || height <= 0) {  // minimised: nothing to draw until restored
+      settle = 0;
+      continue;
+    }
+    const double seconds = since(last_draw);
+    last_draw = Clock::now();
+    if (since(last_change) >= kQuietS) ++stats_.quiet_frames;
+    ++stats_.frames;
+    host_->DrawFrame(target, width, height, seconds,
+                     [&] { animating = frame(width, height, seconds); });
+    if (animating) {
+      settle = kSettleFrames;
+      last_change = Clock::now();
+    } else if (settle > 0) {
+      --settle;
+    }
+    const bool last_frame = back_to_back && stats_.frames >= options_.quit_after_frames;
+    if (options_.capture_last_frame && (last_frame || options_.quit_after_seconds > 0))
+      last_picture = target.ReadPixels();
     context_->Present(target);
     if (last_frame) break;
   }

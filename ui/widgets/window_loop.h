@@ -21,8 +21,18 @@ class ImGuiHost;
 struct WindowOptions {
   int width = 1600, height = 900;  // pixels
   std::string title = "Calibench";
-  int quit_after_frames = 0;        // > 0: close after that many frames (tests)
-  bool capture_last_frame = false;  // with quit_after_frames: keep that frame's picture
+  // > 0: close after that many frames, drawn back to back (tests of what a frame shows).
+  int quit_after_frames = 0;
+  bool capture_last_frame = false;  // keep the last drawn frame's picture
+  // > 0: close after this long (seconds), drawing as a user's session does (tests of idling).
+  double quit_after_seconds = 0.0;
+};
+
+// What a window run drew: every frame, and those drawn when nothing had moved for a second (no
+// input, nothing animating), which a window that idles at zero never draws.
+struct FrameStats {
+  int frames = 0;
+  int quiet_frames = 0;
 };
 
 // The window, its GL context (current) and its ImGui host.
@@ -34,14 +44,20 @@ class Window {
   Window(const Window&) = delete;
   Window& operator=(const Window&) = delete;
 
-  // Runs frames until the user closes the window (or quit_after_frames):
-  // frame(width, height, seconds_since_last_frame) issues the ImGui calls of one frame. Returns
-  // the last frame's picture with capture_last_frame, when the run reached it.
-  std::optional<ImageU8> Run(const std::function<void(int, int, double)>& frame);
+  // Runs frames until the user closes the window (or quit_after_frames / quit_after_seconds):
+  // frame(width, height, seconds_since_last_frame) issues the ImGui calls of one frame and says
+  // whether the next one would differ without input (a worker or a replay running). A frame is
+  // drawn only after input (and a few more, for ImGui to settle hover and layout), while the
+  // workbench animates (at most 60 per second), and every quarter second while a text field
+  // takes typing (its cursor blinks); otherwise the loop sleeps in the window system.
+  // Returns the last frame's picture with capture_last_frame.
+  std::optional<ImageU8> Run(const std::function<bool(int, int, double)>& frame);
+  const FrameStats& stats() const { return stats_; }
 
  private:
   Window(const WindowOptions& options, std::unique_ptr<gfx::WindowContext> context);
   WindowOptions options_;
+  FrameStats stats_;
   std::unique_ptr<gfx::WindowContext> context_;
   std::unique_ptr<ImGuiHost> host_;  // destroyed before the context
 };
@@ -51,6 +67,7 @@ struct WindowRun {
   bool opened = false;  // false: no window, see `why`
   std::string why;
   std::optional<ImageU8> last_frame;  // see Window::Run
+  FrameStats stats;
 };
 
 // A workbench (either method's) in a window against its controller, applying the intents its
@@ -64,10 +81,13 @@ WindowRun RunWorkbenchWindow(const WindowOptions& options, Controller& controlle
   run.opened = true;
   Workbench workbench;
   run.last_frame = window->Run([&](int width, int height, double seconds) {
-    for (const auto& intent :
-         workbench.Frame(controller.GetSnapshot(), width, height, layout, seconds))
-      controller.Apply(intent);
+    const auto snapshot = controller.GetSnapshot();
+    const auto intents = workbench.Frame(snapshot, width, height, layout, seconds);
+    for (const auto& intent : intents) controller.Apply(intent);
+    // An applied intent usually queues work: the next frame shows it starting.
+    return !intents.empty() || workbench.Animating(snapshot);
   });
+  run.stats = window->stats();
   return run;
 }
 

@@ -21,6 +21,10 @@ class WorkbenchFrame {
 
   // Call between ImGui::NewFrame() and ImGui::Render(); width/height of the display in pixels;
   // seconds_since_last_frame advances the solver replay.
+  // Whether the next frame will look different without any input: the worker is busy (progress,
+  // results on their way) or a replay runs. The window redraws only then, or on input.
+  bool Animating(const Snapshot& s) const { return s.busy || replay_.playing(); }
+
   std::vector<Intent> Frame(const Snapshot& s, int width, int height, Layout layout,
                             double seconds_since_last_frame) {
     std::vector<Intent> intents;
