@@ -3,11 +3,15 @@
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 
+#include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 
 #include "core/sim/sim.h"
+#include "tests/acfr_manifest.h"
 #include "ui/gfx/context.h"
 #include "ui/gfx/framebuffer.h"
 #include "ui/gfx/gl_api.h"
@@ -123,6 +127,45 @@ BENCHMARK(BM_WorkbenchFrameAfterEdit1600x900)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// Opening the real 40-pair VLP-16 + fisheye set in the workbench: how long until the selected
+// pair is on screen (its cloud, its LiDAR plane and its camera image), and until every pair has
+// loaded behind it.
+void BM_WorkbenchFirstPairReal40(benchmark::State& state) {
+  const char* env = std::getenv("CALIBENCH_SHARED_DIR");
+  const std::filesystem::path shared = env ? env : CALIBENCH_SHARED_DIR_DEFAULT;
+  const auto dir = shared / "datasets/acfr-vlp16-chessboard";
+  if (!std::filesystem::exists(dir)) {
+    state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
+    return;
+  }
+  const auto work = std::filesystem::temp_directory_path() / "calibench_bench" / "first_pair";
+  std::filesystem::create_directories(work);
+  const auto manifest = test::WriteAcfrManifest(dir, work);
+  double first_s = 0, all_s = 0;
+  for (auto _ : state) {
+    std::filesystem::remove(work / "first_pair.session.json");
+    const auto start = std::chrono::steady_clock::now();
+    ui::Controller controller;
+    controller.OpenDataset(manifest, work / "first_pair.session.json");
+    auto since = [&] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    while (true) {
+      const ui::Snapshot s = controller.GetSnapshot();
+      if (s.selected >= 0 && s.pairs[s.selected].cloud && s.pairs[s.selected].lidar &&
+          s.selected_image)
+        break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    first_s = since();
+    controller.WaitIdle();
+    all_s = since();
+  }
+  state.counters["first_pair_s"] = first_s;
+  state.counters["all_pairs_s"] = all_s;
+}
+BENCHMARK(BM_WorkbenchFirstPairReal40)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 void BM_Session40PairsMemory(benchmark::State& state) {
   const auto manifest = SimulatedDemo(40);

@@ -93,9 +93,18 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
                   dataset.manifest.string(),
               false);
   }
+  // The selected pair and its image first, so that it is on screen while the others load.
+  int first = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    first = std::max(0, state_.selected);
+  }
+  if (!dataset.pairs.empty()) {
+    worker_.Enqueue([this, first] { LoadPair(first); });
+    worker_.Enqueue([this] { EnsureSelectedImage(); });
+  }
   for (int i = 0; i < static_cast<int>(dataset.pairs.size()); ++i)
-    worker_.Enqueue([this, i] { LoadPair(i); });
-  worker_.Enqueue([this] { EnsureSelectedImage(); });
+    if (i != first) worker_.Enqueue([this, i] { LoadPair(i); });
 }
 
 void Controller::ApplySessionToState(const Session& session) {
@@ -222,30 +231,38 @@ void Controller::LoadPair(int index) {
   } else {
     loaded.camera_failure = why;
   }
-  std::lock_guard<std::mutex> lock(mutex_);
-  PairView& pair = state_.pairs[index];
-  // Loading is the pair's first job after Open: besides its header nothing was derived yet.
-  static_cast<PairHeader&>(loaded) = pair;
-  loaded.loaded = true;
-  pair = std::move(loaded);
-  ++state_.loading_done;
-  ++state_.generation;
-  // Detection waits for every cloud: the background model over them keeps static board-sized
-  // panels out (as CalibrateDataset does).
-  const bool detects = !pair.brush_from_seed && !painted;
-  if (pair.cloud && !detects) worker_.Enqueue([this, index] { RefitLidar(index); });
-  if (pair.cloud && detects) pair.lidar_failure = "finding the board once every pair is loaded ...";
-  if (!pair.cloud) {
-    pair.status = PairStatus::kFailed;
-    pair.reason = pair.camera_failure;
+  bool refit_now = false;  // the selected pair's plane comes before the other pairs load
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    PairView& pair = state_.pairs[index];
+    // Loading is the pair's first job after Open: besides its header nothing was derived yet.
+    static_cast<PairHeader&>(loaded) = pair;
+    loaded.loaded = true;
+    pair = std::move(loaded);
+    ++state_.loading_done;
+    ++state_.generation;
+    // Detection waits for every cloud: the background model over them keeps static board-sized
+    // panels out (as CalibrateDataset does).
+    const bool detects = !pair.brush_from_seed && !painted;
+    refit_now = pair.cloud && !detects && index == state_.selected &&
+                state_.loading_done < state_.loading_total;
+    if (pair.cloud && !detects && !refit_now) worker_.Enqueue([this, index] { RefitLidar(index); });
+    if (pair.cloud && detects)
+      pair.lidar_failure = "finding the board once every pair is loaded ...";
+    if (!pair.cloud) {
+      pair.status = PairStatus::kFailed;
+      pair.reason = pair.camera_failure;
+    }
+    if (state_.loading_done == state_.loading_total) {
+      worker_.Enqueue([this] { DetectWithBackground(); });
+      SetStatus("loaded " + std::to_string(state_.loading_total) + " pairs", false);
+      // A reopened session with a result shows its reprojection again.
+      const int selected = state_.selected;
+      if (state_.solver.result)
+        worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
+    }
   }
-  if (state_.loading_done == state_.loading_total) {
-    worker_.Enqueue([this] { DetectWithBackground(); });
-    SetStatus("loaded " + std::to_string(state_.loading_total) + " pairs", false);
-    // A reopened session with a result shows its reprojection again.
-    const int selected = state_.selected;
-    if (state_.solver.result) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
-  }
+  if (refit_now) RefitLidar(index);
 }
 
 void Controller::DetectWithBackground() {
