@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 
 #include "core/geometry/geometry.h"
 #include "tests/acfr_manifest.h"
@@ -27,6 +29,11 @@ std::filesystem::path TempDir(const std::string& name) {
 std::string CalibenchExe() {
   const char* env = std::getenv("CALIBENCH_EXE");
   return env ? env : (std::string(CALIBENCH_BINARY_DIR) + "/calibench");
+}
+
+std::string ReadFileBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 int RunCommand(const std::string& command, std::string* output) {

@@ -23,6 +23,9 @@ std::filesystem::path TempDir(const std::string& name);
 // The calibench executable built next to the tests (from $CALIBENCH_EXE).
 std::string CalibenchExe();
 
+// The whole file as bytes (empty when it cannot be read).
+std::string ReadFileBytes(const std::filesystem::path& path);
+
 // Runs a shell command, returns its exit code; stdout+stderr go to *output when given.
 int RunCommand(const std::string& command, std::string* output = nullptr);
 

@@ -135,9 +135,9 @@ std::vector<cv::Mat> SearchPyramid(const cv::Mat& grey) {
 // pixels (pyrDown samples the even pixels, so x_full = 2^level * x_level). The exhaustive,
 // upsampled search finds more boards (small, tilted squares) but takes about four times longer
 // than the fast one at full resolution; it runs last, and only there.
-bool FindCheckerboard(const cv::Mat& grey, const cv::Size& pattern,
+bool FindCheckerboard(const cv::Mat& grey, const cv::Size& pattern, bool pyramid,
                       std::vector<cv::Point2f>* corners) {
-  const std::vector<cv::Mat> levels = SearchPyramid(grey);
+  const std::vector<cv::Mat> levels = pyramid ? SearchPyramid(grey) : std::vector<cv::Mat>{grey};
   for (int level = static_cast<int>(levels.size()) - 1; level >= 0; --level) {
     if (!cv::findChessboardCornersSB(levels[level], pattern, *corners,
                                      cv::CALIB_CB_NORMALIZE_IMAGE))
@@ -157,7 +157,7 @@ std::optional<BoardDetection> DetectCheckerboard(const cv::Mat& grey, const Boar
   const cv::Size pattern(board.cols, board.rows);
   std::vector<cv::Point2f> corners;
   // cornerSubPix below converges to the same point from any level's start.
-  const bool found = FindCheckerboard(grey, pattern, &corners);
+  const bool found = FindCheckerboard(grey, pattern, options.pyramid_search, &corners);
   if (!found || static_cast<int>(corners.size()) != board.cols * board.rows) {
     *why = "chessboard " + name + " not found";
     return std::nullopt;

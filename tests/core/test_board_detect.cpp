@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/geometry/geometry.h"
+#include "core/io/image_io.h"
 #include "core/sim/sim.h"
 #include "core/target/board_camera.h"
 #include "tests/core/board_test_scenes.h"
@@ -289,6 +290,37 @@ TEST(BoardDetect, RenderedCharucoOffsetIsMeasuredAndCorrected) {
   // OpenCV 4.6's offset (issue 25539). If this fails, OpenCV changed: re-measure the correction.
   EXPECT_NEAR(raw_all.Mean().x(), 0.5, 0.06);
   EXPECT_NEAR(raw_all.Mean().y(), 0.5, 0.06);
+}
+
+// Real 1920 x 1208 fisheye images: the board found on a reduced pyramid level and refined at full
+// resolution gives the corners the full-resolution search gives.
+TEST(BoardDetect, PyramidSearchGivesTheFullResolutionCornersOnRealImages) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  BoardSpec board;
+  board.cols = 5;
+  board.rows = 7;
+  board.square_size = 0.095;
+  BoardDetectionOptions full_resolution;
+  full_resolution.pyramid_search = false;
+  double worst_px = 0.0;
+  int compared = 0;
+  for (int pose : {1, 8, 16, 24, 33, 40}) {
+    const std::string name = "pose" + std::to_string(pose) + ".png";
+    const ImageU8 image = LoadImage(shared / "datasets/acfr-vlp16-chessboard/images" / name);
+    std::string why;
+    const auto reduced = DetectBoard(image, board, BoardDetectionOptions{}, &why);
+    ASSERT_TRUE(reduced) << name << ": " << why;
+    const auto full = DetectBoard(image, board, full_resolution, &why);
+    if (!full) continue;  // the full-resolution fast search misses a board the pyramid finds
+    ASSERT_EQ(full->ids, reduced->ids) << name;
+    for (size_t i = 0; i < full->pixels.size(); ++i)
+      worst_px = std::max(worst_px, (full->pixels[i] - reduced->pixels[i]).norm());
+    ++compared;
+  }
+  std::printf("[ pyramid ] %d real images, largest corner difference %.5f px\n", compared,
+              worst_px);
+  EXPECT_GE(compared, 5);
+  EXPECT_LT(worst_px, 0.01);
 }
 
 TEST(BoardDetect, DetectionFailsWithAReason) {

@@ -51,11 +51,6 @@ void WriteFile(const fs::path& path, const std::string& bytes) {
   out << bytes;
 }
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 template <typename T>
 void Append(std::string* out, T value, bool big_endian = false) {
   char bytes[sizeof(T)];
@@ -106,7 +101,7 @@ TEST(CloudIo, PcdRoundTripOptionalChannels) {
 TEST(CloudIo, PcdWritesRingAsU2) {
   const fs::path path = test::TempDir("cloud_io_ring_u2") / "cloud.pcd";
   SavePcd(path, RandomCloud(5, true, true, false, 2), PcdEncoding::kAscii);
-  const std::string text = ReadFile(path);
+  const std::string text = test::ReadFileBytes(path);
   EXPECT_NE(text.find("FIELDS x y z intensity ring\nSIZE 4 4 4 4 2\nTYPE F F F F U\n"),
             std::string::npos)
       << text;
@@ -275,7 +270,7 @@ TEST(CloudIo, BadInputsNameTheFileAndTheProblem) {
 
   // Truncated binary data.
   SavePcd(dir / "truncated.pcd", RandomCloud(100, true, false, false, 5), PcdEncoding::kBinary);
-  std::string bytes = ReadFile(dir / "truncated.pcd");
+  std::string bytes = test::ReadFileBytes(dir / "truncated.pcd");
   WriteFile(dir / "truncated.pcd", bytes.substr(0, bytes.size() - 10));
   ExpectLoadError(dir / "truncated.pcd", "expected 1600 bytes of point data, file has 1590");
 
@@ -303,7 +298,7 @@ TEST(CloudIo, BadInputsNameTheFileAndTheProblem) {
   // Corrupt compressed data.
   SavePcd(dir / "lzf.pcd", RandomCloud(100, false, false, false, 6),
           PcdEncoding::kBinaryCompressed);
-  bytes = ReadFile(dir / "lzf.pcd");
+  bytes = test::ReadFileBytes(dir / "lzf.pcd");
   const size_t data = bytes.find("DATA binary_compressed\n") + 23 + 8;
   for (size_t i = data; i < bytes.size(); ++i) bytes[i] = static_cast<char>(0xff);
   WriteFile(dir / "lzf.pcd", bytes);

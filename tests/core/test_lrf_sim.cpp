@@ -23,11 +23,6 @@ LrfSimOptions SmallOptions(const std::string& preset) {
   return options;
 }
 
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 TEST(ThreeFaceTarget, FacePlanesContainTheirCornersAndFaceTheSensors) {
   const ThreeFaceTarget target;
   std::string why;
@@ -201,7 +196,7 @@ TEST(LrfSim, WrittenDatasetIsDeterministicAndLoads) {
     if (!entry.is_regular_file()) continue;
     ++files;
     const fs::path other = dir_b / entry.path().lexically_relative(dir_a);
-    EXPECT_EQ(ReadBytes(entry.path()), ReadBytes(other)) << entry.path();
+    EXPECT_EQ(test::ReadFileBytes(entry.path()), test::ReadFileBytes(other)) << entry.path();
   }
   EXPECT_EQ(files, 2 + 3 * 3);  // two manifests, scans, depth, depth_right
   const LrfDataset dataset = LoadLrfDataset(manifest);
@@ -216,7 +211,8 @@ TEST(LrfSim, WrittenDatasetIsDeterministicAndLoads) {
   options.seed = 9;
   const fs::path dir_c = TempDir("lrf_sim_c");
   WriteLrfSimDataset(options, dir_c);
-  EXPECT_NE(ReadBytes(dir_a / "scans/0000.json"), ReadBytes(dir_c / "scans/0000.json"));
+  EXPECT_NE(test::ReadFileBytes(dir_a / "scans/0000.json"),
+            test::ReadFileBytes(dir_c / "scans/0000.json"));
 }
 
 TEST(LrfSim, StereoGroundTruthAndRightDepthAgreeWithTheLeft) {

@@ -18,13 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 void WriteBytes(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
 }
@@ -114,7 +107,7 @@ void ExpectRejected(const fs::path& dir, const std::string& text, const std::str
     EXPECT_NE(message.find(path.string()), std::string::npos) << message;
     EXPECT_NE(message.find(problem), std::string::npos) << message;
   }
-  EXPECT_EQ(ReadBytes(path), text);
+  EXPECT_EQ(test::ReadFileBytes(path), text);
   EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
 }
 
@@ -322,7 +315,7 @@ TEST(SessionTest, SaveIsAtomicAndReplacesAnExistingFile) {
   s.pairs[0].reason = "blurred";
   SaveSession(path, s);
   EXPECT_EQ(LoadSession(path), s);
-  EXPECT_EQ(ReadBytes(path), SessionToJson(s, path));
+  EXPECT_EQ(test::ReadFileBytes(path), SessionToJson(s, path));
   EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
   int files = 0;
   for (const auto& entry : fs::directory_iterator(dir)) files += entry.is_regular_file();

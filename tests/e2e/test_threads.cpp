@@ -16,13 +16,6 @@ namespace calibench {
 namespace {
 namespace fs = std::filesystem;
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
 TEST(Threads, CalibrateWritesTheSameBytesOnOneThreadAndOnSeveral) {
   const fs::path dir = test::TempDir("threads_calibrate_" + std::to_string(getpid()));
   SimOptions sim = SimPreset("default");
@@ -47,7 +40,7 @@ TEST(Threads, CalibrateWritesTheSameBytesOnOneThreadAndOnSeveral) {
                          &log),
         0)
         << log;
-    results[k] = ReadFile(out);
+    results[k] = test::ReadFileBytes(out);
     ASSERT_FALSE(results[k].empty());
   }
   EXPECT_EQ(results[0], results[1]) << "--threads 1 and --threads 3 differ";

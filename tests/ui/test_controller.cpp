@@ -10,11 +10,6 @@
 namespace calibench::ui {
 namespace {
 
-Snapshot Loaded(Controller& controller) {
-  controller.WaitIdle();
-  return controller.GetSnapshot();
-}
-
 TEST(Controller, LoadsEveryPairAndExtractsBothPlanes) {
   Controller controller;
   controller.OpenDataset(test::UiDataset(), test::TempDir("controller_load") / "s.json");

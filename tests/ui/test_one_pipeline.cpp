@@ -18,18 +18,6 @@
 namespace calibench::ui {
 namespace {
 
-Snapshot Loaded(Controller& controller) {
-  controller.WaitIdle();
-  return controller.GetSnapshot();
-}
-
-std::string ReadText(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // Bit for bit: the same doubles, not merely close ones.
 template <typename A, typename B>
 void ExpectIdentical(const A& a, const B& b, const char* what) {
@@ -96,7 +84,7 @@ TEST(OnePipeline, WorkbenchAndCalibrateAgreeBitForBit) {
   controller.WaitIdle();
   const auto written = dir / "calibrated.json";
   WriteResult(written, cli, options.solver);
-  EXPECT_EQ(ReadText(exported), ReadText(written));
+  EXPECT_EQ(test::ReadFileBytes(exported), test::ReadFileBytes(written));
 }
 
 TEST(OnePipeline, CalibrateWithTheSessionFlagMatchesTheWorkbench) {

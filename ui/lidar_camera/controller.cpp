@@ -210,6 +210,11 @@ void Controller::LoadPair(int index) {
   PairView loaded;
   std::string why;
   auto inputs = LoadPairInputs(dataset, entry, &why);
+  bool selected = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    selected = index == state_.selected;
+  }
   if (inputs) {
     auto cloud = std::make_shared<LidarCloud>(std::move(inputs->cloud));
     auto lidar_image = std::make_shared<LidarImage>(ProjectById(*cloud, LidarImageOptions{}));
@@ -228,6 +233,9 @@ void Controller::LoadPair(int index) {
     }
     loaded.cloud = cloud;
     loaded.lidar_image = lidar_image;
+    // The camera view shows the selected pair's image: decoded once, here.
+    if (selected)
+      KeepDecodedImage(entry.image, std::make_shared<const ImageU8>(std::move(inputs->image)));
   } else {
     loaded.camera_failure = why;
   }

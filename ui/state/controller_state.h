@@ -74,6 +74,7 @@ class ControllerState {
       *path = state_.dataset->pairs[state_.selected].image;
     }
     if (path->empty()) return nullptr;
+    if (decoded_image_ && decoded_image_path_ == *path) return std::move(decoded_image_);
     try {
       return std::make_shared<const ImageU8>(LoadImage(*path));
     } catch (const IoError& e) {
@@ -81,6 +82,12 @@ class ControllerState {
       SetStatus(e.what(), true);
       return nullptr;
     }
+  }
+  // An image a job has just decoded (worker thread): the next LoadSelectedImageFile of that path
+  // takes it instead of decoding the file again.
+  void KeepDecodedImage(const std::filesystem::path& path, std::shared_ptr<const ImageU8> image) {
+    decoded_image_path_ = path;
+    decoded_image_ = std::move(image);
   }
   // True while `path` is still the selected pair's image (a newer selection drops the old
   // image); call with mutex_ held.
@@ -93,6 +100,10 @@ class ControllerState {
   mutable std::mutex mutex_;
   Snapshot state_;
   WorkQueue worker_;
+
+ private:
+  std::filesystem::path decoded_image_path_;  // worker thread only
+  std::shared_ptr<const ImageU8> decoded_image_;
 };
 
 }  // namespace calibench::ui
