@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 
+#include "core/base/allocator.h"
 #include "core/sim/sim.h"
 #include "tests/acfr_manifest.h"
 #include "ui/gfx/context.h"
@@ -168,6 +169,7 @@ void BM_WorkbenchFirstPairReal40(benchmark::State& state) {
 BENCHMARK(BM_WorkbenchFirstPairReal40)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 void BM_Session40PairsMemory(benchmark::State& state) {
+  ReleaseFreedMemory();  // what earlier benchmarks left
   const auto manifest = SimulatedDemo(40);
   for (auto _ : state) {
     const long before = ResidentKb();

@@ -1,5 +1,7 @@
 #include "ui/lidar_camera/controller.h"
 
+#include "core/base/allocator.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -298,6 +300,8 @@ void Controller::DetectWithBackground() {
     }
   }
   for (int index : detect) RefitLidar(index);
+  // Loading is over: what its transient buffers took goes back (core/base/allocator.h).
+  ReleaseFreedMemory();
 }
 
 void Controller::RefitLidar(int index) {
