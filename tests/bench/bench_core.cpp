@@ -136,27 +136,23 @@ BENCHMARK(BM_LidarBoardDetection)->DenseRange(0, 2)->Unit(benchmark::kMillisecon
 
 // Reading one real VLP-16 cloud (ASCII PCD, 0.9 MB, 24k points) and one real 1920 x 1208 PNG
 // (1.4 MB): the per-pair file cost, in bytes of file per second.
-void BM_LoadAsciiPcdReal(benchmark::State& state) {
+template <typename Load>
+void LoadRealFile(benchmark::State& state, const char* relative_path, Load load) {
   const auto dir = AcfrDir();
   if (!dir) {
     state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
     return;
   }
-  const fs::path path = *dir / "pcd/pose20_full.pcd";
-  for (auto _ : state) benchmark::DoNotOptimize(LoadCloud(path));
+  const fs::path path = *dir / relative_path;
+  for (auto _ : state) benchmark::DoNotOptimize(load(path));
   state.SetBytesProcessed(state.iterations() * static_cast<int64_t>(fs::file_size(path)));
 }
+void BM_LoadAsciiPcdReal(benchmark::State& state) {
+  LoadRealFile(state, "pcd/pose20_full.pcd", [](const fs::path& p) { return LoadCloud(p); });
+}
 BENCHMARK(BM_LoadAsciiPcdReal)->Unit(benchmark::kMillisecond);
-
 void BM_LoadPngReal1920x1208(benchmark::State& state) {
-  const auto dir = AcfrDir();
-  if (!dir) {
-    state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
-    return;
-  }
-  const fs::path path = *dir / "images/pose20.png";
-  for (auto _ : state) benchmark::DoNotOptimize(LoadImage(path));
-  state.SetBytesProcessed(state.iterations() * static_cast<int64_t>(fs::file_size(path)));
+  LoadRealFile(state, "images/pose20.png", [](const fs::path& p) { return LoadImage(p); });
 }
 BENCHMARK(BM_LoadPngReal1920x1208)->Unit(benchmark::kMillisecond);
 

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <thread>
 
@@ -49,19 +50,28 @@ std::filesystem::path SimulatedDemo(int pairs) {
   return dir / "dataset.json";
 }
 
-void BM_WorkbenchFrame1600x900(benchmark::State& state) {
+// A headless GL context (nullptr after marking the benchmark skipped) and the 3-pair demo opened
+// and solved in `controller`, so that the camera view shows the reprojection with hidden-point
+// removal.
+std::unique_ptr<gfx::GlContext> SolvedDemo(benchmark::State& state, ui::Controller* controller,
+                                           const char* session_name) {
   std::string why;
   auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &why);
   if (!context) {
     state.SkipWithError(why.c_str());
-    return;
+    return nullptr;
   }
+  controller->OpenDataset(SimulatedDemo(3), std::filesystem::temp_directory_path() / session_name);
+  controller->WaitIdle();
+  controller->Apply(ui::RunSolver{});
+  controller->WaitIdle();
+  return context;
+}
+
+void BM_WorkbenchFrame1600x900(benchmark::State& state) {
   ui::Controller controller;
-  controller.OpenDataset(SimulatedDemo(3),
-                         std::filesystem::temp_directory_path() / "bench_ui.json");
-  controller.WaitIdle();
-  controller.Apply(ui::RunSolver{});  // reprojection with hidden-point removal in the camera view
-  controller.WaitIdle();
+  const auto context = SolvedDemo(state, &controller, "bench_ui.json");
+  if (!context) return;
   ui::ImGuiHost host(nullptr);
   ui::Workbench workbench;
   const ui::Snapshot snapshot = controller.GetSnapshot();
@@ -80,18 +90,9 @@ BENCHMARK(BM_WorkbenchFrame1600x900)->Unit(benchmark::kMillisecond)->UseRealTime
 // /1 the reprojected points' opacity changed (a slider: the camera view redraws), /2 a pair
 // rejected (the list changes; no view redraws).
 void BM_WorkbenchFrameAfterEdit1600x900(benchmark::State& state) {
-  std::string why;
-  auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &why);
-  if (!context) {
-    state.SkipWithError(why.c_str());
-    return;
-  }
   ui::Controller controller;
-  controller.OpenDataset(SimulatedDemo(3),
-                         std::filesystem::temp_directory_path() / "bench_ui_edit.json");
-  controller.WaitIdle();
-  controller.Apply(ui::RunSolver{});
-  controller.WaitIdle();
+  const auto context = SolvedDemo(state, &controller, "bench_ui_edit.json");
+  if (!context) return;
   ui::ImGuiHost host(nullptr);
   ui::Workbench workbench;
   ui::RenderWorkbenchHeadless(controller, workbench, host, ui::Layout::kWorkbench, 1600, 900, 3);

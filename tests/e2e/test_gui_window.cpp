@@ -24,18 +24,28 @@ double Texture(const ImageU8& image, int x0, int y0, int x1, int y1) {
   return count ? sum / count : 0;
 }
 
-TEST(GuiWindow, OpensUnderXvfbAndShowsTheThreeViews) {
-  std::string output;
-  if (test::RunCommand("command -v xvfb-run", &output) != 0) {
-    if (std::getenv("CALIBENCH_REQUIRE_SHARED")) FAIL() << "xvfb-run is not installed";
-    GTEST_SKIP() << "xvfb-run is not installed (apt-get install xvfb xauth)";
+// xvfb-run (skipped without it, unless CI requires everything) and a 3-pair demo in `dir_`.
+class GuiWindow : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string output;
+    if (test::RunCommand("command -v xvfb-run", &output) != 0) {
+      if (std::getenv("CALIBENCH_REQUIRE_SHARED")) FAIL() << "xvfb-run is not installed";
+      GTEST_SKIP() << "xvfb-run is not installed (apt-get install xvfb xauth)";
+    }
+    dir_ = test::TempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " simulate --preset demo --pairs 3 --out " +
+                                   (dir_ / "data").string(),
+                               &output),
+              0)
+        << output;
   }
-  const auto dir = test::TempDir("gui_window");
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " simulate --preset demo --pairs 3 --out " +
-                                 (dir / "data").string(),
-                             &output),
-            0)
-      << output;
+  std::filesystem::path dir_;
+};
+
+TEST_F(GuiWindow, OpensUnderXvfbAndShowsTheThreeViews) {
+  const auto& dir = dir_;
+  std::string output;
   const auto shot = dir / "window.png";
   const int code = test::RunCommand(
       "xvfb-run -a -s '-screen 0 1600x900x24' " + test::CalibenchExe() + " gui --dataset " +
@@ -62,18 +72,9 @@ TEST(GuiWindow, OpensUnderXvfbAndShowsTheThreeViews) {
 // Left alone, the window draws nothing: after the pairs load it sleeps in the window system
 // until input or work arrives (a loop that redraws continuously draws hundreds of frames a
 // second under Xvfb, all of them "quiet").
-TEST(GuiWindow, IdleWindowDrawsNoFrames) {
+TEST_F(GuiWindow, IdleWindowDrawsNoFrames) {
+  const auto& dir = dir_;
   std::string output;
-  if (test::RunCommand("command -v xvfb-run", &output) != 0) {
-    if (std::getenv("CALIBENCH_REQUIRE_SHARED")) FAIL() << "xvfb-run is not installed";
-    GTEST_SKIP() << "xvfb-run is not installed (apt-get install xvfb xauth)";
-  }
-  const auto dir = test::TempDir("gui_window_idle");
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " simulate --preset demo --pairs 3 --out " +
-                                 (dir / "data").string(),
-                             &output),
-            0)
-      << output;
   const int code = test::RunCommand(
       "xvfb-run -a -s '-screen 0 1600x900x24' " + test::CalibenchExe() + " gui --dataset " +
           (dir / "data/dataset.json").string() + " --size 1600x900 --quit-after-seconds 6",
