@@ -68,7 +68,10 @@ int RunLrfCalibrate(int argc, char** argv) {
                  "Huber threshold on the point-to-plane distance [m]")
       ->capture_default_str();
   app.add_option("--pairs", pairs_text, "comma-separated pair ids (default: all)");
-  app.add_option("--threads", options.threads, "feature extraction workers")->capture_default_str();
+  app.add_option(
+         "--threads", options.threads,
+         "workers (default: this machine's hardware threads; the result does not depend on it)")
+      ->capture_default_str();
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
   const auto parsed = ParseLrfMethod(method);
   if (!parsed) {
@@ -226,7 +229,9 @@ int RunSweepLrf(int argc, char** argv) {
   app.add_option("--sizes", sizes_text, "numbers of observations")->capture_default_str();
   app.add_option("--seeds", options.seeds, "independent simulations per size")
       ->capture_default_str();
-  app.add_option("--threads", options.pipeline.threads, "workers (seeds run in parallel)")
+  app.add_option("--threads", options.pipeline.threads,
+                 "workers, one seed each (default: this machine's hardware threads; the table does "
+                 "not depend on it)")
       ->capture_default_str();
   app.add_option("--preset", preset, "paper | ideal")->capture_default_str();
   app.add_option("--table", table_path, "also write the markdown table here");

@@ -36,7 +36,10 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
                    "cam_from_lidar to start from: a result.json, or 16 comma-separated numbers "
                    "(row-major 4x4); default: closed form from the planes");
   }
-  app.add_option("--threads", o.threads, "feature extraction threads")->capture_default_str();
+  app.add_option(
+         "--threads", o.threads,
+         "workers (default: this machine's hardware threads; the result does not depend on it)")
+      ->capture_default_str();
   app.add_option("--ransac-threshold", o.lidar_plane.ransac_threshold_m,
                  "LiDAR plane RANSAC inlier distance [m]")
       ->capture_default_str();
