@@ -177,7 +177,9 @@ TEST(LidarBoardDetect, IgnoresAStaticBoardSizedPanelThanksToTheBackground) {
   // Without the background, the poster is a rival: never chosen silently over the board.
   const LidarBoardDetection alone =
       DetectLidarBoard(clouds[0], BoardPreset("a3"), LidarBoardDetectionOptions{});
-  if (alone.board) EXPECT_TRUE(IsTheBoard(alone, boards[0]));
+  if (alone.board) {
+    EXPECT_TRUE(IsTheBoard(alone, boards[0]));
+  }
 }
 
 TEST(LidarBoardDetect, ADoorAndAPosterFlatOnTheWallAreNotTheBoard) {

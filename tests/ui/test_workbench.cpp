@@ -266,7 +266,9 @@ TEST_F(WorkbenchRender, TheLidarChannelShownIsTheOneChosen) {
     choose(channel);
     const ImageU8 shown = render();
     EXPECT_EQ(shown.data, fresh().data) << LidarChannelName(channel);
-    if (channel != LidarChannel::kIntensity) EXPECT_NE(shown.data, intensity.data);
+    if (channel != LidarChannel::kIntensity) {
+      EXPECT_NE(shown.data, intensity.data);
+    }
   }
 }
 
