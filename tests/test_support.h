@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/base/types.h"
 #include "core/sim/sim.h"
@@ -25,6 +26,9 @@ std::string CalibenchExe();
 
 // The whole file as bytes (empty when it cannot be read).
 std::string ReadFileBytes(const std::filesystem::path& path);
+
+// Temporary files (WriteFileAtomically's "<name>.tmp.*") left beside `path`.
+std::vector<std::filesystem::path> TemporariesBeside(const std::filesystem::path& path);
 
 // Runs a shell command, returns its exit code; stdout+stderr go to *output when given.
 int RunCommand(const std::string& command, std::string* output = nullptr);

@@ -80,15 +80,26 @@ void Fail(const std::filesystem::path& path, const std::string& problem) {
 }
 
 std::string ReadWholeFile(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) Fail(path, "file does not exist");
-  if (std::filesystem::is_directory(path, ec)) Fail(path, "is a directory, not a cloud file");
+  const fs::file_status status = fs::status(path, ec);  // follows symbolic links
+  if (status.type() == fs::file_type::not_found) Fail(path, "file does not exist");
+  if (ec) Fail(path, "cannot read: " + ec.message());  // e.g. a loop of symbolic links
+  if (fs::is_directory(status)) Fail(path, "is a directory, not a cloud file");
+  // A FIFO would block forever and a device like /dev/zero would never end.
+  if (!fs::is_regular_file(status))
+    Fail(path, "is not a regular file (a FIFO or a device?); clouds are read from files");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) Fail(path, "cannot read its size: " + ec.message());
   std::ifstream in(path, std::ios::binary);
   if (!in) Fail(path, std::string("cannot open for reading: ") + std::strerror(errno));
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) Fail(path, "read error");
-  return std::move(buffer).str();
+  // Read straight into the string that the parsers read: no stream buffer in between.
+  std::string bytes(static_cast<size_t>(size), '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(size));
+  if (static_cast<std::uintmax_t>(in.gcount()) != size)
+    Fail(path, "read error (" + std::to_string(in.gcount()) + " of " + std::to_string(size) +
+                   " bytes; did the file change while it was read?)");
+  return bytes;
 }
 
 bool ParseDouble(std::string_view token, double* value) {

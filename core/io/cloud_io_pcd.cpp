@@ -270,6 +270,11 @@ void ReadAscii(const std::filesystem::path& path, const std::string& bytes, cons
   if (rows < header.points)
     Fail(path, "expected " + std::to_string(header.points) + " points of ascii data, file has " +
                    std::to_string(rows) + " rows");
+  // Rows beyond POINTS mean a header that does not describe its data: refuse rather than drop.
+  for (const char* rest = cursor; rest < end; ++rest)
+    if (!is_space(*rest) && *rest != '\n')
+      Fail(path, "more ascii rows than POINTS " + std::to_string(header.points) +
+                     " declares (from line " + std::to_string(line_number + 1) + " on)");
 }
 
 void ReadCompressed(const std::filesystem::path& path, const std::string& bytes,
@@ -284,7 +289,7 @@ void ReadCompressed(const std::filesystem::path& path, const std::string& bytes,
   if (uncompressed != expected)
     Fail(path, "binary_compressed block holds " + std::to_string(uncompressed) +
                    " bytes, but POINTS x point size = " + std::to_string(expected));
-  if (available - 8 < compressed)
+  if (available - 8 != compressed)
     Fail(path, "expected " + std::to_string(compressed) +
                    " bytes of compressed point data, file has " + std::to_string(available - 8));
   std::vector<char> raw(expected);
@@ -312,9 +317,9 @@ LidarCloud LoadPcd(const std::filesystem::path& path) {
     case PcdData::kBinary: {
       const size_t expected = header.points * header.point_size;
       const size_t available = bytes.size() - header.data_start;
-      if (available < expected)
-        Fail(path, "expected " + std::to_string(expected) + " bytes of point data, file has " +
-                       std::to_string(available));
+      if (available != expected)
+        Fail(path, "expected " + std::to_string(expected) + " bytes of point data (POINTS x " +
+                       "point size), file has " + std::to_string(available));
       ReadRecords(header, bytes.data() + header.data_start, /*field_major=*/false, &builder);
       break;
     }

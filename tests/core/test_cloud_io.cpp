@@ -2,6 +2,7 @@
 // types and layouts, real files from ../shared, and bad inputs that must raise IoError naming
 // the file.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cmath>
@@ -272,7 +273,8 @@ TEST(CloudIo, BadInputsNameTheFileAndTheProblem) {
   SavePcd(dir / "truncated.pcd", RandomCloud(100, true, false, false, 5), PcdEncoding::kBinary);
   std::string bytes = test::ReadFileBytes(dir / "truncated.pcd");
   WriteFile(dir / "truncated.pcd", bytes.substr(0, bytes.size() - 10));
-  ExpectLoadError(dir / "truncated.pcd", "expected 1600 bytes of point data, file has 1590");
+  ExpectLoadError(dir / "truncated.pcd",
+                  "expected 1600 bytes of point data (POINTS x point size), file has 1590");
 
   // Truncated ascii: a missing row, and a row cut in the middle.
   WriteFile(dir / "rows.pcd", kPcdHeaderXyz + "1 2 3\n4 5 6\n");
@@ -281,6 +283,27 @@ TEST(CloudIo, BadInputsNameTheFileAndTheProblem) {
   ExpectLoadError(dir / "cut.pcd", "line 12 has 2 values, expected 3");
   WriteFile(dir / "word.pcd", kPcdHeaderXyz + "1 2 3\n4 five 6\n7 8 9\n");
   ExpectLoadError(dir / "word.pcd", "cannot parse 'five'");
+
+  // Data beyond what the header declares: a header that does not describe its file.
+  WriteFile(dir / "extra.pcd", kPcdHeaderXyz + "1 2 3\n4 5 6\n7 8 9\n10 11 12\n\n");
+  ExpectLoadError(dir / "extra.pcd", "more ascii rows than POINTS 3 declares");
+  WriteFile(dir / "blank_tail.pcd", kPcdHeaderXyz + "1 2 3\n4 5 6\n7 8 9\n\n  \n");
+  EXPECT_EQ(LoadCloud(dir / "blank_tail.pcd").size(), 3u);  // trailing blank lines are fine
+  SavePcd(dir / "long.pcd", RandomCloud(100, true, false, false, 5), PcdEncoding::kBinary);
+  WriteFile(dir / "long.pcd", test::ReadFileBytes(dir / "long.pcd") + std::string(16, '\0'));
+  ExpectLoadError(dir / "long.pcd",
+                  "expected 1600 bytes of point data (POINTS x point size), "
+                  "file has 1616");
+
+  // Not a regular file: a FIFO would block and a device would never end; a loop of symbolic
+  // links is named as such.
+  ASSERT_EQ(::mkfifo((dir / "fifo.pcd").c_str(), 0600), 0);
+  ExpectLoadError(dir / "fifo.pcd", "is not a regular file");
+  fs::create_symlink("/dev/zero", dir / "zero.bin");
+  ExpectLoadError(dir / "zero.bin", "is not a regular file");
+  fs::create_symlink(dir / "loop_b.pcd", dir / "loop_a.pcd");
+  fs::create_symlink(dir / "loop_a.pcd", dir / "loop_b.pcd");
+  ExpectLoadError(dir / "loop_a.pcd", "symbolic links");
 
   // Header problems.
   WriteFile(dir / "noz.pcd",

@@ -108,7 +108,7 @@ void ExpectRejected(const fs::path& dir, const std::string& text, const std::str
     EXPECT_NE(message.find(problem), std::string::npos) << message;
   }
   EXPECT_EQ(test::ReadFileBytes(path), text);
-  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  EXPECT_TRUE(test::TemporariesBeside(path).empty());
 }
 
 // The saved text with `from` replaced by `to` once (a hand-edited or damaged file).
@@ -316,7 +316,7 @@ TEST(SessionTest, SaveIsAtomicAndReplacesAnExistingFile) {
   SaveSession(path, s);
   EXPECT_EQ(LoadSession(path), s);
   EXPECT_EQ(test::ReadFileBytes(path), SessionToJson(s, path));
-  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  EXPECT_TRUE(test::TemporariesBeside(path).empty());
   int files = 0;
   for (const auto& entry : fs::directory_iterator(dir)) files += entry.is_regular_file();
   EXPECT_EQ(files, 1);
@@ -388,7 +388,7 @@ TEST(SessionTest, AutosaverWritesOnlyWhenTheSessionChanged) {
   EXPECT_EQ(saver.writes(), 2);
   EXPECT_NE(fs::last_write_time(path), old_time);
   EXPECT_EQ(LoadSession(path), s);
-  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  EXPECT_TRUE(test::TemporariesBeside(path).empty());
 
   Autosaver failing(dir / "missing" / "s.json");
   EXPECT_THROW(failing.Save(s), IoError);
