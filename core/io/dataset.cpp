@@ -94,8 +94,13 @@ Dataset LoadFolder(const fs::path& dir) {
   auto list = [&](const char* sub) {
     std::map<std::string, fs::path> by_stem;
     if (!fs::is_directory(dir / sub)) Fail(dir, std::string("folder dataset has no ") + sub + "/");
-    for (const auto& entry : fs::directory_iterator(dir / sub))
-      if (entry.is_regular_file()) by_stem[entry.path().stem().string()] = entry.path();
+    for (const auto& entry : fs::directory_iterator(dir / sub)) {
+      // Everything but folders is listed: a broken link, a loop of links or a FIFO becomes its
+      // pair's failure when that pair's files are read, naming the file and the problem, instead
+      // of ending the whole dataset here (or vanishing from it).
+      std::error_code ec;
+      if (!entry.is_directory(ec)) by_stem[entry.path().stem().string()] = entry.path();
+    }
     return by_stem;
   };
   const auto clouds = list("clouds");

@@ -1,5 +1,6 @@
 // The calibench.dataset.v1 manifest: round trip, the folder shorthand, and bad manifests.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -87,6 +88,18 @@ TEST(Dataset, FolderShorthandPairsCloudsAndImagesByStem) {
   EXPECT_EQ(d.pairs[1].id, "c");
   EXPECT_EQ(d.target.type, BoardType::kCharuco);
   EXPECT_EQ(d.camera.width, 640);
+
+  // A loop of symbolic links and a FIFO among the clouds: the folder still loads, with those
+  // pairs in it; reading them fails that pair, naming the file (the pipeline's job).
+  fs::create_symlink(dir / "clouds/e2.pcd", dir / "clouds/e.pcd");
+  fs::create_symlink(dir / "clouds/e.pcd", dir / "clouds/e2.pcd");
+  ASSERT_EQ(::mkfifo((dir / "clouds/f.pcd").c_str(), 0600), 0);
+  for (const char* stem : {"e", "f"})
+    std::ofstream(dir / "images" / (std::string(stem) + ".png")) << "";
+  const Dataset with_bad_files = LoadDataset(dir);
+  ASSERT_EQ(with_bad_files.pairs.size(), 4u);
+  EXPECT_EQ(with_bad_files.pairs[2].id, "e");
+  EXPECT_EQ(with_bad_files.pairs[3].id, "f");
 }
 
 // Writes `manifest` and expects LoadDataset to throw an IoError naming the file and `problem`.

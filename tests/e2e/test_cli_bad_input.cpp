@@ -1,6 +1,7 @@
 // Bad input through the real executable: every case gets a message that names the file and the
 // problem, and a non-zero exit code; nothing crashes and no made-up result is printed.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <fstream>
@@ -105,6 +106,29 @@ TEST_F(CliBadInput, UnreadableAndCorruptCloudsFailTheirPairsAndAreNamed) {
   EXPECT_NE(out.find("truncated.pcd"), std::string::npos) << out;
   EXPECT_NE(out.find("no_z.pcd"), std::string::npos) << out;
   // The remaining three pairs still calibrate and the result is written.
+  EXPECT_NE(out.find("cam_from_lidar"), std::string::npos) << out;
+}
+
+// A cloud path that is a FIFO (read, it would block forever) and one that is a loop of symbolic
+// links: each fails its own pair with the file named; the others calibrate.
+TEST_F(CliBadInput, FifoAndLinkLoopCloudsFailTheirPairsWithoutHanging) {
+  json m = Manifest();
+  const fs::path fifo = *dir_ / "fifo.pcd";
+  fs::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  m["pairs"][0]["cloud"] = fifo.string();
+  const fs::path loop = *dir_ / "loop.pcd", other = *dir_ / "loop2.pcd";
+  fs::remove(loop);
+  fs::remove(other);
+  fs::create_symlink(other, loop);
+  fs::create_symlink(loop, other);
+  m["pairs"][1]["cloud"] = loop.string();
+  std::string out;
+  EXPECT_EQ(Calibrate(Write("special_files", m), &out), 2);
+  EXPECT_NE(out.find(fifo.string() + ": is not a regular file"), std::string::npos) << out;
+  EXPECT_NE(out.find(loop.string() + ": cannot read: Too many levels of symbolic links"),
+            std::string::npos)
+      << out;
   EXPECT_NE(out.find("cam_from_lidar"), std::string::npos) << out;
 }
 
