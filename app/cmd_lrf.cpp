@@ -36,7 +36,7 @@ void PrintPoseError(const char* what, const Pose& estimate, const Pose& referenc
 }  // namespace
 
 bool IsLrfManifest(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(LrfManifestPath(path));
   if (!in) return false;
   try {
     const nlohmann::json root = nlohmann::json::parse(in);
@@ -54,7 +54,9 @@ int RunLrfCalibrate(int argc, char** argv) {
       "calibench lrf-calibrate"};
   std::string dataset_path, out_path, method = "refined", pairs_text;
   LrfPipelineOptions options;
-  app.add_option("--dataset,-d", dataset_path, "calibench.lrf-dataset.v1 manifest")->required();
+  app.add_option("--dataset,-d", dataset_path,
+                 "calibench.lrf-dataset.v1 manifest, or the folder holding it as manifest.json")
+      ->required();
   app.add_option("--out,-o", out_path, "result file (calibench.result.v1)");
   app.add_option("--method", method,
                  "refined (SE(3) Gauss-Newton over every scan point, seeded by paper-linear) | "

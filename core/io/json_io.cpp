@@ -14,7 +14,12 @@ namespace fs = std::filesystem;
 }
 
 json ReadJson(const fs::path& path) {
-  if (!fs::exists(path)) Fail(path, "no such file");
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found) Fail(path, "no such file");
+  if (ec) Fail(path, "cannot read: " + ec.message());
+  if (fs::is_directory(status)) Fail(path, "is a folder, not a JSON file");
+  if (!fs::is_regular_file(status)) Fail(path, "is not a regular file (a FIFO or a device?)");
   std::ifstream in(path);
   if (!in) Fail(path, "cannot open file");
   try {

@@ -190,8 +190,18 @@ LaserScan LoadScanPcd(const fs::path& path) {
 
 }  // namespace
 
+fs::path LrfManifestPath(const fs::path& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec) ? path / "manifest.json" : path;
+}
+
 LrfDataset LoadLrfDataset(const fs::path& manifest_path) {
-  const fs::path manifest = fs::absolute(manifest_path);
+  const fs::path manifest = fs::absolute(LrfManifestPath(manifest_path));
+  std::error_code ec;
+  if (manifest != fs::absolute(manifest_path) && !fs::exists(manifest, ec))
+    throw IoError(manifest_path.string() +
+                  ": folder holds no manifest.json (an LRF dataset is a "
+                  "calibench.lrf-dataset.v1 manifest, or the folder holding one)");
   const json document = json_io::ReadJson(manifest);
   const Fields root(document, manifest);
   json_io::CheckFormat(root, kFormat);

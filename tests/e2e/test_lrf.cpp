@@ -105,6 +105,31 @@ TEST_F(LrfCli, AdaptiveCountStopsBelowTheThreshold) {
   EXPECT_LE(used, 8);
 }
 
+// The folder `simulate --kind lrf` writes works in place of its manifest, as a folder does for
+// `calibrate`; a folder without manifest.json is named, not an internal error.
+TEST_F(LrfCli, AFolderStandsForItsManifest) {
+  std::string from_folder, from_manifest;
+  ASSERT_EQ(test::RunCommand(Exe() + " lrf-calibrate --dataset " + (*dir_ / "sim").string() +
+                                 " --out " + (*dir_ / "folder.json").string(),
+                             &from_folder),
+            0)
+      << from_folder;
+  ASSERT_EQ(test::RunCommand(Exe() + " lrf-calibrate --dataset " +
+                                 (*dir_ / "sim/manifest.json").string() + " --out " +
+                                 (*dir_ / "manifest.json").string(),
+                             &from_manifest),
+            0)
+      << from_manifest;
+  EXPECT_EQ(test::ReadFileBytes(*dir_ / "folder.json"),
+            test::ReadFileBytes(*dir_ / "manifest.json"));
+  const fs::path empty = *dir_ / "empty_folder";
+  fs::create_directories(empty);
+  std::string out;
+  EXPECT_NE(test::RunCommand(Exe() + " lrf-calibrate --dataset " + empty.string(), &out), 0);
+  EXPECT_NE(out.find(empty.string() + ": folder holds no manifest.json"), std::string::npos) << out;
+  EXPECT_EQ(out.find("internal error"), std::string::npos) << out;
+}
+
 TEST_F(LrfCli, BadInputNamesTheFileAndKeepsTheOtherObservations) {
   std::ifstream in(*dir_ / "sim/manifest.json");
   json manifest = json::parse(in);
