@@ -3,6 +3,7 @@
 
 #include <fstream>
 
+#include "core/session/session.h"
 #include "tests/test_support.h"
 #include "tests/ui/ui_fixture.h"
 #include "ui/lidar_camera/controller.h"
@@ -168,6 +169,64 @@ TEST(Controller, EveryEditAutosavesAndTheSessionReopensExactly) {
   EXPECT_TRUE(s.solver.result->cam_from_lidar.isApprox(saved.result->cam_from_lidar, 0));
   EXPECT_TRUE(s.pairs[0].residual);             // recomputed from the planes on load
   EXPECT_EQ(LoadSession(session_path), saved);  // reopening rewrote nothing
+}
+
+// A relative export or save-as path goes next to the session, never into the folder the program
+// was started from.
+TEST(Controller, RelativeExportAndSaveAsPathsGoNextToTheSession) {
+  const auto dir = test::TempDir("controller_export_place");
+  const auto session_path = dir / "work.session.json";
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), session_path);
+  Loaded(controller);
+  controller.Apply(RunSolver{});
+  Loaded(controller);
+  const auto start_dir = std::filesystem::current_path();
+  std::filesystem::remove(start_dir / "exported_here.json");
+  controller.Apply(ExportResult{"exported_here.json"});
+  EXPECT_TRUE(std::filesystem::exists(dir / "exported_here.json"));
+  EXPECT_FALSE(std::filesystem::exists(start_dir / "exported_here.json"));
+  EXPECT_NE(controller.GetSnapshot().status_line.find((dir / "exported_here.json").string()),
+            std::string::npos);
+  controller.Apply(SaveSessionAs{"copy.session.json"});
+  EXPECT_TRUE(std::filesystem::exists(dir / "copy.session.json"));
+  EXPECT_EQ(controller.GetSnapshot().session_path, dir / "copy.session.json");
+}
+
+// A session whose brush was painted on another LiDAR image layout: that brush is refused with a
+// message naming the cloud and both layouts, the pair falls back to its seed, and the rest of
+// the session (another pair's brush, a rejection) loads as saved.
+TEST(Controller, ABrushOfTheWrongSizeIsDroppedWithAMessageAndTheRestLoads) {
+  const auto dir = test::TempDir("controller_wrong_brush");
+  const auto session_path = dir / "work.session.json";
+  std::vector<int> good_brush;
+  {
+    Controller controller;
+    controller.OpenDataset(test::UiDataset(), session_path);
+    const Snapshot s = Loaded(controller);
+    good_brush = s.pairs[1].brush_pixels;  // the seed's region, painted over as the user's
+    controller.Apply(PaintPoints{1, good_brush, false});
+    controller.Apply(EndStroke{});
+    controller.Apply(SetPairStatus{3, PairStatus::kRejected});
+    Loaded(controller);
+  }
+  Session session = LoadSession(session_path);
+  ASSERT_TRUE(session.pairs[1].brush);
+  session.pairs[0].brush = BrushMask{3, 3, {0, 4, 8}};  // painted on a 3x3 image
+  session.pairs[0].brush_from_seed = false;
+  SaveSession(session_path, session);
+
+  Controller reopened;
+  reopened.OpenSession(session_path);
+  const Snapshot s = Loaded(reopened);
+  EXPECT_NE(s.status_line.find("painted on a 3x3 LiDAR image"), std::string::npos) << s.status_line;
+  EXPECT_NE(s.status_line.find("its brush from the session was dropped"), std::string::npos)
+      << s.status_line;
+  EXPECT_TRUE(s.status_is_error);
+  EXPECT_TRUE(s.pairs[0].lidar);  // back on its seed
+  EXPECT_TRUE(s.pairs[0].brush_from_seed);
+  EXPECT_EQ(s.pairs[1].brush_pixels, session.pairs[1].brush->pixels);
+  EXPECT_EQ(s.pairs[3].status, PairStatus::kRejected);
 }
 
 TEST(Controller, ACorruptSessionIsReportedAndLeftUntouched) {

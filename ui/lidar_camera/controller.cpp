@@ -1,10 +1,9 @@
 #include "ui/lidar_camera/controller.h"
 
-#include "core/base/allocator.h"
-
 #include <algorithm>
 #include <cmath>
 
+#include "core/base/allocator.h"
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
 #include "core/lidar_camera/result_io.h"
@@ -87,6 +86,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     state_.pairs.resize(dataset.pairs.size());
     for (size_t i = 0; i < dataset.pairs.size(); ++i) state_.pairs[i].id = dataset.pairs[i].id;
     state_.loading_total = static_cast<int>(dataset.pairs.size());
+    load_warnings_.clear();
     session_ = std::move(session);
     ApplySessionToState(session_);
     history_.Reset(session_);
@@ -199,6 +199,7 @@ void Controller::LoadPair(int index) {
   PairEntry entry;
   Dataset dataset;
   std::vector<int> saved_brush;
+  std::optional<BrushMask> saved_mask;
   bool painted = false;  // the session holds a brush the user painted (or erased)
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -207,7 +208,9 @@ void Controller::LoadPair(int index) {
     saved_brush = state_.pairs[index].brush_pixels;
     const PairState& saved = session_.pairs[index];
     painted = saved.brush.has_value() && !saved.brush_from_seed;
+    saved_mask = saved.brush;
   }
+  std::string brush_dropped;  // why the session's brush does not fit this pair's cloud
   // The pipeline's own steps (core/lidar_camera/pipeline.h), as `calibench calibrate` runs them.
   PairView loaded;
   std::string why;
@@ -227,6 +230,14 @@ void Controller::LoadPair(int index) {
     loaded.camera_failure = camera.failure;
     // A painted brush replaces the seed; otherwise the seed selects the region and the brush
     // only pictures it (as EditsFromSession tells `calibench calibrate --session`).
+    // A mask painted on another image layout would mark other returns: refused, not reread.
+    if (painted &&
+        !BrushFitsImage(*saved_mask, lidar_image->rows, lidar_image->columns, &brush_dropped)) {
+      brush_dropped = "pair " + entry.id +
+                      ": its brush from the session was dropped: " + entry.cloud.string() + ": " +
+                      brush_dropped;
+      painted = false;
+    }
     if (painted) {
       loaded.brush_pixels = saved_brush;
     } else if (entry.lidar_seed) {
@@ -251,6 +262,12 @@ void Controller::LoadPair(int index) {
     pair = std::move(loaded);
     ++state_.loading_done;
     ++state_.generation;
+    if (!brush_dropped.empty()) {
+      session_.pairs[index].brush.reset();
+      session_.pairs[index].brush_from_seed = false;
+      load_warnings_.push_back(brush_dropped);
+      SetStatus(brush_dropped, true);
+    }
     // Detection waits for every cloud: the background model over them keeps static board-sized
     // panels out (as CalibrateDataset does).
     const bool detects = !pair.brush_from_seed && !painted;
@@ -265,7 +282,11 @@ void Controller::LoadPair(int index) {
     }
     if (state_.loading_done == state_.loading_total) {
       worker_.Enqueue([this] { DetectWithBackground(); });
-      SetStatus("loaded " + std::to_string(state_.loading_total) + " pairs", false);
+      // What went wrong while loading stays on the status line (in the warning colour).
+      std::string loaded_line = "loaded " + std::to_string(state_.loading_total) + " pairs";
+      for (const std::string& warning : load_warnings_) loaded_line += "; " + warning;
+      SetStatus(loaded_line, !load_warnings_.empty());
+      load_warnings_.clear();
       // A reopened session with a result shows its reprojection again.
       const int selected = state_.selected;
       if (state_.solver.result)
@@ -678,6 +699,11 @@ void Controller::Handle(const SetView& view) {
   }
 }
 
+std::filesystem::path Controller::NextToSession(const std::filesystem::path& path) const {
+  if (path.is_absolute() || state_.session_path.empty()) return path;
+  return state_.session_path.parent_path() / path;
+}
+
 template <>
 void Controller::Handle(const ExportResult& export_result) {
   if (!state_.solver.result) {
@@ -689,9 +715,10 @@ void Controller::Handle(const ExportResult& export_result) {
   CalibrationOutcome outcome;
   for (const PairView& pair : state_.pairs) outcome.pairs.push_back(FeaturesOf(pair));
   outcome.solution = ResultForCurrentPairs();
+  const std::filesystem::path path = NextToSession(export_result.path);
   try {
-    WriteResult(export_result.path, outcome, SolverOptionsFromState());
-    SetStatus("exported " + export_result.path.string(), false);
+    WriteResult(path, outcome, SolverOptionsFromState());
+    SetStatus("exported " + path.string(), false);
   } catch (const IoError& e) {
     SetStatus(e.what(), true);
   }
@@ -699,11 +726,12 @@ void Controller::Handle(const ExportResult& export_result) {
 
 template <>
 void Controller::Handle(const SaveSessionAs& save) {
+  const std::filesystem::path path = NextToSession(save.path);
   try {
-    SaveSession(save.path, session_);
-    autosaver_ = std::make_unique<Autosaver>(save.path);
-    state_.session_path = save.path;
-    SetStatus("saved session " + save.path.string(), false);
+    SaveSession(path, session_);
+    autosaver_ = std::make_unique<Autosaver>(path);
+    state_.session_path = path;
+    SetStatus("saved session " + path.string(), false);
   } catch (const IoError& e) {
     SetStatus(e.what(), true);
   }

@@ -168,6 +168,9 @@ class Controller : public ControllerState<Snapshot> {
   static PairFeatures FeaturesOf(const PairView& pair);  // the pipeline's view of a pair
   static bool SolvesWith(const PairView& pair);          // accepted, with both planes
   void ComputeReprojection(int index);
+  // A relative path the user typed (export, save as) goes next to the session, never into the
+  // folder the program was started from. Call with mutex_ held.
+  std::filesystem::path NextToSession(const std::filesystem::path& path) const;
   void EnsureSelectedImage();
   // The solve's result with residuals and robust weights for the pairs accepted now, in order
   // (state_.solver.result must be set); call with mutex_ held.
@@ -193,6 +196,7 @@ class Controller : public ControllerState<Snapshot> {
   SessionHistory history_;
   std::unique_ptr<Autosaver> autosaver_;
   PipelineOptions pipeline_;
+  std::vector<std::string> load_warnings_;     // what loading refused, for the status line (mutex_)
   std::optional<SceneBackground> background_;  // worker thread only (DetectWithBackground)
   bool stroke_open_ = false;  // BrushStroke / PaintPoints dabs since the last EndStroke
 };
