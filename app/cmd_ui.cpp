@@ -43,12 +43,14 @@ std::optional<int> ParseFlags(CLI::App& app, int argc, char** argv, const std::s
 }
 
 // Opens the dataset or session the flags name; false (message printed) when neither is given.
-bool OpenInput(ui::Controller& controller, const std::string& dataset, const std::string& session,
-               const char* command) {
+bool OpenInput(
+    ui::Controller& controller, const std::string& dataset, const std::string& session,
+    const char* command,
+    ui::Controller::ExistingSession existing = ui::Controller::ExistingSession::kReplace) {
   if (!session.empty()) {
     controller.OpenSession(session);
   } else if (!dataset.empty()) {
-    controller.OpenDataset(dataset);
+    controller.OpenDataset(dataset, {}, existing);
   } else {
     std::fprintf(stderr, "calibench %s: give --dataset or --session\n", command);
     return false;
@@ -58,7 +60,7 @@ bool OpenInput(ui::Controller& controller, const std::string& dataset, const std
 
 // The window the gui flags ask for; with --screenshot its last frame is kept.
 ui::WindowOptions WindowOptionsOf(int width, int height, const char* title,
-                                  const std::string& screenshot, const GuiQuit& quit) {
+                                  const std::string& screenshot, const GuiWindowFlags& quit) {
   return {width, height, title, quit.after_frames, !screenshot.empty(), quit.after_seconds};
 }
 
@@ -138,9 +140,13 @@ int RenderLrfHeadless(const std::string& dataset, const ui::HeadlessShot& shot,
 }  // namespace
 
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
-                 const std::string& screenshot, const GuiQuit& quit) {
+                 const std::string& screenshot, const GuiWindowFlags& quit) {
   ui::Controller controller;
-  if (!OpenInput(controller, dataset, session, "gui")) return kUsage;
+  // The window resumes the session beside the dataset (or, with --fresh, backs it up first).
+  if (!OpenInput(controller, dataset, session, "gui",
+                 quit.fresh ? ui::Controller::ExistingSession::kStartFresh
+                            : ui::Controller::ExistingSession::kResume))
+    return kUsage;
   return FinishWindow(ui::RunWorkbenchWindow<ui::Workbench>(
                           WindowOptionsOf(width, height, "Calibench", screenshot, quit), controller,
                           ui::Layout::kWorkbench),
@@ -153,12 +159,15 @@ int RunGui(int argc, char** argv) {
       "reject pairs, solve and inspect.",
       "calibench gui"};
   std::string dataset, session, size = "1600x900", screenshot;
-  GuiQuit quit;
+  GuiWindowFlags quit;
   app.add_option("--dataset,-d", dataset,
                  "dataset.json or dataset folder, or an LRF manifest (calibench.lrf-dataset.v1)");
   app.add_option("--session,-s", session, "a saved session (calibench.session.v1)");
   app.add_option("--size", size, "window size WxH")->capture_default_str();
   app.add_option("--screenshot", screenshot, "write the last frame to this PNG");
+  app.add_flag("--fresh", quit.fresh,
+               "with --dataset: start a new session even if one is beside the dataset (the old "
+               "one is kept as <session>.<date-time>.bak); by default it is resumed");
   app.add_option("--quit-after-frames", quit.after_frames,
                  "close after N frames, drawn back to back (tests)");
   app.add_option("--quit-after-seconds", quit.after_seconds,

@@ -40,15 +40,16 @@ bool IsLrfManifest(const std::string& path);
 int RunGui(int argc, char** argv);
 int RunRender(int argc, char** argv);
 
-// When a test's window closes by itself (0 = never): after that many frames drawn back to back,
-// or after that many seconds of a normal run.
-struct GuiQuit {
+// How `gui` runs its window. A test's window closes by itself (0 = never) after that many frames
+// drawn back to back, or after that many seconds of a normal run.
+struct GuiWindowFlags {
   int after_frames = 0;
   double after_seconds = 0.0;
+  bool fresh = false;  // --fresh: back up the session beside the dataset and start a new one
 };
 // Shared by `gui` and `demo`: opens the workbench window on a dataset or session.
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
-                 const std::string& screenshot, const GuiQuit& quit = {});
+                 const std::string& screenshot, const GuiWindowFlags& quit = {});
 // Shared by `render` and `demo`: draws one view (or the workbench) headless into a PNG.
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
                    bool solve, const std::string& view, int width, int height,

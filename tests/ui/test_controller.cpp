@@ -229,6 +229,62 @@ TEST(Controller, ABrushOfTheWrongSizeIsDroppedWithAMessageAndTheRestLoads) {
   EXPECT_EQ(s.pairs[3].status, PairStatus::kRejected);
 }
 
+// Opening a dataset whose folder holds a session, as the window does: the session resumes (a
+// rejected pair stays rejected, the result stays) and the status line says so; --fresh moves it
+// to a timestamped backup first; a session that does not open is backed up, never overwritten.
+TEST(Controller, ReopeningADatasetResumesItsSessionOrBacksItUp) {
+  const auto dir = test::TempDir("controller_resume");
+  const auto session_path = dir / "calibench.session.json";
+  using Existing = Controller::ExistingSession;
+  {
+    Controller controller;
+    controller.OpenDataset(test::UiDataset(), session_path, Existing::kResume);
+    Loaded(controller);
+    controller.Apply(SetPairStatus{3, PairStatus::kRejected});
+    controller.Apply(RunSolver{});
+    Loaded(controller);
+  }
+  const std::string saved = test::ReadFileBytes(session_path);
+  auto backups = [&] {
+    std::vector<std::filesystem::path> found;
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+      if (entry.path().extension() == ".bak") found.push_back(entry.path());
+    return found;
+  };
+  {
+    Controller resumed;
+    resumed.OpenDataset(test::UiDataset(), session_path, Existing::kResume);
+    const Snapshot s = Loaded(resumed);
+    EXPECT_EQ(s.pairs[3].status, PairStatus::kRejected);
+    EXPECT_TRUE(s.solver.result);
+    EXPECT_NE(s.status_line.find("resumed the session in " + session_path.string()),
+              std::string::npos)
+        << s.status_line;
+    EXPECT_EQ(test::ReadFileBytes(session_path), saved);
+  }
+  {
+    Controller fresh;
+    fresh.OpenDataset(test::UiDataset(), session_path, Existing::kStartFresh);
+    const Snapshot s = Loaded(fresh);
+    EXPECT_EQ(s.pairs[3].status, PairStatus::kAccepted);
+    ASSERT_EQ(backups().size(), 1u);
+    EXPECT_EQ(test::ReadFileBytes(backups()[0]), saved);
+    EXPECT_NE(s.status_line.find("kept the old session as " + backups()[0].string()),
+              std::string::npos)
+        << s.status_line;
+  }
+  const std::string corrupt = "{\"format\": \"calibench.session.v1\", \"pairs\": [";
+  std::ofstream(session_path) << corrupt;
+  Controller after_corrupt;
+  after_corrupt.OpenDataset(test::UiDataset(), session_path, Existing::kResume);
+  const Snapshot s = Loaded(after_corrupt);
+  EXPECT_NE(s.status_line.find("did not open"), std::string::npos) << s.status_line;
+  ASSERT_EQ(backups().size(), 2u);
+  int corrupt_backups = 0;
+  for (const auto& backup : backups()) corrupt_backups += test::ReadFileBytes(backup) == corrupt;
+  EXPECT_EQ(corrupt_backups, 1);
+}
+
 TEST(Controller, ACorruptSessionIsReportedAndLeftUntouched) {
   const auto path = test::TempDir("controller_corrupt") / "broken.session.json";
   const std::string text = "{\"format\": \"calibench.session.v1\", \"version\": 1, \"pairs\": [";

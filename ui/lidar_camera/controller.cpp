@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 
 #include "core/base/allocator.h"
 #include "core/io/cloud_io.h"
@@ -46,8 +47,28 @@ Controller::Controller(PipelineOptions options) : pipeline_(std::move(options)) 
 
 Controller::~Controller() { StopWorker(); }
 
+namespace {
+
+// Moves `path` aside to `<path>.<YYYYmmdd-HHMMSS>.bak` (a new name each time) and returns it.
+std::filesystem::path BackUpSession(const std::filesystem::path& path) {
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", std::localtime(&now));
+  std::filesystem::path backup = path.string() + "." + stamp + ".bak";
+  for (int n = 2; std::filesystem::exists(backup); ++n)
+    backup = path.string() + "." + stamp + "-" + std::to_string(n) + ".bak";
+  std::error_code ec;
+  std::filesystem::rename(path, backup, ec);
+  if (ec)
+    throw IoError(path.string() + ": cannot move the session aside to " + backup.string() + " (" +
+                  ec.message() + "); it was left as it is");
+  return backup;
+}
+
+}  // namespace
+
 void Controller::OpenDataset(const std::filesystem::path& dataset_path,
-                             std::filesystem::path session_path) {
+                             std::filesystem::path session_path, ExistingSession existing) {
   const Dataset dataset = LoadDataset(dataset_path);
   if (session_path.empty()) {
     const auto folder = std::filesystem::is_directory(dataset.manifest)
@@ -55,12 +76,31 @@ void Controller::OpenDataset(const std::filesystem::path& dataset_path,
                             : dataset.manifest.parent_path();
     session_path = folder / "calibench.session.json";
   }
+  std::string note;
+  if (existing != ExistingSession::kReplace && std::filesystem::exists(session_path)) {
+    if (existing == ExistingSession::kResume) {
+      try {
+        OpenSessionFile(session_path,
+                        "resumed the session in " + session_path.string() +
+                            " (calibench gui --fresh starts over and keeps it as a backup)");
+        return;
+      } catch (const IoError& e) {
+        note = "the session there did not open (" + std::string(e.what()) + "): ";
+      }
+    }
+    note += "kept the old session as " + BackUpSession(session_path).string();
+  }
   Session session = NewSession(dataset);
   session.dataset = dataset.manifest;
-  Open(dataset, std::move(session), session_path);
+  Open(dataset, std::move(session), session_path, note);
 }
 
 void Controller::OpenSession(const std::filesystem::path& session_path) {
+  OpenSessionFile(session_path, "");
+}
+
+void Controller::OpenSessionFile(const std::filesystem::path& session_path,
+                                 const std::string& note) {
   Session session = LoadSession(session_path);  // throws IoError; never rewrites the file
   const Dataset dataset = LoadDataset(session.dataset);
   if (session.pairs.size() != dataset.pairs.size())
@@ -72,10 +112,11 @@ void Controller::OpenSession(const std::filesystem::path& session_path) {
       throw IoError(session_path.string() + ": pair " + std::to_string(i) + " is '" +
                     session.pairs[i].id + "' in the session but '" + dataset.pairs[i].id +
                     "' in the dataset");
-  Open(dataset, std::move(session), session_path);
+  Open(dataset, std::move(session), session_path, note);
 }
 
-void Controller::Open(const Dataset& dataset, Session session, std::filesystem::path session_path) {
+void Controller::Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
+                      const std::string& note) {
   WaitIdle();
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -87,6 +128,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     for (size_t i = 0; i < dataset.pairs.size(); ++i) state_.pairs[i].id = dataset.pairs[i].id;
     state_.loading_total = static_cast<int>(dataset.pairs.size());
     load_warnings_.clear();
+    open_note_ = note;
     session_ = std::move(session);
     ApplySessionToState(session_);
     history_.Reset(session_);
@@ -284,6 +326,7 @@ void Controller::LoadPair(int index) {
       worker_.Enqueue([this] { DetectWithBackground(); });
       // What went wrong while loading stays on the status line (in the warning colour).
       std::string loaded_line = "loaded " + std::to_string(state_.loading_total) + " pairs";
+      if (!open_note_.empty()) loaded_line += "; " + open_note_;
       for (const std::string& warning : load_warnings_) loaded_line += "; " + warning;
       SetStatus(loaded_line, !load_warnings_.empty());
       load_warnings_.clear();

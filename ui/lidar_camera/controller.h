@@ -150,7 +150,14 @@ class Controller : public ControllerState<Snapshot> {
   // Opens a dataset (new session saved next to it as <dataset folder>/calibench.session.json
   // unless session_path is given) or a saved session. The manifest / session is read here and
   // throws IoError; the pairs load on the worker thread (see loading_done / loading_total).
-  void OpenDataset(const std::filesystem::path& dataset, std::filesystem::path session_path = {});
+  // What to do when `session_path` already holds a session: kReplace starts a new one over it
+  // (headless renders and tests, which own their session files); kResume opens it instead (the
+  // window: an hour of someone's edits is never overwritten by opening the dataset again) and
+  // says so; kStartFresh moves it to `<session>.<date-time>.bak` first and says where. A session
+  // that does not load or belongs to another dataset is backed up the same way under kResume.
+  enum class ExistingSession { kReplace, kResume, kStartFresh };
+  void OpenDataset(const std::filesystem::path& dataset, std::filesystem::path session_path = {},
+                   ExistingSession existing = ExistingSession::kReplace);
   void OpenSession(const std::filesystem::path& session);
 
   void Apply(const Intent& intent);
@@ -180,7 +187,10 @@ class Controller : public ControllerState<Snapshot> {
   // history's last step is amended, so that one stroke is one undo step.
   void CommitEdit();
   void ApplySessionToState(const Session& session);  // call with mutex_ held
-  void Open(const Dataset& dataset, Session session, std::filesystem::path session_path);
+  // `note` (how the session came to be opened) joins the status line once the pairs have loaded.
+  void Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
+            const std::string& note);
+  void OpenSessionFile(const std::filesystem::path& session, const std::string& note);
 
   // One handler per intent type, each an explicit specialization in controller.cpp (Apply visits
   // them with mutex_ held).
@@ -196,6 +206,7 @@ class Controller : public ControllerState<Snapshot> {
   SessionHistory history_;
   std::unique_ptr<Autosaver> autosaver_;
   PipelineOptions pipeline_;
+  std::string open_note_;  // how the session was opened, for the status line once loaded (mutex_)
   std::vector<std::string> load_warnings_;     // what loading refused, for the status line (mutex_)
   std::optional<SceneBackground> background_;  // worker thread only (DetectWithBackground)
   bool stroke_open_ = false;  // BrushStroke / PaintPoints dabs since the last EndStroke
