@@ -285,6 +285,26 @@ TEST(Controller, ReopeningADatasetResumesItsSessionOrBacksItUp) {
   EXPECT_EQ(corrupt_backups, 1);
 }
 
+// An autosave that cannot be written (here: its folder is gone) is shown on the status line, for
+// edits and for undo alike, and the edit itself stands.
+TEST(Controller, AFailedAutosaveIsShownAndTheEditStands) {
+  const auto dir = test::TempDir("controller_autosave_fails");
+  const auto session_path = dir / "gone" / "work.session.json";
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), session_path);
+  Loaded(controller);
+  controller.Apply(SetPairStatus{2, PairStatus::kRejected});
+  Snapshot s = controller.GetSnapshot();
+  EXPECT_EQ(s.pairs[2].status, PairStatus::kRejected);
+  EXPECT_TRUE(s.status_is_error);
+  EXPECT_NE(s.status_line.find("autosave failed: " + session_path.string()), std::string::npos)
+      << s.status_line;
+  controller.Apply(Undo{});  // must not throw out of Apply
+  s = Loaded(controller);
+  EXPECT_EQ(s.pairs[2].status, PairStatus::kAccepted);
+  EXPECT_NE(s.status_line.find("autosave failed"), std::string::npos) << s.status_line;
+}
+
 TEST(Controller, ACorruptSessionIsReportedAndLeftUntouched) {
   const auto path = test::TempDir("controller_corrupt") / "broken.session.json";
   const std::string text = "{\"format\": \"calibench.session.v1\", \"version\": 1, \"pairs\": [";

@@ -229,12 +229,16 @@ void Controller::CommitEdit() {
     history_.Push(session_);
   state_.can_undo = history_.CanUndo();
   state_.can_redo = history_.CanRedo();
+  Autosave();
+  ++state_.generation;
+}
+
+void Controller::Autosave() {
   try {
     if (autosaver_) autosaver_->Save(session_);
   } catch (const IoError& e) {
     SetStatus(std::string("autosave failed: ") + e.what(), true);
   }
-  ++state_.generation;
 }
 
 void Controller::LoadPair(int index) {
@@ -796,7 +800,7 @@ void Controller::Restore(const std::optional<Session>& restored) {
   session_ = *restored;
   ApplySessionToState(session_);
   RecomputeResiduals();
-  if (autosaver_) autosaver_->Save(session_);
+  Autosave();
   for (int i = 0; i < static_cast<int>(state_.pairs.size()); ++i)
     if (state_.pairs[i].brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });
 }

@@ -178,6 +178,9 @@ class Controller : public ControllerState<Snapshot> {
   // A relative path the user typed (export, save as) goes next to the session, never into the
   // folder the program was started from. Call with mutex_ held.
   std::filesystem::path NextToSession(const std::filesystem::path& path) const;
+  // Writes the session if it changed; a failure goes to the status line in the warning colour
+  // (and is retried at the next change). Call with mutex_ held.
+  void Autosave();
   void EnsureSelectedImage();
   // The solve's result with residuals and robust weights for the pairs accepted now, in order
   // (state_.solver.result must be set); call with mutex_ held.
