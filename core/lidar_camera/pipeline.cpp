@@ -233,9 +233,9 @@ bool AnyPairToDetect(const std::vector<const PairEntry*>& pairs, const PairEdits
 
 }  // namespace
 
-std::optional<SceneBackground> BuildSceneBackground(
-    const std::vector<const PairEntry*>& pairs, int threads, std::string* why,
-    std::vector<std::optional<LidarCloud>>* kept) {
+std::optional<SceneBackground> BuildSceneBackground(const std::vector<const PairEntry*>& pairs,
+                                                    int threads, std::string* why,
+                                                    std::vector<std::optional<LidarCloud>>* kept) {
   std::vector<std::optional<LidarCloud>> clouds(pairs.size());
   ParallelFor(pairs.size(), threads, [&](size_t i) {
     try {

@@ -2,9 +2,9 @@
 // (papers/lrf-depth-camera-vboard.txt Section 3.1 Eq. (6)–(7), Section 4.2 step 3, Fig. 7).
 //
 // Back-projection, RANSAC (one point and its local normal per draw) for the planes in view, the
-// target's three faces chosen among them, and the three pairwise intersection lines AB, AC, AD. Faces are named by the target frame
-// (types.h), assuming the target stands upright (its y axis roughly up in the image): ABC is the
-// face on the camera's left.
+// target's three faces chosen among them, and the three pairwise intersection lines AB, AC, AD.
+// Faces are named by the target frame (types.h), assuming the target stands upright (its y axis
+// roughly up in the image): ABC is the face on the camera's left.
 #pragma once
 
 #include <cstdint>

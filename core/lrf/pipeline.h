@@ -35,7 +35,7 @@ struct LrfPipelineOptions {
   // below this (metres); 0 = use every accepted observation.
   double adaptive_error_threshold_m = 0.0;
   std::vector<std::string> pair_ids;  // empty = every pair
-  int threads = DefaultThreads();  // feature extraction workers
+  int threads = DefaultThreads();     // feature extraction workers
   bool Check(std::string* why) const;
 };
 

@@ -10,6 +10,59 @@
 
 namespace calibench {
 
+namespace {
+
+using SweepError = std::pair<double, double>;  // (rotation deg, translation mm)
+
+// One seed's outcome: per (method, size) its error, or nothing when the solve failed.
+struct SeedRun {
+  std::vector<std::vector<std::optional<SweepError>>> errors;
+  int observations_total = 0, observations_failed = 0;
+};
+
+// Seed number `s`: its own simulation, features, and a solve per (method, size).
+SeedRun RunSeed(const LrfSweepOptions& options, int max_size, size_t s) {
+  SeedRun run;
+  run.errors.assign(options.methods.size(),
+                    std::vector<std::optional<SweepError>>(options.sizes.size()));
+  LrfSimOptions sim = options.sim;
+  // A few extra poses, so that an observation whose features fail (reported below) does not
+  // leave the seed short of max_size usable ones.
+  sim.observations = max_size + max_size / 2 + 2;
+  sim.seed = options.first_seed + static_cast<std::uint64_t>(s);
+  const std::vector<Pose> poses = SampleTargetPoses(sim);
+  std::vector<LrfObservation> usable;
+  for (size_t k = 0; k < poses.size() && static_cast<int>(usable.size()) < max_size; ++k) {
+    const LrfSimObservation rendered =
+        RenderLrfObservation(sim, poses[k], sim.seed * 1000003ull + k);
+    LrfObservation observation;
+    observation.id = std::to_string(k);
+    observation.scan = ExtractScanFeatures(rendered.scan, sim.target, options.pipeline.scan);
+    observation.depth = ExtractDepthFeatures(rendered.depth, sim.target, options.pipeline.depth);
+    ++run.observations_total;
+    if (observation.scan.ok && observation.depth.ok)
+      usable.push_back(std::move(observation));
+    else
+      ++run.observations_failed;
+  }
+  for (size_t m = 0; m < options.methods.size(); ++m) {
+    LrfSolverOptions solver = options.pipeline.solver;
+    solver.method = options.methods[m];
+    for (size_t i = 0; i < options.sizes.size(); ++i) {
+      const int n = options.sizes[i];
+      if (static_cast<int>(usable.size()) < n) continue;
+      const std::vector<LrfObservation> first(usable.begin(), usable.begin() + n);
+      const LrfSolution solution = SolveLrf(first, solver);
+      if (!solution.ok) continue;
+      const PoseError e = ComputePoseError(solution.cam_from_lrf, sim.cam_from_lrf);
+      run.errors[m][i] = std::make_pair(e.rotation_rad * 180.0 / M_PI, e.translation_m * 1e3);
+    }
+  }
+  return run;
+}
+
+}  // namespace
+
 LrfSweepResult RunLrfSweep(const LrfSweepOptions& options,
                            const std::function<void(int, int)>& progress) {
   LrfSweepResult result;
@@ -22,52 +75,10 @@ LrfSweepResult RunLrfSweep(const LrfSweepOptions& options,
       std::vector<std::vector<std::pair<double, double>>>(options.sizes.size()));
   std::vector<std::vector<int>> failures(options.methods.size(),
                                          std::vector<int>(options.sizes.size(), 0));
-  // One seed's outcome: per (method, size) its error, or nothing when the solve failed.
-  struct SeedRun {
-    std::vector<std::vector<std::optional<std::pair<double, double>>>> errors;
-    int observations_total = 0, observations_failed = 0;
-  };
   std::vector<SeedRun> runs(static_cast<size_t>(options.seeds));
   // Seeds run in parallel (options.pipeline.threads); each has its own simulation, and they are
   // reduced in seed order, so the table does not depend on the thread count.
-  auto run_seed = [&](size_t s) {
-    SeedRun& run = runs[s];
-    run.errors.assign(options.methods.size(),
-                      std::vector<std::optional<std::pair<double, double>>>(options.sizes.size()));
-    LrfSimOptions sim = options.sim;
-    // A few extra poses, so that an observation whose features fail (reported below) does not
-    // leave the seed short of max_size usable ones.
-    sim.observations = max_size + max_size / 2 + 2;
-    sim.seed = options.first_seed + static_cast<std::uint64_t>(s);
-    const std::vector<Pose> poses = SampleTargetPoses(sim);
-    std::vector<LrfObservation> usable;
-    for (size_t k = 0; k < poses.size() && static_cast<int>(usable.size()) < max_size; ++k) {
-      const LrfSimObservation rendered =
-          RenderLrfObservation(sim, poses[k], sim.seed * 1000003ull + k);
-      LrfObservation observation;
-      observation.id = std::to_string(k);
-      observation.scan = ExtractScanFeatures(rendered.scan, sim.target, options.pipeline.scan);
-      observation.depth = ExtractDepthFeatures(rendered.depth, sim.target, options.pipeline.depth);
-      ++run.observations_total;
-      if (observation.scan.ok && observation.depth.ok)
-        usable.push_back(std::move(observation));
-      else
-        ++run.observations_failed;
-    }
-    for (size_t m = 0; m < options.methods.size(); ++m) {
-      LrfSolverOptions solver = options.pipeline.solver;
-      solver.method = options.methods[m];
-      for (size_t i = 0; i < options.sizes.size(); ++i) {
-        const int n = options.sizes[i];
-        if (static_cast<int>(usable.size()) < n) continue;
-        const std::vector<LrfObservation> first(usable.begin(), usable.begin() + n);
-        const LrfSolution solution = SolveLrf(first, solver);
-        if (!solution.ok) continue;
-        const PoseError e = ComputePoseError(solution.cam_from_lrf, sim.cam_from_lrf);
-        run.errors[m][i] = std::make_pair(e.rotation_rad * 180.0 / M_PI, e.translation_m * 1e3);
-      }
-    }
-  };
+  auto run_seed = [&](size_t s) { runs[s] = RunSeed(options, max_size, s); };
   ParallelFor(runs.size(), options.pipeline.threads, run_seed, [&](int finished, size_t) {
     if (progress) progress(finished, options.seeds);
   });

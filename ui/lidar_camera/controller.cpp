@@ -41,6 +41,28 @@ std::vector<int> CirclePixels(int rows, int columns, int row, int column, float 
   return pixels;
 }
 
+// The brush a loading pair starts with: the session's painted brush (`painted`, null when none)
+// replaces the seed; otherwise the seed selects the region and the brush only pictures it (as
+// EditsFromSession tells `calibench calibrate --session`). A mask painted on another image layout
+// would mark other returns: it is refused, not reread, and the returned text says why (empty
+// when nothing was refused).
+std::string StartBrush(const PairEntry& entry, const LidarCloud& cloud, const LidarImage& image,
+                       const BrushMask* painted, const std::vector<int>& painted_pixels,
+                       PairView* loaded) {
+  std::string dropped;
+  if (painted && BrushFitsImage(*painted, image.rows, image.columns, &dropped)) {
+    loaded->brush_pixels = painted_pixels;
+    return "";
+  }
+  if (entry.lidar_seed) {
+    loaded->brush_pixels = SeedBrush(cloud, image, *entry.lidar_seed);
+    loaded->brush_from_seed = true;
+  }
+  if (!painted) return "";
+  return "pair " + entry.id + ": its brush from the session was dropped: " + entry.cloud.string() +
+         ": " + dropped;
+}
+
 }  // namespace
 
 Controller::Controller(PipelineOptions options) : pipeline_(std::move(options)) {}
@@ -241,6 +263,19 @@ void Controller::Autosave() {
   }
 }
 
+void Controller::OnAllPairsLoaded() {
+  worker_.Enqueue([this] { DetectWithBackground(); });
+  // What went wrong while loading stays on the status line (in the warning colour).
+  std::string loaded_line = "loaded " + std::to_string(state_.loading_total) + " pairs";
+  if (!open_note_.empty()) loaded_line += "; " + open_note_;
+  for (const std::string& warning : load_warnings_) loaded_line += "; " + warning;
+  SetStatus(loaded_line, !load_warnings_.empty());
+  load_warnings_.clear();
+  // A reopened session with a result shows its reprojection again.
+  const int selected = state_.selected;
+  if (state_.solver.result) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
+}
+
 void Controller::LoadPair(int index) {
   PairEntry entry;
   Dataset dataset;
@@ -274,22 +309,9 @@ void Controller::LoadPair(int index) {
     loaded.detection = std::move(camera.detection);
     loaded.camera = std::move(camera.observation);
     loaded.camera_failure = camera.failure;
-    // A painted brush replaces the seed; otherwise the seed selects the region and the brush
-    // only pictures it (as EditsFromSession tells `calibench calibrate --session`).
-    // A mask painted on another image layout would mark other returns: refused, not reread.
-    if (painted &&
-        !BrushFitsImage(*saved_mask, lidar_image->rows, lidar_image->columns, &brush_dropped)) {
-      brush_dropped = "pair " + entry.id +
-                      ": its brush from the session was dropped: " + entry.cloud.string() + ": " +
-                      brush_dropped;
-      painted = false;
-    }
-    if (painted) {
-      loaded.brush_pixels = saved_brush;
-    } else if (entry.lidar_seed) {
-      loaded.brush_pixels = SeedBrush(*cloud, *lidar_image, *entry.lidar_seed);
-      loaded.brush_from_seed = true;
-    }
+    brush_dropped = StartBrush(entry, *cloud, *lidar_image, painted ? &*saved_mask : nullptr,
+                               saved_brush, &loaded);
+    painted = painted && brush_dropped.empty();
     loaded.cloud = cloud;
     loaded.lidar_image = lidar_image;
     // The camera view shows the selected pair's image: decoded once, here.
@@ -326,19 +348,7 @@ void Controller::LoadPair(int index) {
       pair.status = PairStatus::kFailed;
       pair.reason = pair.camera_failure;
     }
-    if (state_.loading_done == state_.loading_total) {
-      worker_.Enqueue([this] { DetectWithBackground(); });
-      // What went wrong while loading stays on the status line (in the warning colour).
-      std::string loaded_line = "loaded " + std::to_string(state_.loading_total) + " pairs";
-      if (!open_note_.empty()) loaded_line += "; " + open_note_;
-      for (const std::string& warning : load_warnings_) loaded_line += "; " + warning;
-      SetStatus(loaded_line, !load_warnings_.empty());
-      load_warnings_.clear();
-      // A reopened session with a result shows its reprojection again.
-      const int selected = state_.selected;
-      if (state_.solver.result)
-        worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
-    }
+    if (state_.loading_done == state_.loading_total) OnAllPairsLoaded();
   }
   if (refit_now) RefitLidar(index);
 }

@@ -165,6 +165,9 @@ class Controller : public ControllerState<Snapshot> {
  private:
   void LoadAllPairs();
   void LoadPair(int index);
+  // After the last pair loaded (mutex_ held): detection, the status line with what loading
+  // noted or refused, the reopened session's reprojection.
+  void OnAllPairsLoaded();
   void RefitLidar(int index);
   // Once every pair is loaded: the background model over their clouds, then detection for the
   // pairs without a seed or a brush (worker thread).
