@@ -14,6 +14,9 @@ void AddSimFlags(CLI::App& app, SimFlags& flags) {
   app.add_option("--camera", flags.camera, "pinhole | fisheye (default: the preset's)");
   app.add_option("--board", flags.board,
                  "a3 | a4 | paper | charuco-a3 | charuco-a4 (default: the preset's)");
+  app.add_option("--image-size", flags.image_size,
+                 "camera image WxH in pixels, the default camera's field of view kept "
+                 "(default: 1440x1080)");
   app.add_option("--pairs", flags.pairs, "number of pairs (default: the preset's)");
   app.add_option("--lidar-noise", flags.lidar_noise, "LiDAR range noise sigma [m]");
   app.add_option("--lidar-range-offset", flags.lidar_range_offset,
@@ -48,6 +51,26 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
     options->fisheye = flags.camera == "fisheye";
     options->camera = CameraModel{};  // the default camera of that kind
     options->camera.width = 0;
+  }
+  if (!flags.image_size.empty()) {
+    int width = 0, height = 0;
+    char x = 0, rest = 0;
+    if (std::sscanf(flags.image_size.c_str(), "%d%c%d%c", &width, &x, &height, &rest) != 3 ||
+        x != 'x' || width < 64 || height < 64 || width > 20000 || height > 20000) {
+      *why = "--image-size must be WxH with sides in [64, 20000], got '" + flags.image_size + "'";
+      return false;
+    }
+    // The default camera of the chosen kind, its focal length scaled with the width.
+    CameraModel camera =
+        options->camera.width ? options->camera : DefaultSimCamera(options->fisheye);
+    const double scale = static_cast<double>(width) / camera.width;
+    camera.fx *= scale;
+    camera.fy *= scale;
+    camera.cx = 0.5 * (width - 1);
+    camera.cy = 0.5 * (height - 1);
+    camera.width = width;
+    camera.height = height;
+    options->camera = camera;
   }
   if (!flags.board.empty()) {
     try {

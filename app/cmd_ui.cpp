@@ -48,7 +48,7 @@ bool OpenInput(
     const char* command,
     ui::Controller::ExistingSession existing = ui::Controller::ExistingSession::kReplace) {
   if (!session.empty()) {
-    controller.OpenSession(session);
+    controller.OpenSession(session, existing != ui::Controller::ExistingSession::kInMemory);
   } else if (!dataset.empty()) {
     controller.OpenDataset(dataset, {}, existing);
   } else {
@@ -62,6 +62,17 @@ bool OpenInput(
 ui::WindowOptions WindowOptionsOf(int width, int height, const char* title,
                                   const std::string& screenshot, const GuiWindowFlags& quit) {
   return {width, height, title, quit.after_frames, !screenshot.empty(), quit.after_seconds};
+}
+
+// The last save failed (the window showed it on its status line): say so on stderr too, with
+// an exit code, so that a script or a terminal user does not take the session for saved.
+int ReportSaveFailure(ui::Controller& controller, const char* command) {
+  controller.WaitIdle();
+  const ui::Snapshot snapshot = controller.GetSnapshot();
+  if (snapshot.save_error.empty()) return kOk;
+  std::fprintf(stderr, "calibench %s: the session was not saved: %s\n", command,
+               snapshot.save_error.c_str());
+  return kInputError;
 }
 
 // The exit code of a window run; writes the screenshot it captured.
@@ -147,10 +158,11 @@ int RunGuiWindow(const std::string& dataset, const std::string& session, int wid
                  quit.fresh ? ui::Controller::ExistingSession::kStartFresh
                             : ui::Controller::ExistingSession::kResume))
     return kUsage;
-  return FinishWindow(ui::RunWorkbenchWindow<ui::Workbench>(
-                          WindowOptionsOf(width, height, "Calibench", screenshot, quit), controller,
-                          ui::Layout::kWorkbench),
-                      screenshot);
+  const int code = FinishWindow(ui::RunWorkbenchWindow<ui::Workbench>(
+                                    WindowOptionsOf(width, height, "Calibench", screenshot, quit),
+                                    controller, ui::Layout::kWorkbench),
+                                screenshot);
+  return code != kOk ? code : ReportSaveFailure(controller, "gui");
 }
 
 int RunGui(int argc, char** argv) {
@@ -183,7 +195,8 @@ int RunGui(int argc, char** argv) {
 
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
                    bool solve, const std::string& view, int width, int height,
-                   const std::string& out, const std::string& backend_name) {
+                   const std::string& out, const std::string& backend_name,
+                   const std::string& save_session) {
   gfx::HeadlessBackend backend;
   const ui::HeadlessShot shot{pair, solve, width, height};
   const bool lrf = !dataset.empty() && IsLrfManifest(dataset);
@@ -200,11 +213,19 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
   const auto context = OpenHeadless(backend, "calibench render: no headless OpenGL");
   if (!context) return kInputError;
   ui::Controller controller;
-  if (!OpenInput(controller, dataset, session, "render")) return kUsage;
+  // Render draws; it leaves session files alone (a dataset's session may be an hour of work).
+  if (!OpenInput(controller, dataset, session, "render",
+                 ui::Controller::ExistingSession::kInMemory))
+    return kUsage;
   const auto picture =
       ui::RenderShot<ui::Workbench, ui::SelectPair, ui::RunSolver>(controller, layout, shot);
-  return SaveShot(picture, shot, view, out, controller.GetSnapshot().dataset_path.string(),
-                  *context);
+  const int code =
+      SaveShot(picture, shot, view, out, controller.GetSnapshot().dataset_path.string(), *context);
+  if (code != kOk || save_session.empty()) return code;
+  controller.Apply(ui::SaveSessionAs{std::filesystem::absolute(save_session)});
+  if (const int saved = ReportSaveFailure(controller, "render"); saved != kOk) return saved;
+  std::printf("wrote %s\n", save_session.c_str());
+  return kOk;
 }
 
 int RenderDemoViews(const std::string& dataset, const std::string& out_dir) {
@@ -232,6 +253,7 @@ int RenderDemoViews(const std::string& dataset, const std::string& out_dir) {
                                                 view.width, view.height, 4));
     std::printf("rendered %s\n", path.c_str());
   }
+  if (const int code = ReportSaveFailure(controller, "demo"); code != kOk) return code;
   std::printf("session: %s/calibench.session.json (open it with `calibench gui --session ...`)\n",
               out_dir.c_str());
   return kOk;
@@ -254,9 +276,13 @@ int RunRender(int argc, char** argv) {
   app.add_option("--size", size, "WxH")->capture_default_str();
   app.add_option("--out,-o", out, "PNG file")->required();
   app.add_option("--gl", gl, "auto | egl | osmesa")->capture_default_str();
+  std::string save_session;
+  app.add_option("--save-session", save_session,
+                 "write the session (with --solve, its result) to this file; render writes no "
+                 "session otherwise and leaves the one beside the dataset alone");
   int width = 0, height = 0;
   if (const auto code = ParseFlags(app, argc, argv, size, "render", &width, &height)) return *code;
-  return RenderHeadless(dataset, session, pair, solve, view, width, height, out, gl);
+  return RenderHeadless(dataset, session, pair, solve, view, width, height, out, gl, save_session);
 }
 
 }  // namespace calibench::app

@@ -12,6 +12,7 @@ namespace calibench::app {
 struct SimFlags {
   std::string preset = "default";
   std::string lidar, camera, board;
+  std::string image_size;   // "WxH": the preset's camera scaled to it; empty = 1440x1080
   int pairs = 0;            // 0 = the preset's
   double lidar_noise = -1;  // < 0 = the preset's
   double lidar_range_offset = 0;

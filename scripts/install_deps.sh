@@ -6,11 +6,16 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build ccache pkg-config git
   libeigen3-dev libopencv-dev libopencv-contrib-dev libpcl-dev nlohmann-json3-dev libcli11-dev
-  libyaml-cpp-dev
+  libyaml-cpp-dev libtinyxml2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libglfw3-dev libimgui-dev libegl-dev libgl-dev libgles-dev libosmesa6-dev
   xvfb xauth fonts-dejavu-core
 )
+# Only for the robustness scripts: scripts/fuzz.sh (libFuzzer) and scripts/sanitize.sh (valgrind).
+case "${1:-}" in
+  --fuzz) PACKAGES+=(clang-14 libclang-rt-14-dev) ;;
+  --sanitize) PACKAGES+=(valgrind) ;;
+esac
 
 missing=()
 for p in "${PACKAGES[@]}"; do

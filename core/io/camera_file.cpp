@@ -1,11 +1,12 @@
 // LoadCameraFile (core/io/camera_file.h): intrinsics from OpenCV FileStorage, ROS
 // camera_calibration / CameraInfo YAML and Kalibr camchain files. Every file becomes one
 // YAML::Node tree (yaml-cpp for all YAML, OpenCV's %YAML:1.0 files included: it ignores the
-// unknown directive and keeps the !!opencv-matrix tags; cv::FileStorage for XML), then one
+// unknown directive and keeps the !!opencv-matrix tags; tinyxml2 for XML), then one
 // interpreter picks the format by its keys. Both parsers recurse, so the nesting of the text is
 // measured before either sees it.
 #include "core/io/camera_file.h"
 
+#include <tinyxml2.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -13,11 +14,11 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
-#include <opencv2/core.hpp>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
+#include <vector>
 
 #include "core/base/types.h"
 
@@ -206,7 +207,7 @@ size_t MarkupEnd(std::string_view text, size_t i) {
   return std::string_view::npos;
 }
 
-// Element nesting of XML text, as cv::FileStorage's recursive XML parser would meet it.
+// Element nesting of XML text, measured before the parser (which recurses) meets it.
 void CheckXmlNesting(std::string_view text) {
   int depth = 0;
   for (size_t i = text.find('<'); i != std::string_view::npos; i = text.find('<', i + 1)) {
@@ -222,7 +223,7 @@ void CheckXmlNesting(std::string_view text) {
   }
 }
 
-// " (line N)" for a node read from YAML text; nothing for nodes built from OpenCV's XML.
+// " (line N)" for a node read from YAML text; nothing for nodes built from XML.
 std::string LineOf(const YAML::Node& node) {
   const YAML::Mark mark = node.Mark();
   return mark.is_null() ? "" : " (line " + std::to_string(mark.line + 1) + ")";
@@ -244,42 +245,68 @@ YAML::Node ParseYaml(const std::string& text) {
   }
 }
 
-YAML::Node FromFileNode(const cv::FileNode& node) {
-  if (node.isMap() || node.isSeq()) {
-    YAML::Node out(node.isMap() ? YAML::NodeType::Map : YAML::NodeType::Sequence);
-    for (cv::FileNodeIterator it = node.begin(); it != node.end(); ++it) {
-      const cv::FileNode child = *it;
-      if (node.isMap()) {
-        out.force_insert(child.name(), FromFileNode(child));  // keeps a repeated key visible
-      } else {
-        out.push_back(FromFileNode(child));
-      }
+// One token of an OpenCV XML value: numbers in their shortest exact text (as the YAML files give
+// them), strings without OpenCV's quotes.
+YAML::Node XmlToken(std::string_view token) {
+  if (token.size() >= 2 && token.front() == '"' && token.back() == '"')
+    return YAML::Node(std::string(token.substr(1, token.size() - 2)));
+  double value = 0.0;
+  const auto parsed = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (parsed.ec == std::errc() && parsed.ptr == token.data() + token.size()) {
+    char buffer[64];
+    const auto written = std::to_chars(buffer, buffer + sizeof(buffer), value);
+    return YAML::Node(std::string(buffer, written.ptr));
+  }
+  return YAML::Node(std::string(token));
+}
+
+// An element of OpenCV's XML storage format as the YAML tree of the same file: child elements
+// named "_" are a list, other children a map (a repeated name kept visible); text is one value,
+// or a list when it holds several (matrix data, which is always a list).
+YAML::Node FromXmlElement(const tinyxml2::XMLElement& element) {
+  const tinyxml2::XMLElement* child = element.FirstChildElement();
+  if (child != nullptr) {
+    const bool list = std::string_view(child->Name()) == "_";
+    YAML::Node out(list ? YAML::NodeType::Sequence : YAML::NodeType::Map);
+    for (; child != nullptr; child = child->NextSiblingElement()) {
+      if (list)
+        out.push_back(FromXmlElement(*child));
+      else
+        out.force_insert(std::string(child->Name()), FromXmlElement(*child));
     }
     return out;
   }
-  if (node.isInt() || node.isReal()) {
-    char buffer[64];
-    // Shortest text that reads back as the same double: no digits lost on the way.
-    const double value =
-        node.isInt() ? static_cast<double>(static_cast<int>(node)) : static_cast<double>(node);
-    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-    return YAML::Node(std::string(buffer, result.ptr));
+  const char* text = element.GetText();
+  std::vector<std::string_view> tokens;
+  for (std::string_view rest = text ? text : ""; !rest.empty();) {
+    const size_t start = rest.find_first_not_of(" \t\r\n");
+    if (start == std::string_view::npos) break;
+    const size_t end = std::min(rest.size(), rest.find_first_of(" \t\r\n", start));
+    tokens.push_back(rest.substr(start, end - start));
+    rest = rest.substr(end);
   }
-  if (node.isString()) return YAML::Node(static_cast<std::string>(node));
-  return YAML::Node();
+  if (tokens.size() == 1 && std::string_view(element.Name()) != "data") return XmlToken(tokens[0]);
+  YAML::Node out(YAML::NodeType::Sequence);
+  for (const std::string_view token : tokens) out.push_back(XmlToken(token));
+  return out;
 }
 
-// An XML file read by cv::FileStorage.
-YAML::Node ReadXmlWithOpenCv(const std::filesystem::path& path) {
-  try {
-    cv::FileStorage storage(path.string(), cv::FileStorage::READ);
-    if (!storage.isOpened()) throw Problem("OpenCV cannot read this XML file");
-    return FromFileNode(storage.root());
-  } catch (const cv::Exception& e) {
-    // OpenCV's parsers put "file(line): problem" in `func` and their own name in `err`.
-    throw Problem("OpenCV cannot read this XML file: " +
-                  (e.code == cv::Error::StsParseError ? e.func : e.err));
+// An OpenCV FileStorage XML file (<opencv_storage> ...), read with tinyxml2. Not with
+// cv::FileStorage: OpenCV 4.6's XML parser dereferences null on malformed text (found by
+// fuzzing: "<?xml ver4=" crashes it).
+YAML::Node ReadOpenCvXml(const std::string& text) {
+  tinyxml2::XMLDocument document;
+  if (document.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS) {
+    throw Problem("not valid XML: line " + std::to_string(document.ErrorLineNum()) + ": " +
+                  document.ErrorName());
   }
+  const tinyxml2::XMLElement* root = document.RootElement();
+  if (root == nullptr || std::string_view(root->Name()) != "opencv_storage")
+    throw Problem("an XML camera file must be OpenCV FileStorage (<opencv_storage>)");
+  YAML::Node tree = FromXmlElement(*root);
+  if (!tree.IsMap() && !(tree.IsSequence() && tree.size() == 0))
+    throw Problem("<opencv_storage> holds no named fields");
+  return tree.IsMap() ? tree : YAML::Node(YAML::NodeType::Map);
 }
 
 std::string ReadText(const std::filesystem::path& path) {
@@ -576,7 +603,7 @@ CameraModel LoadCameraFile(const std::filesystem::path& path) {
     const size_t first = text.find_first_not_of(" \t\r\n");
     if (first != std::string::npos && text[first] == '<') {
       CheckXmlNesting(text);
-      return Interpret(ReadXmlWithOpenCv(path), /*opencv_file=*/true);
+      return Interpret(ReadOpenCvXml(text), /*opencv_file=*/true);
     }
     CheckYamlText(text);
     // OpenCV's FileStorage writes this header (not valid YAML 1.x; yaml-cpp skips it).

@@ -204,9 +204,15 @@ void CloseAfterWriting(std::ofstream& out, const std::filesystem::path& path) {
 namespace {
 
 // KITTI velodyne .bin: a headerless array of float32 x y z reflectance.
-LidarCloud LoadKittiBin(const std::filesystem::path& path) {
-  const std::string bytes = ReadWholeFile(path);
+LidarCloud LoadKittiBin(const std::filesystem::path& path, const LoadLimits& limits) {
   constexpr size_t kRecord = 4 * sizeof(float);
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec)  // the size is its header: refused before it is read
+    CheckLoadLimit(path, "the point count (file size / 16)",
+                   static_cast<std::int64_t>(size / kRecord), limits.max_cloud_points,
+                   "max_cloud_points");
+  const std::string bytes = ReadWholeFile(path);
   if (bytes.size() % kRecord != 0)
     Fail(path, "size " + std::to_string(bytes.size()) +
                    " bytes is not a multiple of 16 (float32 x y z intensity per point)");
@@ -233,11 +239,11 @@ std::string LowerExtension(const std::filesystem::path& path) {
 }  // namespace
 }  // namespace cloud_io_detail
 
-LidarCloud LoadCloud(const std::filesystem::path& path) {
+LidarCloud LoadCloud(const std::filesystem::path& path, const LoadLimits& limits) {
   const std::string ext = cloud_io_detail::LowerExtension(path);
-  if (ext == ".pcd") return cloud_io_detail::LoadPcd(path);
-  if (ext == ".ply") return cloud_io_detail::LoadPly(path);
-  if (ext == ".bin") return cloud_io_detail::LoadKittiBin(path);
+  if (ext == ".pcd") return cloud_io_detail::LoadPcd(path, limits);
+  if (ext == ".ply") return cloud_io_detail::LoadPly(path, limits);
+  if (ext == ".bin") return cloud_io_detail::LoadKittiBin(path, limits);
   cloud_io_detail::Fail(path, "unknown cloud extension '" + path.extension().string() +
                                   "' (expected .pcd, .ply or .bin)");
 }

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 
+#include "core/io/load_limits.h"
 #include "core/lidar/cloud.h"
 
 namespace calibench {
@@ -11,8 +12,9 @@ namespace calibench {
 // .bin (float32 x y z intensity) by extension. x, y, z are required; `ring` may have any integer
 // type. Points with NaN/inf coordinates are dropped (organized clouds keep their grid only when
 // nothing was dropped). Throws IoError naming the file and the problem (missing file, truncated
-// data, no x/y/z field, unsupported layout, no finite points).
-LidarCloud LoadCloud(const std::filesystem::path& path);
+// data, no x/y/z field, unsupported layout, no finite points, more points declared than
+// limits.max_cloud_points: refused from the header, before the points are read).
+LidarCloud LoadCloud(const std::filesystem::path& path, const LoadLimits& limits = {});
 
 enum class PcdEncoding { kAscii, kBinary, kBinaryCompressed };
 // Writes x y z [intensity] [ring (uint16)] [range]. Throws IoError on failure.

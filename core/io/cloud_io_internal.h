@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/io/load_limits.h"
 #include "core/lidar/cloud.h"
 
 namespace calibench::cloud_io_detail {
@@ -71,7 +72,7 @@ void AppendBytes(std::string* out, T value) {
   out->append(reinterpret_cast<const char*>(&value), sizeof(T));
 }
 
-LidarCloud LoadPcd(const std::filesystem::path& path);
-LidarCloud LoadPly(const std::filesystem::path& path);
+LidarCloud LoadPcd(const std::filesystem::path& path, const LoadLimits& limits);
+LidarCloud LoadPly(const std::filesystem::path& path, const LoadLimits& limits);
 
 }  // namespace calibench::cloud_io_detail

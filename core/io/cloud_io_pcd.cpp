@@ -301,12 +301,14 @@ void ReadCompressed(const std::filesystem::path& path, const std::string& bytes,
 
 }  // namespace
 
-LidarCloud LoadPcd(const std::filesystem::path& path) {
+LidarCloud LoadPcd(const std::filesystem::path& path, const LoadLimits& limits) {
   const std::string bytes = ReadWholeFile(path);
   PcdHeader header;
   const RawHeader raw = ReadRawHeader(path, bytes, &header);
   ParseFields(path, raw, &header);
   ParseLayout(path, raw, &header);
+  CheckLoadLimit(path, "POINTS", static_cast<std::int64_t>(header.points), limits.max_cloud_points,
+                 "max_cloud_points");
   bool has[kNumRoles];
   HasRoles(header, has);
   CloudBuilder builder(path, has, std::min<size_t>(header.points, bytes.size()));

@@ -190,7 +190,7 @@ class PlyBodyReader {
 
 }  // namespace
 
-LidarCloud LoadPly(const std::filesystem::path& path) {
+LidarCloud LoadPly(const std::filesystem::path& path, const LoadLimits& limits) {
   const std::string bytes = ReadWholeFile(path);
   const PlyHeader header = ParsePlyHeader(path, bytes);
   PlyBodyReader reader(path, bytes, header);
@@ -208,6 +208,8 @@ LidarCloud LoadPly(const std::filesystem::path& path) {
       if (!has[role])
         Fail(path, std::string("PLY vertex element has no '") + "xyz"[role] + "' property");
     }
+    CheckLoadLimit(path, "the vertex count", static_cast<std::int64_t>(element.count),
+                   limits.max_cloud_points, "max_cloud_points");
     CloudBuilder builder(path, has, std::min<uint64_t>(element.count, bytes.size()));
     for (uint64_t row = 0; row < element.count; ++row) {
       reader.ReadRow(element, row, values);

@@ -13,19 +13,50 @@ namespace fs = std::filesystem;
   throw IoError(file.string() + ": " + problem);
 }
 
-json ReadJson(const fs::path& path) {
+json ReadJson(const fs::path& path, std::uintmax_t max_bytes) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (status.type() == fs::file_type::not_found) Fail(path, "no such file");
   if (ec) Fail(path, "cannot read: " + ec.message());
   if (fs::is_directory(status)) Fail(path, "is a folder, not a JSON file");
   if (!fs::is_regular_file(status)) Fail(path, "is not a regular file (a FIFO or a device?)");
-  std::ifstream in(path);
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (!ec && size > max_bytes)
+    Fail(path, std::to_string(size) + " bytes is over the limit of " + std::to_string(max_bytes) +
+                   " for this kind of JSON file");
+  std::ifstream in(path, std::ios::binary);
   if (!in) Fail(path, "cannot open file");
+  std::string text(static_cast<size_t>(size), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  text.resize(static_cast<size_t>(in.gcount()));
+  CheckJsonNesting(path, text);
   try {
-    return json::parse(in);
+    return json::parse(text);
   } catch (const json::exception& e) {
     Fail(path, std::string("not valid JSON: ") + e.what());
+  }
+}
+
+void CheckJsonNesting(const fs::path& path, std::string_view text) {
+  int depth = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\')
+        ++i;  // an escaped character, a quote included
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonNesting)
+        Fail(path,
+             "nested deeper than " + std::to_string(kMaxJsonNesting) +
+                 " levels; no Calibench file is (refused before parsing: the parser recurses)");
+    } else if (c == ']' || c == '}') {
+      depth = std::max(0, depth - 1);
+    }
   }
 }
 

@@ -21,8 +21,18 @@ using nlohmann::json;
 
 [[noreturn]] void Fail(const std::filesystem::path& file, const std::string& problem);
 
-// Parses a JSON file; IoError when missing, unreadable or not JSON.
-json ReadJson(const std::filesystem::path& path);
+// Calibench's JSON files nest a handful of levels; nlohmann's parser recurses, so text nested
+// deeper than this is refused before it runs (100,000 levels would overflow the stack).
+constexpr int kMaxJsonNesting = 64;
+// Manifests, sessions, results and scans stay far below this (a 40-pair session with brushes is
+// about 1 MB).
+constexpr std::uintmax_t kMaxJsonBytes = 256ull << 20;
+
+// Parses a JSON file; IoError when missing, unreadable, larger than max_bytes, nested deeper
+// than kMaxJsonNesting, or not JSON.
+json ReadJson(const std::filesystem::path& path, std::uintmax_t max_bytes = kMaxJsonBytes);
+// IoError naming `path` when `text` nests arrays and objects deeper than kMaxJsonNesting.
+void CheckJsonNesting(const std::filesystem::path& path, std::string_view text);
 
 // IoError "<what>: <why>" naming the file unless spec.Check(&why) passes (targets, intrinsics).
 template <typename Spec>

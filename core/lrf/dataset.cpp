@@ -9,6 +9,7 @@
 #include "core/base/atomic_file.h"
 #include "core/geometry/geometry.h"
 #include "core/io/cloud_io.h"
+#include "core/io/image_io.h"
 #include "core/io/json_io.h"
 #include "core/lidar/cloud.h"
 
@@ -119,8 +120,10 @@ double RangeFromJson(const json& value, const fs::path& file, size_t index) {
        "ranges[" + std::to_string(index) + "] is neither a number, null, \"inf\" nor \"nan\"");
 }
 
-LaserScan LoadScanJson(const fs::path& path) {
-  const json document = json_io::ReadJson(path);
+LaserScan LoadScanJson(const fs::path& path, const LoadLimits& limits) {
+  // The file's size bounds its rays before it is parsed: a range takes at least 2 bytes ("1,").
+  const json document = json_io::ReadJson(
+      path, static_cast<std::uintmax_t>(limits.max_scan_points) * 32 + (64 << 10));
   const Fields root(document, path);
   LaserScan scan;
   scan.angle_min = root.Number("angle_min");
@@ -129,6 +132,8 @@ LaserScan LoadScanJson(const fs::path& path) {
   scan.range_max = root.Number("range_max");
   const json& ranges = root.Array("ranges");
   if (ranges.empty()) Fail(path, "'ranges' is empty");
+  CheckLoadLimit(path, "the number of ranges", static_cast<std::int64_t>(ranges.size()),
+                 limits.max_scan_points, "max_scan_points");
   for (size_t i = 0; i < ranges.size(); ++i)
     scan.ranges.push_back(RangeFromJson(ranges[i], path, i));
   if (!std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment) ||
@@ -140,8 +145,10 @@ LaserScan LoadScanJson(const fs::path& path) {
 }
 
 // A 2D PCD: the points are binned by angle into an evenly spaced scan (lrf_dataset.h).
-LaserScan LoadScanPcd(const fs::path& path) {
-  const LidarCloud cloud = LoadCloud(path);
+LaserScan LoadScanPcd(const fs::path& path, const LoadLimits& limits) {
+  LoadLimits scan_limits = limits;
+  scan_limits.max_cloud_points = limits.max_scan_points;
+  const LidarCloud cloud = LoadCloud(path, scan_limits);
   struct Return {
     double angle, range;
   };
@@ -167,6 +174,11 @@ LaserScan LoadScanPcd(const fs::path& path) {
   scan.angle_min = returns.front().angle;
   scan.angle_increment = steps[steps.size() / 2];
   const double span = (returns.back().angle - scan.angle_min) / scan.angle_increment;
+  // Angles that spread unevenly (a few returns far apart, two very close) would make a scan of
+  // billions of bins.
+  CheckLoadLimit(path, "the number of bins at the median angle step",
+                 static_cast<std::int64_t>(std::min(span, 1e18)) + 1, limits.max_scan_points,
+                 "max_scan_points");
   scan.ranges.assign(static_cast<size_t>(std::llround(span)) + 1,
                      std::numeric_limits<double>::quiet_NaN());
   // Real drivers jitter in angle (ACFR-RPG: 0.60–0.66° around a 0.71° median), so two returns can
@@ -267,12 +279,12 @@ void SaveLrfDataset(const fs::path& manifest_path, const LrfDataset& dataset) {
   WriteFileAtomically(manifest_path, root.dump(2) + "\n");
 }
 
-LaserScan LoadLaserScan(const fs::path& path) {
+LaserScan LoadLaserScan(const fs::path& path, const LoadLimits& limits) {
   if (!fs::exists(path)) Fail(path, "no such file");
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  if (ext == ".json") return LoadScanJson(path);
-  if (ext == ".pcd") return LoadScanPcd(path);
+  if (ext == ".json") return LoadScanJson(path, limits);
+  if (ext == ".pcd") return LoadScanPcd(path, limits);
   Fail(path, "unsupported scan file extension '" + ext + "' (use .json or .pcd)");
 }
 
@@ -291,14 +303,27 @@ void SaveLaserScanJson(const fs::path& path, const LaserScan& scan) {
   WriteFileAtomically(path, root.dump() + "\n");
 }
 
-DepthImage LoadDepthPng(const fs::path& path, const DepthIntrinsics& intrinsics) {
-  if (!fs::exists(path)) Fail(path, "no such file");
+DepthImage LoadDepthPng(const fs::path& path, const DepthIntrinsics& intrinsics,
+                        const LoadLimits& limits) {
   json_io::CheckOrFail(intrinsics, path, "depth intrinsics");
+  const std::string bytes = ReadImageFile(path);
+  // The size from the header, before anything is decoded: a 540 KB PNG can declare 16000^2.
+  const ImageHeader header = ReadImageHeader(path, bytes);
+  if (std::string_view(header.format) != "PNG")
+    Fail(path, std::string("a depth image must be a 16-bit PNG, this is a ") + header.format);
+  CheckLoadLimit(path, "depth pixels", header.Pixels(), limits.max_depth_pixels,
+                 "max_depth_pixels");
+  if (header.width != intrinsics.width || header.height != intrinsics.height)
+    Fail(path, "depth PNG is " + std::to_string(header.width) + "x" +
+                   std::to_string(header.height) + " but the depth camera is " +
+                   std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height));
   cv::Mat image;
   try {
-    image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1,
+                          const_cast<char*>(bytes.data()));
+    image = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
-    Fail(path, std::string("cannot decode the image: ") + e.what());
+    Fail(path, std::string("cannot decode the image: ") + e.err);
   }
   if (image.empty()) Fail(path, "cannot decode the image (not a PNG?)");
   if (image.depth() != CV_16U || image.channels() != 1)
@@ -357,8 +382,12 @@ void SaveDepthPng(const fs::path& path, const DepthImage& depth) {
   WriteFileAtomically(path, std::string(bytes.begin(), bytes.end()));
 }
 
-DepthImage LoadDepthCloud(const fs::path& path, const DepthIntrinsics& intrinsics) {
+DepthImage LoadDepthCloud(const fs::path& path, const DepthIntrinsics& intrinsics,
+                          const LoadLimits& limits) {
   json_io::CheckOrFail(intrinsics, path, "depth intrinsics");
+  CheckLoadLimit(path, "the depth camera's pixels (width x height)",
+                 static_cast<std::int64_t>(intrinsics.width) * intrinsics.height,
+                 limits.max_depth_pixels, "max_depth_pixels");
   const LidarCloud cloud = LoadCloud(path);
   DepthImage depth;
   depth.intrinsics = intrinsics;

@@ -18,6 +18,7 @@
 
 #include "core/camera/camera.h"
 #include "core/io/dataset.h"
+#include "core/io/load_limits.h"
 #include "core/lrf/types.h"
 
 namespace calibench {
@@ -70,17 +71,20 @@ void SaveLrfDataset(const std::filesystem::path& manifest_path, const LrfDataset
 // A scan from a LaserScan JSON (null / "inf" / "nan" = no return) or a 2D PCD (x y [z] …;
 // points at the origin are no returns; the points are binned by angle into an evenly spaced
 // scan whose increment is the median angular spacing). Throws IoError naming the file.
-LaserScan LoadLaserScan(const std::filesystem::path& path);
+LaserScan LoadLaserScan(const std::filesystem::path& path, const LoadLimits& limits = {});
 void SaveLaserScanJson(const std::filesystem::path& path, const LaserScan& scan);
 
 // A 16-bit single-channel PNG scaled by intrinsics.depth_scale (0 = no data). Throws IoError
-// naming the file when it is not 16-bit single-channel or its size differs from the intrinsics.
-DepthImage LoadDepthPng(const std::filesystem::path& path, const DepthIntrinsics& intrinsics);
+// naming the file when it is not 16-bit single-channel or its size differs from the intrinsics
+// (both read from the PNG header before decoding), or has more than limits.max_depth_pixels.
+DepthImage LoadDepthPng(const std::filesystem::path& path, const DepthIntrinsics& intrinsics,
+                        const LoadLimits& limits = {});
 // Writes a 16-bit PNG (depth / depth_scale, rounded; values beyond 65535 units become 0).
 void SaveDepthPng(const std::filesystem::path& path, const DepthImage& depth);
 // A PCD in the depth-camera frame, projected by the intrinsics into a depth image (nearest z
 // wins). Throws IoError naming the file.
-DepthImage LoadDepthCloud(const std::filesystem::path& path, const DepthIntrinsics& intrinsics);
+DepthImage LoadDepthCloud(const std::filesystem::path& path, const DepthIntrinsics& intrinsics,
+                          const LoadLimits& limits = {});
 
 // The depth of a pair (PNG or cloud, whichever the entry names).
 DepthImage LoadPairDepth(const LrfDataset& dataset, const LrfPairEntry& pair);

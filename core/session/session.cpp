@@ -3,11 +3,14 @@
 #include "core/session/session.h"
 
 #include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include "core/base/atomic_file.h"
+#include "core/io/json_io.h"
 
 namespace calibench {
 
@@ -122,6 +125,15 @@ PairEdits EditsFromSession(const Session& session) {
 }
 
 Session LoadSession(const std::filesystem::path& path) {
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  if (status.type() == std::filesystem::file_type::not_found)
+    throw IoError(path.string() + ": no such session file");
+  if (!std::filesystem::is_regular_file(status))  // a FIFO would block, a device never end
+    throw IoError(path.string() + ": not a regular file (a folder, a FIFO or a device?)");
+  if (std::filesystem::file_size(path, error) > json_io::kMaxJsonBytes)
+    throw IoError(path.string() + ": larger than any session file (" +
+                  std::to_string(json_io::kMaxJsonBytes >> 20) + " MiB)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path.string() + ": cannot open session file");
   std::ostringstream text;
@@ -171,11 +183,53 @@ std::optional<Session> SessionHistory::Redo() {
   return states_[++cursor_];
 }
 
-Autosaver::Autosaver(std::filesystem::path path) : path_(std::move(path)) {}
+bool AutosaveOptions::Check(std::string* why) const {
+  if (backups < 0 || backups > 100) {
+    *why = "backups must be in [0, 100], got " + std::to_string(backups);
+    return false;
+  }
+  if (!(backup_interval_s >= 0.0)) {
+    *why = "backup_interval_s must be >= 0";
+    return false;
+  }
+  return true;
+}
+
+std::filesystem::path SessionBackupPath(const std::filesystem::path& session, int n) {
+  return session.parent_path() /
+         (session.stem().string() + ".backup-" + std::to_string(n) + session.extension().string());
+}
+
+Autosaver::Autosaver(std::filesystem::path path, AutosaveOptions options)
+    : path_(std::move(path)), options_(options) {
+  std::string why;
+  if (!options_.Check(&why)) throw std::invalid_argument("AutosaveOptions: " + why);
+  RemoveStaleTemporaries(path_);
+}
+
+void Autosaver::BackUp() {
+  const double now =
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  if (options_.backups == 0) return;
+  if (last_backup_s_ >= 0.0 && now - last_backup_s_ < options_.backup_interval_s) return;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path_, ec)) return;
+  // Oldest first, so that a kill between two renames loses at most the oldest backup.
+  for (int n = options_.backups - 1; n >= 1; --n)
+    std::filesystem::rename(SessionBackupPath(path_, n), SessionBackupPath(path_, n + 1), ec);
+  const std::filesystem::path newest = SessionBackupPath(path_, 1);
+  std::filesystem::remove(newest, ec);
+  std::filesystem::create_hard_link(path_, newest, ec);
+  if (ec) std::filesystem::copy_file(path_, newest, ec);  // filesystems without hard links
+  if (ec)
+    throw IoError(newest.string() + ": cannot back up the session before saving: " + ec.message());
+  last_backup_s_ = now;
+}
 
 bool Autosaver::Save(const Session& session) {
   std::string text = SessionToJson(session, path_);
   if (has_written_ && text == last_text_) return false;
+  BackUp();
   WriteFileAtomically(path_, text);
   last_text_ = std::move(text);
   has_written_ = true;

@@ -183,10 +183,27 @@ class SessionHistory {
   std::size_t cursor_ = 0;
 };
 
+// How many earlier versions of a session autosave keeps, and how far apart.
+struct AutosaveOptions {
+  // Earlier versions kept as <stem>.backup-1<ext> (newest) ... backup-<backups><ext>; 0 = none.
+  int backups = 5;
+  // Seconds between backups: the first save of a process backs up the file as it found it, later
+  // saves only when the newest backup is at least this old, so the backups span minutes of work
+  // rather than the last few dabs of one brush stroke. 0 = every save.
+  double backup_interval_s = 60.0;
+  bool Check(std::string* why) const;
+};
+
+// The n-th newest backup of a session file (n >= 1).
+std::filesystem::path SessionBackupPath(const std::filesystem::path& session, int n);
+
 // Saves a session to one file whenever its text changed, so it can be called after every edit.
+// Writes are atomic (temporary, fsync, rename); before a write replaces the file, the file becomes
+// the newest backup (a hard link, so no copy) when a backup is due.
 class Autosaver {
  public:
-  explicit Autosaver(std::filesystem::path path);
+  // Removes the temporaries that killed writers left beside `path`.
+  explicit Autosaver(std::filesystem::path path, AutosaveOptions options = {});
 
   // Writes atomically unless the text equals the last one written; true when it wrote. Throws
   // IoError naming the file; a failed write is retried on the next call.
@@ -195,10 +212,14 @@ class Autosaver {
   int writes() const { return writes_; }  // files actually written
 
  private:
+  void BackUp();
+
   std::filesystem::path path_;
+  AutosaveOptions options_;
   std::string last_text_;
   bool has_written_ = false;
   int writes_ = 0;
+  double last_backup_s_ = -1.0;  // steady-clock seconds; < 0 = none yet in this process
 };
 
 }  // namespace calibench

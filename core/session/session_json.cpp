@@ -9,6 +9,7 @@
 
 #include "core/base/names.h"
 #include "core/io/json_fields.h"
+#include "core/io/json_io.h"
 #include "core/session/session.h"
 
 namespace calibench {
@@ -414,6 +415,7 @@ std::string SessionToJson(const Session& session, const std::filesystem::path& s
 }
 
 Session SessionFromJson(const std::string& text, const std::filesystem::path& source_path) {
+  json_io::CheckJsonNesting(source_path, text);  // the parser recurses
   json root;
   try {
     root = json::parse(text);

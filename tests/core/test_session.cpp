@@ -1,6 +1,9 @@
 // The session file: exact round trips, dataset path handling, rejection of broken files without
 // touching them, atomic saves, undo/redo and the autosaver.
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -9,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
+#include <thread>
 
 #include "core/session/session.h"
 #include "tests/test_support.h"
@@ -395,6 +399,85 @@ TEST(SessionTest, AutosaverWritesOnlyWhenTheSessionChanged) {
   EXPECT_EQ(failing.writes(), 0);
   fs::create_directories(dir / "missing");
   EXPECT_TRUE(failing.Save(s));  // retried after the failure, not skipped as unchanged
+}
+
+TEST(SessionTest, AutosaverKeepsTheLastVersionsAsRotatingBackups) {
+  const fs::path dir = test::TempDir("session_backups");
+  const fs::path path = dir / "calibench.session.json";
+  EXPECT_EQ(SessionBackupPath(path, 2), dir / "calibench.session.backup-2.json");
+  AutosaveOptions every_save;
+  every_save.backups = 3;
+  every_save.backup_interval_s = 0.0;
+  Autosaver saver(path, every_save);
+  Session s = FullSession(dir / "dataset.json");
+  for (int version = 1; version <= 6; ++version) {
+    s.view.brush_radius_px = version;
+    ASSERT_TRUE(saver.Save(s));
+  }
+  EXPECT_EQ(LoadSession(path).view.brush_radius_px, 6);
+  for (int n = 1; n <= 3; ++n)
+    EXPECT_EQ(LoadSession(SessionBackupPath(path, n)).view.brush_radius_px, 6 - n) << n;
+  EXPECT_FALSE(fs::exists(SessionBackupPath(path, 4)));
+
+  // By default the first save of a process keeps the file as it found it; later saves within the
+  // interval do not push it out.
+  Autosaver reopened(path);
+  for (int version = 7; version <= 9; ++version) {
+    s.view.brush_radius_px = version;
+    ASSERT_TRUE(reopened.Save(s));
+  }
+  EXPECT_EQ(LoadSession(SessionBackupPath(path, 1)).view.brush_radius_px, 6);
+  EXPECT_EQ(LoadSession(SessionBackupPath(path, 2)).view.brush_radius_px, 5);
+
+  AutosaveOptions bad;
+  bad.backups = -1;
+  EXPECT_THROW(Autosaver(path, bad), std::invalid_argument);
+}
+
+// A child process autosaves in a loop (a backup at every save) and is killed with SIGKILL at 200
+// random moments: every time the session and its newest backup load whole, and the temporary a
+// kill can leave (only in the instant between naming it and the rename) is gone once the next
+// autosaver starts.
+TEST(SessionTest, AutosaveSurvivesSigkillAtAnyMoment) {
+  const fs::path dir = test::TempDir("session_sigkill");
+  const fs::path path = dir / "calibench.session.json";
+  AutosaveOptions every_save;
+  every_save.backups = 3;
+  every_save.backup_interval_s = 0.0;
+  const Session base = FullSession(dir / "dataset.json");
+  SaveSession(path, base);
+  std::mt19937 random(7);
+  std::uniform_int_distribution<int> delay_us(0, 4000);
+  int named_temporaries_left = 0;
+  for (int kill = 0; kill < 200; ++kill) {
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      Autosaver saver(path, every_save);
+      Session s = base;
+      for (int version = 1;; ++version) {
+        s.view.brush_radius_px = kill * 100000 + version;
+        saver.Save(s);
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(delay_us(random)));
+    ::kill(child, SIGKILL);
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status));
+
+    for (const fs::path& file : {path, SessionBackupPath(path, 1)}) {
+      if (file != path && !fs::exists(file)) continue;
+      Session loaded;
+      ASSERT_NO_THROW(loaded = LoadSession(file)) << "kill " << kill << ": " << file;
+      loaded.view.brush_radius_px = base.view.brush_radius_px;
+      EXPECT_EQ(loaded, base) << "kill " << kill << ": " << file;
+    }
+    named_temporaries_left += static_cast<int>(test::TemporariesBeside(path).size());
+    Autosaver next(path, every_save);  // the next start clears what a kill left
+    ASSERT_TRUE(test::TemporariesBeside(path).empty()) << "kill " << kill;
+  }
+  std::printf("named temporaries left by 200 kills: %d\n", named_temporaries_left);
 }
 
 TEST(SessionTest, ResultIsTakenFromTheSolver) {

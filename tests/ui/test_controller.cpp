@@ -1,5 +1,6 @@
 // The workbench controller without any window: load, brush, accept/reject, solve, undo, sessions.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <fstream>
 
@@ -299,6 +300,7 @@ TEST(Controller, AFailedAutosaveIsShownAndTheEditStands) {
   EXPECT_TRUE(s.status_is_error);
   EXPECT_NE(s.status_line.find("autosave failed: " + session_path.string()), std::string::npos)
       << s.status_line;
+  EXPECT_NE(s.save_error.find(session_path.string()), std::string::npos) << s.save_error;
   controller.Apply(Undo{});  // must not throw out of Apply
   s = Loaded(controller);
   EXPECT_EQ(s.pairs[2].status, PairStatus::kAccepted);
@@ -318,6 +320,74 @@ TEST(Controller, ACorruptSessionIsReportedAndLeftUntouched) {
   }
   std::ifstream in(path);
   EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), {}), text);
+}
+
+// A session whose file no longer opens is resumed from its newest autosave backup that does.
+TEST(Controller, AnUnreadableSessionIsResumedFromItsNewestBackup) {
+  const auto dir = test::TempDir("controller_resume_backup");
+  const auto session_path = dir / "calibench.session.json";
+  using Existing = Controller::ExistingSession;
+  for (int pair : {3, 2}) {  // two sittings: the second's first save backs up the first's file
+    Controller controller;
+    controller.OpenDataset(test::UiDataset(), session_path, Existing::kResume);
+    Loaded(controller);
+    controller.Apply(SetPairStatus{pair, PairStatus::kRejected});
+    Loaded(controller);
+  }
+  ASSERT_TRUE(std::filesystem::exists(SessionBackupPath(session_path, 1)));
+  std::ofstream(session_path, std::ios::trunc) << "{\"format\": \"calibench.session.v1\", \"pai";
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), session_path, Existing::kResume);
+  const Snapshot s = Loaded(controller);
+  EXPECT_EQ(s.pairs[3].status, PairStatus::kRejected);
+  EXPECT_EQ(s.pairs[2].status, PairStatus::kAccepted);  // the newest backup predates that edit
+  EXPECT_NE(s.status_line.find("resumed its newest backup that opens, " +
+                               SessionBackupPath(session_path, 1).string()),
+            std::string::npos)
+      << s.status_line;
+}
+
+// Two workbenches never edit one session: the second is refused, naming the first.
+TEST(Controller, ASecondWorkbenchOnTheSameSessionIsRefused) {
+  const auto session_path = test::TempDir("controller_lock") / "calibench.session.json";
+  using Existing = Controller::ExistingSession;
+  auto first = std::make_unique<Controller>();
+  first->OpenDataset(test::UiDataset(), session_path, Existing::kResume);
+  Loaded(*first);
+  Controller second;
+  try {
+    second.OpenDataset(test::UiDataset(), session_path, Existing::kResume);
+    FAIL() << "a session open in another workbench must not open again";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("open in another Calibench workbench (pid " +
+                                         std::to_string(getpid())),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(second.OpenSession(session_path), IoError);
+  first->OpenDataset(test::UiDataset(), session_path, Existing::kResume);  // its own: fine
+  Loaded(*first);
+  first.reset();
+  second.OpenDataset(test::UiDataset(), session_path, Existing::kResume);
+  EXPECT_EQ(Loaded(second).session_path, session_path);
+}
+
+// kInMemory (render) neither reads nor writes nor locks the session file it is pointed at.
+TEST(Controller, AnInMemorySessionLeavesTheSessionFileAlone) {
+  const auto dir = test::TempDir("controller_in_memory");
+  const auto session_path = dir / "calibench.session.json";
+  std::ofstream(session_path) << "an hour of someone's work";
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), session_path, Controller::ExistingSession::kInMemory);
+  Loaded(controller);
+  controller.Apply(SetPairStatus{1, PairStatus::kRejected});
+  controller.Apply(RunSolver{});
+  const Snapshot s = Loaded(controller);
+  EXPECT_TRUE(s.solver.result);
+  EXPECT_TRUE(s.session_path.empty());
+  EXPECT_TRUE(s.save_error.empty());
+  EXPECT_EQ(test::ReadFileBytes(session_path), "an hour of someone's work");
+  EXPECT_FALSE(std::filesystem::exists(LockPathOf(session_path)));
 }
 
 }  // namespace

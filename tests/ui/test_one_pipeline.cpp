@@ -111,19 +111,21 @@ TEST(OnePipeline, CalibrateWithTheSessionFlagMatchesTheWorkbench) {
 
 TEST(OnePipeline, RenderSolveAndCalibrateWriteTheSameTransform) {
   const auto dir = test::TempDir("one_pipeline_render");
-  // A copy of the dataset's manifest in its own folder: render --solve autosaves its session
-  // next to the dataset.
+  // A copy of the dataset's manifest in its own folder; render writes the session only where
+  // --save-session says.
   const Dataset dataset = LoadDataset(test::UiDataset());
   const auto manifest = dir / "dataset.json";
   SaveDataset(manifest, dataset);
   std::string output;
   ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " render --dataset " + manifest.string() +
                                  " --solve --view camera --size 320x240 --out " +
-                                 (dir / "camera.png").string(),
+                                 (dir / "camera.png").string() + " --save-session " +
+                                 (dir / "render.session.json").string(),
                              &output),
             0)
       << output;
-  const Session session = LoadSession(dir / "calibench.session.json");
+  EXPECT_FALSE(std::filesystem::exists(dir / "calibench.session.json"));
+  const Session session = LoadSession(dir / "render.session.json");
   ASSERT_TRUE(session.result);
   const auto out = dir / "result.json";
   ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " + manifest.string() +

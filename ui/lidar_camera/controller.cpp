@@ -89,42 +89,12 @@ std::filesystem::path BackUpSession(const std::filesystem::path& path) {
 
 }  // namespace
 
-void Controller::OpenDataset(const std::filesystem::path& dataset_path,
-                             std::filesystem::path session_path, ExistingSession existing) {
-  const Dataset dataset = LoadDataset(dataset_path);
-  if (session_path.empty()) {
-    const auto folder = std::filesystem::is_directory(dataset.manifest)
-                            ? dataset.manifest
-                            : dataset.manifest.parent_path();
-    session_path = folder / "calibench.session.json";
-  }
-  std::string note;
-  if (existing != ExistingSession::kReplace && std::filesystem::exists(session_path)) {
-    if (existing == ExistingSession::kResume) {
-      try {
-        OpenSessionFile(session_path,
-                        "resumed the session in " + session_path.string() +
-                            " (calibench gui --fresh starts over and keeps it as a backup)");
-        return;
-      } catch (const IoError& e) {
-        note = "the session there did not open (" + std::string(e.what()) + "): ";
-      }
-    }
-    note += "kept the old session as " + BackUpSession(session_path).string();
-  }
-  Session session = NewSession(dataset);
-  session.dataset = dataset.manifest;
-  Open(dataset, std::move(session), session_path, note);
-}
+namespace {
 
-void Controller::OpenSession(const std::filesystem::path& session_path) {
-  OpenSessionFile(session_path, "");
-}
-
-void Controller::OpenSessionFile(const std::filesystem::path& session_path,
-                                 const std::string& note) {
+// The session in `path`, checked against the dataset it names. Throws IoError.
+std::pair<Session, Dataset> LoadSessionAndDataset(const std::filesystem::path& session_path) {
   Session session = LoadSession(session_path);  // throws IoError; never rewrites the file
-  const Dataset dataset = LoadDataset(session.dataset);
+  Dataset dataset = LoadDataset(session.dataset);
   if (session.pairs.size() != dataset.pairs.size())
     throw IoError(session_path.string() + ": the session has " +
                   std::to_string(session.pairs.size()) + " pairs but " + dataset.manifest.string() +
@@ -134,14 +104,114 @@ void Controller::OpenSessionFile(const std::filesystem::path& session_path,
       throw IoError(session_path.string() + ": pair " + std::to_string(i) + " is '" +
                     session.pairs[i].id + "' in the session but '" + dataset.pairs[i].id +
                     "' in the dataset");
-  Open(dataset, std::move(session), session_path, note);
+  return {std::move(session), std::move(dataset)};
+}
+
+}  // namespace
+
+void Controller::OpenDataset(const std::filesystem::path& dataset_path,
+                             std::filesystem::path session_path, ExistingSession existing) {
+  const Dataset dataset = LoadDataset(dataset_path);
+  Session session = NewSession(dataset);
+  session.dataset = dataset.manifest;
+  if (existing == ExistingSession::kInMemory) {
+    Open(dataset, std::move(session), {}, "", std::nullopt);
+    return;
+  }
+  if (session_path.empty()) {
+    const auto folder = std::filesystem::is_directory(dataset.manifest)
+                            ? dataset.manifest
+                            : dataset.manifest.parent_path();
+    session_path = folder / "calibench.session.json";
+  }
+  std::string note;
+  std::optional<FileLock> lock = LockSession(session_path, &note);
+  if (existing != ExistingSession::kReplace && std::filesystem::exists(session_path)) {
+    if (existing == ExistingSession::kResume) {
+      try {
+        OpenSessionFile(session_path,
+                        "resumed the session in " + session_path.string() +
+                            " (calibench gui --fresh starts over and keeps it as a backup)",
+                        &lock);
+        return;
+      } catch (const IoError& e) {
+        note = "the session there did not open (" + std::string(e.what()) + "): ";
+      }
+      if (ResumeBackup(session_path, note, &lock)) return;
+    }
+    note += "kept the old session as " + BackUpSession(session_path).string();
+  }
+  Open(dataset, std::move(session), session_path, note, std::move(lock));
+}
+
+void Controller::OpenSession(const std::filesystem::path& session_path, bool save) {
+  if (!save) {
+    auto [session, dataset] = LoadSessionAndDataset(session_path);
+    Open(dataset, std::move(session), {}, "", std::nullopt);
+    return;
+  }
+  std::string note;
+  std::optional<FileLock> lock = LockSession(session_path, &note);
+  OpenSessionFile(session_path, note, &lock);
+}
+
+std::optional<FileLock> Controller::LockSession(const std::filesystem::path& session,
+                                                std::string* note) {
+  std::error_code ec;
+  if (session_lock_ && std::filesystem::weakly_canonical(session_lock_->locked(), ec) ==
+                           std::filesystem::weakly_canonical(session, ec))
+    return std::nullopt;  // this controller has it open already
+  std::string holder;
+  try {
+    std::optional<FileLock> lock = FileLock::TryLock(session, &holder);
+    if (!lock)
+      throw IoError(session.string() + ": the session is open in another Calibench workbench (" +
+                    holder + "); close it there first, or open a copy of the file");
+    return lock;
+  } catch (const IoError& e) {
+    if (!holder.empty()) throw;
+    // No lock file can be made, so no session file either: editing goes on, saving will fail
+    // and say so.
+    *note = std::string("cannot lock the session (") + e.what() + ")";
+    return std::nullopt;
+  }
+}
+
+bool Controller::ResumeBackup(const std::filesystem::path& session_path, const std::string& note,
+                              std::optional<FileLock>* lock) {
+  for (int n = 1; n <= AutosaveOptions{}.backups; ++n) {
+    const std::filesystem::path backup = SessionBackupPath(session_path, n);
+    if (!std::filesystem::exists(backup)) continue;
+    try {
+      auto [session, dataset] = LoadSessionAndDataset(backup);
+      const std::string kept = BackUpSession(session_path).string();
+      Open(dataset, std::move(session), session_path,
+           note + "resumed its newest backup that opens, " + backup.string() +
+               "; the one that did not open is kept as " + kept,
+           std::move(*lock));
+      return true;
+    } catch (const IoError&) {
+      // An older backup, then.
+    }
+  }
+  return false;
+}
+
+void Controller::OpenSessionFile(const std::filesystem::path& session_path, const std::string& note,
+                                 std::optional<FileLock>* lock) {
+  auto [session, dataset] = LoadSessionAndDataset(session_path);
+  Open(dataset, std::move(session), session_path, note, std::move(*lock));
 }
 
 void Controller::Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
-                      const std::string& note) {
+                      const std::string& note, std::optional<FileLock> session_lock) {
   WaitIdle();
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (session_lock)
+      session_lock_ = std::move(session_lock);
+    else if (session_path.empty() || !session_lock_ || session_lock_->locked() != session_path)
+      session_lock_.reset();
     state_ = Snapshot{};
     state_.dataset = dataset;
     state_.dataset_path = dataset.manifest;
@@ -154,7 +224,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     session_ = std::move(session);
     ApplySessionToState(session_);
     history_.Reset(session_);
-    autosaver_ = std::make_unique<Autosaver>(session_path);
+    autosaver_ = session_path.empty() ? nullptr : std::make_unique<Autosaver>(session_path);
     SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
                   dataset.manifest.string(),
               false);
@@ -258,7 +328,9 @@ void Controller::CommitEdit() {
 void Controller::Autosave() {
   try {
     if (autosaver_) autosaver_->Save(session_);
+    state_.save_error.clear();
   } catch (const IoError& e) {
+    state_.save_error = e.what();
     SetStatus(std::string("autosave failed: ") + e.what(), true);
   }
 }
@@ -785,11 +857,16 @@ template <>
 void Controller::Handle(const SaveSessionAs& save) {
   const std::filesystem::path path = NextToSession(save.path);
   try {
+    std::string note;
+    std::optional<FileLock> lock = LockSession(path, &note);  // throws when another has it open
     SaveSession(path, session_);
+    if (lock) session_lock_ = std::move(lock);
     autosaver_ = std::make_unique<Autosaver>(path);
     state_.session_path = path;
+    state_.save_error.clear();
     SetStatus("saved session " + path.string(), false);
   } catch (const IoError& e) {
+    state_.save_error = e.what();
     SetStatus(e.what(), true);
   }
 }

@@ -13,6 +13,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/base/file_lock.h"
 #include "core/base/image.h"
 #include "core/camera/undistort.h"
 #include "core/io/dataset.h"
@@ -67,7 +68,8 @@ struct Reprojection {
 
 struct Snapshot : SnapshotHeader {
   std::filesystem::path dataset_path;
-  std::filesystem::path session_path;
+  std::filesystem::path session_path;  // empty: the session lives in memory only (render)
+  std::string save_error;  // the last save's failure (autosave, save as); empty once one succeeds
   std::optional<Dataset> dataset;
   std::vector<PairView> pairs;
   int selected = -1;
@@ -154,11 +156,16 @@ class Controller : public ControllerState<Snapshot> {
   // (headless renders and tests, which own their session files); kResume opens it instead (the
   // window: an hour of someone's edits is never overwritten by opening the dataset again) and
   // says so; kStartFresh moves it to `<session>.<date-time>.bak` first and says where. A session
-  // that does not load or belongs to another dataset is backed up the same way under kResume.
-  enum class ExistingSession { kReplace, kResume, kStartFresh };
+  // that does not load or belongs to another dataset is backed up the same way under kResume,
+  // after its newest autosave backup that does load is resumed instead. kInMemory leaves any
+  // session file alone and never writes one (render draws; it does not edit).
+  // A session file is locked (FileLock) while open: one that another workbench has open throws
+  // IoError naming that process.
+  enum class ExistingSession { kReplace, kResume, kStartFresh, kInMemory };
   void OpenDataset(const std::filesystem::path& dataset, std::filesystem::path session_path = {},
                    ExistingSession existing = ExistingSession::kReplace);
-  void OpenSession(const std::filesystem::path& session);
+  // save = false: the session file is read, never locked or written (render).
+  void OpenSession(const std::filesystem::path& session, bool save = true);
 
   void Apply(const Intent& intent);
 
@@ -195,8 +202,15 @@ class Controller : public ControllerState<Snapshot> {
   void ApplySessionToState(const Session& session);  // call with mutex_ held
   // `note` (how the session came to be opened) joins the status line once the pairs have loaded.
   void Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
-            const std::string& note);
-  void OpenSessionFile(const std::filesystem::path& session, const std::string& note);
+            const std::string& note, std::optional<FileLock> lock);
+  void OpenSessionFile(const std::filesystem::path& session, const std::string& note,
+                       std::optional<FileLock>* lock);
+  // Locks `session` for this controller (kept when it holds that lock already). Throws IoError
+  // when another process holds it; *note says so when the folder cannot hold a lock file.
+  std::optional<FileLock> LockSession(const std::filesystem::path& session, std::string* note);
+  // Under kResume: the newest backup of `session` that opens, resumed; false when none does.
+  bool ResumeBackup(const std::filesystem::path& session, const std::string& note,
+                    std::optional<FileLock>* lock);
 
   // One handler per intent type, each an explicit specialization in controller.cpp (Apply visits
   // them with mutex_ held).
@@ -211,6 +225,7 @@ class Controller : public ControllerState<Snapshot> {
   Session session_;  // the editable state as saved; state_ mirrors it plus derived data
   SessionHistory history_;
   std::unique_ptr<Autosaver> autosaver_;
+  std::optional<FileLock> session_lock_;  // held while session_path is open for editing
   PipelineOptions pipeline_;
   std::string open_note_;  // how the session was opened, for the status line once loaded (mutex_)
   std::vector<std::string> load_warnings_;     // what loading refused, for the status line (mutex_)
