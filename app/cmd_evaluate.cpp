@@ -10,9 +10,11 @@
 #include "app/pipeline_flags.h"
 #include "app/sim_flags.h"
 #include "core/estimation/uncertainty.h"
+#include "core/geometry/geometry.h"
 #include "core/io/dataset.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/result_io.h"
+#include "core/results/export.h"
 #include "core/sim/crlb.h"
 #include "core/sim/sim.h"
 
@@ -100,6 +102,67 @@ int PrintCramerRaoBound(const Dataset& dataset, double corner_sigma_px,
   return kOk;
 }
 
+// How a reference file is read: which of its frames is the camera, and in which convention.
+struct ReferenceFlags {
+  std::string path;
+  std::string camera_frame = "optical";
+  bool swap = false;
+};
+
+// The reference's cam_from_lidar, and a line saying how it was read.
+Pose ReferenceCamFromLidar(const ReferenceFlags& flags, std::string* how) {
+  const ImportedTransform imported = ReadExportedTransform(flags.path);
+  if (!imported.format) {
+    *how = "a calibench result: cam_from_lidar";
+    return imported.parent_from_child.inverse();
+  }
+  ExportFrames frames;
+  frames.camera_is_parent = flags.swap;
+  frames.camera_frame = *ParseCameraFrame(flags.camera_frame);
+  *how = ExportFormatName(*imported.format) + ": the pose of '" + imported.child + "' in '" +
+         imported.parent + "', the camera (" + CameraFrameName(frames.camera_frame) +
+         " frame) being the " + (flags.swap ? "parent" : "child") +
+         " (--reference-swap and --reference-camera-frame say otherwise)";
+  return CamFromLidarOf(imported.parent_from_child, frames);
+}
+
+// `evaluate --reference`: the result against another calibration of the same rig, for real data
+// without ground truth. The difference is also weighed by the result's own covariance (6-dof
+// chi-square: about 6 when the reference lies where the result's uncertainty says the truth is).
+int CompareWithReference(const LoadedResult& result, const ReferenceFlags& flags,
+                         double max_translation_mm, double max_rotation_deg) {
+  if (!ParseCameraFrame(flags.camera_frame)) {
+    std::fprintf(stderr, "calibench evaluate: --reference-camera-frame must be optical or link\n");
+    return kUsage;
+  }
+  std::string how;
+  const Pose reference = ReferenceCamFromLidar(flags, &how);
+  std::printf("reference %s (%s)\n", flags.path.c_str(), how.c_str());
+  const PoseError error = ComputePoseError(result.cam_from_source, reference);
+  // The result's covariance is of a right perturbation: result = reference * Exp(delta).
+  const Vec6 delta = LogSE3(reference.inverse() * result.cam_from_source);
+  const Vec3 in_camera = reference.rotation() * delta.head<3>();
+  std::printf(
+      "difference from the reference: translation %.2f mm (camera axes x/y/z %+.2f / %+.2f "
+      "/ %+.2f mm), rotation %.3f deg\n",
+      error.translation_m * 1e3, in_camera.x() * 1e3, in_camera.y() * 1e3, in_camera.z() * 1e3,
+      error.rotation_rad * 180 / M_PI);
+  if (result.covariance.isZero()) {
+    std::printf("(the result has no covariance: no weighing by its uncertainty)\n");
+  } else {
+    const double chi2 = delta.dot(result.covariance.ldlt().solve(delta));
+    std::printf(
+        "weighed by the result's covariance: chi-square %.1f on 6 dof (about 6 when the "
+        "reference is where the result's uncertainty puts the truth; above 16.8 in 1%% "
+        "of cases)\n",
+        chi2);
+  }
+  const bool too_far =
+      (max_translation_mm >= 0 && error.translation_m * 1000 > max_translation_mm) ||
+      (max_rotation_deg >= 0 && error.rotation_rad * 180 / M_PI > max_rotation_deg);
+  return too_far ? kAccuracyFailed : kOk;
+}
+
 }  // namespace
 
 int RunEvaluate(int argc, char** argv) {
@@ -112,8 +175,16 @@ int RunEvaluate(int argc, char** argv) {
   double max_translation_mm = -1, max_rotation_deg = -1, corner_sigma_px = 0;
   bool crlb = false, sweep = false;
   app.add_option("--result,-r", result_path, "result.json (optional with --crlb)");
-  app.add_option("--dataset,-d", dataset_path, "dataset with ground_truth.cam_from_lidar")
-      ->required();
+  app.add_option("--dataset,-d", dataset_path, "dataset with ground_truth.cam_from_lidar");
+  ReferenceFlags reference;
+  app.add_option("--reference", reference.path,
+                 "compare --result with another calibration instead of ground truth: a result "
+                 "JSON or any `calibench export` format (URDF, launch file, YAML, 4x4 text)");
+  app.add_option("--reference-camera-frame", reference.camera_frame,
+                 "the reference's camera frame: optical or link (REP 103)")
+      ->capture_default_str();
+  app.add_flag("--reference-swap", reference.swap,
+               "in the reference the camera is the parent frame and the LiDAR the child");
   app.add_option("--max-translation-mm", max_translation_mm, "fail (exit 5) above this error");
   app.add_option("--max-rotation-deg", max_rotation_deg, "fail (exit 5) above this error");
   app.add_flag("--crlb", crlb,
@@ -126,6 +197,13 @@ int RunEvaluate(int argc, char** argv) {
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
   if (result_path.empty() && !crlb) {
     std::fprintf(stderr, "calibench evaluate: --result is required (unless --crlb)\n");
+    return kUsage;
+  }
+  if (!reference.path.empty())
+    return CompareWithReference(LoadResult(result_path), reference, max_translation_mm,
+                                max_rotation_deg);
+  if (dataset_path.empty()) {
+    std::fprintf(stderr, "calibench evaluate: give --dataset (ground truth) or --reference\n");
     return kUsage;
   }
   const Dataset dataset = LoadDataset(dataset_path);

@@ -39,6 +39,7 @@ int RunSweepLrf(int argc, char** argv);
 bool IsLrfManifest(const std::string& path);
 int RunGui(int argc, char** argv);
 int RunRender(int argc, char** argv);
+int RunExport(int argc, char** argv);
 
 // How `gui` runs its window. A test's window closes by itself (0 = never) after that many frames
 // drawn back to back, or after that many seconds of a normal run.
@@ -50,10 +51,12 @@ struct GuiWindowFlags {
 // Shared by `gui` and `demo`: opens the workbench window on a dataset or session.
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
                  const std::string& screenshot, const GuiWindowFlags& quit = {});
-// Shared by `render` and `demo`: draws one view (or the workbench) headless into a PNG.
+// Shared by `render` and `demo`: draws one view (or the workbench) headless into a PNG; with
+// save_session, writes the session there (a failure is an error).
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
                    bool solve, const std::string& view, int width, int height,
-                   const std::string& out, const std::string& backend_name);
+                   const std::string& out, const std::string& backend_name,
+                   const std::string& save_session);
 // `demo` on a machine without a display: solve and write the workbench and each view as PNG.
 int RenderDemoViews(const std::string& dataset, const std::string& out_dir);
 

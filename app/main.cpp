@@ -29,6 +29,8 @@ constexpr Command kCommands[] = {
      "the workbench window: brush, accept/reject pairs, solve, inspect (--dataset or --session)"},
     {"render", calibench::app::RunRender,
      "draw the workbench or one view to PNG without a window (EGL / OSMesa)"},
+    {"export", calibench::app::RunExport,
+     "write a result as URDF, ROS 1 / ROS 2 static TF, OpenCV YAML, Autoware, Kalibr or 4x4 text"},
     {"sweep", calibench::app::RunSweep,
      "the paper's Table 1 protocol: error vs. number of pairs and noise on simulated data"},
 };

@@ -80,6 +80,12 @@ ImageHeader ReadImageHeader(const std::filesystem::path& path, std::string_view 
   } else {
     Refuse(path, "not a PNG, JPEG or BMP file");
   }
+  // PNG allows sides up to 2^31 - 1, JPEG 65535, BMP 2^31: anything wider is a broken header
+  // (and the product of two such sides would overflow).
+  constexpr std::int64_t kMaxSide = (std::int64_t{1} << 31) - 1;
+  if (header.width > kMaxSide || header.height > kMaxSide)
+    Refuse(path, std::string("the ") + header.format + " header gives a side beyond 2^31 - 1 (" +
+                     std::to_string(header.width) + "x" + std::to_string(header.height) + ")");
   if (header.width <= 0 || header.height <= 0)
     Refuse(path, std::string("the ") + header.format + " header gives no size (" +
                      std::to_string(header.width) + "x" + std::to_string(header.height) + ")");

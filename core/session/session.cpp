@@ -212,6 +212,7 @@ void Autosaver::BackUp() {
       std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   if (options_.backups == 0) return;
   if (last_backup_s_ >= 0.0 && now - last_backup_s_ < options_.backup_interval_s) return;
+  last_backup_s_ = now;  // due now; a session not yet on disk has nothing to back up
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path_, ec)) return;
   // Oldest first, so that a kill between two renames loses at most the oldest backup.
@@ -223,7 +224,6 @@ void Autosaver::BackUp() {
   if (ec) std::filesystem::copy_file(path_, newest, ec);  // filesystems without hard links
   if (ec)
     throw IoError(newest.string() + ": cannot back up the session before saving: " + ec.message());
-  last_backup_s_ = now;
 }
 
 bool Autosaver::Save(const Session& session) {

@@ -1,0 +1,96 @@
+// calibench export: a result (or a session's result) as a file a robot loads.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "app/commands.h"
+#include "core/base/atomic_file.h"
+#include "core/results/export.h"
+#include "core/results/result_file.h"
+#include "core/session/session.h"
+
+namespace calibench::app {
+
+namespace {
+
+// cam_from_lidar (or cam_from_lrf) of a calibench.result.v1 file or of a session's last solve.
+Pose CalibrationOf(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  if (head.find("calibench.session.v1") == std::string::npos)
+    return LoadResult(path).cam_from_source;
+  const Session session = LoadSession(path);
+  if (!session.result)
+    throw IoError(path.string() +
+                  ": the session has no result yet (press Run in the workbench, "
+                  "or `calibench calibrate --session`)");
+  return session.result->cam_from_lidar;
+}
+
+std::string FormatNames() {
+  std::string names;
+  for (const ExportFormat format : AllExportFormats())
+    names += (names.empty() ? "" : " | ") + ExportFormatName(format);
+  return names;
+}
+
+}  // namespace
+
+int RunExport(int argc, char** argv) {
+  CLI::App app{
+      "Write a calibration in a form a robot loads: a URDF joint, a ROS 1 or ROS 2 static "
+      "transform (launch file and command line), OpenCV YAML, Autoware's "
+      "sensor_kit_calibration.yaml, a Kalibr-style chain, or a plain 4x4 matrix. Each "
+      "file holds the child's pose in the parent frame and says so in words.",
+      "calibench export"};
+  std::string result, format_name, out, camera_frame = "optical";
+  ExportFrames frames;
+  app.add_option("--result,-r", result, "calibench.result.v1 file, or a session with a result")
+      ->required();
+  app.add_option("--format,-f", format_name, FormatNames())->required();
+  app.add_option("--parent-frame", frames.lidar, "the parent frame's name (the LiDAR's)")
+      ->capture_default_str();
+  app.add_option("--child-frame", frames.camera, "the child frame's name (the camera's)")
+      ->capture_default_str();
+  app.add_flag("--swap", frames.camera_is_parent,
+               "the camera is the parent and the LiDAR the child (--parent-frame then names the "
+               "camera's frame and --child-frame the LiDAR's)");
+  app.add_option("--camera-frame", camera_frame,
+                 "optical (z forward, x right, y down: what the calibration computes) or link "
+                 "(REP 103: x forward, y left, z up)")
+      ->capture_default_str();
+  app.add_option("--out,-o", out,
+                 "file to write (default: the format's usual name next to the result)");
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
+  if (frames.camera_is_parent) std::swap(frames.lidar, frames.camera);
+  const auto format = ParseExportFormat(format_name);
+  const auto camera = ParseCameraFrame(camera_frame);
+  std::string why;
+  if (!format || !camera || !frames.Check(&why)) {
+    std::fprintf(
+        stderr, "calibench export: %s\n",
+        !format   ? ("--format must be " + FormatNames() + ", got '" + format_name + "'").c_str()
+        : !camera ? ("--camera-frame must be optical or link, got '" + camera_frame + "'").c_str()
+                  : why.c_str());
+    return kUsage;
+  }
+  frames.camera_frame = *camera;
+  const Pose cam_from_lidar = CalibrationOf(result);
+  const ExportedCalibration exported =
+      ExportCalibration(*format, cam_from_lidar, frames, std::filesystem::path(result).filename());
+  const std::filesystem::path path =
+      out.empty() ? std::filesystem::absolute(result).parent_path() / DefaultExportFileName(*format)
+                  : std::filesystem::path(out);
+  WriteFileAtomically(path, exported.text);
+  std::printf("wrote %s (%s): the pose of '%s' in '%s', camera frame %s\n", path.c_str(),
+              ExportFormatName(*format).c_str(), frames.child().c_str(), frames.parent().c_str(),
+              CameraFrameName(frames.camera_frame).c_str());
+  if (!exported.command.empty()) std::printf("%s\n", exported.command.c_str());
+  return kOk;
+}
+
+}  // namespace calibench::app
