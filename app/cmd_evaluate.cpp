@@ -171,6 +171,12 @@ int RunEvaluate(int argc, char** argv) {
       "Score a calibench.result.v1 file against a dataset's ground_truth, and/or print "
       "the Cramér–Rao bound of a simulated dataset.",
       "calibench evaluate"};
+  app.footer(
+      "Other modes. LRF: with an LRF manifest as --dataset the result is cam_from_lrf "
+      "(`calibench lrf-calibrate`); --stereo --right-result FILE checks the two depth cameras' "
+      "results against the dataset's stereo baseline (the LRF paper's Section 4.3). "
+      "--sweep runs the Table 1 sweep (`calibench sweep --help`). "
+      "`calibench evaluate --stereo --help` shows the LRF flags.");
   std::string result_path, dataset_path;
   double max_translation_mm = -1, max_rotation_deg = -1, corner_sigma_px = 0;
   bool crlb = false, sweep = false;

@@ -98,6 +98,13 @@ int RunSimulate(int argc, char** argv) {
   CLI::App app{
       "Write a synthetic LiDAR + camera dataset (PCD, PNG, dataset.json) with ground truth.",
       "calibench simulate"};
+  app.footer(
+      "The 2D laser rangefinder kind: `calibench simulate --kind lrf --out DIR` writes a 2D LRF + "
+      "depth camera dataset with the three-face target (manifest.json, scans/, depth/), with "
+      "--preset paper|ideal, --observations N (target poses, default 20), --range-noise M, "
+      "--disparity-noise PX, --min-distance / --max-distance M, --seed, --stereo (a right depth "
+      "camera 0.12 m to the right, for `evaluate --stereo`), --no-clutter. "
+      "`calibench simulate --kind lrf --help` shows them with their defaults.");
   std::string out_dir;
   app.add_option("--out,-o", out_dir, "output folder")->required();
   SimFlags flags;

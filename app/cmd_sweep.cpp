@@ -29,6 +29,11 @@ int RunSweep(int argc, char** argv) {
       return RunSweepLrf(argc, argv);
   CLI::App app{"Error vs. number of pairs and LiDAR noise (Ca²Lib Table 1 protocol).",
                "calibench sweep"};
+  app.footer(
+      "The 2D laser rangefinder kind: `calibench sweep --kind lrf` gives errors against the "
+      "number of observations (the LRF paper's Section 4.3 protocol), with --sizes (default "
+      "2,3,4,6,8,10,15,20), --seeds N (simulations per size, default 20), --preset paper|ideal, "
+      "--threads, --table FILE. `calibench sweep --kind lrf --help` shows them.");
   std::string work_dir = "out/sweep", sizes_text = "3,4,5,10,20,30,39",
               noise_text = "0,0.008,0.016", image_noise_text = "0,0.007,0.014", table_path;
   int subsets = 40;

@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -23,7 +24,11 @@ enum ExitCode : int {
 
 // Parses a subcommand's flags; the exit code when parsing ends the command (--help printed: kOk;
 // a bad flag, reported: kUsage), nullopt when the command goes on.
+// A mistyped flag gets a suggestion ("did you mean --threads?").
 std::optional<int> ParseFlags(CLI::App& app, int argc, char** argv);
+// The candidate nearest to `word` by edit distance, or "" when none is near (a third of its
+// length, at least 2 edits).
+std::string Closest(const std::string& word, const std::vector<std::string>& candidates);
 
 int RunCalibrate(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);

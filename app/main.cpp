@@ -3,6 +3,7 @@
 #include <cstring>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include "app/commands.h"
 #include "core/base/allocator.h"
@@ -38,6 +39,27 @@ constexpr Command kCommands[] = {
 void PrintUsage() {
   std::printf("usage: calibench <command> [options]   (calibench <command> --help)\n\ncommands:\n");
   for (const Command& c : kCommands) std::printf("  %-14s %s\n", c.name, c.help);
+  std::printf("  %-14s %s\n", "help", "this list, or `calibench help <command>` for its flags");
+  std::printf("\ncalibench --version prints the version.\n");
+}
+
+const Command* FindCommand(const char* name) {
+  for (const Command& c : kCommands)
+    if (std::strcmp(name, c.name) == 0) return &c;
+  return nullptr;
+}
+
+// Runs a command, turning the errors that escape it into a message and an exit code.
+int Run(const Command& c, int argc, char** argv) {
+  try {
+    return c.run(argc, argv);
+  } catch (const calibench::IoError& e) {
+    std::fprintf(stderr, "calibench %s: error: %s\n", c.name, e.what());
+    return calibench::app::kInputError;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "calibench %s: internal error: %s\n", c.name, e.what());
+    return calibench::app::kInputError;
+  }
 }
 
 }  // namespace
@@ -48,19 +70,30 @@ int main(int argc, char** argv) {
     PrintUsage();
     return argc < 2 ? calibench::app::kUsage : calibench::app::kOk;
   }
-  for (const Command& c : kCommands) {
-    if (std::strcmp(argv[1], c.name) != 0) continue;
-    try {
-      return c.run(argc - 1, argv + 1);
-    } catch (const calibench::IoError& e) {
-      std::fprintf(stderr, "calibench %s: error: %s\n", c.name, e.what());
-      return calibench::app::kInputError;
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "calibench %s: internal error: %s\n", c.name, e.what());
-      return calibench::app::kInputError;
-    }
+  if (!std::strcmp(argv[1], "--version") || !std::strcmp(argv[1], "version")) {
+    std::printf("calibench %s\n", CALIBENCH_VERSION);
+    return calibench::app::kOk;
   }
-  std::fprintf(stderr, "calibench: unknown command '%s'\n\n", argv[1]);
+  if (!std::strcmp(argv[1], "help")) {
+    if (argc < 3) {
+      PrintUsage();
+      return calibench::app::kOk;
+    }
+    const Command* c = FindCommand(argv[2]);
+    if (c == nullptr) {
+      std::fprintf(stderr, "calibench help: unknown command '%s'\n", argv[2]);
+      return calibench::app::kUsage;
+    }
+    char help_flag[] = "--help";
+    char* help_argv[] = {argv[2], help_flag, nullptr};
+    return Run(*c, 2, help_argv);
+  }
+  if (const Command* c = FindCommand(argv[1])) return Run(*c, argc - 1, argv + 1);
+  std::vector<std::string> names;
+  for (const Command& c : kCommands) names.emplace_back(c.name);
+  const std::string suggestion = calibench::app::Closest(argv[1], names);
+  std::fprintf(stderr, "calibench: unknown command '%s'%s\n\n", argv[1],
+               suggestion.empty() ? "" : (" (did you mean '" + suggestion + "'?)").c_str());
   PrintUsage();
   return calibench::app::kUsage;
 }

@@ -21,12 +21,14 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
       ->capture_default_str();
   app.add_option("--max-iterations", o.solver.max_iterations, "Gauss-Newton iterations")
       ->capture_default_str();
-  app.add_flag("!--no-board-edges", o.solver.use_board_edges,
-               "weighted-ml: leave out the board-edge constraints (used by default for targets "
-               "whose sheet size is given)");
-  app.add_flag("!--no-edge-dilation", o.solver.estimate_edge_dilation,
-               "weighted-ml with board edges: do not estimate how much larger than the sheet the "
-               "LiDAR sees it (the beam's footprint; estimated by default)");
+  app.add_flag_callback(
+      "--no-board-edges", [&o] { o.solver.use_board_edges = false; },
+      "weighted-ml: leave out the board-edge constraints (used by default for targets "
+      "whose sheet size is given)");
+  app.add_flag_callback(
+      "--no-edge-dilation", [&o] { o.solver.estimate_edge_dilation = false; },
+      "weighted-ml with board edges: do not estimate how much larger than the sheet the "
+      "LiDAR sees it (the beam's footprint; estimated by default)");
   app.add_flag("--estimate-range-offset", o.solver.estimate_range_offset,
                "weighted-ml: also estimate a constant LiDAR range offset (printed with its "
                "standard deviation and its correlation with the translation)");
@@ -44,9 +46,10 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
                  "LiDAR plane RANSAC inlier distance [m]")
       ->capture_default_str();
   app.add_option("--ransac-seed", o.lidar_plane.seed, "RANSAC seed")->capture_default_str();
-  app.add_flag("!--no-board-growing", o.grow_to_board,
-               "fit the LiDAR plane on the brushed / seeded returns only, instead of growing the "
-               "region to the whole board (limited by the target's sheet size)");
+  app.add_flag_callback(
+      "--no-board-growing", [&o] { o.grow_to_board = false; },
+      "fit the LiDAR plane on the brushed / seeded returns only, instead of growing the "
+      "region to the whole board (limited by the target's sheet size)");
 }
 
 bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {

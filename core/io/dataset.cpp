@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/base/atomic_file.h"
+#include "core/base/names.h"
 #include "core/geometry/geometry.h"
 #include "core/io/camera_file.h"
 #include "core/io/json_io.h"
@@ -92,7 +93,7 @@ Dataset LoadFolder(const fs::path& dir) {
   const json_io::Fields target(target_document, target_file);
   dataset.target = json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
   auto list = [&](const char* sub) {
-    std::map<std::string, fs::path> by_stem;
+    std::map<std::string, fs::path, NaturalOrder> by_stem;  // pose2 before pose10
     if (!fs::is_directory(dir / sub)) Fail(dir, std::string("folder dataset has no ") + sub + "/");
     for (const auto& entry : fs::directory_iterator(dir / sub)) {
       // Everything but folders is listed: a broken link, a loop of links or a FIFO becomes its

@@ -108,27 +108,15 @@ std::string FormatLrfSummary(const LrfCalibrationOutcome& outcome) {
     return out.str();
   }
   const LrfSolution& s = *outcome.solution;
-  const Pose& pose = s.cam_from_lrf;
-  const Vec3 t = pose.translation();
-  const Vec3 rpy = LogSO3(pose.linear()) * 180.0 / M_PI;
-  const Vec3 st = TranslationStd(s.covariance, pose) * 1e3;
-  const Vec3 sr = RotationStdDeg(s.covariance, pose);
   const LrfTargetType target = !outcome.pairs.empty() && !outcome.pairs.front().three_face &&
                                        outcome.pairs.front().board_scan
                                    ? LrfTargetType::kCheckerboard
                                    : LrfTargetType::kThreeFace;
-  char text[512];
-  std::snprintf(text, sizeof(text),
-                "method %s, %d iterations%s\n"
-                "cam_from_lrf: translation [%.4f, %.4f, %.4f] m (std %.1f / %.1f / %.1f mm, "
-                "camera axes)\n"
-                "              rotation vector [%.3f, %.3f, %.3f] deg (std %.3f / %.3f / %.3f "
-                "deg)\n"
-                "%s\n",
-                LrfMethodName(s.method).c_str(), s.iterations, s.converged ? ", converged" : "",
-                t.x(), t.y(), t.z(), st.x(), st.y(), st.z(), rpy.x(), rpy.y(), rpy.z(), sr.x(),
-                sr.y(), sr.z(), LrfResidualText(s, target).c_str());
-  out << text;
+  // Both directions as matrices with their meaning in words, like the 3D method's summary.
+  out << FormatTransform(ResultNames{"cam", "lrf"}, s.cam_from_lrf, s.covariance);
+  out << "method " << LrfMethodName(s.method) << ", " << s.iterations << " iterations"
+      << (s.converged ? ", converged" : "") << "\n"
+      << LrfResidualText(s, target) << "\n";
   if (outcome.adaptive)
     out << "adaptive (Algorithm 1): " << outcome.adaptive->observations_used << " observations used"
         << (outcome.adaptive->reached_threshold ? ", below the threshold"

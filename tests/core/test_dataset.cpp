@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "core/base/names.h"
 #include "core/io/dataset.h"
 #include "tests/test_support.h"
 
@@ -100,6 +101,31 @@ TEST(Dataset, FolderShorthandPairsCloudsAndImagesByStem) {
   ASSERT_EQ(with_bad_files.pairs.size(), 4u);
   EXPECT_EQ(with_bad_files.pairs[2].id, "e");
   EXPECT_EQ(with_bad_files.pairs[3].id, "f");
+}
+
+TEST(Dataset, FolderPairsComeInNaturalOrder) {
+  EXPECT_TRUE(NaturalLess("pose2", "pose10"));
+  EXPECT_FALSE(NaturalLess("pose10", "pose2"));
+  EXPECT_TRUE(NaturalLess("9.pcd", "10.pcd"));
+  EXPECT_TRUE(NaturalLess("007", "7"));
+  EXPECT_TRUE(NaturalLess("a", "b"));
+  EXPECT_TRUE(NaturalLess("pose", "pose1"));
+  EXPECT_FALSE(NaturalLess("x", "x"));
+  const fs::path dir = test::TempDir("dataset_natural_order");
+  fs::create_directories(dir / "clouds");
+  fs::create_directories(dir / "images");
+  for (const char* stem : {"pose10", "pose2", "pose1", "pose11", "pose3"}) {
+    std::ofstream(dir / "clouds" / (std::string(stem) + ".pcd")) << "";
+    std::ofstream(dir / "images" / (std::string(stem) + ".png")) << "";
+  }
+  std::ofstream(dir / "camera.yaml")
+      << "image_width: 640\nimage_height: 480\ndistortion_model: plumb_bob\n"
+         "d: [0, 0, 0, 0, 0]\nk: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n";
+  std::ofstream(dir / "target.json")
+      << R"({"type": "checkerboard", "inner_corners": [5, 7], "square_size": 0.05})";
+  std::vector<std::string> ids;
+  for (const PairEntry& pair : LoadDataset(dir).pairs) ids.push_back(pair.id);
+  EXPECT_EQ(ids, (std::vector<std::string>{"pose1", "pose2", "pose3", "pose10", "pose11"}));
 }
 
 // Writes `manifest` and expects LoadDataset to throw an IoError naming the file and `problem`.

@@ -46,6 +46,8 @@ TEST(NothingLost, CalibrateKilledAtAnyMomentLeavesAWholeResult) {
   sim.camera.cx = 319.5;
   sim.camera.cy = 239.5;
   sim.camera.distortion.assign(5, 0.0);
+  sim.min_distance_m = 1.2;
+  sim.max_distance_m = 2.5;  // the board stays large enough for VGA
   SimulateDataset(sim, dir / "data");
   const fs::path out = dir / "result.json";
 
