@@ -29,15 +29,16 @@ fuzz_one() {
   local work="$build/corpus/$target" findings="$build/findings/$target"
   local log="$build/fuzz-$target.log" status=0
   mkdir -p "$work" "$findings"
+  local started=$SECONDS
   # -rss_limit_mb: a loader that needs more than 2 GB for a file of a few KB is a finding (the
   # load limits must refuse it first). -timeout: 10 s for one input is a hang.
   "$build/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 \
     -print_final_stats=1 -artifact_prefix="$findings/" "$work" "tests/fuzz/corpus/$target" \
     >"$log" 2>&1 || status=1
-  local runs cov
+  local runs cov elapsed=$((SECONDS - started))
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*' || echo 0)
-  echo "fuzz $target: ${seconds} s, $runs executions, coverage $cov edges," \
+  echo "fuzz $target: ${elapsed} s, $runs executions, coverage $cov edges," \
     "work corpus $(find "$work" -type f | wc -l) files," \
     "seed corpus $(find "tests/fuzz/corpus/$target" -type f | wc -l) files" \
     "$([ $status -eq 0 ] && echo "no finding" || echo "FINDING: see $log and $findings/")"

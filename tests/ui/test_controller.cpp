@@ -390,5 +390,54 @@ TEST(Controller, AnInMemorySessionLeavesTheSessionFileAlone) {
   EXPECT_FALSE(std::filesystem::exists(LockPathOf(session_path)));
 }
 
+// Makes a folder read-only for this process: chmod, and for root (whom chmod does not stop) the
+// immutable attribute; undone when it goes out of scope. readonly() is false where neither works.
+class ReadOnlyFolder {
+ public:
+  explicit ReadOnlyFolder(std::filesystem::path dir) : dir_(std::move(dir)) {
+    std::filesystem::permissions(dir_, std::filesystem::perms::owner_write,
+                                 std::filesystem::perm_options::remove);
+    if (!Writable()) return;
+    immutable_ = test::RunCommand("chattr +i '" + dir_.string() + "'") == 0;
+  }
+  ~ReadOnlyFolder() {
+    if (immutable_) test::RunCommand("chattr -i '" + dir_.string() + "'");
+    std::filesystem::permissions(dir_, std::filesystem::perms::owner_write,
+                                 std::filesystem::perm_options::add);
+  }
+  bool readonly() const { return !Writable(); }
+
+ private:
+  bool Writable() const { return ::access(dir_.c_str(), W_OK) == 0 && !immutable_; }
+  std::filesystem::path dir_;
+  bool immutable_ = false;
+};
+
+// A dataset in a read-only folder (a colleague's share, a mounted recording): it opens, edits
+// work, and every save that cannot happen is said on the status line in the warning colour.
+TEST(Controller, AReadOnlyDatasetFolderOpensAndSaysItCannotSave) {
+  const auto dir = test::TempDir("controller_read_only");
+  const Dataset dataset = LoadDataset(test::UiDataset());
+  SaveDataset(dir / "dataset.json", dataset);  // absolute paths to the clouds and images
+  ReadOnlyFolder read_only(dir);
+  if (!read_only.readonly()) GTEST_SKIP() << "cannot make a folder read-only here";
+  Controller controller;
+  controller.OpenDataset(dir / "dataset.json", {}, Controller::ExistingSession::kResume);
+  Snapshot s = Loaded(controller);
+  // Loading already saves (the detected boards): the status line says at once that it cannot.
+  EXPECT_TRUE(s.status_is_error);
+  EXPECT_NE(s.status_line.find((dir / "calibench.session.json").string()), std::string::npos)
+      << s.status_line;
+  controller.Apply(SetPairStatus{1, PairStatus::kRejected});
+  s = controller.GetSnapshot();
+  EXPECT_EQ(s.pairs[1].status, PairStatus::kRejected);
+  EXPECT_TRUE(s.status_is_error);
+  EXPECT_NE(s.status_line.find("autosave failed: " + (dir / "calibench.session.json").string()),
+            std::string::npos)
+      << s.status_line;
+  EXPECT_FALSE(s.save_error.empty());
+  EXPECT_FALSE(std::filesystem::exists(dir / "calibench.session.json"));
+}
+
 }  // namespace
 }  // namespace calibench::ui
