@@ -7,7 +7,6 @@
 #include <charconv>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <sstream>
 
 #include "core/results/export.h"
@@ -131,12 +130,15 @@ ImportedTransform ReadRos2Launch(const std::filesystem::path& path, const std::s
   const size_t start = text.find("arguments=[");
   const size_t end = start == std::string::npos ? start : text.find(']', start);
   if (end == std::string::npos) Fail(path, "no arguments=[...] of a static_transform_publisher");
-  const std::string list = text.substr(start, end - start);
-  const std::regex quoted("\"([^\"]*)\"|'([^']*)'");
+  // The quoted strings of the list, in order ("..." or '...').
   std::vector<std::string> words;
-  for (auto it = std::sregex_iterator(list.begin(), list.end(), quoted);
-       it != std::sregex_iterator(); ++it)
-    words.push_back((*it)[1].matched ? (*it)[1].str() : (*it)[2].str());
+  for (size_t i = start; i < end; ++i) {
+    if (text[i] != '"' && text[i] != '\'') continue;
+    const size_t close = text.find(text[i], i + 1);
+    if (close == std::string::npos || close > end) break;
+    words.push_back(text.substr(i + 1, close - i - 1));
+    i = close;
+  }
   if (words.empty() || words[0].rfind("--", 0) != 0)
     return FromTfArguments(path, words, ExportFormat::kRos2Tf);  // the old positional form
   std::map<std::string, std::string> flags;
@@ -241,12 +243,13 @@ ImportedTransform ReadTxt(const std::filesystem::path& path, const std::string& 
   std::istringstream lines(text);
   for (std::string line; std::getline(lines, line);) {
     const size_t hash = line.find('#');
-    const std::string comment = hash == std::string::npos ? "" : line.substr(hash);
-    const std::regex frames("# parent: (\\S+)\\s+child: (\\S+)");
-    std::smatch match;
-    if (std::regex_search(comment, match, frames)) {
-      imported.parent = match[1];
-      imported.child = match[2];
+    // "# parent: <name>  child: <name>", as Calibench writes it.
+    std::istringstream comment(hash == std::string::npos ? "" : line.substr(hash + 1));
+    std::string parent_key, parent, child_key, child;
+    if (comment >> parent_key >> parent >> child_key >> child && parent_key == "parent:" &&
+        child_key == "child:") {
+      imported.parent = parent;
+      imported.child = child;
     }
     numbers += line.substr(0, hash) + " ";
   }
