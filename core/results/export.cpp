@@ -190,59 +190,51 @@ ExportedCalibration Txt(const Pose& pose, const ExportFrames& frames, const std:
 
 }  // namespace
 
+namespace {
+
+// One row per format: its name on the command line and the file name users give it.
+struct FormatInfo {
+  ExportFormat format;
+  const char* name;
+  const char* file;
+};
+constexpr FormatInfo kFormats[] = {
+    {ExportFormat::kUrdf, "urdf", "calibration.urdf"},
+    {ExportFormat::kRos1Tf, "ros1-tf", "static_tf.launch"},
+    {ExportFormat::kRos2Tf, "ros2-tf", "static_tf.launch.py"},
+    {ExportFormat::kOpenCvYaml, "opencv-yaml", "calibration.opencv.yaml"},
+    {ExportFormat::kAutoware, "autoware", "sensor_kit_calibration.yaml"},
+    {ExportFormat::kKalibr, "kalibr", "calibration.kalibr.yaml"},
+    {ExportFormat::kTxt, "txt", "calibration.txt"},
+};
+
+const FormatInfo& InfoOf(ExportFormat format) {
+  for (const FormatInfo& info : kFormats)
+    if (info.format == format) return info;
+  CALIBENCH_CHECK(false && "export format missing from kFormats");
+  return kFormats[0];
+}
+
+}  // namespace
+
 const std::vector<ExportFormat>& AllExportFormats() {
-  static const std::vector<ExportFormat> formats = {
-      ExportFormat::kUrdf,       ExportFormat::kRos1Tf,   ExportFormat::kRos2Tf,
-      ExportFormat::kOpenCvYaml, ExportFormat::kAutoware, ExportFormat::kKalibr,
-      ExportFormat::kTxt};
+  static const std::vector<ExportFormat> formats = [] {
+    std::vector<ExportFormat> all;
+    for (const FormatInfo& info : kFormats) all.push_back(info.format);
+    return all;
+  }();
   return formats;
 }
 
-std::string ExportFormatName(ExportFormat format) {
-  switch (format) {
-    case ExportFormat::kUrdf:
-      return "urdf";
-    case ExportFormat::kRos1Tf:
-      return "ros1-tf";
-    case ExportFormat::kRos2Tf:
-      return "ros2-tf";
-    case ExportFormat::kOpenCvYaml:
-      return "opencv-yaml";
-    case ExportFormat::kAutoware:
-      return "autoware";
-    case ExportFormat::kKalibr:
-      return "kalibr";
-    case ExportFormat::kTxt:
-      return "txt";
-  }
-  return "?";
-}
+std::string ExportFormatName(ExportFormat format) { return InfoOf(format).name; }
 
 std::optional<ExportFormat> ParseExportFormat(std::string_view name) {
-  for (const ExportFormat format : AllExportFormats())
-    if (ExportFormatName(format) == name) return format;
+  for (const FormatInfo& info : kFormats)
+    if (name == info.name) return info.format;
   return std::nullopt;
 }
 
-std::string DefaultExportFileName(ExportFormat format) {
-  switch (format) {
-    case ExportFormat::kUrdf:
-      return "calibration.urdf";
-    case ExportFormat::kRos1Tf:
-      return "static_tf.launch";
-    case ExportFormat::kRos2Tf:
-      return "static_tf.launch.py";
-    case ExportFormat::kOpenCvYaml:
-      return "calibration.opencv.yaml";
-    case ExportFormat::kAutoware:
-      return "sensor_kit_calibration.yaml";
-    case ExportFormat::kKalibr:
-      return "calibration.kalibr.yaml";
-    case ExportFormat::kTxt:
-      return "calibration.txt";
-  }
-  return "calibration.txt";
-}
+std::string DefaultExportFileName(ExportFormat format) { return InfoOf(format).file; }
 
 std::string CameraFrameName(CameraFrame frame) {
   return frame == CameraFrame::kOptical ? "optical" : "link";
