@@ -15,25 +15,24 @@
 namespace calibench {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 std::vector<double> Vlp16Elevations() {
   std::vector<double> e;
-  for (int r = 0; r < 16; ++r) e.push_back((-15.0 + 2.0 * r) * kDeg);
+  for (int r = 0; r < 16; ++r) e.push_back((-15.0 + 2.0 * r) * kDegToRad);
   return e;
 }
 
 // HDL-64E-like: 32 upper beams about 1/3 degree apart, 32 lower beams 1/2 degree apart.
 std::vector<double> Hdl64Elevations() {
   std::vector<double> e;
-  for (int r = 0; r < 32; ++r) e.push_back((-24.33 + 0.5 * r) * kDeg);
-  for (int r = 0; r < 32; ++r) e.push_back((-8.33 + 10.33 * r / 31.0) * kDeg);
+  for (int r = 0; r < 32; ++r) e.push_back((-24.33 + 0.5 * r) * kDegToRad);
+  for (int r = 0; r < 32; ++r) e.push_back((-8.33 + 10.33 * r / 31.0) * kDegToRad);
   return e;
 }
 
 std::vector<double> Os0_128Elevations() {
   std::vector<double> e;
-  for (int r = 0; r < 128; ++r) e.push_back((-45.0 + 90.0 * r / 127.0) * kDeg);
+  for (int r = 0; r < 128; ++r) e.push_back((-45.0 + 90.0 * r / 127.0) * kDegToRad);
   return e;
 }
 
@@ -116,7 +115,7 @@ TEST(LidarImage, OptionsCheck) {
   EXPECT_FALSE(options.Check(&why));
   EXPECT_NE(why.find("ring_gap_rad"), std::string::npos);
   EXPECT_THROW(ProjectById(LidarCloud(), options), std::invalid_argument);
-  options.ring_gap_rad = 0.15 * kDeg;
+  options.ring_gap_rad = 0.15 * kDegToRad;
   const LidarImage empty = ProjectById(LidarCloud(), options);
   EXPECT_EQ(empty.rows, 0);
   EXPECT_TRUE(empty.point_index.empty());
@@ -233,13 +232,13 @@ TEST(LidarImage, ClusteringIsRobustForDenseAndNoisyBeamTables) {
                         {"os0-128", Os0_128Elevations(), 512, 0.05}};
   for (const Case& c : cases) {
     LidarCloud cloud =
-        CylinderScan(c.elevations, c.azimuths, 5.0, false, false, c.noise_deg * kDeg, 3);
+        CylinderScan(c.elevations, c.azimuths, 5.0, false, false, c.noise_deg * kDegToRad, 3);
     std::vector<int> truth = TrueRings(c.elevations.size(), c.azimuths);
     // Stray points: at the origin, and 1 degree below the lowest beam.
     for (int k = 0; k < 3; ++k) {
       cloud.points.emplace_back(0.f, 0.f, 0.f);
       truth.push_back(-1);
-      const double el = c.elevations.front() - kDeg;
+      const double el = c.elevations.front() - kDegToRad;
       cloud.points.emplace_back(5.f * std::cos(k), 5.f * std::sin(k), 5.f * std::tan(el));
       truth.push_back(0);
     }

@@ -18,7 +18,6 @@
 namespace calibench {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 // A convex planar polygon (target frame) and a ray's first hit on it.
 struct Polygon {
@@ -87,15 +86,15 @@ Pose CamFromLrf() {
 Pose CamFromTarget(double distance, double yaw_deg, double lateral, double height) {
   Pose pose = Pose::Identity();
   pose.linear() = Eigen::DiagonalMatrix<double, 3>(1, -1, -1) *
-                  Eigen::AngleAxisd(yaw_deg * kDeg, Vec3::UnitY()).toRotationMatrix();
+                  Eigen::AngleAxisd(yaw_deg * kDegToRad, Vec3::UnitY()).toRotationMatrix();
   pose.translation() = Vec3(lateral, -0.15 + height, distance);
   return pose;
 }
 
 LaserScan RenderScan(const Scene& lrf_scene, double step_deg, double noise_m, uint64_t seed) {
   LaserScan scan;
-  scan.angle_min = -60 * kDeg;
-  scan.angle_increment = step_deg * kDeg;
+  scan.angle_min = -60 * kDegToRad;
+  scan.angle_increment = step_deg * kDegToRad;
   scan.range_min = 0.05;
   scan.range_max = 20.0;
   std::mt19937_64 rng(seed);
@@ -185,7 +184,7 @@ std::array<double, 3> LineErrors(const DepthFeatures& f, const ThreeFaceTarget& 
 }
 
 double NormalAngleDeg(const Vec3& a, const Vec3& b) {
-  return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) / kDeg;
+  return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) / kDegToRad;
 }
 
 // A few poses that keep the scan on all three faces.
@@ -257,11 +256,11 @@ TEST(LrfScanFeatures, RegionSelectsTheTarget) {
   const ThreeFaceTarget target;
   const Pose pose = CamFromTarget(2.0, 0, 0, 0.0);
   const Observation obs = MakeObservation(target, pose, 0.0, 0.0, 3);
-  const ScanRegion region{-20 * kDeg, 20 * kDeg, 0.5, 3.0};
+  const ScanRegion region{-20 * kDegToRad, 20 * kDegToRad, 0.5, 3.0};
   const ScanFeatures f = ExtractScanFeatures(obs.scan, target, ScanFeatureOptions{}, &region);
   ASSERT_TRUE(f.ok) << f.reason;
   EXPECT_TRUE(test::MatrixNear(f.corners[1], TrueCorners(target, pose)[1], 1e-4));
-  const ScanRegion empty{-20 * kDeg, 20 * kDeg, 10.0, 12.0};
+  const ScanRegion empty{-20 * kDegToRad, 20 * kDegToRad, 10.0, 12.0};
   const ScanFeatures none = ExtractScanFeatures(obs.scan, target, ScanFeatureOptions{}, &empty);
   EXPECT_FALSE(none.ok);
   EXPECT_EQ(none.reason, "no valid returns inside the selected region");
@@ -495,7 +494,7 @@ TEST(LrfBoardScan, LongestStraightRunIsTheWall) {
   EXPECT_LT(board.rms_m, 0.005);
   EXPECT_EQ(board.points.size(), board.indices.size());
 
-  const ScanRegion region{-60 * kDeg, -50 * kDeg, 0.0, 5.0};
+  const ScanRegion region{-60 * kDegToRad, -50 * kDegToRad, 0.0, 5.0};
   const BoardScanPoints in_region = ExtractBoardScanPoints(scan, BoardScanOptions{}, &region);
   ASSERT_TRUE(in_region.ok) << in_region.reason;
   EXPECT_EQ(in_region.points.size(), 20u);
@@ -547,7 +546,7 @@ TEST(LrfBoardScan, RealAcfrScansFindTheBoardAhead) {
   std::sort(files.begin(), files.end());
   ASSERT_EQ(files.size(), 5u);
   // The board straight ahead, well within the scan's 45° window around +x.
-  const ScanRegion ahead{-45 * kDeg, 45 * kDeg, 0.3, 1.5};
+  const ScanRegion ahead{-45 * kDegToRad, 45 * kDegToRad, 0.3, 1.5};
   for (const auto& file : files) {
     const LaserScan scan = ReadAcfrScan(file);
     const BoardScanPoints board = ExtractBoardScanPoints(scan, BoardScanOptions{}, &ahead);
