@@ -15,7 +15,6 @@
 namespace calibench {
 namespace {
 
-
 std::vector<double> Vlp16Elevations() {
   std::vector<double> e;
   for (int r = 0; r < 16; ++r) e.push_back((-15.0 + 2.0 * r) * kDegToRad);

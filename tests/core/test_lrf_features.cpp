@@ -18,7 +18,6 @@
 namespace calibench {
 namespace {
 
-
 // A convex planar polygon (target frame) and a ray's first hit on it.
 struct Polygon {
   std::vector<Vec3> vertices;
