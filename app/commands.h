@@ -45,6 +45,7 @@ bool IsLrfManifest(const std::string& path);
 int RunGui(int argc, char** argv);
 int RunRender(int argc, char** argv);
 int RunExport(int argc, char** argv);
+int RunImport(int argc, char** argv);
 
 // How `gui` runs its window. A test's window closes by itself (0 = never) after that many frames
 // drawn back to back, or after that many seconds of a normal run.

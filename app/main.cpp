@@ -30,6 +30,8 @@ constexpr Command kCommands[] = {
      "the workbench window: brush, accept/reject pairs, solve, inspect (--dataset or --session)"},
     {"render", calibench::app::RunRender,
      "draw the workbench or one view to PNG without a window (EGL / OSMesa)"},
+    {"import", calibench::app::RunImport,
+     "turn a ROS 1 .bag or ROS 2 .db3 / .mcap recording into a dataset folder (--list: topics)"},
     {"export", calibench::app::RunExport,
      "write a result as URDF, ROS 1 / ROS 2 static TF, OpenCV YAML, Autoware, Kalibr or 4x4 text"},
     {"sweep", calibench::app::RunSweep,

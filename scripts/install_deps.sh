@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build ccache pkg-config git
   libeigen3-dev libopencv-dev libopencv-contrib-dev libpcl-dev nlohmann-json3-dev libcli11-dev
-  libyaml-cpp-dev libtinyxml2-dev
+  libyaml-cpp-dev libtinyxml2-dev libsqlite3-dev libzstd-dev liblz4-dev libbz2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libglfw3-dev libimgui-dev libegl-dev libgl-dev libgles-dev libosmesa6-dev
   xvfb xauth fonts-dejavu-core

@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/base/atomic_file.h"
 #include "core/base/types.h"
 
 namespace calibench {
@@ -612,6 +613,54 @@ CameraModel LoadCameraFile(const std::filesystem::path& path) {
   } catch (const Problem& problem) {
     throw IoError("camera file '" + path.string() + "': " + problem.what());
   }
+}
+
+CameraModel CameraFromCameraInfo(const std::string& distortion_model, int width, int height,
+                                 const double (&k)[9], const std::vector<double>& d) {
+  CameraModel camera;
+  camera.width = width;
+  camera.height = height;
+  camera.fx = k[0];
+  camera.fy = k[4];
+  camera.cx = k[2];
+  camera.cy = k[5];
+  try {
+    SetModel(distortion_model, d, &camera);
+  } catch (const Problem& problem) {
+    throw std::invalid_argument(problem.what());
+  }
+  std::string why;
+  if (!camera.Check(&why)) throw std::invalid_argument("intrinsics: " + why);
+  return camera;
+}
+
+void SaveCameraInfoYaml(const std::filesystem::path& path, const CameraModel& camera,
+                        const std::string& camera_name) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  const bool fisheye = camera.type == CameraModelType::kKannalaBrandt;
+  const std::string model = fisheye                        ? "equidistant"
+                            : camera.distortion.size() == 8 ? "rational_polynomial"
+                                                            : "plumb_bob";
+  auto matrix = [&](const char* name, int rows, int cols, const std::vector<double>& data) {
+    out << YAML::Key << name << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "rows" << YAML::Value << rows << YAML::Key << "cols" << YAML::Value
+        << cols;
+    out << YAML::Key << "data" << YAML::Value << YAML::Flow << data << YAML::EndMap;
+  };
+  out << YAML::BeginMap;
+  out << YAML::Key << "image_width" << YAML::Value << camera.width;
+  out << YAML::Key << "image_height" << YAML::Value << camera.height;
+  out << YAML::Key << "camera_name" << YAML::Value << camera_name;
+  matrix("camera_matrix", 3, 3, {camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1});
+  out << YAML::Key << "distortion_model" << YAML::Value << model;
+  matrix("distortion_coefficients", 1, static_cast<int>(camera.distortion.size()),
+         camera.distortion);
+  matrix("rectification_matrix", 3, 3, {1, 0, 0, 0, 1, 0, 0, 0, 1});
+  matrix("projection_matrix", 3, 4,
+         {camera.fx, 0, camera.cx, 0, 0, camera.fy, camera.cy, 0, 0, 0, 1, 0});
+  out << YAML::EndMap;
+  WriteFileAtomically(path, std::string(out.c_str()) + "\n");
 }
 
 }  // namespace calibench

@@ -17,4 +17,16 @@ namespace calibench {
 // deeper than 64 levels (refused before any parser sees it).
 CameraModel LoadCameraFile(const std::filesystem::path& path);
 
+// The camera a ROS CameraInfo describes: its distortion model by name (plumb_bob and
+// rational_polynomial -> pinhole-radtan with 5 or 8 coefficients, equidistant -> kannala-brandt),
+// K row-major, D. Throws std::invalid_argument naming what is wrong (an unknown model, a
+// coefficient count the model does not have, intrinsics that fail CameraModel::Check).
+CameraModel CameraFromCameraInfo(const std::string& distortion_model, int width, int height,
+                                 const double (&k)[9], const std::vector<double>& d);
+
+// Writes the camera as a ROS camera_info YAML (camera_calibration's layout, which
+// LoadCameraFile and ROS's camera_info_manager read). Throws IoError naming the file.
+void SaveCameraInfoYaml(const std::filesystem::path& path, const CameraModel& camera,
+                        const std::string& camera_name);
+
 }  // namespace calibench

@@ -1,0 +1,80 @@
+// A recording -> a dataset folder: the LiDAR and camera topics chosen, clouds paired with images
+// by stamp, only moments when the board stood still, no near-duplicate poses, at most a cap;
+// written as binary PCD + PNG + camera.yaml + dataset.json, with a record of every dropped frame.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/camera/camera.h"
+#include "core/io/bag.h"
+#include "core/io/load_limits.h"
+#include "core/target/board.h"
+
+namespace calibench {
+
+struct BagImportOptions {
+  // Topics; empty = chosen automatically when the recording has exactly one candidate.
+  std::string cloud_topic;        // sensor_msgs/PointCloud2
+  std::string image_topic;        // sensor_msgs/Image or CompressedImage
+  std::string camera_info_topic;  // sensor_msgs/CameraInfo; unused when `camera` is given
+  std::optional<CameraModel> camera;  // intrinsics from a file instead of the recording
+
+  // Pairing: a cloud takes the image with the nearest stamp within this offset [s].
+  double max_pair_offset_s = 0.05;
+  // Stillness: the board poses the camera sees within ±window/2 of the pair [s] (a spinning
+  // LiDAR sweeps for 100 ms) may differ from the pair's by at most these.
+  double still_window_s = 0.4;
+  double still_translation_m = 0.01;
+  double still_rotation_deg = 1.0;
+  // Near-duplicates: a pair whose board pose is within both of these of a kept pair's is dropped.
+  double duplicate_translation_m = 0.10;
+  double duplicate_rotation_deg = 5.0;
+  // At most this many pairs, spread evenly over the recording (0 = no cap).
+  int max_pairs = 60;
+  LoadLimits limits;
+
+  bool Check(std::string* why) const;
+};
+
+// What an import did. Every cloud of the chosen topic is either written or counted under one
+// reason in `dropped`.
+struct BagImportSummary {
+  std::string format;  // the reader's description of the file
+  std::string cloud_topic, image_topic, camera_source;
+  std::int64_t clouds = 0;  // messages on the cloud topic
+  std::int64_t images = 0;  // messages on the image topic
+  int boards_seen = 0;      // images where the board was found
+  std::vector<std::string> pair_ids;       // written, in time order
+  std::map<std::string, int> dropped;      // reason -> clouds dropped for it
+  // Candidates with no other board pose within the stillness window (a camera as slow as the
+  // window): kept, but their stillness is unknown.
+  int kept_without_stillness_check = 0;
+  std::filesystem::path manifest;          // the dataset.json written
+  std::int64_t bytes_read = 0;             // over both passes
+};
+
+// Topics to import when the options name none: exactly one PointCloud2 topic; one image topic
+// (a raw Image is preferred over a CompressedImage of the same camera only when it is the only
+// raw one); the CameraInfo beside the image topic (same namespace) or the only one. Throws
+// IoError naming the file and listing the candidates when the choice is ambiguous or impossible.
+void ChooseTopics(const BagReader& bag, BagImportOptions* options);
+
+// Progress of an import: the phase ("reading", "writing"), bytes done and in all.
+using ImportProgress =
+    std::function<void(const std::string& phase, std::int64_t done, std::int64_t total)>;
+
+// Reads the recording twice (stamps, camera intrinsics and board poses; then the chosen pairs)
+// and writes the dataset into `out_dir` (created; files already there with the same names are
+// replaced, others kept). Throws IoError naming the file on unreadable data, on a camera that
+// cannot be had, or when no pair survives (the summary's reasons are in the message).
+BagImportSummary ImportBag(const std::filesystem::path& bag_path,
+                           const std::filesystem::path& out_dir, const BoardSpec& board,
+                           BagImportOptions options, const ImportProgress& progress = {});
+
+}  // namespace calibench

@@ -1,0 +1,252 @@
+// MCAP (https://mcap.dev/spec), read without a library: Debian packages no C++ MCAP reader.
+//
+// The file: magic, a Header record, the data section (Schema, Channel and Message records, most
+// often inside Chunk records, compressed with zstd or lz4 or not at all), DataEnd, an optional
+// summary section (Schema, Channel, Statistics, ChunkIndex, ...), a Footer pointing at the
+// summary, magic. Every record is <u8 opcode><u64 length><content>; strings are <u32 length>
+// <bytes>. Topics and counts come from the summary when it has Statistics, else from one pass.
+#include <map>
+#include <set>
+
+#include "core/io/bag_internal.h"
+
+namespace calibench::bag_internal {
+namespace {
+namespace fs = std::filesystem;
+
+constexpr std::string_view kMagic("\x89MCAP0\r\n", 8);
+constexpr std::uint8_t kOpHeader = 0x01;
+constexpr std::uint8_t kOpFooter = 0x02;
+constexpr std::uint8_t kOpSchema = 0x03;
+constexpr std::uint8_t kOpChannel = 0x04;
+constexpr std::uint8_t kOpMessage = 0x05;
+constexpr std::uint8_t kOpChunk = 0x06;
+constexpr std::uint8_t kOpChunkIndex = 0x08;
+constexpr std::uint8_t kOpStatistics = 0x0B;
+constexpr std::uint8_t kOpDataEnd = 0x0F;
+constexpr std::int64_t kFooterBytes = 1 + 8 + 8 + 8 + 4;
+
+class Mcap final : public BagReader {
+ public:
+  explicit Mcap(const fs::path& path) : file_(path) {
+    path_ = path;
+    size_bytes_ = file_.Size();
+    std::vector<std::uint8_t> bytes;
+    file_.ReadAt(0, 8, &bytes, "the magic");
+    if (std::string_view(reinterpret_cast<const char*>(bytes.data()), 8) != kMagic)
+      Fail(path, "an MCAP of a version other than 0");
+    std::uint8_t op = 0;
+    const std::int64_t header_end = ReadRecord(8, &op, &bytes);
+    if (op != kOpHeader) Fail(path, "the first record is not the MCAP header");
+    Cursor header(bytes, path_, 8, "the header");
+    profile_ = std::string(header.PrefixedText("the profile"));
+    data_start_ = header_end;
+    if (!ReadSummary()) CountByScanning();
+    format_ = "MCAP (" + (profile_.empty() ? std::string("no") : profile_) + " profile), " +
+              std::to_string(chunk_count_) + " chunks" +
+              (compressions_.empty() ? "" : " (" + Join(compressions_) + ")");
+  }
+
+  void ForEachMessage(const std::vector<bool>& wanted, const BagVisitor& visit,
+                      const BagProgress& progress) override {
+    std::vector<std::uint8_t> content, chunk;
+    std::uint8_t op = 0;
+    for (std::int64_t offset = data_start_; offset < data_end_;) {
+      const std::int64_t next = ReadRecord(offset, &op, &content);
+      bool go_on = true;
+      if (op == kOpChunk) {
+        go_on = VisitChunk(content, offset, &chunk, wanted, visit);
+      } else if (op == kOpDataEnd || op == kOpFooter) {
+        break;
+      } else {
+        go_on = VisitRecord(op, content, offset, wanted, visit);
+      }
+      if (progress) progress(next, size_bytes_);
+      if (!go_on) return;
+      offset = next;
+    }
+  }
+
+ private:
+  // Reads the record at `offset`: its opcode and content. Returns where the next one starts.
+  std::int64_t ReadRecord(std::int64_t offset, std::uint8_t* op,
+                          std::vector<std::uint8_t>* content) const {
+    std::vector<std::uint8_t> head;
+    file_.ReadAt(offset, 9, &head, "a record's opcode and length");
+    *op = head[0];
+    std::uint64_t length;
+    std::memcpy(&length, head.data() + 1, 8);
+    if (length > kMaxChunkBytes)
+      Fail(path_, "the record at byte " + std::to_string(offset) + " declares " +
+                      std::to_string(length) + " bytes, over the limit");
+    file_.ReadAt(offset + 9, static_cast<std::int64_t>(length), content, "a record");
+    return offset + 9 + static_cast<std::int64_t>(length);
+  }
+
+  // The summary's schemas, channels and statistics; false when the file has no usable summary
+  // (a recording that was not closed, or one written without statistics).
+  bool ReadSummary() {
+    if (size_bytes_ < 8 + kFooterBytes + 8) return false;
+    const std::int64_t footer_at = size_bytes_ - 8 - kFooterBytes;
+    std::vector<std::uint8_t> bytes;
+    file_.ReadAt(footer_at, kFooterBytes + 8, &bytes, "the footer");
+    if (bytes[0] != kOpFooter ||
+        std::string_view(reinterpret_cast<const char*>(bytes.data()) + kFooterBytes, 8) != kMagic)
+      return false;
+    std::uint64_t summary_start;
+    std::memcpy(&summary_start, bytes.data() + 9, 8);
+    if (summary_start == 0 || summary_start < static_cast<std::uint64_t>(data_start_) ||
+        summary_start >= static_cast<std::uint64_t>(footer_at))
+      return false;
+    bool statistics = false;
+    std::uint8_t op = 0;
+    for (std::int64_t offset = static_cast<std::int64_t>(summary_start); offset < footer_at;) {
+      const std::int64_t next = ReadRecord(offset, &op, &bytes);
+      if (op == kOpStatistics) {
+        ReadStatistics(bytes, offset);
+        statistics = true;
+      } else if (op == kOpChunkIndex) {
+        Cursor index(bytes, path_, offset, "a chunk index");
+        index.Bytes(8 * 4, "the chunk's times and position");
+        index.Bytes(index.Read<std::uint32_t>(), "the message index offsets");
+        index.Read<std::uint64_t>();  // message index length
+        compressions_.insert(NameOf(std::string(index.PrefixedText("the compression"))));
+      } else {
+        VisitRecord(op, bytes, offset, {}, {});
+      }
+      offset = next;
+    }
+    data_end_ = static_cast<std::int64_t>(summary_start);
+    return statistics;
+  }
+
+  void ReadStatistics(std::span<const std::uint8_t> content, std::int64_t offset) {
+    Cursor stats(content, path_, offset, "the statistics");
+    stats.Read<std::uint64_t>();  // messages
+    stats.Read<std::uint16_t>();  // schemas
+    stats.Read<std::uint32_t>();  // channels
+    stats.Read<std::uint32_t>();  // attachments
+    stats.Read<std::uint32_t>();  // metadata
+    chunk_count_ = stats.Read<std::uint32_t>();
+    stats.Read<std::uint64_t>();  // first message time
+    stats.Read<std::uint64_t>();  // last message time
+    Cursor counts(stats.Bytes(stats.Read<std::uint32_t>(), "the message counts"), path_, offset,
+                  "the statistics' message counts");
+    while (!counts.AtEnd()) {
+      const std::uint16_t channel = counts.Read<std::uint16_t>();
+      const std::uint64_t count = counts.Read<std::uint64_t>();
+      const auto topic = channel_topic_.find(channel);
+      if (topic == channel_topic_.end())
+        Fail(path_, "the statistics count messages of channel " + std::to_string(channel) +
+                        ", which the summary does not define");
+      topics_[topic->second].message_count += static_cast<std::int64_t>(count);
+    }
+  }
+
+  void CountByScanning() {
+    data_end_ = size_bytes_;
+    counting_ = true;
+    chunk_count_ = 0;
+    compressions_.clear();
+    ForEachMessage(
+        {},
+        [&](const BagMessage& message) {
+          ++topics_[message.topic].message_count;
+          return true;
+        },
+        {});
+    counting_ = false;
+  }
+
+  static std::string NameOf(const std::string& compression) {
+    return compression.empty() ? "none" : compression;
+  }
+  static std::string Join(const std::set<std::string>& words) {
+    std::string text;
+    for (const std::string& word : words) text += (text.empty() ? "" : ", ") + word;
+    return text.empty() ? "none" : text;
+  }
+
+  bool VisitChunk(std::span<const std::uint8_t> content, std::int64_t offset,
+                  std::vector<std::uint8_t>* buffer, const std::vector<bool>& wanted,
+                  const BagVisitor& visit) {
+    Cursor chunk(content, path_, offset, "a chunk");
+    chunk.Read<std::uint64_t>();  // first message time
+    chunk.Read<std::uint64_t>();  // last message time
+    const std::uint64_t uncompressed_size = chunk.Read<std::uint64_t>();
+    chunk.Read<std::uint32_t>();  // CRC of the uncompressed records (0 = not computed)
+    const std::string compression(chunk.PrefixedText("the compression"));
+    std::span<const std::uint8_t> records = chunk.Bytes(chunk.Read<std::uint64_t>(), "records");
+    if (counting_) {
+      compressions_.insert(NameOf(compression));
+      ++chunk_count_;
+    }
+    if (!compression.empty()) {
+      Decompress(compression, records, uncompressed_size, buffer, path_, offset);
+      records = *buffer;
+    }
+    Cursor inner(records, path_, offset, "a chunk's records");
+    while (!inner.AtEnd()) {
+      const std::uint8_t op = inner.Read<std::uint8_t>();
+      const auto record = inner.Bytes(inner.Read<std::uint64_t>(), "a record in a chunk");
+      if (!VisitRecord(op, record, offset, wanted, visit)) return false;
+    }
+    return true;
+  }
+
+  // Schemas and channels are registered; messages visited; other records skipped.
+  bool VisitRecord(std::uint8_t op, std::span<const std::uint8_t> content, std::int64_t offset,
+                   const std::vector<bool>& wanted, const BagVisitor& visit) {
+    if (op == kOpSchema) {
+      Cursor schema(content, path_, offset, "a schema");
+      const std::uint16_t id = schema.Read<std::uint16_t>();
+      schema_names_[id] = std::string(schema.PrefixedText("the schema name"));
+    } else if (op == kOpChannel) {
+      Cursor channel(content, path_, offset, "a channel");
+      const std::uint16_t id = channel.Read<std::uint16_t>();
+      const std::uint16_t schema_id = channel.Read<std::uint16_t>();
+      const std::string topic(channel.PrefixedText("the topic"));
+      const std::string encoding(channel.PrefixedText("the message encoding"));
+      if (channel_topic_.count(id)) return true;
+      const auto schema = schema_names_.find(schema_id);
+      if (schema_id != 0 && schema == schema_names_.end())
+        channel.Fail("channel '" + topic + "' names schema " + std::to_string(schema_id) +
+                     ", which comes nowhere before it");
+      channel_topic_[id] =
+          AddTopic(&topics_, topic, schema_id == 0 ? "" : schema->second, encoding);
+    } else if (op == kOpMessage) {
+      Cursor message(content, path_, offset, "a message");
+      const std::uint16_t channel = message.Read<std::uint16_t>();
+      message.Read<std::uint32_t>();  // sequence
+      const std::uint64_t log_time = message.Read<std::uint64_t>();
+      message.Read<std::uint64_t>();  // publish time
+      const auto topic = channel_topic_.find(channel);
+      if (topic == channel_topic_.end())
+        message.Fail("a message on channel " + std::to_string(channel) +
+                     ", which comes nowhere before it");
+      if (!visit || (!wanted.empty() && !wanted[topic->second])) return true;
+      BagMessage out;
+      out.topic = topic->second;
+      out.log_time_ns = static_cast<std::int64_t>(log_time);
+      out.data = message.Bytes(message.Remaining(), "the message data");
+      return visit(out);
+    }
+    return true;
+  }
+
+  RandomAccessFile file_;
+  std::string profile_;
+  std::int64_t data_start_ = 0;
+  std::int64_t data_end_ = 0;
+  std::uint32_t chunk_count_ = 0;
+  bool counting_ = false;  // the first pass over a file without a summary
+  std::set<std::string> compressions_;
+  std::map<std::uint16_t, std::string> schema_names_;
+  std::map<std::uint16_t, int> channel_topic_;
+};
+
+}  // namespace
+
+std::unique_ptr<BagReader> OpenMcap(const fs::path& path) { return std::make_unique<Mcap>(path); }
+
+}  // namespace calibench::bag_internal

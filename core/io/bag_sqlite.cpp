@@ -1,0 +1,136 @@
+// rosbag2's sqlite3 storage (.db3): a `topics` table (id, name, type, serialization_format, ...)
+// and a `messages` table (id, topic_id, timestamp, data). Every layout since Dashing has these
+// columns; newer ones add tables (schema, metadata, message_definitions) we do not need.
+//
+// The file is opened read-only and immutable: a recording may sit on a read-only medium, in WAL
+// mode with no -wal file beside it, and must never be changed by being looked at.
+#include <sqlite3.h>
+
+#include <map>
+
+#include "core/io/bag_internal.h"
+
+namespace calibench::bag_internal {
+namespace {
+namespace fs = std::filesystem;
+
+// sqlite3's URI form needs '%', '?' and '#' escaped in the path.
+std::string ImmutableUri(const fs::path& path) {
+  std::string uri = "file:";
+  for (const char c : fs::absolute(path).string()) {
+    if (c == '%' || c == '?' || c == '#') {
+      static const char* hex = "0123456789ABCDEF";
+      uri += '%';
+      uri += hex[(static_cast<unsigned char>(c) >> 4) & 15];
+      uri += hex[static_cast<unsigned char>(c) & 15];
+    } else {
+      uri += c;
+    }
+  }
+  return uri + "?immutable=1";
+}
+
+class Statement {
+ public:
+  Statement(sqlite3* db, const std::string& sql, const fs::path& path) : path_(path) {
+    if (sqlite3_prepare_v2(db, sql.c_str(), -1, &statement_, nullptr) != SQLITE_OK)
+      Fail(path, std::string("not a rosbag2 recording (") + sqlite3_errmsg(db) + ")");
+  }
+  ~Statement() { sqlite3_finalize(statement_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+
+  // True while rows come; throws IoError naming the file when reading fails.
+  bool Step() {
+    const int status = sqlite3_step(statement_);
+    if (status == SQLITE_ROW) return true;
+    if (status == SQLITE_DONE) return false;
+    Fail(path_, std::string("cannot read the recording (") +
+                    sqlite3_errmsg(sqlite3_db_handle(statement_)) + ")");
+  }
+  std::int64_t Integer(int column) { return sqlite3_column_int64(statement_, column); }
+  std::string Text(int column) {
+    const auto* text = sqlite3_column_text(statement_, column);
+    return text ? reinterpret_cast<const char*>(text) : "";
+  }
+  std::span<const std::uint8_t> Blob(int column) {
+    const void* blob = sqlite3_column_blob(statement_, column);
+    const int size = sqlite3_column_bytes(statement_, column);
+    return {static_cast<const std::uint8_t*>(blob), static_cast<std::size_t>(size)};
+  }
+
+ private:
+  sqlite3_stmt* statement_ = nullptr;
+  fs::path path_;
+};
+
+class SqliteBag final : public BagReader {
+ public:
+  explicit SqliteBag(const fs::path& path) {
+    path_ = path;
+    size_bytes_ = static_cast<std::int64_t>(fs::file_size(path));
+    if (sqlite3_open_v2(ImmutableUri(path).c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI,
+                        nullptr) != SQLITE_OK) {
+      const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
+      sqlite3_close(db_);
+      Fail(path, "cannot open as sqlite3: " + why);
+    }
+    try {
+      ReadTopics();
+    } catch (...) {
+      sqlite3_close(db_);
+      throw;
+    }
+    format_ = "rosbag2 sqlite3";
+  }
+  ~SqliteBag() override { sqlite3_close(db_); }
+
+  void ForEachMessage(const std::vector<bool>& wanted, const BagVisitor& visit,
+                      const BagProgress& progress) override {
+    std::int64_t total = 0, done = 0;
+    for (std::size_t t = 0; t < topics_.size(); ++t)
+      if (wanted.empty() || wanted[t]) total += topics_[t].message_count;
+    Statement rows(db_, "SELECT topic_id, timestamp, data FROM messages ORDER BY timestamp",
+                   path_);
+    while (rows.Step()) {
+      const auto topic = topic_index_.find(rows.Integer(0));
+      if (topic == topic_index_.end())
+        Fail(path_, "a message of topic id " + std::to_string(rows.Integer(0)) +
+                        ", which the topics table does not list");
+      if (!wanted.empty() && !wanted[topic->second]) continue;
+      BagMessage message;
+      message.topic = topic->second;
+      message.log_time_ns = rows.Integer(1);
+      message.data = rows.Blob(2);
+      if (!visit(message)) return;
+      ++done;
+      // Rows do not map to bytes; spread the file's size over the wanted messages.
+      if (progress && total > 0) progress(size_bytes_ * done / total, size_bytes_);
+    }
+  }
+
+ private:
+  void ReadTopics() {
+    Statement topics(db_, "SELECT id, name, type, serialization_format FROM topics ORDER BY id",
+                     path_);
+    while (topics.Step())
+      topic_index_[topics.Integer(0)] =
+          AddTopic(&topics_, topics.Text(1), topics.Text(2), topics.Text(3));
+    Statement counts(db_, "SELECT topic_id, COUNT(*) FROM messages GROUP BY topic_id", path_);
+    while (counts.Step()) {
+      const auto topic = topic_index_.find(counts.Integer(0));
+      if (topic != topic_index_.end()) topics_[topic->second].message_count += counts.Integer(1);
+    }
+  }
+
+  sqlite3* db_ = nullptr;
+  std::map<std::int64_t, int> topic_index_;
+};
+
+}  // namespace
+
+std::unique_ptr<BagReader> OpenSqliteBag(const fs::path& path) {
+  return std::make_unique<SqliteBag>(path);
+}
+
+}  // namespace calibench::bag_internal

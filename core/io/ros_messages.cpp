@@ -1,0 +1,394 @@
+#include "core/io/ros_messages.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "core/io/camera_file.h"
+#include "core/io/image_io.h"
+
+namespace calibench {
+namespace {
+
+[[noreturn]] void Bad(const std::string& what) { throw std::invalid_argument(what); }
+
+template <typename T>
+T ByteSwapped(T value) {
+  std::uint8_t bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  std::reverse(bytes, bytes + sizeof(T));
+  std::memcpy(&value, bytes, sizeof(T));
+  return value;
+}
+
+// Reads one message's fields in order. ROS 1: little-endian, packed. CDR: a 4-byte
+// encapsulation header giving the byte order, then every primitive aligned to its size counted
+// from the end of that header (OMG CDR as ROS 2's rmw implementations write it).
+class MessageCursor {
+ public:
+  MessageCursor(std::span<const std::uint8_t> data, MessageEncoding encoding, const char* type)
+      : data_(data), type_(type) {
+    if (encoding == MessageEncoding::kCdr) {
+      cdr_ = true;
+      if (data.size() < 4) Bad(std::string(type) + ": shorter than the CDR header");
+      // 0x0000 CDR big-endian, 0x0001 CDR little-endian; ROS 2 writes plain CDR only.
+      if (data[0] != 0 || data[1] > 1)
+        Bad(std::string(type) + ": CDR encapsulation " + std::to_string(data[0] * 256 + data[1]) +
+            " (only plain CDR, 0 and 1, is what ROS 2 records)");
+      big_endian_ = data[1] == 0;
+      origin_ = position_ = 4;
+    } else if (encoding != MessageEncoding::kRos1) {
+      Bad(std::string(type) + ": neither ROS 1 nor CDR serialization");
+    }
+  }
+
+  template <typename T>
+  T Read() {
+    Align(sizeof(T));
+    Need(sizeof(T), "a number");
+    T value;
+    std::memcpy(&value, data_.data() + position_, sizeof(T));
+    position_ += sizeof(T);
+    return big_endian_ ? ByteSwapped(value) : value;
+  }
+  std::string String(const char* what) {
+    const std::uint32_t length = Read<std::uint32_t>();
+    Need(length, what);
+    const char* text = reinterpret_cast<const char*>(data_.data() + position_);
+    position_ += length;
+    std::size_t size = length;
+    if (cdr_ && size > 0 && text[size - 1] == '\0') --size;  // CDR counts the terminator
+    return std::string(text, size);
+  }
+  std::span<const std::uint8_t> ByteSequence(const char* what) {
+    const std::uint32_t length = Read<std::uint32_t>();
+    Need(length, what);
+    auto bytes = data_.subspan(position_, length);
+    position_ += length;
+    return bytes;
+  }
+  void ReadDoubles(double* out, std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i) out[i] = Read<double>();
+  }
+
+ private:
+  void Align(std::size_t size) {
+    if (!cdr_) return;
+    const std::size_t from_origin = position_ - origin_;
+    position_ = origin_ + (from_origin + size - 1) / size * size;
+  }
+  void Need(std::uint64_t size, const char* what) const {
+    if (position_ > data_.size() || size > data_.size() - position_)
+      Bad(std::string(type_) + ": the message ends inside " + what + " (byte " +
+          std::to_string(position_) + " of " + std::to_string(data_.size()) + ")");
+  }
+
+  std::span<const std::uint8_t> data_;
+  const char* type_;
+  bool cdr_ = false;
+  bool big_endian_ = false;
+  std::size_t origin_ = 0;
+  std::size_t position_ = 0;
+};
+
+RosHeader ReadHeader(MessageCursor& cursor, MessageEncoding encoding) {
+  RosHeader header;
+  if (encoding == MessageEncoding::kRos1) cursor.Read<std::uint32_t>();  // seq, gone in ROS 2
+  const std::int64_t seconds = encoding == MessageEncoding::kRos1 ? cursor.Read<std::uint32_t>()
+                                                                  : cursor.Read<std::int32_t>();
+  const std::uint32_t nanoseconds = cursor.Read<std::uint32_t>();
+  header.stamp_ns = seconds * 1'000'000'000 + nanoseconds;
+  header.frame_id = cursor.String("the frame id");
+  return header;
+}
+
+// sensor_msgs/PointField datatypes.
+enum PointFieldType : std::uint8_t {
+  kInt8 = 1, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64
+};
+constexpr const char* kPointFieldNames[] = {"?",      "INT8",   "UINT8",   "INT16",  "UINT16",
+                                            "INT32",  "UINT32", "FLOAT32", "FLOAT64"};
+int PointFieldSize(std::uint8_t type) {
+  constexpr int sizes[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
+  return type >= 1 && type <= 8 ? sizes[type] : 0;
+}
+
+struct PointField {
+  std::string name;
+  std::uint32_t offset = 0;
+  std::uint8_t type = 0;
+  std::uint32_t count = 1;
+};
+
+template <typename T>
+double Load(const std::uint8_t* at, bool swap) {
+  T value;
+  std::memcpy(&value, at, sizeof(T));
+  return static_cast<double>(swap ? ByteSwapped(value) : value);
+}
+
+double ReadField(const std::uint8_t* point, const PointField& field, bool swap) {
+  const std::uint8_t* at = point + field.offset;
+  switch (field.type) {
+    case kInt8: return static_cast<std::int8_t>(*at);
+    case kUint8: return *at;
+    case kInt16: return Load<std::int16_t>(at, swap);
+    case kUint16: return Load<std::uint16_t>(at, swap);
+    case kInt32: return Load<std::int32_t>(at, swap);
+    case kUint32: return Load<std::uint32_t>(at, swap);
+    case kFloat32: return Load<float>(at, swap);
+    default: return Load<double>(at, swap);
+  }
+}
+
+const PointField* FindField(const std::vector<PointField>& fields,
+                            std::initializer_list<const char*> names) {
+  for (const char* name : names)
+    for (const PointField& field : fields)
+      if (field.name == name) return &field;
+  return nullptr;
+}
+
+std::vector<PointField> ReadPointFields(MessageCursor& cursor) {
+  const std::uint32_t count = cursor.Read<std::uint32_t>();
+  if (count > 1024) Bad("PointCloud2: " + std::to_string(count) + " fields");
+  std::vector<PointField> fields(count);
+  for (PointField& field : fields) {
+    field.name = cursor.String("a field name");
+    field.offset = cursor.Read<std::uint32_t>();
+    field.type = cursor.Read<std::uint8_t>();
+    field.count = cursor.Read<std::uint32_t>();
+    if (PointFieldSize(field.type) == 0)
+      Bad("PointCloud2: field '" + field.name + "' has datatype " + std::to_string(field.type) +
+          ", which sensor_msgs/PointField does not define");
+  }
+  return fields;
+}
+
+void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>& fields,
+               std::uint32_t width, std::uint32_t height, std::uint32_t point_step,
+               std::uint32_t row_step, bool swap, LidarCloud* cloud) {
+  const PointField* x = FindField(fields, {"x"});
+  const PointField* y = FindField(fields, {"y"});
+  const PointField* z = FindField(fields, {"z"});
+  if (!x || !y || !z) Bad("PointCloud2: no x, y and z fields");
+  const PointField* intensity = FindField(fields, {"intensity", "reflectivity", "i"});
+  const PointField* ring = FindField(fields, {"ring", "laser_id", "channel", "line"});
+  const std::size_t total = static_cast<std::size_t>(width) * height;
+  cloud->points.reserve(total);
+  if (intensity) cloud->intensity.reserve(total);
+  if (ring) cloud->ring.reserve(total);
+  for (std::uint32_t row = 0; row < height; ++row) {
+    const std::uint8_t* row_start = data.data() + static_cast<std::size_t>(row) * row_step;
+    for (std::uint32_t column = 0; column < width; ++column) {
+      const std::uint8_t* point = row_start + static_cast<std::size_t>(column) * point_step;
+      const Eigen::Vector3f xyz(static_cast<float>(ReadField(point, *x, swap)),
+                                static_cast<float>(ReadField(point, *y, swap)),
+                                static_cast<float>(ReadField(point, *z, swap)));
+      if (!xyz.allFinite()) continue;
+      cloud->points.push_back(xyz);
+      if (intensity) cloud->intensity.push_back(static_cast<float>(ReadField(point, *intensity, swap)));
+      if (ring) cloud->ring.push_back(static_cast<int>(ReadField(point, *ring, swap)));
+    }
+  }
+  const bool complete = cloud->points.size() == total;
+  cloud->width = complete && height > 1 ? static_cast<int>(width)
+                                        : static_cast<int>(cloud->points.size());
+  cloud->height = complete && height > 1 ? static_cast<int>(height) : 1;
+}
+
+ImageU8 FromMat(const cv::Mat& mat) {
+  ImageU8 image;
+  image.width = mat.cols;
+  image.height = mat.rows;
+  image.channels = mat.channels();
+  const std::size_t row_bytes = static_cast<std::size_t>(mat.cols) * mat.channels();
+  image.data.resize(row_bytes * mat.rows);
+  for (int row = 0; row < mat.rows; ++row)
+    std::memcpy(image.data.data() + row * row_bytes, mat.ptr(row), row_bytes);
+  return image;
+}
+
+// 16-bit grey scaled so that the image's largest value becomes 255: a 12-bit camera's data in
+// 16-bit words would otherwise be a black picture after a plain shift.
+cv::Mat ScaledToEightBits(const cv::Mat& sixteen) {
+  double largest = 0;
+  cv::minMaxLoc(sixteen, nullptr, &largest);
+  cv::Mat eight;
+  sixteen.convertTo(eight, CV_8U, largest > 0 ? 255.0 / largest : 1.0);
+  return eight;
+}
+
+struct RawEncoding {
+  const char* name;
+  int cv_type;
+  int conversion;  // cv::COLOR_*, or -1 to keep the pixels as they are
+};
+// cv_bridge's table for the Bayer patterns: ROS names the first 2x2 block from the top left,
+// OpenCV names the second row's pair, hence rggb -> BayerBG.
+constexpr RawEncoding kRawEncodings[] = {
+    {"mono8", CV_8UC1, -1},           {"8UC1", CV_8UC1, -1},
+    {"mono16", CV_16UC1, -1},         {"16UC1", CV_16UC1, -1},
+    {"bgr8", CV_8UC3, -1},            {"8UC3", CV_8UC3, -1},
+    {"rgb8", CV_8UC3, cv::COLOR_RGB2BGR}, {"bgra8", CV_8UC4, cv::COLOR_BGRA2BGR},
+    {"rgba8", CV_8UC4, cv::COLOR_RGBA2BGR}, {"bayer_rggb8", CV_8UC1, cv::COLOR_BayerBG2BGR},
+    {"bayer_bggr8", CV_8UC1, cv::COLOR_BayerRG2BGR}, {"bayer_gbrg8", CV_8UC1, cv::COLOR_BayerGR2BGR},
+    {"bayer_grbg8", CV_8UC1, cv::COLOR_BayerGB2BGR}, {"yuv422", CV_8UC2, cv::COLOR_YUV2BGR_UYVY},
+    {"uyvy", CV_8UC2, cv::COLOR_YUV2BGR_UYVY},   {"yuv422_yuy2", CV_8UC2, cv::COLOR_YUV2BGR_YUYV},
+    {"yuyv", CV_8UC2, cv::COLOR_YUV2BGR_YUYV},
+};
+
+std::string KnownEncodings() {
+  std::string names;
+  for (const RawEncoding& encoding : kRawEncodings) names += (names.empty() ? "" : ", ") + std::string(encoding.name);
+  return names;
+}
+
+}  // namespace
+
+RosHeader DecodeRosHeader(std::span<const std::uint8_t> data, MessageEncoding encoding) {
+  MessageCursor cursor(data, encoding, "the message header");
+  return ReadHeader(cursor, encoding);
+}
+
+PointCloud2Message DecodePointCloud2(std::span<const std::uint8_t> data,
+                                     MessageEncoding encoding, const LoadLimits& limits) {
+  MessageCursor cursor(data, encoding, "PointCloud2");
+  PointCloud2Message message;
+  message.header = ReadHeader(cursor, encoding);
+  const std::uint32_t height = cursor.Read<std::uint32_t>();
+  const std::uint32_t width = cursor.Read<std::uint32_t>();
+  const std::vector<PointField> fields = ReadPointFields(cursor);
+  const bool big_endian = cursor.Read<std::uint8_t>() != 0;
+  const std::uint32_t point_step = cursor.Read<std::uint32_t>();
+  const std::uint32_t row_step = cursor.Read<std::uint32_t>();
+  const std::span<const std::uint8_t> points = cursor.ByteSequence("the point data");
+  for (const PointField& field : fields) {
+    message.fields += (message.fields.empty() ? "" : " ") + field.name + ":" +
+                      kPointFieldNames[field.type] + "@" + std::to_string(field.offset);
+    if (static_cast<std::uint64_t>(field.offset) + PointFieldSize(field.type) * std::max<std::uint64_t>(field.count, 1) > point_step)
+      Bad("PointCloud2: field '" + field.name + "' at byte " + std::to_string(field.offset) +
+          " lies beyond point_step " + std::to_string(point_step));
+  }
+  const std::int64_t declared = static_cast<std::int64_t>(width) * height;
+  if (declared > limits.max_cloud_points)
+    Bad("PointCloud2: " + std::to_string(declared) + " points is over the limit of " +
+        std::to_string(limits.max_cloud_points) + " (max_cloud_points)");
+  if (static_cast<std::uint64_t>(row_step) < static_cast<std::uint64_t>(width) * point_step)
+    Bad("PointCloud2: row_step " + std::to_string(row_step) + " is shorter than width x " +
+        "point_step = " + std::to_string(static_cast<std::uint64_t>(width) * point_step));
+  if (static_cast<std::uint64_t>(row_step) * height > points.size())
+    Bad("PointCloud2: " + std::to_string(points.size()) + " bytes of data for row_step x height = " +
+        std::to_string(static_cast<std::uint64_t>(row_step) * height));
+  message.declared_points = static_cast<int>(declared);
+  const bool swap = big_endian != (std::endian::native == std::endian::big);
+  FillCloud(points, fields, width, height, point_step, row_step, swap, &message.cloud);
+  return message;
+}
+
+ImageMessage DecodeImage(std::span<const std::uint8_t> data, MessageEncoding encoding,
+                         const LoadLimits& limits) {
+  MessageCursor cursor(data, encoding, "Image");
+  ImageMessage message;
+  message.header = ReadHeader(cursor, encoding);
+  const std::uint32_t height = cursor.Read<std::uint32_t>();
+  const std::uint32_t width = cursor.Read<std::uint32_t>();
+  message.encoding = cursor.String("the encoding");
+  const bool big_endian = cursor.Read<std::uint8_t>() != 0;
+  const std::uint32_t step = cursor.Read<std::uint32_t>();
+  const std::span<const std::uint8_t> pixels = cursor.ByteSequence("the pixel data");
+  const RawEncoding* raw = nullptr;
+  for (const RawEncoding& candidate : kRawEncodings)
+    if (message.encoding == candidate.name) raw = &candidate;
+  if (!raw)
+    Bad("Image: encoding '" + message.encoding + "' is not one Calibench reads (" +
+        KnownEncodings() + ")");
+  const std::int64_t pixel_count = static_cast<std::int64_t>(width) * height;
+  if (pixel_count > limits.max_image_pixels)
+    Bad("Image: " + std::to_string(width) + " x " + std::to_string(height) +
+        " pixels is over the limit of " + std::to_string(limits.max_image_pixels) +
+        " (max_image_pixels)");
+  if (width == 0 || height == 0 || width > 1u << 20 || height > 1u << 20)
+    Bad("Image: size " + std::to_string(width) + " x " + std::to_string(height));
+  const std::uint64_t row_bytes = static_cast<std::uint64_t>(width) * CV_ELEM_SIZE(raw->cv_type);
+  if (step < row_bytes)
+    Bad("Image: step " + std::to_string(step) + " is shorter than a row of " +
+        std::to_string(row_bytes) + " bytes");
+  if (static_cast<std::uint64_t>(step) * height > pixels.size())
+    Bad("Image: " + std::to_string(pixels.size()) + " bytes of data for step x height = " +
+        std::to_string(static_cast<std::uint64_t>(step) * height));
+  cv::Mat view(static_cast<int>(height), static_cast<int>(width), raw->cv_type,
+               const_cast<std::uint8_t*>(pixels.data()), step);
+  cv::Mat converted = view;
+  if (CV_MAT_DEPTH(raw->cv_type) == CV_16U) {
+    cv::Mat native = view.clone();
+    if (big_endian != (std::endian::native == std::endian::big))
+      for (int row = 0; row < native.rows; ++row)
+        for (auto& value : std::span(native.ptr<std::uint16_t>(row), native.cols))
+          value = ByteSwapped(value);
+    converted = ScaledToEightBits(native);
+  } else if (raw->conversion >= 0) {
+    cv::cvtColor(view, converted, raw->conversion);
+  }
+  message.image = FromMat(converted);
+  return message;
+}
+
+ImageMessage DecodeCompressedImage(std::span<const std::uint8_t> data, MessageEncoding encoding,
+                                   const LoadLimits& limits) {
+  MessageCursor cursor(data, encoding, "CompressedImage");
+  ImageMessage message;
+  message.header = ReadHeader(cursor, encoding);
+  message.encoding = cursor.String("the format");
+  const std::span<const std::uint8_t> bytes = cursor.ByteSequence("the compressed data");
+  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  try {
+    const ImageHeader header = ReadImageHeader("CompressedImage", text);
+    CheckLoadLimit("CompressedImage", "pixel count", header.Pixels(), limits.max_image_pixels,
+                   "max_image_pixels");
+  } catch (const IoError& error) {
+    Bad(error.what());
+  }
+  const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1,
+                        const_cast<std::uint8_t*>(bytes.data()));
+  cv::Mat decoded = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);
+  if (decoded.empty()) Bad("CompressedImage: the " + message.encoding + " data does not decode");
+  if (decoded.depth() == CV_16U) decoded = ScaledToEightBits(decoded.channels() == 1 ? decoded : decoded.reshape(1));
+  if (decoded.channels() == 4) cv::cvtColor(decoded, decoded, cv::COLOR_BGRA2BGR);
+  if (decoded.depth() != CV_8U || (decoded.channels() != 1 && decoded.channels() != 3))
+    Bad("CompressedImage: pixels of a kind Calibench does not read");
+  message.image = FromMat(decoded);
+  return message;
+}
+
+CameraInfoMessage DecodeCameraInfo(std::span<const std::uint8_t> data, MessageEncoding encoding) {
+  MessageCursor cursor(data, encoding, "CameraInfo");
+  CameraInfoMessage message;
+  message.header = ReadHeader(cursor, encoding);
+  const std::uint32_t height = cursor.Read<std::uint32_t>();
+  const std::uint32_t width = cursor.Read<std::uint32_t>();
+  message.distortion_model = cursor.String("the distortion model");
+  const std::uint32_t count = cursor.Read<std::uint32_t>();
+  if (count > 64) Bad("CameraInfo: " + std::to_string(count) + " distortion coefficients");
+  std::vector<double> d(count);
+  cursor.ReadDoubles(d.data(), count);
+  double k[9];
+  cursor.ReadDoubles(k, 9);
+  if (width == 0 || height == 0 || width > 1u << 20 || height > 1u << 20)
+    Bad("CameraInfo: image size " + std::to_string(width) + " x " + std::to_string(height));
+  if (std::all_of(std::begin(k), std::end(k), [](double v) { return v == 0; }))
+    Bad("CameraInfo: K is all zeros (the camera driver publishes no calibration)");
+  try {
+    message.camera = CameraFromCameraInfo(message.distortion_model, static_cast<int>(width),
+                                          static_cast<int>(height), k, d);
+  } catch (const std::invalid_argument& error) {
+    Bad(std::string("CameraInfo: ") + error.what());
+  }
+  return message;
+}
+
+}  // namespace calibench
