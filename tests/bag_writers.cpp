@@ -1,0 +1,507 @@
+#include "tests/bag_writers.h"
+
+#include <bzlib.h>
+#include <lz4frame.h>
+#include <sqlite3.h>
+#include <zstd.h>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+namespace calibench::test {
+namespace {
+namespace fs = std::filesystem;
+
+using Bytes = std::vector<std::uint8_t>;
+
+// Serializes message fields: ROS 1 (packed little-endian) or CDR (4-byte encapsulation header,
+// alignment to each primitive's size from the end of that header, either byte order).
+class MessageWriter {
+ public:
+  MessageWriter(MessageEncoding encoding, bool big_endian)
+      : cdr_(encoding == MessageEncoding::kCdr), big_endian_(big_endian) {
+    if (cdr_) bytes_ = {0, static_cast<std::uint8_t>(big_endian ? 0 : 1), 0, 0};
+  }
+  template <typename T>
+  void Put(T value) {
+    if (cdr_)
+      while ((bytes_.size() - 4) % sizeof(T) != 0) bytes_.push_back(0);
+    std::uint8_t raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));
+    if (big_endian_) std::reverse(raw, raw + sizeof(T));
+    bytes_.insert(bytes_.end(), raw, raw + sizeof(T));
+  }
+  void String(const std::string& text) {
+    Put<std::uint32_t>(static_cast<std::uint32_t>(text.size() + (cdr_ ? 1 : 0)));
+    bytes_.insert(bytes_.end(), text.begin(), text.end());
+    if (cdr_) bytes_.push_back(0);
+  }
+  void ByteSequence(const std::uint8_t* data, std::size_t size) {
+    Put<std::uint32_t>(static_cast<std::uint32_t>(size));
+    bytes_.insert(bytes_.end(), data, data + size);
+  }
+  void Header(std::int64_t stamp_ns, const std::string& frame) {
+    if (!cdr_) Put<std::uint32_t>(7);  // seq
+    Put<std::uint32_t>(static_cast<std::uint32_t>(stamp_ns / 1'000'000'000));
+    Put<std::uint32_t>(static_cast<std::uint32_t>(stamp_ns % 1'000'000'000));
+    String(frame);
+  }
+  Bytes Take() { return std::move(bytes_); }
+
+ private:
+  bool cdr_;
+  bool big_endian_;
+  Bytes bytes_;
+};
+
+template <typename T>
+void PutRaw(Bytes* out, T value, bool big_endian) {
+  std::uint8_t raw[sizeof(T)];
+  std::memcpy(raw, &value, sizeof(T));
+  if (big_endian) std::reverse(raw, raw + sizeof(T));
+  out->insert(out->end(), raw, raw + sizeof(T));
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int64_t stamp_ns,
+                                               const std::string& frame, MessageEncoding encoding,
+                                               bool big_endian) {
+  MessageWriter out(encoding, big_endian);
+  out.Header(stamp_ns, frame);
+  out.Put<std::uint32_t>(static_cast<std::uint32_t>(cloud.height));
+  out.Put<std::uint32_t>(static_cast<std::uint32_t>(cloud.width));
+  struct Field {
+    const char* name;
+    std::uint32_t offset;
+    std::uint8_t type;
+  };
+  std::vector<Field> fields = {{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}};
+  if (cloud.HasIntensity()) fields.push_back({"intensity", 16, 7});
+  if (cloud.HasRing()) fields.push_back({"ring", 20, 4});
+  out.Put<std::uint32_t>(static_cast<std::uint32_t>(fields.size()));
+  for (const Field& field : fields) {
+    out.String(field.name);
+    out.Put<std::uint32_t>(field.offset);
+    out.Put<std::uint8_t>(field.type);
+    out.Put<std::uint32_t>(1);
+  }
+  out.Put<std::uint8_t>(big_endian ? 1 : 0);
+  constexpr std::uint32_t kStep = 32;
+  out.Put<std::uint32_t>(kStep);
+  out.Put<std::uint32_t>(kStep * static_cast<std::uint32_t>(cloud.width));
+  Bytes points;
+  points.reserve(cloud.size() * kStep);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const std::size_t start = points.size();
+    for (int axis = 0; axis < 3; ++axis) PutRaw<float>(&points, cloud.points[i][axis], big_endian);
+    PutRaw<float>(&points, 0.0f, big_endian);  // padding, as PCL's PointXYZ has
+    if (cloud.HasIntensity()) PutRaw<float>(&points, cloud.intensity[i], big_endian);
+    if (cloud.HasRing())
+      PutRaw<std::uint16_t>(&points, static_cast<std::uint16_t>(cloud.ring[i]), big_endian);
+    points.resize(start + kStep, 0);
+  }
+  out.ByteSequence(points.data(), points.size());
+  out.Put<std::uint8_t>(1);  // is_dense
+  return out.Take();
+}
+
+std::vector<std::uint8_t> SerializeImage(const ImageU8& image, const std::string& encoding,
+                                         std::int64_t stamp_ns, const std::string& frame,
+                                         MessageEncoding encoding_kind) {
+  MessageWriter out(encoding_kind, false);
+  out.Header(stamp_ns, frame);
+  out.Put<std::uint32_t>(static_cast<std::uint32_t>(image.height));
+  out.Put<std::uint32_t>(static_cast<std::uint32_t>(image.width));
+  out.String(encoding);
+  out.Put<std::uint8_t>(0);
+  out.Put<std::uint32_t>(static_cast<std::uint32_t>(image.width * image.channels));
+  out.ByteSequence(image.data.data(), image.data.size());
+  return out.Take();
+}
+
+std::vector<std::uint8_t> SerializeCompressedImage(const std::string& format,
+                                                   const std::string& bytes, std::int64_t stamp_ns,
+                                                   const std::string& frame,
+                                                   MessageEncoding encoding_kind) {
+  MessageWriter out(encoding_kind, false);
+  out.Header(stamp_ns, frame);
+  out.String(format);
+  out.ByteSequence(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+  return out.Take();
+}
+
+std::vector<std::uint8_t> SerializeCameraInfo(const CameraModel& camera, std::int64_t stamp_ns,
+                                              const std::string& frame,
+                                              MessageEncoding encoding_kind) {
+  MessageWriter out(encoding_kind, false);
+  out.Header(stamp_ns, frame);
+  out.Put<std::uint32_t>(static_cast<std::uint32_t>(camera.height));
+  out.Put<std::uint32_t>(static_cast<std::uint32_t>(camera.width));
+  out.String(camera.type == CameraModelType::kKannalaBrandt ? "equidistant"
+             : camera.distortion.size() == 8               ? "rational_polynomial"
+                                                           : "plumb_bob");
+  out.Put<std::uint32_t>(static_cast<std::uint32_t>(camera.distortion.size()));
+  for (const double d : camera.distortion) out.Put<double>(d);
+  for (const double k : {camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0})
+    out.Put<double>(k);
+  for (const double r : {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}) out.Put<double>(r);
+  for (const double p :
+       {camera.fx, 0.0, camera.cx, 0.0, 0.0, camera.fy, camera.cy, 0.0, 0.0, 0.0, 1.0, 0.0})
+    out.Put<double>(p);
+  for (int i = 0; i < 6; ++i) out.Put<std::uint32_t>(0);  // binning x, y; roi x, y, h, w
+  out.Put<std::uint8_t>(0);                               // roi.do_rectify
+  return out.Take();
+}
+
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+Bytes Compress(const std::string& method, const Bytes& in) {
+  if (method == "none" || method.empty()) return in;
+  Bytes out;
+  if (method == "bz2") {
+    auto size = static_cast<unsigned int>(in.size() + in.size() / 100 + 600);
+    out.resize(size);
+    if (BZ2_bzBuffToBuffCompress(reinterpret_cast<char*>(out.data()), &size,
+                                 const_cast<char*>(reinterpret_cast<const char*>(in.data())),
+                                 static_cast<unsigned int>(in.size()), 9, 0, 30) != BZ_OK)
+      throw std::runtime_error("bz2 compression failed");
+    out.resize(size);
+  } else if (method == "lz4") {
+    out.resize(LZ4F_compressFrameBound(in.size(), nullptr));
+    const std::size_t size =
+        LZ4F_compressFrame(out.data(), out.size(), in.data(), in.size(), nullptr);
+    if (LZ4F_isError(size)) throw std::runtime_error("lz4 compression failed");
+    out.resize(size);
+  } else if (method == "zstd") {
+    out.resize(ZSTD_compressBound(in.size()));
+    const std::size_t size = ZSTD_compress(out.data(), out.size(), in.data(), in.size(), 3);
+    if (ZSTD_isError(size)) throw std::runtime_error("zstd compression failed");
+    out.resize(size);
+  } else {
+    throw std::invalid_argument("unknown compression " + method);
+  }
+  return out;
+}
+
+template <typename T>
+void Append(Bytes* out, T value) {
+  const std::size_t at = out->size();
+  out->resize(at + sizeof(T));
+  std::memcpy(out->data() + at, &value, sizeof(T));
+}
+void Append(Bytes* out, const Bytes& bytes) { out->insert(out->end(), bytes.begin(), bytes.end()); }
+
+// ROS 1 record header fields.
+struct Field {
+  std::string name;
+  Bytes value;
+};
+template <typename T>
+Field NumberField(const std::string& name, T value) {
+  Bytes bytes;
+  Append(&bytes, value);
+  return {name, bytes};
+}
+Field TextField(const std::string& name, const std::string& value) {
+  return {name, Bytes(value.begin(), value.end())};
+}
+Bytes HeaderBytes(const std::vector<Field>& fields) {
+  Bytes header;
+  for (const Field& field : fields) {
+    Append<std::uint32_t>(&header, static_cast<std::uint32_t>(field.name.size() + 1 +
+                                                              field.value.size()));
+    header.insert(header.end(), field.name.begin(), field.name.end());
+    header.push_back('=');
+    Append(&header, field.value);
+  }
+  return header;
+}
+void Ros1Record(Bytes* out, const std::vector<Field>& fields, const Bytes& data) {
+  const Bytes header = HeaderBytes(fields);
+  Append<std::uint32_t>(out, static_cast<std::uint32_t>(header.size()));
+  Append(out, header);
+  Append<std::uint32_t>(out, static_cast<std::uint32_t>(data.size()));
+  Append(out, data);
+}
+std::uint64_t Ros1Time(std::int64_t ns) {
+  return static_cast<std::uint64_t>(ns / 1'000'000'000) |
+         (static_cast<std::uint64_t>(ns % 1'000'000'000) << 32);
+}
+
+struct Ros1Connection {
+  std::uint32_t id;
+  std::string topic, type;
+};
+
+Bytes ConnectionRecord(const Ros1Connection& connection) {
+  Bytes out;
+  const Bytes data = HeaderBytes({TextField("topic", connection.topic),
+                                  TextField("type", connection.type),
+                                  TextField("md5sum", "*"),
+                                  TextField("message_definition", "")});
+  Ros1Record(&out, {NumberField<std::uint8_t>("op", 0x07), NumberField("conn", connection.id),
+                    TextField("topic", connection.topic)},
+             data);
+  return out;
+}
+
+}  // namespace
+
+void WriteRos1Bag(const fs::path& path, const std::vector<RecordedMessage>& messages,
+                  const std::string& compression, std::size_t chunk_bytes) {
+  std::map<std::string, Ros1Connection> connections;
+  Bytes file(std::begin("#ROSBAG V2.0\n"), std::end("#ROSBAG V2.0\n") - 1);
+  const std::size_t bag_header_at = file.size();
+  file.resize(file.size() + 4096 + 200, 0);  // the bag header, rewritten at the end
+  struct ChunkInfo {
+    std::uint64_t position;
+    std::int64_t start, end;
+    std::map<std::uint32_t, std::uint32_t> counts;
+  };
+  std::vector<ChunkInfo> chunks;
+  std::size_t next = 0;
+  while (next < messages.size()) {
+    Bytes chunk;
+    ChunkInfo info{file.size(), messages[next].log_time_ns, messages[next].log_time_ns, {}};
+    std::map<std::uint32_t, std::vector<std::pair<std::int64_t, std::uint32_t>>> index;
+    std::set<std::uint32_t> defined;
+    while (next < messages.size() && (chunk.empty() || chunk.size() < chunk_bytes)) {
+      const RecordedMessage& message = messages[next++];
+      auto [it, added] = connections.try_emplace(
+          message.topic, Ros1Connection{static_cast<std::uint32_t>(connections.size()),
+                                        message.topic, message.type});
+      if (defined.insert(it->second.id).second) Append(&chunk, ConnectionRecord(it->second));
+      index[it->second.id].emplace_back(message.log_time_ns,
+                                        static_cast<std::uint32_t>(chunk.size()));
+      Ros1Record(&chunk,
+                 {NumberField<std::uint8_t>("op", 0x02), NumberField("conn", it->second.id),
+                  NumberField("time", Ros1Time(message.log_time_ns))},
+                 message.data);
+      ++info.counts[it->second.id];
+      info.start = std::min(info.start, message.log_time_ns);
+      info.end = std::max(info.end, message.log_time_ns);
+    }
+    Ros1Record(&file,
+               {NumberField<std::uint8_t>("op", 0x05), TextField("compression", compression),
+                NumberField("size", static_cast<std::uint32_t>(chunk.size()))},
+               Compress(compression, chunk));
+    for (const auto& [id, entries] : index) {
+      Bytes data;
+      for (const auto& [time, offset] : entries) {
+        Append(&data, Ros1Time(time));
+        Append(&data, offset);
+      }
+      Ros1Record(&file,
+                 {NumberField<std::uint8_t>("op", 0x04), NumberField<std::uint32_t>("ver", 1),
+                  NumberField("conn", id),
+                  NumberField("count", static_cast<std::uint32_t>(entries.size()))},
+                 data);
+    }
+    chunks.push_back(info);
+  }
+  const std::uint64_t index_pos = file.size();
+  for (const auto& [topic, connection] : connections) Append(&file, ConnectionRecord(connection));
+  for (const ChunkInfo& chunk : chunks) {
+    Bytes data;
+    for (const auto& [id, count] : chunk.counts) {
+      Append(&data, id);
+      Append(&data, count);
+    }
+    Ros1Record(&file,
+               {NumberField<std::uint8_t>("op", 0x06), NumberField<std::uint32_t>("ver", 1),
+                NumberField("chunk_pos", chunk.position),
+                NumberField("start_time", Ros1Time(chunk.start)),
+                NumberField("end_time", Ros1Time(chunk.end)),
+                NumberField("count", static_cast<std::uint32_t>(chunk.counts.size()))},
+               data);
+  }
+  // The bag header, padded so that the whole record fills the space reserved for it.
+  Bytes header;
+  const std::vector<Field> fields = {
+      NumberField<std::uint8_t>("op", 0x03), NumberField("index_pos", index_pos),
+      NumberField("conn_count", static_cast<std::uint32_t>(connections.size())),
+      NumberField("chunk_count", static_cast<std::uint32_t>(chunks.size()))};
+  const std::size_t reserved = 4096 + 200;
+  const std::size_t header_size = HeaderBytes(fields).size();
+  Ros1Record(&header, fields, Bytes(reserved - 8 - header_size, ' '));
+  std::copy(header.begin(), header.end(), file.begin() + bag_header_at);
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+}
+
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+void McapString(Bytes* out, const std::string& text) {
+  Append<std::uint32_t>(out, static_cast<std::uint32_t>(text.size()));
+  out->insert(out->end(), text.begin(), text.end());
+}
+void McapRecord(Bytes* out, std::uint8_t op, const Bytes& content) {
+  out->push_back(op);
+  Append<std::uint64_t>(out, content.size());
+  Append(out, content);
+}
+
+std::string Ros2Type(const std::string& type) {
+  const std::size_t slash = type.find('/');
+  return type.substr(0, slash) + "/msg" + type.substr(slash);
+}
+
+}  // namespace
+
+void WriteMcap(const fs::path& path, const std::vector<RecordedMessage>& messages,
+               const std::string& profile, const std::string& compression, bool summary,
+               std::size_t chunk_bytes) {
+  const bool ros2 = profile == "ros2";
+  const Bytes magic = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
+  Bytes file = magic;
+  Bytes header;
+  McapString(&header, profile);
+  McapString(&header, "calibench test writer");
+  McapRecord(&file, 0x01, header);
+  std::map<std::string, std::uint16_t> schemas, channels;
+  Bytes definitions;  // schema and channel records, repeated in the summary
+  for (const RecordedMessage& message : messages) {
+    const std::string type = ros2 ? Ros2Type(message.type) : message.type;
+    if (!schemas.count(type)) {
+      const auto id = static_cast<std::uint16_t>(schemas.size() + 1);
+      schemas[type] = id;
+      Bytes schema;
+      Append(&schema, id);
+      McapString(&schema, type);
+      McapString(&schema, ros2 ? "ros2msg" : "ros1msg");
+      McapString(&schema, "");
+      McapRecord(&definitions, 0x03, schema);
+    }
+    if (!channels.count(message.topic)) {
+      const auto id = static_cast<std::uint16_t>(channels.size());
+      channels[message.topic] = id;
+      Bytes channel;
+      Append(&channel, id);
+      Append(&channel, schemas[type]);
+      McapString(&channel, message.topic);
+      McapString(&channel, ros2 ? "cdr" : "ros1");
+      Append<std::uint32_t>(&channel, 0);  // metadata: an empty map
+      McapRecord(&definitions, 0x04, channel);
+    }
+  }
+  Append(&file, definitions);
+  std::map<std::uint16_t, std::uint64_t> counts;
+  std::uint32_t chunk_count = 0;
+  std::size_t next = 0;
+  while (next < messages.size()) {
+    Bytes records;
+    const std::int64_t first = messages[next].log_time_ns;
+    std::int64_t last = first;
+    while (next < messages.size() && (records.empty() || records.size() < chunk_bytes)) {
+      const RecordedMessage& message = messages[next++];
+      Bytes record;
+      Append(&record, channels[message.topic]);
+      Append<std::uint32_t>(&record, static_cast<std::uint32_t>(next));
+      Append<std::uint64_t>(&record, message.log_time_ns);
+      Append<std::uint64_t>(&record, message.log_time_ns);
+      Append(&record, message.data);
+      McapRecord(&records, 0x05, record);
+      ++counts[channels[message.topic]];
+      last = std::max(last, message.log_time_ns);
+    }
+    Bytes chunk;
+    Append<std::uint64_t>(&chunk, first);
+    Append<std::uint64_t>(&chunk, last);
+    Append<std::uint64_t>(&chunk, records.size());
+    Append<std::uint32_t>(&chunk, 0);  // no CRC
+    McapString(&chunk, compression);
+    const Bytes stored = Compress(compression, records);
+    Append<std::uint64_t>(&chunk, stored.size());
+    Append(&chunk, stored);
+    McapRecord(&file, 0x06, chunk);
+    ++chunk_count;
+  }
+  McapRecord(&file, 0x0F, Bytes(4, 0));  // DataEnd, no CRC
+  std::uint64_t summary_start = 0;
+  if (summary) {
+    summary_start = file.size();
+    Append(&file, definitions);
+    Bytes statistics;
+    Append<std::uint64_t>(&statistics, messages.size());
+    Append<std::uint16_t>(&statistics, static_cast<std::uint16_t>(schemas.size()));
+    Append<std::uint32_t>(&statistics, static_cast<std::uint32_t>(channels.size()));
+    Append<std::uint32_t>(&statistics, 0);
+    Append<std::uint32_t>(&statistics, 0);
+    Append<std::uint32_t>(&statistics, chunk_count);
+    Append<std::uint64_t>(&statistics, messages.empty() ? 0 : messages.front().log_time_ns);
+    Append<std::uint64_t>(&statistics, messages.empty() ? 0 : messages.back().log_time_ns);
+    Append<std::uint32_t>(&statistics, static_cast<std::uint32_t>(counts.size() * 10));
+    for (const auto& [channel, count] : counts) {
+      Append(&statistics, channel);
+      Append(&statistics, count);
+    }
+    McapRecord(&file, 0x0B, statistics);
+  }
+  Bytes footer;
+  Append<std::uint64_t>(&footer, summary_start);
+  Append<std::uint64_t>(&footer, 0);
+  Append<std::uint32_t>(&footer, 0);
+  McapRecord(&file, 0x02, footer);
+  Append(&file, magic);
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+}
+
+// ---------------------------------------------------------------------------------------------
+void WriteDb3(const fs::path& path, const std::vector<RecordedMessage>& messages) {
+  fs::remove(path);
+  sqlite3* db = nullptr;
+  if (sqlite3_open(path.c_str(), &db) != SQLITE_OK) throw std::runtime_error("sqlite3_open");
+  auto exec = [&](const char* sql) {
+    if (sqlite3_exec(db, sql, nullptr, nullptr, nullptr) != SQLITE_OK)
+      throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db));
+  };
+  // rosbag2_storage_default_plugins' schema (Humble).
+  exec("CREATE TABLE schema(schema_version INTEGER PRIMARY KEY,ros_distro TEXT NOT NULL);"
+       "INSERT INTO schema VALUES(3,'humble');"
+       "CREATE TABLE metadata(id INTEGER PRIMARY KEY,metadata_version INTEGER NOT NULL,"
+       "metadata TEXT NOT NULL);"
+       "CREATE TABLE topics(id INTEGER PRIMARY KEY,name TEXT NOT NULL,type TEXT NOT NULL,"
+       "serialization_format TEXT NOT NULL,offered_qos_profiles TEXT NOT NULL);"
+       "CREATE TABLE messages(id INTEGER PRIMARY KEY,topic_id INTEGER NOT NULL,"
+       "timestamp INTEGER NOT NULL, data BLOB NOT NULL);"
+       "CREATE INDEX timestamp_idx ON messages (timestamp ASC);"
+       "BEGIN;");
+  std::map<std::string, int> topics;
+  sqlite3_stmt* topic = nullptr;
+  sqlite3_stmt* message = nullptr;
+  sqlite3_prepare_v2(db, "INSERT INTO topics VALUES(?,?,?,'cdr','')", -1, &topic, nullptr);
+  sqlite3_prepare_v2(db, "INSERT INTO messages(topic_id,timestamp,data) VALUES(?,?,?)", -1,
+                     &message, nullptr);
+  for (const RecordedMessage& m : messages) {
+    if (!topics.count(m.topic)) {
+      const int id = static_cast<int>(topics.size()) + 1;
+      topics[m.topic] = id;
+      const std::string type = Ros2Type(m.type);
+      sqlite3_bind_int(topic, 1, id);
+      sqlite3_bind_text(topic, 2, m.topic.c_str(), -1, SQLITE_TRANSIENT);
+      sqlite3_bind_text(topic, 3, type.c_str(), -1, SQLITE_TRANSIENT);
+      if (sqlite3_step(topic) != SQLITE_DONE) throw std::runtime_error("insert topic");
+      sqlite3_reset(topic);
+    }
+    sqlite3_bind_int(message, 1, topics[m.topic]);
+    sqlite3_bind_int64(message, 2, m.log_time_ns);
+    sqlite3_bind_blob(message, 3, m.data.data(), static_cast<int>(m.data.size()),
+                      SQLITE_STATIC);
+    if (sqlite3_step(message) != SQLITE_DONE) throw std::runtime_error("insert message");
+    sqlite3_reset(message);
+  }
+  sqlite3_finalize(topic);
+  sqlite3_finalize(message);
+  exec("COMMIT;");
+  sqlite3_close(db);
+}
+
+}  // namespace calibench::test

@@ -1,0 +1,56 @@
+// Test-side writers of the three recording formats and the sensor_msgs serializations, written
+// from the format specifications independently of the readers in core/io (which they test):
+// ROS 1 bag 2.0 with uncompressed, bz2 or lz4 chunks and a full index; MCAP with or without a
+// summary, chunks uncompressed, zstd or lz4; rosbag2 sqlite3.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/base/image.h"
+#include "core/camera/camera.h"
+#include "core/io/bag.h"
+#include "core/lidar/cloud.h"
+
+namespace calibench::test {
+
+struct RecordedMessage {
+  std::string topic;
+  std::string type;  // "sensor_msgs/PointCloud2" (written as sensor_msgs/msg/... for ROS 2)
+  std::int64_t log_time_ns = 0;
+  std::vector<std::uint8_t> data;  // serialized in the recording's encoding
+};
+
+// Little-endian float32 x y z [intensity float32] [ring uint16]; point_step padded to 32 bytes
+// like Velodyne's driver. With big_endian the same layout in network order (CDR only).
+std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int64_t stamp_ns,
+                                               const std::string& frame, MessageEncoding encoding,
+                                               bool big_endian = false);
+// `encoding` names the pixel layout of `image` ("bgr8" for 3 channels, "mono8" for 1, or any
+// raw layout the caller has already arranged, e.g. "bayer_rggb8").
+std::vector<std::uint8_t> SerializeImage(const ImageU8& image, const std::string& encoding,
+                                         std::int64_t stamp_ns, const std::string& frame,
+                                         MessageEncoding encoding_kind);
+std::vector<std::uint8_t> SerializeCompressedImage(const std::string& format,
+                                                   const std::string& bytes, std::int64_t stamp_ns,
+                                                   const std::string& frame,
+                                                   MessageEncoding encoding_kind);
+std::vector<std::uint8_t> SerializeCameraInfo(const CameraModel& camera, std::int64_t stamp_ns,
+                                              const std::string& frame,
+                                              MessageEncoding encoding_kind);
+
+// compression: "none", "bz2" or "lz4". Messages are written in the given order, about
+// `chunk_bytes` per chunk.
+void WriteRos1Bag(const std::filesystem::path& path, const std::vector<RecordedMessage>& messages,
+                  const std::string& compression, std::size_t chunk_bytes = 768 * 1024);
+// profile "ros1" (ros1 message encoding) or "ros2" (cdr); compression "", "zstd" or "lz4";
+// summary=false leaves the footer without a summary (a reader must then scan).
+void WriteMcap(const std::filesystem::path& path, const std::vector<RecordedMessage>& messages,
+               const std::string& profile, const std::string& compression, bool summary = true,
+               std::size_t chunk_bytes = 768 * 1024);
+// The rosbag2 sqlite3 layout (topics + messages tables, CDR data).
+void WriteDb3(const std::filesystem::path& path, const std::vector<RecordedMessage>& messages);
+
+}  // namespace calibench::test
