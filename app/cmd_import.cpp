@@ -2,6 +2,8 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <tuple>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -36,7 +38,11 @@ void PrintTopics(const BagReader& bag) {
   for (const BagTopic& topic : bag.Topics()) width = std::max(width, topic.name.size());
   std::printf("  %-*s  %-32s %-5s %8s  %s\n", static_cast<int>(width), "topic", "type", "enc",
               "messages", "import");
-  for (const BagTopic& topic : bag.Topics())
+  std::vector<BagTopic> topics = bag.Topics();
+  std::sort(topics.begin(), topics.end(), [](const BagTopic& a, const BagTopic& b) {
+    return std::tie(a.name, a.type) < std::tie(b.name, b.type);
+  });
+  for (const BagTopic& topic : topics)
     std::printf("  %-*s  %-32s %-5s %8lld  %s\n", static_cast<int>(width), topic.name.c_str(),
                 topic.type.c_str(), EncodingLabel(topic),
                 static_cast<long long>(topic.message_count),

@@ -380,8 +380,8 @@ CameraInfoMessage DecodeCameraInfo(std::span<const std::uint8_t> data, MessageEn
   cursor.ReadDoubles(k, 9);
   if (width == 0 || height == 0 || width > 1u << 20 || height > 1u << 20)
     Bad("CameraInfo: image size " + std::to_string(width) + " x " + std::to_string(height));
-  if (std::all_of(std::begin(k), std::end(k), [](double v) { return v == 0; }))
-    Bad("CameraInfo: K is all zeros (the camera driver publishes no calibration)");
+  if (k[0] == 0 && k[4] == 0)
+    Bad("CameraInfo: K has no focal length (the camera driver publishes no calibration)");
   try {
     message.camera = CameraFromCameraInfo(message.distortion_model, static_cast<int>(width),
                                           static_cast<int>(height), k, d);
