@@ -95,9 +95,10 @@ void Decompress(const std::string& method, std::span<const std::uint8_t> compres
                 std::uint64_t uncompressed_size, std::vector<std::uint8_t>* out,
                 const std::filesystem::path& file, std::int64_t chunk_offset);
 
-// A chunk that claims more than this after decompression is refused before allocation (ROS 1
-// records default to 768 KiB chunks; MCAP writers to 768 KiB .. 4 MiB; a 4K image is 25 MB).
-inline constexpr std::uint64_t kMaxChunkBytes = 1ull << 30;
+// A chunk or record that claims more than this is refused before allocation. Recorders write
+// 768 KiB .. 4 MiB chunks, but a chunk holds at least one whole message: a 4K BGR image is 25 MB,
+// the load limit's 5 million points at 48 bytes 240 MB.
+inline constexpr std::uint64_t kMaxChunkBytes = 512ull << 20;
 
 // Readers of one file format each (bag_ros1.cpp, bag_mcap.cpp, bag_sqlite.cpp).
 std::unique_ptr<BagReader> OpenRos1Bag(const std::filesystem::path& path);

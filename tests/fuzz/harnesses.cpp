@@ -7,10 +7,12 @@
 #include <string>
 
 #include "core/base/types.h"
+#include "core/io/bag.h"
 #include "core/io/camera_file.h"
 #include "core/io/cloud_io.h"
 #include "core/io/dataset.h"
 #include "core/io/image_io.h"
+#include "core/io/ros_messages.h"
 #include "core/lrf/dataset.h"
 #include "core/results/result_file.h"
 #include "core/session/session.h"
@@ -54,6 +56,48 @@ DepthIntrinsics FuzzDepthIntrinsics() {
   return intrinsics;
 }
 
+// One message as `calibench import` decodes it. The decoders refuse a bad message with
+// std::invalid_argument (the import counts it as a dropped frame); nothing else may escape.
+void DecodeLikeImport(const std::string& type, MessageEncoding encoding,
+                      std::span<const std::uint8_t> data) {
+  try {
+    if (type == kPointCloud2Type) {
+      DecodePointCloud2(data, encoding);
+    } else if (type == kImageType) {
+      DecodeImage(data, encoding);
+    } else if (type == kCompressedImageType) {
+      DecodeCompressedImage(data, encoding);
+    } else if (type == kCameraInfoType) {
+      DecodeCameraInfo(data, encoding);
+    } else {
+      DecodeRosHeader(data, encoding);
+    }
+  } catch (const std::invalid_argument&) {
+  }
+}
+
+// A whole recording: its index, every message, each decoded as the import would.
+void ReadRecording(const std::filesystem::path& path) {
+  auto bag = OpenBag(path);
+  bag->ForEachMessage({}, [&](const BagMessage& message) {
+    const BagTopic& topic = bag->Topics()[message.topic];
+    if (topic.encoding != MessageEncoding::kOther)
+      DecodeLikeImport(topic.type, topic.encoding, message.data);
+    return true;
+  });
+}
+
+// One serialized message, without a file: the first byte picks the type (bits 0-1) and the
+// serialization (bit 2: CDR), the rest is the message.
+void DecodeMessageBytes(const std::vector<uint8_t>& bytes) {
+  if (bytes.empty()) return;
+  static const char* const types[] = {kPointCloud2Type, kImageType, kCompressedImageType,
+                                      kCameraInfoType};
+  DecodeLikeImport(types[bytes[0] & 3],
+                   (bytes[0] & 4) ? MessageEncoding::kCdr : MessageEncoding::kRos1,
+                   std::span<const std::uint8_t>(bytes).subspan(1));
+}
+
 #define CALIBENCH_FILE_TARGET(name, extension, call)                                     \
   FuzzTarget {                                                                           \
     name, extension, [](const std::vector<uint8_t>& bytes) {                             \
@@ -77,6 +121,10 @@ const std::vector<FuzzTarget>& FuzzTargets() {
       CALIBENCH_FILE_TARGET("scan", ".json", LoadLaserScan(path)),
       CALIBENCH_FILE_TARGET("depth_png", ".png", LoadDepthPng(path, FuzzDepthIntrinsics())),
       CALIBENCH_FILE_TARGET("image", ".png", LoadImage(path)),
+      CALIBENCH_FILE_TARGET("ros1_bag", ".bag", ReadRecording(path)),
+      CALIBENCH_FILE_TARGET("mcap", ".mcap", ReadRecording(path)),
+      CALIBENCH_FILE_TARGET("db3", ".db3", ReadRecording(path)),
+      FuzzTarget{"ros_message", "", DecodeMessageBytes},
   };
   return targets;
 }

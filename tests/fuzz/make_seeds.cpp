@@ -7,11 +7,13 @@
 #include <filesystem>
 #include <fstream>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
 #include "core/lrf/dataset.h"
+#include "tests/bag_writers.h"
 
 namespace calibench {
 namespace {
@@ -124,6 +126,68 @@ void WriteCameras(const std::filesystem::path& out) {
             "  resolution: [1920, 1208]\n  rostopic: /cam0/image_raw\n");
 }
 
+// A tiny rig recording: a 4 x 3 organized cloud, a 16 x 12 image (raw and PNG-compressed),
+// CameraInfo; in every format and compression the readers know.
+std::vector<test::RecordedMessage> TinyRecording(MessageEncoding encoding) {
+  CameraModel camera;
+  camera.width = 16;
+  camera.height = 12;
+  camera.fx = camera.fy = 20.0;
+  camera.cx = 8.0;
+  camera.cy = 6.0;
+  camera.distortion = {0.01, -0.002, 0.0, 0.0, 0.0};
+  ImageU8 image;
+  image.width = 16;
+  image.height = 12;
+  image.channels = 1;
+  for (int i = 0; i < 16 * 12; ++i) image.data.push_back(static_cast<uint8_t>(i * 13));
+  std::vector<uchar> png;
+  cv::imencode(".png", cv::Mat(12, 16, CV_8UC1, image.data.data()), png);
+  std::vector<test::RecordedMessage> messages;
+  for (std::int64_t i = 0; i < 2; ++i) {
+    const std::int64_t t = (10 + i) * 1'000'000'000;
+    messages.push_back({"/points", "sensor_msgs/PointCloud2", t,
+                        test::SerializePointCloud2(SmallCloud(4, 3), t, "lidar", encoding)});
+    messages.push_back({"/cam/image_raw", "sensor_msgs/Image", t,
+                        test::SerializeImage(image, "mono8", t, "cam", encoding)});
+    messages.push_back({"/cam/image_raw/compressed", "sensor_msgs/CompressedImage", t,
+                        test::SerializeCompressedImage("png", std::string(png.begin(), png.end()),
+                                                       t, "cam", encoding)});
+    messages.push_back({"/cam/camera_info", "sensor_msgs/CameraInfo", t,
+                        test::SerializeCameraInfo(camera, t, "cam", encoding)});
+  }
+  return messages;
+}
+
+void WriteBags(const std::filesystem::path& out) {
+  for (const char* folder : {"ros1_bag", "mcap", "db3", "ros_message"})
+    std::filesystem::create_directories(out / folder);
+  const auto ros1 = TinyRecording(MessageEncoding::kRos1);
+  const auto cdr = TinyRecording(MessageEncoding::kCdr);
+  for (const char* compression : {"none", "bz2", "lz4"})
+    test::WriteRos1Bag(out / "ros1_bag" / (std::string(compression) + ".bag"), ros1, compression,
+                       600);
+  test::WriteMcap(out / "mcap/ros1_zstd.mcap", ros1, "ros1", "zstd", true, 600);
+  test::WriteMcap(out / "mcap/ros2_none.mcap", cdr, "ros2", "", true, 600);
+  test::WriteMcap(out / "mcap/ros2_lz4_no_summary.mcap", cdr, "ros2", "lz4", false, 600);
+  test::WriteDb3(out / "db3/ros2.db3", cdr);
+  // One message per type and serialization, prefixed by the harness's selector byte.
+  static const char* const types[] = {"sensor_msgs/PointCloud2", "sensor_msgs/Image",
+                                      "sensor_msgs/CompressedImage", "sensor_msgs/CameraInfo"};
+  for (const auto* messages : {&ros1, &cdr})
+    for (int type = 0; type < 4; ++type)
+      for (const test::RecordedMessage& message : *messages)
+        if (message.type == types[type]) {
+          const int selector = type | (messages == &cdr ? 4 : 0);
+          std::vector<std::uint8_t> bytes = {static_cast<std::uint8_t>(selector)};
+          bytes.insert(bytes.end(), message.data.begin(), message.data.end());
+          std::ofstream(out / "ros_message" / (std::to_string(selector) + ".msg"),
+                        std::ios::binary)
+              .write(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+          break;
+        }
+}
+
 }  // namespace
 }  // namespace calibench
 
@@ -137,5 +201,6 @@ int main(int argc, char** argv) {
   calibench::WriteLrfFiles(out);
   calibench::WriteImages(out);
   calibench::WriteCameras(out);
+  calibench::WriteBags(out);
   return 0;
 }
