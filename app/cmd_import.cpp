@@ -3,10 +3,10 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <tuple>
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <tuple>
 
 #include "app/commands.h"
 #include "core/io/bag.h"
@@ -21,9 +21,9 @@ namespace fs = std::filesystem;
 namespace {
 
 const char* EncodingLabel(const BagTopic& topic) {
-  return topic.encoding == MessageEncoding::kOther ? topic.encoding_name.c_str()
+  return topic.encoding == MessageEncoding::kOther  ? topic.encoding_name.c_str()
          : topic.encoding == MessageEncoding::kRos1 ? "ros1"
-                                                     : "cdr";
+                                                    : "cdr";
 }
 
 bool Importable(const std::string& type) {
@@ -46,9 +46,9 @@ void PrintTopics(const BagReader& bag) {
     std::printf("  %-*s  %-32s %-5s %8lld  %s\n", static_cast<int>(width), topic.name.c_str(),
                 topic.type.c_str(), EncodingLabel(topic),
                 static_cast<long long>(topic.message_count),
-                !Importable(topic.type)                      ? "-"
+                !Importable(topic.type)                     ? "-"
                 : topic.encoding == MessageEncoding::kOther ? "no (not ROS 1 or CDR)"
-                                                             : "yes");
+                                                            : "yes");
 }
 
 // "[=====     ] 48% reading 120/250 MB" on a terminal; a line per 10 % elsewhere.
@@ -71,15 +71,6 @@ ImportProgress ProgressBar() {
   };
 }
 
-BoardSpec BoardFromFlag(const std::string& board) {
-  if (fs::exists(board) && fs::is_regular_file(board)) {
-    const auto document = json_io::ReadJson(board);
-    const json_io::Fields target(document, board);
-    return json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
-  }
-  return BoardPreset(board);
-}
-
 void PrintSummary(const BagImportSummary& summary, const BagImportOptions& options) {
   std::printf("%s\n", summary.format.c_str());
   std::printf("clouds  %-28s %lld messages\n", summary.cloud_topic.c_str(),
@@ -91,13 +82,24 @@ void PrintSummary(const BagImportSummary& summary, const BagImportOptions& optio
   for (const auto& [reason, count] : summary.dropped)
     std::printf("  dropped %5d  %s\n", count, reason.c_str());
   if (summary.kept_without_stillness_check > 0)
-    std::printf("  note: %d pairs had no other image within %.0f ms, so their stillness was not "
-                "checked\n",
-                summary.kept_without_stillness_check, options.still_window_s * 500);
+    std::printf(
+        "  note: %d pairs had no other image within %.0f ms, so their stillness was not "
+        "checked\n",
+        summary.kept_without_stillness_check, options.still_window_s * 500);
   std::printf("dataset: %s\n", summary.manifest.c_str());
 }
 
 }  // namespace
+
+BoardSpec BoardFromFlag(const std::string& board) {
+  std::error_code error;
+  if (fs::is_regular_file(board, error)) {
+    const auto document = json_io::ReadJson(board);
+    const json_io::Fields target(document, board);
+    return json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
+  }
+  return BoardPreset(board);
+}
 
 int RunImport(int argc, char** argv) {
   CLI::App app{
@@ -113,7 +115,9 @@ int RunImport(int argc, char** argv) {
   app.add_option("bag", bag_path, "the recording (.bag, .db3, .mcap, or a rosbag2 folder)")
       ->required();
   app.add_flag("--list", list, "print the topics, their types and message counts, and stop");
-  app.add_option("--out,-o", out, "dataset folder to write (default: <bag name>.dataset beside it)");
+  app.add_option("--out,-o", out,
+                 "dataset folder to write (default: <bag name>.dataset beside it, or under "
+                 "~/.local/share/calibench/imports when that folder is read-only)");
   app.add_option("--board", board,
                  "the board the camera sees: a3 | a4 | charuco-a3 | charuco-a4 | paper, or a "
                  "target.json")
@@ -165,12 +169,7 @@ int RunImport(int argc, char** argv) {
     std::fprintf(stderr, "calibench import: %s\n", why.c_str());
     return kUsage;
   }
-  if (out.empty()) {
-    const fs::path source = fs::absolute(bag_path).lexically_normal();
-    out = (source.parent_path() / (source.filename().string() + ".dataset")).string();
-    if (fs::path(bag_path).filename().empty())  // "folder/": name it after the folder
-      out = (source.parent_path().parent_path() / (source.parent_path().filename().string() + ".dataset")).string();
-  }
+  if (out.empty()) out = DefaultImportFolder(bag_path).string();
   const BagImportSummary summary = ImportBag(bag_path, out, board_spec, options, ProgressBar());
   PrintSummary(summary, options);
   return kOk;

@@ -8,9 +8,11 @@
 
 #include "app/commands.h"
 #include "core/base/image.h"
+#include "core/io/bag.h"
 #include "core/io/image_io.h"
 #include "ui/gfx/context.h"
 #include "ui/lidar_camera/controller.h"
+#include "ui/lidar_camera/window_shell.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/lrf/controller.h"
 #include "ui/lrf/workbench.h"
@@ -152,17 +154,29 @@ int RenderLrfHeadless(const std::string& dataset, const ui::HeadlessShot& shot,
 
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
                  const std::string& screenshot, const GuiWindowFlags& quit) {
-  ui::Controller controller;
-  // The window resumes the session beside the dataset (or, with --fresh, backs it up first).
-  if (!OpenInput(controller, dataset, session, "gui",
-                 quit.fresh ? ui::Controller::ExistingSession::kStartFresh
-                            : ui::Controller::ExistingSession::kResume))
+  ui::ShellOptions options;
+  options.test_drops = quit.test_drops;
+  try {
+    options.board = BoardFromFlag(quit.board);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "calibench gui: --board: %s\n", e.what());
     return kUsage;
-  const int code = FinishWindow(ui::RunWorkbenchWindow<ui::Workbench>(
-                                    WindowOptionsOf(width, height, "Calibench", screenshot, quit),
-                                    controller, ui::Layout::kWorkbench),
-                                screenshot);
-  return code != kOk ? code : ReportSaveFailure(controller, "gui");
+  }
+  ui::WindowShell shell(options);
+  // The window resumes the session beside the dataset (or, with --fresh, backs it up first).
+  if (!session.empty()) {
+    shell.OpenSession(session);
+  } else if (!dataset.empty()) {
+    shell.OpenDataset(dataset, quit.fresh ? ui::Controller::ExistingSession::kStartFresh
+                                          : ui::Controller::ExistingSession::kResume);
+  } else if (!quit.bag.empty()) {
+    OpenBag(quit.bag);  // a file that is no recording is refused here, before a window opens
+    shell.ImportRecording(quit.bag);
+  }
+  const int code = FinishWindow(
+      shell.Run(WindowOptionsOf(width, height, "Calibench", screenshot, quit)), screenshot);
+  if (!shell.error().empty()) std::fprintf(stderr, "calibench gui: %s\n", shell.error().c_str());
+  return code != kOk ? code : ReportSaveFailure(shell.controller(), "gui");
 }
 
 int RunGui(int argc, char** argv) {
@@ -175,6 +189,16 @@ int RunGui(int argc, char** argv) {
   app.add_option("--dataset,-d", dataset,
                  "dataset.json or dataset folder, or an LRF manifest (calibench.lrf-dataset.v1)");
   app.add_option("--session,-s", session, "a saved session (calibench.session.v1)");
+  app.add_option("--bag", quit.bag,
+                 "a recording (ROS 1 .bag, ROS 2 .db3 / .mcap or a rosbag2 folder): imported "
+                 "behind a progress bar (as `calibench import`), then opened");
+  app.add_option("--board", quit.board,
+                 "the board in recordings opened here: a3 | a4 | charuco-a3 | charuco-a4 | paper, "
+                 "or a target.json")
+      ->capture_default_str();
+  app.add_option("--test-drop", quit.test_drops,
+                 "deliver this path to the window's drop callback after the first frames (tests)")
+      ->group("");
   app.add_option("--size", size, "window size WxH")->capture_default_str();
   app.add_option("--screenshot", screenshot, "write the last frame to this PNG");
   app.add_flag("--fresh", quit.fresh,

@@ -1,7 +1,10 @@
 #include "core/io/bag_import.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -33,6 +36,19 @@ bool BagImportOptions::Check(std::string* why) const {
   return limits.Check(why);
 }
 
+fs::path DefaultImportFolder(const fs::path& bag) {
+  fs::path source = fs::absolute(bag).lexically_normal();
+  if (source.filename().empty()) source = source.parent_path();  // "folder/"
+  const fs::path beside = source.parent_path();
+  const std::string name = source.filename().string() + ".dataset";
+  if (::access(beside.c_str(), W_OK) == 0) return beside / name;
+  const char* data = std::getenv("XDG_DATA_HOME");
+  const char* home = std::getenv("HOME");
+  const fs::path root =
+      data && *data ? fs::path(data) : fs::path(home && *home ? home : "/tmp") / ".local/share";
+  return root / "calibench" / "imports" / name;
+}
+
 namespace {
 
 bool IsImageType(const std::string& type) {
@@ -61,8 +77,8 @@ std::vector<std::string> TopicsOfType(const BagReader& bag,
 }
 
 // Checks a named topic, or picks the only candidate; throws listing the candidates otherwise.
-void ChooseOne(const BagReader& bag, const std::vector<std::string>& candidates,
-               const char* what, const char* flag, std::string* chosen) {
+void ChooseOne(const BagReader& bag, const std::vector<std::string>& candidates, const char* what,
+               const char* flag, std::string* chosen) {
   if (!chosen->empty()) {
     if (std::find(candidates.begin(), candidates.end(), *chosen) == candidates.end())
       throw IoError(bag.Path().string() + ": " + flag + " " + *chosen + " is not a " + what +
@@ -264,8 +280,8 @@ class Importer {
       image_width_ = image.width;
       image_height_ = image.height;
     }
-    if (first_.camera && (first_.camera->width != image.width ||
-                          first_.camera->height != image.height))
+    if (first_.camera &&
+        (first_.camera->width != image.width || first_.camera->height != image.height))
       throw IoError(Where() + ": the images on " + options_.image_topic + " are " +
                     std::to_string(image.width) + " x " + std::to_string(image.height) +
                     " but the camera intrinsics are for " + std::to_string(first_.camera->width) +
@@ -277,8 +293,8 @@ class Importer {
       first_.camera = DecodeCameraInfo(message.data, topic.encoding).camera;
       if (image_width_ > 0 &&
           (first_.camera->width != image_width_ || first_.camera->height != image_height_))
-        throw IoError(Where() + ": the CameraInfo on " + options_.camera_info_topic +
-                      " is for " + std::to_string(first_.camera->width) + " x " +
+        throw IoError(Where() + ": the CameraInfo on " + options_.camera_info_topic + " is for " +
+                      std::to_string(first_.camera->width) + " x " +
                       std::to_string(first_.camera->height) + " images, but " +
                       options_.image_topic + " has " + std::to_string(image_width_) + " x " +
                       std::to_string(image_height_));
@@ -433,8 +449,8 @@ class Importer {
         return false;
       }
       if (cloud.cloud.HasRing())
-        rings_ = std::max(rings_, *std::max_element(cloud.cloud.ring.begin(),
-                                                    cloud.cloud.ring.end()) + 1);
+        rings_ = std::max(rings_,
+                          *std::max_element(cloud.cloud.ring.begin(), cloud.cloud.ring.end()) + 1);
       SavePcd(out_dir_ / "clouds" / (candidate.id + ".pcd"), cloud.cloud, PcdEncoding::kBinary);
       return true;
     } catch (const std::invalid_argument& error) {
@@ -456,8 +472,8 @@ class Importer {
   }
 
   void WriteDataset(const std::vector<Candidate>& kept) {
-    if (kept.empty()) throw IoError(Where() + ": no pair survived the selection (" +
-                                    DroppedText() + ")");
+    if (kept.empty())
+      throw IoError(Where() + ": no pair survived the selection (" + DroppedText() + ")");
     SaveCameraInfoYaml(out_dir_ / "camera.yaml", *first_.camera, "camera");
     Dataset dataset;
     dataset.camera = *first_.camera;
@@ -477,16 +493,12 @@ class Importer {
     }
     summary_.manifest = out_dir_ / "dataset.json";
     SaveDataset(summary_.manifest, dataset);
-    nlohmann::json record = {{"format", "calibench.import.v1"},
-                             {"source", fs::absolute(bag_->Path()).string()},
-                             {"source_format", summary_.format},
-                             {"cloud_topic", summary_.cloud_topic},
-                             {"image_topic", summary_.image_topic},
-                             {"camera", summary_.camera_source},
-                             {"clouds", summary_.clouds},
-                             {"images", summary_.images},
-                             {"dropped", summary_.dropped},
-                             {"pairs", pairs}};
+    nlohmann::json record = {
+        {"format", "calibench.import.v1"},     {"source", fs::absolute(bag_->Path()).string()},
+        {"source_format", summary_.format},    {"cloud_topic", summary_.cloud_topic},
+        {"image_topic", summary_.image_topic}, {"camera", summary_.camera_source},
+        {"clouds", summary_.clouds},           {"images", summary_.images},
+        {"dropped", summary_.dropped},         {"pairs", pairs}};
     record["kept_without_stillness_check"] = summary_.kept_without_stillness_check;
     WriteFileAtomically(out_dir_ / "import.json", record.dump(2) + "\n");
   }

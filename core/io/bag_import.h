@@ -20,9 +20,9 @@ namespace calibench {
 
 struct BagImportOptions {
   // Topics; empty = chosen automatically when the recording has exactly one candidate.
-  std::string cloud_topic;        // sensor_msgs/PointCloud2
-  std::string image_topic;        // sensor_msgs/Image or CompressedImage
-  std::string camera_info_topic;  // sensor_msgs/CameraInfo; unused when `camera` is given
+  std::string cloud_topic;            // sensor_msgs/PointCloud2
+  std::string image_topic;            // sensor_msgs/Image or CompressedImage
+  std::string camera_info_topic;      // sensor_msgs/CameraInfo; unused when `camera` is given
   std::optional<CameraModel> camera;  // intrinsics from a file instead of the recording
 
   // Pairing: a cloud takes the image with the nearest stamp within this offset [s].
@@ -47,16 +47,16 @@ struct BagImportOptions {
 struct BagImportSummary {
   std::string format;  // the reader's description of the file
   std::string cloud_topic, image_topic, camera_source;
-  std::int64_t clouds = 0;  // messages on the cloud topic
-  std::int64_t images = 0;  // messages on the image topic
-  int boards_seen = 0;      // images where the board was found
-  std::vector<std::string> pair_ids;       // written, in time order
-  std::map<std::string, int> dropped;      // reason -> clouds dropped for it
+  std::int64_t clouds = 0;             // messages on the cloud topic
+  std::int64_t images = 0;             // messages on the image topic
+  int boards_seen = 0;                 // images where the board was found
+  std::vector<std::string> pair_ids;   // written, in time order
+  std::map<std::string, int> dropped;  // reason -> clouds dropped for it
   // Candidates with no other board pose within the stillness window (a camera as slow as the
   // window): kept, but their stillness is unknown.
   int kept_without_stillness_check = 0;
-  std::filesystem::path manifest;          // the dataset.json written
-  std::int64_t bytes_read = 0;             // over both passes
+  std::filesystem::path manifest;  // the dataset.json written
+  std::int64_t bytes_read = 0;     // over both passes
 };
 
 // Topics to import when the options name none: exactly one PointCloud2 topic; one image topic
@@ -64,6 +64,11 @@ struct BagImportSummary {
 // raw one); the CameraInfo beside the image topic (same namespace) or the only one. Throws
 // IoError naming the file and listing the candidates when the choice is ambiguous or impossible.
 void ChooseTopics(const BagReader& bag, BagImportOptions* options);
+
+// Where an import of `bag` goes unless the user says otherwise: "<bag name>.dataset" beside it,
+// or, when that folder cannot be written (a recording on a read-only medium), the same name
+// under $XDG_DATA_HOME/calibench/imports (else ~/.local/share/calibench/imports).
+std::filesystem::path DefaultImportFolder(const std::filesystem::path& bag);
 
 // Progress of an import: the phase ("reading", "writing"), bytes done and in all.
 using ImportProgress =

@@ -2,9 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <fstream>
 
 #include "core/base/image.h"
+#include "core/io/cloud_io.h"
+#include "core/io/dataset.h"
 #include "core/io/image_io.h"
+#include "tests/bag_writers.h"
 #include "tests/test_support.h"
 
 namespace calibench {
@@ -27,6 +31,11 @@ double Texture(const ImageU8& image, int x0, int y0, int x1, int y1) {
 // xvfb-run (skipped without it, unless CI requires everything) and a 3-pair demo in `dir_`.
 class GuiWindow : public ::testing::Test {
  protected:
+  // The command prefix: a virtual display, and the recent-sessions list kept in the test's folder.
+  std::string Xvfb() const {
+    return "CALIBENCH_CONFIG_DIR=" + (dir_ / "config").string() +
+           " xvfb-run -a -s '-screen 0 1600x900x24' ";
+  }
   void SetUp() override {
     std::string output;
     if (test::RunCommand("command -v xvfb-run", &output) != 0) {
@@ -48,9 +57,8 @@ TEST_F(GuiWindow, OpensUnderXvfbAndShowsTheThreeViews) {
   std::string output;
   const auto shot = dir / "window.png";
   const int code = test::RunCommand(
-      "xvfb-run -a -s '-screen 0 1600x900x24' " + test::CalibenchExe() + " gui --dataset " +
-          (dir / "data/dataset.json").string() + " --size 1600x900 --quit-after-frames 90 " +
-          "--screenshot " + shot.string(),
+      Xvfb() + test::CalibenchExe() + " gui --dataset " + (dir / "data/dataset.json").string() +
+          " --size 1600x900 --quit-after-frames 90 " + "--screenshot " + shot.string(),
       &output);
   ASSERT_EQ(code, 0) << output;
   const ImageU8 image = LoadImage(shot);
@@ -62,9 +70,10 @@ TEST_F(GuiWindow, OpensUnderXvfbAndShowsTheThreeViews) {
     EXPECT_GT(Texture(image, x0, 120, x1, 440), 3.0)
         << "view " << view << " looks empty; see " << shot;
   }
-  // The title bars of the views (the theme's blue) are where the layout puts them.
+  // The title bars of the views (the theme's blue) are where the layout puts them, below the
+  // File menu's bar.
   for (int x : {10, 543, 1076}) {
-    const std::uint8_t* p = image.Row(8) + 3 * x;
+    const std::uint8_t* p = image.Row(30) + 3 * x;
     EXPECT_GT(p[0], p[2]) << "no title bar at x = " << x << "; see " << shot;  // blue > red (BGR)
   }
 }
@@ -75,10 +84,10 @@ TEST_F(GuiWindow, OpensUnderXvfbAndShowsTheThreeViews) {
 TEST_F(GuiWindow, IdleWindowDrawsNoFrames) {
   const auto& dir = dir_;
   std::string output;
-  const int code = test::RunCommand(
-      "xvfb-run -a -s '-screen 0 1600x900x24' " + test::CalibenchExe() + " gui --dataset " +
-          (dir / "data/dataset.json").string() + " --size 1600x900 --quit-after-seconds 6",
-      &output);
+  const int code = test::RunCommand(Xvfb() + test::CalibenchExe() + " gui --dataset " +
+                                        (dir / "data/dataset.json").string() +
+                                        " --size 1600x900 --quit-after-seconds 6",
+                                    &output);
   ASSERT_EQ(code, 0) << output;
   int frames = -1, quiet = -1;
   const auto at = output.find("frames drawn: ");
@@ -86,6 +95,65 @@ TEST_F(GuiWindow, IdleWindowDrawsNoFrames) {
   ASSERT_EQ(std::sscanf(output.c_str() + at, "frames drawn: %d (%d", &frames, &quiet), 2) << output;
   EXPECT_GT(frames, 0) << output;  // it did draw while loading
   EXPECT_EQ(quiet, 0) << output;
+}
+
+// A folder dropped onto the window opens there (GLFW's drop callback, driven as the window
+// system drives it), and joins the recent sessions.
+TEST_F(GuiWindow, ADroppedDatasetOpens) {
+  std::string output;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " simulate --preset demo --pairs 2 --seed 9 " +
+                                 "--out " + (dir_ / "dropped").string(),
+                             &output),
+            0)
+      << output;
+  const int code = test::RunCommand(Xvfb() + test::CalibenchExe() + " gui --dataset " +
+                                        (dir_ / "data").string() + " --test-drop " +
+                                        (dir_ / "dropped").string() + " --quit-after-frames 40",
+                                    &output);
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "dropped/calibench.session.json")) << output;
+  const std::string recent = test::ReadFileBytes(dir_ / "config/recent.json");
+  const auto dropped_at = recent.find((dir_ / "dropped/calibench.session.json").string());
+  const auto first_at = recent.find((dir_ / "data/calibench.session.json").string());
+  ASSERT_NE(dropped_at, std::string::npos) << recent;
+  ASSERT_NE(first_at, std::string::npos) << recent;
+  EXPECT_LT(dropped_at, first_at) << recent;  // newest first
+}
+
+// `gui --bag`: the recording is imported behind a progress bar, then opened.
+TEST_F(GuiWindow, ABagOpensAfterItsImport) {
+  const Dataset dataset = LoadDataset(dir_ / "data");
+  std::vector<test::RecordedMessage> messages;
+  for (std::size_t i = 0; i < dataset.pairs.size(); ++i) {
+    const std::int64_t t = (30 + static_cast<std::int64_t>(i)) * 1'000'000'000;
+    messages.push_back({"/cam/image_raw", "sensor_msgs/Image", t,
+                        test::SerializeImage(LoadImage(dataset.pairs[i].image), "bgr8", t, "cam",
+                                             MessageEncoding::kRos1)});
+    messages.push_back(
+        {"/cam/camera_info", "sensor_msgs/CameraInfo", t,
+         test::SerializeCameraInfo(dataset.camera, t, "cam", MessageEncoding::kRos1)});
+    messages.push_back({"/points", "sensor_msgs/PointCloud2", t,
+                        test::SerializePointCloud2(LoadCloud(dataset.pairs[i].cloud), t, "lidar",
+                                                   MessageEncoding::kRos1)});
+  }
+  test::WriteRos1Bag(dir_ / "rig.bag", messages, "bz2");
+  std::string output;
+  // --board takes the dataset's own target (a manifest's "target" object).
+  const int code = test::RunCommand(
+      Xvfb() + test::CalibenchExe() + " gui --bag " + (dir_ / "rig.bag").string() + " --board " +
+          (dir_ / "data/dataset.json").string() + " --quit-after-frames 60",
+      &output);
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_EQ(LoadDataset(dir_ / "rig.bag.dataset").pairs.size(), dataset.pairs.size()) << output;
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "rig.bag.dataset/calibench.session.json")) << output;
+  // Not a recording: refused before a window opens, naming the file.
+  std::ofstream(dir_ / "text.bag") << "hello";
+  EXPECT_EQ(test::RunCommand(Xvfb() + test::CalibenchExe() + " gui --bag " +
+                                 (dir_ / "text.bag").string() + " --quit-after-frames 5",
+                             &output),
+            2);
+  EXPECT_NE(output.find((dir_ / "text.bag").string() + ": not a recording"), std::string::npos)
+      << output;
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <dlfcn.h>
 
 #include <stdexcept>
+#include <utility>
 
 #include "ui/gfx/context_internal.h"
 #include "ui/gfx/framebuffer.h"
@@ -182,6 +183,24 @@ void WindowContext::InstallEventCounters() {
   glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* w, int, int) { CountEvent(w); });
   glfwSetWindowRefreshCallback(window_, [](GLFWwindow* w) { CountEvent(w); });
   glfwSetWindowIconifyCallback(window_, [](GLFWwindow* w, int) { CountEvent(w); });
+  glfwSetDropCallback(window_, [](GLFWwindow* w, int count, const char** paths) {
+    auto* self = static_cast<WindowContext*>(glfwGetWindowUserPointer(w));
+    for (int i = 0; i < count; ++i) self->dropped_.emplace_back(paths[i]);
+    CountEvent(w);
+  });
+}
+
+void WindowContext::RequestClose() { glfwSetWindowShouldClose(window_, GLFW_TRUE); }
+
+std::vector<std::string> WindowContext::TakeDroppedPaths() { return std::exchange(dropped_, {}); }
+
+void WindowContext::DeliverDrop(const std::vector<std::string>& paths) {
+  // GLFW has no getter: setting a callback returns the one it replaces.
+  const GLFWdropfun installed = glfwSetDropCallback(window_, nullptr);
+  glfwSetDropCallback(window_, installed);
+  std::vector<const char*> pointers;
+  for (const std::string& path : paths) pointers.push_back(path.c_str());
+  if (installed) installed(window_, static_cast<int>(pointers.size()), pointers.data());
 }
 
 bool WindowContext::ShouldClose() const { return glfwWindowShouldClose(window_); }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 struct GLFWwindow;
 
@@ -54,6 +55,13 @@ class WindowContext : public GlContext {
   // Shows `frame`, drawn offscreen at the framebuffer size: copies it into the back buffer and
   // swaps (waiting for vsync).
   void Present(const Framebuffer& frame);
+  // Files and folders dropped onto the window since the last call (a drop is an event).
+  std::vector<std::string> TakeDroppedPaths();
+  // Asks the loop to end, as the window's close button does.
+  void RequestClose();
+  // Calls the drop callback installed on the GLFW window, as GLFW does when the window system
+  // delivers a drop: what a test of drag and drop drives without a window manager.
+  void DeliverDrop(const std::vector<std::string>& paths);
 
  private:
   explicit WindowContext(GLFWwindow* window) : window_(window) {}
@@ -62,6 +70,7 @@ class WindowContext : public GlContext {
   static void CountEvent(GLFWwindow* window);
   GLFWwindow* window_ = nullptr;
   std::uint64_t events_ = 0;
+  std::vector<std::string> dropped_;
   std::string description_;
 };
 

@@ -5,6 +5,7 @@
 #include <ctime>
 
 #include "core/base/allocator.h"
+#include "core/base/atomic_file.h"
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
 #include "core/lidar_camera/result_io.h"
@@ -846,6 +847,24 @@ void Controller::Handle(const ExportResult& export_result) {
   outcome.solution = ResultForCurrentPairs();
   const std::filesystem::path path = NextToSession(export_result.path);
   try {
+    if (export_result.format) {
+      const ExportFrames& frames = export_result.frames;
+      std::string why;
+      if (!frames.Check(&why)) {
+        SetStatus("export: " + why, true);
+        return;
+      }
+      const std::string source =
+          state_.session_path.empty() ? "the workbench" : state_.session_path.filename().string();
+      WriteFileAtomically(path, ExportCalibration(*export_result.format,
+                                                  outcome.solution->cam_from_lidar, frames, source)
+                                    .text);
+      SetStatus("exported " + path.string() + " (" + ExportFormatName(*export_result.format) +
+                    "): the pose of '" + frames.child() + "' in '" + frames.parent() +
+                    "', camera frame " + CameraFrameName(frames.camera_frame),
+                false);
+      return;
+    }
     WriteResult(path, outcome, SolverOptionsFromState());
     SetStatus("exported " + path.string(), false);
   } catch (const IoError& e) {

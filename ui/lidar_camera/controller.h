@@ -22,6 +22,7 @@
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/solver.h"
 #include "core/reproject/reproject.h"
+#include "core/results/export.h"
 #include "core/session/session.h"
 #include "core/target/board_camera.h"
 #include "core/target/lidar_plane.h"
@@ -128,8 +129,13 @@ struct SetSolverOptions {
 struct SetView {
   ViewState view;
 };
+// Writes the solution: a calibench result (no format), or a file a robot loads in one of the
+// export formats, with the frames named (core/results/export.h). A relative path goes next to
+// the session.
 struct ExportResult {
   std::filesystem::path path;
+  std::optional<ExportFormat> format;
+  ExportFrames frames;
 };
 struct SaveSessionAs {
   std::filesystem::path path;

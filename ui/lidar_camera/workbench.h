@@ -12,6 +12,7 @@
 
 #include "ui/gfx/renderers.h"
 #include "ui/lidar_camera/controller.h"
+#include "ui/widgets/export_row.h"
 #include "ui/widgets/view_window.h"
 #include "ui/widgets/workbench_frame.h"
 #include "ui/widgets/zoom_pan_image.h"
@@ -84,7 +85,7 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   std::string lidar_centered_on_;    // pair whose brush the LiDAR view was last centred on
   ZoomPanImage camera_image_;        // zoom and pan of the camera view
   bool scene_camera_colors_ = true;  // 3D cloud coloured from the image once a solve exists
-  std::string export_path_ = "result.json";
+  ExportChoice export_;
   std::string session_path_ = "session.json";
   ImageRect lidar_image_rect_;
   ImageRect scene_image_rect_;

@@ -8,6 +8,7 @@
 #include "core/lidar_camera/result_io.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/lidar_camera/workbench_gl.h"
+#include "ui/widgets/export_row.h"
 #include "ui/widgets/pair_review.h"
 #include "ui/widgets/path_field.h"
 #include "ui/widgets/solution_readouts.h"
@@ -213,8 +214,8 @@ void Workbench::SolutionReadouts(const SolverResult& res, std::vector<Intent>* i
                        std::to_string(res.iterations) + " iterations, " +
                            (res.converged ? "converged" : "not converged"),
                        "NOT well constrained: add pairs with other board tilts");
-  if (PathField("##export", &export_path_, "Export result"))
-    intents->push_back(ExportResult{export_path_});
+  if (ExportRow(&export_))
+    intents->push_back(ExportResult{export_.path, export_.format, export_.frames});
 }
 
 }  // namespace calibench::ui

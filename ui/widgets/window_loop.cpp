@@ -25,6 +25,12 @@ Window::Window(const WindowOptions& options, std::unique_ptr<gfx::WindowContext>
 
 Window::~Window() = default;
 
+std::vector<std::string> Window::TakeDroppedPaths() { return context_->TakeDroppedPaths(); }
+
+void Window::DeliverDrop(const std::vector<std::string>& paths) { context_->DeliverDrop(paths); }
+
+void Window::RequestClose() { context_->RequestClose(); }
+
 namespace {
 constexpr double kAnimationFrameS = 1.0 / 60;  // frame period while the workbench animates
 constexpr double kIdleWakeS = 1.0;             // wakes to check for close; draws nothing

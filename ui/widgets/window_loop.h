@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/base/image.h"
 
@@ -53,6 +54,12 @@ class Window {
   // Returns the last frame's picture with capture_last_frame.
   std::optional<ImageU8> Run(const std::function<bool(int, int, double)>& frame);
   const FrameStats& stats() const { return stats_; }
+  // Files and folders dropped onto the window since the last call (call from `frame`).
+  std::vector<std::string> TakeDroppedPaths();
+  // Drives the window's drop callback as the window system would (tests).
+  void DeliverDrop(const std::vector<std::string>& paths);
+  // Ends Run after the frame being drawn (the File menu's Quit).
+  void RequestClose();
 
  private:
   Window(const WindowOptions& options, std::unique_ptr<gfx::WindowContext> context);

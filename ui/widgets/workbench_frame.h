@@ -25,12 +25,13 @@ class WorkbenchFrame {
   // results on their way) or a replay runs. The window redraws only then, or on input.
   bool Animating(const Snapshot& s) const { return s.busy || replay_.playing(); }
 
+  // top: pixels above the frame taken by the window's menu bar.
   std::vector<Intent> Frame(const Snapshot& s, int width, int height, Layout layout,
-                            double seconds_since_last_frame) {
+                            double seconds_since_last_frame, float top = 0.0f) {
     std::vector<Intent> intents;
     replay_.Advance(s.solver.iterations.size(), seconds_since_last_frame);
     const FrameRects frame =
-        ArrangeFrame(static_cast<int>(layout), width, height, measurements_share_);
+        ArrangeFrame(static_cast<int>(layout), width, height, measurements_share_, top);
     for (int view = 0; view < 3; ++view)
       if (frame.Shows(view)) View(view, s, frame.views[view], &intents);
     if (!frame.panels()) return intents;

@@ -6,6 +6,15 @@
 
 namespace calibench::ui {
 
+FrameRects ArrangeFrame(int layout, int width, int height, float measurements_share, float top) {
+  FrameRects frame =
+      ArrangeFrame(layout, width, static_cast<int>(height - top), measurements_share);
+  for (Rect* r : {&frame.views[0], &frame.views[1], &frame.views[2], &frame.measurements,
+                  &frame.solver, &frame.status})
+    r->y += top;
+  return frame;
+}
+
 FrameRects ArrangeFrame(int layout, int width, int height, float measurements_share) {
   const float w = static_cast<float>(width), h = static_cast<float>(height);
   FrameRects frame;

@@ -37,5 +37,7 @@ struct FrameRects {
 // The frame of a layout (its enum value) on a width x height display; the measurements list takes
 // measurements_share of the width.
 FrameRects ArrangeFrame(int layout, int width, int height, float measurements_share);
+// The same below a strip of `top` pixels (the window's menu bar).
+FrameRects ArrangeFrame(int layout, int width, int height, float measurements_share, float top);
 
 }  // namespace calibench::ui

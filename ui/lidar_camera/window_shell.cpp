@@ -1,0 +1,307 @@
+#include "ui/lidar_camera/window_shell.h"
+
+#include <imgui.h>
+
+#include <atomic>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include "core/io/bag.h"
+#include "core/results/export.h"
+#include "ui/lidar_camera/workbench.h"
+
+namespace calibench::ui {
+namespace fs = std::filesystem;
+
+// A recording importing on its own thread; the window shows its progress and opens the dataset
+// when it is done.
+struct ImportJob {
+  fs::path recording;
+  std::thread thread;
+  std::mutex mutex;  // guards the fields below
+  std::string phase = "opening";
+  double fraction = 0.0;
+  std::optional<BagImportSummary> summary;
+  std::string error;
+  std::atomic<bool> done{false};
+
+  ~ImportJob() {
+    if (thread.joinable()) thread.join();
+  }
+};
+
+OpenKind KindOfPath(const fs::path& path) {
+  if (LooksLikeBag(path)) return OpenKind::kRecording;
+  std::error_code error;
+  if (fs::is_regular_file(path, error) && path.extension() == ".json") {
+    std::ifstream in(path, std::ios::binary);
+    std::string head(4096, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    if (head.find("calibench.session.v1") != std::string::npos) return OpenKind::kSession;
+  }
+  return OpenKind::kDataset;
+}
+
+WindowShell::WindowShell(ShellOptions options)
+    : options_(std::move(options)),
+      controller_(std::make_unique<Controller>(options_.pipeline)),
+      recent_(options_.recent_file) {
+  if (!recent_.load_error().empty()) {
+    error_ = "the list of recent sessions was not read: " + recent_.load_error();
+    show_error_ = true;
+  }
+}
+
+WindowShell::~WindowShell() = default;
+
+void WindowShell::Replace(std::unique_ptr<Controller> opened) {
+  controller_ = std::move(opened);  // the old controller stops its worker and releases its lock
+  workbench_.reset();               // its textures show the old dataset
+  const fs::path session = controller_->GetSnapshot().session_path;
+  if (!session.empty()) Remember(session);
+}
+
+void WindowShell::Remember(const fs::path& session) {
+  const std::string why = recent_.Add(session);
+  if (!why.empty()) {
+    error_ = "the list of recent sessions was not saved: " + why;
+    show_error_ = true;
+  }
+}
+
+void WindowShell::OpenDataset(const fs::path& dataset, Controller::ExistingSession existing) {
+  auto opened = std::make_unique<Controller>(options_.pipeline);
+  opened->OpenDataset(dataset, {}, existing);
+  Replace(std::move(opened));
+}
+
+void WindowShell::OpenSession(const fs::path& session) {
+  auto opened = std::make_unique<Controller>(options_.pipeline);
+  opened->OpenSession(session);
+  Replace(std::move(opened));
+}
+
+void WindowShell::ImportRecording(const fs::path& recording) {
+  if (import_) {
+    error_ = "an import is running; wait for it to finish";
+    show_error_ = true;
+    return;
+  }
+  import_ = std::make_unique<ImportJob>();
+  ImportJob* job = import_.get();
+  job->recording = recording;
+  const fs::path out = DefaultImportFolder(recording);
+  job->thread = std::thread([job, out, board = options_.board, options = options_.import] {
+    try {
+      BagImportSummary summary =
+          ImportBag(job->recording, out, board, options,
+                    [job](const std::string& phase, std::int64_t done, std::int64_t total) {
+                      std::lock_guard<std::mutex> lock(job->mutex);
+                      job->phase = phase;
+                      job->fraction = total > 0 ? static_cast<double>(done) / total : 0.0;
+                    });
+      std::lock_guard<std::mutex> lock(job->mutex);
+      job->summary = std::move(summary);
+    } catch (const std::exception& e) {  // IoError, or a filesystem error writing the folder
+      std::lock_guard<std::mutex> lock(job->mutex);
+      job->error = e.what();
+    }
+    job->done = true;
+  });
+}
+
+namespace {
+
+// The session file opening `path` would edit (the controller's rule: beside the dataset).
+fs::path SessionOpenedBy(const fs::path& path, OpenKind kind) {
+  if (kind == OpenKind::kSession) return path;
+  std::error_code error;
+  const fs::path folder = fs::is_directory(path, error) ? path : path.parent_path();
+  return folder / "calibench.session.json";
+}
+
+bool SameFile(const fs::path& a, const fs::path& b) {
+  std::error_code error;
+  return !a.empty() && !b.empty() &&
+         fs::weakly_canonical(a, error) == fs::weakly_canonical(b, error);
+}
+
+}  // namespace
+
+void WindowShell::OpenFromUser(const fs::path& path) {
+  const OpenKind kind = KindOfPath(path);
+  if (kind != OpenKind::kRecording &&
+      SameFile(SessionOpenedBy(path, kind), controller_->GetSnapshot().session_path)) {
+    error_ = path.string() + " is open in this window already";
+    show_error_ = true;
+    return;
+  }
+  try {
+    switch (kind) {
+      case OpenKind::kRecording:
+        ImportRecording(path);
+        break;
+      case OpenKind::kSession:
+        OpenSession(path);
+        break;
+      case OpenKind::kDataset:
+        // Opening a dataset again resumes its session: an hour of edits is never overwritten.
+        OpenDataset(path, Controller::ExistingSession::kResume);
+        break;
+    }
+  } catch (const IoError& e) {
+    error_ = e.what();
+    show_error_ = true;
+  }
+}
+
+bool WindowShell::PollImport() {
+  if (!import_) return false;
+  if (!import_->done) return true;
+  std::unique_ptr<ImportJob> job = std::move(import_);
+  job->thread.join();
+  if (!job->error.empty()) {
+    error_ = job->error;
+    show_error_ = true;
+    return false;
+  }
+  last_import_ = job->summary;
+  show_import_summary_ = true;
+  OpenFromUser(job->summary->manifest);
+  return false;
+}
+
+void WindowShell::FinishImport() {
+  if (import_ && import_->thread.joinable()) {
+    while (!import_->done) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  PollImport();
+}
+
+WindowRun WindowShell::Run(const WindowOptions& options) {
+  WindowRun run;
+  const auto window = Window::Open(options, &run.why);
+  if (!window) return run;
+  run.opened = true;
+  run.last_frame = window->Run([&](int width, int height, double seconds) {
+    return Frame(*window, width, height, seconds);
+  });
+  run.stats = window->stats();
+  if (import_) FinishImport();  // a closed window does not abandon an import half-written
+  return run;
+}
+
+bool WindowShell::Frame(Window& window, int width, int height, double seconds) {
+  ++frames_;
+  if (pending_open_) OpenFromUser(*std::exchange(pending_open_, std::nullopt));
+  for (const std::string& dropped : window.TakeDroppedPaths()) pending_open_ = dropped;
+  // Tests: one drop per frame once the workbench has drawn a few, through GLFW's callback.
+  if (frames_ > 3 && !options_.test_drops.empty()) {
+    window.DeliverDrop({options_.test_drops.front()});
+    options_.test_drops.erase(options_.test_drops.begin());
+  }
+  const bool importing = PollImport();  // may open a dataset, replacing the workbench
+  if (!workbench_) workbench_ = std::make_unique<Workbench>();
+  const float top = MenuBar();
+  const Snapshot snapshot = controller_->GetSnapshot();
+  const auto intents = workbench_->Frame(snapshot, width, height, Layout::kWorkbench, seconds, top);
+  for (const Intent& intent : intents) controller_->Apply(intent);
+  if (const auto chosen = browser_.Draw()) pending_open_ = *chosen;
+  Popups();
+  if (quit_) window.RequestClose();
+  return importing || !intents.empty() || workbench_->Animating(snapshot) ||
+         pending_open_.has_value() || !options_.test_drops.empty();
+}
+
+float WindowShell::MenuBar() {
+  if (ImGui::GetIO().KeyCtrl && ImGui::IsKeyPressed('O', false))
+    browser_.Open(controller_->GetSnapshot().dataset_path, "Open dataset, session or recording");
+  if (!ImGui::BeginMainMenuBar()) return 0.0f;
+  FileMenu();
+  const float height = ImGui::GetWindowSize().y;
+  ImGui::EndMainMenuBar();
+  return height;
+}
+
+void WindowShell::FileMenu() {
+  if (!ImGui::BeginMenu("File")) return;
+  const fs::path here = controller_->GetSnapshot().dataset_path;
+  if (ImGui::MenuItem("Open dataset or session...", "Ctrl+O"))
+    browser_.Open(here, "Open dataset, session or recording");
+  if (ImGui::MenuItem("Open recording (.bag .db3 .mcap)...", nullptr, false, !import_))
+    browser_.Open(here, "Open a recording to import");
+  if (ImGui::BeginMenu("Recent sessions")) {
+    const auto recent = recent_.Paths();
+    if (recent.empty()) ImGui::TextDisabled("none yet");
+    for (const fs::path& path : recent)
+      if (ImGui::MenuItem(path.string().c_str())) pending_open_ = path;
+    ImGui::EndMenu();
+  }
+  ImGui::Separator();
+  ExportMenu();
+  ImGui::Separator();
+  if (ImGui::MenuItem("Quit")) quit_ = true;
+  ImGui::EndMenu();
+}
+
+void WindowShell::ExportMenu() {
+  const Snapshot snapshot = controller_->GetSnapshot();
+  if (!ImGui::BeginMenu("Export", snapshot.solver.result.has_value())) return;
+  ImGui::TextDisabled("next to the session; the solver panel names frames and files");
+  if (ImGui::MenuItem("calibench result (result.json)"))
+    controller_->Apply(ExportResult{"result.json", std::nullopt, {}});
+  for (const ExportFormat format : AllExportFormats()) {
+    const std::string label = ExportFormatName(format) + " (" + DefaultExportFileName(format) + ")";
+    if (ImGui::MenuItem(label.c_str()))
+      controller_->Apply(ExportResult{DefaultExportFileName(format), format, {}});
+  }
+  ImGui::EndMenu();
+}
+
+void WindowShell::Popups() {
+  if (import_ && !ImGui::IsPopupOpen("Importing")) ImGui::OpenPopup("Importing");
+  if (ImGui::BeginPopupModal("Importing", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    if (!import_) {
+      ImGui::CloseCurrentPopup();  // done: the dataset is open, or the error shows next
+    } else {
+      std::lock_guard<std::mutex> lock(import_->mutex);
+      ImGui::Text("%s", import_->recording.filename().c_str());
+      ImGui::ProgressBar(
+          static_cast<float>(import_->fraction), {420, 0},
+          (import_->phase + " " + std::to_string(static_cast<int>(import_->fraction * 100)) + "%")
+              .c_str());
+      ImGui::TextDisabled("clouds paired with images; still boards only; then the files");
+    }
+    ImGui::EndPopup();
+  }
+  if (show_error_) {
+    ImGui::OpenPopup("Cannot open");
+    show_error_ = false;
+  }
+  if (ImGui::BeginPopupModal("Cannot open", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    ImGui::PushTextWrapPos(640);
+    ImGui::TextColored({1.0f, 0.45f, 0.4f, 1}, "%s", error_.c_str());
+    ImGui::PopTextWrapPos();
+    if (ImGui::Button("OK")) ImGui::CloseCurrentPopup();
+    ImGui::EndPopup();
+  }
+  if (show_import_summary_ && !show_error_ && last_import_) {
+    ImGui::OpenPopup("Imported");
+    show_import_summary_ = false;
+  }
+  if (ImGui::BeginPopupModal("Imported", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    const BagImportSummary& s = *last_import_;
+    ImGui::Text("%zu pairs from %lld clouds (%s) and %lld images (%s)", s.pair_ids.size(),
+                static_cast<long long>(s.clouds), s.cloud_topic.c_str(),
+                static_cast<long long>(s.images), s.image_topic.c_str());
+    for (const auto& [reason, count] : s.dropped)
+      ImGui::BulletText("dropped %d: %s", count, reason.c_str());
+    ImGui::TextDisabled("%s", s.manifest.c_str());
+    if (ImGui::Button("OK")) ImGui::CloseCurrentPopup();
+    ImGui::EndPopup();
+  }
+}
+
+}  // namespace calibench::ui

@@ -1,0 +1,94 @@
+// The workbench window as a user runs it: a File menu over the workbench (Open dataset or
+// folder, Open recording, Recent, Export, Quit), drag and drop of a dataset, folder, session or
+// recording onto the window, and recordings imported on a thread behind a progress bar. Owns the
+// controller of what is open and replaces it (with the workbench's GL resources) when the user
+// opens something else; a failure to open shows in a popup and leaves the open work alone.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/io/bag_import.h"
+#include "core/target/board.h"
+#include "ui/lidar_camera/controller.h"
+#include "ui/state/recent_files.h"
+#include "ui/widgets/file_browser.h"
+#include "ui/widgets/window_loop.h"
+
+namespace calibench::ui {
+
+class Workbench;
+struct ImportJob;  // a recording importing on its thread (window_shell.cpp)
+
+struct ShellOptions {
+  PipelineOptions pipeline;
+  BoardSpec board = BoardPreset("a4");  // the board seen in imported recordings
+  BagImportOptions import;
+  std::filesystem::path recent_file = DefaultRecentFilesPath();
+  // Delivered through the window's drop callback once the first frames are drawn, one path per
+  // drop, as a window system would (tests of drag and drop).
+  std::vector<std::string> test_drops;
+};
+
+// What a path is to the workbench.
+enum class OpenKind { kDataset, kSession, kRecording };
+// By content: a recording (LooksLikeBag), a session file, else a dataset (manifest or folder).
+OpenKind KindOfPath(const std::filesystem::path& path);
+
+class WindowShell {
+ public:
+  explicit WindowShell(ShellOptions options);
+  ~WindowShell();
+  WindowShell(const WindowShell&) = delete;
+  WindowShell& operator=(const WindowShell&) = delete;
+
+  // What the window opens with; the command line's errors are thrown (IoError) before a window
+  // exists. A recording starts importing and opens when done.
+  void OpenDataset(const std::filesystem::path& dataset, Controller::ExistingSession existing);
+  void OpenSession(const std::filesystem::path& session);
+  void ImportRecording(const std::filesystem::path& recording);
+  // What the File menu, Recent and a drop do: any kind of path; failures go to the popup.
+  void OpenFromUser(const std::filesystem::path& path);
+
+  // Runs the window until the user closes it.
+  WindowRun Run(const WindowOptions& options);
+
+  // The controller of what is open (an empty one before anything is).
+  Controller& controller() { return *controller_; }
+  // The last failure shown in the popup (empty when none); the last import's summary.
+  const std::string& error() const { return error_; }
+  const std::optional<BagImportSummary>& last_import() const { return last_import_; }
+  // Waits for a running import and opens its dataset (tests without a window).
+  void FinishImport();
+
+ private:
+  bool Frame(Window& window, int width, int height, double seconds);
+  float MenuBar();  // returns its height
+  void FileMenu();
+  void ExportMenu();
+  void Popups();
+  // Opens what a finished import wrote; true while an import runs.
+  bool PollImport();
+  // Replaces the controller with one that opened `path`; the old one stays on failure.
+  void Replace(std::unique_ptr<Controller> opened);
+  void Remember(const std::filesystem::path& session);
+
+  ShellOptions options_;
+  std::unique_ptr<Controller> controller_;
+  std::unique_ptr<Workbench> workbench_;  // made in the window's first frame (GL resources)
+  RecentFiles recent_;
+  FileBrowser browser_;
+  std::unique_ptr<ImportJob> import_;
+  std::optional<BagImportSummary> last_import_;
+  std::optional<std::filesystem::path> pending_open_;  // chosen during a frame, opened at the next
+  std::string error_;
+  bool show_error_ = false;
+  bool show_import_summary_ = false;
+  bool quit_ = false;
+  int frames_ = 0;
+};
+
+}  // namespace calibench::ui
