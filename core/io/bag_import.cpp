@@ -250,7 +250,7 @@ class Importer {
     try {
       const RosHeader header = DecodeRosHeader(message.data, topic.encoding);
       first_.clouds.push_back({StampOrLogTime(header, message), index});
-    } catch (const std::invalid_argument& error) {
+    } catch (const std::invalid_argument&) {
       Drop("cloud message unreadable");
     }
   }
@@ -453,9 +453,8 @@ class Importer {
                           *std::max_element(cloud.cloud.ring.begin(), cloud.cloud.ring.end()) + 1);
       SavePcd(out_dir_ / "clouds" / (candidate.id + ".pcd"), cloud.cloud, PcdEncoding::kBinary);
       return true;
-    } catch (const std::invalid_argument& error) {
+    } catch (const std::invalid_argument&) {
       Drop("cloud message unreadable");
-      if (first_.image_problem.empty()) first_.image_problem = error.what();
       return false;
     }
   }
@@ -465,7 +464,7 @@ class Importer {
       const ImageMessage image = DecodeAnyImage(topic, message, options_.limits);
       SaveImage(out_dir_ / "images" / (candidate.id + ".png"), image.image);
       return true;
-    } catch (const std::invalid_argument& error) {
+    } catch (const std::invalid_argument&) {
       Drop("image unreadable");
       return false;
     }

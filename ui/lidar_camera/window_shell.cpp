@@ -239,10 +239,24 @@ void WindowShell::FileMenu() {
       if (ImGui::MenuItem(path.string().c_str())) pending_open_ = path;
     ImGui::EndMenu();
   }
+  BoardMenu();
   ImGui::Separator();
   ExportMenu();
   ImGui::Separator();
   if (ImGui::MenuItem("Quit")) quit_ = true;
+  ImGui::EndMenu();
+}
+
+void WindowShell::BoardMenu() {
+  if (!ImGui::BeginMenu("Board in recordings")) return;
+  for (const char* preset : {"a3", "a4", "charuco-a3", "charuco-a4", "paper"}) {
+    const BoardSpec board = BoardPreset(preset);
+    const bool chosen = board.type == options_.board.type && board.cols == options_.board.cols &&
+                        board.rows == options_.board.rows &&
+                        board.square_size == options_.board.square_size;
+    if (ImGui::MenuItem(preset, nullptr, chosen)) options_.board = board;
+  }
+  ImGui::TextDisabled("or --board FILE on the command line");
   ImGui::EndMenu();
 }
 

@@ -68,6 +68,7 @@ class WindowShell {
   bool Frame(Window& window, int width, int height, double seconds);
   float MenuBar();  // returns its height
   void FileMenu();
+  void BoardMenu();  // the board of recordings opened from the menu
   void ExportMenu();
   void Popups();
   // Opens what a finished import wrote; true while an import runs.

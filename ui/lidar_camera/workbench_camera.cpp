@@ -101,7 +101,7 @@ void Workbench::CameraView(const Snapshot& s, const Rect& r, std::vector<Intent>
   if (!BeginView("Camera", r)) return ImGui::End();
   const PairView* pair = s.selected >= 0 ? &s.pairs[s.selected] : nullptr;
   if (!pair || !s.selected_image || !s.dataset) {
-    ImGui::TextDisabled("loading image ...");
+    ImGui::TextDisabled(s.dataset ? "loading image ..." : "no dataset open");
     return ImGui::End();
   }
   const ViewState view = CameraToolbar(s, *pair, intents);

@@ -60,8 +60,15 @@ void Workbench::LidarView(const Snapshot& s, const Rect& r, std::vector<Intent>*
   if (!BeginView("LiDAR image", r)) return ImGui::End();
   const PairView* pair = s.selected >= 0 ? &s.pairs[s.selected] : nullptr;
   if (!pair || !pair->lidar_image) {
-    ImGui::TextDisabled(s.loading_total ? "loading %d / %d pairs ..." : "no dataset open",
-                        s.loading_done, s.loading_total);
+    if (s.loading_total) {
+      ImGui::TextDisabled("loading %d / %d pairs ...", s.loading_done, s.loading_total);
+    } else {
+      ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+      ImGui::TextWrapped(
+          "no dataset open: File > Open (Ctrl+O), or drop a dataset folder, a "
+          "session or a recording (.bag .db3 .mcap) onto the window");
+      ImGui::PopStyleColor();
+    }
     return ImGui::End();
   }
   LidarToolbar(s, *pair, intents);

@@ -144,7 +144,7 @@ void Workbench::SceneView(const Snapshot& s, const Rect& r, std::vector<Intent>*
   if (!BeginView("3D", r)) return ImGui::End();
   const PairView* pair = s.selected >= 0 ? &s.pairs[s.selected] : nullptr;
   if (!pair || !pair->cloud || !s.dataset) {
-    ImGui::TextDisabled("loading ...");
+    ImGui::TextDisabled(s.dataset ? "loading ..." : "no dataset open");
     return ImGui::End();
   }
   const bool can_use_camera =
