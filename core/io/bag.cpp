@@ -18,7 +18,6 @@
 
 namespace calibench {
 namespace fs = std::filesystem;
-using namespace bag_internal;
 
 namespace bag_internal {
 
@@ -55,8 +54,8 @@ void RandomAccessFile::ReadAt(std::int64_t offset, std::int64_t size,
   out->resize(static_cast<std::size_t>(size));
   std::int64_t done = 0;
   while (done < size) {
-    const ssize_t got = ::pread(fd_, out->data() + done, static_cast<std::size_t>(size - done),
-                                offset + done);
+    const ssize_t got =
+        ::pread(fd_, out->data() + done, static_cast<std::size_t>(size - done), offset + done);
     if (got < 0 && errno == EINTR) continue;
     if (got <= 0)
       Fail(path_, std::string("cannot read ") + what + " at byte " + std::to_string(offset) +
@@ -113,8 +112,8 @@ void Decompress(const std::string& method, std::span<const std::uint8_t> compres
         static_cast<unsigned int>(compressed.size()), 0, 0);
     if (status != BZ_OK || out_size != uncompressed_size)
       Fail(file, "corrupt bz2 data in " + where + " (bzip2 status " + std::to_string(status) +
-                     ", " + std::to_string(out_size) + " of " +
-                     std::to_string(uncompressed_size) + " bytes)");
+                     ", " + std::to_string(out_size) + " of " + std::to_string(uncompressed_size) +
+                     " bytes)");
   } else if (method == "lz4") {
     DecompressLz4Frame(compressed, out, file, where);
   } else if (method == "zstd") {
@@ -191,7 +190,8 @@ class FolderBag final : public BagReader {
     for (const auto& part : parts_) {
       std::vector<int> map;
       for (const BagTopic& topic : part->Topics()) {
-        const int index = AddTopic(&topics_, topic.name, topic.type, topic.encoding_name);
+        const int index =
+            bag_internal::AddTopic(&topics_, topic.name, topic.type, topic.encoding_name);
         topics_[index].message_count += topic.message_count;
         map.push_back(index);
       }
@@ -236,17 +236,18 @@ class FolderBag final : public BagReader {
 std::unique_ptr<BagReader> OpenBagFile(const fs::path& path) {
   switch (SniffFile(path)) {
     case BagKind::kRos1:
-      return OpenRos1Bag(path);
+      return bag_internal::OpenRos1Bag(path);
     case BagKind::kMcap:
-      return OpenMcap(path);
+      return bag_internal::OpenMcap(path);
     case BagKind::kSqlite:
-      return OpenSqliteBag(path);
+      return bag_internal::OpenSqliteBag(path);
     case BagKind::kNone:
       break;
   }
-  Fail(path,
-       "not a recording Calibench reads (expected a ROS 1 .bag, an .mcap or a rosbag2 .db3; "
-       "the file starts with none of their signatures)");
+  bag_internal::Fail(
+      path,
+      "not a recording Calibench reads (expected a ROS 1 .bag, an .mcap or a rosbag2 .db3; "
+      "the file starts with none of their signatures)");
 }
 
 }  // namespace
@@ -266,10 +267,10 @@ std::string NormalizeMessageType(const std::string& type) {
 std::unique_ptr<BagReader> OpenBag(const fs::path& path) {
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
-  if (error || !fs::exists(status)) Fail(path, "no such file or folder");
+  if (error || !fs::exists(status)) bag_internal::Fail(path, "no such file or folder");
   if (!fs::is_directory(status)) return OpenBagFile(path);
   const std::vector<fs::path> files = FolderBagFiles(path);
-  if (files.empty()) Fail(path, "the folder holds no .db3 or .mcap recording");
+  if (files.empty()) bag_internal::Fail(path, "the folder holds no .db3 or .mcap recording");
   if (files.size() == 1) return OpenBagFile(files.front());
   std::vector<std::unique_ptr<BagReader>> parts;
   for (const fs::path& file : files) parts.push_back(OpenBagFile(file));

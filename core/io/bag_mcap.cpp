@@ -14,17 +14,17 @@ namespace calibench::bag_internal {
 namespace {
 namespace fs = std::filesystem;
 
-constexpr std::string_view kMagic("\x89MCAP0\r\n", 8);
-constexpr std::uint8_t kOpHeader = 0x01;
-constexpr std::uint8_t kOpFooter = 0x02;
-constexpr std::uint8_t kOpSchema = 0x03;
-constexpr std::uint8_t kOpChannel = 0x04;
-constexpr std::uint8_t kOpMessage = 0x05;
-constexpr std::uint8_t kOpChunk = 0x06;
-constexpr std::uint8_t kOpChunkIndex = 0x08;
-constexpr std::uint8_t kOpStatistics = 0x0B;
-constexpr std::uint8_t kOpDataEnd = 0x0F;
-constexpr std::int64_t kFooterBytes = 1 + 8 + 8 + 8 + 4;
+constexpr std::string_view kMcapMagic("\x89MCAP0\r\n", 8);
+constexpr std::uint8_t kMcapOpHeader = 0x01;
+constexpr std::uint8_t kMcapOpFooter = 0x02;
+constexpr std::uint8_t kMcapOpSchema = 0x03;
+constexpr std::uint8_t kMcapOpChannel = 0x04;
+constexpr std::uint8_t kMcapOpMessage = 0x05;
+constexpr std::uint8_t kMcapOpChunk = 0x06;
+constexpr std::uint8_t kMcapOpChunkIndex = 0x08;
+constexpr std::uint8_t kMcapOpStatistics = 0x0B;
+constexpr std::uint8_t kMcapOpDataEnd = 0x0F;
+constexpr std::int64_t kMcapFooterBytes = 1 + 8 + 8 + 8 + 4;
 
 class Mcap final : public BagReader {
  public:
@@ -33,11 +33,11 @@ class Mcap final : public BagReader {
     size_bytes_ = file_.Size();
     std::vector<std::uint8_t> bytes;
     file_.ReadAt(0, 8, &bytes, "the magic");
-    if (std::string_view(reinterpret_cast<const char*>(bytes.data()), 8) != kMagic)
+    if (std::string_view(reinterpret_cast<const char*>(bytes.data()), 8) != kMcapMagic)
       Fail(path, "an MCAP of a version other than 0");
     std::uint8_t op = 0;
     const std::int64_t header_end = ReadRecord(8, &op, &bytes);
-    if (op != kOpHeader) Fail(path, "the first record is not the MCAP header");
+    if (op != kMcapOpHeader) Fail(path, "the first record is not the MCAP header");
     Cursor header(bytes, path_, 8, "the header");
     profile_ = std::string(header.PrefixedText("the profile"));
     data_start_ = header_end;
@@ -54,9 +54,9 @@ class Mcap final : public BagReader {
     for (std::int64_t offset = data_start_; offset < data_end_;) {
       const std::int64_t next = ReadRecord(offset, &op, &content);
       bool go_on = true;
-      if (op == kOpChunk) {
+      if (op == kMcapOpChunk) {
         go_on = VisitChunk(content, offset, &chunk, wanted, visit);
-      } else if (op == kOpDataEnd || op == kOpFooter) {
+      } else if (op == kMcapOpDataEnd || op == kMcapOpFooter) {
         break;
       } else {
         go_on = VisitRecord(op, content, offset, wanted, visit);
@@ -86,12 +86,13 @@ class Mcap final : public BagReader {
   // The summary's schemas, channels and statistics; false when the file has no usable summary
   // (a recording that was not closed, or one written without statistics).
   bool ReadSummary() {
-    if (size_bytes_ < 8 + kFooterBytes + 8) return false;
-    const std::int64_t footer_at = size_bytes_ - 8 - kFooterBytes;
+    if (size_bytes_ < 8 + kMcapFooterBytes + 8) return false;
+    const std::int64_t footer_at = size_bytes_ - 8 - kMcapFooterBytes;
     std::vector<std::uint8_t> bytes;
-    file_.ReadAt(footer_at, kFooterBytes + 8, &bytes, "the footer");
-    if (bytes[0] != kOpFooter ||
-        std::string_view(reinterpret_cast<const char*>(bytes.data()) + kFooterBytes, 8) != kMagic)
+    file_.ReadAt(footer_at, kMcapFooterBytes + 8, &bytes, "the footer");
+    if (bytes[0] != kMcapOpFooter ||
+        std::string_view(reinterpret_cast<const char*>(bytes.data()) + kMcapFooterBytes, 8) !=
+            kMcapMagic)
       return false;
     std::uint64_t summary_start;
     std::memcpy(&summary_start, bytes.data() + 9, 8);
@@ -102,10 +103,10 @@ class Mcap final : public BagReader {
     std::uint8_t op = 0;
     for (std::int64_t offset = static_cast<std::int64_t>(summary_start); offset < footer_at;) {
       const std::int64_t next = ReadRecord(offset, &op, &bytes);
-      if (op == kOpStatistics) {
+      if (op == kMcapOpStatistics) {
         ReadStatistics(bytes, offset);
         statistics = true;
-      } else if (op == kOpChunkIndex) {
+      } else if (op == kMcapOpChunkIndex) {
         Cursor index(bytes, path_, offset, "a chunk index");
         index.Bytes(8 * 4, "the chunk's times and position");
         index.Bytes(index.Read<std::uint32_t>(), "the message index offsets");
@@ -148,13 +149,12 @@ class Mcap final : public BagReader {
     counting_ = true;
     chunk_count_ = 0;
     compressions_.clear();
-    ForEachMessage(
-        {},
-        [&](const BagMessage& message) {
-          ++topics_[message.topic].message_count;
-          return true;
-        },
-        {});
+    ForEachMessage({},
+                   [&](const BagMessage& message) {
+                     ++topics_[message.topic].message_count;
+                     return true;
+                   },
+                   {});
     counting_ = false;
   }
 
@@ -197,11 +197,11 @@ class Mcap final : public BagReader {
   // Schemas and channels are registered; messages visited; other records skipped.
   bool VisitRecord(std::uint8_t op, std::span<const std::uint8_t> content, std::int64_t offset,
                    const std::vector<bool>& wanted, const BagVisitor& visit) {
-    if (op == kOpSchema) {
+    if (op == kMcapOpSchema) {
       Cursor schema(content, path_, offset, "a schema");
       const std::uint16_t id = schema.Read<std::uint16_t>();
       schema_names_[id] = std::string(schema.PrefixedText("the schema name"));
-    } else if (op == kOpChannel) {
+    } else if (op == kMcapOpChannel) {
       Cursor channel(content, path_, offset, "a channel");
       const std::uint16_t id = channel.Read<std::uint16_t>();
       const std::uint16_t schema_id = channel.Read<std::uint16_t>();
@@ -214,7 +214,7 @@ class Mcap final : public BagReader {
                      ", which comes nowhere before it");
       channel_topic_[id] =
           AddTopic(&topics_, topic, schema_id == 0 ? "" : schema->second, encoding);
-    } else if (op == kOpMessage) {
+    } else if (op == kMcapOpMessage) {
       Cursor message(content, path_, offset, "a message");
       const std::uint16_t channel = message.Read<std::uint16_t>();
       message.Read<std::uint32_t>();  // sequence

@@ -19,12 +19,12 @@ namespace calibench::bag_internal {
 namespace {
 namespace fs = std::filesystem;
 
-constexpr std::uint8_t kOpMessage = 0x02;
-constexpr std::uint8_t kOpBagHeader = 0x03;
-constexpr std::uint8_t kOpChunk = 0x05;
-constexpr std::uint8_t kOpChunkInfo = 0x06;
-constexpr std::uint8_t kOpConnection = 0x07;
-constexpr std::string_view kMagic = "#ROSBAG V2.0\n";
+constexpr std::uint8_t kRos1OpMessage = 0x02;
+constexpr std::uint8_t kRos1OpBagHeader = 0x03;
+constexpr std::uint8_t kRos1OpChunk = 0x05;
+constexpr std::uint8_t kRos1OpChunkInfo = 0x06;
+constexpr std::uint8_t kRos1OpConnection = 0x07;
+constexpr std::string_view kRos1Magic = "#ROSBAG V2.0\n";
 
 // A record's header fields, viewing the bytes they were parsed from.
 class RecordHeader {
@@ -97,13 +97,13 @@ class Ros1Bag final : public BagReader {
     path_ = path;
     size_bytes_ = file_.Size();
     std::vector<std::uint8_t> magic;
-    file_.ReadAt(0, static_cast<std::int64_t>(kMagic.size()), &magic, "the format line");
-    if (std::string_view(reinterpret_cast<const char*>(magic.data()), magic.size()) != kMagic)
+    file_.ReadAt(0, static_cast<std::int64_t>(kRos1Magic.size()), &magic, "the format line");
+    if (std::string_view(reinterpret_cast<const char*>(magic.data()), magic.size()) != kRos1Magic)
       Fail(path, "a ROS 1 bag of another version than 2.0 (only format 2.0 is read)");
     FileRecord record;
-    ReadRecord(file_, static_cast<std::int64_t>(kMagic.size()), &record);
+    ReadRecord(file_, static_cast<std::int64_t>(kRos1Magic.size()), &record);
     const RecordHeader header(record.header, path, record.offset);
-    if (header.Op() != kOpBagHeader) Fail(path, "the first record is not the bag header");
+    if (header.Op() != kRos1OpBagHeader) Fail(path, "the first record is not the bag header");
     data_start_ = record.next;
     index_pos_ = static_cast<std::int64_t>(header.Number<std::uint64_t>("index_pos"));
     chunk_count_ = header.Number<std::uint32_t>("chunk_count");
@@ -113,8 +113,8 @@ class Ros1Bag final : public BagReader {
       index_pos_ = size_bytes_;  // not closed by its recorder: no index, count by reading
       CountByScanning();
     }
-    format_ = "ROS 1 bag v2.0, " + std::to_string(chunk_count_) + " chunks (" + compression_ +
-              ")" + (indexed_ ? "" : ", no index (recording not closed)");
+    format_ = "ROS 1 bag v2.0, " + std::to_string(chunk_count_) + " chunks (" + compression_ + ")" +
+              (indexed_ ? "" : ", no index (recording not closed)");
   }
 
   void ForEachMessage(const std::vector<bool>& wanted, const BagVisitor& visit,
@@ -126,7 +126,7 @@ class Ros1Bag final : public BagReader {
       const RecordHeader header(record.header, path_, offset);
       const std::uint8_t op = header.Op();
       bool go_on = true;
-      if (op == kOpChunk) {
+      if (op == kRos1OpChunk) {
         std::span<const std::uint8_t> bytes = record.data;
         const std::string compression(header.Get("compression"));
         if (compression != "none") {
@@ -135,9 +135,9 @@ class Ros1Bag final : public BagReader {
           bytes = chunk;
         }
         go_on = VisitChunk(bytes, offset, wanted, visit);
-      } else if (op == kOpMessage) {
+      } else if (op == kRos1OpMessage) {
         go_on = VisitMessage(header, record.data, wanted, visit);
-      } else if (op == kOpConnection) {
+      } else if (op == kRos1OpConnection) {
         AddConnection(header, record.data, offset);
       }
       if (progress) progress(record.next, size_bytes_);
@@ -153,9 +153,9 @@ class Ros1Bag final : public BagReader {
     for (std::int64_t offset = index_pos_; offset < size_bytes_; offset = record.next) {
       ReadRecord(file_, offset, &record);
       const RecordHeader header(record.header, path_, offset);
-      if (header.Op() == kOpConnection) {
+      if (header.Op() == kRos1OpConnection) {
         AddConnection(header, record.data, offset);
-      } else if (header.Op() == kOpChunkInfo) {
+      } else if (header.Op() == kRos1OpChunkInfo) {
         Cursor data(record.data, path_, offset, "a chunk-info record");
         const std::uint32_t connections = header.Number<std::uint32_t>("count");
         for (std::uint32_t i = 0; i < connections; ++i) {
@@ -186,19 +186,18 @@ class Ros1Bag final : public BagReader {
     std::memcpy(&header_length, bytes.data(), 4);
     file_.ReadAt(offset + 4, header_length, &bytes, "a chunk header");
     const RecordHeader header(bytes, path_, offset);
-    if (header.Op() != kOpChunk)
+    if (header.Op() != kRos1OpChunk)
       Fail(path_, "the index points at byte " + std::to_string(offset) + ", which is no chunk");
     compressions->insert(std::string(header.Get("compression")));
   }
 
   void CountByScanning() {
-    ForEachMessage(
-        {},
-        [&](const BagMessage& message) {
-          ++topics_[message.topic].message_count;
-          return true;
-        },
-        {});
+    ForEachMessage({},
+                   [&](const BagMessage& message) {
+                     ++topics_[message.topic].message_count;
+                     return true;
+                   },
+                   {});
     compression_ = "unindexed";
   }
 
@@ -226,9 +225,9 @@ class Ros1Bag final : public BagReader {
       const auto data = cursor.Bytes(cursor.Read<std::uint32_t>(), "a record's data");
       const RecordHeader header(header_bytes, path_, chunk_offset);
       const std::uint8_t op = header.Op();
-      if (op == kOpConnection) {
+      if (op == kRos1OpConnection) {
         AddConnection(header, data, chunk_offset);
-      } else if (op == kOpMessage && !VisitMessage(header, data, wanted, visit)) {
+      } else if (op == kRos1OpMessage && !VisitMessage(header, data, wanted, visit)) {
         return false;
       }
     }

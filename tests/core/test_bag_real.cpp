@@ -16,7 +16,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // "topic type" -> message count.
-std::map<std::string, std::int64_t> Counts(const BagReader& bag) {
+std::map<std::string, std::int64_t> TopicCounts(const BagReader& bag) {
   std::map<std::string, std::int64_t> counts;
   for (const BagTopic& topic : bag.Topics())
     counts[topic.name + " " + topic.type] += topic.message_count;
@@ -24,7 +24,7 @@ std::map<std::string, std::int64_t> Counts(const BagReader& bag) {
 }
 
 // What each importable message decoded to, per topic: "WxH encoding" or "N points" counts.
-std::map<std::string, std::map<std::string, int>> DecodeAll(BagReader& bag) {
+std::map<std::string, std::map<std::string, int>> DecodeEveryImportable(BagReader& bag) {
   std::map<std::string, std::map<std::string, int>> seen;
   bag.ForEachMessage({}, [&](const BagMessage& message) {
     const BagTopic& topic = bag.Topics()[message.topic];
@@ -53,7 +53,7 @@ std::map<std::string, std::map<std::string, int>> DecodeAll(BagReader& bag) {
   return seen;
 }
 
-using Seen = std::map<std::string, std::map<std::string, int>>;
+using DecodedKinds = std::map<std::string, std::map<std::string, int>>;
 
 TEST(RealBags, Ros1LidarLz4) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
@@ -63,14 +63,17 @@ TEST(RealBags, Ros1LidarLz4) {
       {"/luminar_pointcloud sensor_msgs/PointCloud2", 5},
       {"/base_scan sensor_msgs/LaserScan", 5},
       {"/base_pose_ground_truth nav_msgs/Odometry", 5}};
-  EXPECT_EQ(Counts(*bag), expected);
+  EXPECT_EQ(TopicCounts(*bag), expected);
   const std::string fields =
       " points x:FLOAT32@0 y:FLOAT32@4 z:FLOAT32@8 intensity:FLOAT32@16 time_sec:UINT32@20 "
       "time_nsec:UINT32@24 laser_id:UINT16@28";
-  const Seen want = {{"/luminar_pointcloud",
-                      {{"35707" + fields, 1}, {"36055" + fields, 1}, {"36267" + fields, 1},
-                       {"36336" + fields, 1}, {"36457" + fields, 1}}}};
-  EXPECT_EQ(DecodeAll(*bag), want);
+  const DecodedKinds want = {{"/luminar_pointcloud",
+                              {{"35707" + fields, 1},
+                               {"36055" + fields, 1},
+                               {"36267" + fields, 1},
+                               {"36336" + fields, 1},
+                               {"36457" + fields, 1}}}};
+  EXPECT_EQ(DecodeEveryImportable(*bag), want);
 }
 
 TEST(RealBags, Ros1CloudWithRgbAndSixTfConnections) {
@@ -80,21 +83,22 @@ TEST(RealBags, Ros1CloudWithRgbAndSixTfConnections) {
       {"/tf tf2_msgs/TFMessage", 3199},
       {"/tf tf/tfMessage", 333},
       {"/euclidean_cluster_indices_decomposer/output00 sensor_msgs/PointCloud2", 1}};
-  EXPECT_EQ(Counts(*bag), expected);
-  const Seen want = {{"/euclidean_cluster_indices_decomposer/output00",
-                      {{"13966 points x:FLOAT32@0 y:FLOAT32@4 z:FLOAT32@8 rgb:FLOAT32@16", 1}}}};
-  EXPECT_EQ(DecodeAll(*bag), want);
+  EXPECT_EQ(TopicCounts(*bag), expected);
+  const DecodedKinds want = {
+      {"/euclidean_cluster_indices_decomposer/output00",
+       {{"13966 points x:FLOAT32@0 y:FLOAT32@4 z:FLOAT32@8 rgb:FLOAT32@16", 1}}}};
+  EXPECT_EQ(DecodeEveryImportable(*bag), want);
 }
 
 TEST(RealBags, Ros1CameraWithCameraInfo) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
   auto bag = OpenBag(shared / "datasets/ros-bags/ros1_svo_camera_imu.bag");
-  EXPECT_EQ(Counts(*bag).at("/camera/image_raw sensor_msgs/Image"), 10);
-  EXPECT_EQ(Counts(*bag).at("/camera/camera_info sensor_msgs/CameraInfo"), 11);
-  EXPECT_EQ(Counts(*bag).at("/imu/data sensor_msgs/Imu"), 35);
-  const Seen want = {{"/camera/image_raw", {{"752x480 mono8", 10}}},
-                     {"/camera/camera_info", {{"752x480 plumb_bob", 11}}}};
-  EXPECT_EQ(DecodeAll(*bag), want);
+  EXPECT_EQ(TopicCounts(*bag).at("/camera/image_raw sensor_msgs/Image"), 10);
+  EXPECT_EQ(TopicCounts(*bag).at("/camera/camera_info sensor_msgs/CameraInfo"), 11);
+  EXPECT_EQ(TopicCounts(*bag).at("/imu/data sensor_msgs/Imu"), 35);
+  const DecodedKinds want = {{"/camera/image_raw", {{"752x480 mono8", 10}}},
+                             {"/camera/camera_info", {{"752x480 plumb_bob", 11}}}};
+  EXPECT_EQ(DecodeEveryImportable(*bag), want);
   // The first CameraInfo, as FACTS.txt decodes it.
   const int info = bag->FindTopic("/camera/camera_info");
   bag->ForEachMessage({}, [&](const BagMessage& message) {
@@ -118,8 +122,8 @@ TEST(RealBags, Ros1CameraWithCameraInfo) {
 TEST(RealBags, Ros1CompressionsGiveTheSameMessages) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
   std::vector<std::vector<std::string>> all;
-  for (const char* name : {"ros1_turtlesim_none.bag", "ros1_turtlesim_bz2.bag",
-                           "ros1_turtlesim_lz4.bag"}) {
+  for (const char* name :
+       {"ros1_turtlesim_none.bag", "ros1_turtlesim_bz2.bag", "ros1_turtlesim_lz4.bag"}) {
     auto bag = OpenBag(shared / "datasets/ros-bags" / name);
     std::int64_t total = 0;
     for (const BagTopic& topic : bag->Topics()) total += topic.message_count;
@@ -143,12 +147,12 @@ TEST(RealBags, Ros1Bz2WithoutLeadingSlashesAndEmptyDefinitions) {
   auto cartographer = OpenBag(shared / "datasets/ros-bags/ros1_cartographer_bz2_6chunks.bag");
   const std::map<std::string, std::int64_t> expected = {
       {"horizontal_laser_2d sensor_msgs/MultiEchoLaserScan", 222}, {"imu sensor_msgs/Imu", 1243}};
-  EXPECT_EQ(Counts(*cartographer), expected);
+  EXPECT_EQ(TopicCounts(*cartographer), expected);
   int visited = 0;
   cartographer->ForEachMessage({}, [&](const BagMessage&) { return ++visited, true; });
   EXPECT_EQ(visited, 1465);
   auto empty = OpenBag(shared / "datasets/ros-bags/ros1_empty_msgdef.bag");
-  EXPECT_EQ(Counts(*empty).at("/led_array_status led_array_msgs/Status"), 14);
+  EXPECT_EQ(TopicCounts(*empty).at("/led_array_status led_array_msgs/Status"), 14);
 }
 
 TEST(RealBags, McapRos1ProfileEqualsTheBagItWasConvertedFrom) {
@@ -156,10 +160,10 @@ TEST(RealBags, McapRos1ProfileEqualsTheBagItWasConvertedFrom) {
   auto bag = OpenBag(shared / "datasets/ros-bags/ros1_dvs_images.bag");
   auto mcap = OpenBag(shared / "datasets/ros-bags/mcap_ros1_dvs_images_zstd.mcap");
   EXPECT_EQ(mcap->Format(), "MCAP (ros1 profile), 1 chunks (zstd)");
-  EXPECT_EQ(Counts(*bag), Counts(*mcap));
-  const Seen want = {{"/dvs/image_raw", {{"346x260 mono8", 4}}},
-                     {"/dvs1/image_raw", {{"346x260 mono8", 3}}}};
-  EXPECT_EQ(DecodeAll(*mcap), want);
+  EXPECT_EQ(TopicCounts(*bag), TopicCounts(*mcap));
+  const DecodedKinds want = {{"/dvs/image_raw", {{"346x260 mono8", 4}}},
+                             {"/dvs1/image_raw", {{"346x260 mono8", 3}}}};
+  EXPECT_EQ(DecodeEveryImportable(*mcap), want);
   auto messages = [](BagReader& reader) {
     std::vector<std::string> all;
     reader.ForEachMessage({}, [&](const BagMessage& message) {
@@ -174,15 +178,15 @@ TEST(RealBags, McapRos1ProfileEqualsTheBagItWasConvertedFrom) {
 TEST(RealBags, McapOrganizedOusterCloud) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
   auto mcap = OpenBag(shared / "datasets/ros-bags/mcap_ros1_ouster_os1_zstd.mcap");
-  EXPECT_EQ(Counts(*mcap).at("/os1_node/lidar_packets ouster_ros/PacketMsg"), 206);
+  EXPECT_EQ(TopicCounts(*mcap).at("/os1_node/lidar_packets ouster_ros/PacketMsg"), 206);
   const std::string fields =
       "131072 points x:FLOAT32@0 y:FLOAT32@4 z:FLOAT32@8 intensity:FLOAT32@16 t:UINT32@20 "
       "reflectivity:UINT16@24 ring:UINT8@26 noise:UINT16@28 range:UINT32@32";
-  const Seen want = {{"/os1_cloud_node/points", {{fields, 2}}},
-                     {"/img_node/intensity_image", {{"2048x64 mono8", 2}}},
-                     {"/img_node/noise_image", {{"2048x64 mono8", 2}}},
-                     {"/img_node/range_image", {{"2048x64 mono8", 2}}}};
-  EXPECT_EQ(DecodeAll(*mcap), want);
+  const DecodedKinds want = {{"/os1_cloud_node/points", {{fields, 2}}},
+                             {"/img_node/intensity_image", {{"2048x64 mono8", 2}}},
+                             {"/img_node/noise_image", {{"2048x64 mono8", 2}}},
+                             {"/img_node/range_image", {{"2048x64 mono8", 2}}}};
+  EXPECT_EQ(DecodeEveryImportable(*mcap), want);
   // Organized 64 x 2048, ring from the uint8 field: the whole grid is kept.
   const int points = mcap->FindTopic("/os1_cloud_node/points");
   mcap->ForEachMessage({}, [&](const BagMessage& message) {
@@ -201,27 +205,28 @@ TEST(RealBags, McapRos2HumbleSensorMessages) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
   auto mcap = OpenBag(shared / "datasets/ros-bags/mcap_ros2_humble_sensor_msgs.mcap");
   EXPECT_EQ(mcap->Topics().size(), 32u);
-  const Seen want = {
+  const DecodedKinds want = {
       {"/camera_info", {{"640x480 plumb_bob", 1}}},
       {"/compressed_image", {{"640x480 jpeg", 1}}},
       {"/image", {{"640x480 rgb8", 1}}},
-      {"/point_cloud2", {{"200 points x:FLOAT32@0 y:FLOAT32@4 z:FLOAT32@8 intensity:FLOAT32@12", 1}}}};
-  EXPECT_EQ(DecodeAll(*mcap), want);
+      {"/point_cloud2",
+       {{"200 points x:FLOAT32@0 y:FLOAT32@4 z:FLOAT32@8 intensity:FLOAT32@12", 1}}}};
+  EXPECT_EQ(DecodeEveryImportable(*mcap), want);
 }
 
 TEST(RealBags, McapRos2TestFixturesAndDb3Layouts) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
   const fs::path dir = shared / "datasets/ros-bags";
   auto cdr = OpenBag(dir / "mcap_ros2_cdr_test.mcap");
-  EXPECT_EQ(Counts(*cdr).at("/array_topic test_msgs/Arrays"), 4);
-  EXPECT_EQ(Counts(*cdr).at("/test_topic test_msgs/BasicTypes"), 3);
+  EXPECT_EQ(TopicCounts(*cdr).at("/array_topic test_msgs/Arrays"), 4);
+  EXPECT_EQ(TopicCounts(*cdr).at("/test_topic test_msgs/BasicTypes"), 3);
   auto talker = OpenBag(dir / "mcap_ros2_talker_zstd.mcap");
-  EXPECT_EQ(Counts(*talker).at("/topic std_msgs/String"), 10);
+  EXPECT_EQ(TopicCounts(*talker).at("/topic std_msgs/String"), 10);
   // Schema 4 (message_definitions table) and Humble's schema 3.
   auto schema4 = OpenBag(dir / "db3_ros2_cdr_test_schema4.db3");
-  EXPECT_EQ(Counts(*schema4), Counts(*cdr));
+  EXPECT_EQ(TopicCounts(*schema4), TopicCounts(*cdr));
   auto vlp16 = OpenBag(dir / "db3_humble_vlp16_packets.db3");
-  EXPECT_EQ(Counts(*vlp16).at("/velodyne_packets velodyne_msgs/VelodyneScan"), 4);
+  EXPECT_EQ(TopicCounts(*vlp16).at("/velodyne_packets velodyne_msgs/VelodyneScan"), 4);
   std::int64_t last = 0;
   int visited = 0;
   vlp16->ForEachMessage({}, [&](const BagMessage& message) {
@@ -236,10 +241,9 @@ TEST(RealBags, McapRos2TestFixturesAndDb3Layouts) {
 TEST(RealBags, TruncatedFilesAreRefusedByName) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
   const fs::path dir = calibench::test::TempDir("truncated_bags");
-  for (const char* name : {"ros1_luminar_lidar_lz4.bag", "mcap_ros1_ouster_os1_zstd.mcap",
-                           "ros1_turtlesim_bz2.bag"}) {
-    const std::string bytes =
-        calibench::test::ReadFileBytes(shared / "datasets/ros-bags" / name);
+  for (const char* name :
+       {"ros1_luminar_lidar_lz4.bag", "mcap_ros1_ouster_os1_zstd.mcap", "ros1_turtlesim_bz2.bag"}) {
+    const std::string bytes = calibench::test::ReadFileBytes(shared / "datasets/ros-bags" / name);
     const fs::path cut = dir / name;
     std::ofstream(cut, std::ios::binary).write(bytes.data(), bytes.size() * 2 / 3);
     try {

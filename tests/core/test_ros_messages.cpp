@@ -12,7 +12,7 @@
 namespace calibench {
 namespace {
 
-LidarCloud SmallCloud(int width, int height) {
+LidarCloud MessageTestCloud(int width, int height) {
   LidarCloud cloud;
   for (int row = 0; row < height; ++row)
     for (int column = 0; column < width; ++column) {
@@ -25,7 +25,7 @@ LidarCloud SmallCloud(int width, int height) {
   return cloud;
 }
 
-ImageU8 Gradient(int width, int height, int channels) {
+ImageU8 GradientImage(int width, int height, int channels) {
   ImageU8 image;
   image.width = width;
   image.height = height;
@@ -38,12 +38,12 @@ ImageU8 Gradient(int width, int height, int channels) {
 }
 
 TEST(RosMessages, PointCloud2InEveryByteOrderAndSerialization) {
-  const LidarCloud cloud = SmallCloud(12, 4);
+  const LidarCloud cloud = MessageTestCloud(12, 4);
   for (const auto& [encoding, big_endian] :
        {std::pair{MessageEncoding::kRos1, false}, std::pair{MessageEncoding::kCdr, false},
         std::pair{MessageEncoding::kCdr, true}}) {
-    const auto bytes = test::SerializePointCloud2(cloud, 1'234'567'890'123, "lidar", encoding,
-                                                  big_endian);
+    const auto bytes =
+        test::SerializePointCloud2(cloud, 1'234'567'890'123, "lidar", encoding, big_endian);
     const PointCloud2Message message = DecodePointCloud2(bytes, encoding);
     EXPECT_EQ(message.header.stamp_ns, 1'234'567'890'123);
     EXPECT_EQ(message.header.frame_id, "lidar");
@@ -51,13 +51,14 @@ TEST(RosMessages, PointCloud2InEveryByteOrderAndSerialization) {
     EXPECT_EQ(message.cloud.intensity, cloud.intensity);
     EXPECT_EQ(message.cloud.ring, cloud.ring);
     EXPECT_TRUE(message.cloud.IsOrganized());
-    EXPECT_EQ(message.fields, "x:FLOAT32@0 y:FLOAT32@4 z:FLOAT32@8 intensity:FLOAT32@16 "
-                              "ring:UINT16@20");
+    EXPECT_EQ(message.fields,
+              "x:FLOAT32@0 y:FLOAT32@4 z:FLOAT32@8 intensity:FLOAT32@16 "
+              "ring:UINT16@20");
   }
 }
 
 TEST(RosMessages, NonFinitePointsAreDroppedAndTheGridWithThem) {
-  LidarCloud cloud = SmallCloud(5, 2);
+  LidarCloud cloud = MessageTestCloud(5, 2);
   cloud.points[3].x() = std::numeric_limits<float>::quiet_NaN();
   const auto bytes = test::SerializePointCloud2(cloud, 1, "lidar", MessageEncoding::kRos1);
   const PointCloud2Message message = DecodePointCloud2(bytes, MessageEncoding::kRos1);
@@ -67,7 +68,7 @@ TEST(RosMessages, NonFinitePointsAreDroppedAndTheGridWithThem) {
 }
 
 TEST(RosMessages, MalformedCloudsAreRefusedWithTheReason) {
-  const LidarCloud cloud = SmallCloud(6, 1);
+  const LidarCloud cloud = MessageTestCloud(6, 1);
   auto bytes = test::SerializePointCloud2(cloud, 1, "lidar", MessageEncoding::kRos1);
   bytes.resize(bytes.size() - 40);  // cut into the point data
   EXPECT_THROW(
@@ -89,14 +90,13 @@ TEST(RosMessages, MalformedCloudsAreRefusedWithTheReason) {
     DecodePointCloud2(whole, MessageEncoding::kRos1, limits);
     ADD_FAILURE() << "6 points passed a limit of 5";
   } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find("6 points is over the limit of 5"),
-              std::string::npos)
+    EXPECT_NE(std::string(error.what()).find("6 points is over the limit of 5"), std::string::npos)
         << error.what();
   }
 }
 
 TEST(RosMessages, ImageEncodingsGiveTheSamePixels) {
-  const ImageU8 bgr = Gradient(16, 10, 3);
+  const ImageU8 bgr = GradientImage(16, 10, 3);
   const ImageMessage direct = DecodeImage(
       test::SerializeImage(bgr, "bgr8", 5, "cam", MessageEncoding::kCdr), MessageEncoding::kCdr);
   EXPECT_EQ(direct.image.data, bgr.data);
@@ -105,9 +105,10 @@ TEST(RosMessages, ImageEncodingsGiveTheSamePixels) {
   const ImageMessage from_rgb = DecodeImage(
       test::SerializeImage(rgb, "rgb8", 5, "cam", MessageEncoding::kRos1), MessageEncoding::kRos1);
   EXPECT_EQ(from_rgb.image.data, bgr.data);
-  const ImageU8 mono = Gradient(16, 10, 1);
-  const ImageMessage grey = DecodeImage(
-      test::SerializeImage(mono, "mono8", 5, "cam", MessageEncoding::kRos1), MessageEncoding::kRos1);
+  const ImageU8 mono = GradientImage(16, 10, 1);
+  const ImageMessage grey =
+      DecodeImage(test::SerializeImage(mono, "mono8", 5, "cam", MessageEncoding::kRos1),
+                  MessageEncoding::kRos1);
   EXPECT_EQ(grey.image.channels, 1);
   EXPECT_EQ(grey.image.data, mono.data);
 }
@@ -116,10 +117,9 @@ TEST(RosMessages, ImageEncodingsGiveTheSamePixels) {
 // patterns use cv_bridge's names.
 TEST(RosMessages, BayerPatternsDebayerToTheRightColours) {
   cv::Mat colour(32, 32, CV_8UC3, cv::Scalar(200, 100, 30));  // B G R
-  for (const auto& [name, offset] : {std::pair{"bayer_rggb8", cv::Point(0, 0)},
-                                     std::pair{"bayer_bggr8", cv::Point(1, 1)},
-                                     std::pair{"bayer_gbrg8", cv::Point(0, 1)},
-                                     std::pair{"bayer_grbg8", cv::Point(1, 0)}}) {
+  for (const auto& [name, offset] :
+       {std::pair{"bayer_rggb8", cv::Point(0, 0)}, std::pair{"bayer_bggr8", cv::Point(1, 1)},
+        std::pair{"bayer_gbrg8", cv::Point(0, 1)}, std::pair{"bayer_grbg8", cv::Point(1, 0)}}) {
     ImageU8 mosaic;
     mosaic.width = mosaic.height = 32;
     mosaic.channels = 1;
@@ -130,8 +130,9 @@ TEST(RosMessages, BayerPatternsDebayerToTheRightColours) {
         const int channel = px == 0 && py == 0 ? 2 : px == 1 && py == 1 ? 0 : 1;
         mosaic.data.push_back(colour.at<cv::Vec3b>(y, x)[channel]);
       }
-    const ImageMessage decoded = DecodeImage(
-        test::SerializeImage(mosaic, name, 1, "cam", MessageEncoding::kRos1), MessageEncoding::kRos1);
+    const ImageMessage decoded =
+        DecodeImage(test::SerializeImage(mosaic, name, 1, "cam", MessageEncoding::kRos1),
+                    MessageEncoding::kRos1);
     ASSERT_EQ(decoded.image.channels, 3) << name;
     const std::uint8_t* centre = decoded.image.Row(16) + 16 * 3;
     EXPECT_NEAR(centre[0], 200, 2) << name;
@@ -149,9 +150,9 @@ TEST(RosMessages, Mono16IsScaledByItsLargestValue) {
     sixteen.data.push_back(value & 0xff);
     sixteen.data.push_back(value >> 8);
   }
-  const ImageMessage decoded = DecodeImage(
-      test::SerializeImage(sixteen, "mono16", 1, "cam", MessageEncoding::kRos1),
-      MessageEncoding::kRos1);
+  const ImageMessage decoded =
+      DecodeImage(test::SerializeImage(sixteen, "mono16", 1, "cam", MessageEncoding::kRos1),
+                  MessageEncoding::kRos1);
   const std::vector<std::uint8_t> expected = {0, 64, 128, 255};
   EXPECT_EQ(decoded.image.data, expected);
 }
@@ -161,9 +162,9 @@ TEST(RosMessages, CompressedPngAndJpeg) {
   cv::randu(colour, 0, 255);
   std::vector<std::uint8_t> png;
   cv::imencode(".png", colour, png);
-  const auto message = test::SerializeCompressedImage(
-      "bgr8; png compressed bgr8", std::string(png.begin(), png.end()), 1, "cam",
-      MessageEncoding::kCdr);
+  const auto message = test::SerializeCompressedImage("bgr8; png compressed bgr8",
+                                                      std::string(png.begin(), png.end()), 1, "cam",
+                                                      MessageEncoding::kCdr);
   const ImageMessage decoded = DecodeCompressedImage(message, MessageEncoding::kCdr);
   ASSERT_EQ(decoded.image.width, 40);
   EXPECT_EQ(0, std::memcmp(decoded.image.data.data(), colour.data, decoded.image.data.size()));
@@ -181,8 +182,8 @@ TEST(RosMessages, CameraInfoModels) {
   camera.cx = 719.75;
   camera.cy = 541.125;
   for (const auto& [type, distortion, name] :
-       {std::tuple{CameraModelType::kPinholeRadTan, std::vector<double>{-0.1, 0.05, 1e-4, -2e-4, 0.01},
-                   "plumb_bob"},
+       {std::tuple{CameraModelType::kPinholeRadTan,
+                   std::vector<double>{-0.1, 0.05, 1e-4, -2e-4, 0.01}, "plumb_bob"},
         std::tuple{CameraModelType::kPinholeRadTan,
                    std::vector<double>{-0.1, 0.05, 1e-4, -2e-4, 0.01, 0.2, -0.03, 0.004},
                    "rational_polynomial"},
@@ -191,8 +192,8 @@ TEST(RosMessages, CameraInfoModels) {
     camera.type = type;
     camera.distortion = distortion;
     for (const MessageEncoding encoding : {MessageEncoding::kRos1, MessageEncoding::kCdr}) {
-      const CameraInfoMessage info = DecodeCameraInfo(
-          test::SerializeCameraInfo(camera, 1, "cam", encoding), encoding);
+      const CameraInfoMessage info =
+          DecodeCameraInfo(test::SerializeCameraInfo(camera, 1, "cam", encoding), encoding);
       EXPECT_EQ(info.distortion_model, name);
       EXPECT_EQ(info.camera.type, type);
       EXPECT_EQ(info.camera.distortion, distortion);

@@ -20,8 +20,8 @@ namespace {
 namespace fs = std::filesystem;
 using test::RecordedMessage;
 
-constexpr std::int64_t kSecond = 1'000'000'000;
-constexpr std::int64_t kMs = 1'000'000;
+constexpr std::int64_t kBagSecond = 1'000'000'000;
+constexpr std::int64_t kBagMs = 1'000'000;
 
 class BagImport : public ::testing::Test {
  protected:
@@ -46,20 +46,21 @@ class BagImport : public ::testing::Test {
     std::vector<ImageU8> images;
     for (const PairEntry& pair : pairs) images.push_back(LoadImage(pair.image));
     for (int i = 0; i < static_cast<int>(pairs.size()); ++i) {
-      const std::int64_t t = 100 * kSecond + 2 * kSecond * i;
+      const std::int64_t t = 100 * kBagSecond + 2 * kBagSecond * i;
       for (int k = -1; k <= 1; ++k) {
         const int shown = image_of(i, k);
         if (shown < 0) continue;
-        const std::int64_t stamp = t + k * 40 * kMs;
-        messages.push_back({"/camera/image_raw", "sensor_msgs/Image", stamp + kMs,
-                            test::SerializeImage(images[shown], "bgr8", stamp, "camera", encoding)});
+        const std::int64_t stamp = t + k * 40 * kBagMs;
         messages.push_back(
-            {"/camera/camera_info", "sensor_msgs/CameraInfo", stamp + kMs,
+            {"/camera/image_raw", "sensor_msgs/Image", stamp + kBagMs,
+             test::SerializeImage(images[shown], "bgr8", stamp, "camera", encoding)});
+        messages.push_back(
+            {"/camera/camera_info", "sensor_msgs/CameraInfo", stamp + kBagMs,
              test::SerializeCameraInfo(dataset_->camera, stamp, "camera", encoding)});
       }
       const LidarCloud cloud = LoadCloud(pairs[i].cloud);
-      messages.push_back({"/velodyne_points", "sensor_msgs/PointCloud2", t + 20 * kMs,
-                          test::SerializePointCloud2(cloud, t + 5 * kMs, "velodyne", encoding)});
+      messages.push_back({"/velodyne_points", "sensor_msgs/PointCloud2", t + 20 * kBagMs,
+                          test::SerializePointCloud2(cloud, t + 5 * kBagMs, "velodyne", encoding)});
     }
     std::stable_sort(messages.begin(), messages.end(),
                      [](const RecordedMessage& a, const RecordedMessage& b) {

@@ -20,7 +20,7 @@ namespace calibench::ui {
 namespace {
 namespace fs = std::filesystem;
 
-void Touch(const fs::path& path, const std::string& text = "x") {
+void TouchFile(const fs::path& path, const std::string& text = "x") {
   fs::create_directories(path.parent_path());
   std::ofstream(path) << text;
 }
@@ -31,13 +31,13 @@ TEST(FolderListing, FoldersFirstInNaturalOrderWithTheirKinds) {
   fs::create_directories(dir / "pose2");
   fs::create_directories(dir / "rig/clouds");
   fs::create_directories(dir / "rig/images");
-  Touch(dir / "ros2_rec/metadata.yaml");
-  Touch(dir / "run10.bag");
-  Touch(dir / "run2.mcap");
-  Touch(dir / "run3.db3");
-  Touch(dir / "work.session.json");
-  Touch(dir / "notes.txt");
-  Touch(dir / ".hidden.bag");
+  TouchFile(dir / "ros2_rec/metadata.yaml");
+  TouchFile(dir / "run10.bag");
+  TouchFile(dir / "run2.mcap");
+  TouchFile(dir / "run3.db3");
+  TouchFile(dir / "work.session.json");
+  TouchFile(dir / "notes.txt");
+  TouchFile(dir / ".hidden.bag");
   fs::create_directories(dir / ".git");
   const std::vector<FolderEntry> entries = ListFolder(dir);
   std::vector<std::string> listed;
@@ -56,7 +56,7 @@ TEST(RecentFiles, NewestFirstCappedPersistedAndTolerantOfABrokenList) {
   {
     RecentFiles recent(list, 3);
     for (int i = 0; i < 5; ++i) {
-      Touch(dir / ("s" + std::to_string(i) + ".session.json"));
+      TouchFile(dir / ("s" + std::to_string(i) + ".session.json"));
       EXPECT_EQ(recent.Add(dir / ("s" + std::to_string(i) + ".session.json")), "");
     }
     recent.Add(dir / "s2.session.json");  // again: moves to the front
@@ -68,7 +68,7 @@ TEST(RecentFiles, NewestFirstCappedPersistedAndTolerantOfABrokenList) {
   EXPECT_EQ(reloaded.Paths(), expected);
   fs::remove(dir / "s4.session.json");  // a session deleted since is not offered
   EXPECT_EQ(reloaded.Paths().size(), 2u);
-  Touch(list, "{ not json");
+  TouchFile(list, "{ not json");
   RecentFiles broken(list, 3);
   EXPECT_TRUE(broken.Paths().empty());
   EXPECT_NE(broken.load_error().find(list.string()), std::string::npos) << broken.load_error();
