@@ -108,10 +108,17 @@ RosHeader ReadHeader(MessageCursor& cursor, MessageEncoding encoding) {
 
 // sensor_msgs/PointField datatypes.
 enum PointFieldType : std::uint8_t {
-  kInt8 = 1, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64
+  kInt8 = 1,
+  kUint8,
+  kInt16,
+  kUint16,
+  kInt32,
+  kUint32,
+  kFloat32,
+  kFloat64
 };
-constexpr const char* kPointFieldNames[] = {"?",      "INT8",   "UINT8",   "INT16",  "UINT16",
-                                            "INT32",  "UINT32", "FLOAT32", "FLOAT64"};
+constexpr const char* kPointFieldNames[] = {"?",     "INT8",   "UINT8",   "INT16",  "UINT16",
+                                            "INT32", "UINT32", "FLOAT32", "FLOAT64"};
 int PointFieldSize(std::uint8_t type) {
   constexpr int sizes[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
   return type >= 1 && type <= 8 ? sizes[type] : 0;
@@ -134,14 +141,22 @@ double Load(const std::uint8_t* at, bool swap) {
 double ReadField(const std::uint8_t* point, const PointField& field, bool swap) {
   const std::uint8_t* at = point + field.offset;
   switch (field.type) {
-    case kInt8: return static_cast<std::int8_t>(*at);
-    case kUint8: return *at;
-    case kInt16: return Load<std::int16_t>(at, swap);
-    case kUint16: return Load<std::uint16_t>(at, swap);
-    case kInt32: return Load<std::int32_t>(at, swap);
-    case kUint32: return Load<std::uint32_t>(at, swap);
-    case kFloat32: return Load<float>(at, swap);
-    default: return Load<double>(at, swap);
+    case kInt8:
+      return static_cast<std::int8_t>(*at);
+    case kUint8:
+      return *at;
+    case kInt16:
+      return Load<std::int16_t>(at, swap);
+    case kUint16:
+      return Load<std::uint16_t>(at, swap);
+    case kInt32:
+      return Load<std::int32_t>(at, swap);
+    case kUint32:
+      return Load<std::uint32_t>(at, swap);
+    case kFloat32:
+      return Load<float>(at, swap);
+    default:
+      return Load<double>(at, swap);
   }
 }
 
@@ -191,13 +206,21 @@ void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>
                                 static_cast<float>(ReadField(point, *z, swap)));
       if (!xyz.allFinite()) continue;
       cloud->points.push_back(xyz);
-      if (intensity) cloud->intensity.push_back(static_cast<float>(ReadField(point, *intensity, swap)));
-      if (ring) cloud->ring.push_back(static_cast<int>(ReadField(point, *ring, swap)));
+      if (intensity)
+        cloud->intensity.push_back(static_cast<float>(ReadField(point, *intensity, swap)));
+      if (ring) {
+        // The rule of the cloud files (cloud_io.cpp): a ring is a laser index, 0 .. 65535.
+        const double index = ReadField(point, *ring, swap);
+        if (!std::isfinite(index) || index < 0 || index > 65535 || index != std::round(index))
+          Bad("PointCloud2: point " + std::to_string(cloud->points.size() - 1) + " has " +
+              ring->name + " " + std::to_string(index) + ", not a laser index");
+        cloud->ring.push_back(static_cast<int>(index));
+      }
     }
   }
   const bool complete = cloud->points.size() == total;
-  cloud->width = complete && height > 1 ? static_cast<int>(width)
-                                        : static_cast<int>(cloud->points.size());
+  cloud->width =
+      complete && height > 1 ? static_cast<int>(width) : static_cast<int>(cloud->points.size());
   cloud->height = complete && height > 1 ? static_cast<int>(height) : 1;
 }
 
@@ -231,20 +254,29 @@ struct RawEncoding {
 // cv_bridge's table for the Bayer patterns: ROS names the first 2x2 block from the top left,
 // OpenCV names the second row's pair, hence rggb -> BayerBG.
 constexpr RawEncoding kRawEncodings[] = {
-    {"mono8", CV_8UC1, -1},           {"8UC1", CV_8UC1, -1},
-    {"mono16", CV_16UC1, -1},         {"16UC1", CV_16UC1, -1},
-    {"bgr8", CV_8UC3, -1},            {"8UC3", CV_8UC3, -1},
-    {"rgb8", CV_8UC3, cv::COLOR_RGB2BGR}, {"bgra8", CV_8UC4, cv::COLOR_BGRA2BGR},
-    {"rgba8", CV_8UC4, cv::COLOR_RGBA2BGR}, {"bayer_rggb8", CV_8UC1, cv::COLOR_BayerBG2BGR},
-    {"bayer_bggr8", CV_8UC1, cv::COLOR_BayerRG2BGR}, {"bayer_gbrg8", CV_8UC1, cv::COLOR_BayerGR2BGR},
-    {"bayer_grbg8", CV_8UC1, cv::COLOR_BayerGB2BGR}, {"yuv422", CV_8UC2, cv::COLOR_YUV2BGR_UYVY},
-    {"uyvy", CV_8UC2, cv::COLOR_YUV2BGR_UYVY},   {"yuv422_yuy2", CV_8UC2, cv::COLOR_YUV2BGR_YUYV},
+    {"mono8", CV_8UC1, -1},
+    {"8UC1", CV_8UC1, -1},
+    {"mono16", CV_16UC1, -1},
+    {"16UC1", CV_16UC1, -1},
+    {"bgr8", CV_8UC3, -1},
+    {"8UC3", CV_8UC3, -1},
+    {"rgb8", CV_8UC3, cv::COLOR_RGB2BGR},
+    {"bgra8", CV_8UC4, cv::COLOR_BGRA2BGR},
+    {"rgba8", CV_8UC4, cv::COLOR_RGBA2BGR},
+    {"bayer_rggb8", CV_8UC1, cv::COLOR_BayerBG2BGR},
+    {"bayer_bggr8", CV_8UC1, cv::COLOR_BayerRG2BGR},
+    {"bayer_gbrg8", CV_8UC1, cv::COLOR_BayerGR2BGR},
+    {"bayer_grbg8", CV_8UC1, cv::COLOR_BayerGB2BGR},
+    {"yuv422", CV_8UC2, cv::COLOR_YUV2BGR_UYVY},
+    {"uyvy", CV_8UC2, cv::COLOR_YUV2BGR_UYVY},
+    {"yuv422_yuy2", CV_8UC2, cv::COLOR_YUV2BGR_YUYV},
     {"yuyv", CV_8UC2, cv::COLOR_YUV2BGR_YUYV},
 };
 
 std::string KnownEncodings() {
   std::string names;
-  for (const RawEncoding& encoding : kRawEncodings) names += (names.empty() ? "" : ", ") + std::string(encoding.name);
+  for (const RawEncoding& encoding : kRawEncodings)
+    names += (names.empty() ? "" : ", ") + std::string(encoding.name);
   return names;
 }
 
@@ -255,8 +287,8 @@ RosHeader DecodeRosHeader(std::span<const std::uint8_t> data, MessageEncoding en
   return ReadHeader(cursor, encoding);
 }
 
-PointCloud2Message DecodePointCloud2(std::span<const std::uint8_t> data,
-                                     MessageEncoding encoding, const LoadLimits& limits) {
+PointCloud2Message DecodePointCloud2(std::span<const std::uint8_t> data, MessageEncoding encoding,
+                                     const LoadLimits& limits) {
   MessageCursor cursor(data, encoding, "PointCloud2");
   PointCloud2Message message;
   message.header = ReadHeader(cursor, encoding);
@@ -270,19 +302,23 @@ PointCloud2Message DecodePointCloud2(std::span<const std::uint8_t> data,
   for (const PointField& field : fields) {
     message.fields += (message.fields.empty() ? "" : " ") + field.name + ":" +
                       kPointFieldNames[field.type] + "@" + std::to_string(field.offset);
-    if (static_cast<std::uint64_t>(field.offset) + PointFieldSize(field.type) * std::max<std::uint64_t>(field.count, 1) > point_step)
+    if (static_cast<std::uint64_t>(field.offset) +
+            PointFieldSize(field.type) * std::max<std::uint64_t>(field.count, 1) >
+        point_step)
       Bad("PointCloud2: field '" + field.name + "' at byte " + std::to_string(field.offset) +
           " lies beyond point_step " + std::to_string(point_step));
   }
-  const std::int64_t declared = static_cast<std::int64_t>(width) * height;
-  if (declared > limits.max_cloud_points)
+  // Both factors are uint32: their product always fits in 64 unsigned bits.
+  const std::uint64_t declared = static_cast<std::uint64_t>(width) * height;
+  if (declared > static_cast<std::uint64_t>(limits.max_cloud_points))
     Bad("PointCloud2: " + std::to_string(declared) + " points is over the limit of " +
         std::to_string(limits.max_cloud_points) + " (max_cloud_points)");
   if (static_cast<std::uint64_t>(row_step) < static_cast<std::uint64_t>(width) * point_step)
     Bad("PointCloud2: row_step " + std::to_string(row_step) + " is shorter than width x " +
         "point_step = " + std::to_string(static_cast<std::uint64_t>(width) * point_step));
   if (static_cast<std::uint64_t>(row_step) * height > points.size())
-    Bad("PointCloud2: " + std::to_string(points.size()) + " bytes of data for row_step x height = " +
+    Bad("PointCloud2: " + std::to_string(points.size()) +
+        " bytes of data for row_step x height = " +
         std::to_string(static_cast<std::uint64_t>(row_step) * height));
   message.declared_points = static_cast<int>(declared);
   const bool swap = big_endian != (std::endian::native == std::endian::big);
@@ -307,8 +343,8 @@ ImageMessage DecodeImage(std::span<const std::uint8_t> data, MessageEncoding enc
   if (!raw)
     Bad("Image: encoding '" + message.encoding + "' is not one Calibench reads (" +
         KnownEncodings() + ")");
-  const std::int64_t pixel_count = static_cast<std::int64_t>(width) * height;
-  if (pixel_count > limits.max_image_pixels)
+  const std::uint64_t pixel_count = static_cast<std::uint64_t>(width) * height;
+  if (pixel_count > static_cast<std::uint64_t>(limits.max_image_pixels))
     Bad("Image: " + std::to_string(width) + " x " + std::to_string(height) +
         " pixels is over the limit of " + std::to_string(limits.max_image_pixels) +
         " (max_image_pixels)");
@@ -357,7 +393,8 @@ ImageMessage DecodeCompressedImage(std::span<const std::uint8_t> data, MessageEn
                         const_cast<std::uint8_t*>(bytes.data()));
   cv::Mat decoded = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);
   if (decoded.empty()) Bad("CompressedImage: the " + message.encoding + " data does not decode");
-  if (decoded.depth() == CV_16U) decoded = ScaledToEightBits(decoded.channels() == 1 ? decoded : decoded.reshape(1));
+  if (decoded.depth() == CV_16U)
+    decoded = ScaledToEightBits(decoded.channels() == 1 ? decoded : decoded.reshape(1));
   if (decoded.channels() == 4) cv::cvtColor(decoded, decoded, cv::COLOR_BGRA2BGR);
   if (decoded.depth() != CV_8U || (decoded.channels() != 1 && decoded.channels() != 3))
     Bad("CompressedImage: pixels of a kind Calibench does not read");

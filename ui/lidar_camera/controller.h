@@ -134,8 +134,8 @@ struct SetView {
 // the session.
 struct ExportResult {
   std::filesystem::path path;
-  std::optional<ExportFormat> format;
-  ExportFrames frames;
+  std::optional<ExportFormat> format = std::nullopt;
+  ExportFrames frames = {};
 };
 struct SaveSessionAs {
   std::filesystem::path path;
