@@ -194,6 +194,7 @@ void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>
   const PointField* intensity = FindField(fields, {"intensity", "reflectivity", "i"});
   const PointField* ring = FindField(fields, {"ring", "laser_id", "channel", "line"});
   const std::size_t total = static_cast<std::size_t>(width) * height;
+  if (total == 0) return;  // no points: not 4 billion empty rows walked through
   cloud->points.reserve(total);
   if (intensity) cloud->intensity.reserve(total);
   if (ring) cloud->ring.reserve(total);
