@@ -140,7 +140,12 @@ class Mcap final : public BagReader {
       if (topic == channel_topic_.end())
         Fail(path_, "the statistics count messages of channel " + std::to_string(channel) +
                         ", which the summary does not define");
-      topics_[topic->second].message_count += static_cast<std::int64_t>(count);
+      // A message record takes 31 bytes at least: more than the file can hold is damage.
+      std::int64_t& total = topics_[topic->second].message_count;
+      if (count > static_cast<std::uint64_t>(size_bytes_ / 31 - total))
+        Fail(path_, "the statistics count " + std::to_string(count) + " messages on channel " +
+                        std::to_string(channel) + ", more than the file can hold");
+      total += static_cast<std::int64_t>(count);
     }
   }
 
