@@ -143,8 +143,8 @@ std::vector<std::uint8_t> SerializeCameraInfo(const CameraModel& camera, std::in
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(camera.height));
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(camera.width));
   out.String(camera.type == CameraModelType::kKannalaBrandt ? "equidistant"
-             : camera.distortion.size() == 8               ? "rational_polynomial"
-                                                           : "plumb_bob");
+             : camera.distortion.size() == 8                ? "rational_polynomial"
+                                                            : "plumb_bob");
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(camera.distortion.size()));
   for (const double d : camera.distortion) out.Put<double>(d);
   for (const double k : {camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0})
@@ -214,8 +214,8 @@ Field TextField(const std::string& name, const std::string& value) {
 Bytes HeaderBytes(const std::vector<Field>& fields) {
   Bytes header;
   for (const Field& field : fields) {
-    Append<std::uint32_t>(&header, static_cast<std::uint32_t>(field.name.size() + 1 +
-                                                              field.value.size()));
+    Append<std::uint32_t>(&header,
+                          static_cast<std::uint32_t>(field.name.size() + 1 + field.value.size()));
     header.insert(header.end(), field.name.begin(), field.name.end());
     header.push_back('=');
     Append(&header, field.value);
@@ -241,12 +241,12 @@ struct Ros1Connection {
 
 Bytes ConnectionRecord(const Ros1Connection& connection) {
   Bytes out;
-  const Bytes data = HeaderBytes({TextField("topic", connection.topic),
-                                  TextField("type", connection.type),
-                                  TextField("md5sum", "*"),
-                                  TextField("message_definition", "")});
-  Ros1Record(&out, {NumberField<std::uint8_t>("op", 0x07), NumberField("conn", connection.id),
-                    TextField("topic", connection.topic)},
+  const Bytes data =
+      HeaderBytes({TextField("topic", connection.topic), TextField("type", connection.type),
+                   TextField("md5sum", "*"), TextField("message_definition", "")});
+  Ros1Record(&out,
+             {NumberField<std::uint8_t>("op", 0x07), NumberField("conn", connection.id),
+              TextField("topic", connection.topic)},
              data);
   return out;
 }
@@ -313,13 +313,13 @@ void WriteRos1Bag(const fs::path& path, const std::vector<RecordedMessage>& mess
       Append(&data, id);
       Append(&data, count);
     }
-    Ros1Record(&file,
-               {NumberField<std::uint8_t>("op", 0x06), NumberField<std::uint32_t>("ver", 1),
-                NumberField("chunk_pos", chunk.position),
-                NumberField("start_time", Ros1Time(chunk.start)),
-                NumberField("end_time", Ros1Time(chunk.end)),
-                NumberField("count", static_cast<std::uint32_t>(chunk.counts.size()))},
-               data);
+    Ros1Record(
+        &file,
+        {NumberField<std::uint8_t>("op", 0x06), NumberField<std::uint32_t>("ver", 1),
+         NumberField("chunk_pos", chunk.position), NumberField("start_time", Ros1Time(chunk.start)),
+         NumberField("end_time", Ros1Time(chunk.end)),
+         NumberField("count", static_cast<std::uint32_t>(chunk.counts.size()))},
+        data);
   }
   // The bag header, padded so that the whole record fills the space reserved for it.
   Bytes header;
@@ -464,16 +464,17 @@ void WriteDb3(const fs::path& path, const std::vector<RecordedMessage>& messages
       throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db));
   };
   // rosbag2_storage_default_plugins' schema (Humble).
-  exec("CREATE TABLE schema(schema_version INTEGER PRIMARY KEY,ros_distro TEXT NOT NULL);"
-       "INSERT INTO schema VALUES(3,'humble');"
-       "CREATE TABLE metadata(id INTEGER PRIMARY KEY,metadata_version INTEGER NOT NULL,"
-       "metadata TEXT NOT NULL);"
-       "CREATE TABLE topics(id INTEGER PRIMARY KEY,name TEXT NOT NULL,type TEXT NOT NULL,"
-       "serialization_format TEXT NOT NULL,offered_qos_profiles TEXT NOT NULL);"
-       "CREATE TABLE messages(id INTEGER PRIMARY KEY,topic_id INTEGER NOT NULL,"
-       "timestamp INTEGER NOT NULL, data BLOB NOT NULL);"
-       "CREATE INDEX timestamp_idx ON messages (timestamp ASC);"
-       "BEGIN;");
+  exec(
+      "CREATE TABLE schema(schema_version INTEGER PRIMARY KEY,ros_distro TEXT NOT NULL);"
+      "INSERT INTO schema VALUES(3,'humble');"
+      "CREATE TABLE metadata(id INTEGER PRIMARY KEY,metadata_version INTEGER NOT NULL,"
+      "metadata TEXT NOT NULL);"
+      "CREATE TABLE topics(id INTEGER PRIMARY KEY,name TEXT NOT NULL,type TEXT NOT NULL,"
+      "serialization_format TEXT NOT NULL,offered_qos_profiles TEXT NOT NULL);"
+      "CREATE TABLE messages(id INTEGER PRIMARY KEY,topic_id INTEGER NOT NULL,"
+      "timestamp INTEGER NOT NULL, data BLOB NOT NULL);"
+      "CREATE INDEX timestamp_idx ON messages (timestamp ASC);"
+      "BEGIN;");
   std::map<std::string, int> topics;
   sqlite3_stmt* topic = nullptr;
   sqlite3_stmt* message = nullptr;
@@ -493,8 +494,7 @@ void WriteDb3(const fs::path& path, const std::vector<RecordedMessage>& messages
     }
     sqlite3_bind_int(message, 1, topics[m.topic]);
     sqlite3_bind_int64(message, 2, m.log_time_ns);
-    sqlite3_bind_blob(message, 3, m.data.data(), static_cast<int>(m.data.size()),
-                      SQLITE_STATIC);
+    sqlite3_bind_blob(message, 3, m.data.data(), static_cast<int>(m.data.size()), SQLITE_STATIC);
     if (sqlite3_step(message) != SQLITE_DONE) throw std::runtime_error("insert message");
     sqlite3_reset(message);
   }

@@ -131,6 +131,12 @@ void Decompress(const std::string& method, std::span<const std::uint8_t> compres
   }
 }
 
+std::string JoinWords(const std::set<std::string>& words) {
+  std::string text;
+  for (const std::string& word : words) text += (text.empty() ? "" : ", ") + word;
+  return text.empty() ? "none" : text;
+}
+
 int AddTopic(std::vector<BagTopic>* topics, const std::string& name, const std::string& type,
              const std::string& encoding_name) {
   const std::string normalized = NormalizeMessageType(type);

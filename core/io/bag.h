@@ -28,8 +28,8 @@ struct BagTopic {
 };
 
 struct BagMessage {
-  int topic = 0;                 // index into BagReader::Topics()
-  std::int64_t log_time_ns = 0;  // when the recorder received it (not the header stamp)
+  int topic = 0;                       // index into BagReader::Topics()
+  std::int64_t log_time_ns = 0;        // when the recorder received it (not the header stamp)
   std::span<const std::uint8_t> data;  // valid only during the visit
 };
 

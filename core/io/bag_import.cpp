@@ -333,9 +333,13 @@ class Importer {
   bool BoardStill(const ImageMoment& pair_image, std::int64_t cloud_stamp, bool* judged) const {
     const auto half = static_cast<std::int64_t>(options_.still_window_s * 0.5e9);
     *judged = false;
-    for (const ImageMoment& image : first_.images) {
+    const auto& images = first_.images;  // sorted by stamp: only the window is looked at
+    auto from = std::lower_bound(
+        images.begin(), images.end(), cloud_stamp - half,
+        [](const ImageMoment& image, std::int64_t t) { return image.stamp_ns < t; });
+    for (auto it = from; it != images.end() && it->stamp_ns <= cloud_stamp + half; ++it) {
+      const ImageMoment& image = *it;
       if (&image == &pair_image || !image.cam_from_board) continue;
-      if (std::abs(image.stamp_ns - cloud_stamp) > half) continue;
       *judged = true;
       if (TranslationM(*image.cam_from_board, *pair_image.cam_from_board) >
               options_.still_translation_m ||

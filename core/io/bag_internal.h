@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -104,6 +105,9 @@ inline constexpr std::uint64_t kMaxChunkBytes = 512ull << 20;
 std::unique_ptr<BagReader> OpenRos1Bag(const std::filesystem::path& path);
 std::unique_ptr<BagReader> OpenMcap(const std::filesystem::path& path);
 std::unique_ptr<BagReader> OpenSqliteBag(const std::filesystem::path& path);
+
+// "bz2, lz4" for a listing's compressions; "none" when there are none.
+std::string JoinWords(const std::set<std::string>& words);
 
 // Adds a topic (or finds the one with the same name and type) and returns its index.
 int AddTopic(std::vector<BagTopic>* topics, const std::string& name, const std::string& type,

@@ -44,7 +44,7 @@ class Mcap final : public BagReader {
     if (!ReadSummary()) CountByScanning();
     format_ = "MCAP (" + (profile_.empty() ? std::string("no") : profile_) + " profile), " +
               std::to_string(chunk_count_) + " chunks" +
-              (compressions_.empty() ? "" : " (" + Join(compressions_) + ")");
+              (compressions_.empty() ? "" : " (" + JoinWords(compressions_) + ")");
   }
 
   void ForEachMessage(const std::vector<bool>& wanted, const BagVisitor& visit,
@@ -166,12 +166,6 @@ class Mcap final : public BagReader {
   static std::string NameOf(const std::string& compression) {
     return compression.empty() ? "none" : compression;
   }
-  static std::string Join(const std::set<std::string>& words) {
-    std::string text;
-    for (const std::string& word : words) text += (text.empty() ? "" : ", ") + word;
-    return text.empty() ? "none" : text;
-  }
-
   bool VisitChunk(std::span<const std::uint8_t> content, std::int64_t offset,
                   std::vector<std::uint8_t>* buffer, const std::vector<bool>& wanted,
                   const BagVisitor& visit) {

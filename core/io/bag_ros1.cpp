@@ -175,7 +175,7 @@ class Ros1Bag final : public BagReader {
       topics_[topic->second].message_count += count;
     }
     indexed_ = true;
-    compression_ = Join(compressions);
+    compression_ = JoinWords(compressions);
   }
 
   // The chunk's compression, from its header alone (its data is not read).
@@ -199,12 +199,6 @@ class Ros1Bag final : public BagReader {
                    },
                    {});
     compression_ = "unindexed";
-  }
-
-  static std::string Join(const std::set<std::string>& words) {
-    std::string text;
-    for (const std::string& word : words) text += (text.empty() ? "" : ", ") + word;
-    return text.empty() ? "none" : text;
   }
 
   void AddConnection(const RecordHeader& header, std::span<const std::uint8_t> data,

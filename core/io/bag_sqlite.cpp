@@ -90,8 +90,7 @@ class SqliteBag final : public BagReader {
     std::int64_t total = 0, done = 0;
     for (std::size_t t = 0; t < topics_.size(); ++t)
       if (wanted.empty() || wanted[t]) total += topics_[t].message_count;
-    Statement rows(db_, "SELECT topic_id, timestamp, data FROM messages ORDER BY timestamp",
-                   path_);
+    Statement rows(db_, "SELECT topic_id, timestamp, data FROM messages ORDER BY timestamp", path_);
     while (rows.Step()) {
       const auto topic = topic_index_.find(rows.Integer(0));
       if (topic == topic_index_.end())

@@ -639,13 +639,12 @@ void SaveCameraInfoYaml(const std::filesystem::path& path, const CameraModel& ca
   YAML::Emitter out;
   out.SetDoublePrecision(17);
   const bool fisheye = camera.type == CameraModelType::kKannalaBrandt;
-  const std::string model = fisheye                        ? "equidistant"
+  const std::string model = fisheye                         ? "equidistant"
                             : camera.distortion.size() == 8 ? "rational_polynomial"
                                                             : "plumb_bob";
   auto matrix = [&](const char* name, int rows, int cols, const std::vector<double>& data) {
     out << YAML::Key << name << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "rows" << YAML::Value << rows << YAML::Key << "cols" << YAML::Value
-        << cols;
+    out << YAML::Key << "rows" << YAML::Value << rows << YAML::Key << "cols" << YAML::Value << cols;
     out << YAML::Key << "data" << YAML::Value << YAML::Flow << data << YAML::EndMap;
   };
   out << YAML::BeginMap;

@@ -28,16 +28,16 @@ RosHeader DecodeRosHeader(std::span<const std::uint8_t> data, MessageEncoding en
 
 struct PointCloud2Message {
   RosHeader header;
-  LidarCloud cloud;    // finite points only; organized when nothing was dropped
-  std::string fields;  // "x:FLOAT32@0 y:FLOAT32@4 ..." as the message declares them
+  LidarCloud cloud;         // finite points only; organized when nothing was dropped
+  std::string fields;       // "x:FLOAT32@0 y:FLOAT32@4 ..." as the message declares them
   int declared_points = 0;  // width x height
 };
 // Any field layout: x, y, z of any numeric type; intensity from `intensity` (else
 // `reflectivity`, `i`); ring from `ring` (else `laser_id`, `channel`, `line`); either byte order.
 // Throws std::invalid_argument naming what is wrong (no x/y/z, fields beyond point_step, data
 // shorter than row_step x height, more points than limits.max_cloud_points, ...).
-PointCloud2Message DecodePointCloud2(std::span<const std::uint8_t> data,
-                                     MessageEncoding encoding, const LoadLimits& limits = {});
+PointCloud2Message DecodePointCloud2(std::span<const std::uint8_t> data, MessageEncoding encoding,
+                                     const LoadLimits& limits = {});
 
 struct ImageMessage {
   RosHeader header;

@@ -1,9 +1,10 @@
 // Import throughput on a 1 GB simulated recording in each format: a ROS 1 bag (uncompressed, as
 // `rosbag record` writes by default), an MCAP of the ros2 profile uncompressed (as `ros2 bag
 // record -s mcap` writes by default) and with zstd chunks, and a rosbag2 .db3. Throughput is the
-// messages' bytes (about 1.02 GB in every format) per second; the zstd file is smaller. The recordings are written once into build/bench_bags/ (about 3 GB of disk) from
-// an 8-pair demo simulation (OS0-128, 131k points; 1440 x 1080 bgr8): 56 moments, each a cloud
-// and three images of a still board, cycling over the pairs.
+// messages' bytes (about 1.02 GB in every format) per second; the zstd file is smaller. The
+// recordings are written once into build/bench_bags/ (about 3 GB of disk) from an 8-pair demo
+// simulation (OS0-128, 131k points; 1440 x 1080 bgr8): 56 moments, each a cloud and three images of
+// a still board, cycling over the pairs.
 //   BM_BagRead     every message handed out (MB/s of the file)
 //   BM_BagDecode   every PointCloud2 and Image decoded too
 //   BM_BagImport   `calibench import` as a whole: two passes, board detection on every image,
@@ -52,12 +53,12 @@ std::vector<test::RecordedMessage> Moments(MessageEncoding encoding) {
     const std::size_t pair = moment % dataset.pairs.size();
     const std::int64_t t = (100 + moment) * 1'000'000'000LL;
     for (const std::int64_t offset : {-50'000'000LL, 0LL, 50'000'000LL}) {
-      messages.push_back({"/camera/image_raw", "sensor_msgs/Image", t + offset,
-                          test::SerializeImage(images[pair], "bgr8", t + offset, "camera",
-                                               encoding)});
-      messages.push_back({"/camera/camera_info", "sensor_msgs/CameraInfo", t + offset,
-                          test::SerializeCameraInfo(dataset.camera, t + offset, "camera",
-                                                    encoding)});
+      messages.push_back(
+          {"/camera/image_raw", "sensor_msgs/Image", t + offset,
+           test::SerializeImage(images[pair], "bgr8", t + offset, "camera", encoding)});
+      messages.push_back(
+          {"/camera/camera_info", "sensor_msgs/CameraInfo", t + offset,
+           test::SerializeCameraInfo(dataset.camera, t + offset, "camera", encoding)});
     }
     messages.push_back({"/os_cloud_node/points", "sensor_msgs/PointCloud2", t + 10'000'000,
                         test::SerializePointCloud2(clouds[pair], t, "os_lidar", encoding)});
@@ -142,7 +143,10 @@ void BM_BagImport(benchmark::State& state) {
                  " pairs written");
   state.SetBytesProcessed(state.iterations() * MessageBytes(path));
 }
-BENCHMARK(BM_BagImport)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime()
+BENCHMARK(BM_BagImport)
+    ->DenseRange(0, 3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
     ->Iterations(1);
 
 }  // namespace

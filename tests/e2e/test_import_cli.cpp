@@ -54,9 +54,9 @@ TEST(ImportCli, RefusesWhatIsNotARecordingByName) {
                 test::CalibenchExe() + " import --list " + (dir / "notes.bag").string(), &output),
             2);
   EXPECT_NE(output.find("not a recording Calibench reads"), std::string::npos) << output;
-  EXPECT_EQ(test::RunCommand(test::CalibenchExe() + " import " + (dir / "notes.bag").string() +
-                                 " --board a5",
-                             &output),
+  EXPECT_EQ(test::RunCommand(
+                test::CalibenchExe() + " import " + (dir / "notes.bag").string() + " --board a5",
+                &output),
             1);
   EXPECT_NE(output.find("known: a3, a4"), std::string::npos) << output;
 }
@@ -73,18 +73,19 @@ TEST(ImportCli, ABagBecomesADatasetThatCalibrates) {
     const ImageU8 image = LoadImage(dataset.pairs[i].image);
     messages.push_back({"/cam/image_raw", "sensor_msgs/Image", t,
                         test::SerializeImage(image, "bgr8", t, "cam", MessageEncoding::kRos1)});
-    messages.push_back({"/cam/camera_info", "sensor_msgs/CameraInfo", t,
-                        test::SerializeCameraInfo(dataset.camera, t, "cam", MessageEncoding::kRos1)});
+    messages.push_back(
+        {"/cam/camera_info", "sensor_msgs/CameraInfo", t,
+         test::SerializeCameraInfo(dataset.camera, t, "cam", MessageEncoding::kRos1)});
     messages.push_back({"/points", "sensor_msgs/PointCloud2", t + 1000,
                         test::SerializePointCloud2(LoadCloud(dataset.pairs[i].cloud), t + 1000,
                                                    "lidar", MessageEncoding::kRos1)});
   }
   test::WriteRos1Bag(dir / "rig.bag", messages, "lz4");
   std::string output;
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " import " + (dir / "rig.bag").string() +
-                                 " --board a3",
-                             &output),
-            0)
+  ASSERT_EQ(
+      test::RunCommand(
+          test::CalibenchExe() + " import " + (dir / "rig.bag").string() + " --board a3", &output),
+      0)
       << output;
   EXPECT_NE(output.find("pairs written: 4"), std::string::npos) << output;
   // One image per cloud: nothing to judge stillness by, and the summary says so.

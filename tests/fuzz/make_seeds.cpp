@@ -181,8 +181,7 @@ void WriteBags(const std::filesystem::path& out) {
           const int selector = type | (messages == &cdr ? 4 : 0);
           std::vector<std::uint8_t> bytes = {static_cast<std::uint8_t>(selector)};
           bytes.insert(bytes.end(), message.data.begin(), message.data.end());
-          std::ofstream(out / "ros_message" / (std::to_string(selector) + ".msg"),
-                        std::ios::binary)
+          std::ofstream(out / "ros_message" / (std::to_string(selector) + ".msg"), std::ios::binary)
               .write(reinterpret_cast<const char*>(bytes.data()), bytes.size());
           break;
         }
