@@ -6,6 +6,7 @@
 #include <string>
 
 #include "ui/gfx/gl_api.h"
+#include "ui/gfx/texture_versions.h"
 
 namespace calibench::gfx {
 namespace {
@@ -120,10 +121,13 @@ void Framebuffer::Resize(int width, int height) {
   }
   width_ = width;
   height_ = height;
+  MarkTextureChanged(color_texture_);  // a new texture (GL may reuse a deleted one's name)
 }
 
 void Framebuffer::Bind() const {
   if (!framebuffer_) throw std::logic_error("Framebuffer::Bind before Resize");
+  // Bound to be drawn into: whoever shows the texture must assume new pixels.
+  MarkTextureChanged(color_texture_);
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
   glViewport(0, 0, width_, height_);
 }

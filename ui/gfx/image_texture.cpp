@@ -6,6 +6,7 @@
 #include "ui/gfx/renderers.h"
 #include "ui/gfx/shader.h"
 #include "ui/gfx/shader_sources.h"
+#include "ui/gfx/texture_versions.h"
 
 namespace calibench::gfx {
 
@@ -53,6 +54,7 @@ void ImageTexture::Upload(const ImageU8& image, bool linear_filtering) {
   glBindTexture(GL_TEXTURE_2D, static_cast<GLuint>(previous_texture));
   width_ = image.width;
   height_ = image.height;
+  MarkTextureChanged(texture_);
 }
 
 void ImageTexture::Draw(float x0, float y0, float x1, float y1) const {

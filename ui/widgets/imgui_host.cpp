@@ -9,8 +9,12 @@
 #include <imgui.h>
 
 #include <filesystem>
+#include <stdexcept>
+#include <vector>
 
 #include "ui/gfx/framebuffer.h"
+#include "ui/gfx/texture_versions.h"
+#include "ui/widgets/redraw_regions.h"
 
 // Debian's ImGui backends, compiled in third_party/imgui with our GL loader.
 #include <backends/imgui_impl_glfw.h>
@@ -53,9 +57,20 @@ ImGuiHost::ImGuiHost(GLFWwindow* window) : windowed_(window != nullptr) {
     io.KeyMap[ImGuiKey_Backspace] = GLFW_KEY_BACKSPACE;
   }
   ImGui_ImplOpenGL3_Init("#version 330 core");
+  // Repainting regions gathers every window's draw list into one, whose commands then index
+  // vertices past 65535: the backend must apply VtxOffset (GL >= 3.2, which we create).
+  if (!(io.BackendFlags & ImGuiBackendFlags_RendererHasVtxOffset))
+    throw std::runtime_error(
+        "ImGui's OpenGL3 backend found no glDrawElementsBaseVertex (GL < 3.2)");
+  regions_ = std::make_unique<RedrawRegions>([](ImTextureID texture) {
+    return gfx::TextureVersion(
+        static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(texture)));
+  });
+  region_redraw_ = std::make_unique<RegionRedraw>();
 }
 
 ImGuiHost::~ImGuiHost() {
+  region_redraw_.reset();  // its draw list belongs to the context
   ImGui_ImplOpenGL3_Shutdown();
   if (windowed_) ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
@@ -73,19 +88,41 @@ void ImGuiHost::NewFrame(int width, int height, double delta_seconds) {
   ImGui::NewFrame();
 }
 
-void ImGuiHost::Render() {
-  ImGui::Render();
-  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-}
-
 void ImGuiHost::DrawFrame(gfx::Framebuffer& target, int width, int height, double delta_seconds,
                           const std::function<void()>& build_frame) {
+  constexpr float kBackground[4] = {0.06f, 0.06f, 0.07f, 1.0f};
   NewFrame(width, height, delta_seconds);
   build_frame();
   target.Resize(width, height);
+  // Anything else drawn into the target since (or a new target that reuses the texture's name)
+  // left another version: repaint everything.
+  if (!repaint_only_changes_ || target.color_texture() != drawn_texture_ ||
+      gfx::TextureVersion(target.color_texture()) != drawn_version_)
+    regions_->Forget();
   target.Bind();
-  target.Clear(0.06f, 0.06f, 0.07f, 1.0f);
-  Render();
+  ImGui::Render();
+  const ImDrawData& draw_data = *ImGui::GetDrawData();
+  std::vector<PixelBox> regions = regions_->Update(draw_data);
+  const ImDrawData* redraw = region_redraw_->Compose(draw_data, regions);
+  if (!redraw) {  // user callbacks: drawn whole, and nothing assumed of this frame next time
+    regions = {WholeFramebuffer(draw_data)};
+    regions_->Forget();
+  }
+  // Each region starts from the background, as a whole frame does.
+  glEnable(GL_SCISSOR_TEST);
+  glClearColor(kBackground[0], kBackground[1], kBackground[2], kBackground[3]);
+  last_repainted_pixels_ = 0;
+  for (const PixelBox& region : regions) {
+    glScissor(region.x, region.y, region.width, region.height);
+    glClear(GL_COLOR_BUFFER_BIT);
+    last_repainted_pixels_ += region.Area();
+  }
+  glDisable(GL_SCISSOR_TEST);
+  if (!regions.empty())
+    ImGui_ImplOpenGL3_RenderDrawData(redraw ? const_cast<ImDrawData*>(redraw)
+                                            : ImGui::GetDrawData());
+  drawn_texture_ = target.color_texture();
+  drawn_version_ = gfx::TextureVersion(drawn_texture_);
 }
 
 ImageU8 RenderFramesHeadless(ImGuiHost& host, int width, int height, int frames,

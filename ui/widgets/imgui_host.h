@@ -4,7 +4,9 @@
 // (RenderWorkbenchHeadless below; headless_render.h prepares what such a render shows).
 #pragma once
 
+#include <cstdint>
 #include <functional>
+#include <memory>
 
 #include "core/base/image.h"
 
@@ -16,6 +18,9 @@ class Framebuffer;
 
 namespace calibench::ui {
 
+class RedrawRegions;
+class RegionRedraw;
+
 class ImGuiHost {
  public:
   // Requires a current GL context. window == nullptr: headless (no platform backend).
@@ -26,15 +31,27 @@ class ImGuiHost {
 
   // Starts a frame. Headless: display size and delta time come from the arguments.
   void NewFrame(int width, int height, double delta_seconds);
-  // Renders the frame's draw data into the currently bound framebuffer.
-  void Render();
   // One whole frame drawn into `target` (resized to width x height): NewFrame, build_frame()
-  // (the frame's ImGui calls), then the draw data over the workbench's background.
+  // (the frame's ImGui calls), then the draw data over the workbench's background. When `target`
+  // still holds this host's last frame, only the regions that changed are repainted
+  // (redraw_regions.h); the picture is the same either way.
   void DrawFrame(gfx::Framebuffer& target, int width, int height, double delta_seconds,
                  const std::function<void()>& build_frame);
+  // Pixels the last DrawFrame repainted: 0 when nothing on screen changed.
+  long long last_repainted_pixels() const { return last_repainted_pixels_; }
+  // false: every frame repaints the whole target (the reference the region repaint is tested
+  // against).
+  void set_repaint_only_changes(bool on) { repaint_only_changes_ = on; }
 
  private:
   bool windowed_ = false;
+  std::unique_ptr<RedrawRegions> regions_;
+  std::unique_ptr<RegionRedraw> region_redraw_;
+  // The target of the last frame and its content version after it (gfx::TextureVersion).
+  std::uint32_t drawn_texture_ = 0;
+  std::uint64_t drawn_version_ = 0;
+  long long last_repainted_pixels_ = 0;
+  bool repaint_only_changes_ = true;
 };
 
 // The dark theme and DejaVu Sans (from fonts-dejavu-core; ImGui's built-in font otherwise).
