@@ -1,6 +1,6 @@
-// What a view's offscreen picture shows, hashed (FNV-1a over the bytes of everything it depends
-// on): the 3D views redraw their framebuffer only when the key changes, since drawing a large
-// cloud on a software renderer costs most of a frame.
+// What a view's offscreen picture shows, hashed (a 64-bit mix over the bytes of everything it
+// depends on): the 3D views redraw their framebuffer only when the key changes, since drawing a
+// large cloud on a software renderer costs most of a frame.
 #pragma once
 
 #include <cstddef>

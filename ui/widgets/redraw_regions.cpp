@@ -5,36 +5,13 @@
 #include <unordered_map>
 #include <utility>
 
+#include "ui/widgets/frame_key.h"
+
 namespace calibench::ui {
 namespace {
 
 // More boxes than this are repainted as their union: each box costs a pass over the commands.
 constexpr size_t kMaxRegions = 16;
-
-// A fast 64-bit hash of bytes, 8 at a time (change detection, not security): a multiply-xorshift
-// mix per word.
-class Fingerprint {
- public:
-  void Mix(std::uint64_t word) {
-    hash_ = (hash_ ^ word) * 0x9E3779B97F4A7C15ull;
-    hash_ ^= hash_ >> 29;
-  }
-  void MixBytes(const void* data, size_t bytes) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    std::uint64_t word = 0;
-    for (; bytes >= 8; bytes -= 8, p += 8) {
-      std::memcpy(&word, p, 8);
-      Mix(word);
-    }
-    word = 0;
-    std::memcpy(&word, p, bytes);
-    Mix(word ^ (static_cast<std::uint64_t>(bytes) << 56));
-  }
-  std::uint64_t value() const { return hash_; }
-
- private:
-  std::uint64_t hash_ = 0xcbf29ce484222325ull;
-};
 
 bool Empty(const PixelBox& b) { return b.width <= 0 || b.height <= 0; }
 
@@ -89,9 +66,14 @@ ImVec4 ClipRectFor(const ImDrawData& draw_data, const PixelBox& box, int fb_heig
 }
 
 std::uint64_t NameHash(const char* name) {
-  Fingerprint fingerprint;
-  if (name) fingerprint.MixBytes(name, std::strlen(name));
-  return fingerprint.value();
+  FrameKey key(0);
+  if (name) key.Mix(name, std::strlen(name));
+  return key.value();
+}
+
+template <typename T>
+void MixValue(FrameKey* key, const T& value) {
+  key->Mix(&value, sizeof(value));
 }
 
 }  // namespace
@@ -130,22 +112,21 @@ std::vector<RedrawRegions::ListPrint> RedrawRegions::Print(const ImDrawData& dra
       CommandPrint& out = print.commands.emplace_back();
       out.box = CommandScissor(draw_data, command);
       print.bounds = Union(print.bounds, out.box);
-      Fingerprint fingerprint;
-      fingerprint.MixBytes(&out.box, sizeof(out.box));
-      const auto texture = reinterpret_cast<std::uintptr_t>(command.TextureId);
-      fingerprint.Mix(texture);
-      fingerprint.Mix(texture_version_(command.TextureId));
-      fingerprint.Mix(reinterpret_cast<std::uintptr_t>(command.UserCallback));
-      fingerprint.Mix(command.ElemCount);
+      FrameKey key(0);
+      MixValue(&key, out.box);
+      MixValue(&key, command.TextureId);
+      MixValue(&key, texture_version_(command.TextureId));
+      MixValue(&key, command.UserCallback);
+      MixValue(&key, command.ElemCount);
       if (command.ElemCount > 0) {
         // The indices, and the vertices they reach.
         const ImDrawIdx* indices = list.IdxBuffer.Data + command.IdxOffset;
-        fingerprint.MixBytes(indices, command.ElemCount * sizeof(ImDrawIdx));
+        key.Mix(indices, command.ElemCount * sizeof(ImDrawIdx));
         const auto [lo, hi] = std::minmax_element(indices, indices + command.ElemCount);
-        fingerprint.MixBytes(list.VtxBuffer.Data + command.VtxOffset + *lo,
-                             (static_cast<size_t>(*hi) - *lo + 1) * sizeof(ImDrawVert));
+        key.Mix(list.VtxBuffer.Data + command.VtxOffset + *lo,
+                (static_cast<size_t>(*hi) - *lo + 1) * sizeof(ImDrawVert));
       }
-      out.hash = fingerprint.value();
+      out.hash = key.value();
     }
   }
   return lists;
