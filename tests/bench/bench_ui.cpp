@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <random>
 #include <string>
 #include <thread>
 
@@ -17,6 +18,7 @@
 #include "ui/gfx/context.h"
 #include "ui/gfx/framebuffer.h"
 #include "ui/gfx/gl_api.h"
+#include "ui/gfx/renderers.h"
 #include "ui/lidar_camera/controller.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/widgets/imgui_host.h"
@@ -89,13 +91,16 @@ BENCHMARK(BM_WorkbenchFrame1600x900)->Unit(benchmark::kMillisecond)->UseRealTime
 // without the headless readback: /0 the 3D view turned (an orbit drag: the 3D view redraws),
 // /1 the reprojected points' opacity changed (a slider: the camera view redraws), /2 a pair
 // rejected (the list changes; no view redraws). Second argument: 1 repaints only the regions that
-// changed (the window's way), 0 the whole frame (as before regions; the comparison).
+// changed (the window's way), 0 the whole frame (as before regions; the comparison). Third
+// argument: 1 points drawn as PointRenderer chooses (the software splat on llvmpipe), 0 always
+// GL_POINTS (as before the splat; the comparison).
 void BM_WorkbenchFrameAfterEdit1600x900(benchmark::State& state) {
   ui::Controller controller;
   const auto context = SolvedDemo(state, &controller, "bench_ui_edit.json");
   if (!context) return;
   ui::ImGuiHost host(nullptr);
   host.set_repaint_only_changes(state.range(1) != 0);
+  if (state.range(2) == 0) gfx::SetPointDrawingForNewRenderers(gfx::PointDrawing::kGlPoints);
   ui::Workbench workbench;
   ui::RenderWorkbenchHeadless(controller, workbench, host, ui::Layout::kWorkbench, 1600, 900, 3);
   gfx::Framebuffer target;
@@ -123,10 +128,11 @@ void BM_WorkbenchFrameAfterEdit1600x900(benchmark::State& state) {
     });
     glFinish();
   }
+  gfx::SetPointDrawingForNewRenderers(std::nullopt);
   state.SetLabel(context->Description());
 }
 BENCHMARK(BM_WorkbenchFrameAfterEdit1600x900)
-    ->ArgsProduct({{0, 1, 2}, {0, 1}})
+    ->ArgsProduct({{0, 1, 2}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -183,6 +189,37 @@ void BM_Session40PairsMemory(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_Session40PairsMemory)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+// Points alone, as the 3D view draws them: n points in front of the camera, all inside a
+// 530 x 420 view (the 3D view's size at 1600 x 900), 2 px round, opaque. Second argument: 0
+// GL_POINTS, 1 the software splat that PointRenderer picks on llvmpipe.
+void BM_PointsInView530x420(benchmark::State& state) {
+  std::string why;
+  const auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &why);
+  if (!context) return state.SkipWithError(why.c_str());
+  const auto n = static_cast<size_t>(state.range(0));
+  std::mt19937 random(1);
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  std::vector<Eigen::Vector3f> positions(n);
+  for (auto& p : positions) p = {uniform(random), uniform(random), -3.0f + uniform(random)};
+  gfx::PointRenderer points;
+  points.Upload(positions, std::vector<gfx::Rgba>(n, gfx::Rgba{200, 100, 50, 255}));
+  points.set_drawing(state.range(1) ? gfx::PointDrawing::kSoftwareSplat
+                                    : gfx::PointDrawing::kGlPoints);
+  gfx::Framebuffer target;
+  target.Resize(530, 420);
+  const gfx::Matrix4f view_projection = gfx::Perspective(1.0f, 530.0f / 420.0f, 0.1f, 100.0f);
+  for (auto _ : state) {
+    target.Clear(0, 0, 0, 1);
+    points.Draw(view_projection, 2.0f);
+    glFinish();
+  }
+  state.SetLabel(context->Description());
+}
+BENCHMARK(BM_PointsInView530x420)
+    ->ArgsProduct({{31000, 131000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace calibench

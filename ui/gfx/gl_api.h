@@ -106,6 +106,7 @@
   X(PFNGLTEXSUBIMAGE2DPROC, glTexSubImage2D) \
   X(PFNGLUNIFORM1FPROC, glUniform1f) \
   X(PFNGLUNIFORM1IPROC, glUniform1i) \
+  X(PFNGLUNIFORM2IPROC, glUniform2i) \
   X(PFNGLUNIFORM4FPROC, glUniform4f) \
   X(PFNGLUNIFORMMATRIX4FVPROC, glUniformMatrix4fv) \
   X(PFNGLUSEPROGRAMPROC, glUseProgram) \
@@ -188,6 +189,7 @@
 #define glTexSubImage2D calibench_glTexSubImage2D
 #define glUniform1f calibench_glUniform1f
 #define glUniform1i calibench_glUniform1i
+#define glUniform2i calibench_glUniform2i
 #define glUniform4f calibench_glUniform4f
 #define glUniformMatrix4fv calibench_glUniformMatrix4fv
 #define glUseProgram calibench_glUseProgram

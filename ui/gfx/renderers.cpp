@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -9,6 +10,7 @@
 
 #include "core/base/types.h"
 #include "ui/gfx/gl_api.h"
+#include "ui/gfx/point_splat.h"
 #include "ui/gfx/shader.h"
 #include "ui/gfx/shader_sources.h"
 
@@ -86,17 +88,126 @@ void ColoredVertices::DrawAll(std::uint32_t mode) const {
   glDepthMask(GL_TRUE);
 }
 
+bool IsSoftwareRenderer() {
+  const GLubyte* text = glGetString(GL_RENDERER);
+  if (!text) return false;
+  const std::string renderer(reinterpret_cast<const char*>(text));
+  for (const char* software : {"llvmpipe", "softpipe", "SwiftShader", "Software Rasterizer"})
+    if (renderer.find(software) != std::string::npos) return true;
+  return false;
+}
+
+namespace {
+std::atomic<int> point_drawing_for_new_renderers{-1};  // -1: by renderer, else a PointDrawing
+}  // namespace
+
+void SetPointDrawingForNewRenderers(std::optional<PointDrawing> drawing) {
+  point_drawing_for_new_renderers = drawing ? static_cast<int>(*drawing) : -1;
+}
+
 PointRenderer::PointRenderer()
-    : ColoredVertices("points", shader_sources::kPointsVert, shader_sources::kPointsFrag, 1) {}
+    : ColoredVertices("points", shader_sources::kPointsVert, shader_sources::kPointsFrag, 1) {
+  const int drawing = point_drawing_for_new_renderers;
+  drawing_ = drawing >= 0           ? static_cast<PointDrawing>(drawing)
+             : IsSoftwareRenderer() ? PointDrawing::kSoftwareSplat
+                                    : PointDrawing::kGlPoints;
+}
+
+PointRenderer::~PointRenderer() {
+  if (splat_program_) glDeleteProgram(splat_program_);
+  if (splat_vao_) glDeleteVertexArrays(1, &splat_vao_);
+  if (splat_color_) glDeleteTextures(1, &splat_color_);
+  if (splat_depth_) glDeleteTextures(1, &splat_depth_);
+}
+
+void PointRenderer::Upload(const std::vector<Eigen::Vector3f>& positions,
+                           const std::vector<Rgba>& colors) {
+  ColoredVertices::Upload(positions, colors);
+  // Kept whatever the drawing, so that set_drawing may switch at any time.
+  positions_ = positions;
+  colors_ = colors;
+  all_opaque_ = std::all_of(colors.begin(), colors.end(), [](Rgba c) { return c.a == 255; });
+}
 
 void PointRenderer::Draw(const Matrix4f& view_projection, float point_size_px,
                          float opacity) const {
+  if (drawing_ == PointDrawing::kSoftwareSplat && opacity >= 1.0f && all_opaque_) {
+    if (size() > 0) DrawSplat(view_projection, point_size_px);
+    return;
+  }
   // Translucent points must not hide each other, opaque ones must.
   if (!Prepare(view_projection, opacity >= 1.0f)) return;
   glUniform1f(glGetUniformLocation(program(), "point_size_px"), point_size_px);
   glUniform1f(glGetUniformLocation(program(), "opacity"), std::clamp(opacity, 0.0f, 1.0f));
   glEnable(GL_PROGRAM_POINT_SIZE);  // size from gl_PointSize in the vertex shader
   DrawAll(GL_POINTS);
+}
+
+void PointRenderer::DrawSplat(const Matrix4f& view_projection, float point_size_px) const {
+  GLint viewport[4] = {0, 0, 0, 0};
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  const int width = viewport[2], height = viewport[3];
+  if (width <= 0 || height <= 0) return;
+  if (!splat_) splat_ = std::make_unique<PointSplat>();
+  SplatPoints(positions_, colors_, view_projection, point_size_px, width, height, splat_.get());
+  if (!splat_program_) {
+    splat_program_ = BuildProgram("splat", shader_sources::kSplatVert, shader_sources::kSplatFrag);
+    glGenVertexArrays(1, &splat_vao_);  // core profile draws need one, even without attributes
+    glGenTextures(1, &splat_color_);
+    glGenTextures(1, &splat_depth_);
+  }
+  GLint previous_active = 0, previous_alignment = 0, previous_row_length = 0;
+  glGetIntegerv(GL_ACTIVE_TEXTURE, &previous_active);
+  glGetIntegerv(GL_UNPACK_ALIGNMENT, &previous_alignment);
+  glGetIntegerv(GL_UNPACK_ROW_LENGTH, &previous_row_length);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);  // 4-byte texels: rows are always aligned
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  const bool reallocate = width != splat_width_ || height != splat_height_;
+  const struct {
+    GLuint texture;
+    GLint internal_format;
+    GLenum format, type;
+    const void* data;
+  } layers[2] = {{splat_color_, GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, splat_->color.data()},
+                 {splat_depth_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, splat_->depth.data()}};
+  for (int unit = 0; unit < 2; ++unit) {
+    glActiveTexture(GL_TEXTURE0 + unit);
+    glBindTexture(GL_TEXTURE_2D, layers[unit].texture);
+    if (reallocate) {
+      glTexImage2D(GL_TEXTURE_2D, 0, layers[unit].internal_format, width, height, 0,
+                   layers[unit].format, layers[unit].type, layers[unit].data);
+      // texelFetch ignores filtering, but an integer texture with a mipmapping default filter
+      // is incomplete and reads as zero.
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    } else {
+      glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, layers[unit].format, layers[unit].type,
+                      layers[unit].data);
+    }
+  }
+  splat_width_ = width;
+  splat_height_ = height;
+  glPixelStorei(GL_UNPACK_ALIGNMENT, previous_alignment);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, previous_row_length);
+  glUseProgram(splat_program_);
+  glUniform1i(glGetUniformLocation(splat_program_, "splat_color"), 0);
+  glUniform1i(glGetUniformLocation(splat_program_, "splat_depth"), 1);
+  glUniform2i(glGetUniformLocation(splat_program_, "viewport_origin"), viewport[0], viewport[1]);
+  // Opaque points hide what lies behind them and replace the colour (GL_POINTS' blending with
+  // alpha 1 does the same); the depth test decides against what is already drawn.
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glBindVertexArray(splat_vao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glUseProgram(0);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  glActiveTexture(static_cast<GLenum>(previous_active));
 }
 
 LineRenderer::LineRenderer()

@@ -7,6 +7,8 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/base/image.h"
@@ -49,11 +51,45 @@ class ColoredVertices {
   size_t count_ = 0;
 };
 
+struct PointSplat;
+
+// How a PointRenderer rasterises opaque points. Both give the same picture (GfxPointSplat tests
+// it): kSoftwareSplat is about three times faster on a software OpenGL (llvmpipe), GL_POINTS is
+// what any GPU draws fastest.
+enum class PointDrawing { kGlPoints, kSoftwareSplat };
+
+// Whether the current context rasterises on the CPU (Mesa's llvmpipe or softpipe, SwiftShader).
+bool IsSoftwareRenderer();
+
+// The drawing PointRenderers constructed from now on use: `drawing`, or with nullopt (the
+// default) the software splat on a software renderer and GL_POINTS elsewhere. Process-wide; for
+// benchmarks and tests that compare the two.
+void SetPointDrawingForNewRenderers(std::optional<PointDrawing> drawing);
+
 // Round, depth-tested points with per-point colour; size in pixels.
 class PointRenderer : public ColoredVertices {
  public:
+  // See SetPointDrawingForNewRenderers for the drawing it starts with.
   PointRenderer();
+  ~PointRenderer();
+  void Upload(const std::vector<Eigen::Vector3f>& positions, const std::vector<Rgba>& colors);
   void Draw(const Matrix4f& view_projection, float point_size_px, float opacity = 1.0f) const;
+  // Translucent points (opacity < 1 or a colour's alpha < 255) always go to GL_POINTS: their
+  // blending depends on the draw order of everything, which only GL sees.
+  void set_drawing(PointDrawing drawing) { drawing_ = drawing; }
+  PointDrawing drawing() const { return drawing_; }
+
+ private:
+  void DrawSplat(const Matrix4f& view_projection, float point_size_px) const;
+
+  PointDrawing drawing_;
+  // For kSoftwareSplat: the points on the CPU side too, and the splat's buffers and textures.
+  std::vector<Eigen::Vector3f> positions_;
+  std::vector<Rgba> colors_;
+  bool all_opaque_ = true;
+  mutable std::unique_ptr<PointSplat> splat_;
+  mutable std::uint32_t splat_program_ = 0, splat_vao_ = 0, splat_color_ = 0, splat_depth_ = 0;
+  mutable int splat_width_ = 0, splat_height_ = 0;
 };
 
 // Line segments (pairs of vertices) with per-vertex colour.
