@@ -2,6 +2,7 @@
 // profile, zstd) and a rosbag2 .db3, imported, then calibrated: the same transform as the folder
 // (<= 1e-9). And the import's selection: moving boards, near-duplicates, missing images, the cap.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 
@@ -29,11 +30,19 @@ class BagImport : public ::testing::Test {
     SimOptions sim = SimPreset("default");
     sim.num_pairs = 8;
     sim.seed = 11;
-    dataset_ = new Dataset(SimulateDataset(sim, test::TempDir("bag_import_sim")));
+    // One directory per process: ctest runs each test of the suite as its own process, in
+    // parallel, and each sets the suite up (a shared directory was wiped under a running test).
+    sim_dir_ = new fs::path(test::TempDir("bag_import_sim_" + std::to_string(getpid())));
+    dataset_ = new Dataset(SimulateDataset(sim, *sim_dir_));
     // The import writes no brush seeds: the folder is calibrated the same way, by detection.
     for (PairEntry& pair : dataset_->pairs) pair.lidar_seed.reset();
   }
-  static void TearDownTestSuite() { delete dataset_; }
+  static void TearDownTestSuite() {
+    delete dataset_;
+    std::error_code ignored;
+    fs::remove_all(*sim_dir_, ignored);
+    delete sim_dir_;
+  }
 
   // Pair i's messages around t_i = 100 s + 2 s i: the cloud 5 ms after the image, and the same
   // image 40 ms before and after (the board held still), CameraInfo with every image.
@@ -83,8 +92,10 @@ class BagImport : public ::testing::Test {
   }
 
   static Dataset* dataset_;
+  static fs::path* sim_dir_;
 };
 Dataset* BagImport::dataset_ = nullptr;
+fs::path* BagImport::sim_dir_ = nullptr;
 
 TEST_F(BagImport, EveryFormatCalibratesLikeTheFolder) {
   const fs::path dir = test::TempDir("bag_import_round_trip");

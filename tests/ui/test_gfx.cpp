@@ -15,6 +15,7 @@
 #include "ui/gfx/context.h"
 #include "ui/gfx/framebuffer.h"
 #include "ui/gfx/gl_api.h"  // first GL header of this file: glGetError for the checks
+#include "ui/gfx/point_splat.h"
 #include "ui/gfx/renderers.h"
 
 namespace calibench::gfx {
@@ -264,6 +265,51 @@ int DifferingPixels(const ImageU8& a, const ImageU8& b) {
     differing +=
         a.data[i] != b.data[i] || a.data[i + 1] != b.data[i + 1] || a.data[i + 2] != b.data[i + 2];
   return differing;
+}
+
+// The splat's rules on hand-placed points, without GL: identity view-projection, so positions
+// are normalized device coordinates; a 4 x 4 viewport, 2 px points.
+TEST(GfxPointSplat, FollowsGlPointRules) {
+  const Rgba red{255, 0, 0, 255}, green{0, 255, 0, 255}, blue{0, 0, 255, 255};
+  const auto splat = [](const std::vector<Eigen::Vector3f>& positions,
+                        const std::vector<Rgba>& colors, float size_px) {
+    PointSplat out;
+    SplatPoints(positions, colors, Matrix4f::Identity(), size_px, 4, 4, &out);
+    return out;
+  };
+  const auto covered = [](const PointSplat& s) {
+    std::vector<int> pixels;
+    for (int i = 0; i < s.width * s.height; ++i)
+      if (s.depth[i] != PointSplat::kEmpty) pixels.push_back(i);
+    return pixels;
+  };
+  // A point at the viewport's centre (window 2, 2) covers the four pixels around it, at window
+  // depth 0.5 as 24 bits.
+  PointSplat s = splat({{0, 0, 0}}, {red}, 2.0f);
+  EXPECT_EQ(covered(s), (std::vector<int>{5, 6, 9, 10}));
+  EXPECT_EQ(s.depth[5], 8388607u);  // 0.5 * (2^24 - 1), truncated
+  EXPECT_EQ(s.color[10].r, 255);
+  // A 3 px point centred on pixel (1, 1)'s centre (window 1.5, 1.5 = NDC -0.25): its square
+  // holds 3 x 3 pixel centres and its disc, radius 1.5, keeps them all (corners 1.41 away).
+  EXPECT_EQ(covered(splat({{-0.25f, -0.25f, 0}}, {red}, 3.0f)).size(), 9u);
+  // 4 px centred on (2, 2): 16 centres in the square, the four corners (distance 2.12 > 2) cut.
+  EXPECT_EQ(covered(splat({{0, 0, 0}}, {red}, 4.0f)).size(), 12u);
+  // Depth: the nearer point wins whatever the order; at equal depth the later one (GL_LEQUAL).
+  s = splat({{0, 0, 0.2f}, {0, 0, -0.2f}, {0, 0, 0.1f}}, {red, green, blue}, 2.0f);
+  EXPECT_EQ(s.color[5].g, 255);
+  s = splat({{0, 0, 0}, {0, 0, 0}}, {red, blue}, 2.0f);
+  EXPECT_EQ(s.color[5].b, 255);
+  // Outside the clip volume by its centre: dropped, although its disc would reach into the view
+  // (x = 1.1 is window 4.2, the disc spans 3.2 to 5.2); beyond the far or the near plane; behind
+  // the eye (w < 0 through a perspective matrix).
+  EXPECT_TRUE(covered(splat({{1.1f, 0, 0}}, {red}, 2.0f)).empty());
+  EXPECT_TRUE(covered(splat({{0, 0, 1.5f}}, {red}, 2.0f)).empty());
+  EXPECT_TRUE(covered(splat({{0, 0, -1.5f}}, {red}, 2.0f)).empty());
+  PointSplat behind;
+  SplatPoints({{0, 0, 1}}, {red}, Perspective(1.0f, 1.0f, 0.1f, 10.0f), 2.0f, 4, 4, &behind);
+  EXPECT_TRUE(covered(behind).empty());
+  // On the viewport's edge (window x = 4): only the half inside is drawn.
+  EXPECT_EQ(covered(splat({{1.0f, 0, 0}}, {red}, 2.0f)), (std::vector<int>{7, 11}));
 }
 
 TEST(GfxPointSplat, DrawsThePicturesGlPointsDraw) {
