@@ -15,6 +15,7 @@
 #include "ui/lidar_camera/window_shell.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/lrf/controller.h"
+#include "ui/lrf/window.h"
 #include "ui/lrf/workbench.h"
 #include "ui/widgets/headless_render.h"
 #include "ui/widgets/imgui_host.h"
@@ -95,14 +96,18 @@ int FinishWindow(const ui::WindowRun& run, const std::string& screenshot) {
   return kOk;
 }
 
-// The LRF workbench in a window (a calibench.lrf-dataset.v1 manifest).
+// The LRF workbench in a window (a calibench.lrf-dataset.v1 manifest), with its File menu.
 int RunLrfGuiWindow(const std::string& dataset, const ui::WindowOptions& window,
-                    const std::string& screenshot) {
+                    const std::string& screenshot, const std::vector<std::string>& test_drops) {
   ui::LrfController controller;
   controller.Open(dataset);  // a bad manifest shows its error in the window's status line
-  return FinishWindow(
-      ui::RunWorkbenchWindow<ui::LrfWorkbench>(window, controller, ui::LrfLayout::kWorkbench),
-      screenshot);
+  std::string error;
+  const int code =
+      FinishWindow(ui::RunLrfWindow(window, controller, {test_drops}, &error), screenshot);
+  if (!error.empty()) std::fprintf(stderr, "calibench gui: %s\n", error.c_str());
+  const ui::LrfSnapshot last = controller.GetSnapshot();
+  if (!last.manifest.empty()) std::printf("open at the end: %s\n", last.manifest.c_str());
+  return code;
 }
 
 // The headless GL context of a render, or nullptr after printing `failure`: why.
@@ -213,7 +218,7 @@ int RunGui(int argc, char** argv) {
   if (!dataset.empty() && IsLrfManifest(dataset))
     return RunLrfGuiWindow(dataset,
                            WindowOptionsOf(width, height, "Calibench (2D LRF)", screenshot, quit),
-                           screenshot);
+                           screenshot, quit.test_drops);
   return RunGuiWindow(dataset, session, width, height, screenshot, quit);
 }
 

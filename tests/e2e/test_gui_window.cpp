@@ -120,6 +120,45 @@ TEST_F(GuiWindow, ADroppedDatasetOpens) {
   EXPECT_LT(dropped_at, first_at) << recent;  // newest first
 }
 
+// The LRF window has the File menu's bar over its views; a LiDAR-camera dataset dropped onto it
+// is refused with the reason and leaves the open dataset alone; an LRF manifest dropped after it
+// opens.
+TEST_F(GuiWindow, TheLrfWindowOpensADroppedManifestAndRefusesOtherDatasets) {
+  std::string output;
+  for (const char* name : {"lrf_a", "lrf_b"}) {
+    ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " simulate --kind lrf --observations 4 " +
+                                   "--seed " + (name[4] == 'a' ? "3" : "4") + " --out " +
+                                   (dir_ / name).string(),
+                               &output),
+              0)
+        << output;
+  }
+  const auto shot = dir_ / "lrf_window.png";
+  const int code = test::RunCommand(
+      Xvfb() + test::CalibenchExe() + " gui --dataset " + (dir_ / "lrf_a/manifest.json").string() +
+          " --test-drop " + (dir_ / "data/dataset.json").string() + " --test-drop " +
+          (dir_ / "lrf_b/manifest.json").string() +
+          " --size 1600x900 --quit-after-frames 60 --screenshot " + shot.string(),
+      &output);
+  ASSERT_EQ(code, 0) << output;
+  // The refused drop is named with the reason, the manifest dropped last is what is open.
+  EXPECT_NE(output.find("calibench gui: "), std::string::npos) << output;
+  EXPECT_NE(output.find("data/dataset.json"), std::string::npos) << output;
+  EXPECT_NE(output.find("open at the end: " + (dir_ / "lrf_b/manifest.json").string()),
+            std::string::npos)
+      << output;
+  const ImageU8 image = LoadImage(shot);
+  // The views' title bars (the theme's blue) sit below the menu bar, as in the LiDAR-camera
+  // window; without a menu bar they would start at the top row.
+  for (int x : {10, 543, 1076}) {
+    const std::uint8_t* bar = image.Row(30) + 3 * x;
+    EXPECT_GT(bar[0], bar[2]) << "no title bar at x = " << x << "; see " << shot;
+    const std::uint8_t* menu = image.Row(5) + 3 * x;
+    EXPECT_LE(std::abs(menu[0] - menu[2]), 12)
+        << "no grey menu bar at x = " << x << "; see " << shot;
+  }
+}
+
 // `gui --bag`: the recording is imported behind a progress bar, then opened.
 TEST_F(GuiWindow, ABagOpensAfterItsImport) {
   const Dataset dataset = LoadDataset(dir_ / "data");

@@ -173,6 +173,15 @@ TEST(LrfController, ExportsTheSolvedResult) {
   text << std::ifstream(path).rdbuf();
   EXPECT_NE(text.str().find("cam_from_lrf"), std::string::npos);
   EXPECT_NE(text.str().find("calibench.result.v1"), std::string::npos);
+  // A relative name (the solver panel's default, the File menu's) goes beside the manifest, not
+  // into the working directory.
+  const auto beside = LrfUiDataset().parent_path() / "relative_result.json";
+  std::filesystem::remove(beside);
+  controller.Apply(LrfExportResult{"relative_result.json"});
+  EXPECT_FALSE(controller.GetSnapshot().status_is_error) << controller.GetSnapshot().status_line;
+  EXPECT_TRUE(std::filesystem::exists(beside));
+  EXPECT_FALSE(std::filesystem::exists("relative_result.json"));
+  EXPECT_EQ(test::ReadFileBytes(beside), test::ReadFileBytes(path));
 }
 
 class LrfWorkbenchRender : public ::testing::Test {

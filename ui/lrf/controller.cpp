@@ -257,9 +257,13 @@ void LrfController::Apply(const LrfIntent& intent) {
     }
     LrfPipelineOptions options = options_;
     options.solver.method = outcome_->solution->method;
+    // A relative path goes beside the manifest, as the lidar-camera exports go beside the
+    // session: not into wherever the program happened to be started.
+    std::filesystem::path path = export_result->path;
+    if (path.is_relative() && !state_.manifest.empty()) path = state_.manifest.parent_path() / path;
     try {
-      WriteLrfResult(export_result->path, *outcome_, options);
-      SetStatus("exported " + export_result->path.string(), false);
+      WriteLrfResult(path, *outcome_, options);
+      SetStatus("exported " + path.string(), false);
     } catch (const IoError& e) {
       SetStatus(e.what(), true);
     }

@@ -66,7 +66,7 @@ struct LrfSetMethod {
   LrfMethod method;
 };
 struct LrfExportResult {
-  std::filesystem::path path;
+  std::filesystem::path path;  // a relative path is taken from the manifest's folder
 };
 using LrfIntent = std::variant<LrfSelectPair, LrfSetPairStatus, LrfRunSolver, LrfResetSolver,
                                LrfSetMethod, LrfExportResult>;

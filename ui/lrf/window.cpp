@@ -1,0 +1,126 @@
+#include "ui/lrf/window.h"
+
+#include <imgui.h>
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <utility>
+
+#include "ui/lrf/workbench.h"
+#include "ui/widgets/file_browser.h"
+
+namespace calibench::ui {
+namespace {
+namespace fs = std::filesystem;
+
+// Where the File menu's export goes: beside the manifest, as the lidar-camera window's exports
+// go beside the session.
+constexpr const char* kMenuExportFile = "lrf_result.json";
+
+class LrfWindowShell {
+ public:
+  LrfWindowShell(LrfController& controller, LrfWindowOptions options)
+      : controller_(controller), options_(std::move(options)) {}
+
+  // One frame; true while the next one would differ without input.
+  bool Frame(Window& window, int width, int height, double seconds) {
+    ++frames_;
+    if (pending_open_) Open(*std::exchange(pending_open_, std::nullopt));
+    for (const std::string& dropped : window.TakeDroppedPaths()) pending_open_ = dropped;
+    if (frames_ > 3 && !options_.test_drops.empty()) {
+      window.DeliverDrop({options_.test_drops.front()});
+      options_.test_drops.erase(options_.test_drops.begin());
+    }
+    if (!workbench_) workbench_ = std::make_unique<LrfWorkbench>();
+    const float top = MenuBar();
+    const LrfSnapshot snapshot = controller_.GetSnapshot();
+    const auto intents =
+        workbench_->Frame(snapshot, width, height, LrfLayout::kWorkbench, seconds, top);
+    for (const LrfIntent& intent : intents) controller_.Apply(intent);
+    if (const auto chosen = browser_.Draw()) pending_open_ = *chosen;
+    Popups();
+    if (quit_) window.RequestClose();
+    return !intents.empty() || workbench_->Animating(snapshot) || pending_open_.has_value() ||
+           !options_.test_drops.empty();
+  }
+
+  const std::string& error() const { return error_; }
+
+ private:
+  void Open(const fs::path& manifest) {
+    if (controller_.Open(manifest)) {
+      workbench_.reset();  // its textures and view keys show the old dataset
+      return;
+    }
+    error_ = controller_.GetSnapshot().status_line;
+    show_error_ = true;
+  }
+
+  float MenuBar() {
+    const fs::path here = controller_.GetSnapshot().manifest;
+    if (ImGui::GetIO().KeyCtrl && ImGui::IsKeyPressed('O', false))
+      browser_.Open(here, "Open an LRF dataset (calibench.lrf-dataset.v1 manifest)");
+    if (!ImGui::BeginMainMenuBar()) return 0.0f;
+    if (ImGui::BeginMenu("File")) {
+      if (ImGui::MenuItem("Open LRF dataset...", "Ctrl+O"))
+        browser_.Open(here, "Open an LRF dataset (calibench.lrf-dataset.v1 manifest)");
+      ImGui::Separator();
+      const bool solved = controller_.GetSnapshot().solver.solution.has_value();
+      const std::string label = std::string("Export result (") + kMenuExportFile + ")";
+      if (ImGui::MenuItem(label.c_str(), nullptr, false, solved && !here.empty()))
+        controller_.Apply(LrfExportResult{here.parent_path() / kMenuExportFile});
+      ImGui::TextDisabled("beside the manifest; the solver panel exports anywhere");
+      ImGui::Separator();
+      if (ImGui::MenuItem("Quit")) quit_ = true;
+      ImGui::EndMenu();
+    }
+    const float height = ImGui::GetWindowSize().y;
+    ImGui::EndMainMenuBar();
+    return height;
+  }
+
+  void Popups() {
+    if (show_error_) {
+      ImGui::OpenPopup("Cannot open");
+      show_error_ = false;
+    }
+    if (ImGui::BeginPopupModal("Cannot open", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+      ImGui::PushTextWrapPos(640);
+      ImGui::TextColored({1.0f, 0.45f, 0.4f, 1}, "%s", error_.c_str());
+      ImGui::TextDisabled("LiDAR-camera datasets open with calibench gui --dataset PATH");
+      ImGui::PopTextWrapPos();
+      if (ImGui::Button("OK")) ImGui::CloseCurrentPopup();
+      ImGui::EndPopup();
+    }
+  }
+
+  LrfController& controller_;
+  LrfWindowOptions options_;
+  std::unique_ptr<LrfWorkbench> workbench_;
+  FileBrowser browser_;
+  std::optional<fs::path> pending_open_;
+  std::string error_;
+  bool show_error_ = false;
+  bool quit_ = false;
+  int frames_ = 0;
+};
+
+}  // namespace
+
+WindowRun RunLrfWindow(const WindowOptions& window_options, LrfController& controller,
+                       LrfWindowOptions options, std::string* error) {
+  WindowRun run;
+  const auto window = Window::Open(window_options, &run.why);
+  if (!window) return run;
+  run.opened = true;
+  LrfWindowShell shell(controller, std::move(options));
+  run.last_frame = window->Run([&](int width, int height, double seconds) {
+    return shell.Frame(*window, width, height, seconds);
+  });
+  run.stats = window->stats();
+  if (error) *error = shell.error();
+  return run;
+}
+
+}  // namespace calibench::ui
