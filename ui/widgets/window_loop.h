@@ -77,25 +77,4 @@ struct WindowRun {
   FrameStats stats;
 };
 
-// A workbench (either method's) in a window against its controller, applying the intents its
-// panels return. The workbench is made once the window's context is current (it owns GL
-// resources).
-template <typename Workbench, typename Controller, typename Layout>
-WindowRun RunWorkbenchWindow(const WindowOptions& options, Controller& controller, Layout layout) {
-  WindowRun run;
-  const auto window = Window::Open(options, &run.why);
-  if (!window) return run;
-  run.opened = true;
-  Workbench workbench;
-  run.last_frame = window->Run([&](int width, int height, double seconds) {
-    const auto snapshot = controller.GetSnapshot();
-    const auto intents = workbench.Frame(snapshot, width, height, layout, seconds);
-    for (const auto& intent : intents) controller.Apply(intent);
-    // An applied intent usually queues work: the next frame shows it starting.
-    return !intents.empty() || workbench.Animating(snapshot);
-  });
-  run.stats = window->stats();
-  return run;
-}
-
 }  // namespace calibench::ui
