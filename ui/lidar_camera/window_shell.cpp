@@ -10,6 +10,7 @@
 #include "core/io/bag.h"
 #include "core/results/export.h"
 #include "ui/lidar_camera/workbench.h"
+#include "ui/widgets/error_popup.h"
 
 namespace calibench::ui {
 namespace fs = std::filesystem;
@@ -290,17 +291,7 @@ void WindowShell::Popups() {
     }
     ImGui::EndPopup();
   }
-  if (show_error_) {
-    ImGui::OpenPopup("Cannot open");
-    show_error_ = false;
-  }
-  if (ImGui::BeginPopupModal("Cannot open", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
-    ImGui::PushTextWrapPos(640);
-    ImGui::TextColored({1.0f, 0.45f, 0.4f, 1}, "%s", error_.c_str());
-    ImGui::PopTextWrapPos();
-    if (ImGui::Button("OK")) ImGui::CloseCurrentPopup();
-    ImGui::EndPopup();
-  }
+  ErrorPopup("Cannot open", error_, &show_error_);
   if (show_import_summary_ && !show_error_ && last_import_) {
     ImGui::OpenPopup("Imported");
     show_import_summary_ = false;

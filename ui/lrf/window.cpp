@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "ui/lrf/workbench.h"
+#include "ui/widgets/error_popup.h"
 #include "ui/widgets/file_browser.h"
 
 namespace calibench::ui {
@@ -39,7 +40,8 @@ class LrfWindowShell {
         workbench_->Frame(snapshot, width, height, LrfLayout::kWorkbench, seconds, top);
     for (const LrfIntent& intent : intents) controller_.Apply(intent);
     if (const auto chosen = browser_.Draw()) pending_open_ = *chosen;
-    Popups();
+    ErrorPopup("Cannot open", error_, &show_error_,
+               "LiDAR-camera datasets open with calibench gui --dataset PATH");
     if (quit_) window.RequestClose();
     return !intents.empty() || workbench_->Animating(snapshot) || pending_open_.has_value() ||
            !options_.test_drops.empty();
@@ -78,21 +80,6 @@ class LrfWindowShell {
     const float height = ImGui::GetWindowSize().y;
     ImGui::EndMainMenuBar();
     return height;
-  }
-
-  void Popups() {
-    if (show_error_) {
-      ImGui::OpenPopup("Cannot open");
-      show_error_ = false;
-    }
-    if (ImGui::BeginPopupModal("Cannot open", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
-      ImGui::PushTextWrapPos(640);
-      ImGui::TextColored({1.0f, 0.45f, 0.4f, 1}, "%s", error_.c_str());
-      ImGui::TextDisabled("LiDAR-camera datasets open with calibench gui --dataset PATH");
-      ImGui::PopTextWrapPos();
-      if (ImGui::Button("OK")) ImGui::CloseCurrentPopup();
-      ImGui::EndPopup();
-    }
   }
 
   LrfController& controller_;
