@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -307,6 +308,19 @@ TEST(GfxPointSplat, FollowsGlPointRules) {
   EXPECT_TRUE(covered(splat({{0, 0, -1.5f}}, {red}, 2.0f)).empty());
   PointSplat behind;
   SplatPoints({{0, 0, 1}}, {red}, Perspective(1.0f, 1.0f, 0.1f, 10.0f), 2.0f, 4, 4, &behind);
+  EXPECT_TRUE(covered(behind).empty());
+  // Points that are not numbers (a cloud's missing returns) or infinite draw nothing.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  EXPECT_TRUE(
+      covered(splat({{nan, 0, 0}, {0, inf, 0}, {0, 0, -inf}}, {red, red, red}, 2.0f)).empty());
+  // An oblique view mixes every coordinate into clip x, y, z and w: (-inf, 0, 0) gives w = +inf
+  // and |x| = inf, which passes "|x| <= w"; only the finiteness check keeps its NaN window
+  // coordinates from an int cast (undefined behaviour, which on x86 happens to draw nothing).
+  const Matrix4f oblique =
+      Perspective(1.0f, 1.0f, 0.1f, 10.0f) * LookAt({3, 2, 5}, {0, 0, 0}, {0, 1, 0});
+  SplatPoints({{0, 0, -inf}, {inf, 0, -1}, {-inf, 0, 0}}, {red, red, red}, oblique, 2.0f, 4, 4,
+              &behind);
   EXPECT_TRUE(covered(behind).empty());
   // On the viewport's edge (window x = 4): only the half inside is drawn.
   EXPECT_EQ(covered(splat({{1.0f, 0, 0}}, {red}, 2.0f)), (std::vector<int>{7, 11}));

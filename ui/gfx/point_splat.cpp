@@ -27,8 +27,11 @@ void SplatPoints(const std::vector<Eigen::Vector3f>& positions, const std::vecto
   for (size_t i = 0; i < positions.size(); ++i) {
     const Eigen::Vector4f clip = m * positions[i].homogeneous();
     const float w = clip.w();
-    // Inside the clip volume: -w <= x, y, z <= w (which also needs w > 0).
-    if (!(std::abs(clip.x()) <= w && std::abs(clip.y()) <= w && std::abs(clip.z()) <= w)) continue;
+    // Inside the clip volume: -w <= x, y, z <= w (which also needs w > 0). A finite w keeps an
+    // infinite coordinate out (inf <= inf would let it in); NaN fails every comparison.
+    if (!(std::isfinite(w) && std::abs(clip.x()) <= w && std::abs(clip.y()) <= w &&
+          std::abs(clip.z()) <= w))
+      continue;
     const float inverse_w = 1.0f / w;
     // Viewport transform with glDepthRange(0, 1): window x, y in pixels from the bottom left.
     // Written as scale and offset, the way GL implementations apply it, for the same rounding.

@@ -27,15 +27,16 @@ class ColoredVertices {
   ColoredVertices(const ColoredVertices&) = delete;
   ColoredVertices& operator=(const ColoredVertices&) = delete;
   // Equal counts, a multiple of the primitive's vertex count (1, 2 or 3); std::invalid_argument
-  // otherwise.
-  void Upload(const std::vector<Eigen::Vector3f>& positions, const std::vector<Rgba>& colors);
+  // otherwise. Virtual: PointRenderer keeps a CPU copy for its software splat.
+  virtual void Upload(const std::vector<Eigen::Vector3f>& positions,
+                      const std::vector<Rgba>& colors);
   size_t size() const { return count_; }
 
  protected:
   // name: for messages; group: vertices per primitive. Requires a current context.
   ColoredVertices(const char* name, const char* vertex_shader, const char* fragment_shader,
                   size_t group);
-  ~ColoredVertices();
+  virtual ~ColoredVertices();
   // Sets the program, its view_projection and all the state a draw depends on; false when there
   // is nothing to draw. depth_write: whether the primitives hide what is drawn after them (off
   // lets translucent surfaces show what lies behind them whatever the draw order).
@@ -71,8 +72,9 @@ class PointRenderer : public ColoredVertices {
  public:
   // See SetPointDrawingForNewRenderers for the drawing it starts with.
   PointRenderer();
-  ~PointRenderer();
-  void Upload(const std::vector<Eigen::Vector3f>& positions, const std::vector<Rgba>& colors);
+  ~PointRenderer() override;
+  void Upload(const std::vector<Eigen::Vector3f>& positions,
+              const std::vector<Rgba>& colors) override;
   void Draw(const Matrix4f& view_projection, float point_size_px, float opacity = 1.0f) const;
   // Translucent points (opacity < 1 or a colour's alpha < 255) always go to GL_POINTS: their
   // blending depends on the draw order of everything, which only GL sees.
