@@ -203,9 +203,9 @@ void BM_PointsInView530x420(benchmark::State& state) {
   std::vector<Eigen::Vector3f> positions(n);
   for (auto& p : positions) p = {uniform(random), uniform(random), -3.0f + uniform(random)};
   gfx::PointRenderer points;
-  points.Upload(positions, std::vector<gfx::Rgba>(n, gfx::Rgba{200, 100, 50, 255}));
   points.set_drawing(state.range(1) ? gfx::PointDrawing::kSoftwareSplat
                                     : gfx::PointDrawing::kGlPoints);
+  points.Upload(positions, std::vector<gfx::Rgba>(n, gfx::Rgba{200, 100, 50, 255}));
   gfx::Framebuffer target;
   target.Resize(530, 420);
   const gfx::Matrix4f view_projection = gfx::Perspective(1.0f, 530.0f / 420.0f, 0.1f, 100.0f);

@@ -39,9 +39,11 @@ class BagImport : public ::testing::Test {
   }
   static void TearDownTestSuite() {
     delete dataset_;
+    if (!sim_dir_) return;  // the set-up threw before making it
     std::error_code ignored;
     fs::remove_all(*sim_dir_, ignored);
     delete sim_dir_;
+    sim_dir_ = nullptr;
   }
 
   // Pair i's messages around t_i = 100 s + 2 s i: the cloud 5 ms after the image, and the same

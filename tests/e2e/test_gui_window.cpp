@@ -147,6 +147,17 @@ TEST_F(GuiWindow, TheLrfWindowOpensADroppedManifestAndRefusesOtherDatasets) {
   EXPECT_NE(output.find("open at the end: " + (dir_ / "lrf_b/manifest.json").string()),
             std::string::npos)
       << output;
+  // Refused alone, the LiDAR-camera dataset leaves set A open.
+  ASSERT_EQ(test::RunCommand(Xvfb() + test::CalibenchExe() + " gui --dataset " +
+                                 (dir_ / "lrf_a/manifest.json").string() + " --test-drop " +
+                                 (dir_ / "data").string() + " --quit-after-frames 30",
+                             &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("calibench gui: "), std::string::npos) << output;
+  EXPECT_NE(output.find("open at the end: " + (dir_ / "lrf_a/manifest.json").string()),
+            std::string::npos)
+      << output;
   const ImageU8 image = LoadImage(shot);
   // The views' title bars (the theme's blue) sit below the menu bar, as in the LiDAR-camera
   // window; without a menu bar they would start at the top row.

@@ -173,7 +173,7 @@ TEST(LrfController, ExportsTheSolvedResult) {
   text << std::ifstream(path).rdbuf();
   EXPECT_NE(text.str().find("cam_from_lrf"), std::string::npos);
   EXPECT_NE(text.str().find("calibench.result.v1"), std::string::npos);
-  // A relative name (the solver panel's default, the File menu's) goes beside the manifest, not
+  // A relative name (the solver panel's default, lrf_result.json) goes beside the manifest, not
   // into the working directory.
   const auto beside = LrfUiDataset().parent_path() / "relative_result.json";
   std::filesystem::remove(beside);

@@ -26,10 +26,15 @@ struct PointSplat {
   std::vector<std::uint32_t> depth;
 };
 
+// The point sizes SplatPoints draws, in pixels: llvmpipe's GL_POINT_SIZE_RANGE.
+inline constexpr float kMinPointSizePx = 1.0f, kMaxPointSizePx = 255.0f;
+
 // Draws positions[i] in colors[i] through view_projection into a width x height viewport, as
-// GL_POINTS of point_size_px pixels with points.frag.glsl's disc would:
+// GL_POINTS of point_size_px pixels (clamped to the range above) with points.frag.glsl's disc
+// would on llvmpipe:
 // - a point whose position lies outside the clip volume is dropped (GL's rule for points);
-// - it covers the pixels whose centres lie inside its square and inside its inscribed disc;
+// - it covers the pixels whose centres lie inside its square (half-open: left and bottom edges
+//   in, right and top out) and inside its inscribed disc (its rim included);
 // - depth is tested as GL_LEQUAL in the order of the points, so a later point at the same 24-bit
 //   depth wins.
 // Opaque points only: the caller keeps translucent ones on GL. Reuses out's buffers.

@@ -120,10 +120,16 @@ PointRenderer::~PointRenderer() {
   if (splat_depth_) glDeleteTextures(1, &splat_depth_);
 }
 
+void PointRenderer::set_drawing(PointDrawing drawing) {
+  if (drawing == drawing_) return;
+  if (size() > 0) throw std::logic_error("PointRenderer::set_drawing after Upload");
+  drawing_ = drawing;
+}
+
 void PointRenderer::Upload(const std::vector<Eigen::Vector3f>& positions,
                            const std::vector<Rgba>& colors) {
   ColoredVertices::Upload(positions, colors);
-  // Kept whatever the drawing, so that set_drawing may switch at any time.
+  if (drawing_ != PointDrawing::kSoftwareSplat) return;  // GPUs: no copy
   positions_ = positions;
   colors_ = colors;
   all_opaque_ = std::all_of(colors.begin(), colors.end(), [](Rgba c) { return c.a == 255; });
@@ -156,8 +162,15 @@ void PointRenderer::DrawSplat(const Matrix4f& view_projection, float point_size_
     glGenTextures(1, &splat_color_);
     glGenTextures(1, &splat_depth_);
   }
+  // The state this draw changes and gives back: texture unit and its bindings, unpacking, blend.
   GLint previous_active = 0, previous_alignment = 0, previous_row_length = 0;
+  GLint previous_textures[2] = {0, 0};
   glGetIntegerv(GL_ACTIVE_TEXTURE, &previous_active);
+  for (int unit = 0; unit < 2; ++unit) {
+    glActiveTexture(GL_TEXTURE0 + unit);
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &previous_textures[unit]);
+  }
+  const bool previous_blend = glIsEnabled(GL_BLEND) == GL_TRUE;
   glGetIntegerv(GL_UNPACK_ALIGNMENT, &previous_alignment);
   glGetIntegerv(GL_UNPACK_ROW_LENGTH, &previous_row_length);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);  // 4-byte texels: rows are always aligned
@@ -204,10 +217,12 @@ void PointRenderer::DrawSplat(const Matrix4f& view_projection, float point_size_
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindVertexArray(0);
   glUseProgram(0);
-  glBindTexture(GL_TEXTURE_2D, 0);
-  glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, 0);
+  for (int unit = 0; unit < 2; ++unit) {
+    glActiveTexture(GL_TEXTURE0 + unit);
+    glBindTexture(GL_TEXTURE_2D, static_cast<GLuint>(previous_textures[unit]));
+  }
   glActiveTexture(static_cast<GLenum>(previous_active));
+  if (previous_blend) glEnable(GL_BLEND);
 }
 
 LineRenderer::LineRenderer()

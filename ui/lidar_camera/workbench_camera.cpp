@@ -143,15 +143,18 @@ ViewState Workbench::CameraToolbar(const Snapshot& s, const PairView& pair,
   ImGui::SetNextItemWidth(70);
   float size = static_cast<float>(view.point_size_px),
         opacity = static_cast<float>(view.point_opacity);
-  if (ImGui::SliderFloat("size", &size, 1.0f, 8.0f, "%.1f")) view.point_size_px = size;
+  // AlwaysClamp: a Ctrl+click typed value stays in range too.
+  if (ImGui::SliderFloat("size", &size, 1.0f, 8.0f, "%.1f", ImGuiSliderFlags_AlwaysClamp))
+    view.point_size_px = size;
   SameLineIfFits(ToolbarItemWidth("opacity", 70));
   ImGui::SetNextItemWidth(70);
-  if (ImGui::SliderFloat("opacity", &opacity, 0.1f, 1.0f, "%.2f")) view.point_opacity = opacity;
+  if (ImGui::SliderFloat("opacity", &opacity, 0.1f, 1.0f, "%.2f", ImGuiSliderFlags_AlwaysClamp))
+    view.point_opacity = opacity;
   if (view.visibility == VisibilityMode::kHpr) {
     SameLineIfFits(ToolbarItemWidth("HPR 10^", 70));
     ImGui::SetNextItemWidth(70);
     float exponent = static_cast<float>(view.hpr_radius_exponent);
-    if (ImGui::SliderFloat("HPR 10^", &exponent, 1.0f, 4.0f, "%.1f"))
+    if (ImGui::SliderFloat("HPR 10^", &exponent, 1.0f, 4.0f, "%.1f", ImGuiSliderFlags_AlwaysClamp))
       view.hpr_radius_exponent = exponent;
   }
   if (!(view == s.view)) intents->push_back(SetView{view});

@@ -96,7 +96,8 @@ void Workbench::LidarToolbar(const Snapshot& s, const PairView& pair,
   SameLineIfFits(ToolbarItemWidth("brush [ ]", 110));
   ImGui::SetNextItemWidth(110);
   float radius = static_cast<float>(s.view.brush_radius_px);
-  if (ImGui::SliderFloat("brush [ ]", &radius, 1.0f, 60.0f, "%.0f px")) {
+  if (ImGui::SliderFloat("brush [ ]", &radius, 1.0f, 60.0f, "%.0f px",
+                         ImGuiSliderFlags_AlwaysClamp)) {
     ViewState view = s.view;
     view.brush_radius_px = radius;
     intents->push_back(SetView{view});

@@ -3,6 +3,7 @@
 #include <imgui.h>
 
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -18,6 +19,16 @@ namespace fs = std::filesystem;
 // Where the File menu's export goes: beside the manifest, as the lidar-camera window's exports
 // go beside the session.
 constexpr const char* kMenuExportFile = "lrf_result.json";
+
+// Whether `path` is a LiDAR-camera dataset: its manifest, or a folder holding one.
+bool LooksLikeLidarCameraDataset(const fs::path& path) {
+  std::error_code error;
+  std::ifstream in(fs::is_directory(path, error) ? path / "dataset.json" : path, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return head.find("\"calibench.dataset.v1\"") != std::string::npos;
+}
 
 class LrfWindowShell {
  public:
@@ -40,8 +51,11 @@ class LrfWindowShell {
         workbench_->Frame(snapshot, width, height, LrfLayout::kWorkbench, seconds, top);
     for (const LrfIntent& intent : intents) controller_.Apply(intent);
     if (const auto chosen = browser_.Draw()) pending_open_ = *chosen;
-    ErrorPopup("Cannot open", error_, &show_error_,
-               "LiDAR-camera datasets open with calibench gui --dataset PATH");
+    ErrorPopup(
+        "Cannot open", error_, &show_error_,
+        lidar_camera_refused_
+            ? "a LiDAR-camera dataset: it opens in its own window, calibench gui --dataset PATH"
+            : nullptr);
     if (quit_) window.RequestClose();
     return !intents.empty() || workbench_->Animating(snapshot) || pending_open_.has_value() ||
            !options_.test_drops.empty();
@@ -57,6 +71,7 @@ class LrfWindowShell {
     }
     error_ = controller_.GetSnapshot().status_line;
     show_error_ = true;
+    lidar_camera_refused_ = LooksLikeLidarCameraDataset(manifest);
   }
 
   float MenuBar() {
@@ -89,6 +104,7 @@ class LrfWindowShell {
   std::optional<fs::path> pending_open_;
   std::string error_;
   bool show_error_ = false;
+  bool lidar_camera_refused_ = false;  // the refused path is a LiDAR-camera dataset
   bool quit_ = false;
   int frames_ = 0;
 };
