@@ -64,7 +64,15 @@ bool OpenInput(
 // The window the gui flags ask for; with --screenshot its last frame is kept.
 ui::WindowOptions WindowOptionsOf(int width, int height, const char* title,
                                   const std::string& screenshot, const GuiWindowFlags& quit) {
-  return {width, height, title, quit.after_frames, !screenshot.empty(), quit.after_seconds};
+  ui::WindowOptions options;
+  options.width = width;
+  options.height = height;
+  options.title = title;
+  options.quit_after_frames = quit.after_frames;
+  options.capture_last_frame = !screenshot.empty();
+  options.quit_after_seconds = quit.after_seconds;
+  options.test_drops = quit.test_drops;
+  return options;
 }
 
 // The last save failed (the window showed it on its status line): say so on stderr too, with
@@ -98,12 +106,11 @@ int FinishWindow(const ui::WindowRun& run, const std::string& screenshot) {
 
 // The LRF workbench in a window (a calibench.lrf-dataset.v1 manifest), with its File menu.
 int RunLrfGuiWindow(const std::string& dataset, const ui::WindowOptions& window,
-                    const std::string& screenshot, const std::vector<std::string>& test_drops) {
+                    const std::string& screenshot) {
   ui::LrfController controller;
   controller.Open(dataset);  // a bad manifest shows its error in the window's status line
   std::string error;
-  const int code =
-      FinishWindow(ui::RunLrfWindow(window, controller, {test_drops}, &error), screenshot);
+  const int code = FinishWindow(ui::RunLrfWindow(window, controller, &error), screenshot);
   if (!error.empty()) std::fprintf(stderr, "calibench gui: %s\n", error.c_str());
   const ui::LrfSnapshot last = controller.GetSnapshot();
   if (!last.manifest.empty()) std::printf("open at the end: %s\n", last.manifest.c_str());
@@ -160,7 +167,6 @@ int RenderLrfHeadless(const std::string& dataset, const ui::HeadlessShot& shot,
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
                  const std::string& screenshot, const GuiWindowFlags& quit) {
   ui::ShellOptions options;
-  options.test_drops = quit.test_drops;
   try {
     options.board = BoardFromFlag(quit.board);
   } catch (const std::invalid_argument& e) {
@@ -218,7 +224,7 @@ int RunGui(int argc, char** argv) {
   if (!dataset.empty() && IsLrfManifest(dataset))
     return RunLrfGuiWindow(dataset,
                            WindowOptionsOf(width, height, "Calibench (2D LRF)", screenshot, quit),
-                           screenshot, quit.test_drops);
+                           screenshot);
   return RunGuiWindow(dataset, session, width, height, screenshot, quit);
 }
 

@@ -21,7 +21,7 @@ struct PointSplat {
   // depth of a pixel no point covers; above every 24-bit depth
   static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
   int width = 0, height = 0;
-  std::vector<Rgba> color;
+  std::vector<Rgba> color;  // meaningful where depth is not kEmpty (not cleared between splats)
   // Window depth as the 24-bit integer a GL_DEPTH_COMPONENT24 buffer stores, kEmpty if none.
   std::vector<std::uint32_t> depth;
 };

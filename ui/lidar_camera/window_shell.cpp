@@ -195,14 +195,8 @@ WindowRun WindowShell::Run(const WindowOptions& options) {
 }
 
 bool WindowShell::Frame(Window& window, int width, int height, double seconds) {
-  ++frames_;
   if (pending_open_) OpenFromUser(*std::exchange(pending_open_, std::nullopt));
   for (const std::string& dropped : window.TakeDroppedPaths()) pending_open_ = dropped;
-  // Tests: one drop per frame once the workbench has drawn a few, through GLFW's callback.
-  if (frames_ > 3 && !options_.test_drops.empty()) {
-    window.DeliverDrop({options_.test_drops.front()});
-    options_.test_drops.erase(options_.test_drops.begin());
-  }
   const bool importing = PollImport();  // may open a dataset, replacing the workbench
   if (!workbench_) workbench_ = std::make_unique<Workbench>();
   const float top = MenuBar();
@@ -213,7 +207,7 @@ bool WindowShell::Frame(Window& window, int width, int height, double seconds) {
   Popups();
   if (quit_) window.RequestClose();
   return importing || !intents.empty() || workbench_->Animating(snapshot) ||
-         pending_open_.has_value() || !options_.test_drops.empty();
+         pending_open_.has_value();
 }
 
 float WindowShell::MenuBar() {

@@ -28,9 +28,6 @@ struct ShellOptions {
   BoardSpec board = BoardPreset("a4");  // the board seen in imported recordings
   BagImportOptions import;
   std::filesystem::path recent_file = DefaultRecentFilesPath();
-  // Delivered through the window's drop callback once the first frames are drawn, one path per
-  // drop, as a window system would (tests of drag and drop).
-  std::vector<std::string> test_drops;
 };
 
 // What a path is to the workbench.
@@ -89,7 +86,6 @@ class WindowShell {
   bool show_error_ = false;
   bool show_import_summary_ = false;
   bool quit_ = false;
-  int frames_ = 0;
 };
 
 }  // namespace calibench::ui

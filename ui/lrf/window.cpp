@@ -32,18 +32,12 @@ bool LooksLikeLidarCameraDataset(const fs::path& path) {
 
 class LrfWindowShell {
  public:
-  LrfWindowShell(LrfController& controller, LrfWindowOptions options)
-      : controller_(controller), options_(std::move(options)) {}
+  explicit LrfWindowShell(LrfController& controller) : controller_(controller) {}
 
   // One frame; true while the next one would differ without input.
   bool Frame(Window& window, int width, int height, double seconds) {
-    ++frames_;
     if (pending_open_) Open(*std::exchange(pending_open_, std::nullopt));
     for (const std::string& dropped : window.TakeDroppedPaths()) pending_open_ = dropped;
-    if (frames_ > 3 && !options_.test_drops.empty()) {
-      window.DeliverDrop({options_.test_drops.front()});
-      options_.test_drops.erase(options_.test_drops.begin());
-    }
     if (!workbench_) workbench_ = std::make_unique<LrfWorkbench>();
     const float top = MenuBar();
     const LrfSnapshot snapshot = controller_.GetSnapshot();
@@ -57,8 +51,7 @@ class LrfWindowShell {
             ? "a LiDAR-camera dataset: it opens in its own window, calibench gui --dataset PATH"
             : nullptr);
     if (quit_) window.RequestClose();
-    return !intents.empty() || workbench_->Animating(snapshot) || pending_open_.has_value() ||
-           !options_.test_drops.empty();
+    return !intents.empty() || workbench_->Animating(snapshot) || pending_open_.has_value();
   }
 
   const std::string& error() const { return error_; }
@@ -85,8 +78,8 @@ class LrfWindowShell {
       ImGui::Separator();
       const bool solved = controller_.GetSnapshot().solver.solution.has_value();
       const std::string label = std::string("Export result (") + kMenuExportFile + ")";
-      if (ImGui::MenuItem(label.c_str(), nullptr, false, solved && !here.empty()))
-        controller_.Apply(LrfExportResult{here.parent_path() / kMenuExportFile});
+      if (ImGui::MenuItem(label.c_str(), nullptr, false, solved))
+        controller_.Apply(LrfExportResult{kMenuExportFile});  // relative: beside the manifest
       ImGui::TextDisabled("beside the manifest; the solver panel exports anywhere");
       ImGui::Separator();
       if (ImGui::MenuItem("Quit")) quit_ = true;
@@ -98,7 +91,6 @@ class LrfWindowShell {
   }
 
   LrfController& controller_;
-  LrfWindowOptions options_;
   std::unique_ptr<LrfWorkbench> workbench_;
   FileBrowser browser_;
   std::optional<fs::path> pending_open_;
@@ -106,18 +98,17 @@ class LrfWindowShell {
   bool show_error_ = false;
   bool lidar_camera_refused_ = false;  // the refused path is a LiDAR-camera dataset
   bool quit_ = false;
-  int frames_ = 0;
 };
 
 }  // namespace
 
 WindowRun RunLrfWindow(const WindowOptions& window_options, LrfController& controller,
-                       LrfWindowOptions options, std::string* error) {
+                       std::string* error) {
   WindowRun run;
   const auto window = Window::Open(window_options, &run.why);
   if (!window) return run;
   run.opened = true;
-  LrfWindowShell shell(controller, std::move(options));
+  LrfWindowShell shell(controller);
   run.last_frame = window->Run([&](int width, int height, double seconds) {
     return shell.Frame(*window, width, height, seconds);
   });

@@ -4,22 +4,15 @@
 #pragma once
 
 #include <string>
-#include <vector>
 
 #include "ui/lrf/controller.h"
 #include "ui/widgets/window_loop.h"
 
 namespace calibench::ui {
 
-struct LrfWindowOptions {
-  // Delivered through the window's drop callback once the first frames are drawn, one path per
-  // drop, as a window system would (tests of drag and drop).
-  std::vector<std::string> test_drops;
-};
-
 // Runs the window until the user closes it; `controller` holds what is open and opens what the
 // user chooses. The last failure to open is in *error (empty if none) when error is not null.
 WindowRun RunLrfWindow(const WindowOptions& window, LrfController& controller,
-                       LrfWindowOptions options = {}, std::string* error = nullptr);
+                       std::string* error = nullptr);
 
 }  // namespace calibench::ui

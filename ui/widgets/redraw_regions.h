@@ -3,7 +3,7 @@
 // whatever changed, because every pixel is shaded again. The window keeps its last frame in an
 // offscreen framebuffer, so a frame only needs to repaint the pixels whose draw commands differ
 // from the last frame's: RedrawRegions finds them (a fingerprint of each command: its vertices,
-// indices, clip rectangle, texture and the texture's content version), and ComposeRedraw turns the
+// indices, clip rectangle, texture and the texture's content version), and RegionRedraw turns the
 // draw data into one draw list whose commands are clipped to those regions. Inside a region
 // everything is drawn again in the original order, so the result is the full frame's, pixel for
 // pixel (tests/ui/test_redraw_regions.cpp).

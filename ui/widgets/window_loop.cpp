@@ -76,12 +76,17 @@ std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& 
       settle = 0;
       continue;
     }
+    if (stats_.frames >= kSettleFrames && !options_.test_drops.empty()) {
+      DeliverDrop({options_.test_drops.front()});
+      options_.test_drops.erase(options_.test_drops.begin());
+    }
     const double seconds = since(last_draw);
     last_draw = Clock::now();
     if (since(last_change) >= kQuietS) ++stats_.quiet_frames;
     ++stats_.frames;
     host_->DrawFrame(target, width, height, seconds,
                      [&] { animating = frame(width, height, seconds); });
+    animating = animating || !options_.test_drops.empty();
     if (animating) {
       settle = kSettleFrames;
       last_change = Clock::now();

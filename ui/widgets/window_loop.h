@@ -27,6 +27,9 @@ struct WindowOptions {
   bool capture_last_frame = false;  // keep the last drawn frame's picture
   // > 0: close after this long (seconds), drawing as a user's session does (tests of idling).
   double quit_after_seconds = 0.0;
+  // Delivered through the window's drop callback once the first frames are drawn, one path per
+  // frame, as a window system would (tests of drag and drop); frames keep coming until all are.
+  std::vector<std::string> test_drops;
 };
 
 // What a window run drew: every frame, and those drawn when nothing had moved for a second (no
