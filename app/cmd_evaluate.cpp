@@ -55,6 +55,7 @@ std::optional<int> RunOtherEvaluation(int argc, char** argv) {
       return RunEvaluateLrf(argc, argv);
   }
   for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--subsets") return RunEvaluateSubsets(argc, argv);
     if (std::string(argv[i]) == "--sweep") {
       std::vector<char*> rest;
       for (int k = 0; k < argc; ++k)

@@ -259,12 +259,11 @@ int RunSweepLrf(int argc, char** argv) {
   }
   const LrfSweepResult result = RunLrfSweep(
       options, [](int done, int total) { std::fprintf(stderr, "seed %d of %d\n", done, total); });
-  const std::string table = FormatLrfSweepTable(result);
-  std::printf("%s", table.c_str());
+  const int code =
+      PrintAndWriteTable(FormatLrfSweepTable(result), table_path, "calibench sweep --kind lrf");
   std::printf("feature extraction failed on %d of %d simulated observations\n",
               result.observations_failed, result.observations_total);
-  if (!table_path.empty()) std::ofstream(table_path) << table;
-  return kOk;
+  return code;
 }
 
 }  // namespace calibench::app

@@ -1,7 +1,6 @@
 // `calibench sweep`: the paper's Table 1 protocol (core/sim/plane_sweep.h) from the command line.
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "app/commands.h"
@@ -25,6 +24,8 @@ std::vector<double> ParseList(const std::string& text) {
 
 int RunSweep(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--guided") return RunSweepGuided(argc, argv);
+  for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--kind" || std::string(argv[i]).rfind("--kind=", 0) == 0)
       return RunSweepLrf(argc, argv);
   CLI::App app{"Error vs. number of pairs and LiDAR noise (Ca²Lib Table 1 protocol).",
@@ -33,7 +34,8 @@ int RunSweep(int argc, char** argv) {
       "The 2D laser rangefinder kind: `calibench sweep --kind lrf` gives errors against the "
       "number of observations (the LRF paper's Section 4.3 protocol), with --sizes (default "
       "2,3,4,6,8,10,15,20), --seeds N (simulations per size, default 20), --preset paper|ideal, "
-      "--threads, --table FILE. `calibench sweep --kind lrf --help` shows them.");
+      "--threads, --table FILE. `calibench sweep --kind lrf --help` shows them. "
+      "Guided capture against random placement: `calibench sweep --guided --help`.");
   std::string work_dir = "out/sweep", sizes_text = "3,4,5,10,20,30,39",
               noise_text = "0,0.008,0.016", image_noise_text = "0,0.007,0.014", table_path;
   int subsets = 40;
@@ -91,10 +93,7 @@ int RunSweep(int argc, char** argv) {
   }
   const PlaneSweepResult result = RunPlaneSweep(
       sweep, [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); });
-  const std::string table = FormatPlaneSweepTable(result);
-  std::printf("%s", table.c_str());
-  if (!table_path.empty()) std::ofstream(table_path) << table;
-  return kOk;
+  return PrintAndWriteTable(FormatPlaneSweepTable(result), table_path, "calibench sweep");
 }
 
 }  // namespace calibench::app

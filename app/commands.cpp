@@ -3,7 +3,10 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <exception>
 #include <vector>
+
+#include "core/base/atomic_file.h"
 
 namespace calibench::app {
 
@@ -63,6 +66,18 @@ std::optional<int> ParseFlags(CLI::App& app, int argc, char** argv) {
     return code;
   }
   return std::nullopt;
+}
+
+int PrintAndWriteTable(const std::string& table, const std::string& path, const char* command) {
+  std::printf("%s", table.c_str());
+  if (path.empty()) return kOk;
+  try {
+    WriteFileAtomically(path, table);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: cannot write the table to %s: %s\n", command, path.c_str(), e.what());
+    return kInputError;
+  }
+  return kOk;
 }
 
 }  // namespace calibench::app

@@ -32,11 +32,20 @@ std::optional<int> ParseFlags(CLI::App& app, int argc, char** argv);
 // length, at least 2 edits).
 std::string Closest(const std::string& word, const std::vector<std::string>& candidates);
 
+// Prints a table (Markdown) on stdout and, when `path` is not empty, writes it there atomically;
+// kOk, or kInputError with the file and the reason on stderr (prefixed by `command`).
+int PrintAndWriteTable(const std::string& table, const std::string& path, const char* command);
+
 int RunCalibrate(int argc, char** argv);
+int RunAdvise(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
+// `evaluate --subsets`: the σ-honesty protocol (core/sim/subset_coverage.h).
+int RunEvaluateSubsets(int argc, char** argv);
 int RunSimulate(int argc, char** argv);
 int RunDemo(int argc, char** argv);
 int RunSweep(int argc, char** argv);
+// `sweep --guided`: guided against random placement (core/guidance/guided_sweep.h).
+int RunSweepGuided(int argc, char** argv);
 int RunLrfCalibrate(int argc, char** argv);
 // `simulate --kind lrf` and the LRF side of `evaluate` (dispatched from RunSimulate/RunEvaluate).
 int RunSimulateLrf(int argc, char** argv);

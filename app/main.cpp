@@ -23,7 +23,11 @@ constexpr Command kCommands[] = {
     {"lrf-calibrate", calibench::app::RunLrfCalibrate,
      "calibrate a 2D laser rangefinder to a depth camera (three-face target) or an RGB camera "
      "(checkerboard)"},
-    {"evaluate", calibench::app::RunEvaluate, "score a result against a dataset's ground truth"},
+    {"advise", calibench::app::RunAdvise,
+     "is the capture enough for the goal (σ per axis, stop rule), and where to hold the board "
+     "next"},
+    {"evaluate", calibench::app::RunEvaluate,
+     "score a result against a dataset's ground truth (--subsets: is the reported σ honest?)"},
     {"simulate", calibench::app::RunSimulate, "write a synthetic dataset with ground truth"},
     {"demo", calibench::app::RunDemo, "simulate the demo dataset, calibrate it, print the error"},
     {"gui", calibench::app::RunGui,

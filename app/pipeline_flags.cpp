@@ -32,6 +32,14 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
   app.add_flag("--estimate-range-offset", o.solver.estimate_range_offset,
                "weighted-ml: also estimate a constant LiDAR range offset (printed with its "
                "standard deviation and its correlation with the translation)");
+  app.add_option("--range-offset-prior-mm", flags.range_offset_prior_mm,
+                 "weighted-ml: 1σ of the LiDAR range offset known before the data [mm] (0 = "
+                 "none): estimated, a prior on it; left out, the bias it could cause is in the "
+                 "reported σ")
+      ->capture_default_str();
+  app.add_flag_callback(
+      "--no-jackknife", [&o] { o.solver.jackknife_covariance = false; },
+      "weighted-ml: do not widen the reported covariance to the leave-one-pair-out spread");
   if (with_selection) {
     app.add_option("--pairs", flags.pairs, "comma-separated pair ids to use (default: all)");
     app.add_option("--initial-guess", flags.initial_guess,
@@ -59,6 +67,7 @@ bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {
     return false;
   }
   flags.options.solver.method = *method;
+  flags.options.solver.range_offset_prior_sigma_m = flags.range_offset_prior_mm * 1e-3;
   if (!flags.pairs.empty()) {
     std::stringstream ss(flags.pairs);
     std::string id;

@@ -13,6 +13,7 @@ struct PipelineFlags {
   std::string pairs;          // comma-separated pair ids
   std::string initial_guess;  // result.json, or 16 numbers (row-major 4x4)
   std::string method = "weighted-ml";
+  double range_offset_prior_mm = 0.0;  // SolverOptions::range_offset_prior_sigma_m, in mm
 };
 
 // with_selection adds --pairs and --initial-guess (not wanted where pairs are simulated).

@@ -73,4 +73,21 @@ std::filesystem::path WriteAcfrManifest(const std::filesystem::path& dataset_dir
   return manifest;
 }
 
+std::filesystem::path WriteAcfrFolder(const std::filesystem::path& acfr,
+                                      const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  fs::remove_all(dir);
+  fs::create_directories(dir / "clouds");
+  fs::create_directories(dir / "images");
+  for (int n = 1; n <= 40; ++n) {
+    const std::string id = "pose" + std::to_string(n);
+    fs::create_symlink(acfr / "pcd" / (id + "_full.pcd"), dir / "clouds" / (id + ".pcd"));
+    fs::create_symlink(acfr / "images" / (id + ".png"), dir / "images" / (id + ".png"));
+  }
+  fs::create_symlink(acfr / "camera_info.yaml", dir / "camera.yaml");
+  std::ofstream(dir / "target.json") << R"({"type": "checkerboard", "inner_corners": [5, 7],
+    "square_size": 0.095, "board_size": [0.61, 0.85]})";
+  return dir;
+}
+
 }  // namespace calibench::test

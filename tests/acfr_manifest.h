@@ -19,4 +19,9 @@ std::filesystem::path WriteAcfrManifest(const std::filesystem::path& dataset_dir
                                         const std::filesystem::path& out_dir,
                                         double seed_radius_m = 0.25);
 
+// The ACFR files as a user lays them out: clouds/, images/, camera.yaml, target.json (with the
+// sheet size), no seeds anywhere. Links, not copies; `dir` is emptied first.
+std::filesystem::path WriteAcfrFolder(const std::filesystem::path& acfr,
+                                      const std::filesystem::path& dir);
+
 }  // namespace calibench::test

@@ -164,4 +164,11 @@ void CompleteWithCamera(const Dataset& dataset, const std::vector<const PairEntr
   }
 }
 
+std::string BoardDisagreement(const LidarPlaneFit& lidar, const CameraBoardObservation& camera,
+                              const Pose& cam_from_lidar, const BoardSpec& target,
+                              const PipelineOptions& options) {
+  return Disagreement(lidar, camera, Predict(camera, cam_from_lidar),
+                      std::hypot(target.SheetWidth(), target.SheetHeight()), options);
+}
+
 }  // namespace calibench

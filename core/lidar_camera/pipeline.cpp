@@ -90,9 +90,11 @@ CameraFeatures ExtractCameraFeatures(const Dataset& dataset, const ImageU8& imag
   CameraFeatures features;
   std::string why;
   features.detection = DetectBoard(image, dataset.target, options.detection, &why);
-  if (features.detection)
+  if (features.detection) {
     features.observation =
         EstimateBoardPose(dataset.camera, *features.detection, options.pnp, &why);
+    features.edge_width_px = ChessboardEdgeWidthPx(image, dataset.target, *features.detection);
+  }
   if (!features.observation) features.failure = why;
   return features;
 }
@@ -212,6 +214,7 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
   }
   CameraFeatures camera = ExtractCameraFeatures(dataset, inputs->image, options);
   features.camera = std::move(camera.observation);
+  features.edge_width_px = camera.edge_width_px;
   SetStatusFromFeatures(&features, lidar_failure, camera.failure);
   if (edit.rejected) {
     features.status = PairStatus::kRejected;

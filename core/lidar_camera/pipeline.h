@@ -67,6 +67,7 @@ struct PairFeatures {
   std::optional<LidarPlaneFit> lidar;
   std::optional<CameraBoardObservation> camera;
   BoardOrigin board_origin;
+  std::optional<double> edge_width_px;  // ChessboardEdgeWidthPx of its detection (blur)
 };
 
 // options.lidar_plane for `target`: its grow radius (when options.grow_to_board) and its sheet size
@@ -98,6 +99,7 @@ struct CameraFeatures {
   std::optional<BoardDetection> detection;
   std::optional<CameraBoardObservation> observation;
   std::string failure;
+  std::optional<double> edge_width_px;  // ChessboardEdgeWidthPx (checkerboards)
 };
 CameraFeatures ExtractCameraFeatures(const Dataset& dataset, const ImageU8& image,
                                      const PipelineOptions& options);
@@ -176,6 +178,13 @@ std::optional<SceneBackground> BuildSceneBackground(
 void CompleteWithCamera(const Dataset& dataset, const std::vector<const PairEntry*>& pairs,
                         const PipelineOptions& options, const PairEdits& edits,
                         CalibrationOutcome* outcome);
+
+// Why a pair's LiDAR board disagrees with where its camera board puts it under cam_from_lidar
+// (the gate of CompleteWithCamera: both planes' σ, floored by options.guided_min_angle_deg and
+// guided_min_offset_m), or "" when they agree.
+std::string BoardDisagreement(const LidarPlaneFit& lidar, const CameraBoardObservation& camera,
+                              const Pose& cam_from_lidar, const BoardSpec& target,
+                              const PipelineOptions& options);
 
 // Extracts every selected pair (in parallel with options.threads) and solves.
 CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,

@@ -29,7 +29,10 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
                     // What the data said about the noise models: 1 = they held.
                     {"plane_variance_factor", s.plane_variance_factor},
                     {"edge_variance_factor", s.edge_variance_factor},
-                    {"covariance_inflation", s.covariance_inflation}};
+                    {"covariance_inflation", s.covariance_inflation},
+                    // The leave-one-pair-out check behind the reported σ (0 pairs = not run).
+                    {"jackknife_pairs", s.jackknife_pairs},
+                    {"jackknife_widened", s.jackknife_widened}};
   if (s.edge_dilation) {
     root["solver"]["board_edge_dilation"] = {
         {"value_m", s.edge_dilation->value_m},
@@ -167,9 +170,10 @@ void PrintModelFigures(const SolverResult& s, std::ostringstream& out) {
   }
   if (s.covariance_inflation > 1.0) {
     std::snprintf(line, sizeof(line),
-                  "covariance widened up to %.1fx (variance) by the spread over the pairs: the "
+                  "covariance widened up to %.1fx (variance) by the spread over the pairs%s: the "
                   "noise models underestimate this data\n",
-                  s.covariance_inflation);
+                  s.covariance_inflation,
+                  s.jackknife_widened ? " (leave-one-out, widened for the few pairs)" : "");
     out << line;
   }
 }

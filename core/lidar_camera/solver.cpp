@@ -41,6 +41,8 @@ bool SolverOptions::Check(std::string* why) const {
   if (!(range_offset_significance > 0))
     return fail("range_offset_significance must be > 0 (standard deviations)");
   if (!(edge_floor_sigma_m > 0)) return fail("edge_floor_sigma_m must be > 0 (metres)");
+  if (!(range_offset_prior_sigma_m >= 0))
+    return fail("range_offset_prior_sigma_m must be >= 0 (metres; 0 = no prior)");
   if (estimate_range_offset && method != SolverMethod::kWeightedMl)
     return fail("a range offset is estimated by the weighted-ml method only, not by " +
                 SolverMethodName(method));
@@ -252,6 +254,7 @@ PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(const Pose& 
     for (size_t i = 0; i < pairs_.size(); ++i) {
       if (gated_[i]) continue;
       const Vec7 gradient_before = lin.gradient;
+      const Mat7 information_before = lin.information;
       const WeightedResidual w = ComputeWeightedResidual(cam_from_lidar, pairs_[i], range_offset_m);
       jacobian.leftCols<6>() = w.jacobian;
       jacobian.col(kRangeOffset) = w.offset_jacobian;
@@ -267,6 +270,14 @@ PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(const Pose& 
       if (options_.use_board_edges && pairs_[i].sheet_half_size_m.minCoeff() > 0)
         LinearizeEdges(cam_from_lidar, range_offset_m, pairs_[i], &lin);
       lin.pair_gradients.push_back(lin.gradient - gradient_before);
+      lin.pair_informations.push_back(lin.information - information_before);
+    }
+    // The offset's prior, a pseudo-observation b = 0 ± σ (only where b is estimated).
+    const double prior = options_.range_offset_prior_sigma_m;
+    if (options_.estimate_range_offset && prior > 0) {
+      lin.information(kRangeOffset, kRangeOffset) += 1.0 / (prior * prior);
+      lin.gradient[kRangeOffset] += range_offset_m / (prior * prior);
+      lin.cost += 0.5 * range_offset_m * range_offset_m / (prior * prior);
     }
     return lin;
   }
@@ -426,6 +437,18 @@ Mat6 WeightedPlaneInformation(const std::vector<PlanePair>& pairs, const Pose& c
     information += w.jacobian.transpose() * w.covariance.inverse() * w.jacobian;
   }
   return information;
+}
+
+Mat6 ExpectedPoseInformation(const std::vector<PlanePair>& pairs, const Pose& cam_from_lidar,
+                             const SolverOptions& options, double plane_variance_factor,
+                             double edge_variance_factor) {
+  if (pairs.empty()) return Mat6::Zero();
+  SolverOptions model = options;
+  model.method = SolverMethod::kWeightedMl;
+  model.estimate_range_offset = false;
+  PlaneAlignmentSolver solver(pairs, model, cam_from_lidar);
+  solver.SetVarianceFactors(plane_variance_factor, edge_variance_factor);
+  return solver.PoseInformation();
 }
 
 }  // namespace calibench

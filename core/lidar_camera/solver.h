@@ -69,6 +69,17 @@ struct SolverOptions {
   // kWeightedMl: report the larger of the model's covariance and the pairs' cluster-robust
   // (sandwich) covariance along every direction (see SolverResult::covariance_inflation).
   bool sandwich_covariance = true;
+  // kWeightedMl: where the leave-one-pair-out (jackknife) scatter of the estimate shows the model
+  // violated, no narrower than the jackknife widened for the few pairs it comes from (see
+  // solver_summary.cpp). Where the sandwich needs more pairs than parameters, the jackknife
+  // already speaks from 4 pairs on.
+  bool jackknife_covariance = true;
+  // kWeightedMl: what is known of the LiDAR's range offset before the data (1σ, metres; 0 = no
+  // prior). Estimated (estimate_range_offset), it is a pseudo-observation b = 0 ± σ; left out,
+  // the pose's covariance carries the bias such an offset would cause (σ² g gᵀ, g the pose's
+  // response to the offset): a spinning LiDAR's factory range calibration is good to about
+  // 1-3 cm, and boards seen from one side cannot tell that from the translation.
+  double range_offset_prior_sigma_m = 0.0;
   // Above this standard deviation (metres) the offset is reported as not determined by the data
   // (a weak direction).
   double range_offset_max_sigma_m = 0.01;
@@ -130,6 +141,17 @@ struct SolverResult {
   // How much the pairs' spread widened the model's covariance (the largest variance ratio, ≥ 1;
   // SolverOptions::sandwich_covariance). Near 1: the noise models hold.
   double covariance_inflation = 1.0;
+  // The jackknife (SolverOptions::jackknife_covariance): the pairs it was computed over (0 = not
+  // computed: too few pairs, or a pair whose absence leaves the pose undetermined) and the
+  // standard deviations of the pairs' scatter it shows, free of the pairs' leverage (camera
+  // axes; metres, degrees), so that a stop rule can ask whether the leave-one-out spread agrees
+  // with the reported σ.
+  int jackknife_pairs = 0;
+  Vec3 jackknife_sigma_t_m = Vec3::Zero();
+  Vec3 jackknife_sigma_r_deg = Vec3::Zero();
+  // The pairs' scatter exceeded the model's (its per-pair errors are larger than its features'
+  // noise says), so the reported covariance is the jackknife's, widened for the few pairs.
+  bool jackknife_widened = false;
 };
 
 // The LiDAR plane the board really has under a range offset b: the fitted one moved back by
@@ -145,6 +167,15 @@ std::optional<Pose> InitialGuessFromPlanes(const std::vector<PlanePair>& pairs, 
 // pair's own covariances, no robust weights and no variance factor. With noise-free planes and the
 // features' Cramér–Rao covariances this is the Fisher information of the extrinsic.
 Mat6 WeightedPlaneInformation(const std::vector<PlanePair>& pairs, const Pose& cam_from_lidar);
+
+// The information JᵀWJ over the pose (right perturbation, [rho; phi]) that `pairs` contribute at
+// cam_from_lidar under the solver's own residual model (weighted planes, and board edges with
+// options.use_board_edges), their noise scaled by the given variance factors (a finished solve's
+// SolverResult::plane_variance_factor / edge_variance_factor). At noise-free features the robust
+// weights are 1: the expected information of planned board poses (core/guidance).
+Mat6 ExpectedPoseInformation(const std::vector<PlanePair>& pairs, const Pose& cam_from_lidar,
+                             const SolverOptions& options, double plane_variance_factor = 1.0,
+                             double edge_variance_factor = 1.0);
 
 // Eq. (14) solved by Gauss-Newton with iteratively reweighted Huber weights.
 class PlaneAlignmentSolver {
@@ -169,6 +200,8 @@ class PlaneAlignmentSolver {
   // SolverResult::plane_variance_factor / edge_variance_factor), so that Summarize at its
   // estimate weighs the residuals as that solve did.
   void SetVarianceFactors(double plane_variance_factor, double edge_variance_factor);
+  // JᵀWJ over the pose at the current estimate (robust weights and variance factors applied).
+  Mat6 PoseInformation() const { return LinearizeHere().information.topLeftCorner<6, 6>(); }
 
  private:
   // Parameters [rho; phi; b]: the pose's right perturbation and the range offset. The offset's
@@ -189,6 +222,7 @@ class PlaneAlignmentSolver {
     std::vector<double> pair_dilations_m;  // those pairs' dilations
     Mat7 edge_information = Mat7::Zero();  // the edges' part of `information`
     std::vector<Vec7> pair_gradients;      // kWeightedMl: each used pair's share of `gradient`
+    std::vector<Mat7> pair_informations;   // kWeightedMl: each used pair's share of `information`
     std::vector<double> pair_weights;      // per pair, its planes' robust weight (0 = gated)
     double edge_weighted_squared_error = 0.0;
   };
@@ -207,7 +241,7 @@ class PlaneAlignmentSolver {
   // estimated) from the information scaled by the variance factor, widened to the pairs' spread
   // (sandwich) where that is larger; *inflation gets the widening (1 = none).
   Mat7 Covariance(const Linearization& lin, const std::vector<int>& active, double variance_factor,
-                  double* inflation) const;
+                  SolverResult* result) const;
   // The offset's correlation with the camera-frame translation R ρ (right perturbation).
   Vec3 OffsetCorrelation(const Mat7& joint_covariance) const;
   // The estimated range offset, or (not estimated) the score test's significant one.

@@ -1,11 +1,15 @@
 // PlaneAlignmentSolver::Summarize: what the solution says about itself — residuals and weights,
 // covariance (model and sandwich), the range offset, observability.
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
+#include <utility>
 
+#include "core/estimation/uncertainty.h"
 #include "core/lidar_camera/solver.h"
 
 namespace calibench {
@@ -21,6 +25,66 @@ std::optional<EdgeDilationEstimate> DilationOverPairs(const std::vector<double>&
   dilation.spread_m = n > 1 ? std::sqrt(dilation.spread_m / (n - 1)) : 0.0;
   dilation.sigma_m = dilation.spread_m / std::sqrt(n);
   return dilation;
+}
+
+// `base` widened to `other` along every direction where `other` is larger by more than
+// `noise_ratio` (a variance ratio; 1 = any excess): other v = λ base v with vᵀ base v = 1, so in
+// the basis V, base = V⁻ᵀV⁻¹ and other = V⁻ᵀΛV⁻¹, and V⁻ᵀ max(Λ / noise_ratio, 1) V⁻¹ is the
+// larger of the two along every direction. `base` when the pencil cannot be solved.
+Eigen::MatrixXd LargerAlongEveryDirection(const Eigen::MatrixXd& base, const Eigen::MatrixXd& other,
+                                          double noise_ratio) {
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> generalized(other, base);
+  if (generalized.info() != Eigen::Success) return base;
+  const Eigen::MatrixXd to_basis = generalized.eigenvectors().inverse();
+  const Eigen::VectorXd widening = (generalized.eigenvalues() / noise_ratio).cwiseMax(1.0);
+  return to_basis.transpose() * widening.asDiagonal() * to_basis;
+}
+
+// The quantile of F(a, b) at the normal's z, by Paulson's normal approximation of the cube root
+// (within a few per cent for a >= 3): solves (A y − B)² = z² (C y² + D) for y = F^(1/3).
+double FQuantile(int a, int b, double z) {
+  const double c = 2.0 / (9.0 * b), d = 2.0 / (9.0 * a);
+  const double big_a = 1.0 - c, big_b = 1.0 - d;
+  const double quadratic = big_a * big_a - z * z * c;
+  const double discriminant =
+      big_a * big_a * big_b * big_b - quadratic * (big_b * big_b - z * z * d);
+  if (!(quadratic > 0) || !(discriminant >= 0)) return 1e9;  // too few residuals to tell
+  const double y = (big_a * big_b + std::sqrt(discriminant)) / quadratic;
+  return y * y * y;
+}
+
+// The standard normal's quantile (Acklam's rational approximation, relative error < 1.2e-9 in
+// the upper tail used here).
+double NormalQuantile(double p) {
+  // Upper region only (p > 0.97575), which is all this file asks for.
+  const double q = std::sqrt(-2.0 * std::log(1.0 - p));
+  static constexpr double c[] = {-7.784894002430293e-03, -3.223964580411365e-01,
+                                 -2.400758277161838e+00, -2.549732539343734e+00,
+                                 4.374664141464968e+00,  2.938163982698783e+00};
+  static constexpr double d[] = {7.784695709041462e-03, 3.224671290700398e-01,
+                                 2.445134137142996e+00, 3.754408661907416e+00};
+  return -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+         ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+}
+
+// The Student t quantile at the normal's 3σ (one-sided 0.99865) for `dof` degrees of freedom,
+// interpolated in 1/dof between tabulated values (computed by numerical integration of the t
+// density); 3 in the limit.
+double StudentQuantileAt3Sigma(int dof) {
+  static constexpr std::pair<double, double> kTable[] = {
+      {1, 235.8},  {2, 19.21},  {3, 9.219},  {4, 6.620},  {5, 5.507},
+      {6, 4.904},  {7, 4.530},  {8, 4.277},  {9, 4.094},  {10, 3.957},
+      {12, 3.764}, {15, 3.586}, {20, 3.422}, {30, 3.270}, {60, 3.130}};
+  if (dof <= 1) return kTable[0].second;
+  for (size_t i = 1; i < std::size(kTable); ++i) {
+    if (dof > kTable[i].first) continue;
+    const auto [v0, q0] = kTable[i - 1];
+    const auto [v1, q1] = kTable[i];
+    const double f = (1.0 / v0 - 1.0 / dof) / (1.0 / v0 - 1.0 / v1);
+    return q0 + f * (q1 - q0);
+  }
+  const auto [v_last, q_last] = kTable[std::size(kTable) - 1];
+  return 3.0 + (q_last - 3.0) * v_last / dof;
 }
 
 }  // namespace
@@ -51,7 +115,7 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   // component estimated for it times the common factor that remains.
   result.plane_variance_factor = plane_variance_scale_ * variance_factor;
   result.edge_variance_factor = edge_variance_scale_ * variance_factor;
-  const Mat7 covariance = Covariance(lin, active, variance_factor, &result.covariance_inflation);
+  const Mat7 covariance = Covariance(lin, active, variance_factor, &result);
   result.covariance = covariance.topLeftCorner<6, 6>();
   ReportRangeOffset(lin, covariance, variance_factor, &result);
   result.observability = Observability(result, redundancy);
@@ -61,7 +125,7 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
 PlaneAlignmentSolver::Mat7 PlaneAlignmentSolver::Covariance(const Linearization& lin,
                                                             const std::vector<int>& active,
                                                             double variance_factor,
-                                                            double* inflation) const {
+                                                            SolverResult* result) const {
   // With the offset estimated, the pose covariance is the marginal of the joint one: the offset's
   // uncertainty spreads into the translation it is correlated with.
   const int num_parameters = static_cast<int>(active.size());
@@ -78,37 +142,124 @@ PlaneAlignmentSolver::Mat7 PlaneAlignmentSolver::Covariance(const Linearization&
                                            inverse_eigenvalues.asDiagonal() *
                                            eigen.eigenvectors().transpose();
   covariance(active, active) = model_covariance;
+  const int clusters = static_cast<int>(lin.pair_gradients.size());
+  if (options_.method != SolverMethod::kWeightedMl || !(variance_factor > 0) ||
+      !(eigen.eigenvalues()[0] > 1e-12 * largest))
+    return covariance;
+  const Eigen::MatrixXd inverse_information = model_covariance / variance_factor;
+  Eigen::MatrixXd reported = model_covariance;
   // The model's covariance trusts every residual to be independent. On real sensors they are
   // not (a pair's edge points share its range-dependent beam footprint, its board's flatness,
   // its rings' angle errors), which the model cannot see and the spread over pairs shows. The
   // cluster-robust (sandwich) covariance with the pairs as clusters, H⁻¹ (Σᵢ gᵢgᵢᵀ) H⁻¹ scaled by
   // n/(n − p), measures that spread from the data; the reported covariance is the larger of the
   // two in every direction (beyond the sandwich's own sampling noise).
-  const int clusters = static_cast<int>(lin.pair_gradients.size());
-  if (options_.method != SolverMethod::kWeightedMl || !options_.sandwich_covariance ||
-      clusters <= num_parameters + 2 || !(variance_factor > 0) ||
-      !(eigen.eigenvalues()[0] > 1e-12 * largest))
-    return covariance;
-  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
-  for (const Vec7& g : lin.pair_gradients) {
-    const Eigen::VectorXd active_g = g(active);
-    meat += active_g * active_g.transpose();
+  if (options_.sandwich_covariance && clusters > num_parameters + 2) {
+    Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
+    for (const Vec7& g : lin.pair_gradients) {
+      const Eigen::VectorXd active_g = g(active);
+      meat += active_g * active_g.transpose();
+    }
+    const Eigen::MatrixXd sandwich = static_cast<double>(clusters) / (clusters - num_parameters) *
+                                     inverse_information * meat * inverse_information;
+    // A variance ratio estimated from n clusters scatters by about √(2 / (n − p)) even when the
+    // model holds: only the excess beyond that one-σ noise inflates, so that a correct model
+    // keeps its covariance (and its χ² calibration) while a violated one widens.
+    reported = LargerAlongEveryDirection(reported, sandwich,
+                                         1.0 + std::sqrt(2.0 / (clusters - num_parameters)));
   }
-  const Eigen::MatrixXd inverse_information = model_covariance / variance_factor;
-  const Eigen::MatrixXd sandwich = static_cast<double>(clusters) / (clusters - num_parameters) *
-                                   inverse_information * meat * inverse_information;
-  // sandwich v = λ model v with vᵀ model v = 1: in the basis V, model = V⁻ᵀV⁻¹ and
-  // sandwich = V⁻ᵀΛV⁻¹, so V⁻ᵀ max(Λ, 1) V⁻¹ is the larger of the two along every direction.
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> generalized(sandwich, model_covariance);
-  if (generalized.info() != Eigen::Success) return covariance;
-  // A variance ratio estimated from n clusters scatters by about √(2 / (n − p)) even when the
-  // model holds: only the excess beyond that one-σ noise inflates, so that a correct model
-  // keeps its covariance (and its χ² calibration) while a violated one widens.
-  const double noise = 1.0 + std::sqrt(2.0 / (clusters - num_parameters));
-  const Eigen::MatrixXd to_basis = generalized.eigenvectors().inverse();
-  const Eigen::VectorXd widening = (generalized.eigenvalues() / noise).cwiseMax(1.0);
-  covariance(active, active) = to_basis.transpose() * widening.asDiagonal() * to_basis;
-  *inflation = widening.maxCoeff();
+  // The jackknife: how far the estimate moves when each pair is left out, one Gauss-Newton step
+  // from the solution without that pair's share, Δᵢ = (H − Hᵢ)⁻¹ gᵢ (gᵢ: the pair's gradient,
+  // Hᵢ its information). Unlike the sandwich it sees a pair's leverage (a pair the others hardly
+  // constrain moves the estimate by more than H⁻¹ gᵢ), and it needs only 4 pairs. With few pairs
+  // its variance is itself uncertain (k − 1 degrees of freedom), so it is widened by the Student
+  // t quantile over the normal one at 3σ: a 3σ test of the result then keeps its 99.7 %.
+  if (options_.jackknife_covariance && clusters >= 4) {
+    // Per pair: its move Δᵢ = Aᵢ gᵢ with Aᵢ = (H − Hᵢ)⁻¹, and what the model expects of that
+    // move's spread, s² Aᵢ Hᵢ Aᵢᵀ (gᵢ has covariance s² Hᵢ when the model holds).
+    std::vector<Eigen::VectorXd> moves;
+    Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
+    bool all_determined = true;
+    for (int i = 0; i < clusters && all_determined; ++i) {
+      const Eigen::MatrixXd pair_information = lin.pair_informations[i](active, active);
+      const Eigen::MatrixXd without = information - pair_information;
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> without_eigen(without);
+      const Eigen::VectorXd lambdas = without_eigen.eigenvalues();
+      all_determined = lambdas[0] > 1e-9 * lambdas[num_parameters - 1];
+      if (!all_determined) break;
+      const Eigen::MatrixXd inverse =
+          without.ldlt().solve(Eigen::MatrixXd::Identity(num_parameters, num_parameters));
+      moves.push_back(inverse * lin.pair_gradients[i](active));
+      expected += variance_factor * inverse * pair_information * inverse.transpose();
+    }
+    const Eigen::LLT<Eigen::MatrixXd> expected_llt(expected);
+    const Eigen::LLT<Eigen::MatrixXd> model_llt(model_covariance);
+    if (all_determined && expected_llt.info() == Eigen::Success &&
+        model_llt.info() == Eigen::Success) {
+      Eigen::VectorXd mean = Eigen::VectorXd::Zero(num_parameters);
+      for (const Eigen::VectorXd& move : moves) mean += move / clusters;
+      Eigen::MatrixXd jackknife = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
+      for (const Eigen::VectorXd& move : moves)
+        jackknife += (move - mean) * (move - mean).transpose();
+      jackknife *= (clusters - 1.0) / clusters;
+      expected *= (clusters - 1.0) / clusters;
+      // A pair of high leverage moves the estimate more than the model's covariance suggests
+      // even when the model holds (with k pairs and p parameters the average pair carries p/k of
+      // the information): the jackknife's excess is judged against what the model expects of
+      // it, X = L_E⁻¹ J L_E⁻ᵀ (the identity when the model holds), and carried over to the
+      // model's covariance, L_M X L_Mᵀ: the covariance the pairs' scatter says, free of leverage.
+      const Eigen::MatrixXd l_expected = expected_llt.matrixL();
+      const Eigen::MatrixXd l_model = model_llt.matrixL();
+      const Eigen::MatrixXd excess = l_expected.triangularView<Eigen::Lower>().solve(
+          l_expected.triangularView<Eigen::Lower>().solve(jackknife).transpose());
+      const Eigen::MatrixXd scatter = l_model * excess * l_model.transpose();
+      Mat7 scatter_pose = Mat7::Zero();
+      scatter_pose(active, active) = scatter;
+      result->jackknife_pairs = clusters;
+      result->jackknife_sigma_t_m =
+          TranslationStd(scatter_pose.topLeftCorner<6, 6>(), cam_from_lidar_);
+      result->jackknife_sigma_r_deg =
+          RotationStdDeg(scatter_pose.topLeftCorner<6, 6>(), cam_from_lidar_);
+      // Where the model holds, that scatter's variance along a direction lies around the
+      // model's like an F(k − 1, r) ratio (the model's own scale is estimated from the r
+      // redundant residuals), and the model, which knows every residual's noise, is the better
+      // estimate. Only a scatter beyond that ratio's 99 % quantile for the largest of the p
+      // directions (Bonferroni: 1 − 0.01/p, z = 2.93 for six) says the model is violated (real
+      // sensors' per-pair errors). Then the jackknife itself is reported where it is larger,
+      // widened by the t quantile for its k − 1 degrees of freedom: with few pairs its leverage
+      // makes it conservative, which is the side to err on once the model is known not to hold.
+      const int redundancy = lin.num_residuals - lin.num_edge_dilations - num_parameters;
+      const double threshold = FQuantile(clusters - 1, std::max(1, redundancy),
+                                         NormalQuantile(1.0 - 0.01 / num_parameters));
+      Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> test(scatter, model_covariance);
+      if (test.info() == Eigen::Success && test.eigenvalues().maxCoeff() > threshold) {
+        const double widen = StudentQuantileAt3Sigma(clusters - 1) / 3.0;
+        reported = LargerAlongEveryDirection(reported, widen * widen * jackknife, 1.0);
+        result->jackknife_widened = true;
+      }
+    }
+  }
+  covariance(active, active) = reported;
+  // An offset left out that the data cannot see still biases the pose by g·b (g = −H_pp⁻¹ H_pb,
+  // the pose's response to an offset): its prior spreads into the covariance as σ_b² g gᵀ.
+  const double prior = options_.range_offset_prior_sigma_m;
+  if (!options_.estimate_range_offset && prior > 0 && variance_factor > 0) {
+    // What the data itself says of b (the information left for it once the pose is free, at
+    // the solve's variance factor) narrows the prior: σ_post² = 1 / (1/σ_b² + I_b|pose).
+    const Mat6 pose_information = lin.information.topLeftCorner<6, 6>();
+    const Vec6 cross = lin.information.block<6, 1>(0, kRangeOffset);
+    const Vec6 response = -pose_information.ldlt().solve(cross);
+    const double offset_information = std::max(
+        0.0, (lin.information(kRangeOffset, kRangeOffset) + cross.dot(response)) / variance_factor);
+    const double posterior = 1.0 / (1.0 / (prior * prior) + offset_information);
+    if (response.allFinite() && std::isfinite(posterior))
+      covariance.topLeftCorner<6, 6>() += posterior * response * response.transpose();
+  }
+  // How much wider than the model the reported covariance is, along its widest direction.
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ratio(covariance(active, active),
+                                                                  model_covariance);
+  if (ratio.info() == Eigen::Success)
+    result->covariance_inflation = std::max(1.0, ratio.eigenvalues().maxCoeff());
   return covariance;
 }
 

@@ -439,4 +439,57 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
   return dataset;
 }
 
+SimulatedPair SimulatePairAt(const SimOptions& resolved, const Pose& cam_from_board,
+                             int pair_index) {
+  CheckOrThrow(resolved);
+  const SimOptions& r = resolved;
+  const BeamTable beams = MakeBeamTable(r.lidar);
+  const BoardPrint print(r.board);
+  LidarScene scene = RoomScene(r);
+  std::mt19937_64 rng(MixSeed(r.seed, pair_index, 0));
+  const double azimuth_offset =
+      2.0 * M_PI / beams.azimuth_steps * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+  scene.lidar_from_board = r.cam_from_lidar.inverse() * cam_from_board;
+  SimulatedPair pair;
+  pair.seed = LidarSeed{BoardHitCentroid(beams, print, scene.lidar_from_board, azimuth_offset),
+                        r.seed_radius_m};
+  LidarScanOptions scan_options;
+  scan_options.range_noise_m = r.lidar_range_noise_m;
+  scan_options.range_offset_m = r.lidar_range_offset_m;
+  scan_options.azimuth_offset_rad = azimuth_offset;
+  scan_options.seed = MixSeed(r.seed, pair_index, 1);
+  pair.cloud = SimulateLidarScan(beams, print, scene, scan_options).ToCloud();
+  RenderOptions render;
+  render.image_noise = r.image_noise;
+  render.seed = MixSeed(r.seed, pair_index, 2);
+  pair.image = RenderBoardImage(r.camera, r.board, cam_from_board, render);
+  return pair;
+}
+
+bool PlaceableInSimulation(const SimOptions& resolved, const Pose& cam_from_board,
+                           std::string* why) {
+  const SimOptions& r = resolved;
+  const BeamTable beams = MakeBeamTable(r.lidar);
+  const BoardPrint print(r.board);
+  const LidarScene scene = RoomScene(r);
+  const Pose lidar_from_board = r.cam_from_lidar.inverse() * cam_from_board;
+  auto fail = [&](const char* reason) {
+    if (why) *why = reason;
+    return false;
+  };
+  if (!SheetInImage(r, cam_from_board)) return fail("the sheet leaves the image");
+  if (!SheetFitsRoom(r, scene, lidar_from_board)) return fail("the sheet does not fit the room");
+  if (!SheetInLidarFov(r, beams, lidar_from_board))
+    return fail("the sheet leaves the LiDAR's vertical field of view");
+  if (!EnoughLidarHits(beams, print, lidar_from_board, 0.0))
+    return fail("too few LiDAR rings or points on the sheet");
+  return true;
+}
+
+Pose RandomPlacement(const SimOptions& resolved, int pair_index) {
+  const BeamTable beams = MakeBeamTable(resolved.lidar);
+  const BoardPrint print(resolved.board);
+  return PlanPair(resolved, beams, print, RoomScene(resolved), pair_index).cam_from_board;
+}
+
 }  // namespace calibench

@@ -163,6 +163,27 @@ struct SimPairTruth {
 };
 std::vector<SimPairTruth> SimulatePairTruth(const SimOptions& options);
 
+// One pair simulated in memory at a given board pose (guided capture, core/guidance): the cloud
+// with the room, the image, and the seed a user's brush would give. `pair_index` draws the
+// noise and the firing phase as SimulateDataset's pair of that index would. Options as
+// ResolveSimOptions returns them.
+struct SimulatedPair {
+  LidarCloud cloud;
+  ImageU8 image;
+  LidarSeed seed;
+};
+SimulatedPair SimulatePairAt(const SimOptions& resolved, const Pose& cam_from_board,
+                             int pair_index);
+
+// Whether the simulator itself would place a board there: the whole sheet in the image with a
+// 5 % margin, in the room, inside the LiDAR's vertical field of view and hit by >= 4 rings and
+// >= 60 points. *why (optional) names the first failed check.
+bool PlaceableInSimulation(const SimOptions& resolved, const Pose& cam_from_board,
+                           std::string* why = nullptr);
+
+// The board pose SimulateDataset's pair `pair_index` gets (random placement).
+Pose RandomPlacement(const SimOptions& resolved, int pair_index);
+
 // The simulator's options as recorded in a dataset it wrote (Dataset::simulation); throws
 // IoError naming the manifest when the dataset carries no simulation record.
 SimOptions SimOptionsFromDataset(const Dataset& dataset);

@@ -66,4 +66,10 @@ std::optional<CameraBoardObservation> EstimateBoardPose(const CameraModel& camer
                                                         const PnpOptions& options,
                                                         std::string* why);
 
+// Motion blur: OpenCV's estimateChessboardSharpness over a checkerboard's full detection, the
+// mean width of the squares' edges in pixels (a sharp print: 1.5-2.5 px); nullopt for ChArUco
+// or a partial detection.
+std::optional<double> ChessboardEdgeWidthPx(const ImageU8& image, const BoardSpec& board,
+                                            const BoardDetection& detection);
+
 }  // namespace calibench

@@ -250,4 +250,35 @@ std::optional<BoardDetection> DetectBoard(const ImageU8& image, const BoardSpec&
                                                 : DetectCharuco(grey, board, options, why);
 }
 
+std::optional<double> ChessboardEdgeWidthPx(const ImageU8& image, const BoardSpec& board,
+                                            const BoardDetection& detection) {
+  if (board.type != BoardType::kCheckerboard ||
+      static_cast<int>(detection.pixels.size()) != board.cols * board.rows || image.empty())
+    return std::nullopt;
+  cv::Mat grey;
+  const cv::Mat view(image.height, image.width, image.channels == 1 ? CV_8UC1 : CV_8UC3,
+                     const_cast<std::uint8_t*>(image.data.data()));
+  if (image.channels == 1)
+    grey = view;
+  else
+    cv::cvtColor(view, grey, cv::COLOR_BGR2GRAY);
+  std::vector<cv::Point2f> corners;
+  for (const Vec2& p : detection.pixels)
+    corners.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  // OpenCV measures the edges of one direction per call (horizontal lines by default): a board
+  // moved sideways smears only the vertical ones, so both are measured and the wider is kept.
+  double widest = 0.0;
+  for (const bool vertical : {false, true}) {
+    try {
+      const cv::Scalar sharpness = cv::estimateChessboardSharpness(
+          grey, cv::Size(board.cols, board.rows), corners, 0.8F, vertical);
+      if (sharpness[0] > 0 && std::isfinite(sharpness[0])) widest = std::max(widest, sharpness[0]);
+    } catch (const cv::Exception&) {
+      // An edge OpenCV cannot follow: that direction says nothing.
+    }
+  }
+  if (!(widest > 0)) return std::nullopt;
+  return widest;
+}
+
 }  // namespace calibench

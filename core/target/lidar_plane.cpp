@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 
 namespace calibench {
 
@@ -331,6 +332,11 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
   if (fit->grown && options.sheet_size_m.minCoeff() > 0) {
     fit->edge_points = ExtractBoardEdgePoints(cloud, fit->inliers, fit->plane, options.edges);
     fit->sheet_size_m = options.sheet_size_m;
+  }
+  if (cloud.HasRing()) {
+    std::set<int> rings;
+    for (int i : fit->inliers) rings.insert(cloud.ring[i]);
+    fit->num_rings = static_cast<int>(rings.size());
   }
   return fit;
 }

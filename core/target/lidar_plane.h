@@ -56,6 +56,7 @@ struct LidarPlaneFit {
   std::vector<LidarEdgePoint> edge_points;
   Vec2 sheet_size_m = Vec2::Zero();
   double rms_m = 0.0;  // point-to-plane RMS of the inliers
+  int num_rings = 0;   // distinct rings among the inliers (0 = the cloud has no rings)
 };
 
 // Points on rays within the cone that a disc of `seed.radius` (metres) around `seed.point`

@@ -194,29 +194,11 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
   }
 }
 
-// The ACFR files as a user lays them out: clouds/, images/, camera.yaml, target.json (with the
-// sheet size), no seeds anywhere. Links, not copies.
-std::filesystem::path WriteAcfrFolder(const std::filesystem::path& acfr,
-                                      const std::filesystem::path& dir) {
-  namespace fs = std::filesystem;
-  fs::remove_all(dir);
-  fs::create_directories(dir / "clouds");
-  fs::create_directories(dir / "images");
-  for (int n = 1; n <= 40; ++n) {
-    const std::string id = "pose" + std::to_string(n);
-    fs::create_symlink(acfr / "pcd" / (id + "_full.pcd"), dir / "clouds" / (id + ".pcd"));
-    fs::create_symlink(acfr / "images" / (id + ".png"), dir / "images" / (id + ".png"));
-  }
-  fs::create_symlink(acfr / "camera_info.yaml", dir / "camera.yaml");
-  std::ofstream(dir / "target.json") << R"({"type": "checkerboard", "inner_corners": [5, 7],
-    "square_size": 0.095, "board_size": [0.61, 0.85]})";
-  return dir;
-}
-
 TEST(RealVlp16, NoSeedsNoBrushingTheBoardIsDetectedInEveryCloud) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
   const auto acfr = shared / "datasets/acfr-vlp16-chessboard";
-  const Dataset folder = LoadDataset(WriteAcfrFolder(acfr, test::TempDir("real_vlp16_folder")));
+  const Dataset folder =
+      LoadDataset(test::WriteAcfrFolder(acfr, test::TempDir("real_vlp16_folder")));
   const Dataset seeded =
       LoadDataset(test::WriteAcfrManifest(acfr, test::TempDir("real_vlp16_seeded")));
   ASSERT_EQ(folder.pairs.size(), 40u);

@@ -1,0 +1,91 @@
+// `calibench advise`: where a capture stands against the user's goal and where to hold the board
+// next (core/guidance).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "app/commands.h"
+#include "app/pipeline_flags.h"
+#include "core/guidance/advise.h"
+#include "core/guidance/lrf_meter.h"
+#include "core/io/dataset.h"
+#include "core/lrf/dataset.h"
+
+namespace calibench::app {
+
+int RunAdvise(int argc, char** argv) {
+  CLI::App app{
+      "Say whether the dataset's poses are enough for the goal (1σ per axis, with a σ that "
+      "can be trusted) and, if not, where to hold the board next.",
+      "calibench advise"};
+  std::string dataset_path;
+  AdviseOptions options;
+  bool json = false;
+  app.add_option("--dataset,-d", dataset_path, "dataset.json or dataset folder")->required();
+  app.add_option("--goal-mm", options.goal.translation_mm,
+                 "goal: 1σ of the translation per axis [mm]")
+      ->capture_default_str();
+  app.add_option("--goal-deg", options.goal.rotation_deg, "goal: 1σ of the rotation per axis [deg]")
+      ->capture_default_str();
+  app.add_option("--min-distance", options.min_distance_m,
+                 "nearest usable board distance from the camera [m] (default: from the data)");
+  app.add_option("--max-distance", options.max_distance_m,
+                 "farthest usable board distance from the camera [m] (default: from the data)");
+  app.add_flag("--json", json, "print exactly one JSON object on stdout");
+  double lrf_threshold_mm = 10.0;
+  app.add_option("--error-threshold-mm", lrf_threshold_mm,
+                 "LRF datasets: Algorithm 1's threshold on the newest observation's Eq. (12) "
+                 "error [mm]; σ counts as final once it is reached")
+      ->capture_default_str();
+  PipelineFlags flags;
+  AddPipelineFlags(app, flags, /*with_selection=*/true);
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
+  std::string why;
+  if (!FinalizePipelineFlags(flags, &why)) {
+    std::fprintf(stderr, "calibench advise: %s\n", why.c_str());
+    return kUsage;
+  }
+  options.pipeline = flags.options;
+  if (IsLrfManifest(dataset_path)) {
+    if (!options.goal.Check(&why) || !options.stop.Check(&why) || !(lrf_threshold_mm > 0)) {
+      if (why.empty()) why = "--error-threshold-mm must be > 0";
+      std::fprintf(stderr, "calibench advise: %s\n", why.c_str());
+      return kUsage;
+    }
+    const LrfDataset lrf = LoadLrfDataset(dataset_path);
+    LrfPipelineOptions lrf_options;
+    lrf_options.threads = flags.options.threads;
+    lrf_options.adaptive_error_threshold_m = lrf_threshold_mm * 1e-3;
+    const LrfCalibrationOutcome outcome =
+        CalibrateLrfDataset(lrf, lrf_options, StderrProgress("extracted"));
+    // Algorithm 1's check stands in for the jackknife's, which is what asks for 8 pairs.
+    StopRuleOptions lrf_stop = options.stop;
+    lrf_stop.min_pairs = 4;
+    const LrfCaptureAdvice advice =
+        AdviseLrfCapture(outcome, lrf_options.adaptive_error_threshold_m, options.goal, lrf_stop);
+    std::printf("%s", json ? (LrfCaptureAdviceJson(advice) + "\n").c_str()
+                           : FormatLrfCaptureAdvice(advice).c_str());
+    return kOk;
+  }
+  if (!options.Check(&why)) {
+    std::fprintf(stderr, "calibench advise: %s\n", why.c_str());
+    return kUsage;
+  }
+  const Dataset dataset = LoadDataset(dataset_path);
+  const CalibrationOutcome outcome =
+      CalibrateDataset(dataset, options.pipeline, StderrProgress("extracted"));
+  bool input_error = false;
+  for (const PairFeatures& p : outcome.pairs) input_error |= p.input_error;
+  const CaptureAdvice advice = AdviseCapture(dataset, outcome, options);
+  if (json)
+    std::printf("%s\n", CaptureAdviceJson(advice).c_str());
+  else
+    std::printf("%s", FormatCaptureAdvice(advice).c_str());
+  if (input_error) {
+    std::fprintf(stderr, "calibench advise: some pair files of %s could not be read (see above)\n",
+                 dataset.manifest.string().c_str());
+    return kInputError;
+  }
+  return kOk;
+}
+
+}  // namespace calibench::app

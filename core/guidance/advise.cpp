@@ -1,0 +1,215 @@
+#include "core/guidance/advise.h"
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "core/guidance/meter_json.h"
+#include "core/io/cloud_io.h"
+
+namespace calibench {
+
+bool AdviseOptions::Check(std::string* why) const {
+  if (!goal.Check(why) || !stop.Check(why) || !guidance.Check(why) || !preflight.Check(why) ||
+      !pipeline.Check(why))
+    return false;
+  if (min_distance_m < 0 || max_distance_m < 0 ||
+      (max_distance_m > 0 && !(max_distance_m > min_distance_m)))
+    return *why = "the distance range must satisfy 0 <= min < max (0 = from the data)", false;
+  if (clouds_for_beams < 1) return *why = "clouds_for_beams must be >= 1", false;
+  return true;
+}
+
+namespace {
+
+// Each pair's cloud − image stamp (seconds) from the import.json `calibench import` writes beside
+// the manifest; empty when there is none (a folder of files has no stamps).
+std::map<std::string, double> StampOffsets(const Dataset& dataset) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  const fs::path folder =
+      fs::is_directory(dataset.manifest, error) ? dataset.manifest : dataset.manifest.parent_path();
+  std::map<std::string, double> offsets;
+  std::ifstream in(folder / "import.json");
+  if (!in) return offsets;
+  const nlohmann::json record = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (!record.is_object() || record.value("format", "") != "calibench.import.v1" ||
+      !record.contains("pairs") || !record["pairs"].is_array())
+    return offsets;
+  for (const nlohmann::json& pair : record["pairs"]) {
+    if (!pair.is_object() || !pair.contains("id") || !pair["id"].is_string() ||
+        !pair.contains("cloud_stamp_ns") || !pair["cloud_stamp_ns"].is_number_integer() ||
+        !pair.contains("image_stamp_ns") || !pair["image_stamp_ns"].is_number_integer())
+      continue;
+    offsets[pair["id"].get<std::string>()] =
+        1e-9 * static_cast<double>(pair["cloud_stamp_ns"].get<std::int64_t>() -
+                                   pair["image_stamp_ns"].get<std::int64_t>());
+  }
+  return offsets;
+}
+
+}  // namespace
+
+CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& outcome,
+                            const AdviseOptions& options) {
+  CaptureAdvice advice;
+  advice.goal = options.goal;
+  // Pre-flight, pair by pair in capture order, against the pairs before it. A pair a check
+  // rejects leaves the solve, with the finding as its reason.
+  std::vector<PairFeatures> pairs = outcome.pairs;
+  std::vector<PairFeatures> earlier;
+  const std::map<std::string, double> stamp_offsets = StampOffsets(dataset);
+  bool rejected_any = false;
+  for (PairFeatures& p : pairs) {
+    PairAdvice pair;
+    pair.id = p.id;
+    PreflightInputs in;
+    in.pair = &p;
+    in.camera = &dataset.camera;
+    in.board = &dataset.target;
+    if (outcome.solution) in.cam_from_lidar = outcome.solution->cam_from_lidar;
+    in.earlier = &earlier;
+    in.pipeline = &options.pipeline;
+    if (const auto it = stamp_offsets.find(p.id); it != stamp_offsets.end())
+      in.stamp_offset_s = it->second;
+    pair.findings = PreflightPair(in, options.preflight);
+    for (const PreflightFinding& f : pair.findings) {
+      if (f.severity != PreflightSeverity::kReject || p.status != PairStatus::kAccepted) continue;
+      p.status = PairStatus::kRejected;
+      p.reason = "pre-flight: " + f.words;
+      rejected_any = true;
+    }
+    pair.status = p.status;
+    pair.reason = p.reason;
+    advice.pairs.push_back(std::move(pair));
+    earlier.push_back(p);
+  }
+  advice.solution = outcome.solution;
+  if (rejected_any) {
+    const CalibrationOutcome again = SolveFromFeatures(pairs, options.pipeline);
+    advice.solution = again.solution;
+  }
+  std::vector<Pose> seen;
+  for (const PairFeatures& p : pairs) {
+    if (p.status != PairStatus::kAccepted) continue;
+    ++advice.pairs_used;
+    if (p.camera) seen.push_back(p.camera->cam_from_board);
+  }
+  if (advice.solution)
+    advice.state = JudgeCapture(*advice.solution, advice.pairs_used, options.goal, options.stop);
+  if (advice.state && advice.state->done) return advice;
+  // The LiDAR's rings from a few accepted pairs' clouds.
+  std::vector<LidarCloud> clouds;
+  clouds.reserve(options.clouds_for_beams);
+  for (const PairFeatures& p : pairs) {
+    if (p.status != PairStatus::kAccepted ||
+        static_cast<int>(clouds.size()) >= options.clouds_for_beams)
+      continue;
+    for (const PairEntry& entry : dataset.pairs) {
+      if (entry.id != p.id) continue;
+      try {
+        clouds.push_back(LoadCloud(entry.cloud));
+      } catch (const std::exception&) {
+        // Unreadable now: the pair's own status already says so, or it changed since.
+      }
+    }
+  }
+  std::vector<const LidarCloud*> cloud_views;
+  for (const LidarCloud& c : clouds) cloud_views.push_back(&c);
+  std::string why;
+  auto sensors =
+      LearnSensorGeometry(dataset.camera, dataset.target, LearnBeamTable(cloud_views), pairs, &why);
+  if (!sensors) {
+    advice.next_failure = why;
+    return advice;
+  }
+  if (options.max_distance_m > 0) {
+    sensors->min_distance_m = options.min_distance_m;
+    sensors->max_distance_m = options.max_distance_m;
+  }
+  // Guidance needs a solution that fixes all six degrees of freedom.
+  std::optional<SolverResult> usable = advice.solution;
+  if (usable && !usable->observability.well_constrained) usable.reset();
+  advice.next = NextBestPose(*sensors, usable, seen, options.goal, options.guidance,
+                             options.pipeline.solver, &advice.next_failure);
+  return advice;
+}
+
+std::string CaptureAdviceJson(const CaptureAdvice& advice) {
+  nlohmann::json out = MeterJson(
+      advice.pairs_used, advice.goal, "cam_from_lidar",
+      advice.solution ? std::optional<Pose>(advice.solution->cam_from_lidar) : std::nullopt,
+      advice.state, "no calibration yet: at least 3 accepted pairs with differently tilted boards");
+  if (advice.next) {
+    const PoseSuggestion& next = *advice.next;
+    nlohmann::json n;
+    n["lidar_from_board"] =
+        next.lidar_from_board ? MatrixJson(next.lidar_from_board->matrix()) : nlohmann::json();
+    n["cam_from_board"] = MatrixJson((next.cam_from_board * ShownFromBoardSpec()).matrix());
+    n["words"] = next.words;
+    if (next.lidar_from_board) {
+      n["predicted_sigma_t_mm"] = VecJson(next.predicted_sigma_t_mm);
+      n["predicted_sigma_r_deg"] = VecJson(next.predicted_sigma_r_deg);
+      n["predicted_rings"] = next.feasibility.rings;
+      n["predicted_points"] = next.feasibility.points;
+    }
+    out["next"] = n;
+  } else {
+    out["next"] = nullptr;
+    if (!(advice.state && advice.state->done)) out["next_failure"] = advice.next_failure;
+  }
+  nlohmann::json pairs = nlohmann::json::array();
+  for (const PairAdvice& p : advice.pairs) {
+    nlohmann::json findings = nlohmann::json::array();
+    for (const PreflightFinding& f : p.findings)
+      findings.push_back(
+          {{"check", f.check},
+           {"severity", f.severity == PreflightSeverity::kReject ? "reject" : "weak"},
+           {"words", f.words}});
+    pairs.push_back({{"name", p.id},
+                     {"status", PairStatusName(p.status)},
+                     {"reason", p.reason},
+                     {"findings", findings}});
+  }
+  out["pairs"] = pairs;
+  return out.dump();
+}
+
+std::string FormatCaptureAdvice(const CaptureAdvice& advice) {
+  std::string out;
+  for (const PairAdvice& p : advice.pairs) {
+    if (p.status != PairStatus::kAccepted)
+      out += "pair " + p.id + ": " + PairStatusName(p.status) + ": " + p.reason + "\n";
+    for (const PreflightFinding& f : p.findings)
+      out += "pair " + p.id + ": " +
+             (f.severity == PreflightSeverity::kReject ? "reject: " : "weak: ") + f.words + "\n";
+  }
+  if (advice.state) {
+    out += DescribeCaptureState(*advice.state, advice.goal) + "\n";
+  } else {
+    out += std::to_string(advice.pairs_used) +
+           " pairs accepted: no calibration yet (at least 3 with differently tilted boards)\n";
+  }
+  if (advice.next) {
+    out += "next pose: " + advice.next->words + "\n";
+    if (advice.next->lidar_from_board) {
+      char text[200];
+      std::snprintf(text, sizeof(text),
+                    "  expected σ after it: %.1f/%.1f/%.1f mm, %.3f/%.3f/%.3f deg (%d rings, %d "
+                    "points on the sheet)\n",
+                    advice.next->predicted_sigma_t_mm.x(), advice.next->predicted_sigma_t_mm.y(),
+                    advice.next->predicted_sigma_t_mm.z(), advice.next->predicted_sigma_r_deg.x(),
+                    advice.next->predicted_sigma_r_deg.y(), advice.next->predicted_sigma_r_deg.z(),
+                    advice.next->feasibility.rings, advice.next->feasibility.points);
+      out += text;
+    }
+  } else if (!(advice.state && advice.state->done)) {
+    out += "no next pose: " + advice.next_failure + "\n";
+  }
+  return out;
+}
+
+}  // namespace calibench

@@ -1,0 +1,127 @@
+// Where to hold the board next: the expected information of a board pose under the solver's own
+// residual model (planes and board edges), whether the pose is feasible for both sensors, and the
+// feasible pose that shrinks the uncertainty most in units of the user's goal.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/camera/camera.h"
+#include "core/lidar/cloud.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/sim/sim.h"
+#include "core/target/board.h"
+
+namespace calibench {
+
+// What the user asks of the calibration: 1σ per axis (camera frame), translation and rotation.
+struct CaptureGoal {
+  double translation_mm = 5.0;
+  double rotation_deg = 0.1;
+  bool Check(std::string* why) const;
+};
+
+// What guidance knows of the two sensors, learnt from the data seen so far (LearnSensorGeometry)
+// or, in the simulator, from its models.
+struct SensorGeometry {
+  CameraModel camera;
+  BoardSpec board;
+  BeamTable lidar;              // ring elevations and azimuth steps
+  double min_distance_m = 1.0;  // board centre from the camera, the usable range
+  double max_distance_m = 4.0;
+  double range_sigma_m = 0.01;   // LiDAR range noise (1σ along the ray)
+  double corner_sigma_px = 0.3;  // corner noise (1σ per coordinate)
+  bool Check(std::string* why) const;
+};
+
+// The LiDAR's rings from its clouds: each ring's elevation (median over its returns) and the
+// azimuth step (median gap between neighbouring returns of a ring). Clouds without rings give an
+// empty table. Only rings with at least 20 returns count.
+BeamTable LearnBeamTable(const std::vector<const LidarCloud*>& clouds);
+
+// The rest of SensorGeometry from the pairs' features: the distance range of the boards seen so
+// far (widened by 10 % and to at least 1 m of span, never below the nearest seen − 0.5 m), the
+// median LiDAR plane RMS as range noise and the median PnP corner noise. Needs one accepted pair.
+std::optional<SensorGeometry> LearnSensorGeometry(const CameraModel& camera, const BoardSpec& board,
+                                                  const BeamTable& lidar,
+                                                  const std::vector<PairFeatures>& pairs,
+                                                  std::string* why);
+
+struct GuidanceOptions {
+  double image_margin_fraction = 0.03;  // the whole sheet this far inside the image (of width)
+  double min_square_px = 12.0;          // a pattern square at least this wide in the image
+  int min_rings = 4;                    // rings with >= 3 returns on the sheet
+  int min_points = 40;                  // returns on the sheet
+  double max_incidence_deg = 60.0;      // board normal against the ray, for both sensors
+  // The candidate grid (camera frame): distances across the usable range, image cells, and
+  // tilts of the board about its vertical and horizontal axes and in its own plane.
+  int distance_steps = 4;
+  int image_columns = 3;
+  int image_rows = 3;
+  std::vector<double> yaw_deg{-45, -25, 0, 25, 45};
+  std::vector<double> pitch_deg{-30, 0, 30};
+  std::vector<double> roll_deg{0, 45};
+  bool Check(std::string* why) const;
+};
+
+// The board's noise-free returns for a pose: the points and, per ring, where it leaves the sheet.
+struct PredictedReturns {
+  std::vector<Vec3> points;  // LiDAR frame
+  std::vector<int> ring;
+  std::vector<LidarEdgePoint> edges;
+  int rings = 0;  // rings with >= 3 returns
+};
+PredictedReturns PredictBoardReturns(const SensorGeometry& sensors, const Pose& lidar_from_board);
+
+struct Feasibility {
+  bool feasible = false;
+  std::string why;  // the first failed check, in words
+  int rings = 0;
+  int points = 0;
+  double camera_incidence_deg = 0.0;
+  double lidar_incidence_deg = 0.0;
+  double distance_m = 0.0;
+};
+// cam_from_board in BoardSpec's frame (z away from the camera); cam_from_lidar the current
+// estimate. The LiDAR checks are skipped when cam_from_lidar is absent (no solution yet).
+Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pose>& cam_from_lidar,
+                          const Pose& cam_from_board, const GuidanceOptions& options,
+                          PredictedReturns* returns = nullptr);
+
+// One planned pair as the solver would see it: true planes with their Cramér–Rao covariances at
+// the sensors' noise, and the board edges the rings would cross.
+PlanePair PlannedPair(const SensorGeometry& sensors, const Pose& cam_from_lidar,
+                      const Pose& cam_from_board, const PredictedReturns& returns);
+
+struct PoseSuggestion {
+  Pose cam_from_board = Pose::Identity();    // BoardSpec frame
+  std::optional<Pose> lidar_from_board;      // shown frame (ShownFromBoardSpec); with a solution
+  Vec3 predicted_sigma_t_mm = Vec3::Zero();  // after adding this pose (with a solution)
+  Vec3 predicted_sigma_r_deg = Vec3::Zero();
+  double score = 0.0;  // Σ (predicted σ / goal)² over the six axes (lower is better)
+  Feasibility feasibility;
+  std::string words;
+};
+
+// The feasible candidate that leaves the smallest Σ (σ/goal)² over the six axes after it is
+// added (dominated by the weakest direction; ties by the largest ratio): Σ' = (Σ⁻¹ + I)⁻¹ with I
+// its expected information at the current variance factors, discounted by the current
+// covariance inflation. Without a solution (fewer than 3 pairs), the feasible pose
+// that differs most from the boards seen so far (`seen`, camera frame), frontal first.
+std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
+                                           const std::optional<SolverResult>& solution,
+                                           const std::vector<Pose>& seen, const CaptureGoal& goal,
+                                           const GuidanceOptions& options,
+                                           const SolverOptions& solver_options, std::string* why);
+
+// The board frame shown to people (DESIGN.md): origin at the sheet centre, x along its width,
+// y up on the print, z out of the printed face: BoardSpec's frame turned 180° about x.
+Pose ShownFromBoardSpec();
+
+// Words a person can follow while holding the board: distance, where in the image, how to turn
+// it. E.g. "about 2.5 m away, left third of the image, turn it ~30° about its vertical axis (left
+// edge nearer), keep it upright".
+std::string DescribeBoardPose(const CameraModel& camera, const Pose& cam_from_board);
+
+}  // namespace calibench
