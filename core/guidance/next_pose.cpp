@@ -368,6 +368,16 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
               ++feasible;
               double score = 0.0, tie = 0.0;
               Vec3 sigma_t = Vec3::Zero(), sigma_r = Vec3::Zero();
+              // A board where one was already held adds what that pose added: if the model
+              // over-promises there (a detection noisier than its bound), suggesting it again
+              // would repeat the same disappointment.
+              bool repeat = false;
+              for (const Pose& held : seen)
+                repeat |= (held.translation() - cam_from_board.translation()).norm() <
+                              options.repeat_distance_m &&
+                          RotationAngle(held.linear(), cam_from_board.linear()) <
+                              options.repeat_angle_deg * kDegToRad;
+              if (repeat) continue;
               if (cam_from_lidar) {
                 const PlanePair planned =
                     PlannedPair(sensors, *cam_from_lidar, cam_from_board, returns);

@@ -62,6 +62,9 @@ struct GuidanceOptions {
   std::vector<double> yaw_deg{-45, -25, 0, 25, 45};
   std::vector<double> pitch_deg{-30, 0, 30};
   std::vector<double> roll_deg{0, 45};
+  // Candidates this close to a board already held (camera frame) are not suggested again.
+  double repeat_distance_m = 0.15;
+  double repeat_angle_deg = 10.0;
   bool Check(std::string* why) const;
 };
 

@@ -21,6 +21,7 @@ MeterInputs MeterFrom(const SolverResult& solution) {
   m.jackknife_pairs = solution.jackknife_pairs;
   m.jackknife_sigma_t_m = solution.jackknife_sigma_t_m;
   m.jackknife_sigma_r_deg = solution.jackknife_sigma_r_deg;
+  m.jackknife_skipped = solution.jackknife_skipped;
   return m;
 }
 
@@ -56,10 +57,16 @@ CaptureState JudgeCapture(const MeterInputs& solution, int pairs_used, const Cap
     state.trust_note = solution.other_trust_note;
   } else if (!solution.has_jackknife) {
     // The method's own rule (above) stands in for the leave-one-out check.
+  } else if (solution.jackknife_pairs == 0) {
+    state.trust_note = "no leave-one-out check: " +
+                       (solution.jackknife_skipped.empty() ? std::string("it did not run")
+                                                           : solution.jackknife_skipped);
   } else if (solution.jackknife_pairs < options.min_pairs) {
-    state.trust_note =
-        "no leave-one-out check yet (a pair whose absence leaves the pose "
-        "undetermined, or the jackknife is off)";
+    std::snprintf(text, sizeof(text),
+                  "the leave-one-out check ran over %d pairs (the solve set the others aside as "
+                  "outliers); σ is trusted from %d",
+                  solution.jackknife_pairs, options.min_pairs);
+    state.trust_note = text;
   } else {
     const Vec3 t = solution.jackknife_sigma_t_m * 1e3;
     const Vec3 r = solution.jackknife_sigma_r_deg;

@@ -42,6 +42,7 @@ struct MeterInputs {
   int jackknife_pairs = 0;
   Vec3 jackknife_sigma_t_m = Vec3::Zero();
   Vec3 jackknife_sigma_r_deg = Vec3::Zero();
+  std::string jackknife_skipped;  // why it did not run (SolverResult::jackknife_skipped)
   std::string other_trust_note;  // non-empty: a method's own rule says σ is not final yet
 };
 MeterInputs MeterFrom(const SolverResult& solution);

@@ -152,6 +152,7 @@ struct SolverResult {
   // The pairs' scatter exceeded the model's (its per-pair errors are larger than its features'
   // noise says), so the reported covariance is the jackknife's, widened for the few pairs.
   bool jackknife_widened = false;
+  std::string jackknife_skipped;  // why it did not run, in words ("" when it ran)
 };
 
 // The LiDAR plane the board really has under a range offset b: the fitted one moved back by

@@ -174,9 +174,15 @@ PlaneAlignmentSolver::Mat7 PlaneAlignmentSolver::Covariance(const Linearization&
   // constrain moves the estimate by more than H⁻¹ gᵢ), and it needs only 4 pairs. With few pairs
   // its variance is itself uncertain (k − 1 degrees of freedom), so it is widened by the Student
   // t quantile over the normal one at 3σ: a 3σ test of the result then keeps its 99.7 %.
+  if (!options_.jackknife_covariance) result->jackknife_skipped = "the jackknife is off";
+  if (options_.jackknife_covariance && clusters < 4)
+    result->jackknife_skipped = "fewer than 4 pairs in the solve";
   if (options_.jackknife_covariance && clusters >= 4) {
     // Per pair: its move Δᵢ = Aᵢ gᵢ with Aᵢ = (H − Hᵢ)⁻¹, and what the model expects of that
     // move's spread, s² Aᵢ Hᵢ Aᵢᵀ (gᵢ has covariance s² Hᵢ when the model holds).
+    std::vector<size_t> used;  // the pairs behind pair_gradients: those not gated
+    for (size_t j = 0; j < pairs_.size(); ++j)
+      if (!gated_[j]) used.push_back(j);
     std::vector<Eigen::VectorXd> moves;
     Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
     bool all_determined = true;
@@ -186,7 +192,11 @@ PlaneAlignmentSolver::Mat7 PlaneAlignmentSolver::Covariance(const Linearization&
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> without_eigen(without);
       const Eigen::VectorXd lambdas = without_eigen.eigenvalues();
       all_determined = lambdas[0] > 1e-9 * lambdas[num_parameters - 1];
-      if (!all_determined) break;
+      if (!all_determined) {
+        result->jackknife_skipped = "leaving pair " + pairs_[used[i]].id +
+                                    " out leaves the pose undetermined";
+        break;
+      }
       const Eigen::MatrixXd inverse =
           without.ldlt().solve(Eigen::MatrixXd::Identity(num_parameters, num_parameters));
       moves.push_back(inverse * lin.pair_gradients[i](active));
