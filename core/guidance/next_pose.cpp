@@ -338,7 +338,7 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
   }
   std::optional<PoseSuggestion> best;
   double best_score = std::numeric_limits<double>::infinity(), best_tie = best_score;
-  int feasible = 0;
+  int candidates = 0;
   std::string last_reason;
   for (int di = 0; di < options.distance_steps; ++di) {
     const double distance =
@@ -359,13 +359,13 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
               cam_from_board.linear() = BoardRotation(*bearing, yaw, pitch, roll);
               cam_from_board.translation() = distance * bearing->normalized();
               PredictedReturns returns;
+              ++candidates;
               const Feasibility f =
                   CheckFeasible(sensors, cam_from_lidar, cam_from_board, options, &returns);
               if (!f.feasible) {
                 last_reason = f.why;
                 continue;
               }
-              ++feasible;
               double score = 0.0, tie = 0.0;
               Vec3 sigma_t = Vec3::Zero(), sigma_r = Vec3::Zero();
               // A board where one was already held adds what that pose added: if the model
@@ -436,8 +436,9 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
     }
   }
   if (!best) {
-    *why = "no feasible board pose in the candidate grid" +
-           (last_reason.empty() ? std::string() : " (last reason: " + last_reason + ")");
+    *why = "none of the " + std::to_string(candidates) +
+           " candidate board poses is feasible or new" +
+           (last_reason.empty() ? std::string() : " (the last refused: " + last_reason + ")");
     return std::nullopt;
   }
   best->words = DescribeBoardPose(sensors.camera, best->cam_from_board);
