@@ -58,9 +58,9 @@ CaptureState JudgeCapture(const MeterInputs& solution, int pairs_used, const Cap
   } else if (!solution.has_jackknife) {
     // The method's own rule (above) stands in for the leave-one-out check.
   } else if (solution.jackknife_pairs == 0) {
-    state.trust_note = "no leave-one-out check: " +
-                       (solution.jackknife_skipped.empty() ? std::string("it did not run")
-                                                           : solution.jackknife_skipped);
+    state.trust_note = "no leave-one-out check: " + (solution.jackknife_skipped.empty()
+                                                         ? std::string("it did not run")
+                                                         : solution.jackknife_skipped);
   } else if (solution.jackknife_pairs < options.min_pairs) {
     std::snprintf(text, sizeof(text),
                   "the leave-one-out check ran over %d pairs (the solve set the others aside as "

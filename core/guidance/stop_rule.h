@@ -43,7 +43,7 @@ struct MeterInputs {
   Vec3 jackknife_sigma_t_m = Vec3::Zero();
   Vec3 jackknife_sigma_r_deg = Vec3::Zero();
   std::string jackknife_skipped;  // why it did not run (SolverResult::jackknife_skipped)
-  std::string other_trust_note;  // non-empty: a method's own rule says σ is not final yet
+  std::string other_trust_note;   // non-empty: a method's own rule says σ is not final yet
 };
 MeterInputs MeterFrom(const SolverResult& solution);
 

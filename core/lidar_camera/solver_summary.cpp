@@ -193,8 +193,8 @@ PlaneAlignmentSolver::Mat7 PlaneAlignmentSolver::Covariance(const Linearization&
       const Eigen::VectorXd lambdas = without_eigen.eigenvalues();
       all_determined = lambdas[0] > 1e-9 * lambdas[num_parameters - 1];
       if (!all_determined) {
-        result->jackknife_skipped = "leaving pair " + pairs_[used[i]].id +
-                                    " out leaves the pose undetermined";
+        result->jackknife_skipped =
+            "leaving pair " + pairs_[used[i]].id + " out leaves the pose undetermined";
         break;
       }
       const Eigen::MatrixXd inverse =
