@@ -51,6 +51,24 @@ std::map<std::string, double> StampOffsets(const Dataset& dataset) {
   return offsets;
 }
 
+// Up to `count` accepted pairs' clouds, read again to learn the LiDAR's rings from.
+std::vector<LidarCloud> RingClouds(const Dataset& dataset, const std::vector<PairFeatures>& pairs,
+                                   int count) {
+  std::vector<LidarCloud> clouds;
+  for (const PairFeatures& p : pairs) {
+    if (p.status != PairStatus::kAccepted || static_cast<int>(clouds.size()) >= count) continue;
+    for (const PairEntry& entry : dataset.pairs) {
+      if (entry.id != p.id) continue;
+      try {
+        clouds.push_back(LoadCloud(entry.cloud));
+      } catch (const std::exception&) {
+        // Unreadable now: the pair's own status already says so, or it changed since.
+      }
+    }
+  }
+  return clouds;
+}
+
 }  // namespace
 
 CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& outcome,
@@ -101,22 +119,7 @@ CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& ou
   if (advice.solution)
     advice.state = JudgeCapture(*advice.solution, advice.pairs_used, options.goal, options.stop);
   if (advice.state && advice.state->done) return advice;
-  // The LiDAR's rings from a few accepted pairs' clouds.
-  std::vector<LidarCloud> clouds;
-  clouds.reserve(options.clouds_for_beams);
-  for (const PairFeatures& p : pairs) {
-    if (p.status != PairStatus::kAccepted ||
-        static_cast<int>(clouds.size()) >= options.clouds_for_beams)
-      continue;
-    for (const PairEntry& entry : dataset.pairs) {
-      if (entry.id != p.id) continue;
-      try {
-        clouds.push_back(LoadCloud(entry.cloud));
-      } catch (const std::exception&) {
-        // Unreadable now: the pair's own status already says so, or it changed since.
-      }
-    }
-  }
+  const std::vector<LidarCloud> clouds = RingClouds(dataset, pairs, options.clouds_for_beams);
   std::vector<const LidarCloud*> cloud_views;
   for (const LidarCloud& c : clouds) cloud_views.push_back(&c);
   std::string why;

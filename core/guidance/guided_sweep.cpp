@@ -56,6 +56,22 @@ std::optional<SensorGeometry> SensorsFromData(const SimOptions& sim,
   return sensors;
 }
 
+// A simulated pair through the pipeline's steps, the LiDAR side from the seed a brush would give.
+PairFeatures FeaturesOf(const Dataset& dataset, const SimulatedPair& pair, const std::string& id,
+                        const PipelineOptions& pipeline) {
+  PairFeatures f;
+  f.id = id;
+  std::string lidar_failure;
+  BoardHint hint;
+  hint.seed = pair.seed;
+  f.lidar = ExtractLidarFeatures(dataset, pair.cloud, hint, pipeline, &lidar_failure);
+  CameraFeatures camera = ExtractCameraFeatures(dataset, pair.image, pipeline);
+  f.camera = std::move(camera.observation);
+  f.edge_width_px = camera.edge_width_px;
+  SetStatusFromFeatures(&f, lidar_failure, camera.failure);
+  return f;
+}
+
 }  // namespace
 
 GuidedRun RunGuidedCapture(const GuidedSweepOptions& options, std::uint64_t seed, bool guided) {
@@ -98,19 +114,7 @@ GuidedRun RunGuidedCapture(const GuidedSweepOptions& options, std::uint64_t seed
     }
     seen.push_back(cam_from_board);
     SimulatedPair pair = SimulatePairAt(sim, cam_from_board, k);
-    PairEntry entry;
-    entry.id = std::to_string(k);
-    entry.lidar_seed = pair.seed;
-    PairFeatures f;
-    f.id = entry.id;
-    std::string lidar_failure;
-    BoardHint hint;
-    hint.seed = pair.seed;
-    f.lidar = ExtractLidarFeatures(dataset, pair.cloud, hint, pipeline, &lidar_failure);
-    CameraFeatures camera = ExtractCameraFeatures(dataset, pair.image, pipeline);
-    f.camera = std::move(camera.observation);
-    f.edge_width_px = camera.edge_width_px;
-    SetStatusFromFeatures(&f, lidar_failure, camera.failure);
+    PairFeatures f = FeaturesOf(dataset, pair, std::to_string(k), pipeline);
     features.push_back(std::move(f));
     if (clouds.size() < 8 && features.back().status == PairStatus::kAccepted)
       clouds.push_back(std::move(pair.cloud));

@@ -239,9 +239,7 @@ Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pos
   // The sheet must face the camera (its back would show no pattern).
   if (camera_normal.dot(cam_from_board.translation()) <= 0 ||
       f.camera_incidence_deg > options.max_incidence_deg) {
-    std::snprintf(text, sizeof(text), "too oblique to the camera (%.0f deg, at most %.0f)",
-                  f.camera_incidence_deg, options.max_incidence_deg);
-    f.why = text;
+    f.why = TooOblique("camera", f.camera_incidence_deg, options.max_incidence_deg);
     return f;
   }
   const double margin = options.image_margin_fraction * sensors.camera.width;
@@ -274,9 +272,7 @@ Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pos
     f.lidar_incidence_deg = IncidenceDeg(lidar_normal, lidar_from_board.translation());
     if (lidar_normal.dot(lidar_from_board.translation()) <= 0 ||
         f.lidar_incidence_deg > options.max_incidence_deg) {
-      std::snprintf(text, sizeof(text), "too oblique to the LiDAR (%.0f deg, at most %.0f)",
-                    f.lidar_incidence_deg, options.max_incidence_deg);
-      f.why = text;
+      f.why = TooOblique("LiDAR", f.lidar_incidence_deg, options.max_incidence_deg);
       return f;
     }
     PredictedReturns predicted = PredictBoardReturns(sensors, lidar_from_board);
@@ -316,11 +312,82 @@ PlanePair PlannedPair(const SensorGeometry& sensors, const Pose& cam_from_lidar,
   return pair;
 }
 
-Pose ShownFromBoardSpec() {
-  Pose pose = Pose::Identity();
-  pose.linear() = Eigen::AngleAxisd(M_PI, Vec3::UnitX()).toRotationMatrix();
-  return pose;
+namespace {
+
+// One pose of the candidate grid (camera frame, BoardSpec's board frame).
+struct Candidate {
+  Pose cam_from_board = Pose::Identity();
+  bool middle_row = false;    // in the image's middle band
+  double turn_deg = 0.0;      // |yaw| + |pitch| + |roll| of the grid
+  double off_axis = 0.0;      // |bearing − optical axis|
+  double off_centre_m = 0.0;  // distance from the middle of the usable range
+  bool moderate = false;      // |yaw|, |pitch| <= 30 degrees
+};
+
+// Distances across the usable range × image cells × the tilts of GuidanceOptions.
+std::vector<Candidate> CandidateGrid(const SensorGeometry& sensors,
+                                     const GuidanceOptions& options) {
+  std::vector<Candidate> grid;
+  const double middle = 0.5 * (sensors.min_distance_m + sensors.max_distance_m);
+  for (int di = 0; di < options.distance_steps; ++di) {
+    const double distance =
+        options.distance_steps == 1
+            ? middle
+            : sensors.min_distance_m + (sensors.max_distance_m - sensors.min_distance_m) * di /
+                                           (options.distance_steps - 1);
+    for (int col = 0; col < options.image_columns; ++col) {
+      for (int row = 0; row < options.image_rows; ++row) {
+        const Vec2 pixel(sensors.camera.width * (col + 0.5) / options.image_columns,
+                         sensors.camera.height * (row + 0.5) / options.image_rows);
+        const auto bearing = sensors.camera.Unproject(pixel);
+        if (!bearing) continue;
+        for (double yaw : options.yaw_deg) {
+          for (double pitch : options.pitch_deg) {
+            for (double roll : options.roll_deg) {
+              Candidate c;
+              c.cam_from_board.linear() = BoardRotation(*bearing, yaw, pitch, roll);
+              c.cam_from_board.translation() = distance * bearing->normalized();
+              c.middle_row = options.image_rows == 1 || row == options.image_rows / 2;
+              c.turn_deg = std::abs(yaw) + std::abs(pitch) + std::abs(roll);
+              c.off_axis = (bearing->normalized() - Vec3::UnitZ()).norm();
+              c.off_centre_m = std::abs(distance - middle);
+              c.moderate = std::abs(yaw) <= 30 && std::abs(pitch) <= 30;
+              grid.push_back(c);
+            }
+          }
+        }
+      }
+    }
+  }
+  return grid;
 }
+
+// A board where one was already held adds what that pose added: if the model over-promises there
+// (a detection noisier than its bound), suggesting it again would repeat the disappointment.
+bool NearAHeldBoard(const Pose& cam_from_board, const std::vector<Pose>& seen,
+                    const GuidanceOptions& options) {
+  for (const Pose& held : seen)
+    if ((held.translation() - cam_from_board.translation()).norm() < options.repeat_distance_m &&
+        RotationAngle(held.linear(), cam_from_board.linear()) <
+            options.repeat_angle_deg * kDegToRad)
+      return true;
+  return false;
+}
+
+// Without a solution: unlike what was seen (normals and positions), frontal first; ties by the
+// distance from the middle of the usable range. Lower is better.
+std::pair<double, double> StarterScore(const Candidate& c, const std::vector<Pose>& seen) {
+  if (seen.empty()) return {c.turn_deg + c.off_axis, c.off_centre_m};
+  double nearest = 1e9;
+  for (const Pose& s : seen) {
+    const double angle =
+        std::acos(std::clamp(s.linear().col(2).dot(c.cam_from_board.linear().col(2)), -1.0, 1.0));
+    nearest = std::min(nearest, angle + (s.translation() - c.cam_from_board.translation()).norm());
+  }
+  return {-nearest, c.off_centre_m};
+}
+
+}  // namespace
 
 std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
                                            const std::optional<SolverResult>& solution,
@@ -336,166 +403,64 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
     if (ldlt.info() == Eigen::Success && ldlt.isPositive())
       current_information = ldlt.solve(Mat6::Identity());
   }
+  const std::vector<Candidate> grid = CandidateGrid(sensors, options);
   std::optional<PoseSuggestion> best;
-  double best_score = std::numeric_limits<double>::infinity(), best_tie = best_score;
-  int candidates = 0;
+  std::pair<double, double> best_score(std::numeric_limits<double>::infinity(), 0.0);
   std::string last_reason;
-  for (int di = 0; di < options.distance_steps; ++di) {
-    const double distance =
-        options.distance_steps == 1
-            ? 0.5 * (sensors.min_distance_m + sensors.max_distance_m)
-            : sensors.min_distance_m + (sensors.max_distance_m - sensors.min_distance_m) * di /
-                                           (options.distance_steps - 1);
-    for (int col = 0; col < options.image_columns; ++col) {
-      for (int row = 0; row < options.image_rows; ++row) {
-        const Vec2 pixel(sensors.camera.width * (col + 0.5) / options.image_columns,
-                         sensors.camera.height * (row + 0.5) / options.image_rows);
-        const auto bearing = sensors.camera.Unproject(pixel);
-        if (!bearing) continue;
-        for (double yaw : options.yaw_deg) {
-          for (double pitch : options.pitch_deg) {
-            for (double roll : options.roll_deg) {
-              Pose cam_from_board = Pose::Identity();
-              cam_from_board.linear() = BoardRotation(*bearing, yaw, pitch, roll);
-              cam_from_board.translation() = distance * bearing->normalized();
-              PredictedReturns returns;
-              ++candidates;
-              const Feasibility f =
-                  CheckFeasible(sensors, cam_from_lidar, cam_from_board, options, &returns);
-              if (!f.feasible) {
-                last_reason = f.why;
-                continue;
-              }
-              double score = 0.0, tie = 0.0;
-              Vec3 sigma_t = Vec3::Zero(), sigma_r = Vec3::Zero();
-              // A board where one was already held adds what that pose added: if the model
-              // over-promises there (a detection noisier than its bound), suggesting it again
-              // would repeat the same disappointment.
-              bool repeat = false;
-              for (const Pose& held : seen)
-                repeat |= (held.translation() - cam_from_board.translation()).norm() <
-                              options.repeat_distance_m &&
-                          RotationAngle(held.linear(), cam_from_board.linear()) <
-                              options.repeat_angle_deg * kDegToRad;
-              if (repeat) continue;
-              if (cam_from_lidar) {
-                const PlanePair planned =
-                    PlannedPair(sensors, *cam_from_lidar, cam_from_board, returns);
-                // The model's information, discounted by how much wider than the model the
-                // reported covariance is (the pairs' scatter on real sensors): a new pair is
-                // expected to help as much as the ones seen so far did.
-                const Mat6 added =
-                    ExpectedPoseInformation({planned}, *cam_from_lidar, solver_options,
-                                            solution->plane_variance_factor,
-                                            solution->edge_variance_factor) /
-                    std::max(1.0, solution->covariance_inflation);
-                const Mat6 predicted = (current_information + added).inverse();
-                // The sum of squared σ/goal over the six axes (A-optimal in units of the goal:
-                // the weakest axis dominates it), the largest ratio breaking ties. Chasing the
-                // largest ratio alone alternates between axes and took more poses in the
-                // guided sweep (OS0-128 + fisheye: 16 against 11.5 poses, median of 4 seeds).
-                std::tie(tie, score) = GoalScore(predicted, *cam_from_lidar, goal);
-                sigma_t = SigmaT(predicted, *cam_from_lidar);
-                sigma_r = RotationStdDeg(predicted, *cam_from_lidar);
-              } else {
-                // No solution yet: the LiDAR cannot be checked, so stay where a spinning LiDAR
-                // beside the camera sees most (the image's middle band, moderate turns), unlike
-                // what was seen (normals and positions), frontal first.
-                if (options.image_rows > 1 && row != options.image_rows / 2) continue;
-                if (std::abs(yaw) > 30 || std::abs(pitch) > 30) continue;
-                double nearest = 1e9;
-                for (const Pose& s : seen) {
-                  const double angle = std::acos(
-                      std::clamp(s.linear().col(2).dot(cam_from_board.linear().col(2)), -1.0, 1.0));
-                  nearest = std::min(
-                      nearest, angle + (s.translation() - cam_from_board.translation()).norm());
-                }
-                score = seen.empty() ? std::abs(yaw) + std::abs(pitch) + std::abs(roll) +
-                                           (bearing->normalized() - Vec3::UnitZ()).norm()
-                                     : -nearest;
-                tie = std::abs(distance - 0.5 * (sensors.min_distance_m + sensors.max_distance_m));
-              }
-              if (score < best_score - 1e-12 || (score <= best_score + 1e-12 && tie < best_tie)) {
-                best_score = score;
-                best_tie = tie;
-                PoseSuggestion suggestion;
-                suggestion.cam_from_board = cam_from_board;
-                if (cam_from_lidar)
-                  suggestion.lidar_from_board =
-                      cam_from_lidar->inverse() * cam_from_board * ShownFromBoardSpec();
-                suggestion.predicted_sigma_t_mm = sigma_t;
-                suggestion.predicted_sigma_r_deg = sigma_r;
-                suggestion.score = score;
-                suggestion.feasibility = f;
-                best = suggestion;
-              }
-            }
-          }
-        }
-      }
+  for (const Candidate& c : grid) {
+    if (NearAHeldBoard(c.cam_from_board, seen, options)) continue;
+    // No solution yet: the LiDAR cannot be checked, so stay where a spinning LiDAR beside the
+    // camera sees most (the image's middle band, moderate turns).
+    if (!cam_from_lidar && !(c.middle_row && c.moderate)) continue;
+    PredictedReturns returns;
+    const Feasibility f =
+        CheckFeasible(sensors, cam_from_lidar, c.cam_from_board, options, &returns);
+    if (!f.feasible) {
+      last_reason = f.why;
+      continue;
+    }
+    PoseSuggestion suggestion;
+    suggestion.cam_from_board = c.cam_from_board;
+    suggestion.feasibility = f;
+    std::pair<double, double> score;
+    if (cam_from_lidar) {
+      // The model's information, discounted by how much wider than the model the reported
+      // covariance is (the pairs' scatter on real sensors): a new pair is expected to help as
+      // much as the ones seen so far did.
+      const Mat6 added =
+          ExpectedPoseInformation(
+              {PlannedPair(sensors, *cam_from_lidar, c.cam_from_board, returns)}, *cam_from_lidar,
+              solver_options, solution->plane_variance_factor, solution->edge_variance_factor) /
+          std::max(1.0, solution->covariance_inflation);
+      const Mat6 predicted = (current_information + added).inverse();
+      // The sum of squared σ/goal over the six axes (A-optimal in units of the goal: the weakest
+      // axis dominates it), the largest ratio breaking ties. Chasing the largest ratio alone
+      // alternates between axes and took more poses in the guided sweep (OS0-128 + fisheye: 16
+      // against 11.5 poses, median of 4 seeds).
+      const auto [largest, sum_of_squares] = GoalScore(predicted, *cam_from_lidar, goal);
+      score = {sum_of_squares, largest};
+      suggestion.lidar_from_board =
+          cam_from_lidar->inverse() * c.cam_from_board * ShownFromBoardSpec();
+      suggestion.predicted_sigma_t_mm = SigmaT(predicted, *cam_from_lidar);
+      suggestion.predicted_sigma_r_deg = RotationStdDeg(predicted, *cam_from_lidar);
+    } else {
+      score = StarterScore(c, seen);
+    }
+    suggestion.score = score.first;
+    if (score.first < best_score.first - 1e-12 ||
+        (score.first <= best_score.first + 1e-12 && score.second < best_score.second)) {
+      best_score = score;
+      best = std::move(suggestion);
     }
   }
   if (!best) {
-    *why = "none of the " + std::to_string(candidates) +
+    *why = "none of the " + std::to_string(grid.size()) +
            " candidate board poses is feasible or new" +
            (last_reason.empty() ? std::string() : " (the last refused: " + last_reason + ")");
     return std::nullopt;
   }
   best->words = DescribeBoardPose(sensors.camera, best->cam_from_board);
   return best;
-}
-
-std::string DescribeBoardPose(const CameraModel& camera, const Pose& cam_from_board) {
-  const Vec3 centre = cam_from_board.translation();
-  char text[400];
-  std::string words;
-  std::snprintf(text, sizeof(text), "about %.1f m away", centre.norm());
-  words = text;
-  // Where in the image.
-  const auto pixel = camera.Project(centre);
-  if (pixel) {
-    const double u = pixel->x() / camera.width, v = pixel->y() / camera.height;
-    const char* column = u < 1.0 / 3 ? "left third" : u > 2.0 / 3 ? "right third" : "centre";
-    const char* row = v < 1.0 / 3 ? "upper part" : v > 2.0 / 3 ? "lower part" : "";
-    words += ", ";
-    words += column;
-    words += std::string(" of the image") + (row[0] ? std::string(", ") + row : "");
-  }
-  // The normal out of the print (towards the camera) in the frame that faces the camera.
-  const Vec3 z = centre.normalized();
-  const Vec3 x = (Vec3::UnitX() - Vec3::UnitX().dot(z) * z).normalized();
-  const Vec3 y = z.cross(x);  // down in the image
-  const Vec3 normal = -cam_from_board.linear().col(2);
-  const double yaw = std::atan2(normal.dot(x), -normal.dot(z)) * kRadToDeg;
-  const double pitch = std::atan2(normal.dot(y), -normal.dot(z)) * kRadToDeg;
-  auto rounded = [](double deg) { return static_cast<int>(std::lround(std::abs(deg) / 5.0) * 5); };
-  if (rounded(yaw) >= 10) {
-    // The normal turned towards +x (right): the right edge went further, the left came nearer.
-    std::snprintf(text, sizeof(text), ", turn it ~%d° about its vertical axis (%s edge nearer)",
-                  rounded(yaw), yaw > 0 ? "left" : "right");
-    words += text;
-  }
-  if (rounded(pitch) >= 10) {
-    // The normal turned down (+y): the bottom edge went further, the top came nearer.
-    std::snprintf(text, sizeof(text), ", tilt it ~%d° about its horizontal axis (%s edge nearer)",
-                  rounded(pitch), pitch > 0 ? "top" : "bottom");
-    words += text;
-  }
-  // In-plane rotation: the sheet's width axis against the image's horizontal. A rectangle looks
-  // the same turned by 180°, so the angle is folded into (-90°, 90°].
-  const Vec3 width_axis = cam_from_board.linear().col(0);
-  double roll = std::atan2(width_axis.dot(y), width_axis.dot(x)) * kRadToDeg;
-  if (roll > 90) roll -= 180;
-  if (roll <= -90) roll += 180;
-  if (rounded(roll) < 10) {
-    words += ", keep it upright";
-  } else {
-    std::snprintf(text, sizeof(text), ", rotate it ~%d° %s in its own plane%s", rounded(roll),
-                  roll > 0 ? "clockwise" : "anticlockwise",
-                  rounded(roll) >= 35 && rounded(roll) <= 55 ? " (a diamond)" : "");
-    words += text;
-  }
-  return words;
 }
 
 }  // namespace calibench

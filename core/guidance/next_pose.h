@@ -122,6 +122,9 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
 // y up on the print, z out of the printed face: BoardSpec's frame turned 180° about x.
 Pose ShownFromBoardSpec();
 
+// "too oblique to the <sensor> (<angle> deg, at most <max>)": the one wording of that refusal.
+std::string TooOblique(const char* sensor, double angle_deg, double max_deg);
+
 // Words a person can follow while holding the board: distance, where in the image, how to turn
 // it. E.g. "about 2.5 m away, left third of the image, turn it ~30° about its vertical axis (left
 // edge nearer), keep it upright".

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "core/estimation/uncertainty.h"
 #include "core/lidar_camera/solver.h"
@@ -87,6 +89,116 @@ double StudentQuantileAt3Sigma(int dof) {
   return 3.0 + (q_last - 3.0) * v_last / dof;
 }
 
+// The cluster-robust covariance H⁻¹ (Σᵢ gᵢgᵢᵀ) H⁻¹ · n/(n − p), the pairs as clusters.
+Eigen::MatrixXd Sandwich(const std::vector<Eigen::VectorXd>& gradients,
+                         const Eigen::MatrixXd& inverse_information) {
+  const int n = static_cast<int>(gradients.size());
+  const int p = static_cast<int>(inverse_information.rows());
+  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p, p);
+  for (const Eigen::VectorXd& g : gradients) meat += g * g.transpose();
+  return static_cast<double>(n) / (n - p) * inverse_information * meat * inverse_information;
+}
+
+// The leave-one-pair-out estimate: `raw` the jackknife of the moves, `scatter` what it says of
+// the covariance once the pairs' leverage is taken out; `skipped` says why there is none.
+struct Jackknife {
+  int pairs = 0;
+  Eigen::MatrixXd raw;
+  Eigen::MatrixXd scatter;
+  std::string skipped;
+};
+
+// How far the estimate moves when each pair is left out, one Gauss-Newton step from the solution
+// without that pair's share: Δᵢ = Aᵢ gᵢ with Aᵢ = (H − Hᵢ)⁻¹ (gᵢ the pair's gradient, Hᵢ its
+// information). Unlike the sandwich it sees a pair's leverage (a pair the others hardly constrain
+// moves the estimate by more than H⁻¹ gᵢ), and it needs only 4 pairs. But a pair of high leverage
+// moves the estimate more than the model's covariance suggests even when the model holds (with k
+// pairs and p parameters the average pair carries p/k of the information): gᵢ has covariance
+// s² Hᵢ then, so the jackknife is judged against E = s² Σ Aᵢ Hᵢ Aᵢᵀ, its excess X = L_E⁻¹ J L_E⁻ᵀ
+// (the identity when the model holds) carried over to the model's covariance, L_M X L_Mᵀ.
+Jackknife LeaveOnePairOut(const Eigen::MatrixXd& information,
+                          const std::vector<Eigen::MatrixXd>& pair_informations,
+                          const std::vector<Eigen::VectorXd>& pair_gradients,
+                          const std::vector<std::string>& pair_ids, double variance_factor,
+                          const Eigen::MatrixXd& model_covariance) {
+  const int k = static_cast<int>(pair_gradients.size());
+  const int p = static_cast<int>(information.rows());
+  Jackknife out;
+  out.pairs = k;
+  std::vector<Eigen::VectorXd> moves;
+  Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(p, p);
+  for (int i = 0; i < k; ++i) {
+    const Eigen::MatrixXd without = information - pair_informations[i];
+    const Eigen::VectorXd lambdas =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(without).eigenvalues();
+    if (!(lambdas[0] > 1e-9 * lambdas[p - 1])) {
+      out.skipped = "leaving pair " + pair_ids[i] + " out leaves the pose undetermined";
+      return out;
+    }
+    const Eigen::MatrixXd inverse = without.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
+    moves.push_back(inverse * pair_gradients[i]);
+    expected += variance_factor * inverse * pair_informations[i] * inverse.transpose();
+  }
+  const Eigen::LLT<Eigen::MatrixXd> expected_llt(expected * ((k - 1.0) / k));
+  const Eigen::LLT<Eigen::MatrixXd> model_llt(model_covariance);
+  if (expected_llt.info() != Eigen::Success || model_llt.info() != Eigen::Success) {
+    out.skipped = "the leave-one-out moves could not be compared with the model";
+    return out;
+  }
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(p);
+  for (const Eigen::VectorXd& move : moves) mean += move / k;
+  out.raw = Eigen::MatrixXd::Zero(p, p);
+  for (const Eigen::VectorXd& move : moves) out.raw += (move - mean) * (move - mean).transpose();
+  out.raw *= (k - 1.0) / k;
+  const Eigen::MatrixXd l_expected = expected_llt.matrixL();
+  const Eigen::MatrixXd l_model = model_llt.matrixL();
+  const Eigen::MatrixXd excess = l_expected.triangularView<Eigen::Lower>().solve(
+      l_expected.triangularView<Eigen::Lower>().solve(out.raw).transpose());
+  out.scatter = l_model * excess * l_model.transpose();
+  return out;
+}
+
+// Where the model holds, the jackknife's scatter along a direction lies around the model's
+// variance like an F(k − 1, r) ratio (the model's own scale is estimated from the r redundant
+// residuals), and the model, which knows every residual's noise, is the better estimate. Only a
+// scatter beyond that ratio's 99 % quantile for the largest of the p directions (Bonferroni:
+// 1 − 0.01/p, z = 2.93 for six) says the model is violated (real sensors' per-pair errors). Then
+// the jackknife itself is reported where it is larger, widened by the Student t quantile over the
+// normal's at 3σ for its k − 1 degrees of freedom (a 3σ test then keeps its 99.7 %): with few
+// pairs its leverage makes it conservative, the side to err on once the model is known not to
+// hold. True when *reported was widened.
+bool WidenWhereTheModelFails(const Jackknife& jackknife, const Eigen::MatrixXd& model_covariance,
+                             int redundancy, Eigen::MatrixXd* reported) {
+  const int pairs = jackknife.pairs;
+  const int parameters = static_cast<int>(model_covariance.rows());
+  const double threshold =
+      FQuantile(pairs - 1, std::max(1, redundancy), NormalQuantile(1.0 - 0.01 / parameters));
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> test(jackknife.scatter,
+                                                                 model_covariance);
+  if (test.info() != Eigen::Success || !(test.eigenvalues().maxCoeff() > threshold)) return false;
+  const double widen = StudentQuantileAt3Sigma(pairs - 1) / 3.0;
+  *reported = LargerAlongEveryDirection(*reported, widen * widen * jackknife.raw, 1.0);
+  return true;
+}
+
+// An offset left out that the data cannot see still biases the pose by g·b (g = −H_pp⁻¹ H_pb,
+// the pose's response to an offset): its prior σ_b, narrowed by what the data itself says of b
+// (the information left for it once the pose is free, at the solve's variance factor),
+// σ_post² = 1 / (1/σ_b² + I_b|pose), spreads into the pose's covariance as σ_post² g gᵀ.
+template <typename Information>
+Mat6 RangeOffsetPriorCovariance(const Information& information, int offset, double prior_sigma_m,
+                                double variance_factor) {
+  if (!(variance_factor > 0)) return Mat6::Zero();
+  const Mat6 pose_information = information.template topLeftCorner<6, 6>();
+  const Vec6 cross = information.template block<6, 1>(0, offset);
+  const Vec6 response = -pose_information.ldlt().solve(cross);
+  const double offset_information =
+      std::max(0.0, (information(offset, offset) + cross.dot(response)) / variance_factor);
+  const double posterior = 1.0 / (1.0 / (prior_sigma_m * prior_sigma_m) + offset_information);
+  if (!response.allFinite() || !std::isfinite(posterior)) return Mat6::Zero();
+  return posterior * response * response.transpose();
+}
+
 }  // namespace
 
 SolverResult PlaneAlignmentSolver::Summarize() const {
@@ -146,125 +258,53 @@ PlaneAlignmentSolver::Mat7 PlaneAlignmentSolver::Covariance(const Linearization&
   if (options_.method != SolverMethod::kWeightedMl || !(variance_factor > 0) ||
       !(eigen.eigenvalues()[0] > 1e-12 * largest))
     return covariance;
-  const Eigen::MatrixXd inverse_information = model_covariance / variance_factor;
+  // Each used pair's share of the gradient and the information, over the active parameters.
+  std::vector<Eigen::VectorXd> gradients;
+  std::vector<Eigen::MatrixXd> informations;
+  for (int i = 0; i < clusters; ++i) {
+    gradients.push_back(lin.pair_gradients[i](active));
+    informations.push_back(lin.pair_informations[i](active, active));
+  }
   Eigen::MatrixXd reported = model_covariance;
   // The model's covariance trusts every residual to be independent. On real sensors they are
   // not (a pair's edge points share its range-dependent beam footprint, its board's flatness,
   // its rings' angle errors), which the model cannot see and the spread over pairs shows. The
-  // cluster-robust (sandwich) covariance with the pairs as clusters, H⁻¹ (Σᵢ gᵢgᵢᵀ) H⁻¹ scaled by
-  // n/(n − p), measures that spread from the data; the reported covariance is the larger of the
-  // two in every direction (beyond the sandwich's own sampling noise).
-  if (options_.sandwich_covariance && clusters > num_parameters + 2) {
-    Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
-    for (const Vec7& g : lin.pair_gradients) {
-      const Eigen::VectorXd active_g = g(active);
-      meat += active_g * active_g.transpose();
-    }
-    const Eigen::MatrixXd sandwich = static_cast<double>(clusters) / (clusters - num_parameters) *
-                                     inverse_information * meat * inverse_information;
-    // A variance ratio estimated from n clusters scatters by about √(2 / (n − p)) even when the
-    // model holds: only the excess beyond that one-σ noise inflates, so that a correct model
-    // keeps its covariance (and its χ² calibration) while a violated one widens.
-    reported = LargerAlongEveryDirection(reported, sandwich,
-                                         1.0 + std::sqrt(2.0 / (clusters - num_parameters)));
-  }
-  // The jackknife: how far the estimate moves when each pair is left out, one Gauss-Newton step
-  // from the solution without that pair's share, Δᵢ = (H − Hᵢ)⁻¹ gᵢ (gᵢ: the pair's gradient,
-  // Hᵢ its information). Unlike the sandwich it sees a pair's leverage (a pair the others hardly
-  // constrain moves the estimate by more than H⁻¹ gᵢ), and it needs only 4 pairs. With few pairs
-  // its variance is itself uncertain (k − 1 degrees of freedom), so it is widened by the Student
-  // t quantile over the normal one at 3σ: a 3σ test of the result then keeps its 99.7 %.
-  if (!options_.jackknife_covariance) result->jackknife_skipped = "the jackknife is off";
-  if (options_.jackknife_covariance && clusters < 4)
+  // cluster-robust (sandwich) covariance with the pairs as clusters measures that spread from the
+  // data; the reported covariance is the larger of the two in every direction (beyond the
+  // sandwich's own sampling noise: a variance ratio estimated from n clusters scatters by about
+  // √(2 / (n − p)) even when the model holds, so a correct model keeps its χ² calibration).
+  if (options_.sandwich_covariance && clusters > num_parameters + 2)
+    reported =
+        LargerAlongEveryDirection(reported, Sandwich(gradients, model_covariance / variance_factor),
+                                  1.0 + std::sqrt(2.0 / (clusters - num_parameters)));
+  if (!options_.jackknife_covariance) {
+    result->jackknife_skipped = "the jackknife is off";
+  } else if (clusters < 4) {
     result->jackknife_skipped = "fewer than 4 pairs in the solve";
-  if (options_.jackknife_covariance && clusters >= 4) {
-    // Per pair: its move Δᵢ = Aᵢ gᵢ with Aᵢ = (H − Hᵢ)⁻¹, and what the model expects of that
-    // move's spread, s² Aᵢ Hᵢ Aᵢᵀ (gᵢ has covariance s² Hᵢ when the model holds).
-    std::vector<size_t> used;  // the pairs behind pair_gradients: those not gated
+  } else {
+    std::vector<std::string> ids;  // the pairs behind pair_gradients: those not gated
     for (size_t j = 0; j < pairs_.size(); ++j)
-      if (!gated_[j]) used.push_back(j);
-    std::vector<Eigen::VectorXd> moves;
-    Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
-    bool all_determined = true;
-    for (int i = 0; i < clusters && all_determined; ++i) {
-      const Eigen::MatrixXd pair_information = lin.pair_informations[i](active, active);
-      const Eigen::MatrixXd without = information - pair_information;
-      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> without_eigen(without);
-      const Eigen::VectorXd lambdas = without_eigen.eigenvalues();
-      all_determined = lambdas[0] > 1e-9 * lambdas[num_parameters - 1];
-      if (!all_determined) {
-        result->jackknife_skipped =
-            "leaving pair " + pairs_[used[i]].id + " out leaves the pose undetermined";
-        break;
-      }
-      const Eigen::MatrixXd inverse =
-          without.ldlt().solve(Eigen::MatrixXd::Identity(num_parameters, num_parameters));
-      moves.push_back(inverse * lin.pair_gradients[i](active));
-      expected += variance_factor * inverse * pair_information * inverse.transpose();
-    }
-    const Eigen::LLT<Eigen::MatrixXd> expected_llt(expected);
-    const Eigen::LLT<Eigen::MatrixXd> model_llt(model_covariance);
-    if (all_determined && expected_llt.info() == Eigen::Success &&
-        model_llt.info() == Eigen::Success) {
-      Eigen::VectorXd mean = Eigen::VectorXd::Zero(num_parameters);
-      for (const Eigen::VectorXd& move : moves) mean += move / clusters;
-      Eigen::MatrixXd jackknife = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
-      for (const Eigen::VectorXd& move : moves)
-        jackknife += (move - mean) * (move - mean).transpose();
-      jackknife *= (clusters - 1.0) / clusters;
-      expected *= (clusters - 1.0) / clusters;
-      // A pair of high leverage moves the estimate more than the model's covariance suggests
-      // even when the model holds (with k pairs and p parameters the average pair carries p/k of
-      // the information): the jackknife's excess is judged against what the model expects of
-      // it, X = L_E⁻¹ J L_E⁻ᵀ (the identity when the model holds), and carried over to the
-      // model's covariance, L_M X L_Mᵀ: the covariance the pairs' scatter says, free of leverage.
-      const Eigen::MatrixXd l_expected = expected_llt.matrixL();
-      const Eigen::MatrixXd l_model = model_llt.matrixL();
-      const Eigen::MatrixXd excess = l_expected.triangularView<Eigen::Lower>().solve(
-          l_expected.triangularView<Eigen::Lower>().solve(jackknife).transpose());
-      const Eigen::MatrixXd scatter = l_model * excess * l_model.transpose();
+      if (!gated_[j]) ids.push_back(pairs_[j].id);
+    const Jackknife jackknife = LeaveOnePairOut(information, informations, gradients, ids,
+                                                variance_factor, model_covariance);
+    result->jackknife_skipped = jackknife.skipped;
+    if (jackknife.skipped.empty()) {
       Mat7 scatter_pose = Mat7::Zero();
-      scatter_pose(active, active) = scatter;
+      scatter_pose(active, active) = jackknife.scatter;
       result->jackknife_pairs = clusters;
       result->jackknife_sigma_t_m =
           TranslationStd(scatter_pose.topLeftCorner<6, 6>(), cam_from_lidar_);
       result->jackknife_sigma_r_deg =
           RotationStdDeg(scatter_pose.topLeftCorner<6, 6>(), cam_from_lidar_);
-      // Where the model holds, that scatter's variance along a direction lies around the
-      // model's like an F(k − 1, r) ratio (the model's own scale is estimated from the r
-      // redundant residuals), and the model, which knows every residual's noise, is the better
-      // estimate. Only a scatter beyond that ratio's 99 % quantile for the largest of the p
-      // directions (Bonferroni: 1 − 0.01/p, z = 2.93 for six) says the model is violated (real
-      // sensors' per-pair errors). Then the jackknife itself is reported where it is larger,
-      // widened by the t quantile for its k − 1 degrees of freedom: with few pairs its leverage
-      // makes it conservative, which is the side to err on once the model is known not to hold.
       const int redundancy = lin.num_residuals - lin.num_edge_dilations - num_parameters;
-      const double threshold = FQuantile(clusters - 1, std::max(1, redundancy),
-                                         NormalQuantile(1.0 - 0.01 / num_parameters));
-      Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> test(scatter, model_covariance);
-      if (test.info() == Eigen::Success && test.eigenvalues().maxCoeff() > threshold) {
-        const double widen = StudentQuantileAt3Sigma(clusters - 1) / 3.0;
-        reported = LargerAlongEveryDirection(reported, widen * widen * jackknife, 1.0);
-        result->jackknife_widened = true;
-      }
+      result->jackknife_widened =
+          WidenWhereTheModelFails(jackknife, model_covariance, redundancy, &reported);
     }
   }
   covariance(active, active) = reported;
-  // An offset left out that the data cannot see still biases the pose by g·b (g = −H_pp⁻¹ H_pb,
-  // the pose's response to an offset): its prior spreads into the covariance as σ_b² g gᵀ.
-  const double prior = options_.range_offset_prior_sigma_m;
-  if (!options_.estimate_range_offset && prior > 0 && variance_factor > 0) {
-    // What the data itself says of b (the information left for it once the pose is free, at
-    // the solve's variance factor) narrows the prior: σ_post² = 1 / (1/σ_b² + I_b|pose).
-    const Mat6 pose_information = lin.information.topLeftCorner<6, 6>();
-    const Vec6 cross = lin.information.block<6, 1>(0, kRangeOffset);
-    const Vec6 response = -pose_information.ldlt().solve(cross);
-    const double offset_information = std::max(
-        0.0, (lin.information(kRangeOffset, kRangeOffset) + cross.dot(response)) / variance_factor);
-    const double posterior = 1.0 / (1.0 / (prior * prior) + offset_information);
-    if (response.allFinite() && std::isfinite(posterior))
-      covariance.topLeftCorner<6, 6>() += posterior * response * response.transpose();
-  }
+  if (!options_.estimate_range_offset && options_.range_offset_prior_sigma_m > 0)
+    covariance.topLeftCorner<6, 6>() += RangeOffsetPriorCovariance(
+        lin.information, kRangeOffset, options_.range_offset_prior_sigma_m, variance_factor);
   // How much wider than the model the reported covariance is, along its widest direction.
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ratio(covariance(active, active),
                                                                   model_covariance);

@@ -259,6 +259,18 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
   return fit;
 }
 
+namespace {
+
+// Rings among the points (0 when the cloud has none).
+int DistinctRings(const LidarCloud& cloud, const std::vector<int>& indices) {
+  if (!cloud.HasRing()) return 0;
+  std::set<int> rings;
+  for (int i : indices) rings.insert(cloud.ring[i]);
+  return static_cast<int>(rings.size());
+}
+
+}  // namespace
+
 std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
                                            const std::vector<int>& candidates,
                                            const LidarPlaneOptions& options, std::string* why) {
@@ -333,11 +345,7 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
     fit->edge_points = ExtractBoardEdgePoints(cloud, fit->inliers, fit->plane, options.edges);
     fit->sheet_size_m = options.sheet_size_m;
   }
-  if (cloud.HasRing()) {
-    std::set<int> rings;
-    for (int i : fit->inliers) rings.insert(cloud.ring[i]);
-    fit->num_rings = static_cast<int>(rings.size());
-  }
+  fit->num_rings = DistinctRings(cloud, fit->inliers);
   return fit;
 }
 
