@@ -1,6 +1,7 @@
 #include "core/guidance/next_pose.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -298,8 +299,11 @@ PlanePair PlannedPair(const SensorGeometry& sensors, const Pose& cam_from_lidar,
   // Camera plane: normal towards the camera (BoardSpec's z points away from it).
   const Vec3 camera_normal = -cam_from_board.linear().col(2);
   pair.camera_plane = Plane{camera_normal, -camera_normal.dot(cam_from_board.translation())};
-  pair.camera_covariance = CameraPlaneBoundCovariance(
-      sensors.camera, BoardCornerPoints(sensors.board), cam_from_board, sensors.corner_sigma_px);
+  const std::vector<Vec3> corners = BoardCornerPoints(sensors.board);
+  pair.camera_covariance =
+      CameraPlaneBoundCovariance(sensors.camera, corners, cam_from_board, sensors.corner_sigma_px);
+  pair.camera_pose_covariance =
+      CameraPoseBoundCovariance(sensors.camera, corners, cam_from_board, sensors.corner_sigma_px);
   const Pose lidar_from_board = cam_from_lidar.inverse() * cam_from_board;
   const Vec3 lidar_normal = -lidar_from_board.linear().col(2);
   pair.lidar_plane = Plane{lidar_normal, -lidar_normal.dot(lidar_from_board.translation())};
@@ -376,6 +380,26 @@ bool NearAHeldBoard(const Pose& cam_from_board, const std::vector<Pose>& seen,
 
 // Without a solution: unlike what was seen (normals and positions), frontal first; ties by the
 // distance from the middle of the usable range. Lower is better.
+// What a new pair's model information is expected to be worth, as the map D of I ↦ D I Dᵀ. In
+// the coordinates where the model's covariance is the identity (T = H^½, H the model's
+// information), the reported covariance reads W = T C T: how much wider than the model each
+// direction came out. The new pair is discounted by W^-½ on both sides, D = T W^-½ T⁻¹, which
+// maps the seen pairs' own information H onto C⁻¹ exactly. A scalar discount by the largest
+// widening would also shrink the directions the model got right, and favour poses for the
+// wrong axis where the widening is lopsided.
+Mat6 InformationDiscount(const SolverResult& solution) {
+  const Eigen::SelfAdjointEigenSolver<Mat6> model(solution.model_covariance);
+  if (model.info() != Eigen::Success || !(model.eigenvalues().minCoeff() > 0))
+    return Mat6::Identity() / std::sqrt(std::max(1.0, solution.covariance_inflation));
+  const Mat6 root = model.operatorInverseSqrt();  // T = M^-½ = H^½
+  const Mat6 root_inverse = model.operatorSqrt();
+  const Eigen::SelfAdjointEigenSolver<Mat6> widening(root * solution.covariance * root);
+  // Never credit a pair with more than its model information (W ≥ I).
+  const Vec6 shrink = widening.eigenvalues().cwiseMax(1.0).cwiseInverse().cwiseSqrt();
+  return root * widening.eigenvectors() * shrink.asDiagonal() *
+         widening.eigenvectors().transpose() * root_inverse;
+}
+
 std::pair<double, double> StarterScore(const Candidate& c, const std::vector<Pose>& seen) {
   if (seen.empty()) return {c.turn_deg + c.off_axis, c.off_centre_m};
   double nearest = 1e9;
@@ -403,6 +427,7 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
     if (ldlt.info() == Eigen::Success && ldlt.isPositive())
       current_information = ldlt.solve(Mat6::Identity());
   }
+  const Mat6 discount = solution ? InformationDiscount(*solution) : Mat6::Identity();
   const std::vector<Candidate> grid = CandidateGrid(sensors, options);
   std::optional<PoseSuggestion> best;
   std::pair<double, double> best_score(std::numeric_limits<double>::infinity(), 0.0);
@@ -427,11 +452,10 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
       // The model's information, discounted by how much wider than the model the reported
       // covariance is (the pairs' scatter on real sensors): a new pair is expected to help as
       // much as the ones seen so far did.
-      const Mat6 added =
-          ExpectedPoseInformation(
-              {PlannedPair(sensors, *cam_from_lidar, c.cam_from_board, returns)}, *cam_from_lidar,
-              solver_options, solution->plane_variance_factor, solution->edge_variance_factor) /
-          std::max(1.0, solution->covariance_inflation);
+      const Mat6 model_added = ExpectedPoseInformation(
+          {PlannedPair(sensors, *cam_from_lidar, c.cam_from_board, returns)}, *cam_from_lidar,
+          solver_options, solution->plane_variance_factor, solution->edge_variance_factor);
+      const Mat6 added = discount * model_added * discount.transpose();
       const Mat6 predicted = (current_information + added).inverse();
       // The sum of squared σ/goal over the six axes (A-optimal in units of the goal: the weakest
       // axis dominates it), the largest ratio breaking ties. Chasing the largest ratio alone

@@ -62,7 +62,8 @@ PlanePair MakePlanePair(const std::string& id, const LidarPlaneFit& lidar,
           lidar.range_offset_jacobian,
           lidar.edge_points,
           camera.cam_from_board,
-          0.5 * lidar.sheet_size_m};
+          0.5 * lidar.sheet_size_m,
+          camera.pose_covariance};
 }
 
 std::optional<PairInputs> LoadPairInputs(const Dataset& dataset, const PairEntry& pair,

@@ -254,6 +254,7 @@ PlaneAlignmentSolver::Mat7 PlaneAlignmentSolver::Covariance(const Linearization&
                                            inverse_eigenvalues.asDiagonal() *
                                            eigen.eigenvectors().transpose();
   covariance(active, active) = model_covariance;
+  result->model_covariance = covariance.topLeftCorner<6, 6>();
   const int clusters = static_cast<int>(lin.pair_gradients.size());
   if (options_.method != SolverMethod::kWeightedMl || !(variance_factor > 0) ||
       !(eigen.eigenvalues()[0] > 1e-12 * largest))

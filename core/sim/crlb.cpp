@@ -41,8 +41,8 @@ Mat4 LidarPlaneBoundCovariance(const std::vector<Vec3>& points, const Plane& pla
   return TangentToCoefficients(information.inverse(), plane.normal);
 }
 
-Mat4 CameraPlaneBoundCovariance(const CameraModel& camera, const std::vector<Vec3>& board_corners,
-                                const Pose& cam_from_board, double corner_sigma_px) {
+Mat6 CameraPoseBoundCovariance(const CameraModel& camera, const std::vector<Vec3>& board_corners,
+                               const Pose& cam_from_board, double corner_sigma_px) {
   CALIBENCH_CHECK(corner_sigma_px > 0);
   // Fisher information of the board pose (right perturbation) from the corner pixels.
   Mat6 pose_information = Mat6::Zero();
@@ -57,7 +57,13 @@ Mat4 CameraPlaneBoundCovariance(const CameraModel& camera, const std::vector<Vec
     const Eigen::Matrix<double, 2, 6> j = d_pixel_d_point * d_point;
     pose_information += j.transpose() * j / (corner_sigma_px * corner_sigma_px);
   }
-  const Mat6 pose_covariance = pose_information.inverse();
+  return pose_information.inverse();
+}
+
+Mat4 CameraPlaneBoundCovariance(const CameraModel& camera, const std::vector<Vec3>& board_corners,
+                                const Pose& cam_from_board, double corner_sigma_px) {
+  const Mat6 pose_covariance =
+      CameraPoseBoundCovariance(camera, board_corners, cam_from_board, corner_sigma_px);
   // The board plane in the camera frame: n = R e_z (sign fixed by OrientTowardsOrigin),
   // d = −n·t. dn = −R [e_z]× δφ, dt = R δρ.
   const Mat3& r = cam_from_board.linear();

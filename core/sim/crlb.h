@@ -23,6 +23,11 @@ namespace calibench {
 Mat4 LidarPlaneBoundCovariance(const std::vector<Vec3>& points, const Plane& plane,
                                double range_sigma_m);
 
+// Inverse Fisher information of the board pose (right perturbation, [rho; phi]) for corners
+// `board_corners` (board frame) seen at `cam_from_board` with pixel noise `corner_sigma_px`.
+Mat6 CameraPoseBoundCovariance(const CameraModel& camera, const std::vector<Vec3>& board_corners,
+                               const Pose& cam_from_board, double corner_sigma_px);
+
 // Inverse Fisher information of the board plane (n, d) in the camera frame (4x4, rank 3) for
 // corners `board_corners` (board frame) seen at `cam_from_board` with pixel noise
 // `corner_sigma_px` (1σ per coordinate).

@@ -99,7 +99,7 @@ std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
 double BoardEdgeResidual(const Pose& cam_from_lidar, const Pose& camera_from_board,
                          const Vec2& sheet_half_size_m, const LidarEdgePoint& edge,
                          double floor_sigma_m, Eigen::Matrix<double, 1, 6>* jacobian,
-                         double* sigma_m) {
+                         double* sigma_m, Eigen::Matrix<double, 1, 6>* board_pose_jacobian) {
   const Mat3 board_from_camera = camera_from_board.linear().transpose();
   const Vec3 in_camera = cam_from_lidar * edge.point;
   const Vec3 in_board = board_from_camera * (in_camera - camera_from_board.translation());
@@ -115,6 +115,12 @@ double BoardEdgeResidual(const Pose& cam_from_lidar, const Pose& camera_from_boa
   if (jacobian) {
     jacobian->head<3>() = d_camera * rotation;
     jacobian->tail<3>() = -d_camera * rotation * Skew(edge.point);
+  }
+  if (board_pose_jacobian) {
+    // The point in the perturbed board frame: Exp(−xi)(p − ρ) ≈ p − ρ − φ × p = p − ρ + [p]× φ.
+    const Eigen::RowVector3d d_board = sign * Eigen::RowVector3d::Unit(axis);
+    board_pose_jacobian->head<3>() = -d_board;
+    board_pose_jacobian->tail<3>() = d_board * Skew(in_board);
   }
   if (sigma_m) {
     const double along = d_camera.dot(rotation * edge.along_ring) * edge.sigma_along_m;

@@ -46,10 +46,13 @@ std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
 // the signed distance, in the board plane, from the point to the sheet edge nearest to it
 // (positive outside). `camera_from_board` is the PnP pose. With `jacobian`, d/d(delta) for the
 // right perturbation cam_from_lidar·Exp(delta), [rho; phi]; with `sigma_m`, the residual's
-// standard deviation from the crossing's uncertainty along the ring and `floor_sigma_m`.
+// standard deviation from the crossing's uncertainty along the ring and `floor_sigma_m`. With
+// `board_pose_jacobian`, d/d(xi) for the right perturbation camera_from_board·Exp(xi) of the
+// camera's board pose, [rho; phi]: every edge point of a pair shares that pose's error.
 double BoardEdgeResidual(const Pose& cam_from_lidar, const Pose& camera_from_board,
                          const Vec2& sheet_half_size_m, const LidarEdgePoint& edge,
                          double floor_sigma_m, Eigen::Matrix<double, 1, 6>* jacobian,
-                         double* sigma_m);
+                         double* sigma_m,
+                         Eigen::Matrix<double, 1, 6>* board_pose_jacobian = nullptr);
 
 }  // namespace calibench
