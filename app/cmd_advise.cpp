@@ -20,7 +20,7 @@ int RunAdvise(int argc, char** argv) {
   std::string dataset_path;
   AdviseOptions options;
   bool json = false;
-  app.add_option("--dataset,-d", dataset_path, "dataset.json or dataset folder")->required();
+  AddDatasetOption(app, &dataset_path, "a LiDAR-camera or 2D LRF dataset")->required();
   app.add_option("--goal-mm", options.goal.translation_mm,
                  "goal: 1σ of the translation per axis [mm]")
       ->capture_default_str();

@@ -14,7 +14,7 @@ int RunCalibrate(int argc, char** argv) {
       "Gauss-Newton with a Huber kernel).",
       "calibench calibrate"};
   std::string dataset_path, session_path, out_path;
-  app.add_option("--dataset,-d", dataset_path, "dataset.json or dataset folder");
+  AddDatasetOption(app, &dataset_path, "a LiDAR-camera dataset");
   app.add_option("--session", session_path,
                  "a workbench session (calibench.session.json): its brushes, rejections and "
                  "solver choices are used, so the result is the workbench's; its dataset unless "

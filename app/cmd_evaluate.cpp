@@ -25,7 +25,7 @@ void PrintError(const PoseError& error, const Mat6& covariance, const Pose& cam_
   const Vec3 st = TranslationStd(covariance, cam_from_lidar) * 1000.0;
   const Vec3 sr = RotationStdDeg(covariance, cam_from_lidar);
   std::printf("error against ground truth: translation %.2f mm, rotation %.3f deg\n",
-              error.translation_m * 1000.0, error.rotation_rad * 180.0 / M_PI);
+              error.translation_m * 1000.0, error.rotation_rad * kRadToDeg);
   std::printf("reported std: translation %.2f mm, rotation %.3f deg (root of summed variances)\n",
               st.norm(), sr.norm());
 }
@@ -147,7 +147,7 @@ int CompareWithReference(const LoadedResult& result, const ReferenceFlags& flags
       "difference from the reference: translation %.2f mm (camera axes x/y/z %+.2f / %+.2f "
       "/ %+.2f mm), rotation %.3f deg\n",
       error.translation_m * 1e3, in_camera.x() * 1e3, in_camera.y() * 1e3, in_camera.z() * 1e3,
-      error.rotation_rad * 180 / M_PI);
+      error.rotation_rad * kRadToDeg);
   if (result.covariance.isZero()) {
     std::printf("(the result has no covariance: no weighing by its uncertainty)\n");
   } else {
@@ -160,7 +160,7 @@ int CompareWithReference(const LoadedResult& result, const ReferenceFlags& flags
   }
   const bool too_far =
       (max_translation_mm >= 0 && error.translation_m * 1000 > max_translation_mm) ||
-      (max_rotation_deg >= 0 && error.rotation_rad * 180 / M_PI > max_rotation_deg);
+      (max_rotation_deg >= 0 && error.rotation_rad * kRadToDeg > max_rotation_deg);
   return too_far ? kAccuracyFailed : kOk;
 }
 
@@ -182,7 +182,7 @@ int RunEvaluate(int argc, char** argv) {
   double max_translation_mm = -1, max_rotation_deg = -1, corner_sigma_px = 0;
   bool crlb = false, sweep = false;
   app.add_option("--result,-r", result_path, "result.json (optional with --crlb)");
-  app.add_option("--dataset,-d", dataset_path, "dataset with ground_truth.cam_from_lidar");
+  AddDatasetOption(app, &dataset_path, "a LiDAR-camera dataset with ground_truth.cam_from_lidar");
   ReferenceFlags reference;
   app.add_option("--reference", reference.path,
                  "compare --result with another calibration instead of ground truth: a result "
@@ -232,10 +232,10 @@ int RunEvaluate(int argc, char** argv) {
   if (bound)
     std::printf("error / bound: translation %.2f, rotation %.2f\n",
                 error.translation_m / bound->translation_rms_m,
-                error.rotation_rad * 180 / M_PI / bound->rotation_rms_deg);
+                error.rotation_rad * kRadToDeg / bound->rotation_rms_deg);
   const bool too_far =
       (max_translation_mm >= 0 && error.translation_m * 1000 > max_translation_mm) ||
-      (max_rotation_deg >= 0 && error.rotation_rad * 180 / M_PI > max_rotation_deg);
+      (max_rotation_deg >= 0 && error.rotation_rad * kRadToDeg > max_rotation_deg);
   return too_far ? kAccuracyFailed : kOk;
 }
 

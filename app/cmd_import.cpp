@@ -118,10 +118,7 @@ int RunImport(int argc, char** argv) {
   app.add_option("--out,-o", out,
                  "dataset folder to write (default: <bag name>.dataset beside it, or under "
                  "~/.local/share/calibench/imports when that folder is read-only)");
-  app.add_option("--board", board,
-                 "the board the camera sees: a3 | a4 | charuco-a3 | charuco-a4 | paper, or a "
-                 "target.json")
-      ->capture_default_str();
+  AddBoardOption(app, &board, "the board the camera sees");
   app.add_option("--cloud-topic", options.cloud_topic, "PointCloud2 topic (default: the only one)");
   app.add_option("--image-topic", options.image_topic,
                  "Image or CompressedImage topic (default: the only one)");

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "core/io/dataset_source.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/lrf/pipeline.h"
 #include "core/lrf/result_io.h"
@@ -30,20 +31,15 @@ std::vector<std::string> SplitIds(const std::string& text) {
 void PrintPoseError(const char* what, const Pose& estimate, const Pose& reference) {
   const PoseError e = ComputePoseError(estimate, reference);
   std::printf("%s: translation %.2f mm, rotation %.3f deg\n", what, e.translation_m * 1e3,
-              e.rotation_rad * 180.0 / M_PI);
+              e.rotation_rad * kRadToDeg);
 }
 
 }  // namespace
 
 bool IsLrfManifest(const std::string& path) {
-  std::ifstream in(LrfManifestPath(path));
-  if (!in) return false;
-  try {
-    const nlohmann::json root = nlohmann::json::parse(in);
-    return root.value("format", "") == "calibench.lrf-dataset.v1";
-  } catch (const std::exception&) {
-    return false;
-  }
+  std::string ignored;
+  const auto source = RecogniseDataset(path, &ignored);
+  return source && source->kind == DatasetKind::kLrf;
 }
 
 int RunLrfCalibrate(int argc, char** argv) {
@@ -54,9 +50,7 @@ int RunLrfCalibrate(int argc, char** argv) {
       "calibench lrf-calibrate"};
   std::string dataset_path, out_path, method = "refined", pairs_text;
   LrfPipelineOptions options;
-  app.add_option("--dataset,-d", dataset_path,
-                 "calibench.lrf-dataset.v1 manifest, or the folder holding it as manifest.json")
-      ->required();
+  AddDatasetOption(app, &dataset_path, "a 2D LRF dataset (calibench.lrf-dataset.v1)")->required();
   app.add_option("--out,-o", out_path, "result file (calibench.result.v1)");
   app.add_option("--method", method,
                  "refined (SE(3) Gauss-Newton over every scan point, seeded by paper-linear) | "
@@ -172,9 +166,9 @@ int RunEvaluateLrf(int argc, char** argv) {
   app.add_option("--result,-r", result_path, "result.json (the left camera's with --stereo)")
       ->required();
   app.add_option("--right-result", right_result_path, "--stereo: the right camera's result");
-  app.add_option("--dataset,-d", dataset_path,
-                 "LRF manifest with ground_truth.cam_from_lrf (with --stereo: one carrying "
-                 "stereo.right_from_left)")
+  AddDatasetOption(app, &dataset_path,
+                   "a 2D LRF dataset with ground_truth.cam_from_lrf (with --stereo: one carrying "
+                   "stereo.right_from_left)")
       ->required();
   app.add_flag("--stereo", stereo, "the stereo-baseline check");
   app.add_option("--max-translation-mm", max_translation_mm, "fail (exit 5) above this error");
@@ -216,7 +210,7 @@ int RunEvaluateLrf(int argc, char** argv) {
   }
   const PoseError e = ComputePoseError(estimate, reference);
   const bool too_far = (max_translation_mm >= 0 && e.translation_m * 1e3 > max_translation_mm) ||
-                       (max_rotation_deg >= 0 && e.rotation_rad * 180 / M_PI > max_rotation_deg);
+                       (max_rotation_deg >= 0 && e.rotation_rad * kRadToDeg > max_rotation_deg);
   return too_far ? kAccuracyFailed : kOk;
 }
 

@@ -20,7 +20,7 @@ int RunEvaluateSubsets(int argc, char** argv) {
   SubsetCoverageOptions coverage;
   bool subsets = false;
   app.add_flag("--subsets", subsets, "this mode");
-  app.add_option("--dataset,-d", dataset_path, "dataset.json or dataset folder")->required();
+  AddDatasetOption(app, &dataset_path, "a LiDAR-camera dataset")->required();
   app.add_option("--first-k", coverage.first_k, "prefix sizes (comma-separated)")
       ->delimiter(',')
       ->capture_default_str();

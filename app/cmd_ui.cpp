@@ -197,16 +197,12 @@ int RunGui(int argc, char** argv) {
       "calibench gui"};
   std::string dataset, session, size = "1600x900", screenshot;
   GuiWindowFlags quit;
-  app.add_option("--dataset,-d", dataset,
-                 "dataset.json or dataset folder, or an LRF manifest (calibench.lrf-dataset.v1)");
+  AddDatasetOption(app, &dataset, "a LiDAR-camera or 2D LRF dataset");
   app.add_option("--session,-s", session, "a saved session (calibench.session.v1)");
   app.add_option("--bag", quit.bag,
                  "a recording (ROS 1 .bag, ROS 2 .db3 / .mcap or a rosbag2 folder): imported "
                  "behind a progress bar (as `calibench import`), then opened");
-  app.add_option("--board", quit.board,
-                 "the board in recordings opened here: a3 | a4 | charuco-a3 | charuco-a4 | paper, "
-                 "or a target.json")
-      ->capture_default_str();
+  AddBoardOption(app, &quit.board, "the board in recordings opened here");
   app.add_option("--test-drop", quit.test_drops,
                  "deliver this path to the window's drop callback after the first frames (tests)")
       ->group("");
@@ -301,7 +297,7 @@ int RunRender(int argc, char** argv) {
       "calibench render"};
   std::string dataset, session, pair, view = "workbench", size = "1600x900", out, gl = "auto";
   bool solve = false;
-  app.add_option("--dataset,-d", dataset, "dataset.json or dataset folder");
+  AddDatasetOption(app, &dataset, "a LiDAR-camera or 2D LRF dataset");
   app.add_option("--session,-s", session, "a saved session");
   app.add_option("--pair", pair, "pair id to show (default: the session's selection)");
   app.add_flag("--solve", solve, "run the solver before drawing");

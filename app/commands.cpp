@@ -68,6 +68,20 @@ std::optional<int> ParseFlags(CLI::App& app, int argc, char** argv) {
   return std::nullopt;
 }
 
+CLI::Option* AddDatasetOption(CLI::App& app, std::string* path, const std::string& what) {
+  return app.add_option("--dataset,-d", *path,
+                        what +
+                            ": its manifest under any name, or the folder holding it "
+                            "(dataset.json, manifest.json, another *.json, or the folder form)");
+}
+
+CLI::Option* AddBoardOption(CLI::App& app, std::string* board, const std::string& what) {
+  return app
+      .add_option("--board", *board,
+                  what + ": a3 | a4 | charuco-a3 | charuco-a4 | paper, or a target.json")
+      ->capture_default_str();
+}
+
 int PrintAndWriteTable(const std::string& table, const std::string& path, const char* command) {
   std::printf("%s", table.c_str());
   if (path.empty()) return kOk;

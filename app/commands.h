@@ -10,7 +10,8 @@
 
 namespace CLI {
 class App;
-}
+class Option;
+}  // namespace CLI
 
 namespace calibench::app {
 
@@ -35,6 +36,12 @@ std::string Closest(const std::string& word, const std::vector<std::string>& can
 // Prints a table (Markdown) on stdout and, when `path` is not empty, writes it there atomically;
 // kOk, or kInputError with the file and the reason on stderr (prefixed by `command`).
 int PrintAndWriteTable(const std::string& table, const std::string& path, const char* command);
+
+// --dataset,-d of every command that opens a dataset: `what` names the kind it needs; the help
+// adds how a path is recognised (core/io/dataset_source.h: a manifest of any name, a folder).
+CLI::Option* AddDatasetOption(CLI::App& app, std::string* path, const std::string& what);
+// --board of `import` and `gui` (BoardFromFlag): `what` says which board it is.
+CLI::Option* AddBoardOption(CLI::App& app, std::string* board, const std::string& what);
 
 int RunCalibrate(int argc, char** argv);
 int RunAdvise(int argc, char** argv);

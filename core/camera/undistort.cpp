@@ -11,7 +11,7 @@ UndistortedView Undistort(const CameraModel& camera, const ImageU8& image) {
   view.pinhole.type = CameraModelType::kPinholeRadTan;
   view.pinhole.distortion.assign(5, 0.0);
   if (camera.type == CameraModelType::kKannalaBrandt) {
-    const double focal = 0.5 * camera.width / std::tan(60.0 * M_PI / 180.0);
+    const double focal = 0.5 * camera.width / std::tan(60.0 * kDegToRad);
     view.pinhole.fx = focal;
     view.pinhole.fy = focal * camera.fy / camera.fx;
   }

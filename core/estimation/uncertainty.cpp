@@ -61,7 +61,7 @@ Vec3 TranslationStd(const Mat6& covariance, const Pose& cam_from_lidar) {
 Vec3 RotationStdDeg(const Mat6& covariance, const Pose& cam_from_lidar) {
   const Mat3& r = cam_from_lidar.linear();
   const Mat3 in_cam = r * covariance.bottomRightCorner<3, 3>() * r.transpose();
-  return in_cam.diagonal().cwiseMax(0.0).cwiseSqrt() * (180.0 / M_PI);
+  return in_cam.diagonal().cwiseMax(0.0).cwiseSqrt() * kRadToDeg;
 }
 
 }  // namespace calibench

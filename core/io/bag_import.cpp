@@ -158,7 +158,7 @@ ImageMessage DecodeAnyImage(const BagTopic& topic, const BagMessage& message,
 
 double RotationDeg(const Pose& a, const Pose& b) {
   const Eigen::AngleAxisd delta(a.rotation().transpose() * b.rotation());
-  return delta.angle() * 180.0 / M_PI;
+  return delta.angle() * kRadToDeg;
 }
 
 double TranslationM(const Pose& a, const Pose& b) {

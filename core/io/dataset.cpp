@@ -10,6 +10,7 @@
 #include "core/base/names.h"
 #include "core/geometry/geometry.h"
 #include "core/io/camera_file.h"
+#include "core/io/dataset_source.h"
 #include "core/io/json_io.h"
 
 namespace calibench {
@@ -118,12 +119,9 @@ Dataset LoadFolder(const fs::path& dir) {
 }  // namespace
 
 Dataset LoadDataset(const fs::path& path) {
-  if (!fs::exists(path)) Fail(path, "no such file or folder");
-  if (fs::is_directory(path)) {
-    if (fs::exists(path / "dataset.json")) return LoadManifest(fs::absolute(path / "dataset.json"));
-    return LoadFolder(fs::absolute(path));
-  }
-  return LoadManifest(fs::absolute(path));
+  const DatasetSource source = ResolveDataset(path, DatasetKind::kLidarCamera);
+  return source.folder_form ? LoadFolder(fs::absolute(source.path))
+                            : LoadManifest(fs::absolute(source.path));
 }
 
 void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {

@@ -212,7 +212,7 @@ bool LidarImageOptions::Check(std::string* why) const {
   }
   // Below 0.05 degrees the elevation histogram gets needlessly fine (and slow); above 0.1 rad
   // (5.7 degrees) the gap exceeds the beam spacing of every spinning LiDAR.
-  constexpr double kMinGap = 0.05 * M_PI / 180.0, kMaxGap = 0.1;
+  constexpr double kMinGap = 0.05 * kDegToRad, kMaxGap = 0.1;
   if (!(ring_gap_rad >= kMinGap && ring_gap_rad < kMaxGap)) {
     if (why)
       *why = "ring_gap_rad must be in [0.05 deg, 0.1 rad) and below the beam spacing, got " +

@@ -11,7 +11,7 @@ struct LidarImageOptions {
   int columns = 0;  // azimuth bins over 360 degrees; 0 = choose from the cloud (about 1 per point)
   // Elevation clustering when neither ring nor organized layout is known: a new ring starts
   // where sorted elevations jump by more than this (radians). Default 0.15 deg.
-  double ring_gap_rad = 0.15 * M_PI / 180.0;
+  double ring_gap_rad = 0.15 * kDegToRad;
   bool Check(std::string* why) const;
 };
 

@@ -9,6 +9,7 @@
 #include "core/base/atomic_file.h"
 #include "core/geometry/geometry.h"
 #include "core/io/cloud_io.h"
+#include "core/io/dataset_source.h"
 #include "core/io/image_io.h"
 #include "core/io/json_io.h"
 #include "core/lidar/cloud.h"
@@ -23,7 +24,6 @@ using json_io::Fields;
 namespace {
 
 constexpr char kFormat[] = "calibench.lrf-dataset.v1";
-constexpr double kDeg = M_PI / 180.0;
 
 ThreeFaceTarget ParseThreeFace(const Fields& node) {
   ThreeFaceTarget t;
@@ -63,8 +63,8 @@ json DepthCameraToJson(const DepthIntrinsics& in) {
 
 ScanRegion ParseScanRegion(const Fields& node) {
   ScanRegion region;
-  region.angle_min = node.GetOr("angle_min_deg", -180.0) * kDeg;
-  region.angle_max = node.GetOr("angle_max_deg", 180.0) * kDeg;
+  region.angle_min = node.GetOr("angle_min_deg", -180.0) * kDegToRad;
+  region.angle_max = node.GetOr("angle_max_deg", 180.0) * kDegToRad;
   region.range_min = node.GetOr("range_min", region.range_min);
   region.range_max = node.GetOr("range_max", region.range_max);
   if (!(region.angle_min < region.angle_max && region.range_min >= 0 &&
@@ -97,8 +97,8 @@ LrfPairEntry ParsePair(const Fields& p, LrfTargetType type) {
 }
 
 json ScanRegionToJson(const ScanRegion& region) {
-  return {{"angle_min_deg", region.angle_min / kDeg},
-          {"angle_max_deg", region.angle_max / kDeg},
+  return {{"angle_min_deg", region.angle_min / kDegToRad},
+          {"angle_max_deg", region.angle_max / kDegToRad},
           {"range_min", region.range_min},
           {"range_max", region.range_max}};
 }
@@ -202,18 +202,8 @@ LaserScan LoadScanPcd(const fs::path& path, const LoadLimits& limits) {
 
 }  // namespace
 
-fs::path LrfManifestPath(const fs::path& path) {
-  std::error_code ec;
-  return fs::is_directory(path, ec) ? path / "manifest.json" : path;
-}
-
-LrfDataset LoadLrfDataset(const fs::path& manifest_path) {
-  const fs::path manifest = fs::absolute(LrfManifestPath(manifest_path));
-  std::error_code ec;
-  if (manifest != fs::absolute(manifest_path) && !fs::exists(manifest, ec))
-    throw IoError(manifest_path.string() +
-                  ": folder holds no manifest.json (an LRF dataset is a "
-                  "calibench.lrf-dataset.v1 manifest, or the folder holding one)");
+LrfDataset LoadLrfDataset(const fs::path& path) {
+  const fs::path manifest = fs::absolute(ResolveDataset(path, DatasetKind::kLrf).path);
   const json document = json_io::ReadJson(manifest);
   const Fields root(document, manifest);
   json_io::CheckFormat(root, kFormat);

@@ -58,13 +58,10 @@ struct LrfDataset {
   std::optional<Pose> right_from_left;  // stereo: right camera from left camera
 };
 
-// The manifest a path stands for: a folder stands for the manifest.json in it (as `calibench
-// simulate --kind lrf` writes it), anything else for itself.
-std::filesystem::path LrfManifestPath(const std::filesystem::path& path);
-
-// `manifest_path` may be the folder (LrfManifestPath). Throws IoError naming the file and the
-// problem (missing fields, wrong format string, missing files, bad target or intrinsics).
-LrfDataset LoadLrfDataset(const std::filesystem::path& manifest_path);
+// `path` is the manifest, whatever its name, or a folder holding it (ResolveDataset). Throws
+// IoError naming the file and the problem (not an LRF dataset, missing fields, wrong format
+// string, missing files, bad target or intrinsics).
+LrfDataset LoadLrfDataset(const std::filesystem::path& path);
 // Writes atomically; paths relative to the manifest's folder when they lie under it.
 void SaveLrfDataset(const std::filesystem::path& manifest_path, const LrfDataset& dataset);
 

@@ -55,7 +55,7 @@ bool ThreeFaceTarget::Check(std::string* why) const {
   for (int i = 0; i < 3; ++i) {
     for (int j = i + 1; j < 3; ++j) {
       const double cosine = std::clamp(planes[i].normal.dot(planes[j].normal), -1.0, 1.0);
-      if (std::acos(cosine) * 180.0 / M_PI < kMinFaceAngleDeg)
+      if (std::acos(cosine) * kRadToDeg < kMinFaceAngleDeg)
         return FailCheck(why, "three-face target faces " + std::to_string(i) + " and " +
                                   std::to_string(j) + " are nearly parallel (< 5 degrees)");
     }

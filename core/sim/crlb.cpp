@@ -88,7 +88,7 @@ CramerRaoBound BoundFromInformation(const Mat6& information) {
   bound.covariance = eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
   bound.translation_rms_m = std::sqrt(bound.covariance.topLeftCorner<3, 3>().trace());
   bound.rotation_rms_deg =
-      std::sqrt(bound.covariance.bottomRightCorner<3, 3>().trace()) * 180.0 / M_PI;
+      std::sqrt(bound.covariance.bottomRightCorner<3, 3>().trace()) * kRadToDeg;
   return bound;
 }
 

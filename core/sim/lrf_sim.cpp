@@ -13,7 +13,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Validity of a sampled pose: the scan needs a few points on each segment E…F, F…G, G…H, H…I to
 // fit its lines (paper Fig. 6), and the depth camera a few hundred pixels per face to fit planes
@@ -171,8 +170,8 @@ LaserScan RenderScan(const LrfSimOptions& options, const Scene& scene, Rng* rng,
                      std::vector<double>* target_x = nullptr) {
   const LrfSensorSpec& lrf = options.lrf;
   LaserScan scan;
-  scan.angle_min = -0.5 * lrf.fov_deg * kDeg;
-  scan.angle_increment = lrf.angular_step_deg * kDeg;
+  scan.angle_min = -0.5 * lrf.fov_deg * kDegToRad;
+  scan.angle_increment = lrf.angular_step_deg * kDegToRad;
   scan.range_min = lrf.range_min_m;
   scan.range_max = lrf.range_max_m;
   const size_t count = RayCount(lrf);
@@ -236,8 +235,8 @@ std::optional<Pose> DrawCandidate(const LrfSimOptions& options, Rng& rng) {
   const ThreeFaceTarget& target = options.target;
   const DepthIntrinsics& in = options.depth.intrinsics;
   const double distance = rng.Uniform(options.target_distance_min_m, options.target_distance_max_m);
-  const double yaw = rng.Uniform(-1, 1) * options.target_max_yaw_deg * kDeg;
-  const double tilt = rng.Uniform(-1, 1) * options.target_max_tilt_deg * kDeg;
+  const double yaw = rng.Uniform(-1, 1) * options.target_max_yaw_deg * kDegToRad;
+  const double tilt = rng.Uniform(-1, 1) * options.target_max_tilt_deg * kDegToRad;
   const double tent = target.apex_y - target.foot_y;
   const double ridge_y = rng.Uniform(target.foot_y + tent / 3, target.apex_y - tent / 3);
   const double half_fov = std::atan(std::min(in.cx, in.width - in.cx) / in.fx);
@@ -382,7 +381,7 @@ Pose DefaultCamFromLrf() {
   axes << 0, -1, 0, 0, 0, -1, 1, 0, 0;
   Pose cam_from_lrf = Pose::Identity();
   // Roll 1.5°, pitch -2°, yaw 1° about the LRF's own axes: "level to within a few degrees".
-  cam_from_lrf.linear() = axes * ExpSO3(Vec3(1.5, -2.0, 1.0) * kDeg);
+  cam_from_lrf.linear() = axes * ExpSO3(Vec3(1.5, -2.0, 1.0) * kDegToRad);
   cam_from_lrf.translation() = Vec3(0.0, -0.15, -0.10);  // LRF origin: 0.15 m up, 0.10 m back
   return cam_from_lrf;
 }

@@ -55,7 +55,7 @@ SeedRun RunSeed(const LrfSweepOptions& options, int max_size, size_t s) {
       const LrfSolution solution = SolveLrf(first, solver);
       if (!solution.ok) continue;
       const PoseError e = ComputePoseError(solution.cam_from_lrf, sim.cam_from_lrf);
-      run.errors[m][i] = std::make_pair(e.rotation_rad * 180.0 / M_PI, e.translation_m * 1e3);
+      run.errors[m][i] = std::make_pair(e.rotation_rad * kRadToDeg, e.translation_m * 1e3);
     }
   }
   return run;

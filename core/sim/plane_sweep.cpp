@@ -81,7 +81,7 @@ PlaneSweepCell RunSubsets(const std::vector<Subset>& subsets, const Pose& truth,
     }
     const PoseError e = ComputePoseError(solution->cam_from_lidar, truth);
     t_err.push_back(e.translation_m * 1000);
-    r_err.push_back(e.rotation_rad * 180 / M_PI);
+    r_err.push_back(e.rotation_rad * kRadToDeg);
     bound_t2 += std::pow(subset.bound.translation_rms_m * 1000, 2);
     bound_r2 += std::pow(subset.bound.rotation_rms_deg, 2);
     if (!solution->observability.well_constrained) ++cell.weak;

@@ -57,7 +57,7 @@ std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
     half_width = std::max(half_width, std::abs(relative_azimuth(cloud.points[i].cast<double>())));
     ++inliers_per_ring[rings[i]];
   }
-  const double window = half_width + 3.0 * M_PI / 180.0;
+  const double window = half_width + 3.0 * kDegToRad;
   // Per ring, every return in the board's azimuth window, sorted by azimuth.
   std::map<int, std::vector<std::pair<double, int>>> by_ring;
   for (size_t i = 0; i < cloud.size(); ++i) {
@@ -65,7 +65,7 @@ std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
     const double azimuth = relative_azimuth(cloud.points[i].cast<double>());
     if (std::abs(azimuth) <= window) by_ring[rings[i]].push_back({azimuth, static_cast<int>(i)});
   }
-  const double max_gap = options.max_azimuth_gap_deg * M_PI / 180.0;
+  const double max_gap = options.max_azimuth_gap_deg * kDegToRad;
   for (auto& [ring, returns] : by_ring) {
     if (inliers_per_ring[ring] < 2) continue;
     std::sort(returns.begin(), returns.end());

@@ -116,7 +116,7 @@ std::vector<std::vector<int>> GrowSegments(const AngularGrid& grid,
                                            const std::vector<Vec3>& cell_points,
                                            const std::vector<LocalPlane>& planes,
                                            const LidarBoardDetectionOptions& options) {
-  const double cos_tolerance = std::cos(options.normal_tolerance_deg * M_PI / 180.0);
+  const double cos_tolerance = std::cos(options.normal_tolerance_deg * kDegToRad);
   std::vector<int> label(grid.point.size(), -1);
   std::vector<std::vector<int>> segments;
   std::vector<int> queue;  // cells whose neighbours are still to visit, from `next` on
@@ -398,7 +398,7 @@ bool LidarBoardDetectionOptions::Check(std::string* why) const {
 
 std::string LidarBoardCandidate::Describe() const {
   return Format("a %.2f x %.2f m plane at %.1f m, azimuth %.0f deg", extent_m.x(), extent_m.y(),
-                centre.norm(), std::atan2(centre.y(), centre.x()) * 180.0 / M_PI);
+                centre.norm(), std::atan2(centre.y(), centre.x()) * kRadToDeg);
 }
 
 LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& board,
@@ -440,7 +440,7 @@ LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& b
   const double sheet_diagonal = sheet.max.norm();
   auto same_sheet = [&](const LidarBoardCandidate& other) {
     return (other.centre - best.centre).norm() < 0.75 * sheet_diagonal &&
-           std::abs(other.plane.normal.dot(best.plane.normal)) > std::cos(10.0 * M_PI / 180.0);
+           std::abs(other.plane.normal.dot(best.plane.normal)) > std::cos(10.0 * kDegToRad);
   };
   const auto rival = std::find_if(result.candidates.begin() + 1, result.candidates.end(),
                                   [&](const auto& other) { return !same_sheet(other); });
@@ -462,7 +462,7 @@ LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& b
 // ---- SceneBackground ----
 
 SceneBackground::SceneBackground(double cell_deg, double tolerance_m)
-    : cell_rad_(cell_deg * M_PI / 180.0), tolerance_m_(tolerance_m) {
+    : cell_rad_(cell_deg * kDegToRad), tolerance_m_(tolerance_m) {
   CALIBENCH_CHECK(cell_deg > 0 && tolerance_m > 0);
 }
 

@@ -62,8 +62,8 @@ double AutoCellDeg(const LidarCloud& cloud) {
   std::unordered_set<std::int64_t> occupied;
   for (const Eigen::Vector3f& p : cloud.points) {
     if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
-    const auto az = static_cast<std::int64_t>(std::floor(std::atan2(p.y(), p.x()) * 180.0 / M_PI));
-    const auto el = static_cast<std::int64_t>(std::floor(Elevation(p) * 180.0 / M_PI));
+    const auto az = static_cast<std::int64_t>(std::floor(std::atan2(p.y(), p.x()) * kRadToDeg));
+    const auto el = static_cast<std::int64_t>(std::floor(Elevation(p) * kRadToDeg));
     occupied.insert(el * 1000 + az);
   }
   if (occupied.empty()) return 1.0;
@@ -72,7 +72,7 @@ double AutoCellDeg(const LidarCloud& cloud) {
 
 AngularGrid FromAngles(const LidarCloud& cloud, double cell_deg) {
   AngularGrid grid;
-  const double cell = (cell_deg > 0 ? cell_deg : AutoCellDeg(cloud)) * M_PI / 180.0;
+  const double cell = (cell_deg > 0 ? cell_deg : AutoCellDeg(cloud)) * kDegToRad;
   double top = -M_PI, bottom = M_PI;
   for (const Eigen::Vector3f& p : cloud.points) {
     if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;

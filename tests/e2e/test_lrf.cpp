@@ -126,7 +126,9 @@ TEST_F(LrfCli, AFolderStandsForItsManifest) {
   fs::create_directories(empty);
   std::string out;
   EXPECT_NE(test::RunCommand(Exe() + " lrf-calibrate --dataset " + empty.string(), &out), 0);
-  EXPECT_NE(out.find(empty.string() + ": folder holds no manifest.json"), std::string::npos) << out;
+  EXPECT_NE(out.find(empty.string() + ": not a dataset folder (looked for a manifest"),
+            std::string::npos)
+      << out;
   EXPECT_EQ(out.find("internal error"), std::string::npos) << out;
 }
 

@@ -8,6 +8,7 @@
 #include <optional>
 #include <utility>
 
+#include "core/io/dataset_source.h"
 #include "ui/lrf/workbench.h"
 #include "ui/widgets/error_popup.h"
 #include "ui/widgets/file_browser.h"
@@ -20,14 +21,11 @@ namespace fs = std::filesystem;
 // go beside the session.
 constexpr const char* kMenuExportFile = "lrf_result.json";
 
-// Whether `path` is a LiDAR-camera dataset: its manifest, or a folder holding one.
+// Whether `path` is a LiDAR-camera dataset (any manifest name, the folder form).
 bool LooksLikeLidarCameraDataset(const fs::path& path) {
-  std::error_code error;
-  std::ifstream in(fs::is_directory(path, error) ? path / "dataset.json" : path, std::ios::binary);
-  std::string head(4096, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  return head.find("\"calibench.dataset.v1\"") != std::string::npos;
+  std::string ignored;
+  const auto source = RecogniseDataset(path, &ignored);
+  return source && source->kind == DatasetKind::kLidarCamera;
 }
 
 class LrfWindowShell {

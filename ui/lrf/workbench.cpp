@@ -672,7 +672,7 @@ void LrfWorkbench::SolutionReadouts(const LrfSnapshot& s, std::vector<LrfIntent>
     const Pose& truth = *s.dataset->cam_from_lrf_ground_truth;
     ImGui::TextDisabled("vs ground truth: %.1f mm, %.3f deg",
                         (pose.translation() - truth.translation()).norm() * 1e3,
-                        RotationAngle(pose.linear(), truth.linear()) * 180.0 / M_PI);
+                        RotationAngle(pose.linear(), truth.linear()) * kRadToDeg);
   }
   const char* convergence = solution.method != LrfMethod::kRefined ? ""
                             : solution.converged                   ? ", converged"

@@ -4,19 +4,20 @@
 
 #include "core/base/names.h"
 #include "core/base/types.h"
+#include "core/io/dataset_source.h"
 
 namespace calibench::ui {
 namespace fs = std::filesystem;
 
 namespace {
 
+// By content, as `--dataset` recognises it (a manifest of any name, the folder form, rosbag2).
 EntryKind FolderKind(const fs::path& folder) {
-  std::error_code error;
-  if (fs::exists(folder / "metadata.yaml", error)) return EntryKind::kRosbag2Folder;
-  if (fs::exists(folder / "dataset.json", error) ||
-      (fs::is_directory(folder / "clouds", error) && fs::is_directory(folder / "images", error)))
-    return EntryKind::kDatasetFolder;
-  return EntryKind::kFolder;
+  std::string ignored;
+  const auto source = RecogniseDataset(folder, &ignored);
+  if (!source) return EntryKind::kFolder;
+  return source->kind == DatasetKind::kRecording ? EntryKind::kRosbag2Folder
+                                                 : EntryKind::kDatasetFolder;
 }
 
 bool IsRecording(const std::string& extension) {
