@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 
+#include "core/base/text.h"
 #include "core/target/lidar_board_grid.h"
 
 namespace calibench {
@@ -266,12 +267,6 @@ double FreeEdgeFraction(const LidarCloud& cloud, const AngularGrid& grid,
   return 0.5 * (h + v);
 }
 
-std::string Format(const char* format, double a, double b = 0, double c = 0, double d = 0) {
-  char text[160];
-  std::snprintf(text, sizeof(text), format, a, b, c, d);
-  return text;
-}
-
 // Fits, measures and tests one segment. The candidate's `rejection` says why it is not the board.
 // The plane, centre, RMS and outline of a set of returns.
 void Measure(const LidarCloud& cloud, LidarBoardCandidate* c) {
@@ -360,10 +355,10 @@ LidarBoardCandidate Evaluate(const LidarCloud& cloud, const AngularGrid& grid,
   c.score =
       (0.4 * size_score + 0.4 * c.free_edge_fraction + 0.2 * flatness) * (1.0 - c.static_fraction);
   if (c.free_edge_fraction < options.min_free_edge_fraction)
-    c.rejection = Format("attached to what is behind it (%.0f%% of its border free)",
+    c.rejection = Printf("attached to what is behind it (%.0f%% of its border free)",
                          100 * c.free_edge_fraction);
   else if (c.static_fraction > options.max_static_fraction)
-    c.rejection = Format("part of the static scene (%.0f%% of its returns in every cloud)",
+    c.rejection = Printf("part of the static scene (%.0f%% of its returns in every cloud)",
                          100 * c.static_fraction);
   return c;
 }
@@ -397,7 +392,7 @@ bool LidarBoardDetectionOptions::Check(std::string* why) const {
 }
 
 std::string LidarBoardCandidate::Describe() const {
-  return Format("a %.2f x %.2f m plane at %.1f m, azimuth %.0f deg", extent_m.x(), extent_m.y(),
+  return Printf("a %.2f x %.2f m plane at %.1f m, azimuth %.0f deg", extent_m.x(), extent_m.y(),
                 centre.norm(), std::atan2(centre.y(), centre.x()) * kRadToDeg);
 }
 
@@ -427,7 +422,7 @@ LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& b
   const LidarBoardCandidate* near_miss =
       result.near_misses.empty() ? nullptr : &result.near_misses.front();
   const std::string wanted =
-      Format("no planar segment of %.2f x %.2f m standing free", sheet.max.y(), sheet.max.x());
+      Printf("no planar segment of %.2f x %.2f m standing free", sheet.max.y(), sheet.max.x());
   if (result.candidates.empty()) {
     result.reason = wanted + (near_miss ? "; best candidate: " + near_miss->Describe() + ", " +
                                               near_miss->rejection
@@ -457,79 +452,6 @@ LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& b
   result.board = best;
   CompleteSheet(cloud, sheet, options, &*result.board);
   return result;
-}
-
-// ---- SceneBackground ----
-
-SceneBackground::SceneBackground(double cell_deg, double tolerance_m)
-    : cell_rad_(cell_deg * kDegToRad), tolerance_m_(tolerance_m) {
-  CALIBENCH_CHECK(cell_deg > 0 && tolerance_m > 0);
-}
-
-std::int64_t SceneBackground::Key(const LidarCloud& cloud, int index) const {
-  const Eigen::Vector3f& p = cloud.points[index];
-  const auto azimuth =
-      static_cast<std::int64_t>(std::floor((std::atan2(p.y(), p.x()) + M_PI) / cell_rad_));
-  std::int64_t row;
-  if (cloud.HasRing())
-    row = cloud.ring[index];
-  else if (cloud.IsOrganized())
-    row = index / cloud.width;
-  else
-    row = 100000 +
-          static_cast<std::int64_t>(std::floor(
-              std::atan2(double(p.z()), std::hypot(double(p.x()), double(p.y()))) / cell_rad_));
-  return row * 1000000 + azimuth;
-}
-
-void SceneBackground::Add(const LidarCloud& cloud) {
-  std::unordered_map<std::int64_t, float> nearest;
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3f& p = cloud.points[i];
-    if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
-    const std::int64_t key = Key(cloud, static_cast<int>(i));
-    auto [it, fresh] = nearest.try_emplace(key, p.norm());
-    if (!fresh) it->second = std::min(it->second, p.norm());
-  }
-  for (const auto& [key, range] : nearest) ranges_[key].push_back(range);
-  ++clouds_;
-  usable_ = false;
-}
-
-bool SceneBackground::Finish(std::string* why) {
-  median_.clear();
-  usable_ = false;
-  if (clouds_ < 3) {
-    *why = "a background needs at least 3 clouds, have " + std::to_string(clouds_);
-    return false;
-  }
-  long agree = 0, total = 0;
-  for (auto& [key, ranges] : ranges_) {
-    if (2 * static_cast<int>(ranges.size()) < clouds_) continue;
-    std::vector<float> sorted = ranges;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const float median = sorted[sorted.size() / 2];
-    median_[key] = median;
-    for (float r : ranges) agree += std::abs(r - median) < tolerance_m_;
-    total += static_cast<long>(ranges.size());
-  }
-  // A static sensor sees the same room in every cloud; most returns then sit on their medians.
-  if (total == 0 || agree < total / 2) {
-    *why = Format(
-        "the clouds do not share a static scene (%.0f%% of returns repeat): the sensor "
-        "moved between pairs, so no background model",
-        total ? 100.0 * agree / total : 0.0);
-    median_.clear();
-    return false;
-  }
-  usable_ = true;
-  return true;
-}
-
-bool SceneBackground::IsStatic(const LidarCloud& cloud, int index) const {
-  if (!usable_) return false;
-  const auto it = median_.find(Key(cloud, index));
-  return it != median_.end() && std::abs(cloud.points[index].norm() - it->second) < tolerance_m_;
 }
 
 }  // namespace calibench

@@ -71,6 +71,13 @@ struct LrfExportResult {
 using LrfIntent = std::variant<LrfSelectPair, LrfSetPairStatus, LrfRunSolver, LrfResetSolver,
                                LrfSetMethod, LrfExportResult>;
 
+// Appends an intent constructed in place (a moved temporary variant trips GCC 12's
+// -Wmaybe-uninitialized).
+template <typename T, typename... Args>
+void EmitLrfIntent(std::vector<LrfIntent>* intents, Args&&... args) {
+  intents->emplace_back(std::in_place_type<T>, T{std::forward<Args>(args)...});
+}
+
 class LrfController : public ControllerState<LrfSnapshot> {
  public:
   explicit LrfController(LrfPipelineOptions options = {});

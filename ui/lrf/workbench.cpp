@@ -10,6 +10,7 @@
 #include "core/lrf/result_io.h"
 #include "ui/gfx/framebuffer.h"
 #include "ui/gfx/renderers.h"
+#include "ui/lrf/workbench_draw.h"
 #include "ui/widgets/frame_key.h"
 #include "ui/widgets/pair_review.h"
 #include "ui/widgets/path_field.h"
@@ -29,20 +30,7 @@ struct LrfWorkbench::Gl {
   double floor_y = 1.0;                // camera y of the grid (y down), metres
 };
 
-namespace {
-
-// Faces 0 (base), 1 (ABC), 2 (ACD): the same colours in every view. RGB.
-constexpr std::uint8_t kFaceRgb[3][3] = {{80, 150, 255}, {240, 90, 200}, {70, 215, 120}};
-constexpr const char* kFaceNames[3] = {"base", "ABC", "ACD"};
-const ImU32 kScanInCamera = IM_COL32(255, 225, 40, 255);  // scan points moved into the camera
-const ImU32 kBoardColor = IM_COL32(255, 150, 40, 255);
-
-ImU32 FaceColor(int face, int alpha = 255) {
-  return IM_COL32(kFaceRgb[face][0], kFaceRgb[face][1], kFaceRgb[face][2], alpha);
-}
-ImVec4 FaceColorVec(int face) {
-  return {kFaceRgb[face][0] / 255.f, kFaceRgb[face][1] / 255.f, kFaceRgb[face][2] / 255.f, 1};
-}
+namespace lrf_view {
 
 const LrfPairFeatures* SelectedFeatures(const LrfSnapshot& s) {
   if (s.selected < 0 || s.selected >= static_cast<int>(s.pairs.size())) return nullptr;
@@ -73,6 +61,12 @@ std::vector<std::pair<Vec2, int>> TargetPoints(const LrfPairFeatures& pair) {
     for (const Vec2& p : pair.board_scan->points) points.push_back({p, 3});
   return points;
 }
+
+}  // namespace lrf_view
+
+using namespace lrf_view;
+
+namespace {
 
 // The depth frame as a grey picture (near bright) with the three faces tinted. BGR.
 ImageU8 ComposeDepthPicture(const DepthImage& depth, const DepthFeatures& features) {
@@ -116,167 +110,6 @@ std::optional<Vec2> ProjectToImage(const LrfDataset& dataset, const Vec3& x) {
 }
 
 Vec3 OnScanPlane(const Vec2& p) { return Vec3(p.x(), p.y(), 0.0); }
-
-// Corner `c` (0..2: F, G, H) of the three-face target as a white ring with its name.
-void DrawCornerRing(ImDrawList* draw, ImVec2 q, int c) {
-  constexpr const char* kCorners[3] = {"F", "G", "H"};
-  draw->AddCircle(q, 6.0f, IM_COL32(255, 255, 255, 255), 16, 2.0f);
-  draw->AddText({q.x + 8, q.y - 8}, IM_COL32(255, 255, 255, 255), kCorners[c]);
-}
-
-// Constructs the intent in place (a moved temporary variant trips GCC 12's
-// -Wmaybe-uninitialized).
-template <typename T, typename... Args>
-void Emit(std::vector<LrfIntent>* intents, Args&&... args) {
-  intents->emplace_back(std::in_place_type<T>, T{std::forward<Args>(args)...});
-}
-
-// ---- The scan view: the LRF frame seen from above, screen right = LRF -y, screen up = LRF +x.
-
-struct ScanCanvas {
-  ImVec2 origin, size;  // screen pixels
-  Vec2 center;          // the LRF-frame point at the canvas's centre, metres
-  double scale = 1;     // pixels per metre
-
-  ImVec2 end() const { return ImVec2(origin.x + size.x, origin.y + size.y); }
-  ImVec2 ToScreen(const Vec2& p) const {
-    const ImVec2 mid(origin.x + size.x / 2, origin.y + size.y / 2);
-    return ImVec2(mid.x - static_cast<float>((p.y() - center.y()) * scale),
-                  mid.y - static_cast<float>((p.x() - center.x()) * scale));
-  }
-  bool Inside(const ImVec2& q) const {
-    return q.x >= origin.x && q.x <= end().x && q.y >= origin.y && q.y <= end().y;
-  }
-};
-
-// Fits the LRF origin and the target (margin 0.3 m and a fifth of their extent); `zoom` about the
-// target's centre.
-ScanCanvas FitScanCanvas(ImVec2 origin, ImVec2 size,
-                         const std::vector<std::pair<Vec2, int>>& target, float zoom) {
-  Vec2 lo(0, 0), hi(0, 0), target_center(1, 0);
-  if (!target.empty()) {
-    target_center.setZero();
-    for (const auto& [p, face] : target) {
-      lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-      target_center += p / static_cast<double>(target.size());
-    }
-  } else {
-    lo = Vec2(-1, -1), hi = Vec2(1, 1);
-  }
-  const Vec2 margin = Vec2::Constant(0.3) + 0.2 * (hi - lo);
-  lo -= margin, hi += margin;
-  const double fit = std::min(size.x / (hi.y() - lo.y()), size.y / (hi.x() - lo.x()));
-  ScanCanvas canvas{origin, size, target_center + ((lo + hi) / 2 - target_center) / zoom};
-  canvas.scale = fit * zoom;
-  return canvas;
-}
-
-// Metre grid lines labelled with their x and y: the smallest of 0.1 / 0.2 / 0.5 / 1 / 2 / 5 m at
-// least 45 px apart.
-void DrawScanGrid(ImDrawList* draw, const ScanCanvas& canvas) {
-  double spacing = 5.0;
-  for (double candidate : {0.1, 0.2, 0.5, 1.0, 2.0, 5.0})
-    if (candidate * canvas.scale >= 45) {
-      spacing = candidate;
-      break;
-    }
-  const ImVec2 origin = canvas.origin, end = canvas.end();
-  const double half_x = canvas.size.y / 2 / canvas.scale, half_y = canvas.size.x / 2 / canvas.scale;
-  auto line_color = [](int k) {
-    return k == 0 ? IM_COL32(95, 95, 105, 255) : IM_COL32(50, 50, 58, 255);
-  };
-  char label[32];
-  for (int k = static_cast<int>(std::floor((canvas.center.x() - half_x) / spacing));
-       k * spacing <= canvas.center.x() + half_x; ++k) {
-    const float y = canvas.ToScreen(Vec2(k * spacing, 0)).y;
-    draw->AddLine({origin.x, y}, {end.x, y}, line_color(k));
-    std::snprintf(label, sizeof(label), "x %g m", k * spacing);
-    draw->AddText({origin.x + 3, y - 15}, IM_COL32(120, 120, 130, 255), label);
-  }
-  for (int k = static_cast<int>(std::floor((canvas.center.y() - half_y) / spacing));
-       k * spacing <= canvas.center.y() + half_y; ++k) {
-    const float x = canvas.ToScreen(Vec2(0, k * spacing)).x;
-    draw->AddLine({x, origin.y}, {x, end.y}, line_color(k));
-    std::snprintf(label, sizeof(label), "y %g", k * spacing);
-    draw->AddText({x + 3, end.y - 16}, IM_COL32(120, 120, 130, 255), label);
-  }
-}
-
-// A fitted line as a segment over its points' extent (plus 5 cm).
-void DrawFittedLine(ImDrawList* draw, const ScanCanvas& canvas, const Line2& line,
-                    const std::vector<Vec2>& points, ImU32 color) {
-  if (points.empty()) return;
-  const Vec2 direction(-line.normal.y(), line.normal.x());
-  const Vec2 foot = -line.normal * line.offset;
-  double t0 = 1e9, t1 = -1e9;
-  for (const Vec2& p : points)
-    t0 = std::min(t0, (p - foot).dot(direction)), t1 = std::max(t1, (p - foot).dot(direction));
-  draw->AddLine(canvas.ToScreen(foot + (t0 - 0.05) * direction),
-                canvas.ToScreen(foot + (t1 + 0.05) * direction), color, 1.5f);
-}
-
-// Every return in grey, the target's points coloured by face, the fitted lines and corners.
-void DrawScanPoints(ImDrawList* draw, const ScanCanvas& canvas, const LrfPairFeatures& pair,
-                    const std::vector<std::pair<Vec2, int>>& target) {
-  const LaserScan& scan = pair.scan;
-  for (size_t i = 0; i < scan.ranges.size(); ++i) {
-    if (!scan.Valid(i)) continue;
-    const ImVec2 q = canvas.ToScreen(scan.Point(i));
-    if (canvas.Inside(q))
-      draw->AddRectFilled({q.x - 1, q.y - 1}, {q.x + 1, q.y + 1}, IM_COL32(150, 150, 158, 255));
-  }
-  for (const auto& [p, face] : target)
-    draw->AddCircleFilled(canvas.ToScreen(p), 2.5f, face < 3 ? FaceColor(face) : kBoardColor, 8);
-  if (pair.three_face && pair.three_face->scan.ok) {
-    const ScanFeatures& features = pair.three_face->scan;
-    for (int face = 0; face < 3; ++face)
-      DrawFittedLine(draw, canvas, features.lines[face], features.face_points[face],
-                     FaceColor(face, 200));
-    for (int c = 0; c < 3; ++c) DrawCornerRing(draw, canvas.ToScreen(features.corners[c]), c);
-  }
-  if (pair.board_scan && pair.board_scan->ok)
-    DrawFittedLine(draw, canvas, pair.board_scan->line, pair.board_scan->points, kBoardColor);
-}
-
-// The LRF's axes (x forward: red, up the screen; y left: green) and, with an estimate, the
-// camera's centre and optical axis seen from above.
-void DrawScanSensors(ImDrawList* draw, const ScanCanvas& canvas, const Pose* estimate) {
-  const ImVec2 o = canvas.ToScreen(Vec2::Zero());
-  draw->AddLine(o, {o.x, o.y - 40}, IM_COL32(255, 70, 70, 255), 2.0f);
-  draw->AddLine(o, {o.x - 40, o.y}, IM_COL32(70, 230, 70, 255), 2.0f);
-  draw->AddCircleFilled(o, 4.0f, IM_COL32(235, 235, 235, 255), 12);
-  draw->AddText({o.x + 6, o.y + 2}, IM_COL32(235, 235, 235, 255), "LRF");
-  if (!estimate) return;
-  const Pose lrf_from_cam = estimate->inverse();
-  const Vec3 c = lrf_from_cam.translation(), axis = lrf_from_cam.linear().col(2);
-  const ImVec2 q = canvas.ToScreen(c.head<2>());
-  draw->AddLine(q, canvas.ToScreen(c.head<2>() + 0.3 * axis.head<2>()), IM_COL32(80, 220, 255, 255),
-                2.0f);
-  draw->AddCircleFilled(q, 4.0f, IM_COL32(80, 220, 255, 255), 12);
-  draw->AddText({q.x + 6, q.y - 16}, IM_COL32(80, 220, 255, 255), "camera");
-}
-
-// Rays, target points and line RMS (or why there is no target); the face colours.
-void ScanReadouts(const LrfPairFeatures& pair, size_t target_points) {
-  const size_t rays = pair.scan.ranges.size();
-  if (pair.three_face && pair.three_face->scan.ok) {
-    ImGui::Text("%zu rays, %zu on the target, line RMS %.1f mm", rays, target_points,
-                pair.three_face->scan.rms_m * 1e3);
-  } else if (pair.board_scan && pair.board_scan->ok) {
-    ImGui::Text("%zu rays, %zu on the board, line RMS %.1f mm", rays, target_points,
-                pair.board_scan->rms_m * 1e3);
-  } else {
-    const std::string why = pair.three_face   ? pair.three_face->scan.reason
-                            : pair.board_scan ? pair.board_scan->reason
-                                              : pair.reason;
-    ImGui::TextColored({1.0f, 0.5f, 0.4f, 1}, "no target: %s", why.c_str());
-  }
-  for (int face = 0; face < 3 && pair.three_face; ++face) {
-    ImGui::TextColored(FaceColorVec(face), "%s", kFaceNames[face]);
-    ImGui::SameLine();
-  }
-  ImGui::TextDisabled("rings: F G H   wheel: zoom about the target");
-}
 
 // ---- The image view: the depth picture (three-face) or the camera image (checkerboard).
 
@@ -398,45 +231,6 @@ void LabelAt(const gfx::Matrix4f& view_projection, ImVec2 origin, ImVec2 size, c
                                       IM_COL32(220, 220, 220, 255), text);
 }
 
-// ---- The panels.
-
-void TextMm(const std::optional<double>& metres) {
-  if (metres) ImGui::Text("%.1f", *metres * 1e3);
-}
-
-// Id (selects the pair), status, scan and depth (or PnP) RMS, Eq. 12 and plane residuals (mm),
-// what the pair gave.
-void PairRow(const LrfSnapshot& s, int index, std::vector<LrfIntent>* intents) {
-  const LrfPairView& pair = s.pairs[index];
-  const LrfPairFeatures* f = pair.features.get();
-  ImGui::TableNextRow();
-  ImGui::TableNextColumn();
-  if (PairSelectable(index, pair.id, index == s.selected)) Emit<LrfSelectPair>(intents, index);
-  ImGui::TableNextColumn();
-  PairStatusText(pair.status, pair.extracted ? PairStatusName(pair.status) : "extracting");
-  ImGui::TableNextColumn();
-  if (f && f->three_face && f->three_face->scan.ok) TextMm(f->three_face->scan.rms_m);
-  if (f && f->board_scan && f->board_scan->ok) TextMm(f->board_scan->rms_m);
-  ImGui::TableNextColumn();
-  if (f && f->three_face && f->three_face->depth.ok) TextMm(f->three_face->depth.rms_m);
-  if (f && f->camera) ImGui::Text("%.2f", f->camera->reprojection_rms_px);
-  ImGui::TableNextColumn();
-  TextMm(pair.point_to_line_m);
-  ImGui::TableNextColumn();
-  TextMm(pair.point_to_plane_rms_m);
-  ImGui::TableNextColumn();
-  if (!pair.reason.empty())
-    ImGui::TextWrapped("%s", pair.reason.c_str());
-  else if (f && f->three_face)
-    ImGui::TextDisabled(
-        "%zu scan points, faces %d / %d / %d px", f->three_face->scan.target_indices.size(),
-        f->three_face->depth.inlier_counts[0], f->three_face->depth.inlier_counts[1],
-        f->three_face->depth.inlier_counts[2]);
-  else if (f && f->board_scan && f->camera)
-    ImGui::TextDisabled("%zu board points, %d corners", f->board_scan->points.size(),
-                        f->camera->num_corners);
-}
-
 }  // namespace
 
 bool ParseLrfLayout(const std::string& name, LrfLayout* layout) {
@@ -461,29 +255,6 @@ std::string LrfWorkbench::Opened(const LrfSnapshot& s) const {
 const Pose* LrfWorkbench::DisplayedEstimate(const LrfSnapshot& s) const {
   return replay().ShownEstimate(s.solver.iterations,
                                 s.solver.solution ? &s.solver.solution->cam_from_lrf : nullptr);
-}
-
-void LrfWorkbench::ScanView(const LrfSnapshot& s, const Rect& r) {
-  const LrfPairFeatures* pair = BeginPairView("Scan (LRF frame, top-down)", s, r);
-  if (!pair) return ImGui::End();
-  const auto target = TargetPoints(*pair);
-  ScanReadouts(*pair, target.size());
-  const ImVec2 origin = ImGui::GetCursorScreenPos();
-  const ImVec2 avail = ImGui::GetContentRegionAvail();
-  if (avail.x < 10 || avail.y < 10) return ImGui::End();
-  ImGui::InvisibleButton("scan_canvas", avail);
-  const bool hovered = ImGui::IsItemHovered();
-  const ScanCanvas canvas = FitScanCanvas(origin, avail, target, scan_zoom_);
-  ImDrawList* draw = ImGui::GetWindowDrawList();
-  draw->PushClipRect(origin, canvas.end(), true);
-  draw->AddRectFilled(origin, canvas.end(), IM_COL32(22, 22, 27, 255));
-  DrawScanGrid(draw, canvas);
-  DrawScanPoints(draw, canvas, *pair, target);
-  DrawScanSensors(draw, canvas, DisplayedEstimate(s));
-  draw->PopClipRect();
-  if (hovered && ImGui::GetIO().MouseWheel != 0)
-    scan_zoom_ = std::clamp(scan_zoom_ * std::pow(1.25f, ImGui::GetIO().MouseWheel), 1.0f, 60.0f);
-  ImGui::End();
 }
 
 void LrfWorkbench::ImageView(const LrfSnapshot& s, const Rect& r) {
@@ -610,90 +381,6 @@ void LrfWorkbench::SceneView(const LrfSnapshot& s, const Rect& r) {
   if (estimate) LabelAt(view_projection, origin, ImVec2(tw, th), estimate->translation(), "LRF");
   if (ImGui::IsItemHovered()) orbit_.HandleMouse(/*drag_turns_right=*/true, 0.2f, 20.0f);
   ImGui::End();
-}
-
-void LrfWorkbench::MeasurementsPanel(const LrfSnapshot& s, const Rect& r,
-                                     std::vector<LrfIntent>* intents) {
-  if (!BeginPanel("Measurements", r)) return ImGui::End();
-  PairProgress("extracting", s.extracted_done, s.extracted_total);
-  if (const auto status = ReviewButtons(s.selected >= 0, "arrows: previous / next; figures in mm"))
-    Emit<LrfSetPairStatus>(intents, s.selected, *status);
-  const bool board_case = s.dataset && s.dataset->target_type == LrfTargetType::kCheckerboard;
-  if (BeginPairsTable({{"pair", 60},
-                       {"status", 70},
-                       {"scan", 45},
-                       {board_case ? "PnP px" : "depth", 50},
-                       {"Eq.12", 50},
-                       {"plane", 45},
-                       {"details"}})) {
-    for (int i = 0; i < static_cast<int>(s.pairs.size()); ++i) PairRow(s, i, intents);
-    ImGui::EndTable();
-  }
-  ImGui::End();
-}
-
-void LrfWorkbench::SolverPanel(const LrfSnapshot& s, const Rect& r,
-                               std::vector<LrfIntent>* intents) {
-  if (!BeginPanel("Solver", r)) return ImGui::End();
-  static const char* kMethods[] = {"paper-linear (Eq. 9-11)", "refined (point-to-plane GN)"};
-  int method = s.solver.method == LrfMethod::kPaperLinear ? 0 : 1;
-  ImGui::SetNextItemWidth(230);
-  if (ImGui::Combo("method", &method, kMethods, 2))
-    Emit<LrfSetMethod>(intents, method == 0 ? LrfMethod::kPaperLinear : LrfMethod::kRefined);
-  const SolverReplay::Request request =
-      replay().Buttons(s.solver.iterations.size(), s.solver.running);
-  if (request.run) Emit<LrfRunSolver>(intents);
-  if (request.reset) Emit<LrfResetSolver>(intents);
-  if (s.solver.running) {
-    ImGui::SameLine();
-    ImGui::TextColored({0.95f, 0.8f, 0.3f, 1}, "solving ...");
-  }
-  if (!s.solver.iterations.empty())
-    replay().CostPlot(s.solver.iterations, ImVec2(r.w * 0.55f, 60));
-  else if (s.solver.solution)
-    ImGui::TextDisabled("closed form (Eq. 11): no iterations to replay");
-  if (!s.solver.failure.empty())
-    ImGui::TextColored({1.0f, 0.4f, 0.35f, 1}, "%s", s.solver.failure.c_str());
-  if (s.solver.solution) SolutionReadouts(s, intents);
-  ImGui::End();
-}
-
-void LrfWorkbench::SolutionReadouts(const LrfSnapshot& s, std::vector<LrfIntent>* intents) {
-  const LrfSolution& solution = *s.solver.solution;
-  const Pose& pose = solution.cam_from_lrf;
-  PoseReadout("cam_from_lrf", "x_cam = cam_from_lrf * x_lrf", pose);
-  StdReadout(s.solver.std_translation_mm, s.solver.std_rotation_deg);
-  ImGui::Text(
-      "%s over %zu pairs",
-      LrfResidualText(solution, s.dataset ? s.dataset->target_type : LrfTargetType::kThreeFace)
-          .c_str(),
-      s.solver.solved_pair_ids.size());
-  if (s.dataset && s.dataset->cam_from_lrf_ground_truth) {
-    const Pose& truth = *s.dataset->cam_from_lrf_ground_truth;
-    ImGui::TextDisabled("vs ground truth: %.1f mm, %.3f deg",
-                        (pose.translation() - truth.translation()).norm() * 1e3,
-                        RotationAngle(pose.linear(), truth.linear()) * kRadToDeg);
-  }
-  const char* convergence = solution.method != LrfMethod::kRefined ? ""
-                            : solution.converged                   ? ", converged"
-                                                                   : ", not converged";
-  ObservabilityReadout(solution.observability,
-                       LrfMethodName(solution.method) + ", " + std::to_string(solution.iterations) +
-                           " iterations" + convergence,
-                       "NOT well constrained: add observations with other target poses");
-  if (PathField("##export", &export_path_, "Export result"))
-    Emit<LrfExportResult>(intents, export_path_);
-}
-
-void LrfWorkbench::HandleKeys(const LrfSnapshot& s, std::vector<LrfIntent>* intents) {
-  if (ImGui::GetIO().WantTextInput || s.selected < 0) return;
-  const int n = static_cast<int>(s.pairs.size());
-  const ReviewKeys keys = ReadReviewKeys();
-  if (keys.accept) Emit<LrfSetPairStatus>(intents, s.selected, PairStatus::kAccepted);
-  if (keys.reject) Emit<LrfSetPairStatus>(intents, s.selected, PairStatus::kRejected);
-  if (keys.next) Emit<LrfSelectPair>(intents, std::min(n - 1, s.selected + 1));
-  if (keys.previous) Emit<LrfSelectPair>(intents, std::max(0, s.selected - 1));
-  if (keys.run) Emit<LrfRunSolver>(intents);
 }
 
 }  // namespace calibench::ui
