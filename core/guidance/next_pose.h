@@ -110,8 +110,9 @@ struct PoseSuggestion {
 // The feasible candidate that leaves the smallest Σ (σ/goal)² over the six axes after it is
 // added (dominated by the weakest direction; ties by the largest ratio): Σ' = (Σ⁻¹ + I)⁻¹ with I
 // its expected information at the current variance factors, discounted direction by direction
-// by how much wider than the model the reported covariance is. Without a solution (fewer than 3 pairs), the feasible pose
-// that differs most from the boards seen so far (`seen`, camera frame), frontal first.
+// by how much wider than the model the reported covariance is. Without a solution (fewer than 3
+// pairs), the feasible pose that differs most from the boards seen so far (`seen`, camera frame),
+// frontal first.
 std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
                                            const std::optional<SolverResult>& solution,
                                            const std::vector<Pose>& seen, const CaptureGoal& goal,

@@ -246,6 +246,18 @@ class PlaneAlignmentSolver {
   Linearization LinearizeHere() const { return Linearize(cam_from_lidar_, range_offset_m_); }
   // Indices of the estimated parameters: the pose's six, then b when estimated.
   std::vector<int> ActiveParameters() const;
+  // One board-edge point at a pose: its residual (signed distance outside the sheet's edge,
+  // metres), σ and Jacobians over the parameters and over the camera's board pose.
+  struct EdgeRow {
+    double residual = 0.0;
+    double sigma = 0.0;
+    Eigen::Matrix<double, 1, kNumParameters> jacobian;
+    Eigen::Matrix<double, 1, 6> board_pose_jacobian;
+  };
+  std::vector<EdgeRow> EdgeRows(const Pose& cam_from_lidar, double range_offset_m,
+                                const PlanePair& pair) const;
+  // Each row's weight (Huber over 1/σ²) about the pair's robust dilation, when it is estimated.
+  std::vector<double> EdgeWeights(const std::vector<EdgeRow>& rows, bool with_dilation) const;
   // Adds one pair's board-edge residuals to `lin`.
   void LinearizeEdges(const Pose& cam_from_lidar, double range_offset_m, const PlanePair& pair,
                       Linearization* lin) const;

@@ -22,14 +22,8 @@ bool InvertCovariance(const Mat6& covariance, Mat6* information) {
 
 }  // namespace
 
-void PlaneAlignmentSolver::LinearizeEdges(const Pose& cam_from_lidar, double range_offset_m,
-                                          const PlanePair& pair, Linearization* lin) const {
-  struct EdgeRow {
-    double residual = 0.0;  // signed distance outside the sheet's edge, metres
-    double sigma = 0.0;
-    Eigen::Matrix<double, 1, kNumParameters> jacobian;
-    Eigen::Matrix<double, 1, 6> board_pose_jacobian;  // d residual / d camera_from_board
-  };
+std::vector<PlaneAlignmentSolver::EdgeRow> PlaneAlignmentSolver::EdgeRows(
+    const Pose& cam_from_lidar, double range_offset_m, const PlanePair& pair) const {
   std::vector<EdgeRow> rows;
   rows.reserve(pair.lidar_edges.size());
   Eigen::Matrix<double, 1, 6> edge_jacobian;
@@ -49,12 +43,15 @@ void PlaneAlignmentSolver::LinearizeEdges(const Pose& cam_from_lidar, double ran
     row.jacobian[kRangeOffset] = -edge_jacobian.head<3>().dot(ray);
     rows.push_back(row);
   }
-  if (rows.empty()) return;
+  return rows;
+}
+
+std::vector<double> PlaneAlignmentSolver::EdgeWeights(const std::vector<EdgeRow>& rows,
+                                                      bool with_dilation) const {
   // The pair's dilation δ (SolverOptions::estimate_edge_dilation): every crossing should lie δ
   // outside its edge. Its robust weighted mean at this pose sets the Huber weights.
   double dilation = 0.0;
   std::vector<double> weights(rows.size());
-  const bool with_dilation = options_.estimate_edge_dilation && rows.size() >= 3;
   for (int pass = 0; pass < (with_dilation ? 4 : 1); ++pass) {
     double weighted_sum = 0.0;
     double weight_sum = 0.0;
@@ -66,6 +63,15 @@ void PlaneAlignmentSolver::LinearizeEdges(const Pose& cam_from_lidar, double ran
     }
     if (with_dilation && pass < 3) dilation = weighted_sum / weight_sum;
   }
+  return weights;
+}
+
+void PlaneAlignmentSolver::LinearizeEdges(const Pose& cam_from_lidar, double range_offset_m,
+                                          const PlanePair& pair, Linearization* lin) const {
+  const std::vector<EdgeRow> rows = EdgeRows(cam_from_lidar, range_offset_m, pair);
+  if (rows.empty()) return;
+  const bool with_dilation = options_.estimate_edge_dilation && rows.size() >= 3;
+  const std::vector<double> weights = EdgeWeights(rows, with_dilation);
   // The pair's nuisances, eliminated in closed form (Schur complement; variable projection):
   // the dilation (flat prior; residual r − δ) and, with edge_board_pose_uncertainty, the error of
   // the camera's board pose (prior: its PnP covariance), which every edge point shares.
