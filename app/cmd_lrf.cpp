@@ -231,6 +231,20 @@ int RunSweepLrf(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--preset", preset, "paper | ideal")->capture_default_str();
   app.add_option("--table", table_path, "also write the markdown table here");
+  DepthFeatureOptions& depth = options.pipeline.depth;
+  app.add_option("--depth-normals", depth.normals,
+                 "grid (ours: PCA over grid neighbours, depth-dependent window) | pcl (PCL's "
+                 "IntegralImageNormalEstimation)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, DepthNormalMethod>{
+          {"grid", DepthNormalMethod::kGridPca}, {"pcl", DepthNormalMethod::kPclIntegralImage}}))
+      ->default_str("grid");
+  app.add_option(
+         "--depth-plane-search", depth.plane_search,
+         "ours (one point and its normal per draw) | pcl (PCL's SACSegmentationFromNormals)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, DepthPlaneSearch>{{"ours", DepthPlaneSearch::kPointNormalRansac},
+                                                  {"pcl", DepthPlaneSearch::kPclSacNormalPlane}}))
+      ->default_str("ours");
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
   auto sim = LrfSimPreset(preset);
   if (kind != "lrf" || !sim || options.seeds < 1) {

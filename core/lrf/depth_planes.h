@@ -15,6 +15,15 @@
 
 namespace calibench {
 
+// How the local normals are estimated: PCA over grid neighbours with a depth-dependent window
+// that leaves points across a depth jump out (ours, the default), or PCL's
+// IntegralImageNormalEstimation (covariance method, one window size for the image), kept for the
+// comparison in depth_pcl.cpp's header comment.
+enum class DepthNormalMethod { kGridPca, kPclIntegralImage };
+// How each RANSAC round draws its plane: one point and its normal per draw (ours, the default),
+// or PCL's SACSegmentationFromNormals with SACMODEL_NORMAL_PLANE (three points per draw).
+enum class DepthPlaneSearch { kPointNormalRansac, kPclSacNormalPlane };
+
 struct DepthFeatureOptions {
   int stride_px = 2;  // back-project every stride-th pixel in u and v
   double max_depth_m = 6.0;
@@ -25,6 +34,8 @@ struct DepthFeatureOptions {
   int max_planes = 8;               // planes extracted before choosing the target's three
   double min_face_angle_deg = 8.0;  // faces closer to parallel fail with a reason
   uint64_t seed = 7;                // RANSAC sampling
+  DepthNormalMethod normals = DepthNormalMethod::kGridPca;
+  DepthPlaneSearch plane_search = DepthPlaneSearch::kPointNormalRansac;
   bool Check(std::string* why) const;
 };
 

@@ -244,13 +244,21 @@ void BM_LrfScanFeatures(benchmark::State& state) {
 }
 BENCHMARK(BM_LrfScanFeatures)->Unit(benchmark::kMillisecond);
 
+// Arguments: normals (0 ours, 1 PCL's integral image), plane search (0 ours, 1 PCL's SAC).
 void BM_LrfDepthFeatures1280x720(benchmark::State& state) {
   const LrfSimObservation& o = LrfObservationForBench();
+  DepthFeatureOptions options;
+  options.normals =
+      state.range(0) ? DepthNormalMethod::kPclIntegralImage : DepthNormalMethod::kGridPca;
+  options.plane_search =
+      state.range(1) ? DepthPlaneSearch::kPclSacNormalPlane : DepthPlaneSearch::kPointNormalRansac;
   for (auto _ : state)
-    benchmark::DoNotOptimize(
-        ExtractDepthFeatures(o.depth, ThreeFaceTarget{}, DepthFeatureOptions{}));
+    benchmark::DoNotOptimize(ExtractDepthFeatures(o.depth, ThreeFaceTarget{}, options));
 }
-BENCHMARK(BM_LrfDepthFeatures1280x720)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LrfDepthFeatures1280x720)
+    ->ArgNames({"pcl_normals", "pcl_sac"})
+    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
 
 void BM_LrfRefinedSolve10Observations(benchmark::State& state) {
   LrfSimOptions options = *LrfSimPreset("paper");
