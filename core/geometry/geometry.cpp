@@ -95,6 +95,25 @@ Plane OrientTowardsOrigin(const Plane& plane) {
   return Plane{-plane.normal, -plane.distance};
 }
 
+Eigen::Matrix<double, 3, 2> PlaneTangentBasis(const Vec3& normal) {
+  Eigen::Matrix<double, 3, 2> basis;
+  basis.col(0) = normal.unitOrthogonal();
+  basis.col(1) = normal.cross(basis.col(0));
+  return basis;
+}
+
+Eigen::Matrix<double, 4, 3> TangentToPlaneCoefficients(const Vec3& normal) {
+  Eigen::Matrix<double, 4, 3> to_coefficients = Eigen::Matrix<double, 4, 3>::Zero();
+  to_coefficients.topLeftCorner<3, 2>() = PlaneTangentBasis(normal);
+  to_coefficients(3, 2) = 1.0;
+  return to_coefficients;
+}
+
+Mat4 TangentToPlaneCovariance(const Mat3& tangent_covariance, const Vec3& normal) {
+  const Eigen::Matrix<double, 4, 3> to_coefficients = TangentToPlaneCoefficients(normal);
+  return to_coefficients * tangent_covariance * to_coefficients.transpose();
+}
+
 namespace {
 
 // Point k of a plane fit's input is point_at(k): an Eigen 3-vector of doubles or an expression of
@@ -106,9 +125,7 @@ namespace {
 template <typename PointAt, typename WeightAt>
 void SetPlaneCovariance(size_t count, const PointAt& point_at, const WeightAt& weight_at,
                         PlaneFit* fit) {
-  Eigen::Matrix<double, 3, 2> tangent;
-  tangent.col(0) = fit->plane.normal.unitOrthogonal();
-  tangent.col(1) = fit->plane.normal.cross(tangent.col(0));
+  const Eigen::Matrix<double, 3, 2> tangent = PlaneTangentBasis(fit->plane.normal);
   Mat3 normal_matrix = Mat3::Zero();
   double weighted_sq = 0.0, sum_sq = 0.0;
   for (size_t k = 0; k < count; ++k) {
@@ -122,10 +139,7 @@ void SetPlaneCovariance(size_t count, const PointAt& point_at, const WeightAt& w
   fit->rms_m = std::sqrt(sum_sq / count);
   const double dof = std::max<double>(1.0, static_cast<double>(count) - 3.0);
   const Mat3 local_cov = (weighted_sq / dof) * normal_matrix.inverse();
-  Eigen::Matrix<double, 4, 3> to_coefficients = Eigen::Matrix<double, 4, 3>::Zero();
-  to_coefficients.topLeftCorner<3, 2>() = tangent;
-  to_coefficients(3, 2) = 1.0;
-  fit->covariance = to_coefficients * local_cov * to_coefficients.transpose();
+  fit->covariance = TangentToPlaneCovariance(local_cov, fit->plane.normal);
 }
 
 // Weighted total least squares: the plane through the weighted centroid normal to the smallest

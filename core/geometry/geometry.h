@@ -56,6 +56,14 @@ Plane OrientTowardsOrigin(const Plane& plane);
 // the plane (|n·u| < 0.02), whose range is unbounded.
 std::optional<double> RangeOnPlane(const Plane& plane, const Vec3& point);
 
+// A plane normal's two degrees of freedom: n = n₀ + B δ, δ ∈ ℝ², B = PlaneTangentBasis(n₀)
+// (orthonormal, perpendicular to n₀).
+Eigen::Matrix<double, 3, 2> PlaneTangentBasis(const Vec3& normal);
+// A covariance over the tangent parameters (δ, δ_d) mapped to the plane's (n, d) coefficients.
+Mat4 TangentToPlaneCovariance(const Mat3& tangent_covariance, const Vec3& normal);
+// The map itself: (n, d) = J (δ, δ_d), a 4×3 matrix.
+Eigen::Matrix<double, 4, 3> TangentToPlaneCoefficients(const Vec3& normal);
+
 // A total-least-squares plane with the covariance of its coefficients.
 struct PlaneFit {
   Plane plane;                     // normal towards the frame's origin (d > 0)

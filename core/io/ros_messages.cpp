@@ -16,6 +16,19 @@ namespace {
 
 [[noreturn]] void Bad(const std::string& what) { throw std::invalid_argument(what); }
 
+// A message's rows (PointCloud2, Image): the declared stride holds a row of row_bytes, and the
+// data holds stride x height bytes. Both products of uint32 fit in 64 unsigned bits.
+void CheckRows(const char* type, const char* stride_name, std::uint32_t stride,
+               const char* row_name, std::uint64_t row_bytes, std::uint32_t height,
+               std::size_t data_bytes) {
+  if (stride < row_bytes)
+    Bad(std::string(type) + ": " + stride_name + " " + std::to_string(stride) +
+        " is shorter than " + row_name + " = " + std::to_string(row_bytes) + " bytes");
+  if (static_cast<std::uint64_t>(stride) * height > data_bytes)
+    Bad(std::string(type) + ": " + std::to_string(data_bytes) + " bytes of data for " +
+        stride_name + " x height = " + std::to_string(static_cast<std::uint64_t>(stride) * height));
+}
+
 template <typename T>
 T ByteSwapped(T value) {
   std::uint8_t bytes[sizeof(T)];
@@ -314,13 +327,8 @@ PointCloud2Message DecodePointCloud2(std::span<const std::uint8_t> data, Message
   if (declared > static_cast<std::uint64_t>(limits.max_cloud_points))
     Bad("PointCloud2: " + std::to_string(declared) + " points is over the limit of " +
         std::to_string(limits.max_cloud_points) + " (max_cloud_points)");
-  if (static_cast<std::uint64_t>(row_step) < static_cast<std::uint64_t>(width) * point_step)
-    Bad("PointCloud2: row_step " + std::to_string(row_step) + " is shorter than width x " +
-        "point_step = " + std::to_string(static_cast<std::uint64_t>(width) * point_step));
-  if (static_cast<std::uint64_t>(row_step) * height > points.size())
-    Bad("PointCloud2: " + std::to_string(points.size()) +
-        " bytes of data for row_step x height = " +
-        std::to_string(static_cast<std::uint64_t>(row_step) * height));
+  CheckRows("PointCloud2", "row_step", row_step, "width x point_step",
+            static_cast<std::uint64_t>(width) * point_step, height, points.size());
   message.declared_points = static_cast<int>(declared);
   const bool swap = big_endian != (std::endian::native == std::endian::big);
   FillCloud(points, fields, width, height, point_step, row_step, swap, &message.cloud);
@@ -351,13 +359,8 @@ ImageMessage DecodeImage(std::span<const std::uint8_t> data, MessageEncoding enc
         " (max_image_pixels)");
   if (width == 0 || height == 0 || width > 1u << 20 || height > 1u << 20)
     Bad("Image: size " + std::to_string(width) + " x " + std::to_string(height));
-  const std::uint64_t row_bytes = static_cast<std::uint64_t>(width) * CV_ELEM_SIZE(raw->cv_type);
-  if (step < row_bytes)
-    Bad("Image: step " + std::to_string(step) + " is shorter than a row of " +
-        std::to_string(row_bytes) + " bytes");
-  if (static_cast<std::uint64_t>(step) * height > pixels.size())
-    Bad("Image: " + std::to_string(pixels.size()) + " bytes of data for step x height = " +
-        std::to_string(static_cast<std::uint64_t>(step) * height));
+  CheckRows("Image", "step", step, "a row of width x pixel size",
+            static_cast<std::uint64_t>(width) * CV_ELEM_SIZE(raw->cv_type), height, pixels.size());
   cv::Mat view(static_cast<int>(height), static_cast<int>(width), raw->cv_type,
                const_cast<std::uint8_t*>(pixels.data()), step);
   cv::Mat converted = view;

@@ -71,9 +71,7 @@ WeightedResidual ComputeWeightedResidual(const Pose& cam_from_lidar, const Plane
   const Plane lidar_plane = CorrectedLidarPlane(pair, range_offset_m);
   const Plane moved = TransformPlane(cam_from_lidar, lidar_plane);
   const Vec3& n_c = pair.camera_plane.normal;
-  Eigen::Matrix<double, 3, 2> basis;
-  basis.col(0) = n_c.unitOrthogonal();
-  basis.col(1) = n_c.cross(basis.col(0));
+  const Eigen::Matrix<double, 3, 2> basis = PlaneTangentBasis(n_c);
   WeightedResidual out;
   out.residual.head<2>() = basis.transpose() * (moved.normal - n_c);
   out.residual[2] = moved.distance - pair.camera_plane.distance;

@@ -4,30 +4,12 @@
 #include <cmath>
 
 namespace calibench {
-namespace {
-
-Eigen::Matrix<double, 3, 2> TangentBasis(const Vec3& normal) {
-  Eigen::Matrix<double, 3, 2> basis;
-  basis.col(0) = normal.unitOrthogonal();
-  basis.col(1) = normal.cross(basis.col(0));
-  return basis;
-}
-
-// Maps a covariance of (tangent δn, δd) to (n, d) coefficients.
-Mat4 TangentToCoefficients(const Mat3& local, const Vec3& normal) {
-  Eigen::Matrix<double, 4, 3> to_coefficients = Eigen::Matrix<double, 4, 3>::Zero();
-  to_coefficients.topLeftCorner<3, 2>() = TangentBasis(normal);
-  to_coefficients(3, 2) = 1.0;
-  return to_coefficients * local * to_coefficients.transpose();
-}
-
-}  // namespace
 
 Mat4 LidarPlaneBoundCovariance(const std::vector<Vec3>& points, const Plane& plane,
                                double range_sigma_m) {
   CALIBENCH_CHECK(range_sigma_m > 0);
   // The Jacobian of FitPlaneRangeMl's range residual, at the true plane.
-  const Eigen::Matrix<double, 3, 2> basis = TangentBasis(plane.normal);
+  const Eigen::Matrix<double, 3, 2> basis = PlaneTangentBasis(plane.normal);
   Mat3 information = Mat3::Zero();
   for (const Vec3& x : points) {
     const Vec3 ray = x.normalized();
@@ -38,7 +20,7 @@ Mat4 LidarPlaneBoundCovariance(const std::vector<Vec3>& points, const Plane& pla
     j(2) = 1.0 / cos_incidence;
     information += j.transpose() * j / (range_sigma_m * range_sigma_m);
   }
-  return TangentToCoefficients(information.inverse(), plane.normal);
+  return TangentToPlaneCovariance(information.inverse(), plane.normal);
 }
 
 Mat6 CameraPoseBoundCovariance(const CameraModel& camera, const std::vector<Vec3>& board_corners,

@@ -177,70 +177,72 @@ std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
   return fit;
 }
 
-std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
-                                             const std::vector<int>& indices,
-                                             const Plane& initial) {
-  if (indices.size() < 4) return std::nullopt;
+namespace {
+
+// The range residuals of FitPlaneRangeMl: each return's ray (unit) and measured range.
+struct RangeResiduals {
   std::vector<Vec3> rays;
   std::vector<double> ranges;
-  rays.reserve(indices.size());
-  ranges.reserve(indices.size());
-  for (int i : indices) {
-    const Vec3 x = cloud.points[i].cast<double>();
-    const double r = x.norm();
-    if (r <= 0) return std::nullopt;
-    rays.push_back(x / r);
-    ranges.push_back(r);
-  }
-  Plane plane = OrientTowardsOrigin(initial);
-  auto tangent_of = [](const Vec3& n) {
-    Eigen::Matrix<double, 3, 2> b;
-    b.col(0) = n.unitOrthogonal();
-    b.col(1) = n.cross(b.col(0));
-    return b;
-  };
-  // Residual e_i = r_i − r̂_i, r̂_i = −d/(n·u_i). With n ← n + B δ and d ← d + δ_d:
-  // ∂r̂/∂δ = d (u_iᵀ B)/(n·u_i)², ∂r̂/∂δ_d = −1/(n·u_i); ∂e/∂· = −∂r̂/∂·.
-  Vec3 sum_jacobian = Vec3::Zero();  // Σ ∂e_i/∂θ at the last linearisation
-  auto linearize = [&](const Plane& p, Mat3* normal_matrix, Vec3* gradient, double* sum_sq) {
-    const Eigen::Matrix<double, 3, 2> b = tangent_of(p.normal);
+
+  // Gauss-Newton's normal matrix JᵀJ, gradient Jᵀe and Σe² at plane p, over θ = (δ, δ_d) with
+  // n ← n + B δ, d ← d + δ_d; *sum_jacobian = Σ ∂e_i/∂θ. Residual e_i = r_i − r̂_i,
+  // r̂_i = −d/(n·u_i): ∂r̂/∂δ = d (u_iᵀ B)/(n·u_i)², ∂r̂/∂δ_d = −1/(n·u_i); ∂e/∂· = −∂r̂/∂·.
+  // False when a ray grazes the plane (|cos| < 0.02, beyond 88.9°): no finite predicted range.
+  bool Linearize(const Plane& p, Mat3* normal_matrix, Vec3* gradient, double* sum_sq,
+                 Vec3* sum_jacobian) const {
+    const Eigen::Matrix<double, 3, 2> b = PlaneTangentBasis(p.normal);
     *normal_matrix = Mat3::Zero();
     *gradient = Vec3::Zero();
     *sum_sq = 0.0;
-    sum_jacobian.setZero();
+    sum_jacobian->setZero();
     for (size_t k = 0; k < rays.size(); ++k) {
       const double cos_incidence = p.normal.dot(rays[k]);
-      // A ray grazing the plane (|cos| < 0.02, beyond 88.9°) has no finite predicted range.
       if (std::abs(cos_incidence) < 0.02) return false;
-      const double predicted = -p.distance / cos_incidence;
-      const double e = ranges[k] - predicted;
+      const double e = ranges[k] + p.distance / cos_incidence;
       Eigen::RowVector3d j;
       j.head<2>() = -p.distance * rays[k].transpose() * b / (cos_incidence * cos_incidence);
       j(2) = 1.0 / cos_incidence;
       *normal_matrix += j.transpose() * j;
       *gradient += j.transpose() * e;
       *sum_sq += e * e;
-      sum_jacobian += j.transpose();
+      *sum_jacobian += j.transpose();
     }
     return true;
-  };
+  }
+};
+
+}  // namespace
+
+std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
+                                             const std::vector<int>& indices,
+                                             const Plane& initial) {
+  if (indices.size() < 4) return std::nullopt;
+  RangeResiduals residuals;
+  residuals.rays.reserve(indices.size());
+  residuals.ranges.reserve(indices.size());
+  for (int i : indices) {
+    const Vec3 x = cloud.points[i].cast<double>();
+    const double r = x.norm();
+    if (r <= 0) return std::nullopt;
+    residuals.rays.push_back(x / r);
+    residuals.ranges.push_back(r);
+  }
+  Plane plane = OrientTowardsOrigin(initial);
   Mat3 normal_matrix;
-  Vec3 gradient;
+  Vec3 gradient, sum_jacobian;  // Σ ∂e_i/∂θ at the last linearisation
   double sum_sq = 0.0;
   bool converged = false;
-  for (int iteration = 0; iteration < 20; ++iteration) {
-    if (!linearize(plane, &normal_matrix, &gradient, &sum_sq)) return std::nullopt;
+  for (int iteration = 0; iteration < 20 && !converged; ++iteration) {
+    if (!residuals.Linearize(plane, &normal_matrix, &gradient, &sum_sq, &sum_jacobian))
+      return std::nullopt;
     const Vec3 step = normal_matrix.ldlt().solve(-gradient);
     if (!step.allFinite()) return std::nullopt;
-    const Eigen::Matrix<double, 3, 2> b = tangent_of(plane.normal);
-    plane.normal = (plane.normal + b * step.head<2>()).normalized();
+    plane.normal = (plane.normal + PlaneTangentBasis(plane.normal) * step.head<2>()).normalized();
     plane.distance += step(2);
-    if (step.norm() < 1e-12) {
-      converged = true;
-      break;
-    }
+    converged = step.norm() < 1e-12;
   }
-  if (!converged || !linearize(plane, &normal_matrix, &gradient, &sum_sq)) return std::nullopt;
+  if (!converged || !residuals.Linearize(plane, &normal_matrix, &gradient, &sum_sq, &sum_jacobian))
+    return std::nullopt;
   LidarPlaneFit fit;
   fit.plane = OrientTowardsOrigin(plane);
   fit.inliers = indices;
@@ -248,14 +250,11 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
   fit.num_candidates = static_cast<int>(indices.size());
   fit.rms_m = std::sqrt(sum_sq / indices.size());
   const double dof = std::max<double>(1.0, static_cast<double>(indices.size()) - 3.0);
-  const Mat3 local_cov = (sum_sq / dof) * normal_matrix.inverse();
-  Eigen::Matrix<double, 4, 3> to_coefficients = Eigen::Matrix<double, 4, 3>::Zero();
-  to_coefficients.topLeftCorner<3, 2>() = tangent_of(plane.normal);
-  to_coefficients(3, 2) = 1.0;
-  fit.covariance = to_coefficients * local_cov * to_coefficients.transpose();
+  fit.covariance = TangentToPlaneCovariance((sum_sq / dof) * normal_matrix.inverse(), plane.normal);
   // A range offset b adds b to every residual; the Gauss-Newton solution then moves by
   // −(JᵀJ)⁻¹ Jᵀ 1 per metre of b.
-  fit.range_offset_jacobian = to_coefficients * (-normal_matrix.ldlt().solve(sum_jacobian));
+  fit.range_offset_jacobian =
+      TangentToPlaneCoefficients(plane.normal) * (-normal_matrix.ldlt().solve(sum_jacobian));
   return fit;
 }
 

@@ -218,8 +218,8 @@ class Controller : public ControllerState<Snapshot> {
   bool ResumeBackup(const std::filesystem::path& session, const std::string& note,
                     std::optional<FileLock>* lock);
 
-  // One handler per intent type, each an explicit specialization in controller.cpp (Apply visits
-  // them with mutex_ held).
+  // One handler per intent type, each an explicit specialization declared after the class and
+  // defined by concern in controller*.cpp (Apply visits them with mutex_ held).
   template <typename IntentType>
   void Handle(const IntentType& intent);
   bool ValidPair(int index) const;
@@ -238,5 +238,37 @@ class Controller : public ControllerState<Snapshot> {
   std::optional<SceneBackground> background_;  // worker thread only (DetectWithBackground)
   bool stroke_open_ = false;  // BrushStroke / PaintPoints dabs since the last EndStroke
 };
+
+// The handlers (controller.cpp, controller_pairs.cpp, controller_session.cpp).
+template <>
+void Controller::Handle(const SelectPair&);
+template <>
+void Controller::Handle(const SetPairStatus&);
+template <>
+void Controller::Handle(const BrushStroke&);
+template <>
+void Controller::Handle(const EndStroke&);
+template <>
+void Controller::Handle(const ClearBrush&);
+template <>
+void Controller::Handle(const DetectBoardAgain&);
+template <>
+void Controller::Handle(const PaintPoints&);
+template <>
+void Controller::Handle(const RunSolver&);
+template <>
+void Controller::Handle(const ResetSolver&);
+template <>
+void Controller::Handle(const SetSolverOptions&);
+template <>
+void Controller::Handle(const SetView&);
+template <>
+void Controller::Handle(const ExportResult&);
+template <>
+void Controller::Handle(const SaveSessionAs&);
+template <>
+void Controller::Handle(const Undo&);
+template <>
+void Controller::Handle(const Redo&);
 
 }  // namespace calibench::ui

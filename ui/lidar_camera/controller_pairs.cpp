@@ -1,0 +1,321 @@
+// The controller's pairs: loading each pair's files on the worker, the board's detection (with
+// the scene's background), the LiDAR refit after a brush edit, and the brush intents.
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+
+#include "core/base/allocator.h"
+#include "core/base/atomic_file.h"
+#include "core/io/cloud_io.h"
+#include "core/io/image_io.h"
+#include "core/lidar_camera/result_io.h"
+#include "ui/lidar_camera/controller.h"
+
+namespace calibench::ui {
+namespace {
+
+constexpr int kThumbnailWidth = 160;  // pixels
+
+std::vector<int> SeedBrush(const LidarCloud& cloud, const LidarImage& image,
+                           const LidarSeed& seed) {
+  std::vector<int> pixels;
+  for (int i : SelectSeedRegion(cloud, seed))
+    if (image.pixel_of_point[i] >= 0) pixels.push_back(image.pixel_of_point[i]);
+  std::sort(pixels.begin(), pixels.end());
+  pixels.erase(std::unique(pixels.begin(), pixels.end()), pixels.end());
+  return pixels;
+}
+
+// Pixels of a circle on the LiDAR image; columns wrap around (azimuth is periodic).
+std::vector<int> CirclePixels(int rows, int columns, int row, int column, float radius) {
+  std::vector<int> pixels;
+  const int r = static_cast<int>(std::ceil(radius));
+  for (int dr = -r; dr <= r; ++dr) {
+    const int y = row + dr;
+    if (y < 0 || y >= rows) continue;
+    for (int dc = -r; dc <= r; ++dc) {
+      if (dr * dr + dc * dc > radius * radius) continue;
+      const int x = ((column + dc) % columns + columns) % columns;
+      pixels.push_back(y * columns + x);
+    }
+  }
+  std::sort(pixels.begin(), pixels.end());
+  return pixels;
+}
+
+// The brush a loading pair starts with: the session's painted brush (`painted`, null when none)
+// replaces the seed; otherwise the seed selects the region and the brush only pictures it (as
+// EditsFromSession tells `calibench calibrate --session`). A mask painted on another image layout
+// would mark other returns: it is refused, not reread, and the returned text says why (empty
+// when nothing was refused).
+std::string StartBrush(const PairEntry& entry, const LidarCloud& cloud, const LidarImage& image,
+                       const BrushMask* painted, const std::vector<int>& painted_pixels,
+                       PairView* loaded) {
+  std::string dropped;
+  if (painted && BrushFitsImage(*painted, image.rows, image.columns, &dropped)) {
+    loaded->brush_pixels = painted_pixels;
+    return "";
+  }
+  if (entry.lidar_seed) {
+    loaded->brush_pixels = SeedBrush(cloud, image, *entry.lidar_seed);
+    loaded->brush_from_seed = true;
+  }
+  if (!painted) return "";
+  return "pair " + entry.id + ": its brush from the session was dropped: " + entry.cloud.string() +
+         ": " + dropped;
+}
+
+}  // namespace
+
+void Controller::OnAllPairsLoaded() {
+  worker_.Enqueue([this] { DetectWithBackground(); });
+  // What went wrong while loading stays on the status line (in the warning colour).
+  std::string loaded_line = "loaded " + std::to_string(state_.loading_total) + " pairs";
+  if (!open_note_.empty()) loaded_line += "; " + open_note_;
+  for (const std::string& warning : load_warnings_) loaded_line += "; " + warning;
+  SetStatus(loaded_line, !load_warnings_.empty());
+  load_warnings_.clear();
+  // A reopened session with a result shows its reprojection again.
+  const int selected = state_.selected;
+  if (state_.solver.result) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
+}
+
+void Controller::LoadPair(int index) {
+  PairEntry entry;
+  Dataset dataset;
+  std::vector<int> saved_brush;
+  std::optional<BrushMask> saved_mask;
+  bool painted = false;  // the session holds a brush the user painted (or erased)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    entry = state_.dataset->pairs[index];
+    dataset = *state_.dataset;
+    saved_brush = state_.pairs[index].brush_pixels;
+    const PairState& saved = session_.pairs[index];
+    painted = saved.brush.has_value() && !saved.brush_from_seed;
+    saved_mask = saved.brush;
+  }
+  std::string brush_dropped;  // why the session's brush does not fit this pair's cloud
+  // The pipeline's own steps (core/lidar_camera/pipeline.h), as `calibench calibrate` runs them.
+  PairView loaded;
+  std::string why;
+  auto inputs = LoadPairInputs(dataset, entry, &why);
+  bool selected = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    selected = index == state_.selected;
+  }
+  if (inputs) {
+    auto cloud = std::make_shared<LidarCloud>(std::move(inputs->cloud));
+    auto lidar_image = std::make_shared<LidarImage>(ProjectById(*cloud, LidarImageOptions{}));
+    loaded.thumbnail = std::make_shared<ImageU8>(ResizeImage(inputs->image, kThumbnailWidth));
+    CameraFeatures camera = ExtractCameraFeatures(dataset, inputs->image, pipeline_);
+    loaded.detection = std::move(camera.detection);
+    loaded.camera = std::move(camera.observation);
+    loaded.camera_failure = camera.failure;
+    brush_dropped = StartBrush(entry, *cloud, *lidar_image, painted ? &*saved_mask : nullptr,
+                               saved_brush, &loaded);
+    painted = painted && brush_dropped.empty();
+    loaded.cloud = cloud;
+    loaded.lidar_image = lidar_image;
+    // The camera view shows the selected pair's image: decoded once, here.
+    if (selected)
+      KeepDecodedImage(entry.image, std::make_shared<const ImageU8>(std::move(inputs->image)));
+  } else {
+    loaded.camera_failure = why;
+  }
+  bool refit_now = false;  // the selected pair's plane comes before the other pairs load
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    PairView& pair = state_.pairs[index];
+    // Loading is the pair's first job after Open: besides its header nothing was derived yet.
+    static_cast<PairHeader&>(loaded) = pair;
+    loaded.loaded = true;
+    pair = std::move(loaded);
+    ++state_.loading_done;
+    ++state_.generation;
+    if (!brush_dropped.empty()) {
+      session_.pairs[index].brush.reset();
+      session_.pairs[index].brush_from_seed = false;
+      load_warnings_.push_back(brush_dropped);
+      SetStatus(brush_dropped, true);
+    }
+    // Detection waits for every cloud: the background model over them keeps static board-sized
+    // panels out (as CalibrateDataset does).
+    const bool detects = !pair.brush_from_seed && !painted;
+    refit_now = pair.cloud && !detects && index == state_.selected &&
+                state_.loading_done < state_.loading_total;
+    if (pair.cloud && !detects && !refit_now) worker_.Enqueue([this, index] { RefitLidar(index); });
+    if (pair.cloud && detects)
+      pair.lidar_failure = "finding the board once every pair is loaded ...";
+    if (!pair.cloud) {
+      pair.status = PairStatus::kFailed;
+      pair.reason = pair.camera_failure;
+    }
+    if (state_.loading_done == state_.loading_total) OnAllPairsLoaded();
+  }
+  if (refit_now) RefitLidar(index);
+}
+
+void Controller::DetectWithBackground() {
+  std::vector<std::shared_ptr<const LidarCloud>> clouds;
+  std::vector<int> detect;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (size_t i = 0; i < state_.pairs.size(); ++i) {
+      const PairView& pair = state_.pairs[i];
+      if (!pair.cloud) continue;
+      clouds.push_back(pair.cloud);
+      if (!pair.brush_from_seed && !pair.brush_edited) detect.push_back(static_cast<int>(i));
+    }
+  }
+  background_.reset();
+  if (!detect.empty() && pipeline_.background_model) {
+    SceneBackground background;
+    for (const auto& cloud : clouds) background.Add(*cloud);
+    std::string why;
+    if (background.Finish(&why)) {
+      background_ = std::move(background);
+    } else {
+      std::lock_guard<std::mutex> lock(mutex_);
+      SetStatus("board detection without a background model: " + why, false);
+    }
+  }
+  for (int index : detect) RefitLidar(index);
+  // Loading is over: what its transient buffers took goes back (core/base/allocator.h).
+  ReleaseFreedMemory();
+}
+
+void Controller::RefitLidar(int index) {
+  std::shared_ptr<const LidarCloud> cloud;
+  std::shared_ptr<const LidarImage> image;
+  std::vector<int> brush;
+  bool brush_from_seed = false;
+  bool brush_edited = false;
+  Dataset dataset;
+  std::optional<LidarSeed> seed;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    dataset = *state_.dataset;
+    seed = dataset.pairs[index].lidar_seed;
+    cloud = state_.pairs[index].cloud;
+    image = state_.pairs[index].lidar_image;
+    brush = state_.pairs[index].brush_pixels;
+    brush_from_seed = state_.pairs[index].brush_from_seed;
+    brush_edited = state_.pairs[index].brush_edited;
+  }
+  if (!cloud || !image) return;
+  // The same choice of region as `calibench calibrate`: the seed itself while the brush only
+  // pictures it; once painted (or erased), the brush.
+  BoardHint hint;
+  hint.image = image.get();
+  // Seed, else the user's brush (an erased one means "no board here"), else detection.
+  if (brush_from_seed)
+    hint.seed = seed;
+  else if (brush_edited)
+    hint.brush_pixels = &brush;
+  hint.detect = !brush_edited;
+  hint.background = background_ ? &*background_ : nullptr;  // written on this thread only
+  std::string why;
+  BoardOrigin origin;
+  const std::optional<LidarPlaneFit> fit =
+      ExtractLidarFeatures(dataset, *cloud, hint, pipeline_, &why, &origin);
+  std::lock_guard<std::mutex> lock(mutex_);
+  PairView& pair = state_.pairs[index];
+  if (pair.brush_pixels != brush) return;  // a newer stroke queued its own refit
+  pair.lidar = fit;
+  pair.lidar_failure = fit ? "" : why;
+  pair.board_origin = origin;
+  // A detected board shows as the brush (in its own colour) until the user edits it.
+  if (origin.source == BoardSource::kDetected) {
+    pair.brush_pixels.clear();
+    if (fit)
+      for (int i : fit->inliers)
+        if (pair.lidar_image->pixel_of_point[i] >= 0)
+          pair.brush_pixels.push_back(pair.lidar_image->pixel_of_point[i]);
+    std::sort(pair.brush_pixels.begin(), pair.brush_pixels.end());
+    pair.brush_detected = true;
+  }
+  // A pair with both planes is usable and accepted unless the user rejected it; one that lost a
+  // plane fails with the reason.
+  if (pair.status != PairStatus::kRejected) {
+    PairFeatures features = FeaturesOf(pair);
+    SetStatusFromFeatures(&features, pair.lidar_failure, pair.camera_failure);
+    pair.status = features.status;
+    pair.reason = features.reason;
+  }
+  ++state_.generation;
+  if (state_.loading_done == state_.loading_total) {
+    RecomputeResiduals();
+    CommitEdit();
+  }
+}
+
+template <>
+void Controller::Handle(const BrushStroke& stroke) {
+  if (!ValidPair(stroke.index) || !state_.pairs[stroke.index].lidar_image) return;
+  const LidarImage& image = *state_.pairs[stroke.index].lidar_image;
+  Paint(stroke.index,
+        CirclePixels(image.rows, image.columns, stroke.row, stroke.column, stroke.radius_px),
+        stroke.erase);
+}
+
+template <>
+void Controller::Handle(const ClearBrush& clear) {
+  if (!ValidPair(clear.index)) return;
+  state_.pairs[clear.index].brush_pixels.clear();
+  state_.pairs[clear.index].brush_from_seed = false;
+  state_.pairs[clear.index].brush_edited = true;
+  state_.pairs[clear.index].brush_detected = false;
+  CommitEdit();
+  const int index = clear.index;
+  worker_.Enqueue([this, index] { RefitLidar(index); });
+}
+
+template <>
+void Controller::Handle(const EndStroke&) {
+  stroke_open_ = false;
+}
+
+template <>
+void Controller::Handle(const DetectBoardAgain& again) {
+  if (!again.all && !ValidPair(again.index)) return;
+  for (size_t i = 0; i < state_.pairs.size(); ++i) {
+    if (!again.all && static_cast<int>(i) != again.index) continue;
+    PairView& pair = state_.pairs[i];
+    if (!pair.lidar_image) continue;
+    pair.brush_pixels.clear();
+    pair.brush_from_seed = false;
+    pair.brush_edited = false;
+    pair.brush_detected = false;
+    const int index = static_cast<int>(i);
+    worker_.Enqueue([this, index] { RefitLidar(index); });
+  }
+  CommitEdit();
+}
+
+template <>
+void Controller::Handle(const PaintPoints& paint) {
+  if (ValidPair(paint.index)) Paint(paint.index, paint.pixels, paint.erase);
+}
+
+void Controller::Paint(int index, const std::vector<int>& pixels, bool erase) {
+  PairView& pair = state_.pairs[index];
+  std::vector<int> merged;
+  if (erase)
+    std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), pixels.begin(),
+                        pixels.end(), std::back_inserter(merged));
+  else
+    std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), pixels.begin(), pixels.end(),
+                   std::back_inserter(merged));
+  if (merged == pair.brush_pixels) return;
+  pair.brush_pixels = std::move(merged);
+  pair.brush_from_seed = false;  // painted: the brush replaces the seed from now on
+  pair.brush_edited = true;
+  pair.brush_detected = false;
+  CommitEdit();
+  stroke_open_ = true;  // the stroke's later dabs amend this undo step
+  worker_.Enqueue([this, index] { RefitLidar(index); });
+}
+
+}  // namespace calibench::ui

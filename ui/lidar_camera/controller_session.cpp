@@ -1,0 +1,322 @@
+// The controller's session lifecycle: opening a dataset or a session (lock, backup, resume),
+// the session mirrored into the view state, committing edits to the undo history, autosave,
+// save-as, undo and redo.
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+
+#include "core/base/allocator.h"
+#include "core/base/atomic_file.h"
+#include "core/io/cloud_io.h"
+#include "core/io/image_io.h"
+#include "core/lidar_camera/result_io.h"
+#include "ui/lidar_camera/controller.h"
+
+namespace calibench::ui {
+
+namespace {
+
+// Moves `path` aside to `<path>.<YYYYmmdd-HHMMSS>.bak` (a new name each time) and returns it.
+std::filesystem::path BackUpSession(const std::filesystem::path& path) {
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", std::localtime(&now));
+  std::filesystem::path backup = path.string() + "." + stamp + ".bak";
+  for (int n = 2; std::filesystem::exists(backup); ++n)
+    backup = path.string() + "." + stamp + "-" + std::to_string(n) + ".bak";
+  std::error_code ec;
+  std::filesystem::rename(path, backup, ec);
+  if (ec)
+    throw IoError(path.string() + ": cannot move the session aside to " + backup.string() + " (" +
+                  ec.message() + "); it was left as it is");
+  return backup;
+}
+
+}  // namespace
+
+namespace {
+
+// The session in `path`, checked against the dataset it names. Throws IoError.
+std::pair<Session, Dataset> LoadSessionAndDataset(const std::filesystem::path& session_path) {
+  Session session = LoadSession(session_path);  // throws IoError; never rewrites the file
+  Dataset dataset = LoadDataset(session.dataset);
+  if (session.pairs.size() != dataset.pairs.size())
+    throw IoError(session_path.string() + ": the session has " +
+                  std::to_string(session.pairs.size()) + " pairs but " + dataset.manifest.string() +
+                  " has " + std::to_string(dataset.pairs.size()));
+  for (size_t i = 0; i < dataset.pairs.size(); ++i)
+    if (session.pairs[i].id != dataset.pairs[i].id)
+      throw IoError(session_path.string() + ": pair " + std::to_string(i) + " is '" +
+                    session.pairs[i].id + "' in the session but '" + dataset.pairs[i].id +
+                    "' in the dataset");
+  return {std::move(session), std::move(dataset)};
+}
+
+}  // namespace
+
+void Controller::OpenDataset(const std::filesystem::path& dataset_path,
+                             std::filesystem::path session_path, ExistingSession existing) {
+  const Dataset dataset = LoadDataset(dataset_path);
+  Session session = NewSession(dataset);
+  session.dataset = dataset.manifest;
+  if (existing == ExistingSession::kInMemory) {
+    Open(dataset, std::move(session), {}, "", std::nullopt);
+    return;
+  }
+  if (session_path.empty()) {
+    const auto folder = std::filesystem::is_directory(dataset.manifest)
+                            ? dataset.manifest
+                            : dataset.manifest.parent_path();
+    session_path = folder / "calibench.session.json";
+  }
+  std::string note;
+  std::optional<FileLock> lock = LockSession(session_path, &note);
+  if (existing != ExistingSession::kReplace && std::filesystem::exists(session_path)) {
+    if (existing == ExistingSession::kResume) {
+      try {
+        OpenSessionFile(session_path,
+                        "resumed the session in " + session_path.string() +
+                            " (calibench gui --fresh starts over and keeps it as a backup)",
+                        &lock);
+        return;
+      } catch (const IoError& e) {
+        note = "the session there did not open (" + std::string(e.what()) + "): ";
+      }
+      if (ResumeBackup(session_path, note, &lock)) return;
+    }
+    note += "kept the old session as " + BackUpSession(session_path).string();
+  }
+  Open(dataset, std::move(session), session_path, note, std::move(lock));
+}
+
+void Controller::OpenSession(const std::filesystem::path& session_path, bool save) {
+  if (!save) {
+    auto [session, dataset] = LoadSessionAndDataset(session_path);
+    Open(dataset, std::move(session), {}, "", std::nullopt);
+    return;
+  }
+  std::string note;
+  std::optional<FileLock> lock = LockSession(session_path, &note);
+  OpenSessionFile(session_path, note, &lock);
+}
+
+std::optional<FileLock> Controller::LockSession(const std::filesystem::path& session,
+                                                std::string* note) {
+  std::error_code ec;
+  if (session_lock_ && std::filesystem::weakly_canonical(session_lock_->locked(), ec) ==
+                           std::filesystem::weakly_canonical(session, ec))
+    return std::nullopt;  // this controller has it open already
+  std::string holder;
+  try {
+    std::optional<FileLock> lock = FileLock::TryLock(session, &holder);
+    if (!lock)
+      throw IoError(session.string() + ": the session is open in another Calibench workbench (" +
+                    holder + "); close it there first, or open a copy of the file");
+    return lock;
+  } catch (const IoError& e) {
+    if (!holder.empty()) throw;
+    // No lock file can be made, so no session file either: editing goes on, saving will fail
+    // and say so.
+    *note = std::string("cannot lock the session (") + e.what() + ")";
+    return std::nullopt;
+  }
+}
+
+bool Controller::ResumeBackup(const std::filesystem::path& session_path, const std::string& note,
+                              std::optional<FileLock>* lock) {
+  for (int n = 1; n <= AutosaveOptions{}.backups; ++n) {
+    const std::filesystem::path backup = SessionBackupPath(session_path, n);
+    if (!std::filesystem::exists(backup)) continue;
+    try {
+      auto [session, dataset] = LoadSessionAndDataset(backup);
+      const std::string kept = BackUpSession(session_path).string();
+      Open(dataset, std::move(session), session_path,
+           note + "resumed its newest backup that opens, " + backup.string() +
+               "; the one that did not open is kept as " + kept,
+           std::move(*lock));
+      return true;
+    } catch (const IoError&) {
+      // An older backup, then.
+    }
+  }
+  return false;
+}
+
+void Controller::OpenSessionFile(const std::filesystem::path& session_path, const std::string& note,
+                                 std::optional<FileLock>* lock) {
+  auto [session, dataset] = LoadSessionAndDataset(session_path);
+  Open(dataset, std::move(session), session_path, note, std::move(*lock));
+}
+
+void Controller::Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
+                      const std::string& note, std::optional<FileLock> session_lock) {
+  WaitIdle();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (session_lock)
+      session_lock_ = std::move(session_lock);
+    else if (session_path.empty() || !session_lock_ || session_lock_->locked() != session_path)
+      session_lock_.reset();
+    state_ = Snapshot{};
+    state_.dataset = dataset;
+    state_.dataset_path = dataset.manifest;
+    state_.session_path = session_path;
+    state_.pairs.resize(dataset.pairs.size());
+    for (size_t i = 0; i < dataset.pairs.size(); ++i) state_.pairs[i].id = dataset.pairs[i].id;
+    state_.loading_total = static_cast<int>(dataset.pairs.size());
+    load_warnings_.clear();
+    open_note_ = note;
+    session_ = std::move(session);
+    ApplySessionToState(session_);
+    history_.Reset(session_);
+    autosaver_ = session_path.empty() ? nullptr : std::make_unique<Autosaver>(session_path);
+    SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
+                  dataset.manifest.string(),
+              false);
+  }
+  // The selected pair and its image first, so that it is on screen while the others load.
+  int first = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    first = std::max(0, state_.selected);
+  }
+  if (!dataset.pairs.empty()) {
+    worker_.Enqueue([this, first] { LoadPair(first); });
+    worker_.Enqueue([this] { EnsureSelectedImage(); });
+  }
+  for (int i = 0; i < static_cast<int>(dataset.pairs.size()); ++i)
+    if (i != first) worker_.Enqueue([this, i] { LoadPair(i); });
+}
+
+void Controller::ApplySessionToState(const Session& session) {
+  ApplySessionOptions(session, &pipeline_);
+  state_.view = session.view;
+  state_.method = session.method;
+  state_.huber_delta = session.huber_delta;
+  state_.max_iterations = session.max_iterations;
+  state_.estimate_range_offset = session.estimate_range_offset;
+  for (size_t i = 0; i < session.pairs.size() && i < state_.pairs.size(); ++i) {
+    PairView& pair = state_.pairs[i];
+    pair.status = session.pairs[i].status;
+    pair.reason = session.pairs[i].reason;
+    if (session.pairs[i].brush) pair.brush_pixels = session.pairs[i].brush->pixels;
+    pair.brush_from_seed = session.pairs[i].brush_from_seed;
+    pair.brush_edited = session.pairs[i].brush.has_value() && !pair.brush_from_seed;
+  }
+  state_.selected = -1;
+  for (size_t i = 0; i < state_.pairs.size(); ++i)
+    if (state_.pairs[i].id == session.view.selected_pair) state_.selected = static_cast<int>(i);
+  if (state_.selected < 0 && !state_.pairs.empty()) state_.selected = 0;
+  state_.solver = SolverView{};
+  if (session.result) {
+    state_.solver.result = SolverResultFromSession(*session.result, session.method);
+    // The recorded convergence, so that the solver panel and the replay look as they did.
+    const auto& costs = session.result->cost_history;
+    const auto& steps = session.result->step_history;
+    const auto& estimates = session.result->estimate_history;
+    if (steps.size() == costs.size() && estimates.size() == costs.size())
+      for (size_t i = 0; i < costs.size(); ++i)
+        state_.solver.iterations.push_back({static_cast<int>(i), costs[i], steps[i], estimates[i]});
+    for (int k : session.result->reweighted_iterations)
+      if (k >= 0 && k < static_cast<int>(state_.solver.iterations.size()))
+        state_.solver.iterations[k].reweighted = true;
+  }
+  state_.can_undo = history_.CanUndo();
+  state_.can_redo = history_.CanRedo();
+  ++state_.generation;
+}
+
+void Controller::CommitEdit() {
+  const bool had_selected =
+      state_.selected >= 0 && state_.selected < static_cast<int>(state_.pairs.size());
+  state_.view.selected_pair = had_selected ? state_.pairs[state_.selected].id : "";
+  session_.view = state_.view;
+  session_.method = state_.method;
+  session_.huber_delta = state_.huber_delta;
+  session_.max_iterations = state_.max_iterations;
+  session_.estimate_range_offset = state_.estimate_range_offset;
+  for (size_t i = 0; i < state_.pairs.size(); ++i) {
+    PairState& p = session_.pairs[i];
+    const PairView& v = state_.pairs[i];
+    p.status = v.status;
+    p.reason = v.reason;
+    // No brush for a pair left to detection: reopened (or calibrated with --session) it is
+    // detected again, while an erased brush stays erased.
+    if (v.lidar_image && (v.brush_edited || v.brush_from_seed)) {
+      BrushMask mask{v.lidar_image->rows, v.lidar_image->columns, v.brush_pixels};
+      p.brush = mask;
+      p.brush_from_seed = v.brush_from_seed;
+    } else if (v.lidar_image) {
+      p.brush.reset();
+      p.brush_from_seed = false;
+    }
+  }
+  session_.result.reset();
+  if (state_.solver.result) {
+    session_.result = SessionResultFromSolver(*state_.solver.result);
+    for (const IterationReport& it : state_.solver.iterations) {
+      session_.result->step_history.push_back(it.step_norm);
+      session_.result->estimate_history.push_back(it.cam_from_lidar);
+      if (it.reweighted) session_.result->reweighted_iterations.push_back(it.iteration);
+    }
+  }
+  if (stroke_open_)
+    history_.Amend(session_);
+  else
+    history_.Push(session_);
+  state_.can_undo = history_.CanUndo();
+  state_.can_redo = history_.CanRedo();
+  Autosave();
+  ++state_.generation;
+}
+
+void Controller::Autosave() {
+  try {
+    if (autosaver_) autosaver_->Save(session_);
+    state_.save_error.clear();
+  } catch (const IoError& e) {
+    state_.save_error = e.what();
+    SetStatus(std::string("autosave failed: ") + e.what(), true);
+  }
+}
+
+template <>
+void Controller::Handle(const SaveSessionAs& save) {
+  const std::filesystem::path path = NextToSession(save.path);
+  try {
+    std::string note;
+    std::optional<FileLock> lock = LockSession(path, &note);  // throws when another has it open
+    SaveSession(path, session_);
+    if (lock) session_lock_ = std::move(lock);
+    autosaver_ = std::make_unique<Autosaver>(path);
+    state_.session_path = path;
+    state_.save_error.clear();
+    SetStatus("saved session " + path.string(), false);
+  } catch (const IoError& e) {
+    state_.save_error = e.what();
+    SetStatus(e.what(), true);
+  }
+}
+
+template <>
+void Controller::Handle(const Undo&) {
+  Restore(history_.Undo());
+}
+template <>
+void Controller::Handle(const Redo&) {
+  Restore(history_.Redo());
+}
+
+void Controller::Restore(const std::optional<Session>& restored) {
+  if (!restored) return;
+  std::vector<std::vector<int>> before;
+  for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
+  session_ = *restored;
+  ApplySessionToState(session_);
+  RecomputeResiduals();
+  Autosave();
+  for (int i = 0; i < static_cast<int>(state_.pairs.size()); ++i)
+    if (state_.pairs[i].brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });
+}
+
+}  // namespace calibench::ui
