@@ -26,6 +26,9 @@ constexpr Command kCommands[] = {
     {"advise", calibench::app::RunAdvise,
      "is the capture enough for the goal (σ per axis, stop rule), and where to hold the board "
      "next"},
+    {"watch", calibench::app::RunWatch,
+     "follow a capture while it is written (a growing folder): per pair, accept/reject, σ against "
+     "the goal, the next pose"},
     {"evaluate", calibench::app::RunEvaluate,
      "score a result against a dataset's ground truth (--subsets: is the reported σ honest?)"},
     {"simulate", calibench::app::RunSimulate, "write a synthetic dataset with ground truth"},

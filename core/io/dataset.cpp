@@ -81,18 +81,7 @@ Dataset LoadManifest(const fs::path& manifest) {
 
 // Folder shorthand: clouds/ and images/ paired by file stem, camera.yaml, target.json.
 Dataset LoadFolder(const fs::path& dir) {
-  Dataset dataset;
-  dataset.manifest = dir;
-  const fs::path camera_file = dir / "camera.yaml";
-  const fs::path target_file = dir / "target.json";
-  if (!fs::exists(camera_file))
-    Fail(dir, "folder dataset has no camera.yaml (and no dataset.json)");
-  if (!fs::exists(target_file))
-    Fail(dir, "folder dataset has no target.json (and no dataset.json)");
-  dataset.camera = LoadCameraFile(camera_file);
-  const json target_document = json_io::ReadJson(target_file);
-  const json_io::Fields target(target_document, target_file);
-  dataset.target = json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
+  Dataset dataset = LoadFolderSetup(dir);
   auto list = [&](const char* sub) {
     std::map<std::string, fs::path, NaturalOrder> by_stem;  // pose2 before pose10
     if (!fs::is_directory(dir / sub)) Fail(dir, std::string("folder dataset has no ") + sub + "/");
@@ -117,6 +106,22 @@ Dataset LoadFolder(const fs::path& dir) {
 }
 
 }  // namespace
+
+Dataset LoadFolderSetup(const fs::path& dir) {
+  Dataset dataset;
+  dataset.manifest = dir;
+  const fs::path camera_file = dir / "camera.yaml";
+  const fs::path target_file = dir / "target.json";
+  if (!fs::exists(camera_file))
+    Fail(dir, "folder dataset has no camera.yaml (and no dataset.json)");
+  if (!fs::exists(target_file))
+    Fail(dir, "folder dataset has no target.json (and no dataset.json)");
+  dataset.camera = LoadCameraFile(camera_file);
+  const json target_document = json_io::ReadJson(target_file);
+  const json_io::Fields target(target_document, target_file);
+  dataset.target = json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
+  return dataset;
+}
 
 Dataset LoadDataset(const fs::path& path) {
   const DatasetSource source = ResolveDataset(path, DatasetKind::kLidarCamera);

@@ -52,6 +52,10 @@ struct Dataset {
 // file and the problem; validates the camera and the target.
 Dataset LoadDataset(const std::filesystem::path& path);
 
+// The folder form's camera (camera.yaml) and target (target.json) without its pairs: a capture
+// that has not written any yet (`calibench watch`). Throws IoError like LoadDataset.
+Dataset LoadFolderSetup(const std::filesystem::path& dir);
+
 // Writes a manifest; paths are written relative to the manifest's folder when they lie under it.
 void SaveDataset(const std::filesystem::path& manifest_path, const Dataset& dataset);
 

@@ -15,6 +15,7 @@
 #include "core/lrf/depth_planes.h"
 #include "core/lrf/scan_lines.h"
 #include "core/lrf/solver.h"
+#include "core/session/capture_job.h"
 #include "core/sim/lrf_sim.h"
 #include "core/sim/sim.h"
 #include "core/target/board_camera.h"
@@ -226,6 +227,33 @@ void BM_CalibrateReal40Pairs2Threads(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(CalibrateDataset(dataset, options));
 }
 BENCHMARK(BM_CalibrateReal40Pairs2Threads)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+// `watch`'s step for one new pair (core/session/capture_job.h): the real ACFR capture's first
+// state.range(0) - 1 pairs already in the job, then the next pair read, detected, solved with the
+// others from the last solution, checked and advised. The job is copied outside the timing.
+void BM_WatchIncrementalStep(benchmark::State& state) {
+  const auto acfr = AcfrDir();
+  if (!acfr) {
+    state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
+    return;
+  }
+  const fs::path folder = test::WriteAcfrFolder(*acfr, BenchDir("watch_step"));
+  Dataset all = LoadDataset(folder);
+  const int before = static_cast<int>(state.range(0)) - 1;
+  Dataset setup = all;
+  setup.pairs.assign(all.pairs.begin(), all.pairs.begin() + before);
+  CaptureJob prepared(setup, CaptureJobOptions{});
+  prepared.Solve();
+  for (auto _ : state) {
+    state.PauseTiming();
+    CaptureJob job = prepared;
+    state.ResumeTiming();
+    job.AddPair(all.pairs[before]);
+    benchmark::DoNotOptimize(job.Solve());
+  }
+  state.SetLabel("pair " + std::to_string(before + 1) + " of a real VLP-16 + 1920x1208 capture");
+}
+BENCHMARK(BM_WatchIncrementalStep)->Arg(10)->Arg(40)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 // One simulated three-face observation (R2000 scan, 1280x720 ZED-like depth).
 const LrfSimObservation& LrfObservationForBench() {

@@ -1,0 +1,257 @@
+// `calibench watch`: follows a capture while it is written (a folder in the folder form that a
+// capture script fills), pair by pair: detect, pre-flight, accept or reject, solve again, σ
+// against the goal, the next pose (core/session/capture_job.h over core/io/folder_watch.h).
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "app/commands.h"
+#include "app/pipeline_flags.h"
+#include "core/guidance/stop_rule.h"
+#include "core/io/folder_watch.h"
+#include "core/session/capture_job.h"
+#include "core/session/feature_cache.h"
+#include "core/session/session.h"
+
+namespace calibench::app {
+namespace {
+namespace fs = std::filesystem;
+
+double SteadySeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+double UnixSeconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+// Where the stream goes: one JSON object per line, or one line for people per event.
+class EventStream {
+ public:
+  explicit EventStream(bool json_lines) : json_lines_(json_lines) {}
+
+  void Emit(nlohmann::json event, const std::string& human) {
+    if (json_lines_) {
+      event["time"] = UnixSeconds();
+      std::printf("%s\n",
+                  event.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+    } else {
+      std::printf("%s\n", human.c_str());
+    }
+    std::fflush(stdout);
+  }
+  void Note(const std::string& kind, const std::string& name, const std::string& reason) {
+    Emit({{"event", kind}, {"name", name}, {"reason", reason}},
+         kind + (name.empty() ? "" : " " + name) + ": " + reason);
+  }
+
+ private:
+  bool json_lines_;
+};
+
+// The advice's first line (σ against the goal) and the next pose in words.
+std::string HumanProgress(const CaptureAdvice& advice) {
+  std::string line;
+  if (advice.state) {
+    line = DescribeCaptureState(*advice.state, advice.goal);
+  } else {
+    line = std::to_string(advice.pairs_used) + " pairs accepted: no calibration yet";
+  }
+  if (advice.next) line += "; next: " + advice.next->words;
+  return line;
+}
+
+struct WatchFlags {
+  std::string source;
+  std::string session;
+  bool json_lines = false;
+  bool exit_when_done = false;
+  double idle_exit_s = 0.0;
+  double poll_s = 0.1;
+  FolderWatchOptions folder;
+};
+
+// Waits for the folder's camera.yaml and target.json (a capture script may write them after
+// starting); nullopt when --idle-exit passes first.
+std::optional<Dataset> WaitForSetup(const WatchFlags& flags, EventStream& stream) {
+  const fs::path folder(flags.source);
+  const double start = SteadySeconds();
+  bool said = false;
+  for (;;) {
+    std::error_code error;
+    if (fs::exists(folder / "camera.yaml", error) && fs::exists(folder / "target.json", error))
+      return LoadFolderSetup(fs::absolute(folder));
+    if (!said) {
+      stream.Note("waiting", "", "waiting for camera.yaml and target.json in " + folder.string());
+      said = true;
+    }
+    if (flags.idle_exit_s > 0 && SteadySeconds() - start >= flags.idle_exit_s) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::duration<double>(flags.poll_s));
+  }
+}
+
+}  // namespace
+
+int RunWatch(int argc, char** argv) {
+  CLI::App app{
+      "Follow a capture while it is written: a folder in the folder form (clouds/, images/, "
+      "camera.yaml, target.json) that grows pair by pair. Each new pair is detected, checked, "
+      "accepted or rejected with the reason, and everything so far is solved again: σ against "
+      "the goal and where to hold the board next, per pair.",
+      "calibench watch"};
+  WatchFlags flags;
+  CaptureJobOptions options;
+  app.add_option("source", flags.source, "the folder the capture writes")->required();
+  app.add_option("--goal-mm", options.advise.goal.translation_mm,
+                 "goal: 1σ of the translation per axis [mm]")
+      ->capture_default_str();
+  app.add_option("--goal-deg", options.advise.goal.rotation_deg,
+                 "goal: 1σ of the rotation per axis [deg]")
+      ->capture_default_str();
+  app.add_flag("--json-lines", flags.json_lines,
+               "one JSON object per line: {\"event\": \"pair\", ...} per pair, {\"event\": "
+               "\"solve\", ...advise --json's fields} per solve");
+  app.add_flag("--exit-when-done", flags.exit_when_done, "end when the stop rule says done");
+  app.add_option("--idle-exit", flags.idle_exit_s,
+                 "end after this many seconds without new data [s] (0 = never)")
+      ->capture_default_str();
+  app.add_option("--session", flags.session,
+                 "the session file kept up to date (default: SOURCE/calibench.session.json)");
+  app.add_option("--settle", flags.folder.settle_s,
+                 "a file is written when its size and time have not changed for this long [s]")
+      ->capture_default_str();
+  app.add_option("--partner-timeout", flags.folder.partner_timeout_s,
+                 "report a cloud without its image (or the reverse) after this long [s]")
+      ->capture_default_str();
+  PipelineFlags pipeline;
+  AddPipelineFlags(app, pipeline, /*with_selection=*/false);
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
+  std::string why;
+  if (!FinalizePipelineFlags(pipeline, &why) || !flags.folder.Check(&why) ||
+      !(flags.idle_exit_s >= 0)) {
+    if (why.empty()) why = "--idle-exit must be >= 0 (seconds)";
+    std::fprintf(stderr, "calibench watch: %s\n", why.c_str());
+    return kUsage;
+  }
+  options.advise.pipeline = pipeline.options;
+  if (!options.Check(&why)) {
+    std::fprintf(stderr, "calibench watch: %s\n", why.c_str());
+    return kUsage;
+  }
+  std::error_code error;
+  if (!fs::is_directory(flags.source, error)) {
+    std::fprintf(stderr,
+                 "calibench watch: %s is not a folder (watch follows a folder in the folder "
+                 "form: clouds/, images/, camera.yaml, target.json)\n",
+                 flags.source.c_str());
+    return kInputError;
+  }
+  EventStream stream(flags.json_lines);
+  std::optional<Dataset> setup = WaitForSetup(flags, stream);
+  if (!setup) {
+    stream.Note("end", "", "no camera.yaml and target.json within --idle-exit");
+    return kInputError;
+  }
+  const fs::path session_path = flags.session.empty()
+                                    ? fs::path(flags.source) / "calibench.session.json"
+                                    : fs::path(flags.session);
+  Autosaver autosaver(session_path);
+  // The features of pairs an earlier watch of this capture detected: not detected again.
+  int cache_skipped = 0;
+  const std::map<std::string, CachedPair> cache =
+      LoadFeatureCache(FeatureCachePath(session_path), &cache_skipped);
+  FeatureCacheWriter cache_writer(FeatureCachePath(session_path));
+  std::map<std::string, std::string> cached_state;  // what the cache last says, by pair
+  auto state_of = [](const PairFeatures& f) {
+    return PairStatusName(f.status) + (f.lidar ? "+lidar" : "") + (f.camera ? "+camera" : "") +
+           ":" + f.reason;
+  };
+  int resumed = 0;
+  CaptureJob job(std::move(*setup), options);
+  GrowingFolder folder(fs::absolute(flags.source), flags.folder);
+  double last_activity = SteadySeconds();
+  std::map<std::string, std::pair<bool, std::string>> reported;  // verdicts said, by pair
+  for (;;) {
+    const double now = SteadySeconds();
+    std::vector<std::string> added;
+    for (const FolderEvent& event : folder.Poll(now)) {
+      last_activity = now;
+      if (event.kind == FolderEvent::Kind::kPairComplete) {
+        const auto hit = cache.find(event.stem);
+        if (hit != cache.end() && hit->second.entry.cloud == event.pair.cloud &&
+            hit->second.entry.image == event.pair.image) {
+          job.AddPair(event.pair, &hit->second.features);
+          cached_state[event.stem] = state_of(hit->second.features);
+          ++resumed;
+        } else {
+          job.AddPair(event.pair);
+        }
+        added.push_back(event.stem);
+      } else {
+        stream.Note(event.kind == FolderEvent::Kind::kIncomplete ? "incomplete" : "removed",
+                    event.stem, event.reason);
+      }
+    }
+    if (!added.empty()) {
+      if (resumed > 0) {
+        stream.Note("resumed", "",
+                    std::to_string(resumed) + " pairs taken from " +
+                        FeatureCachePath(session_path).string() + ", not detected again" +
+                        (cache_skipped ? " (" + std::to_string(cache_skipped) +
+                                             " stale or cut-short lines ignored)"
+                                       : ""));
+        resumed = 0;
+      }
+      const CaptureAdvice& advice = job.Solve();
+      // New pairs, and pairs the solve's completion changed, go to the cache.
+      for (size_t i = 0; i < job.pairs().size(); ++i) {
+        const PairFeatures& features = job.pairs()[i];
+        std::string& said = cached_state[features.id];
+        if (said == state_of(features)) continue;
+        try {
+          cache_writer.Append(job.dataset().pairs[i], features);
+          said = state_of(features);
+        } catch (const IoError& e) {
+          stream.Note("error", features.id, std::string("feature cache: ") + e.what());
+        }
+      }
+      // The new pairs, and every earlier pair whose verdict this solve changed (a board found
+      // later at the camera's prediction, a pair a better solution disagrees with).
+      for (const PairAdvice& pair : advice.pairs) {
+        const bool accepted = pair.status == PairStatus::kAccepted;
+        const std::string reason = accepted ? "" : pair.reason;
+        const auto before = reported.find(pair.id);
+        if (before != reported.end() && before->second == std::make_pair(accepted, reason))
+          continue;
+        reported[pair.id] = {accepted, reason};
+        stream.Emit(
+            {{"event", "pair"}, {"name", pair.id}, {"accepted", accepted}, {"reason", reason}},
+            pair.id + ": " + (accepted ? "accepted" : PairStatusName(pair.status) + ": " + reason));
+      }
+      nlohmann::json solve = nlohmann::json::parse(CaptureAdviceJson(advice));
+      solve["event"] = "solve";
+      solve["latency_s"] = SteadySeconds() - now;  // from the look that saw the pairs complete
+      stream.Emit(solve, HumanProgress(advice));
+      try {
+        autosaver.Save(job.ToSession(fs::absolute(flags.source)));
+      } catch (const IoError& e) {
+        stream.Note("error", "", std::string("session not saved: ") + e.what());
+      }
+      if (flags.exit_when_done && advice.state && advice.state->done) {
+        stream.Note("end", "", "done: the goal is met with a σ that can be trusted");
+        return kOk;
+      }
+    }
+    if (flags.idle_exit_s > 0 && SteadySeconds() - last_activity >= flags.idle_exit_s) {
+      stream.Note("end", "",
+                  "no new data for " + std::to_string(static_cast<int>(flags.idle_exit_s)) + " s");
+      return kOk;
+    }
+    std::this_thread::sleep_for(std::chrono::duration<double>(flags.poll_s));
+  }
+}
+
+}  // namespace calibench::app

@@ -1,0 +1,64 @@
+// The feature cache of `watch`: features read back are the features written, a line cut short by
+// a kill is ignored, and a pair whose file changed is detected again.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "core/session/feature_cache.h"
+#include "core/sim/sim.h"
+#include "tests/test_support.h"
+
+namespace calibench {
+namespace {
+namespace fs = std::filesystem;
+
+TEST(FeatureCache, ReadsBackWhatItWroteAndDropsWhatNoLongerHolds) {
+  const fs::path dir = test::TempDir("feature_cache");
+  SimOptions sim = SimPreset("default");
+  sim.num_pairs = 3;
+  const Dataset dataset = SimulateDataset(sim, dir / "sim");
+  const fs::path cache = FeatureCachePath(dir / "calibench.session.json");
+  EXPECT_EQ(cache, dir / "calibench.session.features.jsonl");
+  FeatureCacheWriter writer(cache);
+  std::vector<PairFeatures> written;
+  for (const PairEntry& pair : dataset.pairs) {
+    written.push_back(ExtractPairFeatures(dataset, pair, PipelineOptions{}));
+    ASSERT_TRUE(written.back().lidar && written.back().camera) << written.back().reason;
+    writer.Append(pair, written.back());
+  }
+  // A later line of a pair replaces its earlier one.
+  PairFeatures failed = written[2];
+  failed.status = PairStatus::kFailed;
+  failed.reason = "LiDAR board disagrees with the camera's";
+  writer.Append(dataset.pairs[2], failed);
+  // A line cut short by a kill.
+  std::ofstream(cache, std::ios::app) << R"({"format": "calibench.features.v1", "id": "00)";
+
+  int skipped = -1;
+  auto read = LoadFeatureCache(cache, &skipped);
+  EXPECT_EQ(skipped, 1);
+  ASSERT_EQ(read.size(), 3u);
+  const PairFeatures& back = read.at(dataset.pairs[0].id).features;
+  EXPECT_EQ(read.at(dataset.pairs[0].id).entry.cloud, dataset.pairs[0].cloud);
+  EXPECT_EQ(back.status, written[0].status);
+  EXPECT_EQ(back.lidar->plane.Coefficients(), written[0].lidar->plane.Coefficients());
+  EXPECT_EQ(back.lidar->covariance, written[0].lidar->covariance);
+  EXPECT_EQ(back.lidar->inliers, written[0].lidar->inliers);
+  EXPECT_EQ(back.lidar->edge_points.size(), written[0].lidar->edge_points.size());
+  EXPECT_EQ(back.camera->cam_from_board.matrix(), written[0].camera->cam_from_board.matrix());
+  EXPECT_EQ(back.camera->pose_covariance, written[0].camera->pose_covariance);
+  EXPECT_EQ(back.board_origin.source, written[0].board_origin.source);
+  EXPECT_EQ(read.at(dataset.pairs[2].id).features.status, PairStatus::kFailed);
+  EXPECT_EQ(read.at(dataset.pairs[2].id).features.reason, failed.reason);
+
+  // Pair 1's image rewritten: its lines no longer hold.
+  const std::string image = test::ReadFileBytes(dataset.pairs[1].image);
+  std::ofstream(dataset.pairs[1].image, std::ios::binary) << image << " ";
+  read = LoadFeatureCache(cache, &skipped);
+  EXPECT_EQ(read.count(dataset.pairs[1].id), 0u);
+  EXPECT_EQ(skipped, 2);
+  EXPECT_TRUE(LoadFeatureCache(dir / "none.jsonl").empty());
+}
+
+}  // namespace
+}  // namespace calibench
