@@ -163,7 +163,7 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
                                  LidarCloud* preloaded_cloud = nullptr);
 
 // The background model over the selected pairs' clouds (for detection); nullopt with *why when it
-// cannot be built (fewer than 3 readable clouds, or the sensor moved between pairs). `clouds`
+// cannot be built (fewer than 3 readable clouds, or they repeat no static scene). `clouds`
 // (optional) receives the clouds it read, per pair (nullopt where unreadable), so that the
 // extraction does not read them again.
 std::optional<SceneBackground> BuildSceneBackground(

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_set>
 
 #include "core/base/text.h"
 #include "core/base/types.h"
@@ -38,7 +39,12 @@ void SceneBackground::Add(const LidarCloud& cloud) {
     auto [it, fresh] = nearest.try_emplace(key, p.norm());
     if (!fresh) it->second = std::min(it->second, p.norm());
   }
-  for (const auto& [key, range] : nearest) ranges_[key].push_back(range);
+  std::unordered_set<std::int64_t> azimuths;
+  for (const auto& [key, range] : nearest) {
+    ranges_[key].push_back(range);
+    azimuths.insert(key % 1000000);
+  }
+  azimuth_span_deg_.push_back(static_cast<double>(azimuths.size()) * cell_rad_ * kRadToDeg);
   ++clouds_;
   usable_ = false;
 }
@@ -62,10 +68,24 @@ bool SceneBackground::Finish(std::string* why) {
   }
   // A static sensor sees the same room in every cloud; most returns then sit on their medians.
   if (total == 0 || agree < total / 2) {
-    *why = Printf(
-        "the clouds do not share a static scene (%.0f%% of returns repeat): the sensor "
-        "moved between pairs, so no background model",
-        total ? 100.0 * agree / total : 0.0);
+    // Say what was seen. Clouds that each cover a narrow azimuth are segments (the board cropped
+    // out of the scan): there is no scene in them to learn. Full scans that do not repeat come
+    // from a sensor that moved, or a scene that changed: which of the two is not known here.
+    std::vector<double> spans = azimuth_span_deg_;
+    std::nth_element(spans.begin(), spans.begin() + spans.size() / 2, spans.end());
+    const double median_span = spans[spans.size() / 2];
+    const double repeat = total ? 100.0 * agree / total : 0.0;
+    if (median_span < kSegmentSpanDeg) {
+      *why = Printf(
+          "the clouds hold segments, not scans (each covers about %.0f deg of azimuth, median): "
+          "no static scene to learn, so no background model",
+          median_span);
+    } else {
+      *why = Printf(
+          "the clouds do not share a static scene (%.0f%% of returns repeat from cloud to "
+          "cloud): the sensor moved or the scene changed between pairs, so no background model",
+          repeat);
+    }
     median_.clear();
     return false;
   }

@@ -19,7 +19,8 @@ class SceneBackground {
   explicit SceneBackground(double cell_deg = 0.5, double tolerance_m = 0.05);
   void Add(const LidarCloud& cloud);
   // Computes the medians; false with *why when fewer than 3 clouds were added or the scene does
-  // not repeat (the sensor moved between pairs), after which IsStatic answers false.
+  // not repeat, saying what was seen (segments rather than scans, or scans that differ), after
+  // which IsStatic answers false.
   bool Finish(std::string* why);
   bool usable() const { return usable_; }
   int clouds() const { return clouds_; }
@@ -35,6 +36,11 @@ class SceneBackground {
   bool usable_ = false;
   std::unordered_map<std::int64_t, std::vector<float>> ranges_;  // per cell, nearest per cloud
   std::unordered_map<std::int64_t, float> median_;
+  std::vector<double> azimuth_span_deg_;  // per cloud: the azimuth its returns cover
 };
+
+// Clouds whose returns cover less azimuth than this (median) are segments, not scans: a board
+// cropped out of a spinning LiDAR's 360° or a scanner's 100°+ field.
+inline constexpr double kSegmentSpanDeg = 60.0;
 
 }  // namespace calibench

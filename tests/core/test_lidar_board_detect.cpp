@@ -96,6 +96,32 @@ void DetectAllAcfr(bool ringless) {
   EXPECT_EQ(wrong, 0);
 }
 
+// Why there is no background model, in what was seen: the authors' board-only segments of the
+// real scans are segments; the full scans turned by a different yaw each (a sensor that moved)
+// are scans that do not repeat.
+TEST(SceneBackground, SaysSegmentsForBoardOnlyCloudsAndNonRepeatingScansForAMovedSensor) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  const auto dir = shared / "datasets/acfr-vlp16-chessboard/pcd";
+  SceneBackground segments, moved;
+  for (int n = 1; n <= 8; ++n) {
+    segments.Add(LoadCloud(dir / ("pose" + std::to_string(n) + "_target.pcd")));
+    LidarCloud scan = LoadCloud(dir / ("pose" + std::to_string(n) + "_full.pcd"));
+    const Eigen::Matrix3f turn =
+        Eigen::AngleAxisf(static_cast<float>(n * 37 * kDegToRad), Eigen::Vector3f::UnitZ())
+            .toRotationMatrix();
+    const Eigen::Vector3f shift(0.4f * n, -0.3f * n, 0.0f);
+    for (Eigen::Vector3f& p : scan.points) p = turn * p + shift;
+    moved.Add(scan);
+  }
+  std::string why;
+  EXPECT_FALSE(segments.Finish(&why));
+  EXPECT_NE(why.find("the clouds hold segments, not scans"), std::string::npos) << why;
+  EXPECT_EQ(why.find("moved"), std::string::npos) << why;
+  EXPECT_FALSE(moved.Finish(&why));
+  EXPECT_NE(why.find("do not share a static scene"), std::string::npos) << why;
+  EXPECT_NE(why.find("the sensor moved or the scene changed"), std::string::npos) << why;
+}
+
 TEST(LidarBoardDetect, FindsTheBoardInTheRealVlp16Scans) { DetectAllAcfr(false); }
 TEST(LidarBoardDetect, FindsTheBoardInRinglessCopiesOfThem) { DetectAllAcfr(true); }
 
