@@ -12,6 +12,7 @@
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "core/guidance/stop_rule.h"
+#include "core/io/dataset_source.h"
 #include "core/io/folder_watch.h"
 #include "core/session/capture_job.h"
 #include "core/session/feature_cache.h"
@@ -66,6 +67,7 @@ std::string HumanProgress(const CaptureAdvice& advice) {
 
 struct WatchFlags {
   std::string source;
+  fs::path manifest;  // a manifest given instead of its folder
   std::string session;
   bool json_lines = false;
   bool exit_when_done = false;
@@ -74,18 +76,35 @@ struct WatchFlags {
   FolderWatchOptions folder;
 };
 
-// Waits for the folder's camera.yaml and target.json (a capture script may write them after
-// starting); nullopt when --idle-exit passes first.
-std::optional<Dataset> WaitForSetup(const WatchFlags& flags, EventStream& stream) {
-  const fs::path folder(flags.source);
+// The capture's camera and target: the folder form's camera.yaml and target.json, or a
+// LiDAR-camera manifest of any name in the folder (core/io/dataset_source.h; its pairs are the
+// files clouds/ and images/ hold as they come). A capture script may write them after starting:
+// waits, and when --idle-exit passes first, returns nullopt with the resolver's *why (what was
+// looked for). Another kind of dataset is refused at once (IoError naming the command for it).
+std::optional<Dataset> WaitForSetup(const WatchFlags& flags, EventStream& stream,
+                                    std::string* why) {
+  const fs::path folder = fs::absolute(flags.source);
   const double start = SteadySeconds();
   bool said = false;
   for (;;) {
     std::error_code error;
-    if (fs::exists(folder / "camera.yaml", error) && fs::exists(folder / "target.json", error))
-      return LoadFolderSetup(fs::absolute(folder));
+    if (flags.manifest.empty() && fs::exists(folder / "camera.yaml", error) &&
+        fs::exists(folder / "target.json", error))
+      return LoadFolderSetup(folder);
+    const std::optional<DatasetSource> source =
+        flags.manifest.empty() ? RecogniseDataset(folder, why) : std::nullopt;
+    if (!flags.manifest.empty() || (source && !source->folder_form)) {
+      const DatasetSource lidar_camera = ResolveDataset(
+          flags.manifest.empty() ? folder : flags.manifest, DatasetKind::kLidarCamera);
+      Dataset setup = LoadDataset(lidar_camera.path);
+      setup.pairs.clear();
+      setup.manifest = folder;
+      return setup;
+    }
     if (!said) {
-      stream.Note("waiting", "", "waiting for camera.yaml and target.json in " + folder.string());
+      stream.Note(
+          "waiting", "",
+          "waiting for camera.yaml and target.json (or a dataset manifest) in " + folder.string());
       said = true;
     }
     if (flags.idle_exit_s > 0 && SteadySeconds() - start >= flags.idle_exit_s) return std::nullopt;
@@ -104,7 +123,10 @@ int RunWatch(int argc, char** argv) {
       "calibench watch"};
   WatchFlags flags;
   CaptureJobOptions options;
-  app.add_option("source", flags.source, "the folder the capture writes")->required();
+  app.add_option("source", flags.source,
+                 "the folder the capture writes (the folder form, or a folder holding a "
+                 "LiDAR-camera manifest of any name; or that manifest itself)")
+      ->required();
   app.add_option("--goal-mm", options.advise.goal.translation_mm,
                  "goal: 1σ of the translation per axis [mm]")
       ->capture_default_str();
@@ -142,6 +164,10 @@ int RunWatch(int argc, char** argv) {
     return kUsage;
   }
   std::error_code error;
+  if (fs::is_regular_file(flags.source, error)) {  // a manifest, named: its folder is watched
+    flags.manifest = ResolveDataset(flags.source, DatasetKind::kLidarCamera).path;
+    flags.source = fs::absolute(flags.manifest).parent_path().string();
+  }
   if (!fs::is_directory(flags.source, error)) {
     std::fprintf(stderr,
                  "calibench watch: %s is not a folder (watch follows a folder in the folder "
@@ -150,9 +176,11 @@ int RunWatch(int argc, char** argv) {
     return kInputError;
   }
   EventStream stream(flags.json_lines);
-  std::optional<Dataset> setup = WaitForSetup(flags, stream);
+  std::string not_yet;
+  std::optional<Dataset> setup = WaitForSetup(flags, stream, &not_yet);
   if (!setup) {
-    stream.Note("end", "", "no camera.yaml and target.json within --idle-exit");
+    stream.Note("end", "", not_yet);
+    std::fprintf(stderr, "calibench watch: error: %s\n", not_yet.c_str());
     return kInputError;
   }
   const fs::path session_path = flags.session.empty()

@@ -64,6 +64,20 @@ class DatasetResolver : public ::testing::Test {
                   &out),
               0)
         << out;
+    // watch follows the folder (camera and target from the manifest, pairs from its files as
+    // they come); its session goes elsewhere, so that the folder stays as the others found it.
+    ASSERT_EQ(Run("watch " + dataset + " --json-lines --idle-exit 1 --session " +
+                      Path("watch_session.json"),
+                  &out),
+              0)
+        << out;
+    size_t accepted = 0;
+    for (size_t at = out.find("\"accepted\":true"); at != std::string::npos;
+         at = out.find("\"accepted\":true", at + 1))
+      ++accepted;
+    EXPECT_EQ(accepted, 6u) << out;
+    fs::remove(Path("watch_session.json"));
+    fs::remove(Path("watch_session.features.jsonl"));
   }
   static void ExpectLrfOpens(const std::string& dataset) {
     SCOPED_TRACE(dataset);
@@ -147,6 +161,7 @@ TEST_F(DatasetResolver, EveryCommandRefusesAFolderOfNeitherKindAlike) {
       "evaluate --dataset " + neither + " --result " + Path("result.json"),
       "evaluate --subsets --dataset " + neither,
       "render --dataset " + neither + " --out " + Path("never.png"),
+      "watch " + neither + " --idle-exit 1 --session " + Path("never_session.json"),
   };
   for (const std::string& command : commands) {
     SCOPED_TRACE(command);
