@@ -52,6 +52,32 @@ class GuiWindow : public ::testing::Test {
   std::filesystem::path dir_;
 };
 
+// The one resolver (core/io/dataset_source.h) in the workbench: a folder whose manifest has
+// another name opens and shows its pairs; a folder of neither kind gets the same message as every
+// command.
+TEST_F(GuiWindow, OpensAFolderByItsManifestWhateverItsNameAndRefusesAFolderOfNeitherKind) {
+  std::filesystem::rename(dir_ / "data/dataset.json", dir_ / "data/rig_a.json");
+  std::string output;
+  const auto shot = dir_ / "named.png";
+  ASSERT_EQ(test::RunCommand(
+                Xvfb() + test::CalibenchExe() + " gui --dataset " + (dir_ / "data").string() +
+                    " --size 1600x900 --quit-after-frames 90 --screenshot " + shot.string(),
+                &output),
+            0)
+      << output;
+  EXPECT_GT(Texture(LoadImage(shot), 20, 120, 513, 440), 3.0) << "the LiDAR view looks empty";
+  std::filesystem::create_directories(dir_ / "neither");
+  std::ofstream(dir_ / "neither/notes.txt") << "not a dataset\n";
+  EXPECT_NE(test::RunCommand(Xvfb() + test::CalibenchExe() + " gui --dataset " +
+                                 (dir_ / "neither").string() + " --quit-after-frames 10",
+                             &output),
+            0);
+  EXPECT_NE(
+      output.find((dir_ / "neither").string() + ": not a dataset folder (looked for a manifest"),
+      std::string::npos)
+      << output;
+}
+
 TEST_F(GuiWindow, OpensUnderXvfbAndShowsTheThreeViews) {
   const auto& dir = dir_;
   std::string output;
