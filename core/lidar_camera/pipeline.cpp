@@ -338,6 +338,7 @@ void EvaluateAtSolution(const std::vector<PairFeatures>& pairs, const SolverOpti
   const SolverResult at_estimate = solver.Summarize();
   solution->residuals = at_estimate.residuals;
   solution->robust_weights = at_estimate.robust_weights;
+  solution->negligible_weight = options.negligible_weight;
 }
 
 }  // namespace calibench

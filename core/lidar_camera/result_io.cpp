@@ -80,6 +80,8 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
     if (p.status == PairStatus::kAccepted && solved_index < s.residuals.size()) {
       entry["residual"] = Vec4ToJson(s.residuals[solved_index]);
       entry["robust_weight"] = s.robust_weights[solved_index];
+      // Accepted, yet weighted as if left out: said, not left to be read off a number.
+      entry["down_weighted"] = s.DownWeighted(solved_index);
       ++solved_index;
     }
     pairs.push_back(entry);
@@ -108,6 +110,7 @@ void PrintPairs(const CalibrationOutcome& outcome, std::ostringstream& out) {
   out << "pairs: " << outcome.pairs.size() << " (" << accepted << " accepted, " << failed
       << " failed)\n";
   size_t solved_index = 0;
+  std::string down_weighted;  // the pairs the solve weighted as if left out, with their |e|
   for (const PairFeatures& p : outcome.pairs) {
     if (p.status == PairStatus::kFailed) {
       out << "  pair " << p.id << " failed: " << p.reason << "\n";
@@ -124,14 +127,25 @@ void PrintPairs(const CalibrationOutcome& outcome, std::ostringstream& out) {
     out << line;
     if (outcome.solution && p.status == PairStatus::kAccepted &&
         solved_index < outcome.solution->residuals.size()) {
-      std::snprintf(line, sizeof(line), " | |e| %.4f weight %.2f",
-                    outcome.solution->residuals[solved_index].norm(),
+      const double residual = outcome.solution->residuals[solved_index].norm();
+      std::snprintf(line, sizeof(line), " | |e| %.4f weight %.2f", residual,
                     outcome.solution->robust_weights[solved_index]);
       out << line;
+      if (outcome.solution->DownWeighted(solved_index)) {
+        out << " (down-weighted to nothing)";
+        std::snprintf(line, sizeof(line), "%s%s (|e| %.4f)", down_weighted.empty() ? "" : ", ",
+                      p.id.c_str(), residual);
+        down_weighted += line;
+      }
       ++solved_index;
     }
     out << "\n";
   }
+  if (!down_weighted.empty())
+    out << "down-weighted to nothing (robust weight < " << outcome.solution->negligible_weight
+        << "): " << down_weighted
+        << ": accepted, but in effect left out of the solve; their planes disagree with the "
+           "others'. Look at these pairs, or reject them.\n";
 }
 
 // What the weighted model estimated besides the pose: board edges, range offset, widening.

@@ -33,6 +33,8 @@ bool SolverOptions::Check(std::string* why) const {
   if (!(huber_delta > 0)) return fail("huber_delta must be > 0");
   if (!(whitened_huber_delta > 0)) return fail("whitened_huber_delta must be > 0 (sigmas)");
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
+  if (!(negligible_weight >= 0 && negligible_weight < 1))
+    return fail("negligible_weight must be in [0, 1)");
   if (!(step_tolerance > 0)) return fail("step_tolerance must be > 0");
   if (!(outlier_gate == 0 || outlier_gate >= 2))
     return fail("outlier_gate must be 0 (off) or at least 2 robust scales");

@@ -98,7 +98,11 @@ struct SolverOptions {
   // shows a range offset all the same; one beyond this many standard deviations (and determined
   // within range_offset_max_sigma_m) is reported (SolverResult::unmodelled_range_offset).
   double range_offset_significance = 3.0;
-  int max_iterations = 50;       // Gauss-Newton iterations
+  int max_iterations = 50;  // Gauss-Newton iterations
+  // A pair whose robust weight at the solution is below this counts for nothing (the outlier
+  // gate's pairs have 0, Huber's far tails come close): accepted, but in effect left out, and
+  // reported so (the summary, the result's "down_weighted", the workbench's pair list).
+  double negligible_weight = 0.05;
   double step_tolerance = 1e-9;  // stop when |delta| (m, rad) falls below this
   // A direction of the information matrix whose eigenvalue is below this fraction of the largest
   // is reported weak (about 2 degrees of spread of the board normals around it).
@@ -137,6 +141,11 @@ struct SolverResult {
   std::vector<double> cost_history;    // one entry per iteration, the initial cost first
   std::vector<Vec4> residuals;         // per pair, Eq. (6) at the solution
   std::vector<double> robust_weights;  // per pair, Huber IRLS weight at the solution (0 = gated)
+  double negligible_weight = SolverOptions{}.negligible_weight;  // the options' threshold
+  // Whether the solved pair `index` (into robust_weights) was down-weighted to nothing.
+  bool DownWeighted(size_t index) const {
+    return index < robust_weights.size() && robust_weights[index] < negligible_weight;
+  }
   ObservabilityReport observability;
   std::optional<RangeOffsetEstimate> range_offset;  // SolverOptions::estimate_range_offset
   // Not estimated, yet significant in the data (SolverOptions::range_offset_significance): the

@@ -214,6 +214,7 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   const Linearization lin = LinearizeHere();
   // As the solver weighed them: with the planes' variance component, 0 for gated pairs.
   result.robust_weights = lin.pair_weights;
+  result.negligible_weight = options_.negligible_weight;
   // The inverse information scaled by the a-posteriori variance factor: for the paper's residual,
   // which has no noise model, that is the noise estimate itself (4 residuals per pair); for the
   // weighted residual (3 per pair) it absorbs what the feature covariances miss on real sensors.

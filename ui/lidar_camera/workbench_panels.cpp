@@ -167,7 +167,15 @@ void Workbench::PairRow(const Snapshot& s, int index, std::vector<Intent>* inten
       ImGui::Text("%.2f", pair.robust_weight);
   }
   ImGui::TableNextColumn();
-  if (!pair.reason.empty()) {
+  const double negligible =
+      s.solver.result ? s.solver.result->negligible_weight : SolverOptions{}.negligible_weight;
+  if (pair.residual && pair.status == PairStatus::kAccepted && pair.robust_weight < negligible) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.55f, 0.3f, 1));
+    ImGui::TextWrapped(
+        "down-weighted to nothing: its planes disagree with the others', in effect left out of "
+        "the solve");
+    ImGui::PopStyleColor();
+  } else if (!pair.reason.empty()) {
     ImGui::TextWrapped("%s", pair.reason.c_str());
   } else if (pair.lidar && pair.camera) {
     ImGui::TextDisabled("%zu inliers, %.1f mm | %d corners, %.2f px", pair.lidar->inliers.size(),
