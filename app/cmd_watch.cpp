@@ -112,6 +112,158 @@ std::optional<Dataset> WaitForSetup(const WatchFlags& flags, EventStream& stream
   }
 }
 
+// The features a watch detected, kept beside its session (core/session/feature_cache.h): what an
+// earlier watch of the capture left is reused, and each pair is appended when it is new or the
+// solve changed it.
+class FeatureCacheKeeper {
+ public:
+  explicit FeatureCacheKeeper(const fs::path& session_path)
+      : path_(FeatureCachePath(session_path)),
+        earlier_(LoadFeatureCache(path_, &skipped_)),
+        writer_(path_) {}
+
+  // The earlier features of `pair`, when its files are the same; counted for ResumedNote.
+  const PairFeatures* Earlier(const PairEntry& pair) {
+    const auto hit = earlier_.find(pair.id);
+    if (hit == earlier_.end() || hit->second.entry.cloud != pair.cloud ||
+        hit->second.entry.image != pair.image)
+      return nullptr;
+    written_[pair.id] = StateOf(hit->second.features);
+    ++resumed_;
+    return &hit->second.features;
+  }
+  // "N pairs taken from ..." once per batch that reused any; "" otherwise.
+  std::string ResumedNote() {
+    if (resumed_ == 0) return "";
+    std::string note =
+        std::to_string(resumed_) + " pairs taken from " + path_.string() + ", not detected again";
+    if (skipped_ > 0)
+      note += " (" + std::to_string(skipped_) + " stale or cut-short lines ignored)";
+    resumed_ = 0;
+    return note;
+  }
+  // Appends the job's pairs that are new or changed since written; the failures, in words.
+  std::vector<std::string> Record(const CaptureJob& job) {
+    std::vector<std::string> failures;
+    for (size_t i = 0; i < job.pairs().size(); ++i) {
+      const PairFeatures& features = job.pairs()[i];
+      std::string& written = written_[features.id];
+      if (written == StateOf(features)) continue;
+      try {
+        writer_.Append(job.dataset().pairs[i], features);
+        written = StateOf(features);
+      } catch (const IoError& e) {
+        failures.push_back(features.id + ": feature cache: " + e.what());
+      }
+    }
+    return failures;
+  }
+
+ private:
+  // What distinguishes two versions of a pair's features in the cache.
+  static std::string StateOf(const PairFeatures& f) {
+    return PairStatusName(f.status) + (f.lidar ? "+lidar" : "") + (f.camera ? "+camera" : "") +
+           ":" + f.reason;
+  }
+
+  fs::path path_;
+  int skipped_ = 0;
+  std::map<std::string, CachedPair> earlier_;
+  FeatureCacheWriter writer_;
+  std::map<std::string, std::string> written_;  // StateOf what the file last says, by pair
+  int resumed_ = 0;
+};
+
+// The watch loop: look, add the completed pairs, solve, say what changed, save; until idle or
+// done.
+class Watch {
+ public:
+  Watch(Dataset setup, const CaptureJobOptions& options, const WatchFlags& flags,
+        fs::path session_path, EventStream* stream)
+      : flags_(flags),
+        session_path_(std::move(session_path)),
+        stream_(*stream),
+        autosaver_(session_path_),
+        cache_(session_path_),
+        job_(std::move(setup), options),
+        folder_(fs::absolute(flags.source), flags.folder) {}
+
+  int Run() {
+    double last_activity = SteadySeconds();
+    for (;;) {
+      const double now = SteadySeconds();
+      bool added = false;
+      for (const FolderEvent& event : folder_.Poll(now)) {
+        last_activity = now;
+        if (event.kind == FolderEvent::Kind::kPairComplete) {
+          job_.AddPair(event.pair, cache_.Earlier(event.pair));
+          added = true;
+        } else {
+          stream_.Note(event.kind == FolderEvent::Kind::kIncomplete ? "incomplete" : "removed",
+                       event.stem, event.reason);
+        }
+      }
+      if (added && SolveAndReport(now)) {
+        stream_.Note("end", "", "done: the goal is met with a σ that can be trusted");
+        return kOk;
+      }
+      if (flags_.idle_exit_s > 0 && SteadySeconds() - last_activity >= flags_.idle_exit_s) {
+        stream_.Note(
+            "end", "",
+            "no new data for " + std::to_string(static_cast<int>(flags_.idle_exit_s)) + " s");
+        return kOk;
+      }
+      std::this_thread::sleep_for(std::chrono::duration<double>(flags_.poll_s));
+    }
+  }
+
+ private:
+  // Solves, then says the verdicts that changed and the solve, and saves; true when the watch
+  // should end (--exit-when-done and done). `looked_s`: when the new pairs were seen complete.
+  bool SolveAndReport(double looked_s) {
+    if (const std::string note = cache_.ResumedNote(); !note.empty())
+      stream_.Note("resumed", "", note);
+    const CaptureAdvice& advice = job_.Solve();
+    for (const std::string& failure : cache_.Record(job_)) stream_.Note("error", "", failure);
+    ReportVerdicts(advice);
+    nlohmann::json solve = nlohmann::json::parse(CaptureAdviceJson(advice));
+    solve["event"] = "solve";
+    solve["latency_s"] = SteadySeconds() - looked_s;
+    stream_.Emit(solve, HumanProgress(advice));
+    try {
+      autosaver_.Save(job_.ToSession(fs::absolute(flags_.source)));
+    } catch (const IoError& e) {
+      stream_.Note("error", "", std::string("session not saved: ") + e.what());
+    }
+    return flags_.exit_when_done && advice.state && advice.state->done;
+  }
+
+  // The new pairs, and every earlier pair whose verdict this solve changed (a board found later
+  // at the camera's prediction, a pair a better solution disagrees with).
+  void ReportVerdicts(const CaptureAdvice& advice) {
+    for (const PairAdvice& pair : advice.pairs) {
+      const bool accepted = pair.status == PairStatus::kAccepted;
+      const std::string reason = accepted ? "" : pair.reason;
+      const auto verdict = std::make_pair(accepted, reason);
+      const auto before = reported_.find(pair.id);
+      if (before != reported_.end() && before->second == verdict) continue;
+      reported_[pair.id] = verdict;
+      stream_.Emit(
+          {{"event", "pair"}, {"name", pair.id}, {"accepted", accepted}, {"reason", reason}},
+          pair.id + ": " + (accepted ? "accepted" : PairStatusName(pair.status) + ": " + reason));
+    }
+  }
+
+  const WatchFlags& flags_;
+  fs::path session_path_;
+  EventStream& stream_;
+  Autosaver autosaver_;
+  FeatureCacheKeeper cache_;
+  CaptureJob job_;
+  GrowingFolder folder_;
+  std::map<std::string, std::pair<bool, std::string>> reported_;  // verdicts said, by pair
+};
+
 }  // namespace
 
 int RunWatch(int argc, char** argv) {
@@ -186,100 +338,8 @@ int RunWatch(int argc, char** argv) {
   const fs::path session_path = flags.session.empty()
                                     ? fs::path(flags.source) / "calibench.session.json"
                                     : fs::path(flags.session);
-  Autosaver autosaver(session_path);
-  // The features of pairs an earlier watch of this capture detected: not detected again.
-  int cache_skipped = 0;
-  const std::map<std::string, CachedPair> cache =
-      LoadFeatureCache(FeatureCachePath(session_path), &cache_skipped);
-  FeatureCacheWriter cache_writer(FeatureCachePath(session_path));
-  std::map<std::string, std::string> cached_state;  // what the cache last says, by pair
-  auto state_of = [](const PairFeatures& f) {
-    return PairStatusName(f.status) + (f.lidar ? "+lidar" : "") + (f.camera ? "+camera" : "") +
-           ":" + f.reason;
-  };
-  int resumed = 0;
-  CaptureJob job(std::move(*setup), options);
-  GrowingFolder folder(fs::absolute(flags.source), flags.folder);
-  double last_activity = SteadySeconds();
-  std::map<std::string, std::pair<bool, std::string>> reported;  // verdicts said, by pair
-  for (;;) {
-    const double now = SteadySeconds();
-    std::vector<std::string> added;
-    for (const FolderEvent& event : folder.Poll(now)) {
-      last_activity = now;
-      if (event.kind == FolderEvent::Kind::kPairComplete) {
-        const auto hit = cache.find(event.stem);
-        if (hit != cache.end() && hit->second.entry.cloud == event.pair.cloud &&
-            hit->second.entry.image == event.pair.image) {
-          job.AddPair(event.pair, &hit->second.features);
-          cached_state[event.stem] = state_of(hit->second.features);
-          ++resumed;
-        } else {
-          job.AddPair(event.pair);
-        }
-        added.push_back(event.stem);
-      } else {
-        stream.Note(event.kind == FolderEvent::Kind::kIncomplete ? "incomplete" : "removed",
-                    event.stem, event.reason);
-      }
-    }
-    if (!added.empty()) {
-      if (resumed > 0) {
-        stream.Note("resumed", "",
-                    std::to_string(resumed) + " pairs taken from " +
-                        FeatureCachePath(session_path).string() + ", not detected again" +
-                        (cache_skipped ? " (" + std::to_string(cache_skipped) +
-                                             " stale or cut-short lines ignored)"
-                                       : ""));
-        resumed = 0;
-      }
-      const CaptureAdvice& advice = job.Solve();
-      // New pairs, and pairs the solve's completion changed, go to the cache.
-      for (size_t i = 0; i < job.pairs().size(); ++i) {
-        const PairFeatures& features = job.pairs()[i];
-        std::string& said = cached_state[features.id];
-        if (said == state_of(features)) continue;
-        try {
-          cache_writer.Append(job.dataset().pairs[i], features);
-          said = state_of(features);
-        } catch (const IoError& e) {
-          stream.Note("error", features.id, std::string("feature cache: ") + e.what());
-        }
-      }
-      // The new pairs, and every earlier pair whose verdict this solve changed (a board found
-      // later at the camera's prediction, a pair a better solution disagrees with).
-      for (const PairAdvice& pair : advice.pairs) {
-        const bool accepted = pair.status == PairStatus::kAccepted;
-        const std::string reason = accepted ? "" : pair.reason;
-        const auto before = reported.find(pair.id);
-        if (before != reported.end() && before->second == std::make_pair(accepted, reason))
-          continue;
-        reported[pair.id] = {accepted, reason};
-        stream.Emit(
-            {{"event", "pair"}, {"name", pair.id}, {"accepted", accepted}, {"reason", reason}},
-            pair.id + ": " + (accepted ? "accepted" : PairStatusName(pair.status) + ": " + reason));
-      }
-      nlohmann::json solve = nlohmann::json::parse(CaptureAdviceJson(advice));
-      solve["event"] = "solve";
-      solve["latency_s"] = SteadySeconds() - now;  // from the look that saw the pairs complete
-      stream.Emit(solve, HumanProgress(advice));
-      try {
-        autosaver.Save(job.ToSession(fs::absolute(flags.source)));
-      } catch (const IoError& e) {
-        stream.Note("error", "", std::string("session not saved: ") + e.what());
-      }
-      if (flags.exit_when_done && advice.state && advice.state->done) {
-        stream.Note("end", "", "done: the goal is met with a σ that can be trusted");
-        return kOk;
-      }
-    }
-    if (flags.idle_exit_s > 0 && SteadySeconds() - last_activity >= flags.idle_exit_s) {
-      stream.Note("end", "",
-                  "no new data for " + std::to_string(static_cast<int>(flags.idle_exit_s)) + " s");
-      return kOk;
-    }
-    std::this_thread::sleep_for(std::chrono::duration<double>(flags.poll_s));
-  }
+  Watch watch(std::move(*setup), options, flags, session_path, &stream);
+  return watch.Run();
 }
 
 }  // namespace calibench::app

@@ -1,7 +1,5 @@
 #include "core/session/capture_job.h"
 
-#include <algorithm>
-
 #include "core/io/cloud_io.h"
 
 namespace calibench {
@@ -87,15 +85,11 @@ Session CaptureJob::ToSession(const std::filesystem::path& dataset_path) const {
   session.estimate_range_offset = pipeline.solver.estimate_range_offset;
   session.max_iterations = pipeline.solver.max_iterations;
   session.ransac_threshold_m = pipeline.lidar_plane.ransac_threshold_m;
-  for (PairState& state : session.pairs) {
-    const auto it = std::find_if(pairs_.begin(), pairs_.end(),
-                                 [&](const PairFeatures& p) { return p.id == state.id; });
-    if (it == pairs_.end()) continue;
-    state.status = it->status;
-    state.reason = it->reason;
-    if (!advice_) continue;
-    for (const PairAdvice& judged : advice_->pairs)
-      if (judged.id == state.id) state.status = judged.status, state.reason = judged.reason;
+  // NewSession's pairs, pairs_ and the advice's pairs all follow dataset_.pairs: one index.
+  for (size_t i = 0; i < session.pairs.size() && i < pairs_.size(); ++i) {
+    const bool judged = advice_ && i < advice_->pairs.size();
+    session.pairs[i].status = judged ? advice_->pairs[i].status : pairs_[i].status;
+    session.pairs[i].reason = judged ? advice_->pairs[i].reason : pairs_[i].reason;
   }
   if (advice_ && advice_->solution) session.result = SessionResultFromSolver(*advice_->solution);
   return session;
