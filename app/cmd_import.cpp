@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -12,6 +13,7 @@
 #include "core/io/bag.h"
 #include "core/io/bag_import.h"
 #include "core/io/camera_file.h"
+#include "core/io/dataset.h"
 #include "core/io/json_io.h"
 #include "core/io/ros_messages.h"
 
@@ -75,8 +77,10 @@ void PrintSummary(const BagImportSummary& summary, const BagImportOptions& optio
   std::printf("%s\n", summary.format.c_str());
   std::printf("clouds  %-28s %lld messages\n", summary.cloud_topic.c_str(),
               static_cast<long long>(summary.clouds));
-  std::printf("images  %-28s %lld messages, board found in %d\n", summary.image_topic.c_str(),
-              static_cast<long long>(summary.images), summary.boards_seen);
+  std::printf("images  %-28s %lld messages; searched %d for the board, found in %d\n",
+              summary.image_topic.c_str(), static_cast<long long>(summary.images),
+              summary.images_searched, summary.boards_seen);
+  std::printf("board   %s\n", summary.board_source.c_str());
   std::printf("camera  %s\n", summary.camera_source.c_str());
   std::printf("pairs written: %zu\n", summary.pair_ids.size());
   for (const auto& [reason, count] : summary.dropped)
@@ -91,13 +95,10 @@ void PrintSummary(const BagImportSummary& summary, const BagImportOptions& optio
 
 }  // namespace
 
-BoardSpec BoardFromFlag(const std::string& board) {
+std::optional<BoardSpec> BoardFromFlag(const std::string& board) {
+  if (board.empty()) return std::nullopt;
   std::error_code error;
-  if (fs::is_regular_file(board, error)) {
-    const auto document = json_io::ReadJson(board);
-    const json_io::Fields target(document, board);
-    return json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
-  }
+  if (fs::is_regular_file(board, error)) return LoadTargetFile(board);
   return BoardPreset(board);
 }
 
@@ -109,7 +110,7 @@ int RunImport(int argc, char** argv) {
       "board stood still are kept, near-duplicate poses dropped, and every dropped frame is "
       "counted by reason.",
       "calibench import"};
-  std::string bag_path, out, board = "a4", camera_file;
+  std::string bag_path, out, board, target, camera_file;
   bool list = false;
   BagImportOptions options;
   app.add_option("bag", bag_path, "the recording (.bag, .db3, .mcap, or a rosbag2 folder)")
@@ -118,7 +119,10 @@ int RunImport(int argc, char** argv) {
   app.add_option("--out,-o", out,
                  "dataset folder to write (default: <bag name>.dataset beside it, or under "
                  "~/.local/share/calibench/imports when that folder is read-only)");
-  AddBoardOption(app, &board, "the board the camera sees");
+  CLI::Option* board_option = AddBoardOption(app, &board, "the board the camera sees");
+  app.add_option("--target", target, "the board as a target.json (same as --board FILE)")
+      ->check(CLI::ExistingFile)
+      ->excludes(board_option);
   app.add_option("--cloud-topic", options.cloud_topic, "PointCloud2 topic (default: the only one)");
   app.add_option("--image-topic", options.image_topic,
                  "Image or CompressedImage topic (default: the only one)");
@@ -153,9 +157,9 @@ int RunImport(int argc, char** argv) {
     PrintTopics(*OpenBag(bag_path));
     return kOk;
   }
-  BoardSpec board_spec;
+  std::optional<BoardSpec> board_spec;
   try {
-    board_spec = BoardFromFlag(board);
+    board_spec = BoardFromFlag(target.empty() ? board : target);
   } catch (const std::invalid_argument& error) {
     std::fprintf(stderr, "calibench import: --board: %s\n", error.what());
     return kUsage;
@@ -167,8 +171,18 @@ int RunImport(int argc, char** argv) {
     return kUsage;
   }
   if (out.empty()) out = DefaultImportFolder(bag_path).string();
+  const auto start = std::chrono::steady_clock::now();
   const BagImportSummary summary = ImportBag(bag_path, out, board_spec, options, ProgressBar());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   PrintSummary(summary, options);
+  // The last line of a log: what came out and how fast, against the recording's own length.
+  std::fprintf(stderr, "imported %zu pairs from %.0f MB in %.1f s", summary.pair_ids.size(),
+               summary.bytes_read / 1e6, seconds);
+  if (summary.recording_seconds > 0)
+    std::fprintf(stderr, " (the recording spans %.1f s: %.2fx its length)",
+                 summary.recording_seconds, seconds / summary.recording_seconds);
+  std::fprintf(stderr, "\n");
   return kOk;
 }
 

@@ -76,10 +76,12 @@ CLI::Option* AddDatasetOption(CLI::App& app, std::string* path, const std::strin
 }
 
 CLI::Option* AddBoardOption(CLI::App& app, std::string* board, const std::string& what) {
-  return app
-      .add_option("--board", *board,
-                  what + ": a3 | a4 | charuco-a3 | charuco-a4 | paper, or a target.json")
-      ->capture_default_str();
+  return app.add_option(
+      "--board", *board,
+      what +
+          ": a3 | a4 | charuco-a3 | charuco-a4 | paper, or a target.json (default: "
+          "the target.json beside the recording, else the preset that fits the "
+          "images)");
 }
 
 int PrintAndWriteTable(const std::string& table, const std::string& path, const char* command) {

@@ -65,18 +65,20 @@ int RunGui(int argc, char** argv);
 int RunRender(int argc, char** argv);
 int RunExport(int argc, char** argv);
 int RunImport(int argc, char** argv);
-// --board of `import` and `gui`: a preset's name or a target.json file. Throws
+// --board of `import` and `gui`: a preset's name or a target.json file; empty = nullopt (the
+// target.json beside the recording, else the preset that fits its images). Throws
 // std::invalid_argument naming the presets for an unknown name, IoError for a bad file.
-BoardSpec BoardFromFlag(const std::string& board);
+std::optional<BoardSpec> BoardFromFlag(const std::string& board);
 
 // How `gui` runs its window. A test's window closes by itself (0 = never) after that many frames
 // drawn back to back, or after that many seconds of a normal run.
 struct GuiWindowFlags {
   int after_frames = 0;
   double after_seconds = 0.0;
-  bool fresh = false;        // --fresh: back up the session beside the dataset and start a new one
-  std::string bag;           // --bag: a recording to import and open
-  std::string board = "a4";  // --board: the board in imported recordings (preset or target.json)
+  bool fresh = false;  // --fresh: back up the session beside the dataset and start a new one
+  std::string bag;     // --bag: a recording to import and open
+  std::string board;   // --board: the board in imported recordings (preset or target.json; empty =
+                       // automatic)
   std::vector<std::string> test_drops;  // --test-drop: paths dropped onto the window (tests)
 };
 // Shared by `gui` and `demo`: opens the workbench window on a dataset or session.

@@ -251,88 +251,148 @@ Bytes ConnectionRecord(const Ros1Connection& connection) {
   return out;
 }
 
-}  // namespace
+class Ros1BagWriter : public RecordingWriter {
+ public:
+  Ros1BagWriter(const fs::path& path, std::string compression, std::size_t chunk_bytes)
+      : compression_(std::move(compression)), chunk_bytes_(chunk_bytes) {
+    file_.open(path, std::ios::binary | std::ios::trunc);
+    if (!file_) throw std::runtime_error("cannot write " + path.string());
+    Bytes start(std::begin("#ROSBAG V2.0\n"), std::end("#ROSBAG V2.0\n") - 1);
+    header_at_ = start.size();
+    // As rosbag record does: a bag header with index_pos 0 until the recording is closed.
+    Append(&start, BagHeader(0, 0, 0));
+    Put(start);
+  }
+  ~Ros1BagWriter() override {
+    if (!closed_) Close();
+  }
 
-void WriteRos1Bag(const fs::path& path, const std::vector<RecordedMessage>& messages,
-                  const std::string& compression, std::size_t chunk_bytes) {
-  std::map<std::string, Ros1Connection> connections;
-  Bytes file(std::begin("#ROSBAG V2.0\n"), std::end("#ROSBAG V2.0\n") - 1);
-  const std::size_t bag_header_at = file.size();
-  file.resize(file.size() + 4096 + 200, 0);  // the bag header, rewritten at the end
+  void Add(const RecordedMessage& message) override {
+    if (chunk_.empty()) info_ = {position_, message.log_time_ns, message.log_time_ns, {}};
+    auto [it, added] = connections_.try_emplace(
+        message.topic, Ros1Connection{static_cast<std::uint32_t>(connections_.size()),
+                                      message.topic, message.type});
+    if (defined_.insert(it->second.id).second) Append(&chunk_, ConnectionRecord(it->second));
+    index_[it->second.id].emplace_back(message.log_time_ns,
+                                       static_cast<std::uint32_t>(chunk_.size()));
+    Ros1Record(&chunk_,
+               {NumberField<std::uint8_t>("op", 0x02), NumberField("conn", it->second.id),
+                NumberField("time", Ros1Time(message.log_time_ns))},
+               message.data);
+    ++info_.counts[it->second.id];
+    info_.start = std::min(info_.start, message.log_time_ns);
+    info_.end = std::max(info_.end, message.log_time_ns);
+    if (chunk_.size() >= chunk_bytes_) WriteChunk();
+  }
+
+  void Close() override {
+    if (closed_) return;
+    closed_ = true;
+    if (!chunk_.empty()) WriteChunk();
+    const std::uint64_t index_pos = position_;
+    Bytes tail;
+    for (const auto& [topic, connection] : connections_)
+      Append(&tail, ConnectionRecord(connection));
+    for (const ChunkInfo& chunk : chunks_) {
+      Bytes data;
+      for (const auto& [id, count] : chunk.counts) {
+        Append(&data, id);
+        Append(&data, count);
+      }
+      Ros1Record(&tail,
+                 {NumberField<std::uint8_t>("op", 0x06), NumberField<std::uint32_t>("ver", 1),
+                  NumberField("chunk_pos", chunk.position),
+                  NumberField("start_time", Ros1Time(chunk.start)),
+                  NumberField("end_time", Ros1Time(chunk.end)),
+                  NumberField("count", static_cast<std::uint32_t>(chunk.counts.size()))},
+                 data);
+    }
+    Put(tail);
+    file_.seekp(static_cast<std::streamoff>(header_at_));
+    const Bytes header = BagHeader(index_pos, connections_.size(), chunks_.size());
+    file_.write(reinterpret_cast<const char*>(header.data()),
+                static_cast<std::streamsize>(header.size()));
+    file_.close();
+  }
+
+ private:
   struct ChunkInfo {
-    std::uint64_t position;
-    std::int64_t start, end;
+    std::uint64_t position = 0;
+    std::int64_t start = 0, end = 0;
     std::map<std::uint32_t, std::uint32_t> counts;
   };
-  std::vector<ChunkInfo> chunks;
-  std::size_t next = 0;
-  while (next < messages.size()) {
-    Bytes chunk;
-    ChunkInfo info{file.size(), messages[next].log_time_ns, messages[next].log_time_ns, {}};
-    std::map<std::uint32_t, std::vector<std::pair<std::int64_t, std::uint32_t>>> index;
-    std::set<std::uint32_t> defined;
-    while (next < messages.size() && (chunk.empty() || chunk.size() < chunk_bytes)) {
-      const RecordedMessage& message = messages[next++];
-      auto [it, added] = connections.try_emplace(
-          message.topic, Ros1Connection{static_cast<std::uint32_t>(connections.size()),
-                                        message.topic, message.type});
-      if (defined.insert(it->second.id).second) Append(&chunk, ConnectionRecord(it->second));
-      index[it->second.id].emplace_back(message.log_time_ns,
-                                        static_cast<std::uint32_t>(chunk.size()));
-      Ros1Record(&chunk,
-                 {NumberField<std::uint8_t>("op", 0x02), NumberField("conn", it->second.id),
-                  NumberField("time", Ros1Time(message.log_time_ns))},
-                 message.data);
-      ++info.counts[it->second.id];
-      info.start = std::min(info.start, message.log_time_ns);
-      info.end = std::max(info.end, message.log_time_ns);
-    }
-    Ros1Record(&file,
-               {NumberField<std::uint8_t>("op", 0x05), TextField("compression", compression),
-                NumberField("size", static_cast<std::uint32_t>(chunk.size()))},
-               Compress(compression, chunk));
-    for (const auto& [id, entries] : index) {
+
+  // The bag header record, padded so that the whole record fills 4096 + 200 bytes.
+  static Bytes BagHeader(std::uint64_t index_pos, std::size_t connections, std::size_t chunks) {
+    Bytes header;
+    const std::vector<Field> fields = {
+        NumberField<std::uint8_t>("op", 0x03), NumberField("index_pos", index_pos),
+        NumberField("conn_count", static_cast<std::uint32_t>(connections)),
+        NumberField("chunk_count", static_cast<std::uint32_t>(chunks))};
+    const std::size_t reserved = 4096 + 200;
+    Ros1Record(&header, fields, Bytes(reserved - 8 - HeaderBytes(fields).size(), ' '));
+    return header;
+  }
+
+  void Put(const Bytes& bytes) {
+    file_.write(reinterpret_cast<const char*>(bytes.data()),
+                static_cast<std::streamsize>(bytes.size()));
+    file_.flush();
+    position_ += bytes.size();
+  }
+
+  void WriteChunk() {
+    Bytes out;
+    Ros1Record(&out,
+               {NumberField<std::uint8_t>("op", 0x05), TextField("compression", compression_),
+                NumberField("size", static_cast<std::uint32_t>(chunk_.size()))},
+               Compress(compression_, chunk_));
+    for (const auto& [id, entries] : index_) {
       Bytes data;
       for (const auto& [time, offset] : entries) {
         Append(&data, Ros1Time(time));
         Append(&data, offset);
       }
-      Ros1Record(&file,
+      Ros1Record(&out,
                  {NumberField<std::uint8_t>("op", 0x04), NumberField<std::uint32_t>("ver", 1),
                   NumberField("conn", id),
                   NumberField("count", static_cast<std::uint32_t>(entries.size()))},
                  data);
     }
-    chunks.push_back(info);
+    chunks_.push_back(info_);
+    Put(out);
+    chunk_.clear();
+    index_.clear();
+    defined_.clear();
   }
-  const std::uint64_t index_pos = file.size();
-  for (const auto& [topic, connection] : connections) Append(&file, ConnectionRecord(connection));
-  for (const ChunkInfo& chunk : chunks) {
-    Bytes data;
-    for (const auto& [id, count] : chunk.counts) {
-      Append(&data, id);
-      Append(&data, count);
-    }
-    Ros1Record(
-        &file,
-        {NumberField<std::uint8_t>("op", 0x06), NumberField<std::uint32_t>("ver", 1),
-         NumberField("chunk_pos", chunk.position), NumberField("start_time", Ros1Time(chunk.start)),
-         NumberField("end_time", Ros1Time(chunk.end)),
-         NumberField("count", static_cast<std::uint32_t>(chunk.counts.size()))},
-        data);
-  }
-  // The bag header, padded so that the whole record fills the space reserved for it.
-  Bytes header;
-  const std::vector<Field> fields = {
-      NumberField<std::uint8_t>("op", 0x03), NumberField("index_pos", index_pos),
-      NumberField("conn_count", static_cast<std::uint32_t>(connections.size())),
-      NumberField("chunk_count", static_cast<std::uint32_t>(chunks.size()))};
-  const std::size_t reserved = 4096 + 200;
-  const std::size_t header_size = HeaderBytes(fields).size();
-  Ros1Record(&header, fields, Bytes(reserved - 8 - header_size, ' '));
-  std::copy(header.begin(), header.end(), file.begin() + bag_header_at);
-  std::ofstream(path, std::ios::binary)
-      .write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+
+  std::ofstream file_;
+  std::string compression_;
+  std::size_t chunk_bytes_;
+  std::size_t header_at_ = 0;
+  std::uint64_t position_ = 0;
+  bool closed_ = false;
+  std::map<std::string, Ros1Connection> connections_;
+  std::vector<ChunkInfo> chunks_;
+  Bytes chunk_;
+  ChunkInfo info_;
+  std::map<std::uint32_t, std::vector<std::pair<std::int64_t, std::uint32_t>>> index_;
+  std::set<std::uint32_t> defined_;
+};
+
+}  // namespace
+
+std::unique_ptr<RecordingWriter> OpenRos1BagWriter(const fs::path& path,
+                                                   const std::string& compression,
+                                                   std::size_t chunk_bytes) {
+  return std::make_unique<Ros1BagWriter>(path, compression, chunk_bytes);
+}
+
+void WriteRos1Bag(const fs::path& path, const std::vector<RecordedMessage>& messages,
+                  const std::string& compression, std::size_t chunk_bytes) {
+  Ros1BagWriter writer(path, compression, chunk_bytes);
+  for (const RecordedMessage& message : messages) writer.Add(message);
+  writer.Close();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -355,103 +415,173 @@ std::string Ros2Type(const std::string& type) {
 
 }  // namespace
 
-void WriteMcap(const fs::path& path, const std::vector<RecordedMessage>& messages,
-               const std::string& profile, const std::string& compression, bool summary,
-               std::size_t chunk_bytes) {
-  const bool ros2 = profile == "ros2";
-  const Bytes magic = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
-  Bytes file = magic;
-  Bytes header;
-  McapString(&header, profile);
-  McapString(&header, "calibench test writer");
-  McapRecord(&file, 0x01, header);
-  std::map<std::string, std::uint16_t> schemas, channels;
-  Bytes definitions;  // schema and channel records, repeated in the summary
-  for (const RecordedMessage& message : messages) {
-    const std::string type = ros2 ? Ros2Type(message.type) : message.type;
-    if (!schemas.count(type)) {
-      const auto id = static_cast<std::uint16_t>(schemas.size() + 1);
-      schemas[type] = id;
+namespace {
+
+class McapWriter : public RecordingWriter {
+ public:
+  McapWriter(const fs::path& path, const std::string& profile, std::string compression,
+             bool summary, std::size_t chunk_bytes)
+      : ros2_(profile == "ros2"),
+        compression_(std::move(compression)),
+        summary_(summary),
+        chunk_bytes_(chunk_bytes) {
+    file_.open(path, std::ios::binary | std::ios::trunc);
+    if (!file_) throw std::runtime_error("cannot write " + path.string());
+    Bytes start = Magic();
+    Bytes header;
+    McapString(&header, profile);
+    McapString(&header, "calibench test writer");
+    McapRecord(&start, 0x01, header);
+    Put(start);
+  }
+  ~McapWriter() override {
+    if (!closed_) Close();
+  }
+
+  void Add(const RecordedMessage& message) override {
+    Define(message);
+    if (records_.empty()) first_ = last_ = message.log_time_ns;
+    Bytes record;
+    Append(&record, channels_[message.topic]);
+    Append<std::uint32_t>(&record, static_cast<std::uint32_t>(++sequence_));
+    Append<std::uint64_t>(&record, message.log_time_ns);
+    Append<std::uint64_t>(&record, message.log_time_ns);
+    Append(&record, message.data);
+    McapRecord(&records_, 0x05, record);
+    ++counts_[channels_[message.topic]];
+    first_ = std::min(first_, message.log_time_ns);
+    last_ = std::max(last_, message.log_time_ns);
+    start_time_ = std::min(start_time_, message.log_time_ns);
+    end_time_ = std::max(end_time_, message.log_time_ns);
+    ++messages_;
+    if (records_.size() >= chunk_bytes_) WriteChunk();
+  }
+
+  void Close() override {
+    if (closed_) return;
+    closed_ = true;
+    if (!records_.empty()) WriteChunk();
+    Bytes tail;
+    McapRecord(&tail, 0x0F, Bytes(4, 0));  // DataEnd, no CRC
+    std::uint64_t summary_start = 0;
+    if (summary_) {
+      summary_start = position_ + tail.size();
+      Append(&tail, definitions_);
+      Bytes statistics;
+      Append<std::uint64_t>(&statistics, messages_);
+      Append<std::uint16_t>(&statistics, static_cast<std::uint16_t>(schemas_.size()));
+      Append<std::uint32_t>(&statistics, static_cast<std::uint32_t>(channels_.size()));
+      Append<std::uint32_t>(&statistics, 0);
+      Append<std::uint32_t>(&statistics, 0);
+      Append<std::uint32_t>(&statistics, chunk_count_);
+      Append<std::uint64_t>(&statistics, messages_ == 0 ? 0 : start_time_);
+      Append<std::uint64_t>(&statistics, messages_ == 0 ? 0 : end_time_);
+      Append<std::uint32_t>(&statistics, static_cast<std::uint32_t>(counts_.size() * 10));
+      for (const auto& [channel, count] : counts_) {
+        Append(&statistics, channel);
+        Append(&statistics, count);
+      }
+      McapRecord(&tail, 0x0B, statistics);
+    }
+    Bytes footer;
+    Append<std::uint64_t>(&footer, summary_start);
+    Append<std::uint64_t>(&footer, 0);
+    Append<std::uint32_t>(&footer, 0);
+    McapRecord(&tail, 0x02, footer);
+    Append(&tail, Magic());
+    Put(tail);
+    file_.close();
+  }
+
+ private:
+  static Bytes Magic() { return {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'}; }
+
+  void Put(const Bytes& bytes) {
+    file_.write(reinterpret_cast<const char*>(bytes.data()),
+                static_cast<std::streamsize>(bytes.size()));
+    file_.flush();
+    position_ += bytes.size();
+  }
+
+  // Schema and channel records go to the file before the chunk that first uses them, and again
+  // into the summary.
+  void Define(const RecordedMessage& message) {
+    const std::string type = ros2_ ? Ros2Type(message.type) : message.type;
+    Bytes definitions;
+    if (!schemas_.count(type)) {
+      const auto id = static_cast<std::uint16_t>(schemas_.size() + 1);
+      schemas_[type] = id;
       Bytes schema;
       Append(&schema, id);
       McapString(&schema, type);
-      McapString(&schema, ros2 ? "ros2msg" : "ros1msg");
+      McapString(&schema, ros2_ ? "ros2msg" : "ros1msg");
       McapString(&schema, "");
       McapRecord(&definitions, 0x03, schema);
     }
-    if (!channels.count(message.topic)) {
-      const auto id = static_cast<std::uint16_t>(channels.size());
-      channels[message.topic] = id;
+    if (!channels_.count(message.topic)) {
+      const auto id = static_cast<std::uint16_t>(channels_.size());
+      channels_[message.topic] = id;
       Bytes channel;
       Append(&channel, id);
-      Append(&channel, schemas[type]);
+      Append(&channel, schemas_[type]);
       McapString(&channel, message.topic);
-      McapString(&channel, ros2 ? "cdr" : "ros1");
+      McapString(&channel, ros2_ ? "cdr" : "ros1");
       Append<std::uint32_t>(&channel, 0);  // metadata: an empty map
       McapRecord(&definitions, 0x04, channel);
     }
+    if (definitions.empty()) return;
+    Append(&definitions_, definitions);
+    Put(definitions);
   }
-  Append(&file, definitions);
-  std::map<std::uint16_t, std::uint64_t> counts;
-  std::uint32_t chunk_count = 0;
-  std::size_t next = 0;
-  while (next < messages.size()) {
-    Bytes records;
-    const std::int64_t first = messages[next].log_time_ns;
-    std::int64_t last = first;
-    while (next < messages.size() && (records.empty() || records.size() < chunk_bytes)) {
-      const RecordedMessage& message = messages[next++];
-      Bytes record;
-      Append(&record, channels[message.topic]);
-      Append<std::uint32_t>(&record, static_cast<std::uint32_t>(next));
-      Append<std::uint64_t>(&record, message.log_time_ns);
-      Append<std::uint64_t>(&record, message.log_time_ns);
-      Append(&record, message.data);
-      McapRecord(&records, 0x05, record);
-      ++counts[channels[message.topic]];
-      last = std::max(last, message.log_time_ns);
-    }
+
+  void WriteChunk() {
     Bytes chunk;
-    Append<std::uint64_t>(&chunk, first);
-    Append<std::uint64_t>(&chunk, last);
-    Append<std::uint64_t>(&chunk, records.size());
+    Append<std::uint64_t>(&chunk, first_);
+    Append<std::uint64_t>(&chunk, last_);
+    Append<std::uint64_t>(&chunk, records_.size());
     Append<std::uint32_t>(&chunk, 0);  // no CRC
-    McapString(&chunk, compression);
-    const Bytes stored = Compress(compression, records);
+    McapString(&chunk, compression_);
+    const Bytes stored = Compress(compression_, records_);
     Append<std::uint64_t>(&chunk, stored.size());
     Append(&chunk, stored);
-    McapRecord(&file, 0x06, chunk);
-    ++chunk_count;
+    Bytes out;
+    McapRecord(&out, 0x06, chunk);
+    Put(out);
+    ++chunk_count_;
+    records_.clear();
   }
-  McapRecord(&file, 0x0F, Bytes(4, 0));  // DataEnd, no CRC
-  std::uint64_t summary_start = 0;
-  if (summary) {
-    summary_start = file.size();
-    Append(&file, definitions);
-    Bytes statistics;
-    Append<std::uint64_t>(&statistics, messages.size());
-    Append<std::uint16_t>(&statistics, static_cast<std::uint16_t>(schemas.size()));
-    Append<std::uint32_t>(&statistics, static_cast<std::uint32_t>(channels.size()));
-    Append<std::uint32_t>(&statistics, 0);
-    Append<std::uint32_t>(&statistics, 0);
-    Append<std::uint32_t>(&statistics, chunk_count);
-    Append<std::uint64_t>(&statistics, messages.empty() ? 0 : messages.front().log_time_ns);
-    Append<std::uint64_t>(&statistics, messages.empty() ? 0 : messages.back().log_time_ns);
-    Append<std::uint32_t>(&statistics, static_cast<std::uint32_t>(counts.size() * 10));
-    for (const auto& [channel, count] : counts) {
-      Append(&statistics, channel);
-      Append(&statistics, count);
-    }
-    McapRecord(&file, 0x0B, statistics);
-  }
-  Bytes footer;
-  Append<std::uint64_t>(&footer, summary_start);
-  Append<std::uint64_t>(&footer, 0);
-  Append<std::uint32_t>(&footer, 0);
-  McapRecord(&file, 0x02, footer);
-  Append(&file, magic);
-  std::ofstream(path, std::ios::binary)
-      .write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+
+  std::ofstream file_;
+  bool ros2_;
+  std::string compression_;
+  bool summary_;
+  std::size_t chunk_bytes_;
+  std::uint64_t position_ = 0;
+  bool closed_ = false;
+  std::map<std::string, std::uint16_t> schemas_, channels_;
+  Bytes definitions_;
+  std::map<std::uint16_t, std::uint64_t> counts_;
+  std::uint32_t chunk_count_ = 0;
+  std::uint64_t messages_ = 0, sequence_ = 0;
+  Bytes records_;
+  std::int64_t first_ = 0, last_ = 0;
+  std::int64_t start_time_ = INT64_MAX, end_time_ = INT64_MIN;
+};
+
+}  // namespace
+
+std::unique_ptr<RecordingWriter> OpenMcapWriter(const fs::path& path, const std::string& profile,
+                                                const std::string& compression, bool summary,
+                                                std::size_t chunk_bytes) {
+  return std::make_unique<McapWriter>(path, profile, compression, summary, chunk_bytes);
+}
+
+void WriteMcap(const fs::path& path, const std::vector<RecordedMessage>& messages,
+               const std::string& profile, const std::string& compression, bool summary,
+               std::size_t chunk_bytes) {
+  McapWriter writer(path, profile, compression, summary, chunk_bytes);
+  for (const RecordedMessage& message : messages) writer.Add(message);
+  writer.Close();
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,23 @@ std::vector<std::uint8_t> SerializeCompressedImage(const std::string& format,
 std::vector<std::uint8_t> SerializeCameraInfo(const CameraModel& camera, std::int64_t stamp_ns,
                                               const std::string& frame,
                                               MessageEncoding encoding_kind);
+
+// A recording written message by message, as a recorder does: complete chunks reach the file as
+// they fill (flushed), the index or summary only at Close(). Until then the file is what a
+// reader sees of a recording still being written.
+class RecordingWriter {
+ public:
+  virtual ~RecordingWriter() = default;
+  virtual void Add(const RecordedMessage& message) = 0;
+  virtual void Close() = 0;
+};
+std::unique_ptr<RecordingWriter> OpenRos1BagWriter(const std::filesystem::path& path,
+                                                   const std::string& compression,
+                                                   std::size_t chunk_bytes = 768 * 1024);
+std::unique_ptr<RecordingWriter> OpenMcapWriter(const std::filesystem::path& path,
+                                                const std::string& profile,
+                                                const std::string& compression, bool summary = true,
+                                                std::size_t chunk_bytes = 768 * 1024);
 
 // compression: "none", "bz2" or "lz4". Messages are written in the given order, about
 // `chunk_bytes` per chunk.

@@ -14,79 +14,37 @@
 #include "core/io/dataset.h"
 #include "core/io/image_io.h"
 #include "core/io/ros_messages.h"
-#include "core/target/board_camera.h"
 
 namespace calibench {
 namespace fs = std::filesystem;
 
 namespace {
 
-struct CloudMoment {
-  std::int64_t stamp_ns = 0;
-  int index = 0;  // the message's place on its topic
+// A pair written, under its provisional id until the cap is applied.
+struct WrittenPair {
+  int found = 0;  // its place among the pairs found
+  std::int64_t cloud_stamp_ns = 0, image_stamp_ns = 0;
 };
 
-struct ImageMoment {
-  std::int64_t stamp_ns = 0;
-  int index = 0;
-  std::optional<BoardDetection> detection;  // until its pose is estimated
-  bool board_found = false;
-  std::optional<Pose> cam_from_board;
-  bool unreadable = false;
-};
-
-// A candidate pair, from selection to the files.
-struct Candidate {
-  CloudMoment cloud;
-  const ImageMoment* image = nullptr;
-  std::string id;
-};
-
-std::int64_t StampOrLogTime(const RosHeader& header, const BagMessage& message) {
-  return header.stamp_ns != 0 ? header.stamp_ns : message.log_time_ns;
+std::string PairId(int index) {
+  char id[24];
+  std::snprintf(id, sizeof(id), "%04d", index);
+  return id;
 }
-
-ImageMessage DecodeAnyImage(const BagTopic& topic, const BagMessage& message,
-                            const LoadLimits& limits) {
-  return topic.type == kImageType ? DecodeImage(message.data, topic.encoding, limits)
-                                  : DecodeCompressedImage(message.data, topic.encoding, limits);
-}
-
-double RotationDeg(const Pose& a, const Pose& b) {
-  const Eigen::AngleAxisd delta(a.rotation().transpose() * b.rotation());
-  return delta.angle() * kRadToDeg;
-}
-
-double TranslationM(const Pose& a, const Pose& b) {
-  return (a.translation() - b.translation()).norm();
-}
-
-std::string Ms(double seconds) {
-  return std::to_string(static_cast<int>(std::lround(seconds * 1000))) + " ms";
-}
-
-// Everything pass 1 learns from the recording.
-struct FirstPass {
-  std::vector<CloudMoment> clouds;
-  std::vector<ImageMoment> images;  // by stamp after the pass
-  std::optional<CameraModel> camera;
-  std::string camera_problem;  // why the CameraInfo could not be used
-  std::string image_problem;   // the first image that could not be decoded
-};
 
 class Importer {
  public:
-  Importer(const fs::path& bag_path, const fs::path& out_dir, const BoardSpec& board,
+  Importer(const fs::path& bag_path, const fs::path& out_dir, std::optional<BoardSpec> board,
            BagImportOptions options, const ImportProgress& progress)
       : bag_(OpenBag(bag_path)),
         out_dir_(out_dir),
-        board_(board),
+        board_(std::move(board)),
         options_(std::move(options)),
         progress_(progress) {}
 
   BagImportSummary Run() {
     std::string why;
-    if (!options_.Check(&why)) throw IoError(bag_->Path().string() + ": import options: " + why);
+    if (!options_.Check(&why)) throw IoError(Where() + ": import options: " + why);
     ChooseTopics(*bag_, &options_);
     cloud_topic_ = bag_->FindTopic(options_.cloud_topic);
     image_topic_ = bag_->FindTopic(options_.image_topic);
@@ -95,300 +53,148 @@ class Importer {
     summary_.cloud_topic = options_.cloud_topic;
     summary_.image_topic = options_.image_topic;
     summary_.camera_source = options_.camera ? "the --camera file" : options_.camera_info_topic;
-    ReadStampsAndBoards();
-    std::vector<Candidate> kept = Select();
-    WritePairs(&kept);
-    WriteDataset(kept);
+    ResolveBoard();
+    ReadAndWritePairs();
+    Cap();
+    WriteDataset();
     return summary_;
   }
 
  private:
   std::string Where() const { return bag_->Path().string(); }
-  void Drop(const std::string& reason) { ++summary_.dropped[reason]; }
 
-  void ReadStampsAndBoards() {
+  void ResolveBoard() {
+    if (board_) {
+      summary_.board_source = "--board";
+      return;
+    }
+    if (const auto beside = TargetBesideRecording(bag_->Path())) {
+      board_ = LoadTargetFile(*beside);
+      summary_.board_source = beside->string() + " (beside the recording)";
+    }
+  }
+
+  PairTopics Topics() const {
+    const BagTopic& image = bag_->Topics()[image_topic_];
+    PairTopics topics;
+    topics.cloud = bag_->Topics()[cloud_topic_].encoding;
+    topics.image = image.encoding;
+    topics.compressed_image = image.type == kCompressedImageType;
+    topics.image_topic = options_.image_topic;
+    if (info_topic_ >= 0) topics.camera_info = bag_->Topics()[info_topic_].encoding;
+    topics.camera_info_topic = options_.camera_info_topic;
+    return topics;
+  }
+
+  void ReadAndWritePairs() {
+    fs::create_directories(out_dir_ / "clouds");
+    fs::create_directories(out_dir_ / "images");
+    RecordingPairFinder finder(Where(), Topics(), board_, options_.camera, options_);
     std::vector<bool> wanted(bag_->Topics().size(), false);
     wanted[cloud_topic_] = wanted[image_topic_] = true;
     if (info_topic_ >= 0) wanted[info_topic_] = true;
-    first_.camera = options_.camera;
-    int clouds = 0, images = 0;
+    std::int64_t first_ns = INT64_MAX, last_ns = INT64_MIN;
     bag_->ForEachMessage(
         wanted,
         [&](const BagMessage& message) {
-          const BagTopic& topic = bag_->Topics()[message.topic];
+          first_ns = std::min(first_ns, message.log_time_ns);
+          last_ns = std::max(last_ns, message.log_time_ns);
           if (message.topic == cloud_topic_) {
-            ReadCloudStamp(topic, message, clouds++);
+            finder.AddCloud(message.data, message.log_time_ns);
           } else if (message.topic == image_topic_) {
-            ReadImage(topic, message, images++);
-          } else if (!first_.camera) {
-            ReadCameraInfo(topic, message);
+            finder.AddImage(message.data, message.log_time_ns);
+          } else {
+            finder.AddCameraInfo(message.data);
           }
+          Write(finder.TakePairs());
           return true;
         },
         [&](std::int64_t done, std::int64_t total) {
           if (progress_) progress_("reading", done, total);
         });
-    summary_.bytes_read += bag_->SizeBytes();
-    summary_.clouds = clouds;
-    summary_.images = images;
-    if (!first_.camera)
+    finder.Finish();
+    Write(finder.TakePairs());
+    summary_.bytes_read = bag_->SizeBytes();
+    if (last_ns > first_ns) summary_.recording_seconds = (last_ns - first_ns) * 1e-9;
+    const PairFinderStats stats = finder.Stats();
+    summary_.clouds = stats.clouds;
+    summary_.images = stats.images;
+    summary_.tries = stats.tries;
+    summary_.images_searched = stats.images_searched;
+    summary_.boards_seen = stats.boards_found;
+    summary_.dropped = stats.dropped;
+    summary_.kept_without_stillness_check = stats.kept_without_stillness_check;
+    camera_ = finder.Camera();
+    if (const auto board = finder.Board()) summary_.board = *board;
+    if (!board_ && !stats.board_choice.empty()) summary_.board_source = stats.board_choice;
+    if (!camera_)
       throw IoError(Where() + ": no usable camera intrinsics on " + options_.camera_info_topic +
-                    (first_.camera_problem.empty() ? "" : " (" + first_.camera_problem + ")") +
                     ": give them with --camera FILE");
-    EstimateBoardPoses();
-    std::sort(first_.images.begin(), first_.images.end(),
-              [](const ImageMoment& a, const ImageMoment& b) { return a.stamp_ns < b.stamp_ns; });
-    std::sort(first_.clouds.begin(), first_.clouds.end(),
-              [](const CloudMoment& a, const CloudMoment& b) { return a.stamp_ns < b.stamp_ns; });
   }
 
-  void ReadCloudStamp(const BagTopic& topic, const BagMessage& message, int index) {
-    try {
-      const RosHeader header = DecodeRosHeader(message.data, topic.encoding);
-      first_.clouds.push_back({StampOrLogTime(header, message), index});
-    } catch (const std::invalid_argument&) {
-      Drop("cloud message unreadable");
+  void Write(std::vector<FoundPair> pairs) {
+    for (FoundPair& pair : pairs) {
+      const int index = static_cast<int>(written_.size());
+      const std::string id = PairId(index);
+      if (pair.cloud.HasRing())
+        rings_ =
+            std::max(rings_, *std::max_element(pair.cloud.ring.begin(), pair.cloud.ring.end()) + 1);
+      SavePcd(out_dir_ / "clouds" / (id + ".pcd"), pair.cloud, PcdEncoding::kBinary);
+      SaveImage(out_dir_ / "images" / (id + ".png"), pair.image);
+      written_.push_back({index, pair.cloud_stamp_ns, pair.image_stamp_ns});
     }
   }
 
-  void ReadImage(const BagTopic& topic, const BagMessage& message, int index) {
-    ImageMoment moment;
-    moment.index = index;
-    moment.stamp_ns = message.log_time_ns;
-    try {
-      const ImageMessage image = DecodeAnyImage(topic, message, options_.limits);
-      moment.stamp_ns = StampOrLogTime(image.header, message);
-      CheckImageSize(image.image);
-      std::string why;
-      moment.detection = DetectBoard(image.image, board_, BoardDetectionOptions{}, &why);
-      moment.board_found = moment.detection.has_value();
-    } catch (const std::invalid_argument& error) {
-      moment.unreadable = true;
-      if (first_.image_problem.empty()) first_.image_problem = error.what();
-    }
-    first_.images.push_back(std::move(moment));
-  }
-
-  // The first image fixes the size; a camera of another size is a rectified or binned stream,
-  // whose CameraInfo does not describe these pixels.
-  void CheckImageSize(const ImageU8& image) {
-    if (image_width_ == 0) {
-      image_width_ = image.width;
-      image_height_ = image.height;
-    }
-    if (first_.camera &&
-        (first_.camera->width != image.width || first_.camera->height != image.height))
-      throw IoError(Where() + ": the images on " + options_.image_topic + " are " +
-                    std::to_string(image.width) + " x " + std::to_string(image.height) +
-                    " but the camera intrinsics are for " + std::to_string(first_.camera->width) +
-                    " x " + std::to_string(first_.camera->height));
-  }
-
-  void ReadCameraInfo(const BagTopic& topic, const BagMessage& message) {
-    try {
-      first_.camera = DecodeCameraInfo(message.data, topic.encoding).camera;
-      if (image_width_ > 0 &&
-          (first_.camera->width != image_width_ || first_.camera->height != image_height_))
-        throw IoError(Where() + ": the CameraInfo on " + options_.camera_info_topic + " is for " +
-                      std::to_string(first_.camera->width) + " x " +
-                      std::to_string(first_.camera->height) + " images, but " +
-                      options_.image_topic + " has " + std::to_string(image_width_) + " x " +
-                      std::to_string(image_height_));
-    } catch (const std::invalid_argument& error) {
-      first_.camera_problem = error.what();
-    }
-  }
-
-  void EstimateBoardPoses() {
-    for (ImageMoment& image : first_.images) {
-      if (!image.detection) continue;
-      ++summary_.boards_seen;
-      std::string why;
-      const auto observation =
-          EstimateBoardPose(*first_.camera, *image.detection, PnpOptions{}, &why);
-      if (observation) image.cam_from_board = observation->cam_from_board;
-      image.detection.reset();  // the corners are not needed any more
-    }
-  }
-
-  const ImageMoment* NearestImage(std::int64_t stamp) const {
-    const auto& images = first_.images;
-    auto after = std::lower_bound(
-        images.begin(), images.end(), stamp,
-        [](const ImageMoment& image, std::int64_t t) { return image.stamp_ns < t; });
-    const ImageMoment* best = nullptr;
-    if (after != images.end()) best = &*after;
-    if (after != images.begin()) {
-      const ImageMoment* before = &*std::prev(after);
-      if (!best || stamp - before->stamp_ns <= best->stamp_ns - stamp) best = before;
-    }
-    return best;
-  }
-
-  // False when another pose within the window differs from the pair's beyond the thresholds.
-  bool BoardStill(const ImageMoment& pair_image, std::int64_t cloud_stamp, bool* judged) const {
-    const auto half = static_cast<std::int64_t>(options_.still_window_s * 0.5e9);
-    *judged = false;
-    const auto& images = first_.images;  // sorted by stamp: only the window is looked at
-    auto from = std::lower_bound(
-        images.begin(), images.end(), cloud_stamp - half,
-        [](const ImageMoment& image, std::int64_t t) { return image.stamp_ns < t; });
-    for (auto it = from; it != images.end() && it->stamp_ns <= cloud_stamp + half; ++it) {
-      const ImageMoment& image = *it;
-      if (&image == &pair_image || !image.cam_from_board) continue;
-      *judged = true;
-      if (TranslationM(*image.cam_from_board, *pair_image.cam_from_board) >
-              options_.still_translation_m ||
-          RotationDeg(*image.cam_from_board, *pair_image.cam_from_board) >
-              options_.still_rotation_deg)
-        return false;
-    }
-    return true;
-  }
-
-  std::vector<Candidate> Select() {
-    std::vector<Candidate> candidates;
-    const auto max_offset = static_cast<std::int64_t>(options_.max_pair_offset_s * 1e9);
-    int unjudged = 0;
-    for (const CloudMoment& cloud : first_.clouds) {
-      const ImageMoment* image = NearestImage(cloud.stamp_ns);
-      if (!image || std::abs(image->stamp_ns - cloud.stamp_ns) > max_offset) {
-        Drop("no image within " + Ms(options_.max_pair_offset_s));
-      } else if (image->unreadable) {
-        Drop("image unreadable");
-      } else if (!image->board_found) {
-        Drop("board not found in the image");
-      } else if (!image->cam_from_board) {
-        Drop("board pose failed in the image");
-      } else {
-        bool judged = false;
-        if (!BoardStill(*image, cloud.stamp_ns, &judged)) {
-          Drop("board moving (within " + Ms(options_.still_window_s / 2) + ")");
-          continue;
-        }
-        if (!judged) ++unjudged;
-        candidates.push_back({cloud, image, ""});
-      }
-    }
-    std::vector<Candidate> kept;
-    for (const Candidate& candidate : candidates) {
-      const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Candidate& other) {
-        return TranslationM(*other.image->cam_from_board, *candidate.image->cam_from_board) <=
-                   options_.duplicate_translation_m &&
-               RotationDeg(*other.image->cam_from_board, *candidate.image->cam_from_board) <=
-                   options_.duplicate_rotation_deg;
-      });
-      if (duplicate) {
-        Drop("near-duplicate board pose");
-      } else {
-        kept.push_back(candidate);
-      }
-    }
-    summary_.kept_without_stillness_check = unjudged;
-    return Cap(std::move(kept));
-  }
-
-  std::vector<Candidate> Cap(std::vector<Candidate> kept) {
+  // At most max_pairs, spread evenly over the recording; the files of the others are removed and
+  // the kept ones renumbered from 0000 (ids only ever move down, so no rename overwrites a kept
+  // pair's file).
+  void Cap() {
     const auto cap = static_cast<std::size_t>(options_.max_pairs);
-    if (cap == 0 || kept.size() <= cap) return kept;
-    std::vector<Candidate> spread;
-    for (std::size_t i = 0; i < cap; ++i) {
-      const std::size_t pick = cap == 1 ? 0 : i * (kept.size() - 1) / (cap - 1);
-      spread.push_back(kept[pick]);
-    }
-    for (std::size_t i = 0; i < kept.size() - cap; ++i)
-      Drop("over the cap of " + std::to_string(cap) + " pairs");
-    return spread;
-  }
-
-  void WritePairs(std::vector<Candidate>* kept) {
-    fs::create_directories(out_dir_ / "clouds");
-    fs::create_directories(out_dir_ / "images");
-    std::map<int, Candidate*> by_cloud;
-    std::map<int, std::vector<Candidate*>> by_image;
-    for (std::size_t i = 0; i < kept->size(); ++i) {
-      Candidate& candidate = (*kept)[i];
-      char id[24];
-      std::snprintf(id, sizeof(id), "%04zu", i);
-      candidate.id = id;
-      by_cloud[candidate.cloud.index] = &candidate;
-      by_image[candidate.image->index].push_back(&candidate);
-    }
-    std::vector<bool> wanted(bag_->Topics().size(), false);
-    wanted[cloud_topic_] = wanted[image_topic_] = true;
-    int clouds = 0, images = 0;
-    std::set<std::string> failed;
-    bag_->ForEachMessage(
-        wanted,
-        [&](const BagMessage& message) {
-          const BagTopic& topic = bag_->Topics()[message.topic];
-          if (message.topic == cloud_topic_) {
-            const auto found = by_cloud.find(clouds++);
-            if (found != by_cloud.end() && !WriteCloud(topic, message, *found->second))
-              failed.insert(found->second->id);
-          } else {
-            const auto found = by_image.find(images++);
-            if (found != by_image.end())
-              for (Candidate* candidate : found->second)
-                if (!WriteImage(topic, message, *candidate)) failed.insert(candidate->id);
-          }
-          return true;
-        },
-        [&](std::int64_t done, std::int64_t total) {
-          if (progress_) progress_("writing", done, total);
-        });
-    summary_.bytes_read += bag_->SizeBytes();
-    std::erase_if(*kept, [&](const Candidate& c) { return failed.count(c.id) > 0; });
-  }
-
-  bool WriteCloud(const BagTopic& topic, const BagMessage& message, const Candidate& candidate) {
-    try {
-      PointCloud2Message cloud = DecodePointCloud2(message.data, topic.encoding, options_.limits);
-      if (cloud.cloud.size() == 0) {
-        Drop("cloud has no finite point");
-        return false;
+    if (cap == 0 || written_.size() <= cap) return;
+    std::vector<WrittenPair> spread;
+    std::vector<bool> keep(written_.size(), false);
+    for (std::size_t i = 0; i < cap; ++i)
+      keep[cap == 1 ? 0 : i * (written_.size() - 1) / (cap - 1)] = true;
+    for (std::size_t i = 0; i < written_.size(); ++i) {
+      const std::string id = PairId(written_[i].found);
+      if (keep[i]) {
+        spread.push_back(written_[i]);
+        continue;
       }
-      if (cloud.cloud.HasRing())
-        rings_ = std::max(rings_,
-                          *std::max_element(cloud.cloud.ring.begin(), cloud.cloud.ring.end()) + 1);
-      SavePcd(out_dir_ / "clouds" / (candidate.id + ".pcd"), cloud.cloud, PcdEncoding::kBinary);
-      return true;
-    } catch (const std::invalid_argument&) {
-      Drop("cloud message unreadable");
-      return false;
+      fs::remove(out_dir_ / "clouds" / (id + ".pcd"));
+      fs::remove(out_dir_ / "images" / (id + ".png"));
+      ++summary_.dropped["over the cap of " + std::to_string(cap) + " pairs"];
     }
+    for (std::size_t i = 0; i < spread.size(); ++i) {
+      const std::string from = PairId(spread[i].found), to = PairId(static_cast<int>(i));
+      if (from == to) continue;
+      fs::rename(out_dir_ / "clouds" / (from + ".pcd"), out_dir_ / "clouds" / (to + ".pcd"));
+      fs::rename(out_dir_ / "images" / (from + ".png"), out_dir_ / "images" / (to + ".png"));
+      spread[i].found = static_cast<int>(i);
+    }
+    written_ = std::move(spread);
   }
 
-  bool WriteImage(const BagTopic& topic, const BagMessage& message, const Candidate& candidate) {
-    try {
-      const ImageMessage image = DecodeAnyImage(topic, message, options_.limits);
-      SaveImage(out_dir_ / "images" / (candidate.id + ".png"), image.image);
-      return true;
-    } catch (const std::invalid_argument&) {
-      Drop("image unreadable");
-      return false;
-    }
-  }
-
-  void WriteDataset(const std::vector<Candidate>& kept) {
-    if (kept.empty())
+  void WriteDataset() {
+    if (written_.empty())
       throw IoError(Where() + ": no pair survived the selection (" + DroppedText() + ")");
-    SaveCameraInfoYaml(out_dir_ / "camera.yaml", *first_.camera, "camera");
+    SaveCameraInfoYaml(out_dir_ / "camera.yaml", *camera_, "camera");
     Dataset dataset;
-    dataset.camera = *first_.camera;
-    dataset.target = board_;
+    dataset.camera = *camera_;
+    dataset.target = summary_.board;
     dataset.lidar_rings = rings_;
     nlohmann::json pairs = nlohmann::json::array();
-    for (const Candidate& candidate : kept) {
+    for (const WrittenPair& pair : written_) {
+      const std::string id = PairId(pair.found);
       PairEntry entry;
-      entry.id = candidate.id;
-      entry.cloud = fs::absolute(out_dir_ / "clouds" / (candidate.id + ".pcd"));
-      entry.image = fs::absolute(out_dir_ / "images" / (candidate.id + ".png"));
+      entry.id = id;
+      entry.cloud = fs::absolute(out_dir_ / "clouds" / (id + ".pcd"));
+      entry.image = fs::absolute(out_dir_ / "images" / (id + ".png"));
       dataset.pairs.push_back(entry);
-      summary_.pair_ids.push_back(candidate.id);
-      pairs.push_back({{"id", candidate.id},
-                       {"cloud_stamp_ns", candidate.cloud.stamp_ns},
-                       {"image_stamp_ns", candidate.image->stamp_ns}});
+      summary_.pair_ids.push_back(id);
+      pairs.push_back({{"id", id},
+                       {"cloud_stamp_ns", pair.cloud_stamp_ns},
+                       {"image_stamp_ns", pair.image_stamp_ns}});
     }
     summary_.manifest = out_dir_ / "dataset.json";
     SaveDataset(summary_.manifest, dataset);
@@ -399,6 +205,9 @@ class Importer {
         {"clouds", summary_.clouds},           {"images", summary_.images},
         {"dropped", summary_.dropped},         {"pairs", pairs}};
     record["kept_without_stillness_check"] = summary_.kept_without_stillness_check;
+    record["board"] = summary_.board_source;
+    record["tries"] = summary_.tries;
+    record["images_searched"] = summary_.images_searched;
     WriteFileAtomically(out_dir_ / "import.json", record.dump(2) + "\n");
   }
 
@@ -411,20 +220,20 @@ class Importer {
 
   std::unique_ptr<BagReader> bag_;
   fs::path out_dir_;
-  BoardSpec board_;
+  std::optional<BoardSpec> board_;
   BagImportOptions options_;
   ImportProgress progress_;
   int cloud_topic_ = -1, image_topic_ = -1, info_topic_ = -1;
-  int image_width_ = 0, image_height_ = 0;
   int rings_ = 0;
-  FirstPass first_;
+  std::optional<CameraModel> camera_;
+  std::vector<WrittenPair> written_;
   BagImportSummary summary_;
 };
 
 }  // namespace
 
 BagImportSummary ImportBag(const fs::path& bag_path, const fs::path& out_dir,
-                           const BoardSpec& board, BagImportOptions options,
+                           const std::optional<BoardSpec>& board, BagImportOptions options,
                            const ImportProgress& progress) {
   return Importer(bag_path, out_dir, board, std::move(options), progress).Run();
 }

@@ -1,6 +1,7 @@
 // A recording -> a dataset folder: the LiDAR and camera topics chosen, clouds paired with images
 // by stamp, only moments when the board stood still, no near-duplicate poses, at most a cap;
 // written as binary PCD + PNG + camera.yaml + dataset.json, with a record of every dropped frame.
+// The pairs themselves are chosen by core/io/recording_pairs.h, which `watch` shares.
 #pragma once
 
 #include <cstdint>
@@ -14,30 +15,19 @@
 #include "core/camera/camera.h"
 #include "core/io/bag.h"
 #include "core/io/load_limits.h"
+#include "core/io/recording_pairs.h"
 #include "core/target/board.h"
 
 namespace calibench {
 
-struct BagImportOptions {
+struct BagImportOptions : PairSelectionOptions {
   // Topics; empty = chosen automatically when the recording has exactly one candidate.
   std::string cloud_topic;            // sensor_msgs/PointCloud2
   std::string image_topic;            // sensor_msgs/Image or CompressedImage
   std::string camera_info_topic;      // sensor_msgs/CameraInfo; unused when `camera` is given
   std::optional<CameraModel> camera;  // intrinsics from a file instead of the recording
-
-  // Pairing: a cloud takes the image with the nearest stamp within this offset [s].
-  double max_pair_offset_s = 0.05;
-  // Stillness: the board poses the camera sees within ±window/2 of the pair [s] (a spinning
-  // LiDAR sweeps for 100 ms) may differ from the pair's by at most these.
-  double still_window_s = 0.4;
-  double still_translation_m = 0.01;
-  double still_rotation_deg = 1.0;
-  // Near-duplicates: a pair whose board pose is within both of these of a kept pair's is dropped.
-  double duplicate_translation_m = 0.10;
-  double duplicate_rotation_deg = 5.0;
   // At most this many pairs, spread evenly over the recording (0 = no cap).
   int max_pairs = 60;
-  LoadLimits limits;
 
   bool Check(std::string* why) const;
 };
@@ -49,14 +39,19 @@ struct BagImportSummary {
   std::string cloud_topic, image_topic, camera_source;
   std::int64_t clouds = 0;             // messages on the cloud topic
   std::int64_t images = 0;             // messages on the image topic
-  int boards_seen = 0;                 // images where the board was found
+  int tries = 0;                       // sweeps tried (the LiDAR saw the board held still)
+  int images_searched = 0;             // images searched for the board
+  int boards_seen = 0;                 // of those, the board found
   std::vector<std::string> pair_ids;   // written, in time order
   std::map<std::string, int> dropped;  // reason -> clouds dropped for it
-  // Candidates with no other board pose within the stillness window (a camera as slow as the
-  // window): kept, but their stillness is unknown.
+  // Kept pairs with no other image within the stillness window (a camera as slow as the
+  // window): their stillness is unknown.
   int kept_without_stillness_check = 0;
+  BoardSpec board;           // the board the pairs show
+  std::string board_source;  // "--board", "<path> (beside the recording)" or how it was chosen
+  double recording_seconds = 0.0;  // from the first to the last message read
   std::filesystem::path manifest;  // the dataset.json written
-  std::int64_t bytes_read = 0;     // over both passes
+  std::int64_t bytes_read = 0;
 };
 
 // Topics to import when the options name none: exactly one PointCloud2 topic; one image topic
@@ -74,12 +69,18 @@ std::filesystem::path DefaultImportFolder(const std::filesystem::path& bag);
 using ImportProgress =
     std::function<void(const std::string& phase, std::int64_t done, std::int64_t total)>;
 
-// Reads the recording twice (stamps, camera intrinsics and board poses; then the chosen pairs)
-// and writes the dataset into `out_dir` (created; files already there with the same names are
-// replaced, others kept). Throws IoError naming the file on unreadable data, on a camera that
-// cannot be had, or when no pair survives (the summary's reasons are in the message).
+// The target.json a user keeps with a recording: beside the file (or the rosbag2 folder), or
+// inside the rosbag2 folder. nullopt when there is none.
+std::optional<std::filesystem::path> TargetBesideRecording(const std::filesystem::path& bag);
+
+// Reads the recording once (core/io/recording_pairs.h chooses the pairs as it goes) and writes
+// the dataset into `out_dir` (created; files already there with the same names are replaced,
+// others kept). `board` nullopt: the target.json beside the recording, else the preset that
+// fits the images. Throws IoError naming the file on unreadable data, on a camera that cannot be
+// had, on a board no preset explains, or when no pair survives (the reasons in the message).
 BagImportSummary ImportBag(const std::filesystem::path& bag_path,
-                           const std::filesystem::path& out_dir, const BoardSpec& board,
-                           BagImportOptions options, const ImportProgress& progress = {});
+                           const std::filesystem::path& out_dir,
+                           const std::optional<BoardSpec>& board, BagImportOptions options,
+                           const ImportProgress& progress = {});
 
 }  // namespace calibench

@@ -26,7 +26,16 @@ bool BagImportOptions::Check(std::string* why) const {
   if (max_pairs < 0) return fail("the pair cap must be >= 0 (0 = none)");
   std::string camera_why;
   if (camera && !camera->Check(&camera_why)) return fail("camera: " + camera_why);
-  return limits.Check(why);
+  return PairSelectionOptions::Check(why);
+}
+
+std::optional<fs::path> TargetBesideRecording(const fs::path& bag) {
+  fs::path source = fs::absolute(bag).lexically_normal();
+  if (source.filename().empty()) source = source.parent_path();  // "folder/"
+  std::error_code error;
+  for (const fs::path& candidate : {source / "target.json", source.parent_path() / "target.json"})
+    if (fs::is_regular_file(candidate, error)) return candidate;
+  return std::nullopt;
 }
 
 fs::path DefaultImportFolder(const fs::path& bag) {

@@ -117,10 +117,14 @@ Dataset LoadFolderSetup(const fs::path& dir) {
   if (!fs::exists(target_file))
     Fail(dir, "folder dataset has no target.json (and no dataset.json)");
   dataset.camera = LoadCameraFile(camera_file);
-  const json target_document = json_io::ReadJson(target_file);
-  const json_io::Fields target(target_document, target_file);
-  dataset.target = json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
+  dataset.target = LoadTargetFile(target_file);
   return dataset;
+}
+
+BoardSpec LoadTargetFile(const fs::path& path) {
+  const json document = json_io::ReadJson(path);
+  const json_io::Fields target(document, path);
+  return json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
 }
 
 Dataset LoadDataset(const fs::path& path) {

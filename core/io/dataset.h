@@ -56,6 +56,10 @@ Dataset LoadDataset(const std::filesystem::path& path);
 // that has not written any yet (`calibench watch`). Throws IoError like LoadDataset.
 Dataset LoadFolderSetup(const std::filesystem::path& dir);
 
+// A target file: the board spec at the top level or under "target" (target.json, a manifest).
+// Throws IoError naming the file.
+BoardSpec LoadTargetFile(const std::filesystem::path& path);
+
 // Writes a manifest; paths are written relative to the manifest's folder when they lie under it.
 void SaveDataset(const std::filesystem::path& manifest_path, const Dataset& dataset);
 

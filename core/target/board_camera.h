@@ -41,6 +41,25 @@ struct BoardDetection {
 std::optional<BoardDetection> DetectBoard(const ImageU8& image, const BoardSpec& board,
                                           const BoardDetectionOptions& options, std::string* why);
 
+// The corners of `detection`, found in `from`, followed into `to` by pyramidal Lucas-Kanade
+// flow (a board held still, or moved a few pixels): what import uses to check that the board
+// stood still around a pair without searching each image again. nullopt with *why when fewer
+// than `min_tracked_fraction` of the corners are followed (the board moved too far, left the
+// view or was covered).
+std::optional<BoardDetection> TrackBoard(const ImageU8& from, const BoardDetection& detection,
+                                         const ImageU8& to, double min_tracked_fraction,
+                                         std::string* why);
+
+// Whether `board` explains what an image shows. A checkerboard detector finds a 5x4 grid inside
+// a 7x5 board as readily as on a 5x4 board, so "found" is not enough to choose between presets.
+enum class BoardFit {
+  kNotFound,      // the board is not in the image
+  kPartOfLarger,  // found, but as part of a larger board: a checkerboard with one more column or
+                  // row of corners, a ChArUco marker whose id this board does not have
+  kFits,          // found, and nothing of it extends beyond the spec
+};
+BoardFit FitBoard(const ImageU8& image, const BoardSpec& board);
+
 struct CameraBoardObservation {
   Pose cam_from_board;
   Mat6 pose_covariance;   // of cam_from_board, right perturbation, [rho; phi]

@@ -1,11 +1,14 @@
 // Camera-side board detection: checkerboard (findChessboardCornersSB + cornerSubPix) and ChArUco
 // (ArUco markers + interpolateCornersCharuco + offset correction + cornerSubPix).
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -248,6 +251,178 @@ std::optional<BoardDetection> DetectBoard(const ImageU8& image, const BoardSpec&
   if (!ToGrey(image, &grey, why)) return std::nullopt;
   return board.type == BoardType::kCheckerboard ? DetectCheckerboard(grey, board, options, why)
                                                 : DetectCharuco(grey, board, options, why);
+}
+
+namespace {
+
+// Whether the squares of a detected checkerboard go on beyond its spec: the ring of square
+// centres one square outside the outermost squares is sampled (through the homography from grid
+// to image) on each side. On a print of exactly the spec that ring is the white margin or the
+// background, one tone; on a larger print it alternates dark and light with the grid's parity.
+// The outermost squares, which every print has, teach the two tones and the parity.
+bool CheckerboardContinues(const cv::Mat& grey, const BoardSpec& board,
+                           const BoardDetection& detection) {
+  std::vector<cv::Point2f> grid, pixels;
+  for (std::size_t i = 0; i < detection.ids.size(); ++i) {
+    grid.emplace_back(static_cast<float>(detection.ids[i] % board.cols),
+                      static_cast<float>(detection.ids[i] / board.cols));
+    pixels.emplace_back(static_cast<float>(detection.pixels[i].x()),
+                        static_cast<float>(detection.pixels[i].y()));
+  }
+  const cv::Mat homography = cv::findHomography(grid, pixels);
+  if (homography.empty()) return true;
+  // Corners that no homography of the spec's grid maps onto (out of row order) are no fit.
+  // Tolerance: a fraction of a square, so that lens distortion passes.
+  std::vector<cv::Point2f> mapped;
+  cv::perspectiveTransform(grid, mapped, homography);
+  double squared = 0.0;
+  for (std::size_t i = 0; i < mapped.size(); ++i) {
+    const cv::Point2f d = mapped[i] - pixels[i];
+    squared += d.dot(d);
+  }
+  const double rms = std::sqrt(squared / static_cast<double>(mapped.size()));
+  const double square_px = cv::norm(pixels[1] - pixels[0]);
+  if (rms > 0.15 * square_px) return true;
+  // Mean grey of a 3x3 patch at a grid point; -1 outside the image.
+  auto sample = [&](double col, double row) {
+    std::vector<cv::Point2f> at;
+    cv::perspectiveTransform(std::vector<cv::Point2f>{cv::Point2f(col, row)}, at, homography);
+    const int x = cvRound(at[0].x), y = cvRound(at[0].y);
+    if (x < 1 || y < 1 || x >= grey.cols - 1 || y >= grey.rows - 1) return -1.0;
+    return cv::mean(grey(cv::Rect(x - 1, y - 1, 3, 3)))[0];
+  };
+  // A square centre (col, row) at half-integers; its parity says which tone it has.
+  auto parity = [](double col, double row) {
+    return (static_cast<int>(std::floor(col)) + static_cast<int>(std::floor(row))) & 1;
+  };
+  // Centres of the ring `k` squares outside the inner corners (k = 0.5: the outermost squares).
+  auto ring = [&](double k) {
+    std::vector<std::array<double, 3>> centres;  // col, row, side (0 left 1 right 2 top 3 bottom)
+    for (double row = -k; row <= board.rows - 1 + k + 1e-9; row += 1.0) {
+      centres.push_back({-k, row, 0});
+      centres.push_back({board.cols - 1 + k, row, 1});
+    }
+    for (double col = -k + 1; col <= board.cols - 2 + k + 1e-9; col += 1.0) {
+      centres.push_back({col, -k, 2});
+      centres.push_back({col, board.rows - 1 + k, 3});
+    }
+    return centres;
+  };
+  double tone_sum[2] = {0, 0}, tone_squares[2] = {0, 0};
+  int tone_count[2] = {0, 0};
+  for (const auto& [col, row, side] : ring(0.5)) {
+    const double value = sample(col, row);
+    if (value < 0) continue;
+    const int p = parity(col, row);
+    tone_sum[p] += value;
+    tone_squares[p] += value * value;
+    ++tone_count[p];
+  }
+  if (tone_count[0] == 0 || tone_count[1] == 0) return false;  // the view cuts the board
+  const double tone[2] = {tone_sum[0] / tone_count[0], tone_sum[1] / tone_count[1]};
+  const double spread =
+      std::sqrt(std::max({0.0, tone_squares[0] / tone_count[0] - tone[0] * tone[0],
+                          tone_squares[1] / tone_count[1] - tone[1] * tone[1]}));
+  const double contrast = std::abs(tone[0] - tone[1]);
+  // The outermost squares must alternate in two clear tones. A sub-window of a larger print can
+  // come back half a square off its squares (seen with a4's grid on an a3 print at 8 px squares):
+  // the samples then land on edges and margins, in no order.
+  if (contrast < 20 || contrast < 3 * spread) return true;
+  // The ring one square further out, without its corners (a larger print may extend on one side
+  // only, so the squares diagonal to the grid's corners may be off it).
+  int matches[4] = {0, 0, 0, 0}, seen[4] = {0, 0, 0, 0}, dark[4] = {0, 0, 0, 0};
+  const int dark_parity = tone[0] < tone[1] ? 0 : 1;
+  for (const auto& [col, row, side] : ring(1.5)) {
+    const bool corner = (col < -1 || col > board.cols) && (row < -1 || row > board.rows);
+    const double value = corner ? -1 : sample(col, row);
+    if (value < 0) continue;
+    const int s = static_cast<int>(side);
+    ++seen[s];
+    const int p = parity(col, row);
+    // Its parity's tone, by a clear margin; the white margin of an exact print matches only the
+    // light half, the background neither.
+    if (std::abs(value - tone[p]) < 0.3 * contrast) {
+      ++matches[s];
+      dark[s] += p == dark_parity;
+    }
+  }
+  for (int side = 0; side < 4; ++side)
+    if (seen[side] >= 3 && dark[side] > 0 && matches[side] >= 0.8 * seen[side]) return true;
+  return false;
+}
+
+}  // namespace
+
+std::optional<BoardDetection> TrackBoard(const ImageU8& from, const BoardDetection& detection,
+                                         const ImageU8& to, double min_tracked_fraction,
+                                         std::string* why) {
+  std::string local_why;
+  if (!why) why = &local_why;
+  cv::Mat from_grey, to_grey;
+  if (!ToGrey(from, &from_grey, why) || !ToGrey(to, &to_grey, why)) return std::nullopt;
+  if (from_grey.size() != to_grey.size()) {
+    *why = "the images differ in size";
+    return std::nullopt;
+  }
+  if (detection.pixels.empty()) {
+    *why = "no corners to follow";
+    return std::nullopt;
+  }
+  std::vector<cv::Point2f> before, after;
+  for (const Vec2& p : detection.pixels)
+    before.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  std::vector<unsigned char> status, back_status;
+  std::vector<float> error;
+  // 21 px window, 3 pyramid levels: follows up to ~80 px of motion, far beyond the stillness
+  // thresholds, so a board that moved shows as a changed pose rather than as lost corners. Each
+  // corner is followed back as well: a corner that does not come home within half a pixel was
+  // not followed (the flow "succeeds" on a blank image too).
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  cv::calcOpticalFlowPyrLK(from_grey, to_grey, before, after, status, error, cv::Size(21, 21), 3,
+                           criteria);
+  std::vector<cv::Point2f> back;
+  cv::calcOpticalFlowPyrLK(to_grey, from_grey, after, back, back_status, error, cv::Size(21, 21), 3,
+                           criteria);
+  constexpr float kRoundTripPx = 0.5f;
+  BoardDetection tracked;
+  for (std::size_t i = 0; i < after.size(); ++i) {
+    if (!status[i] || !back_status[i] || cv::norm(back[i] - before[i]) > kRoundTripPx ||
+        after[i].x < 0 || after[i].y < 0 || after[i].x > to_grey.cols - 1 ||
+        after[i].y > to_grey.rows - 1)
+      continue;
+    tracked.pixels.emplace_back(after[i].x, after[i].y);
+    tracked.board_points.push_back(detection.board_points[i]);
+    tracked.ids.push_back(detection.ids[i]);
+  }
+  if (static_cast<double>(tracked.pixels.size()) <
+      min_tracked_fraction * static_cast<double>(detection.pixels.size())) {
+    *why = "followed " + std::to_string(tracked.pixels.size()) + " of " +
+           std::to_string(detection.pixels.size()) + " corners";
+    return std::nullopt;
+  }
+  return tracked;
+}
+
+BoardFit FitBoard(const ImageU8& image, const BoardSpec& board) {
+  std::string why;
+  const std::optional<BoardDetection> detection =
+      DetectBoard(image, board, BoardDetectionOptions{}, &why);
+  if (!detection) return BoardFit::kNotFound;
+  cv::Mat grey;
+  if (!ToGrey(image, &grey, &why)) return BoardFit::kNotFound;
+  if (board.type == BoardType::kCheckerboard)
+    return CheckerboardContinues(grey, board, *detection) ? BoardFit::kPartOfLarger
+                                                          : BoardFit::kFits;
+  const cv::Ptr<cv::aruco::Dictionary> dictionary = DictionaryByName(board.dictionary);
+  std::vector<std::vector<cv::Point2f>> marker_corners;
+  std::vector<int> marker_ids;
+  const cv::Ptr<cv::aruco::DetectorParameters> parameters = cv::aruco::DetectorParameters::create();
+  cv::aruco::detectMarkers(grey, dictionary, marker_corners, marker_ids, parameters);
+  // A ChArUco board of cols x rows squares carries markers 0 .. cols*rows/2 - 1.
+  const int markers = board.cols * board.rows / 2;
+  for (int id : marker_ids)
+    if (id >= markers) return BoardFit::kPartOfLarger;
+  return BoardFit::kFits;
 }
 
 std::optional<double> ChessboardEdgeWidthPx(const ImageU8& image, const BoardSpec& board,

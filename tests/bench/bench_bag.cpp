@@ -7,8 +7,8 @@
 // a still board, cycling over the pairs.
 //   BM_BagRead     every message handed out (MB/s of the file)
 //   BM_BagDecode   every PointCloud2 and Image decoded too
-//   BM_BagImport   `calibench import` as a whole: two passes, board detection on every image,
-//                  the chosen pairs written as PCD + PNG
+//   BM_BagImport   `calibench import` as a whole: one pass, each moment tried (its clouds are
+//                  alone in their stillness windows), the chosen pairs written as PCD + PNG
 #include <benchmark/benchmark.h>
 
 #include <filesystem>

@@ -244,11 +244,14 @@ void WindowShell::FileMenu() {
 
 void WindowShell::BoardMenu() {
   if (!ImGui::BeginMenu("Board in recordings")) return;
+  if (ImGui::MenuItem("automatic", nullptr, !options_.board)) options_.board.reset();
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("the target.json beside the recording, else the preset that fits the images");
   for (const char* preset : {"a3", "a4", "charuco-a3", "charuco-a4", "paper"}) {
     const BoardSpec board = BoardPreset(preset);
-    const bool chosen = board.type == options_.board.type && board.cols == options_.board.cols &&
-                        board.rows == options_.board.rows &&
-                        board.square_size == options_.board.square_size;
+    const bool chosen = options_.board && board.type == options_.board->type &&
+                        board.cols == options_.board->cols && board.rows == options_.board->rows &&
+                        board.square_size == options_.board->square_size;
     if (ImGui::MenuItem(preset, nullptr, chosen)) options_.board = board;
   }
   ImGui::TextDisabled("or --board FILE on the command line");

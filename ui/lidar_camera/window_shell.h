@@ -25,7 +25,9 @@ struct ImportJob;  // a recording importing on its thread (window_shell.cpp)
 
 struct ShellOptions {
   PipelineOptions pipeline;
-  BoardSpec board = BoardPreset("a4");  // the board seen in imported recordings
+  // The board seen in imported recordings; nullopt = the target.json beside the recording, else
+  // the preset that fits its images.
+  std::optional<BoardSpec> board;
   BagImportOptions import;
   std::filesystem::path recent_file = DefaultRecentFilesPath();
 };

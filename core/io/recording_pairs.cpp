@@ -1,0 +1,617 @@
+#include "core/io/recording_pairs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "core/io/ros_messages.h"
+#include "core/target/board_camera.h"
+#include "core/target/board_choice.h"
+
+namespace calibench {
+
+namespace {
+
+using Bytes = std::shared_ptr<const std::vector<std::uint8_t>>;
+
+Bytes Copy(std::span<const std::uint8_t> data) {
+  return std::make_shared<const std::vector<std::uint8_t>>(data.begin(), data.end());
+}
+
+std::int64_t Ns(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e9)); }
+
+std::string Ms(double seconds) {
+  return std::to_string(static_cast<int>(std::lround(seconds * 1000))) + " ms";
+}
+
+double RotationDeg(const Pose& a, const Pose& b) {
+  return Eigen::AngleAxisd(a.rotation().transpose() * b.rotation()).angle() * kRadToDeg;
+}
+
+// A checkerboard's corners may come back in either of two orders, 180 degrees apart about its
+// normal (the pattern looks the same turned over): one board pose, two rotations. The origin,
+// at the pattern's centre, is the same for both.
+double BoardRotationDeg(const Pose& a, const Pose& b, const BoardSpec& board) {
+  const double direct = RotationDeg(a, b);
+  if (board.type != BoardType::kCheckerboard) return direct;
+  Pose turned = b;
+  turned.linear() = b.rotation() * Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();
+  return std::min(direct, RotationDeg(a, turned));
+}
+
+double TranslationM(const Pose& a, const Pose& b) {
+  return (a.translation() - b.translation()).norm();
+}
+
+std::int64_t StampOr(const RosHeader& header, std::int64_t log_time_ns) {
+  return header.stamp_ns != 0 ? header.stamp_ns : log_time_ns;
+}
+
+// Sweeps and images stay this long behind the newest stamp (then a try cannot need them).
+constexpr double kKeepBeyondWindowS = 1.5;
+// A sweep is judged once stamps this far past its window have arrived: the recorder may store
+// an image a little after a later sweep.
+constexpr double kJudgeLagS = 0.25;
+// Tries waiting for the camera intrinsics (CameraInfo late in the recording); older ones drop.
+constexpr std::size_t kMaxWaitingForCamera = 8;
+// Tries queued for the second thread; the reader waits beyond that (memory stays bounded).
+constexpr std::size_t kMaxQueuedTries = 4;
+// Tries kept while the board is chosen; with no preset in any of them they are dropped.
+constexpr std::size_t kMaxBoardSamples = 12;
+constexpr const char* kHoldDone = "not needed: its hold already gave a pair";
+// Corners that must be followed into an image of the window for it to count as seen.
+constexpr double kMinTrackedFraction = 0.8;
+
+struct StampedBytes {
+  std::int64_t stamp_ns = 0;
+  Bytes bytes;
+};
+
+// One sweep tried: what the second thread needs, copied out of the reader's window.
+struct Try {
+  int hold = 0;
+  StampedBytes cloud;
+  StampedBytes image;                // the nearest in time
+  std::vector<StampedBytes> others;  // the other images within the stillness window
+  CameraModel camera;
+};
+
+}  // namespace
+
+bool PairSelectionOptions::Check(std::string* why) const {
+  if (!(max_pair_offset_s > 0.0) || !(still_window_s >= 0.0)) {
+    *why = "max_pair_offset_s must be > 0 and still_window_s >= 0";
+    return false;
+  }
+  if (!(still_translation_m >= 0.0) || !(still_rotation_deg >= 0.0) ||
+      !(duplicate_translation_m >= 0.0) || !(duplicate_rotation_deg >= 0.0)) {
+    *why = "stillness and duplicate thresholds must be >= 0";
+    return false;
+  }
+  if (!(retry_s > 0.0) || !(lidar_blind_s > 0.0)) {
+    *why = "retry_s and lidar_blind_s must be > 0";
+    return false;
+  }
+  if (board_sample_images < 1) {
+    *why = "board_sample_images must be >= 1";
+    return false;
+  }
+  return lidar_motion.Check(why) && limits.Check(why);
+}
+
+struct RecordingPairFinder::Impl {
+  Impl(std::string source_in, PairTopics topics_in, std::optional<BoardSpec> board_in,
+       std::optional<CameraModel> camera_in, PairSelectionOptions options_in)
+      : source(std::move(source_in)),
+        topics(std::move(topics_in)),
+        board(std::move(board_in)),
+        camera(std::move(camera_in)),
+        options(std::move(options_in)) {
+    std::string why;
+    if (!options.Check(&why)) throw IoError(source + ": pair selection options: " + why);
+    keep_ns = Ns(options.still_window_s + options.max_pair_offset_s + kKeepBeyondWindowS);
+    worker = std::thread([this] { Work(); });
+  }
+
+  ~Impl() {
+    {
+      std::lock_guard lock(mutex);
+      stopping = true;
+    }
+    wake_worker.notify_all();
+    if (worker.joinable()) worker.join();
+  }
+
+  // ---- reader side ---------------------------------------------------------------------------
+
+  struct RecentCloud {
+    StampedBytes cloud;
+    int hold = 0;
+    bool judged = false;
+  };
+  struct Hold {
+    int tries = 0;
+    std::int64_t last_try_ns = 0;
+    std::uint64_t last_try_serial = 0;  // 0: none queued yet
+    bool gave_a_pair = false;
+  };
+
+  void Drop(const std::string& reason) {
+    std::lock_guard lock(mutex);
+    ++stats.dropped[reason];
+  }
+
+  void RethrowWorkerError() {
+    std::lock_guard lock(mutex);
+    if (worker_error) std::rethrow_exception(worker_error);
+  }
+
+  void AddCloud(std::span<const std::uint8_t> data, std::int64_t log_time_ns) {
+    RethrowWorkerError();
+    {
+      std::lock_guard lock(mutex);
+      ++stats.clouds;
+    }
+    PointCloud2Message message;
+    try {
+      message = DecodePointCloud2(data, topics.cloud, options.limits);
+    } catch (const std::invalid_argument&) {
+      Drop("cloud message unreadable");
+      return;
+    }
+    const std::int64_t stamp = StampOr(message.header, log_time_ns);
+    SweepGrid grid = MakeSweepGrid(message.cloud, options.lidar_motion);
+    if (previous_grid) noise_floor.Add(CompareSweeps(*previous_grid, grid, options.lidar_motion));
+    if (!hold_reference ||
+        !CompareSweeps(*hold_reference, grid, options.lidar_motion, noise_floor.Fraction()).agree) {
+      ++current_hold;
+      hold_reference = grid;
+    }
+    previous_grid = std::move(grid);
+    recent_clouds.push_back({{stamp, Copy(data)}, current_hold, false});
+    Advance(stamp);
+  }
+
+  void AddImage(std::span<const std::uint8_t> data, std::int64_t log_time_ns) {
+    RethrowWorkerError();
+    {
+      std::lock_guard lock(mutex);
+      ++stats.images;
+    }
+    std::int64_t stamp = log_time_ns;
+    try {
+      stamp = StampOr(DecodeRosHeader(data, topics.image), log_time_ns);
+    } catch (const std::invalid_argument&) {
+      // Kept by its log time: the try that picks it reports it unreadable.
+    }
+    const auto at = std::upper_bound(
+        recent_images.begin(), recent_images.end(), stamp,
+        [](std::int64_t t, const StampedBytes& image) { return t < image.stamp_ns; });
+    recent_images.insert(at, {stamp, Copy(data)});
+    Advance(stamp);
+  }
+
+  void AddCameraInfo(std::span<const std::uint8_t> data) {
+    RethrowWorkerError();
+    if (camera) return;
+    try {
+      camera = DecodeCameraInfo(data, topics.camera_info).camera;
+    } catch (const std::invalid_argument& error) {
+      camera_problem = error.what();
+      return;
+    }
+    for (Try& waiting : waiting_for_camera) {
+      waiting.camera = *camera;
+      Queue(std::move(waiting));
+    }
+    waiting_for_camera.clear();
+  }
+
+  void Advance(std::int64_t stamp) {
+    horizon_ns = std::max(horizon_ns, stamp);
+    const std::int64_t ready =
+        horizon_ns - Ns(options.still_window_s / 2 + options.max_pair_offset_s + kJudgeLagS);
+    for (RecentCloud& cloud : recent_clouds)
+      if (!cloud.judged && cloud.cloud.stamp_ns <= ready) Judge(&cloud);
+    const std::int64_t oldest = horizon_ns - keep_ns;
+    while (!recent_clouds.empty() && recent_clouds.front().judged &&
+           recent_clouds.front().cloud.stamp_ns < oldest)
+      recent_clouds.pop_front();
+    while (!recent_images.empty() && recent_images.front().stamp_ns < oldest)
+      recent_images.pop_front();
+  }
+
+  // Whether the LiDAR saw the scene still around `cloud`: kStill when every other sweep within
+  // the window is of its hold, kMoving when one is not, kUnknown with no other sweep there.
+  enum class LidarView { kStill, kMoving, kUnknown };
+  LidarView SeenByLidar(const RecentCloud& cloud) const {
+    const std::int64_t half = Ns(options.still_window_s / 2);
+    LidarView view = LidarView::kUnknown;
+    for (const RecentCloud& other : recent_clouds) {
+      if (&other == &cloud || std::abs(other.cloud.stamp_ns - cloud.cloud.stamp_ns) > half)
+        continue;
+      if (other.hold != cloud.hold) return LidarView::kMoving;
+      view = LidarView::kStill;
+    }
+    return view;
+  }
+
+  void Judge(RecentCloud* cloud) {
+    cloud->judged = true;
+    const std::int64_t stamp = cloud->cloud.stamp_ns;
+    const LidarView view = SeenByLidar(*cloud);
+    if (view == LidarView::kStill) last_still_ns = stamp;
+    if (view == LidarView::kStill) {
+      Hold& hold = holds[cloud->hold];
+      // The hold's last try decides whether more are needed: waiting for it (once per try, a
+      // search's time) keeps the tries, and so the pairs and every count, the same for any
+      // timing of the two threads.
+      if (hold.last_try_serial > 0 && !hold.gave_a_pair) {
+        WaitForTry(hold.last_try_serial);
+        hold.gave_a_pair = HoldGaveAPair(cloud->hold);
+      }
+      if (hold.gave_a_pair) {
+        Drop(kHoldDone);
+        return;
+      }
+      if (hold.tries > 0 && stamp - hold.last_try_ns < Ns(options.retry_s)) {
+        Drop("not tried: its hold was tried within " + Ms(options.retry_s));
+        return;
+      }
+      ++hold.tries;
+      hold.last_try_ns = stamp;
+      hold.last_try_serial = MakeTry(*cloud, cloud->hold);
+    } else if (view == LidarView::kUnknown) {
+      MakeTry(*cloud, --lone_hold);  // a sweep alone in its window: the camera judges
+    } else if (stamp - last_still_ns >= Ns(options.lidar_blind_s) &&
+               stamp - last_blind_try_ns >= Ns(options.retry_s)) {
+      last_blind_try_ns = stamp;
+      MakeTry(*cloud, --lone_hold);
+    } else {
+      Drop("not tried: the LiDAR saw the scene move");
+    }
+  }
+
+  void WaitForTry(std::uint64_t serial) {
+    std::unique_lock lock(mutex);
+    worker_idle.wait(lock, [&] { return tries_done >= serial || worker_error; });
+    if (worker_error) std::rethrow_exception(worker_error);
+  }
+
+  bool HoldGaveAPair(int hold) {
+    std::lock_guard lock(mutex);
+    return satisfied_holds.count(hold) > 0;
+  }
+
+  // The try's serial once queued for the second thread; 0 when it was not (no image, or waiting
+  // for the camera intrinsics).
+  std::uint64_t MakeTry(const RecentCloud& cloud, int hold) {
+    {
+      std::lock_guard lock(mutex);
+      ++stats.tries;
+    }
+    const std::int64_t stamp = cloud.cloud.stamp_ns;
+    const StampedBytes* nearest = nullptr;
+    for (const StampedBytes& image : recent_images)
+      if (!nearest || std::abs(image.stamp_ns - stamp) < std::abs(nearest->stamp_ns - stamp))
+        nearest = &image;
+    if (!nearest || std::abs(nearest->stamp_ns - stamp) > Ns(options.max_pair_offset_s)) {
+      Drop("no image within " + Ms(options.max_pair_offset_s));
+      return 0;
+    }
+    Try attempt;
+    attempt.hold = hold;
+    attempt.cloud = cloud.cloud;
+    attempt.image = *nearest;
+    const std::int64_t half = Ns(options.still_window_s / 2);
+    for (const StampedBytes& image : recent_images)
+      if (&image != nearest && std::abs(image.stamp_ns - stamp) <= half)
+        attempt.others.push_back(image);
+    if (!camera) {
+      if (waiting_for_camera.size() == kMaxWaitingForCamera) {
+        waiting_for_camera.pop_front();
+        Drop("no camera intrinsics yet");
+      }
+      waiting_for_camera.push_back(std::move(attempt));
+      return 0;
+    }
+    attempt.camera = *camera;
+    return Queue(std::move(attempt));
+  }
+
+  std::uint64_t Queue(Try attempt) {
+    std::unique_lock lock(mutex);
+    worker_idle.wait(lock, [&] { return queue.size() < kMaxQueuedTries || worker_error; });
+    if (worker_error) std::rethrow_exception(worker_error);
+    queue.push_back(std::move(attempt));
+    wake_worker.notify_all();
+    return ++tries_queued;
+  }
+
+  void Finish() {
+    RethrowWorkerError();
+    for (RecentCloud& cloud : recent_clouds)
+      if (!cloud.judged) Judge(&cloud);
+    if (!camera && !waiting_for_camera.empty())
+      throw IoError(source + ": no usable camera intrinsics on " + topics.camera_info_topic +
+                    (camera_problem.empty() ? "" : " (" + camera_problem + ")") +
+                    ": give them with --camera FILE");
+    std::unique_lock lock(mutex);
+    finishing = true;
+    wake_worker.notify_all();
+    worker_idle.wait(lock, [&] { return finished || worker_error; });
+    if (worker_error) std::rethrow_exception(worker_error);
+  }
+
+  // ---- second thread -------------------------------------------------------------------------
+
+  void Work() {
+    std::unique_lock lock(mutex);
+    while (true) {
+      wake_worker.wait(lock,
+                       [&] { return stopping || !queue.empty() || (finishing && !finished); });
+      if (stopping) return;
+      if (!queue.empty()) {
+        Try attempt = std::move(queue.front());
+        queue.pop_front();
+        worker_idle.notify_all();
+        if (worker_error) {  // the reader rethrows it; nothing more is tried
+          ++tries_done;
+          continue;
+        }
+        lock.unlock();
+        Guard([&] { Process(std::move(attempt)); });
+        lock.lock();
+        ++tries_done;
+        worker_idle.notify_all();
+        continue;
+      }
+      // Finishing and nothing queued: the board is chosen from whatever samples came.
+      if (!board && !samples.empty() && !worker_error) {
+        lock.unlock();
+        Guard([&] { ChooseBoard(); });
+        lock.lock();
+      }
+      finished = true;
+      worker_idle.notify_all();
+    }
+  }
+
+  template <typename F>
+  void Guard(F&& work) {
+    try {
+      work();
+    } catch (...) {
+      std::lock_guard lock(mutex);
+      if (!worker_error) worker_error = std::current_exception();
+      worker_idle.notify_all();
+    }
+  }
+
+  ImageU8 DecodeTryImage(const StampedBytes& image) const {
+    return topics.compressed_image
+               ? DecodeCompressedImage(*image.bytes, topics.image, options.limits).image
+               : DecodeImage(*image.bytes, topics.image, options.limits).image;
+  }
+
+  struct Sample {
+    Try attempt;
+    std::optional<ImageU8> image;
+  };
+
+  void Process(Try attempt) {
+    if (board) {
+      ProcessWithBoard(attempt, std::nullopt);
+      return;
+    }
+    Sample sample{std::move(attempt), std::nullopt};
+    try {
+      sample.image = DecodeTryImage(sample.attempt.image);
+      chooser.Add(*sample.image);
+    } catch (const std::invalid_argument&) {
+    }
+    samples.push_back(std::move(sample));
+    if (chooser.images_with_a_fit() >= options.board_sample_images ||
+        (samples.size() >= kMaxBoardSamples && chooser.images_with_a_fit() > 0)) {
+      ChooseBoard();
+    } else if (samples.size() >= kMaxBoardSamples && chooser.images_with_a_fit() == 0) {
+      // Nothing like a board yet (the user walking in): these tries cannot give a pair.
+      for (std::size_t i = 0; i < samples.size(); ++i) Drop("board not found in the image");
+      samples.clear();
+    }
+  }
+
+  void ChooseBoard() {
+    const BoardChoice choice = chooser.Choose();
+    if (!choice.board)
+      throw IoError(source + ": no preset board explains the images (" + choice.explanation +
+                    "): give the board with --board NAME|FILE or --target target.json, or put a "
+                    "target.json beside the recording");
+    {
+      std::lock_guard lock(mutex);
+      board = choice.board;
+      stats.board_choice = choice.explanation;
+    }
+    std::deque<Sample> held = std::move(samples);
+    samples.clear();
+    for (Sample& sample : held) ProcessWithBoard(sample.attempt, std::move(sample.image));
+  }
+
+  void ProcessWithBoard(const Try& attempt, std::optional<ImageU8> decoded) {
+    if (HoldGaveAPair(attempt.hold)) {  // tries held while the board was chosen
+      Drop(kHoldDone);
+      return;
+    }
+    ImageU8 image;
+    try {
+      image = decoded ? std::move(*decoded) : DecodeTryImage(attempt.image);
+    } catch (const std::invalid_argument&) {
+      Drop("image unreadable");
+      return;
+    }
+    if (attempt.camera.width != image.width || attempt.camera.height != image.height)
+      throw IoError(source + ": the images on " + topics.image_topic + " are " +
+                    std::to_string(image.width) + " x " + std::to_string(image.height) +
+                    " but the camera intrinsics are for " + std::to_string(attempt.camera.width) +
+                    " x " + std::to_string(attempt.camera.height));
+    std::string why;
+    {
+      std::lock_guard lock(mutex);
+      ++stats.images_searched;
+    }
+    const std::optional<BoardDetection> detection =
+        DetectBoard(image, *board, BoardDetectionOptions{}, &why);
+    if (!detection) {
+      Drop("board not found in the image");
+      return;
+    }
+    {
+      std::lock_guard lock(mutex);
+      ++stats.boards_found;
+    }
+    const auto observation = EstimateBoardPose(attempt.camera, *detection, PnpOptions{}, &why);
+    if (!observation) {
+      Drop("board pose failed in the image");
+      return;
+    }
+    const Pose& pose = observation->cam_from_board;
+    bool judged = false;
+    for (const StampedBytes& other : attempt.others) {
+      ImageU8 other_image;
+      try {
+        other_image = DecodeTryImage(other);
+      } catch (const std::invalid_argument&) {
+        continue;
+      }
+      judged = true;
+      if (!StillIn(image, *detection, other_image, attempt.camera, pose)) {
+        Drop("board moving (within " + Ms(options.still_window_s / 2) + ")");
+        return;
+      }
+    }
+    for (const Pose& kept : kept_poses)
+      if (TranslationM(kept, pose) <= options.duplicate_translation_m &&
+          BoardRotationDeg(kept, pose, *board) <= options.duplicate_rotation_deg) {
+        Drop("near-duplicate board pose");
+        return;
+      }
+    FoundPair pair;
+    try {
+      pair.cloud = DecodePointCloud2(*attempt.cloud.bytes, topics.cloud, options.limits).cloud;
+    } catch (const std::invalid_argument&) {
+      Drop("cloud message unreadable");
+      return;
+    }
+    if (pair.cloud.size() == 0) {
+      Drop("cloud has no finite point");
+      return;
+    }
+    pair.cloud_stamp_ns = attempt.cloud.stamp_ns;
+    pair.image_stamp_ns = attempt.image.stamp_ns;
+    pair.image = std::move(image);
+    pair.cam_from_board = pose;
+    pair.stillness_checked = judged;
+    kept_poses.push_back(pose);
+    std::lock_guard lock(mutex);
+    if (attempt.hold > 0) satisfied_holds.insert(attempt.hold);
+    if (!judged) ++stats.kept_without_stillness_check;
+    found.push_back(std::move(pair));
+  }
+
+  // The camera's view of the board in `other` agrees with `pose`: its corners followed there give
+  // a pose within the stillness thresholds.
+  bool StillIn(const ImageU8& image, const BoardDetection& detection, const ImageU8& other,
+               const CameraModel& camera_model, const Pose& pose) const {
+    std::string why;
+    const auto tracked = TrackBoard(image, detection, other, kMinTrackedFraction, &why);
+    if (!tracked) return false;
+    const auto observation = EstimateBoardPose(camera_model, *tracked, PnpOptions{}, &why);
+    return observation &&
+           TranslationM(observation->cam_from_board, pose) <= options.still_translation_m &&
+           RotationDeg(observation->cam_from_board, pose) <= options.still_rotation_deg;
+  }
+
+  // ---- state ---------------------------------------------------------------------------------
+
+  const std::string source;
+  const PairTopics topics;
+  std::optional<BoardSpec> board;     // set by the worker (under `mutex`) once chosen
+  std::optional<CameraModel> camera;  // the reader's
+  std::string camera_problem;
+  const PairSelectionOptions options;
+  std::int64_t keep_ns = 0;
+
+  // Reader.
+  std::deque<RecentCloud> recent_clouds;
+  std::deque<StampedBytes> recent_images;  // by stamp
+  std::optional<SweepGrid> hold_reference, previous_grid;
+  SweepNoiseFloor noise_floor{options.lidar_motion};
+  int current_hold = 0;
+  int lone_hold = 0;  // negative ids: tries that belong to no hold
+  std::map<int, Hold> holds;
+  std::int64_t horizon_ns = INT64_MIN;
+  std::int64_t last_still_ns = 0;
+  std::int64_t last_blind_try_ns = INT64_MIN / 2;
+  std::deque<Try> waiting_for_camera;
+
+  // Worker.
+  BoardChooser chooser;
+  std::deque<Sample> samples;
+  std::vector<Pose> kept_poses;
+
+  // Shared, under `mutex`.
+  mutable std::mutex mutex;
+  std::condition_variable wake_worker, worker_idle;
+  std::deque<Try> queue;
+  bool finishing = false, finished = false, stopping = false;
+  std::exception_ptr worker_error;
+  std::vector<FoundPair> found;
+  std::set<int> satisfied_holds;  // holds that gave a pair
+  std::uint64_t tries_queued = 0, tries_done = 0;
+  PairFinderStats stats;
+  std::thread worker;  // last: started once everything above exists
+};
+
+RecordingPairFinder::RecordingPairFinder(std::string source, PairTopics topics,
+                                         std::optional<BoardSpec> board,
+                                         std::optional<CameraModel> camera,
+                                         PairSelectionOptions options)
+    : impl_(std::make_unique<Impl>(std::move(source), std::move(topics), std::move(board),
+                                   std::move(camera), std::move(options))) {}
+
+RecordingPairFinder::~RecordingPairFinder() = default;
+
+void RecordingPairFinder::AddCloud(std::span<const std::uint8_t> data, std::int64_t log_time_ns) {
+  impl_->AddCloud(data, log_time_ns);
+}
+void RecordingPairFinder::AddImage(std::span<const std::uint8_t> data, std::int64_t log_time_ns) {
+  impl_->AddImage(data, log_time_ns);
+}
+void RecordingPairFinder::AddCameraInfo(std::span<const std::uint8_t> data) {
+  impl_->AddCameraInfo(data);
+}
+void RecordingPairFinder::Finish() { impl_->Finish(); }
+
+std::vector<FoundPair> RecordingPairFinder::TakePairs() {
+  std::lock_guard lock(impl_->mutex);
+  return std::exchange(impl_->found, {});
+}
+
+PairFinderStats RecordingPairFinder::Stats() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->stats;
+}
+
+std::optional<CameraModel> RecordingPairFinder::Camera() const { return impl_->camera; }
+
+std::optional<BoardSpec> RecordingPairFinder::Board() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->board;
+}
+
+}  // namespace calibench

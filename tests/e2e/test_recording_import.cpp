@@ -1,0 +1,179 @@
+// Import of recordings made as on-site: the board held still at each pose, carried between poses,
+// the LiDAR and the camera streaming throughout (tests/sim_recording.h). One pair per hold, the
+// same from MCAP and from a ROS 1 bag, only a couple of board searches per hold, the board
+// chosen right without --board, and a refusal that says what to pass when no preset fits.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/io/bag_import.h"
+#include "core/io/dataset.h"
+#include "core/io/image_io.h"
+#include "core/io/json_io.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/target/board_camera.h"
+#include "tests/sim_recording.h"
+#include "tests/test_support.h"
+
+namespace calibench {
+namespace {
+namespace fs = std::filesystem;
+
+test::SimRecordingOptions SmallRecording() {
+  test::SimRecordingOptions options;
+  options.poses = 6;
+  options.hold_s = 2.5;
+  options.move_s = 1.0;
+  options.image_width = 640;
+  options.image_height = 360;
+  // 40 mm squares stay >= 7 px at 640 px across.
+  options.max_distance_m = 2.5;
+  return options;
+}
+
+test::SimRecordingTruth Record(const fs::path& path, const test::SimRecordingOptions& options) {
+  const bool bag = path.extension() == ".bag";
+  auto writer = bag ? test::OpenRos1BagWriter(path, "lz4")
+                    : test::OpenMcapWriter(path, "ros2", "lz4", /*summary=*/true);
+  const test::SimRecordingTruth truth = test::WriteSimRecording(
+      writer.get(), bag ? MessageEncoding::kRos1 : MessageEncoding::kCdr, options);
+  writer->Close();
+  return truth;
+}
+
+// The hold a stamp falls in, -1 when the board was moving.
+int HoldOf(const test::SimRecordingTruth& truth, std::int64_t stamp) {
+  for (std::size_t i = 0; i < truth.hold_start_ns.size(); ++i)
+    if (stamp >= truth.hold_start_ns[i] && stamp < truth.hold_end_ns[i]) return static_cast<int>(i);
+  return -1;
+}
+
+nlohmann::json ImportRecord(const BagImportSummary& summary) {
+  std::ifstream in(summary.manifest.parent_path() / "import.json");
+  return nlohmann::json::parse(in);
+}
+
+TEST(RecordingImport, OnePairPerHoldTheSameFromMcapAndBag) {
+  const fs::path dir = test::TempDir("recording_import_holds");
+  const test::SimRecordingOptions options = SmallRecording();
+  std::vector<nlohmann::json> records;
+  for (const char* name : {"capture.mcap", "capture.bag"}) {
+    SCOPED_TRACE(name);
+    const test::SimRecordingTruth truth = Record(dir / name, options);
+    const BagImportSummary summary =
+        ImportBag(dir / name, dir / (std::string(name) + ".dataset"), truth.board, {});
+    ASSERT_EQ(summary.pair_ids.size(), 6u);
+    // A couple of searches per hold, not one per image (there are 15 a second).
+    EXPECT_LE(summary.images_searched, 2 * options.poses) << summary.images_searched;
+    EXPECT_GE(summary.images, 15 * 20);
+    const nlohmann::json record = ImportRecord(summary);
+    std::vector<int> holds;
+    for (const auto& pair : record["pairs"]) {
+      const int hold = HoldOf(truth, pair["cloud_stamp_ns"].get<std::int64_t>());
+      EXPECT_GE(hold, 0) << pair.dump();
+      holds.push_back(hold);
+    }
+    EXPECT_EQ(holds, (std::vector<int>{0, 1, 2, 3, 4, 5}));
+    // Each pair's image shows its hold's pose.
+    const Dataset dataset = LoadDataset(summary.manifest);
+    for (std::size_t i = 0; i < dataset.pairs.size(); ++i) {
+      std::string why;
+      const auto detection = DetectBoard(LoadImage(dataset.pairs[i].image), truth.board, {}, &why);
+      ASSERT_TRUE(detection) << why;
+      const auto observation = EstimateBoardPose(truth.camera, *detection, {}, &why);
+      ASSERT_TRUE(observation) << why;
+      const Pose& held = truth.held_cam_from_board[holds[i]];
+      EXPECT_LT((observation->cam_from_board.translation() - held.translation()).norm(), 0.01);
+    }
+    // And the calibration from it lands on the simulated mount.
+    PipelineOptions pipeline;
+    pipeline.threads = 2;
+    const CalibrationOutcome outcome = CalibrateDataset(dataset, pipeline);
+    ASSERT_TRUE(outcome.solution) << outcome.failure;
+    const Pose error = truth.cam_from_lidar.inverse() * outcome.solution->cam_from_lidar;
+    EXPECT_LT(error.translation().norm(), 0.03);
+    EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle() * kRadToDeg, 1.0);
+    records.push_back(record["pairs"]);
+  }
+  EXPECT_EQ(records[0], records[1]);
+}
+
+// A LiDAR whose sweeps never agree (15 cm of range noise: rain, a non-repeating scan): the
+// holds are still found, by trying a sweep every second and letting the camera judge.
+TEST(RecordingImport, ALidarThatNeverSeesTheSceneStillHidesNoHold) {
+  const fs::path dir = test::TempDir("recording_import_noisy_lidar");
+  test::SimRecordingOptions options = SmallRecording();
+  options.poses = 4;
+  options.lidar_range_noise_m = 0.15;
+  const test::SimRecordingTruth truth = Record(dir / "noisy.mcap", options);
+  const BagImportSummary summary =
+      ImportBag(dir / "noisy.mcap", dir / "noisy.dataset", truth.board, {});
+  std::vector<int> holds;
+  const nlohmann::json record = ImportRecord(summary);
+  for (const auto& pair : record["pairs"])
+    holds.push_back(HoldOf(truth, pair["cloud_stamp_ns"].get<std::int64_t>()));
+  EXPECT_EQ(holds, (std::vector<int>{0, 1, 2, 3}));
+}
+
+BoardSpec Board(int cols, int rows, double square, double width, double height) {
+  BoardSpec board;
+  board.type = BoardType::kCheckerboard;
+  board.cols = cols;
+  board.rows = rows;
+  board.square_size = square;
+  board.board_width = width;
+  board.board_height = height;
+  return board;
+}
+
+TEST(RecordingImport, ChoosesThePresetThatFitsWithoutBeingTold) {
+  const fs::path dir = test::TempDir("recording_import_board");
+  for (const char* preset : {"a4", "a3"}) {
+    SCOPED_TRACE(preset);
+    test::SimRecordingOptions options = SmallRecording();
+    options.poses = 3;
+    options.board = BoardPreset(preset);
+    const fs::path bag = dir / (std::string(preset) + ".mcap");
+    Record(bag, options);
+    const BagImportSummary summary =
+        ImportBag(bag, dir / (std::string(preset) + ".dataset"), std::nullopt, {});
+    EXPECT_EQ(summary.board.cols, options.board.cols);
+    EXPECT_EQ(summary.board.rows, options.board.rows);
+    EXPECT_EQ(summary.board.square_size, options.board.square_size);
+    EXPECT_EQ(summary.board_source.rfind(preset, 0), 0u) << summary.board_source;
+    EXPECT_EQ(summary.pair_ids.size(), 3u);
+    EXPECT_EQ(LoadDataset(summary.manifest).target.cols, options.board.cols);
+  }
+}
+
+TEST(RecordingImport, ABoardNoPresetExplainsIsRefusedUntilItsTargetLiesBeside) {
+  const fs::path dir = test::TempDir("recording_import_large_board");
+  // 8x6 inner corners of 70 mm: a4's 5x4 and a3's 7x5 grids are found inside it.
+  test::SimRecordingOptions options = SmallRecording();
+  options.poses = 3;
+  options.board = Board(8, 6, 0.07, 0.70, 0.56);
+  fs::create_directories(dir / "site");
+  const fs::path bag = dir / "site" / "large.mcap";
+  Record(bag, options);
+  try {
+    ImportBag(bag, dir / "refused.dataset", std::nullopt, {});
+    ADD_FAILURE() << "a board no preset explains was not refused";
+  } catch (const IoError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("no preset board explains the images"), std::string::npos) << what;
+    EXPECT_NE(what.find("part of a larger board"), std::string::npos) << what;
+    EXPECT_NE(what.find("--board"), std::string::npos) << what;
+    EXPECT_NE(what.find("--target"), std::string::npos) << what;
+  }
+  std::ofstream(dir / "site" / "target.json") << json_io::TargetToJson(options.board).dump(2);
+  const BagImportSummary summary = ImportBag(bag, dir / "beside.dataset", std::nullopt, {});
+  EXPECT_EQ(summary.board.cols, 8);
+  EXPECT_EQ(summary.board.square_size, 0.07);
+  EXPECT_NE(summary.board_source.find("beside the recording"), std::string::npos);
+  EXPECT_EQ(summary.pair_ids.size(), 3u);
+}
+
+}  // namespace
+}  // namespace calibench

@@ -1,0 +1,157 @@
+#include "tests/sim_recording.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace calibench::test {
+
+namespace {
+
+constexpr std::int64_t kSecond = 1'000'000'000;
+constexpr std::int64_t kStart = 1'700'000'000 * kSecond;  // a plausible epoch stamp
+
+// The board pose at time t: held, or on its way between two held poses (linear in position,
+// spherical in rotation, eased so that it starts and stops smoothly).
+Pose BoardAt(const SimRecordingTruth& truth, std::int64_t t) {
+  const auto& poses = truth.held_cam_from_board;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    if (t < truth.hold_start_ns[i]) {
+      const std::int64_t from = truth.hold_end_ns[i - 1], to = truth.hold_start_ns[i];
+      const double s = static_cast<double>(t - from) / static_cast<double>(to - from);
+      const double eased = 0.5 - 0.5 * std::cos(M_PI * s);
+      const Eigen::Quaterniond a(poses[i - 1].rotation()), b(poses[i].rotation());
+      Pose pose = Pose::Identity();
+      pose.linear() = a.slerp(eased, b).toRotationMatrix();
+      pose.translation() =
+          (1 - eased) * poses[i - 1].translation() + eased * poses[i].translation();
+      return pose;
+    }
+    if (t < truth.hold_end_ns[i]) return poses[i];
+  }
+  return poses.back();
+}
+
+bool Held(const SimRecordingTruth& truth, std::int64_t t, int* pose) {
+  for (std::size_t i = 0; i < truth.hold_start_ns.size(); ++i)
+    if (t >= truth.hold_start_ns[i] && t < truth.hold_end_ns[i]) {
+      *pose = static_cast<int>(i);
+      return true;
+    }
+  return false;
+}
+
+// Sensor noise on a rendered image, so that the frames of a hold are not byte-identical.
+ImageU8 WithNoise(const ImageU8& image, std::mt19937_64* rng) {
+  ImageU8 noisy = image;
+  std::uniform_int_distribution<int> noise(-2, 2);
+  for (std::uint8_t& v : noisy.data)
+    v = static_cast<std::uint8_t>(std::clamp(v + noise(*rng), 0, 255));
+  return noisy;
+}
+
+}  // namespace
+
+namespace {
+
+SimOptions RecordingSim(const SimRecordingOptions& options) {
+  SimOptions sim = SimPreset("default");
+  sim.num_pairs = options.poses;
+  sim.seed = options.seed;
+  if (options.board.cols > 0) sim.board = options.board;
+  CameraModel camera = DefaultSimCamera(false);
+  const double scale = static_cast<double>(options.image_width) / camera.width;
+  camera.width = options.image_width;
+  camera.height = options.image_height;
+  camera.fx *= scale;
+  camera.fy *= scale;
+  camera.cx = 0.5 * options.image_width;
+  camera.cy = 0.5 * options.image_height;
+  sim.camera = camera;
+  sim.lidar_range_noise_m = options.lidar_range_noise_m;
+  sim.min_distance_m = options.min_distance_m;
+  sim.max_distance_m = options.max_distance_m;
+  return ResolveSimOptions(sim);
+}
+
+}  // namespace
+
+SimRecordingTruth PlanSimRecording(const SimRecordingOptions& options) {
+  const SimOptions resolved = RecordingSim(options);
+  SimRecordingTruth truth;
+  truth.held_cam_from_board = SampleBoardPoses(resolved);
+  truth.camera = resolved.camera;
+  truth.board = resolved.board;
+  truth.cam_from_lidar = resolved.cam_from_lidar;
+  const auto hold = static_cast<std::int64_t>(options.hold_s * kSecond);
+  const auto move = static_cast<std::int64_t>(options.move_s * kSecond);
+  for (int i = 0; i < options.poses; ++i) {
+    truth.hold_start_ns.push_back(kStart + i * (hold + move));
+    truth.hold_end_ns.push_back(truth.hold_start_ns.back() + hold);
+  }
+  truth.seconds = static_cast<double>(truth.hold_end_ns.back() - kStart) / kSecond;
+  return truth;
+}
+
+SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding encoding,
+                                    const SimRecordingOptions& options) {
+  const SimOptions resolved = RecordingSim(options);
+  SimRecordingTruth truth = PlanSimRecording(options);
+  const std::int64_t end = truth.hold_end_ns.back();
+
+  const BeamTable beams = MakeBeamTable(resolved.lidar);
+  const BoardPrint print(resolved.board);
+  std::mt19937_64 rng(options.seed);
+  std::uniform_real_distribution<double> phase(0.0, 2.0 * M_PI / beams.azimuth_steps);
+  RenderOptions still_render;  // once per hold, then noise per frame
+  RenderOptions moving_render;
+  moving_render.supersampling = 1;
+  std::vector<ImageU8> held_images(options.poses);
+
+  const auto cloud_period = static_cast<std::int64_t>(kSecond / options.cloud_hz);
+  const auto image_period = static_cast<std::int64_t>(kSecond / options.image_hz);
+  std::int64_t next_cloud = kStart, next_image = kStart + image_period / 3;
+  std::uint64_t sweep = 0;
+  while (next_cloud < end || next_image < end) {
+    if (next_cloud <= next_image) {
+      const std::int64_t t = next_cloud;
+      next_cloud += cloud_period;
+      LidarScene scene;
+      scene.wall_distance_m = 6.0;
+      scene.lidar_from_board = truth.cam_from_lidar.inverse() * BoardAt(truth, t);
+      LidarScanOptions scan;
+      scan.range_noise_m = options.lidar_range_noise_m;
+      scan.azimuth_offset_rad = phase(rng);
+      scan.seed = options.seed * 7919 + ++sweep;
+      const LidarCloud cloud = SimulateLidarScan(beams, print, scene, scan).ToCloud();
+      // The driver stamps a sweep at its start and publishes it when complete.
+      writer->Add({"/velodyne_points", "sensor_msgs/PointCloud2", t + cloud_period,
+                   SerializePointCloud2(cloud, t, "velodyne", encoding)});
+      ++truth.messages;
+    } else {
+      const std::int64_t t = next_image;
+      next_image += image_period;
+      int pose = -1;
+      ImageU8 image;
+      if (Held(truth, t, &pose)) {
+        if (held_images[pose].empty())
+          held_images[pose] = RenderBoardImage(truth.camera, truth.board,
+                                               truth.held_cam_from_board[pose], still_render);
+        image = WithNoise(held_images[pose], &rng);
+        if (pose > 0) held_images[pose - 1] = ImageU8{};
+      } else {
+        image = RenderBoardImage(truth.camera, truth.board, BoardAt(truth, t), moving_render);
+      }
+      const std::int64_t received = t + 15'000'000;
+      writer->Add(
+          {"/camera/image_raw", "sensor_msgs/Image", received,
+           SerializeImage(image, image.channels == 1 ? "mono8" : "bgr8", t, "camera", encoding)});
+      writer->Add({"/camera/camera_info", "sensor_msgs/CameraInfo", received,
+                   SerializeCameraInfo(truth.camera, t, "camera", encoding)});
+      truth.messages += 2;
+    }
+  }
+  return truth;
+}
+
+}  // namespace calibench::test

@@ -1,0 +1,49 @@
+// A simulated capture recorded as a ROS recording, as a user makes one on-site: the board held
+// still at each pose for `hold_s`, carried to the next over `move_s`, a spinning LiDAR and a
+// camera streaming throughout (PointCloud2, Image, CameraInfo). What import and watch must sort
+// into one pair per hold.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/base/types.h"
+#include "core/camera/camera.h"
+#include "core/io/bag.h"
+#include "core/sim/sim.h"
+#include "tests/bag_writers.h"
+
+namespace calibench::test {
+
+struct SimRecordingOptions {
+  int poses = 30;
+  double hold_s = 6.0;
+  double move_s = 2.0;
+  double cloud_hz = 10.0;
+  double image_hz = 15.0;
+  int image_width = 1280, image_height = 720;
+  BoardSpec board;                                    // cols == 0: the A3 preset
+  double lidar_range_noise_m = 0.01;                  // a VLP-16's
+  double min_distance_m = 1.5, max_distance_m = 4.0;  // board centre from the camera
+  std::uint64_t seed = 7;
+};
+
+struct SimRecordingTruth {
+  std::vector<Pose> held_cam_from_board;  // per pose
+  std::vector<std::int64_t> hold_start_ns, hold_end_ns;
+  CameraModel camera;
+  BoardSpec board;
+  Pose cam_from_lidar;
+  double seconds = 0.0;  // the recording's length
+  std::int64_t messages = 0;
+};
+
+// The recording's truth without writing it (the held poses, spans, camera, board, mount).
+SimRecordingTruth PlanSimRecording(const SimRecordingOptions& options);
+
+// Writes the recording through `writer` (not closed) in log-time order; `encoding` is the
+// writer's (ROS 1 for .bag, CDR for ROS 2 MCAP).
+SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding encoding,
+                                    const SimRecordingOptions& options);
+
+}  // namespace calibench::test
