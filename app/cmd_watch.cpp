@@ -1,6 +1,7 @@
 // `calibench watch`: follows a capture while it is written (a folder in the folder form that a
-// capture script fills), pair by pair: detect, pre-flight, accept or reject, solve again, σ
-// against the goal, the next pose (core/session/capture_job.h over core/io/folder_watch.h).
+// capture script fills, or a recording that rosbag / ros2 bag / an MCAP logger is writing), pair
+// by pair: detect, pre-flight, accept or reject, solve again, σ against the goal, the next pose
+// (core/session/capture_job.h over core/io/folder_watch.h or core/io/recording_watch.h).
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
@@ -12,8 +13,10 @@
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "core/guidance/stop_rule.h"
+#include "core/io/camera_file.h"
 #include "core/io/dataset_source.h"
 #include "core/io/folder_watch.h"
+#include "core/io/recording_watch.h"
 #include "core/session/capture_job.h"
 #include "core/session/feature_cache.h"
 #include "core/session/session.h"
@@ -67,7 +70,11 @@ std::string HumanProgress(const CaptureAdvice& advice) {
 
 struct WatchFlags {
   std::string source;
-  fs::path manifest;  // a manifest given instead of its folder
+  fs::path manifest;       // a manifest given instead of its folder
+  bool recording = false;  // SOURCE is a recording (.bag, .mcap, .db3, a rosbag2 folder)
+  fs::path out;            // recordings: the dataset folder the pairs are written to
+  std::optional<BoardSpec> board;
+  BagImportOptions import;
   std::string session;
   bool json_lines = false;
   bool exit_when_done = false;
@@ -174,29 +181,84 @@ class FeatureCacheKeeper {
   int resumed_ = 0;
 };
 
+// Where the pairs come from: the folder a capture script fills, or a recording being written.
+class PairFeed {
+ public:
+  virtual ~PairFeed() = default;
+  // New complete pairs and what went wrong with others; notes go to `stream`.
+  virtual std::vector<FolderEvent> Poll(double now, EventStream& stream) = 0;
+  // The camera and the target, once known.
+  virtual std::optional<Dataset> Setup() const = 0;
+  // The source says nothing more will come (a recording closed by its recorder).
+  virtual bool Closed() const { return false; }
+  // The folder the session describes.
+  virtual fs::path DatasetFolder() const = 0;
+};
+
+class FolderFeed final : public PairFeed {
+ public:
+  FolderFeed(Dataset setup, const WatchFlags& flags)
+      : setup_(std::move(setup)), folder_(fs::absolute(flags.source), flags.folder) {}
+  std::vector<FolderEvent> Poll(double now, EventStream&) override { return folder_.Poll(now); }
+  std::optional<Dataset> Setup() const override { return setup_; }
+  fs::path DatasetFolder() const override { return folder_.folder(); }
+
+ private:
+  Dataset setup_;
+  GrowingFolder folder_;
+};
+
+class RecordingFeed final : public PairFeed {
+ public:
+  explicit RecordingFeed(const WatchFlags& flags)
+      : recording_(fs::absolute(flags.source), flags.out, flags.board, flags.import) {}
+  std::vector<FolderEvent> Poll(double, EventStream& stream) override {
+    const RecordingUpdate update = recording_.Poll();
+    for (const std::string& note : update.notes) stream.Note("note", "", note);
+    closed_ = update.closed;
+    std::vector<FolderEvent> events;
+    for (const PairEntry& pair : update.pairs) {
+      FolderEvent event;
+      event.stem = pair.id;
+      event.pair = pair;
+      events.push_back(std::move(event));
+    }
+    return events;
+  }
+  std::optional<Dataset> Setup() const override { return recording_.Setup(); }
+  bool Closed() const override { return closed_; }
+  fs::path DatasetFolder() const override { return recording_.OutDir(); }
+
+ private:
+  GrowingRecording recording_;
+  bool closed_ = false;
+};
+
 // The watch loop: look, add the completed pairs, solve, say what changed, save; until idle or
 // done.
 class Watch {
  public:
-  Watch(Dataset setup, const CaptureJobOptions& options, const WatchFlags& flags,
+  Watch(std::unique_ptr<PairFeed> feed, const CaptureJobOptions& options, const WatchFlags& flags,
         fs::path session_path, EventStream* stream)
       : flags_(flags),
+        options_(options),
         session_path_(std::move(session_path)),
         stream_(*stream),
         autosaver_(session_path_),
         cache_(session_path_),
-        job_(std::move(setup), options),
-        folder_(fs::absolute(flags.source), flags.folder) {}
+        feed_(std::move(feed)) {}
 
   int Run() {
     double last_activity = SteadySeconds();
     for (;;) {
       const double now = SteadySeconds();
       bool added = false;
-      for (const FolderEvent& event : folder_.Poll(now)) {
+      for (const FolderEvent& event : feed_->Poll(now, stream_)) {
         last_activity = now;
         if (event.kind == FolderEvent::Kind::kPairComplete) {
-          job_.AddPair(event.pair, cache_.Earlier(event.pair));
+          // The job starts with the first pair: a recording's camera and board are known then.
+          if (!job_) job_.emplace(*feed_->Setup(), options_);
+          job_->AddPair(event.pair, cache_.Earlier(event.pair));
           added = true;
         } else {
           stream_.Note(event.kind == FolderEvent::Kind::kIncomplete ? "incomplete" : "removed",
@@ -205,6 +267,10 @@ class Watch {
       }
       if (added && SolveAndReport(now)) {
         stream_.Note("end", "", "done: the goal is met with a σ that can be trusted");
+        return kOk;
+      }
+      if (feed_->Closed()) {
+        stream_.Note("end", "", "the recording was closed by its recorder");
         return kOk;
       }
       if (flags_.idle_exit_s > 0 && SteadySeconds() - last_activity >= flags_.idle_exit_s) {
@@ -223,15 +289,15 @@ class Watch {
   bool SolveAndReport(double looked_s) {
     if (const std::string note = cache_.ResumedNote(); !note.empty())
       stream_.Note("resumed", "", note);
-    const CaptureAdvice& advice = job_.Solve();
-    for (const std::string& failure : cache_.Record(job_)) stream_.Note("error", "", failure);
+    const CaptureAdvice& advice = job_->Solve();
+    for (const std::string& failure : cache_.Record(*job_)) stream_.Note("error", "", failure);
     ReportVerdicts(advice);
     nlohmann::json solve = nlohmann::json::parse(CaptureAdviceJson(advice));
     solve["event"] = "solve";
     solve["latency_s"] = SteadySeconds() - looked_s;
     stream_.Emit(solve, HumanProgress(advice));
     try {
-      autosaver_.Save(job_.ToSession(fs::absolute(flags_.source)));
+      autosaver_.Save(job_->ToSession(feed_->DatasetFolder()));
     } catch (const IoError& e) {
       stream_.Note("error", "", std::string("session not saved: ") + e.what());
     }
@@ -255,30 +321,64 @@ class Watch {
   }
 
   const WatchFlags& flags_;
+  CaptureJobOptions options_;
   fs::path session_path_;
   EventStream& stream_;
   Autosaver autosaver_;
   FeatureCacheKeeper cache_;
-  CaptureJob job_;
-  GrowingFolder folder_;
+  std::unique_ptr<PairFeed> feed_;
+  std::optional<CaptureJob> job_;
   std::map<std::string, std::pair<bool, std::string>> reported_;  // verdicts said, by pair
 };
+
+// A recording rather than a folder form: a file that starts like one (or is named like one and is
+// not there yet), or a rosbag2 folder (metadata.yaml, or .mcap / .db3 files in it).
+bool IsRecording(const fs::path& source) {
+  std::error_code error;
+  const std::string extension = source.extension().string();
+  if (extension == ".bag" || extension == ".mcap" || extension == ".db3") return true;
+  if (fs::is_regular_file(source, error)) return LooksLikeBag(source);
+  if (!fs::is_directory(source, error)) return false;
+  if (fs::exists(source / "metadata.yaml", error)) return true;
+  if (fs::exists(source / "clouds", error) || fs::exists(source / "images", error)) return false;
+  for (const fs::directory_entry& entry : fs::directory_iterator(source, error)) {
+    const std::string file_extension = entry.path().extension().string();
+    if (file_extension == ".mcap" || file_extension == ".db3") return true;
+  }
+  return false;
+}
 
 }  // namespace
 
 int RunWatch(int argc, char** argv) {
   CLI::App app{
       "Follow a capture while it is written: a folder in the folder form (clouds/, images/, "
-      "camera.yaml, target.json) that grows pair by pair. Each new pair is detected, checked, "
-      "accepted or rejected with the reason, and everything so far is solved again: σ against "
-      "the goal and where to hold the board next, per pair.",
+      "camera.yaml, target.json) that grows pair by pair, or a recording being written (ROS 1 "
+      ".bag, .mcap, rosbag2 .db3 or its folder), whose pairs are chosen as `import` chooses "
+      "them and written to a dataset folder. Each new pair is detected, checked, accepted or "
+      "rejected with the reason, and everything so far is solved again: σ against the goal and "
+      "where to hold the board next, per pair.",
       "calibench watch"};
   WatchFlags flags;
   CaptureJobOptions options;
   app.add_option("source", flags.source,
                  "the folder the capture writes (the folder form, or a folder holding a "
-                 "LiDAR-camera manifest of any name; or that manifest itself)")
+                 "LiDAR-camera manifest of any name; or that manifest itself), or the recording "
+                 "being written (.bag, .mcap, .db3, a rosbag2 folder)")
       ->required();
+  std::string board, out, camera_file;
+  AddBoardOption(app, &board, "recordings: the board the camera sees");
+  app.add_option("--out,-o", out,
+                 "recordings: the dataset folder the pairs are written to (default: <recording "
+                 "name>.dataset beside it, as import)");
+  app.add_option("--cloud-topic", flags.import.cloud_topic,
+                 "recordings: PointCloud2 topic (default: the only one)");
+  app.add_option("--image-topic", flags.import.image_topic,
+                 "recordings: Image or CompressedImage topic (default: the only one)");
+  app.add_option("--camera-info-topic", flags.import.camera_info_topic,
+                 "recordings: CameraInfo topic (default: the one beside the image topic)");
+  app.add_option("--camera", camera_file,
+                 "recordings: intrinsics file instead of the recording's CameraInfo");
   app.add_option("--goal-mm", options.advise.goal.translation_mm,
                  "goal: 1σ of the translation per axis [mm]")
       ->capture_default_str();
@@ -315,6 +415,24 @@ int RunWatch(int argc, char** argv) {
     std::fprintf(stderr, "calibench watch: %s\n", why.c_str());
     return kUsage;
   }
+  EventStream stream(flags.json_lines);
+  flags.recording = IsRecording(flags.source);
+  if (flags.recording) {
+    try {
+      flags.board = BoardFromFlag(board);
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "calibench watch: --board: %s\n", e.what());
+      return kUsage;
+    }
+    if (!camera_file.empty()) flags.import.camera = LoadCameraFile(camera_file);
+    flags.import.max_pairs = 0;  // a capture has no cap: every hold is a pair
+    flags.out = out.empty() ? DefaultImportFolder(flags.source) : fs::path(out);
+    fs::create_directories(flags.out);
+    const fs::path session_path =
+        flags.session.empty() ? flags.out / "calibench.session.json" : fs::path(flags.session);
+    Watch watch(std::make_unique<RecordingFeed>(flags), options, flags, session_path, &stream);
+    return watch.Run();
+  }
   std::error_code error;
   if (fs::is_regular_file(flags.source, error)) {  // a manifest, named: its folder is watched
     flags.manifest = ResolveDataset(flags.source, DatasetKind::kLidarCamera).path;
@@ -327,7 +445,6 @@ int RunWatch(int argc, char** argv) {
                  flags.source.c_str());
     return kInputError;
   }
-  EventStream stream(flags.json_lines);
   std::string not_yet;
   std::optional<Dataset> setup = WaitForSetup(flags, stream, &not_yet);
   if (!setup) {
@@ -338,7 +455,8 @@ int RunWatch(int argc, char** argv) {
   const fs::path session_path = flags.session.empty()
                                     ? fs::path(flags.source) / "calibench.session.json"
                                     : fs::path(flags.session);
-  Watch watch(std::move(*setup), options, flags, session_path, &stream);
+  Watch watch(std::make_unique<FolderFeed>(std::move(*setup), flags), options, flags, session_path,
+              &stream);
   return watch.Run();
 }
 

@@ -41,6 +41,12 @@ RandomAccessFile::RandomAccessFile(const fs::path& path) : path_(path) {
   size_ = info.st_size;
 }
 
+std::int64_t RandomAccessFile::Refresh() {
+  struct stat info {};
+  if (::fstat(fd_, &info) == 0) size_ = info.st_size;
+  return size_;
+}
+
 RandomAccessFile::~RandomAccessFile() {
   if (fd_ >= 0) ::close(fd_);
 }
@@ -239,14 +245,14 @@ class FolderBag final : public BagReader {
   std::vector<std::vector<int>> topic_maps_;
 };
 
-std::unique_ptr<BagReader> OpenBagFile(const fs::path& path) {
+std::unique_ptr<BagReader> OpenBagFile(const fs::path& path, bool follow = false) {
   switch (SniffFile(path)) {
     case BagKind::kRos1:
-      return bag_internal::OpenRos1Bag(path);
+      return bag_internal::OpenRos1Bag(path, follow);
     case BagKind::kMcap:
-      return bag_internal::OpenMcap(path);
+      return bag_internal::OpenMcap(path, follow);
     case BagKind::kSqlite:
-      return bag_internal::OpenSqliteBag(path);
+      return bag_internal::OpenSqliteBag(path, follow);
     case BagKind::kNone:
       break;
   }
@@ -256,7 +262,76 @@ std::unique_ptr<BagReader> OpenBagFile(const fs::path& path) {
       "the file starts with none of their signatures)");
 }
 
+// A rosbag2 folder being recorded: its files followed one after the other as they appear (a
+// split starts a new one), closed once rosbag2 has written metadata.yaml and every file has
+// been read to its end.
+class FollowedFolder final : public BagReader {
+ public:
+  explicit FollowedFolder(const fs::path& folder) {
+    path_ = folder;
+    format_ = "rosbag2 folder, followed";
+  }
+
+  bool FollowNewMessages(const BagVisitor& visit) override {
+    std::error_code error;
+    // Seen before the files are read: what they hold then is all there will be.
+    const bool metadata = fs::exists(path_ / "metadata.yaml", error);
+    const std::vector<fs::path> files = FolderBagFiles(path_);
+    while (parts_.size() < files.size()) {
+      try {
+        parts_.push_back(OpenBagFile(files[parts_.size()], true));
+      } catch (const IoError&) {
+        break;  // a file just begun: the next call
+      }
+      maps_.emplace_back();
+      part_closed_.push_back(false);
+    }
+    size_bytes_ = 0;
+    bool all_closed = parts_.size() == files.size();
+    for (std::size_t p = 0; p < parts_.size(); ++p) {
+      if (!part_closed_[p])
+        part_closed_[p] = parts_[p]->FollowNewMessages([&](const BagMessage& message) {
+          std::vector<int>& map = maps_[p];
+          const auto& topics = parts_[p]->Topics();
+          while (map.size() < topics.size()) {
+            const BagTopic& topic = topics[map.size()];
+            map.push_back(
+                bag_internal::AddTopic(&topics_, topic.name, topic.type, topic.encoding_name));
+          }
+          ++topics_[map[message.topic]].message_count;
+          BagMessage merged = message;
+          merged.topic = map[message.topic];
+          return visit(merged);
+        });
+      size_bytes_ += parts_[p]->SizeBytes();
+      // A .db3 never says it is closed: metadata.yaml says it for the folder.
+      all_closed = all_closed && (part_closed_[p] || metadata);
+    }
+    return metadata && all_closed && !parts_.empty();
+  }
+
+  void ForEachMessage(const std::vector<bool>&, const BagVisitor&, const BagProgress&) override {
+    bag_internal::Fail(path_, "a followed recording is read with FollowNewMessages");
+  }
+
+ private:
+  std::vector<std::unique_ptr<BagReader>> parts_;
+  std::vector<std::vector<int>> maps_;  // per part: its topic index -> ours
+  std::vector<bool> part_closed_;
+};
+
 }  // namespace
+
+bool BagReader::FollowNewMessages(const BagVisitor&) {
+  bag_internal::Fail(path_, "this reader reads a finished recording only");
+}
+
+std::unique_ptr<BagReader> OpenBagToFollow(const fs::path& path) {
+  std::error_code error;
+  if (fs::is_directory(path, error)) return std::make_unique<FollowedFolder>(path);
+  if (!fs::exists(path, error)) bag_internal::Fail(path, "no such file or folder (not yet?)");
+  return OpenBagFile(path, true);
+}
 
 int BagReader::FindTopic(const std::string& name) const {
   for (std::size_t i = 0; i < topics_.size(); ++i)

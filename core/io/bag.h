@@ -55,6 +55,13 @@ class BagReader {
   virtual void ForEachMessage(const std::vector<bool>& wanted, const BagVisitor& visit,
                               const BagProgress& progress = {}) = 0;
 
+  // A recording still being written (a reader from OpenBagToFollow): visits the messages stored
+  // since the last call, of every topic, in file order. Only complete records are read; one cut
+  // short where the file ends now is read by a later call. Topics() grows as topics appear.
+  // Returns true once the recording is closed (its index, summary or metadata written): nothing
+  // more will come. Throws IoError naming the file on damaged data.
+  virtual bool FollowNewMessages(const BagVisitor& visit);
+
  protected:
   std::filesystem::path path_;
   std::string format_;
@@ -66,6 +73,12 @@ class BagReader {
 // recording (its .db3 and .mcap files in natural order, topics merged). Throws IoError naming the
 // file: missing, not a bag, an unsupported version, a damaged index or header.
 std::unique_ptr<BagReader> OpenBag(const std::filesystem::path& path);
+
+// A recording that may still be written: a ROS 1 .bag, an .mcap, a rosbag2 .db3 or a rosbag2
+// folder of them (closed once its metadata.yaml is written). Throws IoError naming the file when
+// it is not there yet or does not start like a recording (a file of a few bytes may be a
+// recording just begun: try again).
+std::unique_ptr<BagReader> OpenBagToFollow(const std::filesystem::path& path);
 
 // True when the file starts like a ROS 1 bag, an MCAP or an SQLite file, or the folder holds a
 // rosbag2 metadata.yaml: for a drop onto the workbench. Never throws.

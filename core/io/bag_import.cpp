@@ -63,33 +63,13 @@ class Importer {
  private:
   std::string Where() const { return bag_->Path().string(); }
 
-  void ResolveBoard() {
-    if (board_) {
-      summary_.board_source = "--board";
-      return;
-    }
-    if (const auto beside = TargetBesideRecording(bag_->Path())) {
-      board_ = LoadTargetFile(*beside);
-      summary_.board_source = beside->string() + " (beside the recording)";
-    }
-  }
-
-  PairTopics Topics() const {
-    const BagTopic& image = bag_->Topics()[image_topic_];
-    PairTopics topics;
-    topics.cloud = bag_->Topics()[cloud_topic_].encoding;
-    topics.image = image.encoding;
-    topics.compressed_image = image.type == kCompressedImageType;
-    topics.image_topic = options_.image_topic;
-    if (info_topic_ >= 0) topics.camera_info = bag_->Topics()[info_topic_].encoding;
-    topics.camera_info_topic = options_.camera_info_topic;
-    return topics;
-  }
+  void ResolveBoard() { board_ = RecordingBoard(bag_->Path(), board_, &summary_.board_source); }
 
   void ReadAndWritePairs() {
     fs::create_directories(out_dir_ / "clouds");
     fs::create_directories(out_dir_ / "images");
-    RecordingPairFinder finder(Where(), Topics(), board_, options_.camera, options_);
+    RecordingPairFinder finder(Where(), ChosenPairTopics(*bag_, options_), board_, options_.camera,
+                               options_);
     std::vector<bool> wanted(bag_->Topics().size(), false);
     wanted[cloud_topic_] = wanted[image_topic_] = true;
     if (info_topic_ >= 0) wanted[info_topic_] = true;
@@ -139,8 +119,7 @@ class Importer {
       if (pair.cloud.HasRing())
         rings_ =
             std::max(rings_, *std::max_element(pair.cloud.ring.begin(), pair.cloud.ring.end()) + 1);
-      SavePcd(out_dir_ / "clouds" / (id + ".pcd"), pair.cloud, PcdEncoding::kBinary);
-      SaveImage(out_dir_ / "images" / (id + ".png"), pair.image);
+      WriteFoundPair(pair, out_dir_, id);
       written_.push_back({index, pair.cloud_stamp_ns, pair.image_stamp_ns});
     }
   }
@@ -231,6 +210,45 @@ class Importer {
 };
 
 }  // namespace
+
+std::optional<BoardSpec> RecordingBoard(const fs::path& bag, const std::optional<BoardSpec>& given,
+                                        std::string* source) {
+  source->clear();
+  if (given) {
+    *source = "--board";
+    return given;
+  }
+  if (const auto beside = TargetBesideRecording(bag)) {
+    *source = beside->string() + " (beside the recording)";
+    return LoadTargetFile(*beside);
+  }
+  return std::nullopt;
+}
+
+PairTopics ChosenPairTopics(const BagReader& bag, const BagImportOptions& options) {
+  const BagTopic& image = bag.Topics()[bag.FindTopic(options.image_topic)];
+  PairTopics topics;
+  topics.cloud = bag.Topics()[bag.FindTopic(options.cloud_topic)].encoding;
+  topics.image = image.encoding;
+  topics.compressed_image = image.type == kCompressedImageType;
+  topics.image_topic = options.image_topic;
+  if (!options.camera && bag.FindTopic(options.camera_info_topic) >= 0)
+    topics.camera_info = bag.Topics()[bag.FindTopic(options.camera_info_topic)].encoding;
+  topics.camera_info_topic = options.camera_info_topic;
+  return topics;
+}
+
+PairEntry WriteFoundPair(const FoundPair& pair, const fs::path& dir, const std::string& id) {
+  fs::create_directories(dir / "clouds");
+  fs::create_directories(dir / "images");
+  PairEntry entry;
+  entry.id = id;
+  entry.cloud = fs::absolute(dir / "clouds" / (id + ".pcd"));
+  entry.image = fs::absolute(dir / "images" / (id + ".png"));
+  SavePcd(entry.cloud, pair.cloud, PcdEncoding::kBinary);
+  SaveImage(entry.image, pair.image);
+  return entry;
+}
 
 BagImportSummary ImportBag(const fs::path& bag_path, const fs::path& out_dir,
                            const std::optional<BoardSpec>& board, BagImportOptions options,

@@ -14,6 +14,7 @@
 
 #include "core/camera/camera.h"
 #include "core/io/bag.h"
+#include "core/io/dataset.h"
 #include "core/io/load_limits.h"
 #include "core/io/recording_pairs.h"
 #include "core/target/board.h"
@@ -72,6 +73,16 @@ using ImportProgress =
 // The target.json a user keeps with a recording: beside the file (or the rosbag2 folder), or
 // inside the rosbag2 folder. nullopt when there is none.
 std::optional<std::filesystem::path> TargetBesideRecording(const std::filesystem::path& bag);
+
+// What import and watch share: the board as the user gave it, else from the target.json beside
+// the recording (*source says which; nullopt and "" = chosen among the presets later); the chosen
+// topics' serializations; a found pair written as clouds/<id>.pcd + images/<id>.png under
+// `dir` (its entry, with absolute paths).
+std::optional<BoardSpec> RecordingBoard(const std::filesystem::path& bag,
+                                        const std::optional<BoardSpec>& given, std::string* source);
+PairTopics ChosenPairTopics(const BagReader& bag, const BagImportOptions& options);
+PairEntry WriteFoundPair(const FoundPair& pair, const std::filesystem::path& dir,
+                         const std::string& id);
 
 // Reads the recording once (core/io/recording_pairs.h chooses the pairs as it goes) and writes
 // the dataset into `out_dir` (created; files already there with the same names are replaced,

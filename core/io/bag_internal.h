@@ -26,6 +26,8 @@ class RandomAccessFile {
   RandomAccessFile& operator=(const RandomAccessFile&) = delete;
 
   std::int64_t Size() const { return size_; }
+  // The file's size now (a recording still being written grows); returns it.
+  std::int64_t Refresh();
   const std::filesystem::path& Path() const { return path_; }
   // Reads exactly `size` bytes at `offset` into `out` (resized); throws IoError "<file>: truncated
   // at byte N (what)" when the file ends first.
@@ -101,10 +103,11 @@ void Decompress(const std::string& method, std::span<const std::uint8_t> compres
 // the load limit's 5 million points at 48 bytes 240 MB.
 inline constexpr std::uint64_t kMaxChunkBytes = 512ull << 20;
 
-// Readers of one file format each (bag_ros1.cpp, bag_mcap.cpp, bag_sqlite.cpp).
-std::unique_ptr<BagReader> OpenRos1Bag(const std::filesystem::path& path);
-std::unique_ptr<BagReader> OpenMcap(const std::filesystem::path& path);
-std::unique_ptr<BagReader> OpenSqliteBag(const std::filesystem::path& path);
+// Readers of one file format each (bag_ros1.cpp, bag_mcap.cpp, bag_sqlite.cpp). With `follow`,
+// only the file's start is read (a recording still being written): FollowNewMessages reads on.
+std::unique_ptr<BagReader> OpenRos1Bag(const std::filesystem::path& path, bool follow = false);
+std::unique_ptr<BagReader> OpenMcap(const std::filesystem::path& path, bool follow = false);
+std::unique_ptr<BagReader> OpenSqliteBag(const std::filesystem::path& path, bool follow = false);
 
 // "bz2, lz4" for a listing's compressions; "none" when there are none.
 std::string JoinWords(const std::set<std::string>& words);

@@ -28,7 +28,7 @@ constexpr std::int64_t kMcapFooterBytes = 1 + 8 + 8 + 8 + 4;
 
 class Mcap final : public BagReader {
  public:
-  explicit Mcap(const fs::path& path) : file_(path) {
+  Mcap(const fs::path& path, bool follow) : file_(path) {
     path_ = path;
     size_bytes_ = file_.Size();
     std::vector<std::uint8_t> bytes;
@@ -41,6 +41,12 @@ class Mcap final : public BagReader {
     Cursor header(bytes, path_, 8, "the header");
     profile_ = std::string(header.PrefixedText("the profile"));
     data_start_ = header_end;
+    follow_offset_ = data_start_;
+    if (follow) {
+      format_ =
+          "MCAP (" + (profile_.empty() ? std::string("no") : profile_) + " profile), followed";
+      return;
+    }
     if (!ReadSummary()) CountByScanning();
     format_ = "MCAP (" + (profile_.empty() ? std::string("no") : profile_) + " profile), " +
               std::to_string(chunk_count_) + " chunks" +
@@ -65,6 +71,39 @@ class Mcap final : public BagReader {
       if (!go_on) return;
       offset = next;
     }
+  }
+
+  bool FollowNewMessages(const BagVisitor& visit_message) override {
+    if (closed_) return true;
+    const BagVisitor visit = [&](const BagMessage& message) {
+      ++topics_[message.topic].message_count;
+      return visit_message(message);
+    };
+    size_bytes_ = file_.Refresh();
+    std::vector<std::uint8_t> head, content, chunk;
+    while (follow_offset_ + 9 <= size_bytes_) {
+      file_.ReadAt(follow_offset_, 9, &head, "a record's opcode and length");
+      const std::uint8_t op = head[0];
+      std::uint64_t length;
+      std::memcpy(&length, head.data() + 1, 8);
+      if (length > kMaxChunkBytes)
+        Fail(path_, "the record at byte " + std::to_string(follow_offset_) + " declares " +
+                        std::to_string(length) + " bytes, over the limit");
+      const std::int64_t next = follow_offset_ + 9 + static_cast<std::int64_t>(length);
+      if (next > size_bytes_) break;  // still being written
+      if (op == kMcapOpDataEnd || op == kMcapOpFooter) {
+        closed_ = true;
+        return true;
+      }
+      file_.ReadAt(follow_offset_ + 9, static_cast<std::int64_t>(length), &content, "a record");
+      if (op == kMcapOpChunk) {
+        VisitChunk(content, follow_offset_, &chunk, {}, visit);
+      } else {
+        VisitRecord(op, content, follow_offset_, {}, visit);
+      }
+      follow_offset_ = next;
+    }
+    return false;
   }
 
  private:
@@ -238,7 +277,9 @@ class Mcap final : public BagReader {
   std::int64_t data_start_ = 0;
   std::int64_t data_end_ = 0;
   std::uint32_t chunk_count_ = 0;
-  bool counting_ = false;  // the first pass over a file without a summary
+  bool counting_ = false;           // the first pass over a file without a summary
+  std::int64_t follow_offset_ = 0;  // FollowNewMessages: where the next record starts
+  bool closed_ = false;
   std::set<std::string> compressions_;
   std::map<std::uint16_t, std::string> schema_names_;
   std::map<std::uint16_t, int> channel_topic_;
@@ -246,6 +287,8 @@ class Mcap final : public BagReader {
 
 }  // namespace
 
-std::unique_ptr<BagReader> OpenMcap(const fs::path& path) { return std::make_unique<Mcap>(path); }
+std::unique_ptr<BagReader> OpenMcap(const fs::path& path, bool follow) {
+  return std::make_unique<Mcap>(path, follow);
+}
 
 }  // namespace calibench::bag_internal

@@ -93,7 +93,7 @@ void ReadRecord(const RandomAccessFile& file, std::int64_t offset, FileRecord* r
 
 class Ros1Bag final : public BagReader {
  public:
-  explicit Ros1Bag(const fs::path& path) : file_(path) {
+  Ros1Bag(const fs::path& path, bool follow) : file_(path) {
     path_ = path;
     size_bytes_ = file_.Size();
     std::vector<std::uint8_t> magic;
@@ -105,6 +105,11 @@ class Ros1Bag final : public BagReader {
     const RecordHeader header(record.header, path, record.offset);
     if (header.Op() != kRos1OpBagHeader) Fail(path, "the first record is not the bag header");
     data_start_ = record.next;
+    follow_offset_ = data_start_;
+    if (follow) {
+      format_ = "ROS 1 bag v2.0, followed";
+      return;
+    }
     index_pos_ = static_cast<std::int64_t>(header.Number<std::uint64_t>("index_pos"));
     chunk_count_ = header.Number<std::uint32_t>("chunk_count");
     if (index_pos_ >= data_start_ && index_pos_ < size_bytes_) {
@@ -143,6 +148,51 @@ class Ros1Bag final : public BagReader {
       if (progress) progress(record.next, size_bytes_);
       if (!go_on) return;
     }
+  }
+
+  // rosbag record appends chunks (each followed by its index records) and, when it closes, the
+  // connection and chunk-info records of the index: the first of those ends the recording.
+  bool FollowNewMessages(const BagVisitor& visit_message) override {
+    if (closed_) return true;
+    const BagVisitor visit = [&](const BagMessage& message) {
+      ++topics_[message.topic].message_count;
+      return visit_message(message);
+    };
+    size_bytes_ = file_.Refresh();
+    std::vector<std::uint8_t> bytes, chunk;
+    FileRecord record;
+    while (follow_offset_ + 8 <= size_bytes_) {
+      file_.ReadAt(follow_offset_, 4, &bytes, "a record's header length");
+      std::uint32_t header_length;
+      std::memcpy(&header_length, bytes.data(), 4);
+      if (follow_offset_ + 8 + header_length > size_bytes_) break;
+      file_.ReadAt(follow_offset_ + 4 + header_length, 4, &bytes, "a record's data length");
+      std::uint32_t data_length;
+      std::memcpy(&data_length, bytes.data(), 4);
+      if (follow_offset_ + 8 + static_cast<std::int64_t>(header_length) + data_length > size_bytes_)
+        break;  // still being written
+      ReadRecord(file_, follow_offset_, &record);
+      const RecordHeader header(record.header, path_, follow_offset_);
+      const std::uint8_t op = header.Op();
+      if (op == kRos1OpConnection || op == kRos1OpChunkInfo) {
+        closed_ = true;
+        return true;
+      }
+      if (op == kRos1OpChunk) {
+        std::span<const std::uint8_t> data = record.data;
+        const std::string compression(header.Get("compression"));
+        if (compression != "none") {
+          Decompress(compression, data, header.Number<std::uint32_t>("size"), &chunk, path_,
+                     follow_offset_);
+          data = chunk;
+        }
+        VisitChunk(data, follow_offset_, {}, visit);
+      } else if (op == kRos1OpMessage) {
+        VisitMessage(header, record.data, {}, visit);
+      }
+      follow_offset_ = record.next;
+    }
+    return false;
   }
 
  private:
@@ -250,6 +300,8 @@ class Ros1Bag final : public BagReader {
   std::int64_t index_pos_ = 0;
   std::uint32_t chunk_count_ = 0;
   bool indexed_ = false;
+  std::int64_t follow_offset_ = 0;  // FollowNewMessages: where the next record starts
+  bool closed_ = false;
   std::string compression_;
   std::map<std::uint32_t, int> connection_topic_;
   std::map<std::uint32_t, std::int64_t> counts_;
@@ -257,8 +309,8 @@ class Ros1Bag final : public BagReader {
 
 }  // namespace
 
-std::unique_ptr<BagReader> OpenRos1Bag(const fs::path& path) {
-  return std::make_unique<Ros1Bag>(path);
+std::unique_ptr<BagReader> OpenRos1Bag(const fs::path& path, bool follow) {
+  return std::make_unique<Ros1Bag>(path, follow);
 }
 
 }  // namespace calibench::bag_internal

@@ -30,6 +30,13 @@ std::string ImmutableUri(const fs::path& path) {
   return uri + "?immutable=1";
 }
 
+// The same file read while rosbag2 writes it: read-only, but not immutable, so that each
+// connection sees what was committed since.
+std::string LiveUri(const fs::path& path) {
+  std::string uri = ImmutableUri(path);
+  return uri.substr(0, uri.size() - std::string("?immutable=1").size()) + "?mode=ro";
+}
+
 class Statement {
  public:
   Statement(sqlite3* db, const std::string& sql, const fs::path& path) : path_(path) {
@@ -66,8 +73,12 @@ class Statement {
 
 class SqliteBag final : public BagReader {
  public:
-  explicit SqliteBag(const fs::path& path) {
+  SqliteBag(const fs::path& path, bool follow) {
     path_ = path;
+    if (follow) {
+      format_ = "rosbag2 sqlite3, followed";
+      return;
+    }
     size_bytes_ = static_cast<std::int64_t>(fs::file_size(path));
     if (sqlite3_open_v2(ImmutableUri(path).c_str(), &db_, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI,
                         nullptr) != SQLITE_OK) {
@@ -108,7 +119,52 @@ class SqliteBag final : public BagReader {
     }
   }
 
+  // rosbag2 commits messages in transactions: each call opens the file afresh and reads the rows
+  // committed since the last. A bare .db3 never says it is closed (its folder's metadata.yaml
+  // does: the folder reader).
+  bool FollowNewMessages(const BagVisitor& visit) override {
+    sqlite3* db = nullptr;
+    if (sqlite3_open_v2(LiveUri(path_).c_str(), &db, SQLITE_OPEN_READONLY | SQLITE_OPEN_URI,
+                        nullptr) != SQLITE_OK) {
+      sqlite3_close(db);
+      return false;  // not created yet, or locked: the next call
+    }
+    sqlite3_busy_timeout(db, 200);
+    try {
+      ReadNewRows(db, visit);
+    } catch (const IoError&) {
+      // The tables may not exist yet (a recording just begun) or a write is under way.
+    }
+    sqlite3_close(db);
+    size_bytes_ = static_cast<std::int64_t>(fs::file_size(path_));
+    return false;
+  }
+
  private:
+  void ReadNewRows(sqlite3* db, const BagVisitor& visit) {
+    Statement topics(db, "SELECT id, name, type, serialization_format FROM topics ORDER BY id",
+                     path_);
+    while (topics.Step())
+      if (!topic_index_.count(topics.Integer(0)))
+        topic_index_[topics.Integer(0)] =
+            AddTopic(&topics_, topics.Text(1), topics.Text(2), topics.Text(3));
+    Statement rows(db,
+                   "SELECT id, topic_id, timestamp, data FROM messages WHERE id > " +
+                       std::to_string(last_row_) + " ORDER BY id",
+                   path_);
+    while (rows.Step()) {
+      last_row_ = rows.Integer(0);
+      const auto topic = topic_index_.find(rows.Integer(1));
+      if (topic == topic_index_.end()) continue;
+      BagMessage message;
+      message.topic = topic->second;
+      message.log_time_ns = rows.Integer(2);
+      message.data = rows.Blob(3);
+      ++topics_[topic->second].message_count;
+      visit(message);
+    }
+  }
+
   void ReadTopics() {
     Statement topics(db_, "SELECT id, name, type, serialization_format FROM topics ORDER BY id",
                      path_);
@@ -124,12 +180,13 @@ class SqliteBag final : public BagReader {
 
   sqlite3* db_ = nullptr;
   std::map<std::int64_t, int> topic_index_;
+  std::int64_t last_row_ = 0;  // FollowNewMessages: the last message row read
 };
 
 }  // namespace
 
-std::unique_ptr<BagReader> OpenSqliteBag(const fs::path& path) {
-  return std::make_unique<SqliteBag>(path);
+std::unique_ptr<BagReader> OpenSqliteBag(const fs::path& path, bool follow) {
+  return std::make_unique<SqliteBag>(path, follow);
 }
 
 }  // namespace calibench::bag_internal

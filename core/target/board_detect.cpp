@@ -447,7 +447,11 @@ std::optional<double> ChessboardEdgeWidthPx(const ImageU8& image, const BoardSpe
     try {
       const cv::Scalar sharpness = cv::estimateChessboardSharpness(
           grey, cv::Size(board.cols, board.rows), corners, 0.8F, vertical);
-      if (sharpness[0] > 0 && std::isfinite(sharpness[0])) widest = std::max(widest, sharpness[0]);
+      // OpenCV answers 9999 when the squares are too small to measure (it prints
+      // "checkerboard too small for calculation"): no measurement, not a blurred board.
+      constexpr double kOpenCvCannotMeasure = 9999.0;
+      if (sharpness[0] > 0 && sharpness[0] < kOpenCvCannotMeasure && std::isfinite(sharpness[0]))
+        widest = std::max(widest, sharpness[0]);
     } catch (const cv::Exception&) {
       // An edge OpenCV cannot follow: that direction says nothing.
     }

@@ -1,0 +1,59 @@
+// A recording followed while it is written (`calibench watch` on a .bag, .mcap, .db3 or rosbag2
+// folder): its messages read as the recorder stores them, its pairs chosen exactly as `import`
+// chooses them (core/io/recording_pairs.h) and written as import writes them into a dataset
+// folder (clouds/<id>.pcd, images/<id>.png; camera.yaml and dataset.json kept up to date, so
+// that the folder can be calibrated at any moment).
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/io/bag_import.h"
+#include "core/io/dataset.h"
+
+namespace calibench {
+
+struct RecordingUpdate {
+  std::vector<PairEntry> pairs;    // new, in the order found
+  std::vector<std::string> notes;  // what was chosen or is awaited, in words
+  bool closed = false;             // the recorder closed the file and every pair of it is out
+};
+
+class GrowingRecording {
+ public:
+  // `board` nullopt: the target.json beside the recording, else the preset that fits (as
+  // import). Nothing is read yet.
+  GrowingRecording(std::filesystem::path recording, std::filesystem::path out_dir,
+                   std::optional<BoardSpec> board, BagImportOptions options);
+  ~GrowingRecording();
+
+  // Reads what the recorder stored since the last call. Throws IoError naming the recording on
+  // damaged data, ambiguous topics (the flag to pass), a board no preset explains.
+  RecordingUpdate Poll();
+
+  // The camera and the board, once the first pair is out (nullopt before); the dataset folder.
+  std::optional<Dataset> Setup() const;
+  const std::filesystem::path& OutDir() const { return out_dir_; }
+
+ private:
+  struct Pending;
+  void ChooseTopicsWhenPresent(bool closed, RecordingUpdate* update);
+  void Route(int topic, std::int64_t log_time_ns, std::span<const std::uint8_t> data);
+  void WritePairs(RecordingUpdate* update);
+
+  std::filesystem::path recording_, out_dir_;
+  std::optional<BoardSpec> board_;
+  std::string board_source_;
+  BagImportOptions options_;
+  std::unique_ptr<BagReader> reader_;
+  std::unique_ptr<RecordingPairFinder> finder_;
+  int cloud_topic_ = -1, image_topic_ = -1, info_topic_ = -1;
+  std::vector<Pending> pending_;  // messages read before the topics were chosen
+  Dataset dataset_;               // the pairs written so far
+  bool said_waiting_ = false, finished_ = false;
+};
+
+}  // namespace calibench
