@@ -585,53 +585,92 @@ void WriteMcap(const fs::path& path, const std::vector<RecordedMessage>& message
 }
 
 // ---------------------------------------------------------------------------------------------
-void WriteDb3(const fs::path& path, const std::vector<RecordedMessage>& messages) {
-  fs::remove(path);
-  sqlite3* db = nullptr;
-  if (sqlite3_open(path.c_str(), &db) != SQLITE_OK) throw std::runtime_error("sqlite3_open");
-  auto exec = [&](const char* sql) {
-    if (sqlite3_exec(db, sql, nullptr, nullptr, nullptr) != SQLITE_OK)
-      throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db));
-  };
-  // rosbag2_storage_default_plugins' schema (Humble).
-  exec(
-      "CREATE TABLE schema(schema_version INTEGER PRIMARY KEY,ros_distro TEXT NOT NULL);"
-      "INSERT INTO schema VALUES(3,'humble');"
-      "CREATE TABLE metadata(id INTEGER PRIMARY KEY,metadata_version INTEGER NOT NULL,"
-      "metadata TEXT NOT NULL);"
-      "CREATE TABLE topics(id INTEGER PRIMARY KEY,name TEXT NOT NULL,type TEXT NOT NULL,"
-      "serialization_format TEXT NOT NULL,offered_qos_profiles TEXT NOT NULL);"
-      "CREATE TABLE messages(id INTEGER PRIMARY KEY,topic_id INTEGER NOT NULL,"
-      "timestamp INTEGER NOT NULL, data BLOB NOT NULL);"
-      "CREATE INDEX timestamp_idx ON messages (timestamp ASC);"
-      "BEGIN;");
-  std::map<std::string, int> topics;
-  sqlite3_stmt* topic = nullptr;
-  sqlite3_stmt* message = nullptr;
-  sqlite3_prepare_v2(db, "INSERT INTO topics VALUES(?,?,?,'cdr','')", -1, &topic, nullptr);
-  sqlite3_prepare_v2(db, "INSERT INTO messages(topic_id,timestamp,data) VALUES(?,?,?)", -1,
-                     &message, nullptr);
-  for (const RecordedMessage& m : messages) {
-    if (!topics.count(m.topic)) {
-      const int id = static_cast<int>(topics.size()) + 1;
-      topics[m.topic] = id;
-      const std::string type = Ros2Type(m.type);
-      sqlite3_bind_int(topic, 1, id);
-      sqlite3_bind_text(topic, 2, m.topic.c_str(), -1, SQLITE_TRANSIENT);
-      sqlite3_bind_text(topic, 3, type.c_str(), -1, SQLITE_TRANSIENT);
-      if (sqlite3_step(topic) != SQLITE_DONE) throw std::runtime_error("insert topic");
-      sqlite3_reset(topic);
-    }
-    sqlite3_bind_int(message, 1, topics[m.topic]);
-    sqlite3_bind_int64(message, 2, m.log_time_ns);
-    sqlite3_bind_blob(message, 3, m.data.data(), static_cast<int>(m.data.size()), SQLITE_STATIC);
-    if (sqlite3_step(message) != SQLITE_DONE) throw std::runtime_error("insert message");
-    sqlite3_reset(message);
+namespace {
+
+// rosbag2's sqlite3 storage as it records: the tables first, then messages committed in
+// transactions of `commit_every` (rosbag2 commits in batches too).
+class Db3Writer : public RecordingWriter {
+ public:
+  Db3Writer(const fs::path& path, int commit_every) : commit_every_(commit_every) {
+    fs::remove(path);
+    if (sqlite3_open(path.c_str(), &db_) != SQLITE_OK) throw std::runtime_error("sqlite3_open");
+    // A reader (watch) may hold a shared lock for a moment: wait for it, as a recorder should.
+    sqlite3_busy_timeout(db_, 5000);
+    // rosbag2_storage_default_plugins' schema (Humble).
+    Exec(
+        "CREATE TABLE schema(schema_version INTEGER PRIMARY KEY,ros_distro TEXT NOT NULL);"
+        "INSERT INTO schema VALUES(3,'humble');"
+        "CREATE TABLE metadata(id INTEGER PRIMARY KEY,metadata_version INTEGER NOT NULL,"
+        "metadata TEXT NOT NULL);"
+        "CREATE TABLE topics(id INTEGER PRIMARY KEY,name TEXT NOT NULL,type TEXT NOT NULL,"
+        "serialization_format TEXT NOT NULL,offered_qos_profiles TEXT NOT NULL);"
+        "CREATE TABLE messages(id INTEGER PRIMARY KEY,topic_id INTEGER NOT NULL,"
+        "timestamp INTEGER NOT NULL, data BLOB NOT NULL);"
+        "CREATE INDEX timestamp_idx ON messages (timestamp ASC);"
+        "BEGIN;");
+    sqlite3_prepare_v2(db_, "INSERT INTO topics VALUES(?,?,?,'cdr','')", -1, &topic_, nullptr);
+    sqlite3_prepare_v2(db_, "INSERT INTO messages(topic_id,timestamp,data) VALUES(?,?,?)", -1,
+                       &message_, nullptr);
   }
-  sqlite3_finalize(topic);
-  sqlite3_finalize(message);
-  exec("COMMIT;");
-  sqlite3_close(db);
+  ~Db3Writer() override {
+    if (db_) Close();
+  }
+
+  void Add(const RecordedMessage& m) override {
+    if (!topics_.count(m.topic)) {
+      const int id = static_cast<int>(topics_.size()) + 1;
+      topics_[m.topic] = id;
+      const std::string type = Ros2Type(m.type);
+      sqlite3_bind_int(topic_, 1, id);
+      sqlite3_bind_text(topic_, 2, m.topic.c_str(), -1, SQLITE_TRANSIENT);
+      sqlite3_bind_text(topic_, 3, type.c_str(), -1, SQLITE_TRANSIENT);
+      if (sqlite3_step(topic_) != SQLITE_DONE) throw std::runtime_error("insert topic");
+      sqlite3_reset(topic_);
+    }
+    sqlite3_bind_int(message_, 1, topics_[m.topic]);
+    sqlite3_bind_int64(message_, 2, m.log_time_ns);
+    sqlite3_bind_blob(message_, 3, m.data.data(), static_cast<int>(m.data.size()), SQLITE_STATIC);
+    if (sqlite3_step(message_) != SQLITE_DONE) throw std::runtime_error("insert message");
+    sqlite3_reset(message_);
+    if (++uncommitted_ >= commit_every_) {
+      Exec("COMMIT; BEGIN;");
+      uncommitted_ = 0;
+    }
+  }
+
+  void Close() override {
+    if (!db_) return;
+    sqlite3_finalize(topic_);
+    sqlite3_finalize(message_);
+    Exec("COMMIT;");
+    sqlite3_close(db_);
+    db_ = nullptr;
+  }
+
+ private:
+  void Exec(const char* sql) {
+    if (sqlite3_exec(db_, sql, nullptr, nullptr, nullptr) != SQLITE_OK)
+      throw std::runtime_error(std::string("sqlite: ") + sqlite3_errmsg(db_));
+  }
+
+  sqlite3* db_ = nullptr;
+  sqlite3_stmt* topic_ = nullptr;
+  sqlite3_stmt* message_ = nullptr;
+  std::map<std::string, int> topics_;
+  int commit_every_;
+  int uncommitted_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<RecordingWriter> OpenDb3Writer(const fs::path& path, int commit_every) {
+  return std::make_unique<Db3Writer>(path, commit_every);
+}
+
+void WriteDb3(const fs::path& path, const std::vector<RecordedMessage>& messages) {
+  Db3Writer writer(path, static_cast<int>(messages.size()) + 1);
+  for (const RecordedMessage& message : messages) writer.Add(message);
+  writer.Close();
 }
 
 }  // namespace calibench::test

@@ -68,6 +68,9 @@ void WriteRos1Bag(const std::filesystem::path& path, const std::vector<RecordedM
 void WriteMcap(const std::filesystem::path& path, const std::vector<RecordedMessage>& messages,
                const std::string& profile, const std::string& compression, bool summary = true,
                std::size_t chunk_bytes = 768 * 1024);
+// The rosbag2 sqlite3 layout written as it records, committing every `commit_every` messages.
+std::unique_ptr<RecordingWriter> OpenDb3Writer(const std::filesystem::path& path,
+                                               int commit_every = 100);
 // The rosbag2 sqlite3 layout (topics + messages tables, CDR data).
 void WriteDb3(const std::filesystem::path& path, const std::vector<RecordedMessage>& messages);
 

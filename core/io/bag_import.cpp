@@ -92,6 +92,8 @@ class Importer {
         [&](std::int64_t done, std::int64_t total) {
           if (progress_) progress_("reading", done, total);
         });
+    // Readers stop at the last message record (an MCAP's summary is not read): say 100 %.
+    if (progress_) progress_("reading", bag_->SizeBytes(), bag_->SizeBytes());
     finder.Finish();
     Write(finder.TakePairs());
     summary_.bytes_read = bag_->SizeBytes();

@@ -131,7 +131,8 @@ class SqliteBag final : public BagReader {
     }
     sqlite3_busy_timeout(db, 200);
     try {
-      ReadNewRows(db, visit);
+      while (ReadNewRows(db, visit) > 0) {
+      }
     } catch (const IoError&) {
       // The tables may not exist yet (a recording just begun) or a write is under way.
     }
@@ -141,18 +142,23 @@ class SqliteBag final : public BagReader {
   }
 
  private:
-  void ReadNewRows(sqlite3* db, const BagVisitor& visit) {
+  // One batch of rows committed since the last; how many.
+  int ReadNewRows(sqlite3* db, const BagVisitor& visit) {
     Statement topics(db, "SELECT id, name, type, serialization_format FROM topics ORDER BY id",
                      path_);
     while (topics.Step())
       if (!topic_index_.count(topics.Integer(0)))
         topic_index_[topics.Integer(0)] =
             AddTopic(&topics_, topics.Text(1), topics.Text(2), topics.Text(3));
+    // In batches: each statement holds a shared lock, which a recorder in rollback-journal mode
+    // must wait for to commit (in WAL mode it never waits).
     Statement rows(db,
                    "SELECT id, topic_id, timestamp, data FROM messages WHERE id > " +
-                       std::to_string(last_row_) + " ORDER BY id",
+                       std::to_string(last_row_) + " ORDER BY id LIMIT 64",
                    path_);
+    int read = 0;
     while (rows.Step()) {
+      ++read;
       last_row_ = rows.Integer(0);
       const auto topic = topic_index_.find(rows.Integer(1));
       if (topic == topic_index_.end()) continue;
@@ -163,6 +169,7 @@ class SqliteBag final : public BagReader {
       ++topics_[topic->second].message_count;
       visit(message);
     }
+    return read;
   }
 
   void ReadTopics() {

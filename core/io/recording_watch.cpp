@@ -12,9 +12,10 @@ namespace {
 // first message); beyond this many the oldest go.
 constexpr std::size_t kMaxPending = 2000;
 
+// A topic of the type with a message read already (a recorder may announce a topic first).
 bool HasTopicOfType(const BagReader& bag, bool (*is)(const std::string&)) {
   for (const BagTopic& topic : bag.Topics())
-    if (is(topic.type)) return true;
+    if (is(topic.type) && topic.message_count > 0) return true;
   return false;
 }
 

@@ -88,6 +88,10 @@ TEST(ImportCli, ABagBecomesADatasetThatCalibrates) {
       0)
       << output;
   EXPECT_NE(output.find("pairs written: 4"), std::string::npos) << output;
+  // stderr is not a terminal here: a line per 10 %, then the summary line a log ends with.
+  EXPECT_NE(output.find("reading 100%"), std::string::npos) << output;
+  EXPECT_NE(output.find("imported 4 pairs from "), std::string::npos) << output;
+  EXPECT_NE(output.find("x its length)"), std::string::npos) << output;
   // One image per cloud: nothing to judge stillness by, and the summary says so.
   EXPECT_NE(output.find("note: 4 pairs had no other image within 200 ms"), std::string::npos)
       << output;

@@ -1,8 +1,8 @@
-// `calibench watch` on a recording while its recorder writes it: an MCAP, a ROS 1 bag and a
-// rosbag2 folder, written message by message at 4x real time (complete chunks reach the file as
-// they fill; the index, summary or metadata.yaml only at the end). The watch follows, says each
-// pair, ends when the recorder closes the file, and its pairs are exactly what `import` makes of
-// the finished recording.
+// `calibench watch` on a recording while its recorder writes it: an MCAP, a ROS 1 bag and rosbag2
+// folders of an MCAP and of a .db3, written message by message at 4x real time (complete chunks
+// reach the file as they fill; the index, summary or metadata.yaml only at the end). The watch
+// follows, says each pair, ends when the recorder closes the file, and its pairs are exactly what
+// `import` makes of the finished recording.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "core/geometry/geometry.h"
+#include "core/results/result_file.h"
 #include "tests/sim_recording.h"
 #include "tests/test_support.h"
 
@@ -53,6 +55,13 @@ std::vector<json> ReadJsonLines(const fs::path& path) {
   return lines;
 }
 
+Pose PoseFromRows(const json& rows) {
+  Mat4 m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m(r, c) = rows.at(r).at(c).get<double>();
+  return Pose(m);
+}
+
 std::vector<std::string> Pngs(const fs::path& images) {
   std::vector<std::string> files;
   for (const auto& entry : fs::directory_iterator(images)) files.push_back(entry.path().filename());
@@ -70,44 +79,63 @@ TEST(WatchRecording, FollowsRecordingsWhileWrittenAndEndsWithImportsPairs) {
   options.max_distance_m = 2.5;
   struct Case {
     const char* name;
-    bool folder;  // a rosbag2 folder: capture_0.mcap, then metadata.yaml at the end
+    const char* file;  // in a rosbag2 folder (metadata.yaml written at the end); "" = no folder
   };
   for (const Case c :
-       {Case{"capture.mcap", false}, Case{"capture.bag", false}, Case{"rosbag2_capture", true}}) {
+       {Case{"capture.mcap", ""}, Case{"capture.bag", ""}, Case{"rosbag2_mcap", "capture_0.mcap"},
+        Case{"rosbag2_db3", "capture_0.db3"}}) {
     SCOPED_TRACE(c.name);
     const fs::path dir = test::TempDir(std::string("watch_recording_") + c.name);
     const fs::path source = dir / c.name;
-    const fs::path file = c.folder ? source / "capture_0.mcap" : source;
-    const bool bag = fs::path(c.name).extension() == ".bag";
-    if (c.folder) fs::create_directories(source);
+    const bool folder = *c.file != 0;
+    const fs::path file = folder ? source / c.file : source;
+    const bool bag = file.extension() == ".bag", db3 = file.extension() == ".db3";
+    if (folder) fs::create_directories(source);
     const fs::path stream = dir / "stream.jsonl";
-    // The watch starts first: the recording does not exist yet.
+    // The MCAP at the recording's own pace, the others 4x faster (the test's time).
+    const double speedup = std::string(c.name) == "capture.mcap" ? 1.0 : 4.0;
+    auto open_writer = [&] {
+      return std::make_unique<PacedWriter>(
+          bag   ? test::OpenRos1BagWriter(file, "lz4", 256 * 1024)
+          : db3 ? test::OpenDb3Writer(file, 50)
+                : test::OpenMcapWriter(file, "ros2", "lz4", true, 256 * 1024),
+          speedup);
+    };
+    // A single file: the watch starts first, the recording does not exist yet. A rosbag2 folder
+    // is recognised by its files: `ros2 bag record` creates the first one with the folder.
+    std::unique_ptr<PacedWriter> writer = folder ? open_writer() : nullptr;
     std::thread watch([&] {
       test::RunCommand(test::CalibenchExe() + " watch " + source.string() +
                        " --board a3 --json-lines --idle-exit 20 --out " +
                        (dir / "watched").string() + " > " + stream.string() + " 2>&1");
     });
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    {
-      PacedWriter writer(bag ? test::OpenRos1BagWriter(file, "lz4", 256 * 1024)
-                             : test::OpenMcapWriter(file, "ros2", "lz4", true, 256 * 1024),
-                         4.0);
-      test::WriteSimRecording(&writer, bag ? MessageEncoding::kRos1 : MessageEncoding::kCdr,
+    std::string write_error;
+    try {
+      if (!writer) writer = open_writer();
+      test::WriteSimRecording(writer.get(), bag ? MessageEncoding::kRos1 : MessageEncoding::kCdr,
                               options);
-      writer.Close();
+      writer->Close();
+    } catch (const std::exception& e) {
+      write_error = e.what();  // the watch still ends (--idle-exit) and is joined below
     }
-    if (c.folder) std::ofstream(source / "metadata.yaml") << "rosbag2_bagfile_information:\n";
+    if (folder) std::ofstream(source / "metadata.yaml") << "rosbag2_bagfile_information:\n";
     watch.join();
+    ASSERT_EQ(write_error, "");
 
     const std::vector<json> lines = ReadJsonLines(stream);
     ASSERT_FALSE(lines.empty());
     int pairs = 0, accepted = 0, solves = 0;
+    std::optional<json> last_solve;
     for (const json& line : lines) {
       if (line["event"] == "pair") {
         ++pairs;
         accepted += line["accepted"].get<bool>();
       }
-      solves += line["event"] == "solve";
+      if (line["event"] == "solve") {
+        ++solves;
+        last_solve = line;
+      }
     }
     EXPECT_EQ(pairs, 4);
     EXPECT_EQ(accepted, 4);
@@ -134,10 +162,22 @@ TEST(WatchRecording, FollowsRecordingsWhileWrittenAndEndsWithImportsPairs) {
                 test::ReadFileBytes(dir / "imported/clouds" / pcd))
           << pcd;
     }
-    // The watched folder is a dataset at any moment: calibrate reads it.
+    // `calibrate` on the imported recording ends where the watch's last solve ended.
+    ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
+                                   (dir / "imported").string() + " --out " +
+                                   (dir / "result.json").string(),
+                               &output),
+              0)
+        << output;
+    ASSERT_TRUE(last_solve && !(*last_solve)["cam_from_lidar"].is_null());
+    const PoseError difference = ComputePoseError(PoseFromRows((*last_solve)["cam_from_lidar"]),
+                                                  LoadResult(dir / "result.json").cam_from_source);
+    EXPECT_LT(difference.translation_m, 0.0005);
+    EXPECT_LT(difference.rotation_rad * kRadToDeg, 0.01);
+    // And the watched folder is a dataset at any moment: calibrate reads it too.
     EXPECT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
                                    (dir / "watched").string() + " --out " +
-                                   (dir / "result.json").string(),
+                                   (dir / "watched_result.json").string(),
                                &output),
               0)
         << output;

@@ -298,6 +298,9 @@ void WindowShell::Popups() {
     ImGui::Text("%zu pairs from %lld clouds (%s) and %lld images (%s)", s.pair_ids.size(),
                 static_cast<long long>(s.clouds), s.cloud_topic.c_str(),
                 static_cast<long long>(s.images), s.image_topic.c_str());
+    ImGui::Text("board: %s", s.board_source.c_str());
+    ImGui::Text("searched %d images for the board (%d sweeps tried), found in %d",
+                s.images_searched, s.tries, s.boards_seen);
     for (const auto& [reason, count] : s.dropped)
       ImGui::BulletText("dropped %d: %s", count, reason.c_str());
     ImGui::TextDisabled("%s", s.manifest.c_str());
