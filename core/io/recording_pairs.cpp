@@ -52,15 +52,18 @@ std::int64_t StampOr(const RosHeader& header, std::int64_t log_time_ns) {
   return header.stamp_ns != 0 ? header.stamp_ns : log_time_ns;
 }
 
-// Sweeps and images stay this long behind the newest stamp (then a try cannot need them).
-constexpr double kKeepBeyondWindowS = 1.5;
+// Sweeps and images stay this long beyond the stillness window and the pairing offset behind
+// the newest stamp: a sweep is judged kJudgeLagS after its window has passed, and its try needs
+// the images back to the window's start.
+constexpr double kKeepBeyondWindowS = 0.5;
 // A sweep is judged once stamps this far past its window have arrived: the recorder may store
 // an image a little after a later sweep.
 constexpr double kJudgeLagS = 0.25;
 // Tries waiting for the camera intrinsics (CameraInfo late in the recording); older ones drop.
 constexpr std::size_t kMaxWaitingForCamera = 8;
-// Tries queued for the second thread; the reader waits beyond that (memory stays bounded).
-constexpr std::size_t kMaxQueuedTries = 4;
+// Tries queued for the second thread (each holds its window's images: ~20 MB at 720p); the
+// reader waits beyond that, so memory stays bounded whatever the recording's length.
+constexpr std::size_t kMaxQueuedTries = 2;
 // Tries kept while the board is chosen; with no preset in any of them they are dropped.
 constexpr std::size_t kMaxBoardSamples = 12;
 constexpr const char* kHoldDone = "not needed: its hold already gave a pair";
