@@ -76,6 +76,17 @@ SimOptions RecordingSim(const SimRecordingOptions& options) {
 
 }  // namespace
 
+SimRecordingOptions SmallSimRecording(int poses) {
+  SimRecordingOptions options;
+  options.poses = poses;
+  options.hold_s = 2.5;
+  options.move_s = 1.0;
+  options.image_width = 640;
+  options.image_height = 360;
+  options.max_distance_m = 2.5;
+  return options;
+}
+
 SimRecordingTruth PlanSimRecording(const SimRecordingOptions& options) {
   const SimOptions resolved = RecordingSim(options);
   SimRecordingTruth truth;

@@ -38,6 +38,10 @@ struct SimRecordingTruth {
   std::int64_t messages = 0;
 };
 
+// What the tests record: 4 s of sensors per pose instead of 8, 640 x 360 images with the board
+// within 2.5 m (40 mm squares stay >= 7 px).
+SimRecordingOptions SmallSimRecording(int poses);
+
 // The recording's truth without writing it (the held poses, spans, camera, board, mount).
 SimRecordingTruth PlanSimRecording(const SimRecordingOptions& options);
 

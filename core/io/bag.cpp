@@ -322,6 +322,13 @@ class FollowedFolder final : public BagReader {
 
 }  // namespace
 
+BagVisitor BagReader::CountingAsVisited(const BagVisitor& visit) {
+  return [this, &visit](const BagMessage& message) {
+    ++topics_[message.topic].message_count;
+    return visit(message);
+  };
+}
+
 bool BagReader::FollowNewMessages(const BagVisitor&) {
   bag_internal::Fail(path_, "this reader reads a finished recording only");
 }

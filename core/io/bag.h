@@ -63,6 +63,9 @@ class BagReader {
   virtual bool FollowNewMessages(const BagVisitor& visit);
 
  protected:
+  // `visit` that also counts each message on its topic (a followed recording has no index).
+  BagVisitor CountingAsVisited(const BagVisitor& visit);
+
   std::filesystem::path path_;
   std::string format_;
   std::vector<BagTopic> topics_;

@@ -75,10 +75,7 @@ class Mcap final : public BagReader {
 
   bool FollowNewMessages(const BagVisitor& visit_message) override {
     if (closed_) return true;
-    const BagVisitor visit = [&](const BagMessage& message) {
-      ++topics_[message.topic].message_count;
-      return visit_message(message);
-    };
+    const BagVisitor visit = CountingAsVisited(visit_message);
     size_bytes_ = file_.Refresh();
     std::vector<std::uint8_t> head, content, chunk;
     while (follow_offset_ + 9 <= size_bytes_) {

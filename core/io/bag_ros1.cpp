@@ -154,10 +154,7 @@ class Ros1Bag final : public BagReader {
   // connection and chunk-info records of the index: the first of those ends the recording.
   bool FollowNewMessages(const BagVisitor& visit_message) override {
     if (closed_) return true;
-    const BagVisitor visit = [&](const BagMessage& message) {
-      ++topics_[message.topic].message_count;
-      return visit_message(message);
-    };
+    const BagVisitor visit = CountingAsVisited(visit_message);
     size_bytes_ = file_.Refresh();
     std::vector<std::uint8_t> bytes, chunk;
     FileRecord record;

@@ -21,18 +21,6 @@ namespace calibench {
 namespace {
 namespace fs = std::filesystem;
 
-test::SimRecordingOptions SmallRecording() {
-  test::SimRecordingOptions options;
-  options.poses = 6;
-  options.hold_s = 2.5;
-  options.move_s = 1.0;
-  options.image_width = 640;
-  options.image_height = 360;
-  // 40 mm squares stay >= 7 px at 640 px across.
-  options.max_distance_m = 2.5;
-  return options;
-}
-
 test::SimRecordingTruth Record(const fs::path& path, const test::SimRecordingOptions& options) {
   const bool bag = path.extension() == ".bag";
   auto writer = bag ? test::OpenRos1BagWriter(path, "lz4")
@@ -57,7 +45,7 @@ nlohmann::json ImportRecord(const BagImportSummary& summary) {
 
 TEST(RecordingImport, OnePairPerHoldTheSameFromMcapAndBag) {
   const fs::path dir = test::TempDir("recording_import_holds");
-  const test::SimRecordingOptions options = SmallRecording();
+  const test::SimRecordingOptions options = test::SmallSimRecording(6);
   std::vector<nlohmann::json> records;
   for (const char* name : {"capture.mcap", "capture.bag"}) {
     SCOPED_TRACE(name);
@@ -104,8 +92,7 @@ TEST(RecordingImport, OnePairPerHoldTheSameFromMcapAndBag) {
 // holds are still found, by trying a sweep every second and letting the camera judge.
 TEST(RecordingImport, ALidarThatNeverSeesTheSceneStillHidesNoHold) {
   const fs::path dir = test::TempDir("recording_import_noisy_lidar");
-  test::SimRecordingOptions options = SmallRecording();
-  options.poses = 4;
+  test::SimRecordingOptions options = test::SmallSimRecording(4);
   options.lidar_range_noise_m = 0.15;
   const test::SimRecordingTruth truth = Record(dir / "noisy.mcap", options);
   const BagImportSummary summary =
@@ -132,8 +119,7 @@ TEST(RecordingImport, ChoosesThePresetThatFitsWithoutBeingTold) {
   const fs::path dir = test::TempDir("recording_import_board");
   for (const char* preset : {"a4", "a3"}) {
     SCOPED_TRACE(preset);
-    test::SimRecordingOptions options = SmallRecording();
-    options.poses = 3;
+    test::SimRecordingOptions options = test::SmallSimRecording(3);
     options.board = BoardPreset(preset);
     const fs::path bag = dir / (std::string(preset) + ".mcap");
     Record(bag, options);
@@ -151,8 +137,7 @@ TEST(RecordingImport, ChoosesThePresetThatFitsWithoutBeingTold) {
 TEST(RecordingImport, ABoardNoPresetExplainsIsRefusedUntilItsTargetLiesBeside) {
   const fs::path dir = test::TempDir("recording_import_large_board");
   // 8x6 inner corners of 70 mm: a4's 5x4 and a3's 7x5 grids are found inside it.
-  test::SimRecordingOptions options = SmallRecording();
-  options.poses = 3;
+  test::SimRecordingOptions options = test::SmallSimRecording(3);
   options.board = Board(8, 6, 0.07, 0.70, 0.56);
   fs::create_directories(dir / "site");
   const fs::path bag = dir / "site" / "large.mcap";

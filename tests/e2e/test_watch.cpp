@@ -17,11 +17,14 @@
 #include "core/session/session.h"
 #include "tests/acfr_manifest.h"
 #include "tests/test_support.h"
+#include "tests/watch_stream.h"
 
 namespace calibench {
 namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
+using test::PoseFromRows;
+using test::ReadJsonLines;
 
 // The ACFR folder (links) and an empty capture folder holding only its camera and target.
 struct Capture {
@@ -58,21 +61,6 @@ void CopyCapturedPair(const Capture& capture, const std::string& stem) {
     for (const auto& entry : fs::directory_iterator(capture.source / sub))
       if (entry.path().stem() == stem)
         WriteLikeACapture(entry.path(), capture.watched / sub / entry.path().filename());
-}
-
-std::vector<json> ReadJsonLines(const fs::path& path) {
-  std::vector<json> lines;
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line)) lines.push_back(json::parse(line));
-  return lines;
-}
-
-Pose PoseFromRows(const json& rows) {
-  Mat4 m;
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) m(r, c) = rows.at(r).at(c).get<double>();
-  return Pose(m);
 }
 
 TEST(Watch, TheRealCaptureReplayedPairByPairEndsWhereCalibrateEnds) {

@@ -14,11 +14,14 @@
 #include "core/results/result_file.h"
 #include "tests/sim_recording.h"
 #include "tests/test_support.h"
+#include "tests/watch_stream.h"
 
 namespace calibench {
 namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
+using test::PoseFromRows;
+using test::ReadJsonLines;
 
 // Hands messages on no faster than `speedup` times the recording's own clock.
 class PacedWriter : public test::RecordingWriter {
@@ -44,24 +47,6 @@ class PacedWriter : public test::RecordingWriter {
   std::chrono::steady_clock::time_point start_;
 };
 
-std::vector<json> ReadJsonLines(const fs::path& path) {
-  std::vector<json> lines;
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] != '{') continue;  // OpenCV's own warnings on stderr
-    lines.push_back(json::parse(line));
-  }
-  return lines;
-}
-
-Pose PoseFromRows(const json& rows) {
-  Mat4 m;
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) m(r, c) = rows.at(r).at(c).get<double>();
-  return Pose(m);
-}
-
 std::vector<std::string> Pngs(const fs::path& images) {
   std::vector<std::string> files;
   for (const auto& entry : fs::directory_iterator(images)) files.push_back(entry.path().filename());
@@ -70,13 +55,7 @@ std::vector<std::string> Pngs(const fs::path& images) {
 }
 
 TEST(WatchRecording, FollowsRecordingsWhileWrittenAndEndsWithImportsPairs) {
-  test::SimRecordingOptions options;
-  options.poses = 4;
-  options.hold_s = 2.5;
-  options.move_s = 1.0;
-  options.image_width = 640;
-  options.image_height = 360;
-  options.max_distance_m = 2.5;
+  const test::SimRecordingOptions options = test::SmallSimRecording(4);
   struct Case {
     const char* name;
     const char* file;  // in a rosbag2 folder (metadata.yaml written at the end); "" = no folder
