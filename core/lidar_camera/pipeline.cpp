@@ -132,7 +132,7 @@ std::vector<int> RegionFor(const Dataset& dataset, const LidarCloud& cloud, cons
     *origin = {BoardSource::kDetected, 0.0, found.reason};
     return {};
   }
-  *origin = {BoardSource::kDetected, found.confidence, found.board->Describe()};
+  *origin = {BoardSource::kDetected, found.confidence, found.board->Describe(dataset.target)};
   return found.board->indices;
 }
 

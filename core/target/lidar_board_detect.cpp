@@ -231,14 +231,18 @@ double FreeEdgeFraction(const LidarCloud& cloud, const AngularGrid& grid,
   // that the segment left out (noise at its border) is stepped over, a wall is not (it stays on
   // the plane for the whole reach).
   const int reach = grid.HalfWindowColumns() + 3;
+  // Cells without a return (a dropout on black ink) are stepped over too; a row end with no
+  // return at all within the reach has nothing behind it (a cloud of the board alone).
   auto along_row = [&](int row, int from, int step) {
+    bool any_return = false;
     for (int k = 1; k <= reach; ++k) {
       const int cell = grid.Cell(row, grid.Wrap(reference + from + step * k));
       if (in_segment[cell] || grid.point[cell] < 0) continue;
+      any_return = true;
       const Border border = Classify(cloud, grid, cell, plane, jump_m);
       if (border != Border::kAttached) return border;
     }
-    return Border::kAttached;
+    return any_return ? Border::kAttached : Border::kFree;
   };
   auto along_column = [&](int column, int from, int step) {
     for (int k = 1; k <= 3; ++k) {
@@ -391,8 +395,25 @@ bool LidarBoardDetectionOptions::Check(std::string* why) const {
   return true;
 }
 
-std::string LidarBoardCandidate::Describe() const {
-  return Printf("a %.2f x %.2f m plane at %.1f m, azimuth %.0f deg", extent_m.x(), extent_m.y(),
+namespace {
+
+// Whether the board's size is written longer side first (board_size [width, height]).
+bool WiderThanTall(const BoardSpec& board) {
+  return board.board_width > 0 && board.board_height > 0
+             ? board.board_width >= board.board_height
+             : board.PatternWidth() >= board.PatternHeight();
+}
+
+// A long side x short side pair, in the order the board's size is written.
+Vec2 InBoardOrder(const Vec2& long_short, const BoardSpec& board) {
+  return WiderThanTall(board) ? long_short : Vec2(long_short.y(), long_short.x());
+}
+
+}  // namespace
+
+std::string LidarBoardCandidate::Describe(const BoardSpec& board) const {
+  const Vec2 size = InBoardOrder(extent_m, board);
+  return Printf("a %.2f x %.2f m plane at %.1f m, azimuth %.0f deg", size.x(), size.y(),
                 centre.norm(), std::atan2(centre.y(), centre.x()) * kRadToDeg);
 }
 
@@ -421,10 +442,11 @@ LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& b
   if (result.near_misses.size() > 5) result.near_misses.resize(5);
   const LidarBoardCandidate* near_miss =
       result.near_misses.empty() ? nullptr : &result.near_misses.front();
+  const Vec2 sheet_size = InBoardOrder(sheet.max, board);  // sheet.max: long side, short side
   const std::string wanted =
-      Printf("no planar segment of %.2f x %.2f m standing free", sheet.max.y(), sheet.max.x());
+      Printf("no planar segment of %.2f x %.2f m standing free", sheet_size.x(), sheet_size.y());
   if (result.candidates.empty()) {
-    result.reason = wanted + (near_miss ? "; best candidate: " + near_miss->Describe() + ", " +
+    result.reason = wanted + (near_miss ? "; best candidate: " + near_miss->Describe(board) + ", " +
                                               near_miss->rejection
                                         : "; no planar segment at all");
     return result;
@@ -441,8 +463,8 @@ LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& b
                                   [&](const auto& other) { return !same_sheet(other); });
   const double second = rival != result.candidates.end() ? rival->score : 0.0;
   if (second > options.ambiguity_ratio * best.score) {
-    result.reason = "two board-like planes, too close to tell apart: " + best.Describe() + " and " +
-                    rival->Describe();
+    result.reason = "two board-like planes, too close to tell apart: " + best.Describe(board) +
+                    " and " + rival->Describe(board);
     return result;
   }
   result.confidence =

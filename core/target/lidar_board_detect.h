@@ -68,8 +68,9 @@ struct LidarBoardCandidate {
   double static_fraction = 0.0;  // on the background model; 0 without one
   double score = 0.0;            // 0..1, higher is more board-like
   std::string rejection;         // why it is not the board; empty for a candidate
-  // "a 0.58 x 0.79 m plane at 2.9 m, azimuth 12 deg".
-  std::string Describe() const;
+  // "a 0.79 x 0.58 m plane at 2.9 m, azimuth 12 deg": width x height in the order of the board's
+  // own size (board_size: the longer side first for a board wider than tall).
+  std::string Describe(const BoardSpec& board) const;
 };
 
 struct LidarBoardDetection {

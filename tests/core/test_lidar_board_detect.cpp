@@ -87,9 +87,9 @@ void DetectAllAcfr(bool ringless) {
     std::printf(
         "pose%d: %s, %d returns, %d rings, free %.2f, static %.2f, confidence %.2f, "
         "%.2f deg / %.1f mm from the authors' board%s\n",
-        n, found.board->Describe().c_str(), int(found.board->indices.size()), found.board->rings,
-        found.board->free_edge_fraction, found.board->static_fraction, found.confidence,
-        error.angle_deg, error.offset_m * 1e3, false_detection ? "  FALSE" : "");
+        n, found.board->Describe(AcfrBoard()).c_str(), int(found.board->indices.size()),
+        found.board->rings, found.board->free_edge_fraction, found.board->static_fraction,
+        found.confidence, error.angle_deg, error.offset_m * 1e3, false_detection ? "  FALSE" : "");
   }
   std::printf("%d of 40 detected, %d false\n", detected, wrong);
   EXPECT_GE(detected, 38);
@@ -174,8 +174,8 @@ Plane TruePlane(const Pose& lidar_from_board) {
   if (error.angle_deg > 2.0 || error.offset_m > 0.03 ||
       (found.board->centre - board.translation()).norm() > 0.15)
     return ::testing::AssertionFailure()
-           << "false detection: " << found.board->Describe() << ", " << error.angle_deg << " deg / "
-           << error.offset_m * 1e3 << " mm off the board";
+           << "false detection: " << found.board->Describe(BoardPreset("a3")) << ", "
+           << error.angle_deg << " deg / " << error.offset_m * 1e3 << " mm off the board";
   return ::testing::AssertionSuccess();
 }
 
@@ -256,9 +256,44 @@ TEST(LidarBoardDetect, TwoBoardsFailThePairAndNameBoth) {
   scene.panels.push_back(second);
   const LidarBoardDetection found = DetectLidarBoard(
       Scan(scene, LidarModel::kOs0_128, 9), BoardPreset("a3"), LidarBoardDetectionOptions{});
-  EXPECT_FALSE(found.board) << found.board->Describe();
+  EXPECT_FALSE(found.board) << found.board->Describe(BoardPreset("a3"));
   EXPECT_NE(found.reason.find("two board-like planes"), std::string::npos) << found.reason;
   EXPECT_EQ(found.candidates.size(), 2u);
+}
+
+// A cloud of the board alone (no floor, no walls: what a cropped segment looks like): nothing lies
+// beyond its border, so it stands free, and no message calls it "attached".
+TEST(LidarBoardDetect, ABoardAloneInItsCloudStandsFree) {
+  for (double distance : {1.5, 2.0, 2.5}) {
+    LidarScene scene;
+    scene.clutter = false;
+    scene.lidar_from_board = BoardFacingLidar(distance, 10.0, 20.0);
+    const LidarBoardDetection found = DetectLidarBoard(
+        Scan(scene, LidarModel::kVlp16, 21), BoardPreset("a3"), LidarBoardDetectionOptions{});
+    EXPECT_TRUE(IsTheBoard(found, scene.lidar_from_board)) << distance << " m";
+    // Every side of it is free: along the rings as well as across them.
+    if (found.board) EXPECT_GT(found.board->free_edge_fraction, 0.75) << distance << " m";
+    for (const LidarBoardCandidate& miss : found.near_misses)
+      EXPECT_EQ(miss.rejection.find("attached"), std::string::npos) << miss.rejection;
+  }
+}
+
+// Sizes read as the target file writes them: width x height in board_size's order, for a board
+// wider than tall and for the same sheet turned upright.
+TEST(LidarBoardDetect, SizesAreSaidInTheBoardSizesOrder) {
+  LidarScene scene;                                           // the room alone: no board to find
+  scene.lidar_from_board = BoardFacingLidar(40.0, 0.0, 0.0);  // far outside the room's walls
+  const LidarCloud cloud = Scan(scene, LidarModel::kVlp16, 4);
+  BoardSpec wide = BoardPreset("a3");  // board_size [0.42, 0.297]
+  BoardSpec tall = wide;
+  std::swap(tall.board_width, tall.board_height);
+  std::swap(tall.cols, tall.rows);
+  const std::string wide_reason = DetectLidarBoard(cloud, wide, {}).reason;
+  const std::string tall_reason = DetectLidarBoard(cloud, tall, {}).reason;
+  EXPECT_NE(wide_reason.find("no planar segment of 0.42 x 0.30 m"), std::string::npos)
+      << wide_reason;
+  EXPECT_NE(tall_reason.find("no planar segment of 0.30 x 0.42 m"), std::string::npos)
+      << tall_reason;
 }
 
 TEST(LidarBoardDetect, FindsTheBoardInASweptCloudWithoutRings) {
