@@ -393,7 +393,8 @@ int RunWatch(int argc, char** argv) {
                  "end after this many seconds without new data [s] (0 = never)")
       ->capture_default_str();
   app.add_option("--session", flags.session,
-                 "the session file kept up to date (default: SOURCE/calibench.session.json)");
+                 "the session file kept up to date (default: SOURCE/calibench.session.json; for a "
+                 "recording, calibench.session.json in its dataset folder)");
   app.add_option("--settle", flags.folder.settle_s,
                  "a file is written when its size and time have not changed for this long [s]")
       ->capture_default_str();
