@@ -73,6 +73,30 @@ ImportProgress ProgressBar() {
   };
 }
 
+// How import chooses its pairs (core/io/recording_pairs.h), as flags.
+void AddSelectionFlags(CLI::App& app, PairSelectionOptions* options_out) {
+  PairSelectionOptions& options = *options_out;
+  app.add_option("--max-offset", options.max_pair_offset_s,
+                 "largest cloud-image stamp difference [s]")
+      ->capture_default_str();
+  app.add_option("--still-window", options.still_window_s,
+                 "the board must stand still over this window around each pair [s]")
+      ->capture_default_str();
+  app.add_option("--still-translation", options.still_translation_m,
+                 "largest board movement within the window [m]")
+      ->capture_default_str();
+  app.add_option("--still-rotation", options.still_rotation_deg,
+                 "largest board rotation within the window [deg]")
+      ->capture_default_str();
+  app.add_option("--duplicate-translation", options.duplicate_translation_m,
+                 "a pair closer than this to a kept one (and within --duplicate-rotation) is a "
+                 "near-duplicate [m]")
+      ->capture_default_str();
+  app.add_option("--duplicate-rotation", options.duplicate_rotation_deg,
+                 "see --duplicate-translation [deg]")
+      ->capture_default_str();
+}
+
 void PrintSummary(const BagImportSummary& summary, const BagImportOptions& options) {
   std::printf("%s\n", summary.format.c_str());
   std::printf("clouds  %-28s %lld messages\n", summary.cloud_topic.c_str(),
@@ -130,25 +154,7 @@ int RunImport(int argc, char** argv) {
                  "CameraInfo topic (default: the one beside the image topic)");
   app.add_option("--camera", camera_file,
                  "intrinsics file instead of the recording's CameraInfo (OpenCV, ROS or Kalibr)");
-  app.add_option("--max-offset", options.max_pair_offset_s,
-                 "largest cloud-image stamp difference [s]")
-      ->capture_default_str();
-  app.add_option("--still-window", options.still_window_s,
-                 "the board must stand still over this window around each pair [s]")
-      ->capture_default_str();
-  app.add_option("--still-translation", options.still_translation_m,
-                 "largest board movement within the window [m]")
-      ->capture_default_str();
-  app.add_option("--still-rotation", options.still_rotation_deg,
-                 "largest board rotation within the window [deg]")
-      ->capture_default_str();
-  app.add_option("--duplicate-translation", options.duplicate_translation_m,
-                 "a pair closer than this to a kept one (and within --duplicate-rotation) is a "
-                 "near-duplicate [m]")
-      ->capture_default_str();
-  app.add_option("--duplicate-rotation", options.duplicate_rotation_deg,
-                 "see --duplicate-translation [deg]")
-      ->capture_default_str();
+  AddSelectionFlags(app, &options);
   app.add_option("--max-pairs", options.max_pairs, "at most this many pairs (0 = no cap)")
       ->capture_default_str();
   if (const auto code = ParseFlags(app, argc, argv)) return *code;

@@ -70,9 +70,8 @@ std::string HumanProgress(const CaptureAdvice& advice) {
 
 struct WatchFlags {
   std::string source;
-  fs::path manifest;       // a manifest given instead of its folder
-  bool recording = false;  // SOURCE is a recording (.bag, .mcap, .db3, a rosbag2 folder)
-  fs::path out;            // recordings: the dataset folder the pairs are written to
+  fs::path manifest;  // a manifest given instead of its folder
+  fs::path out;       // recordings: the dataset folder the pairs are written to
   std::optional<BoardSpec> board;
   BagImportOptions import;
   std::string session;
@@ -348,6 +347,55 @@ bool IsRecording(const fs::path& source) {
   return false;
 }
 
+// `watch` on a recording: import's board, camera and topic flags, pairs written to --out.
+int WatchRecording(WatchFlags* flags, const CaptureJobOptions& options, const std::string& board,
+                   const std::string& out, const std::string& camera_file, EventStream& stream) {
+  try {
+    flags->board = BoardFromFlag(board);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "calibench watch: --board: %s\n", e.what());
+    return kUsage;
+  }
+  if (!camera_file.empty()) flags->import.camera = LoadCameraFile(camera_file);
+  flags->import.max_pairs = 0;  // a capture has no cap: every hold is a pair
+  flags->out = out.empty() ? DefaultImportFolder(flags->source) : fs::path(out);
+  fs::create_directories(flags->out);
+  const fs::path session_path =
+      flags->session.empty() ? flags->out / "calibench.session.json" : fs::path(flags->session);
+  Watch watch(std::make_unique<RecordingFeed>(*flags), options, *flags, session_path, &stream);
+  return watch.Run();
+}
+
+// `watch` on a folder in the folder form (or a manifest's folder).
+int WatchFolder(WatchFlags* flags_in, const CaptureJobOptions& options, EventStream& stream) {
+  WatchFlags& flags = *flags_in;
+  std::error_code error;
+  if (fs::is_regular_file(flags.source, error)) {  // a manifest, named: its folder is watched
+    flags.manifest = ResolveDataset(flags.source, DatasetKind::kLidarCamera).path;
+    flags.source = fs::absolute(flags.manifest).parent_path().string();
+  }
+  if (!fs::is_directory(flags.source, error)) {
+    std::fprintf(stderr,
+                 "calibench watch: %s is not a folder (watch follows a folder in the folder "
+                 "form: clouds/, images/, camera.yaml, target.json)\n",
+                 flags.source.c_str());
+    return kInputError;
+  }
+  std::string not_yet;
+  std::optional<Dataset> setup = WaitForSetup(flags, stream, &not_yet);
+  if (!setup) {
+    stream.Note("end", "", not_yet);
+    std::fprintf(stderr, "calibench watch: error: %s\n", not_yet.c_str());
+    return kInputError;
+  }
+  const fs::path session_path = flags.session.empty()
+                                    ? fs::path(flags.source) / "calibench.session.json"
+                                    : fs::path(flags.session);
+  Watch watch(std::make_unique<FolderFeed>(std::move(*setup), flags), options, flags, session_path,
+              &stream);
+  return watch.Run();
+}
+
 }  // namespace
 
 int RunWatch(int argc, char** argv) {
@@ -417,48 +465,9 @@ int RunWatch(int argc, char** argv) {
     return kUsage;
   }
   EventStream stream(flags.json_lines);
-  flags.recording = IsRecording(flags.source);
-  if (flags.recording) {
-    try {
-      flags.board = BoardFromFlag(board);
-    } catch (const std::invalid_argument& e) {
-      std::fprintf(stderr, "calibench watch: --board: %s\n", e.what());
-      return kUsage;
-    }
-    if (!camera_file.empty()) flags.import.camera = LoadCameraFile(camera_file);
-    flags.import.max_pairs = 0;  // a capture has no cap: every hold is a pair
-    flags.out = out.empty() ? DefaultImportFolder(flags.source) : fs::path(out);
-    fs::create_directories(flags.out);
-    const fs::path session_path =
-        flags.session.empty() ? flags.out / "calibench.session.json" : fs::path(flags.session);
-    Watch watch(std::make_unique<RecordingFeed>(flags), options, flags, session_path, &stream);
-    return watch.Run();
-  }
-  std::error_code error;
-  if (fs::is_regular_file(flags.source, error)) {  // a manifest, named: its folder is watched
-    flags.manifest = ResolveDataset(flags.source, DatasetKind::kLidarCamera).path;
-    flags.source = fs::absolute(flags.manifest).parent_path().string();
-  }
-  if (!fs::is_directory(flags.source, error)) {
-    std::fprintf(stderr,
-                 "calibench watch: %s is not a folder (watch follows a folder in the folder "
-                 "form: clouds/, images/, camera.yaml, target.json)\n",
-                 flags.source.c_str());
-    return kInputError;
-  }
-  std::string not_yet;
-  std::optional<Dataset> setup = WaitForSetup(flags, stream, &not_yet);
-  if (!setup) {
-    stream.Note("end", "", not_yet);
-    std::fprintf(stderr, "calibench watch: error: %s\n", not_yet.c_str());
-    return kInputError;
-  }
-  const fs::path session_path = flags.session.empty()
-                                    ? fs::path(flags.source) / "calibench.session.json"
-                                    : fs::path(flags.session);
-  Watch watch(std::make_unique<FolderFeed>(std::move(*setup), flags), options, flags, session_path,
-              &stream);
-  return watch.Run();
+  if (IsRecording(flags.source))
+    return WatchRecording(&flags, options, board, out, camera_file, stream);
+  return WatchFolder(&flags, options, stream);
 }
 
 }  // namespace calibench::app

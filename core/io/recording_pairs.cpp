@@ -9,8 +9,8 @@
 #include <set>
 #include <thread>
 
+#include "core/io/pair_verdict.h"
 #include "core/io/ros_messages.h"
-#include "core/target/board_camera.h"
 #include "core/target/board_choice.h"
 
 namespace calibench {
@@ -24,29 +24,6 @@ Bytes Copy(std::span<const std::uint8_t> data) {
 }
 
 std::int64_t Ns(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e9)); }
-
-std::string Ms(double seconds) {
-  return std::to_string(static_cast<int>(std::lround(seconds * 1000))) + " ms";
-}
-
-double RotationDeg(const Pose& a, const Pose& b) {
-  return Eigen::AngleAxisd(a.rotation().transpose() * b.rotation()).angle() * kRadToDeg;
-}
-
-// A checkerboard's corners may come back in either of two orders, 180 degrees apart about its
-// normal (the pattern looks the same turned over): one board pose, two rotations. The origin,
-// at the pattern's centre, is the same for both.
-double BoardRotationDeg(const Pose& a, const Pose& b, const BoardSpec& board) {
-  const double direct = RotationDeg(a, b);
-  if (board.type != BoardType::kCheckerboard) return direct;
-  Pose turned = b;
-  turned.linear() = b.rotation() * Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();
-  return std::min(direct, RotationDeg(a, turned));
-}
-
-double TranslationM(const Pose& a, const Pose& b) {
-  return (a.translation() - b.translation()).norm();
-}
 
 std::int64_t StampOr(const RosHeader& header, std::int64_t log_time_ns) {
   return header.stamp_ns != 0 ? header.stamp_ns : log_time_ns;
@@ -67,8 +44,6 @@ constexpr std::size_t kMaxQueuedTries = 2;
 // Tries kept while the board is chosen; with no preset in any of them they are dropped.
 constexpr std::size_t kMaxBoardSamples = 12;
 constexpr const char* kHoldDone = "not needed: its hold already gave a pair";
-// Corners that must be followed into an image of the window for it to count as seen.
-constexpr double kMinTrackedFraction = 0.8;
 
 struct StampedBytes {
   std::int64_t stamp_ns = 0;
@@ -85,27 +60,6 @@ struct Try {
 };
 
 }  // namespace
-
-bool PairSelectionOptions::Check(std::string* why) const {
-  if (!(max_pair_offset_s > 0.0) || !(still_window_s >= 0.0)) {
-    *why = "max_pair_offset_s must be > 0 and still_window_s >= 0";
-    return false;
-  }
-  if (!(still_translation_m >= 0.0) || !(still_rotation_deg >= 0.0) ||
-      !(duplicate_translation_m >= 0.0) || !(duplicate_rotation_deg >= 0.0)) {
-    *why = "stillness and duplicate thresholds must be >= 0";
-    return false;
-  }
-  if (!(retry_s > 0.0) || !(lidar_blind_s > 0.0)) {
-    *why = "retry_s and lidar_blind_s must be > 0";
-    return false;
-  }
-  if (board_sample_images < 1) {
-    *why = "board_sample_images must be >= 1";
-    return false;
-  }
-  return lidar_motion.Check(why) && limits.Check(why);
-}
 
 struct RecordingPairFinder::Impl {
   Impl(std::string source_in, PairTopics topics_in, std::optional<BoardSpec> board_in,
@@ -263,7 +217,7 @@ struct RecordingPairFinder::Impl {
         return;
       }
       if (hold.tries > 0 && stamp - hold.last_try_ns < Ns(options.retry_s)) {
-        Drop("not tried: its hold was tried within " + Ms(options.retry_s));
+        Drop("not tried: its hold was tried within " + MillisecondsText(options.retry_s));
         return;
       }
       ++hold.tries;
@@ -304,7 +258,7 @@ struct RecordingPairFinder::Impl {
       if (!nearest || std::abs(image.stamp_ns - stamp) < std::abs(nearest->stamp_ns - stamp))
         nearest = &image;
     if (!nearest || std::abs(nearest->stamp_ns - stamp) > Ns(options.max_pair_offset_s)) {
-      Drop("no image within " + Ms(options.max_pair_offset_s));
+      Drop("no image within " + MillisecondsText(options.max_pair_offset_s));
       return 0;
     }
     Try attempt;
@@ -462,47 +416,27 @@ struct RecordingPairFinder::Impl {
                     std::to_string(image.width) + " x " + std::to_string(image.height) +
                     " but the camera intrinsics are for " + std::to_string(attempt.camera.width) +
                     " x " + std::to_string(attempt.camera.height));
-    std::string why;
+    const CameraVerdict verdict = JudgeCameraSide(
+        image, attempt.others.size(),
+        [&](std::size_t i) -> std::optional<ImageU8> {
+          try {
+            return DecodeTryImage(attempt.others[i]);
+          } catch (const std::invalid_argument&) {
+            return std::nullopt;
+          }
+        },
+        attempt.camera, *board, kept_poses, options);
     {
       std::lock_guard lock(mutex);
-      ++stats.images_searched;
+      stats.images_searched += verdict.searched;
+      stats.boards_found += verdict.found;
     }
-    const std::optional<BoardDetection> detection =
-        DetectBoard(image, *board, BoardDetectionOptions{}, &why);
-    if (!detection) {
-      Drop("board not found in the image");
+    if (!verdict.cam_from_board) {
+      Drop(verdict.dropped);
       return;
     }
-    {
-      std::lock_guard lock(mutex);
-      ++stats.boards_found;
-    }
-    const auto observation = EstimateBoardPose(attempt.camera, *detection, PnpOptions{}, &why);
-    if (!observation) {
-      Drop("board pose failed in the image");
-      return;
-    }
-    const Pose& pose = observation->cam_from_board;
-    bool judged = false;
-    for (const StampedBytes& other : attempt.others) {
-      ImageU8 other_image;
-      try {
-        other_image = DecodeTryImage(other);
-      } catch (const std::invalid_argument&) {
-        continue;
-      }
-      judged = true;
-      if (!StillIn(image, *detection, other_image, attempt.camera, pose)) {
-        Drop("board moving (within " + Ms(options.still_window_s / 2) + ")");
-        return;
-      }
-    }
-    for (const Pose& kept : kept_poses)
-      if (TranslationM(kept, pose) <= options.duplicate_translation_m &&
-          BoardRotationDeg(kept, pose, *board) <= options.duplicate_rotation_deg) {
-        Drop("near-duplicate board pose");
-        return;
-      }
+    const Pose& pose = *verdict.cam_from_board;
+    const bool judged = verdict.stillness_checked;
     FoundPair pair;
     try {
       pair.cloud = DecodePointCloud2(*attempt.cloud.bytes, topics.cloud, options.limits).cloud;
@@ -524,19 +458,6 @@ struct RecordingPairFinder::Impl {
     if (attempt.hold > 0) satisfied_holds.insert(attempt.hold);
     if (!judged) ++stats.kept_without_stillness_check;
     found.push_back(std::move(pair));
-  }
-
-  // The camera's view of the board in `other` agrees with `pose`: its corners followed there give
-  // a pose within the stillness thresholds.
-  bool StillIn(const ImageU8& image, const BoardDetection& detection, const ImageU8& other,
-               const CameraModel& camera_model, const Pose& pose) const {
-    std::string why;
-    const auto tracked = TrackBoard(image, detection, other, kMinTrackedFraction, &why);
-    if (!tracked) return false;
-    const auto observation = EstimateBoardPose(camera_model, *tracked, PnpOptions{}, &why);
-    return observation &&
-           TranslationM(observation->cam_from_board, pose) <= options.still_translation_m &&
-           RotationDeg(observation->cam_from_board, pose) <= options.still_rotation_deg;
   }
 
   // ---- state ---------------------------------------------------------------------------------

@@ -1,7 +1,6 @@
 // Camera-side board detection: checkerboard (findChessboardCornersSB + cornerSubPix) and ChArUco
 // (ArUco markers + interpolateCornersCharuco + offset correction + cornerSubPix).
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -255,13 +254,10 @@ std::optional<BoardDetection> DetectBoard(const ImageU8& image, const BoardSpec&
 
 namespace {
 
-// Whether the squares of a detected checkerboard go on beyond its spec: the ring of square
-// centres one square outside the outermost squares is sampled (through the homography from grid
-// to image) on each side. On a print of exactly the spec that ring is the white margin or the
-// background, one tone; on a larger print it alternates dark and light with the grid's parity.
-// The outermost squares, which every print has, teach the two tones and the parity.
-bool CheckerboardContinues(const cv::Mat& grey, const BoardSpec& board,
-                           const BoardDetection& detection) {
+// The homography from the spec's grid (column, row of each corner) to the detected pixels;
+// empty when there is none, or when the corners do not follow it (out of row order) within a
+// fraction of a square, a tolerance that lets lens distortion pass.
+cv::Mat GridHomography(const BoardSpec& board, const BoardDetection& detection) {
   std::vector<cv::Point2f> grid, pixels;
   for (std::size_t i = 0; i < detection.ids.size(); ++i) {
     grid.emplace_back(static_cast<float>(detection.ids[i] % board.cols),
@@ -270,9 +266,7 @@ bool CheckerboardContinues(const cv::Mat& grey, const BoardSpec& board,
                         static_cast<float>(detection.pixels[i].y()));
   }
   const cv::Mat homography = cv::findHomography(grid, pixels);
-  if (homography.empty()) return true;
-  // Corners that no homography of the spec's grid maps onto (out of row order) are no fit.
-  // Tolerance: a fraction of a square, so that lens distortion passes.
+  if (homography.empty()) return homography;
   std::vector<cv::Point2f> mapped;
   cv::perspectiveTransform(grid, mapped, homography);
   double squared = 0.0;
@@ -282,7 +276,45 @@ bool CheckerboardContinues(const cv::Mat& grey, const BoardSpec& board,
   }
   const double rms = std::sqrt(squared / static_cast<double>(mapped.size()));
   const double square_px = cv::norm(pixels[1] - pixels[0]);
-  if (rms > 0.15 * square_px) return true;
+  return rms > 0.15 * square_px ? cv::Mat() : homography;
+}
+
+// A square's centre in grid units (half-integers) and the side of the grid it lies on
+// (0 left, 1 right, 2 top, 3 bottom).
+struct SquareCentre {
+  double col = 0.0, row = 0.0;
+  int side = 0;
+};
+
+// The centres of the ring of squares `k` squares outside the inner corners (k = 0.5: the
+// outermost squares).
+std::vector<SquareCentre> RingOfSquares(const BoardSpec& board, double k) {
+  std::vector<SquareCentre> centres;
+  for (double row = -k; row <= board.rows - 1 + k + 1e-9; row += 1.0) {
+    centres.push_back({-k, row, 0});
+    centres.push_back({board.cols - 1 + k, row, 1});
+  }
+  for (double col = -k + 1; col <= board.cols - 2 + k + 1e-9; col += 1.0) {
+    centres.push_back({col, -k, 2});
+    centres.push_back({col, board.rows - 1 + k, 3});
+  }
+  return centres;
+}
+
+// A square's parity: which of the two tones it has.
+int Parity(double col, double row) {
+  return (static_cast<int>(std::floor(col)) + static_cast<int>(std::floor(row))) & 1;
+}
+
+// Whether the squares of a detected checkerboard go on beyond its spec: the ring of square
+// centres one square outside the outermost squares is sampled (through the homography from grid
+// to image) on each side. On a print of exactly the spec that ring is the white margin or the
+// background, one tone; on a larger print it alternates dark and light with the grid's parity.
+// The outermost squares, which every print has, teach the two tones and the parity.
+bool CheckerboardContinues(const cv::Mat& grey, const BoardSpec& board,
+                           const BoardDetection& detection) {
+  const cv::Mat homography = GridHomography(board, detection);
+  if (homography.empty()) return true;
   // Mean grey of a 3x3 patch at a grid point; -1 outside the image.
   auto sample = [&](double col, double row) {
     std::vector<cv::Point2f> at;
@@ -291,29 +323,12 @@ bool CheckerboardContinues(const cv::Mat& grey, const BoardSpec& board,
     if (x < 1 || y < 1 || x >= grey.cols - 1 || y >= grey.rows - 1) return -1.0;
     return cv::mean(grey(cv::Rect(x - 1, y - 1, 3, 3)))[0];
   };
-  // A square centre (col, row) at half-integers; its parity says which tone it has.
-  auto parity = [](double col, double row) {
-    return (static_cast<int>(std::floor(col)) + static_cast<int>(std::floor(row))) & 1;
-  };
-  // Centres of the ring `k` squares outside the inner corners (k = 0.5: the outermost squares).
-  auto ring = [&](double k) {
-    std::vector<std::array<double, 3>> centres;  // col, row, side (0 left 1 right 2 top 3 bottom)
-    for (double row = -k; row <= board.rows - 1 + k + 1e-9; row += 1.0) {
-      centres.push_back({-k, row, 0});
-      centres.push_back({board.cols - 1 + k, row, 1});
-    }
-    for (double col = -k + 1; col <= board.cols - 2 + k + 1e-9; col += 1.0) {
-      centres.push_back({col, -k, 2});
-      centres.push_back({col, board.rows - 1 + k, 3});
-    }
-    return centres;
-  };
   double tone_sum[2] = {0, 0}, tone_squares[2] = {0, 0};
   int tone_count[2] = {0, 0};
-  for (const auto& [col, row, side] : ring(0.5)) {
-    const double value = sample(col, row);
+  for (const SquareCentre& square : RingOfSquares(board, 0.5)) {
+    const double value = sample(square.col, square.row);
     if (value < 0) continue;
-    const int p = parity(col, row);
+    const int p = Parity(square.col, square.row);
     tone_sum[p] += value;
     tone_squares[p] += value * value;
     ++tone_count[p];
@@ -332,13 +347,14 @@ bool CheckerboardContinues(const cv::Mat& grey, const BoardSpec& board,
   // only, so the squares diagonal to the grid's corners may be off it).
   int matches[4] = {0, 0, 0, 0}, seen[4] = {0, 0, 0, 0}, dark[4] = {0, 0, 0, 0};
   const int dark_parity = tone[0] < tone[1] ? 0 : 1;
-  for (const auto& [col, row, side] : ring(1.5)) {
-    const bool corner = (col < -1 || col > board.cols) && (row < -1 || row > board.rows);
-    const double value = corner ? -1 : sample(col, row);
+  for (const SquareCentre& square : RingOfSquares(board, 1.5)) {
+    const bool corner = (square.col < -1 || square.col > board.cols) &&
+                        (square.row < -1 || square.row > board.rows);
+    const double value = corner ? -1 : sample(square.col, square.row);
     if (value < 0) continue;
-    const int s = static_cast<int>(side);
+    const int s = square.side;
     ++seen[s];
-    const int p = parity(col, row);
+    const int p = Parity(square.col, square.row);
     // Its parity's tone, by a clear margin; the white margin of an exact print matches only the
     // light half, the background neither.
     if (std::abs(value - tone[p]) < 0.3 * contrast) {

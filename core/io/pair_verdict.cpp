@@ -1,0 +1,108 @@
+#include "core/io/pair_verdict.h"
+
+#include <cmath>
+
+#include "core/geometry/geometry.h"
+#include "core/target/board_camera.h"
+
+namespace calibench {
+
+namespace {
+
+// Corners that must be followed into an image of the window for it to count as seen.
+constexpr double kMinTrackedFraction = 0.8;
+
+// A checkerboard's corners may come back in either of two orders, 180 degrees apart about its
+// normal (the pattern looks the same turned over): one board pose, two rotations. The origin,
+// at the pattern's centre, is the same for both.
+PoseError BoardPoseError(const Pose& a, const Pose& b, const BoardSpec& board) {
+  PoseError error = ComputePoseError(a, b);
+  if (board.type != BoardType::kCheckerboard) return error;
+  Pose turned = b;
+  turned.linear() = b.rotation() * Eigen::AngleAxisd(M_PI, Vec3::UnitZ()).toRotationMatrix();
+  error.rotation_rad = std::min(error.rotation_rad, ComputePoseError(a, turned).rotation_rad);
+  return error;
+}
+
+bool Within(const PoseError& error, double translation_m, double rotation_deg) {
+  return error.translation_m <= translation_m && error.rotation_rad * kRadToDeg <= rotation_deg;
+}
+
+// The camera's view of the board in `other` agrees with `pose`: its corners followed there give
+// a pose within the stillness thresholds.
+bool StillIn(const ImageU8& image, const BoardDetection& detection, const ImageU8& other,
+             const CameraModel& camera, const Pose& pose, const PairSelectionOptions& options) {
+  std::string why;
+  const auto tracked = TrackBoard(image, detection, other, kMinTrackedFraction, &why);
+  if (!tracked) return false;
+  const auto observation = EstimateBoardPose(camera, *tracked, PnpOptions{}, &why);
+  return observation && Within(ComputePoseError(observation->cam_from_board, pose),
+                               options.still_translation_m, options.still_rotation_deg);
+}
+
+}  // namespace
+
+std::string MillisecondsText(double seconds) {
+  return std::to_string(static_cast<int>(std::lround(seconds * 1000))) + " ms";
+}
+bool PairSelectionOptions::Check(std::string* why) const {
+  if (!(max_pair_offset_s > 0.0) || !(still_window_s >= 0.0)) {
+    *why = "max_pair_offset_s must be > 0 and still_window_s >= 0";
+    return false;
+  }
+  if (!(still_translation_m >= 0.0) || !(still_rotation_deg >= 0.0) ||
+      !(duplicate_translation_m >= 0.0) || !(duplicate_rotation_deg >= 0.0)) {
+    *why = "stillness and duplicate thresholds must be >= 0";
+    return false;
+  }
+  if (!(retry_s > 0.0) || !(lidar_blind_s > 0.0)) {
+    *why = "retry_s and lidar_blind_s must be > 0";
+    return false;
+  }
+  if (board_sample_images < 1) {
+    *why = "board_sample_images must be >= 1";
+    return false;
+  }
+  return lidar_motion.Check(why) && limits.Check(why);
+}
+
+CameraVerdict JudgeCameraSide(const ImageU8& image, std::size_t others,
+                              const std::function<std::optional<ImageU8>(std::size_t)>& other_image,
+                              const CameraModel& camera, const BoardSpec& board,
+                              const std::vector<Pose>& kept, const PairSelectionOptions& options) {
+  CameraVerdict verdict;
+  verdict.searched = true;
+  std::string why;
+  const std::optional<BoardDetection> detection =
+      DetectBoard(image, board, BoardDetectionOptions{}, &why);
+  if (!detection) {
+    verdict.dropped = "board not found in the image";
+    return verdict;
+  }
+  verdict.found = true;
+  const auto observation = EstimateBoardPose(camera, *detection, PnpOptions{}, &why);
+  if (!observation) {
+    verdict.dropped = "board pose failed in the image";
+    return verdict;
+  }
+  const Pose& pose = observation->cam_from_board;
+  for (std::size_t i = 0; i < others; ++i) {
+    const std::optional<ImageU8> other = other_image(i);
+    if (!other) continue;
+    verdict.stillness_checked = true;
+    if (!StillIn(image, *detection, *other, camera, pose, options)) {
+      verdict.dropped = "board moving (within " + MillisecondsText(options.still_window_s / 2) + ")";
+      return verdict;
+    }
+  }
+  for (const Pose& kept_pose : kept)
+    if (Within(BoardPoseError(kept_pose, pose, board), options.duplicate_translation_m,
+               options.duplicate_rotation_deg)) {
+      verdict.dropped = "near-duplicate board pose";
+      return verdict;
+    }
+  verdict.cam_from_board = pose;
+  return verdict;
+}
+
+}  // namespace calibench
