@@ -10,7 +10,10 @@ namespace calibench::app {
 
 void AddSimFlags(CLI::App& app, SimFlags& flags) {
   app.add_option("--preset", flags.preset, "default | paper | demo")->capture_default_str();
-  app.add_option("--lidar", flags.lidar, "hdl64 | vlp16 | os0-128 (default: the preset's)");
+  app.add_option(
+      "--lidar", flags.lidar,
+      "hdl64 | vlp16 | os0-128 | swept-2d (a 2D scanner on a rotary stage, its mirror off "
+      "the axis; no rings) (default: the preset's)");
   app.add_option("--camera", flags.camera, "pinhole | fisheye (default: the preset's)");
   app.add_option("--board", flags.board,
                  "a3 | a4 | paper | charuco-a3 | charuco-a4 (default: the preset's)");
@@ -26,6 +29,9 @@ void AddSimFlags(CLI::App& app, SimFlags& flags) {
   app.add_option("--max-distance", flags.max_distance, "farthest board distance [m]");
   app.add_option("--seed", flags.seed, "random seed")->capture_default_str();
   app.add_flag("--no-clutter", flags.no_clutter, "no floor and walls");
+  app.add_flag("--board-only-clouds", flags.board_only_clouds,
+               "clouds cropped to the board's returns, without rings (as some public sets ship "
+               "them)");
 }
 
 bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* why) {
@@ -38,7 +44,7 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
   if (!flags.lidar.empty()) {
     const auto lidar = ParseLidarModelName(flags.lidar);
     if (!lidar) {
-      *why = "unknown --lidar '" + flags.lidar + "' (hdl64, vlp16, os0-128)";
+      *why = "unknown --lidar '" + flags.lidar + "' (" + LidarModelNames() + ")";
       return false;
     }
     options->lidar = *lidar;
@@ -88,6 +94,7 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
   if (flags.max_distance > 0) options->max_distance_m = flags.max_distance;
   options->seed = flags.seed;
   if (flags.no_clutter) options->clutter = false;
+  if (flags.board_only_clouds) options->board_only_clouds = true;
   return options->Check(why);
 }
 

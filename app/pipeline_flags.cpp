@@ -54,6 +54,12 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
                  "LiDAR plane RANSAC inlier distance [m]")
       ->capture_default_str();
   app.add_option("--ransac-seed", o.lidar_plane.seed, "RANSAC seed")->capture_default_str();
+  app.add_option("--lidar-model", flags.lidar_model,
+                 "the LiDAR's noise model: spinning (ranges along rays from one centre, rings: "
+                 "ring biases and board edges) | swept (a line scanner turned by a stage, rays "
+                 "from a moving mirror) | segment (board-only clouds); swept and segment fit "
+                 "planes point-to-plane with their own covariance. Default: judged from each "
+                 "cloud (rings, cones of elevation, azimuth covered), said in the summary");
   app.add_flag_callback(
       "--no-board-growing", [&o] { o.grow_to_board = false; },
       "fit the LiDAR plane on the brushed / seeded returns only, instead of growing the "
@@ -68,6 +74,15 @@ bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {
   }
   flags.options.solver.method = *method;
   flags.options.solver.range_offset_prior_sigma_m = flags.range_offset_prior_mm * 1e-3;
+  if (!flags.lidar_model.empty()) {
+    const auto model = ParseLidarGeometry(flags.lidar_model);
+    if (!model) {
+      *why = "--lidar-model must be one of " + LidarGeometryNames() + ", not '" +
+             flags.lidar_model + "'";
+      return false;
+    }
+    flags.options.lidar_model = *model;
+  }
   if (!flags.pairs.empty()) {
     std::stringstream ss(flags.pairs);
     std::string id;

@@ -14,6 +14,7 @@ struct PipelineFlags {
   std::string initial_guess;  // result.json, or 16 numbers (row-major 4x4)
   std::string method = "weighted-ml";
   double range_offset_prior_mm = 0.0;  // SolverOptions::range_offset_prior_sigma_m, in mm
+  std::string lidar_model;             // PipelineOptions::lidar_model; "" = from the clouds
 };
 
 // with_selection adds --pairs and --initial-guess (not wanted where pairs are simulated).

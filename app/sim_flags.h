@@ -21,6 +21,7 @@ struct SimFlags {
   double max_distance = 0;  // 0 = the preset's
   std::uint64_t seed = 1;
   bool no_clutter = false;
+  bool board_only_clouds = false;
 };
 
 void AddSimFlags(CLI::App& app, SimFlags& flags);

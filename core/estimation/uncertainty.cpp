@@ -5,7 +5,65 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/base/names.h"
+
 namespace calibench {
+namespace {
+constexpr EnumName<TerminationTest> kTerminationTestNames[] = {
+    {TerminationTest::kNone, "none"},
+    {TerminationTest::kClosedForm, "closed_form"},
+    {TerminationTest::kFunctionTolerance, "function_tolerance"},
+    {TerminationTest::kGradientTolerance, "gradient_tolerance"},
+    {TerminationTest::kParameterTolerance, "parameter_tolerance"},
+    {TerminationTest::kLocalMinimum, "local_minimum"},
+    {TerminationTest::kIterationCap, "iteration_cap"}};
+}  // namespace
+
+std::string TerminationTestName(TerminationTest test) {
+  return NameIn(kTerminationTestNames, test);
+}
+
+std::optional<TerminationTest> ParseTerminationTest(const std::string& name) {
+  return ValueIn(kTerminationTestNames, name);
+}
+
+std::string Termination::Describe() const {
+  char text[256];
+  switch (test) {
+    case TerminationTest::kNone:
+      return "NOT converged: not solved";
+    case TerminationTest::kClosedForm:
+      return "closed form (nothing to iterate)";
+    case TerminationTest::kFunctionTolerance:
+      std::snprintf(text, sizeof(text),
+                    "converged: relative cost change %.1e <= %.0e (function tolerance)", value,
+                    tolerance);
+      return text;
+    case TerminationTest::kGradientTolerance:
+      std::snprintf(text, sizeof(text), "converged: gradient %.1e <= %.0e (gradient tolerance)",
+                    value, tolerance);
+      return text;
+    case TerminationTest::kParameterTolerance:
+      std::snprintf(text, sizeof(text),
+                    "converged: relative step %.1e <= %.0e (parameter tolerance)", value,
+                    tolerance);
+      return text;
+    case TerminationTest::kLocalMinimum:
+      std::snprintf(text, sizeof(text),
+                    "converged: no step lowers the cost, neither Gauss-Newton's (its linearization "
+                    "predicted %.1e of the cost) nor 0.01 or 0.1 sigma along any parameter: a "
+                    "local minimum",
+                    value);
+      return text;
+    case TerminationTest::kIterationCap:
+      std::snprintf(text, sizeof(text),
+                    "NOT converged: stopped at the iteration cap (%d) with the cost still "
+                    "changing by %.1e of itself per iteration (> %.0e)",
+                    cap, value, tolerance);
+      return text;
+  }
+  return "";
+}
 
 ObservabilityReport AnalyseObservability(const Mat6& information, const Pose& cam_from_lidar,
                                          double weak_eigenvalue_ratio) {

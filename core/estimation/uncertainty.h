@@ -2,6 +2,7 @@
 // degrees of freedom, and standard deviations in the camera's axes. Shared by both methods.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,34 @@ struct IterationReport {
   // The weights changed at this iteration (outliers gated, variance factors re-estimated): its
   // cost is the one under the new weights, not comparable with the costs before it.
   bool reweighted = false;
+};
+
+// Which test ended an iterative solve (Ceres's tests: function, gradient and parameter tolerance),
+// or the iteration cap, a safety net that means the solve did not converge.
+enum class TerminationTest {
+  kNone,                // still running, or never run
+  kClosedForm,          // nothing to iterate (the estimate is a closed form)
+  kFunctionTolerance,   // |Δcost| / cost of the last step within function_tolerance
+  kGradientTolerance,   // max |gradient| within gradient_tolerance
+  kParameterTolerance,  // |Δx| within parameter_tolerance · (|x| + parameter_tolerance)
+  kLocalMinimum,        // no step lowers the cost: Gauss-Newton's nor small moves per parameter
+  kIterationCap,        // max_iterations reached with the cost still falling
+};
+std::string TerminationTestName(TerminationTest test);  // "function_tolerance", ...
+std::optional<TerminationTest> ParseTerminationTest(const std::string& name);
+
+struct Termination {
+  TerminationTest test = TerminationTest::kNone;
+  double value = 0.0;      // what the test measured (for the cap: the last relative cost change)
+  double tolerance = 0.0;  // what it was held to (for the cap: the function tolerance)
+  int cap = 0;             // kIterationCap: the cap
+  bool Converged() const {
+    return test != TerminationTest::kNone && test != TerminationTest::kIterationCap;
+  }
+  // In words: "converged: relative cost change 2.1e-09 <= 1e-06 (function tolerance)", or
+  // "NOT converged: ...".
+  std::string Describe() const;
+  bool operator==(const Termination&) const = default;
 };
 
 struct ObservabilityReport {

@@ -54,6 +54,7 @@ SimulationRecord ParseSimulation(const json_io::Fields& sim) {
   record.lidar_range_offset_m = sim.GetOr("lidar_range_offset_m", 0.0);
   record.image_noise = sim.Number("image_noise");
   record.clutter = sim.Bool("clutter");
+  record.board_only_clouds = sim.GetOr("board_only_clouds", false);  // written since issue 32
   record.seed_radius_m = sim.Number("seed_radius_m");
   record.seed = sim.Get<std::uint64_t>("seed");
   return record;
@@ -164,6 +165,7 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
                           {"lidar_range_noise_m", r.lidar_range_noise_m},
                           {"image_noise", r.image_noise},
                           {"clutter", r.clutter},
+                          {"board_only_clouds", r.board_only_clouds},
                           {"seed_radius_m", r.seed_radius_m},
                           {"seed", r.seed},
                           {"lidar_range_offset_m", r.lidar_range_offset_m}};

@@ -33,6 +33,7 @@ struct SimulationRecord {
   double lidar_range_offset_m = 0.0;  // measured = true range + offset
   double image_noise = 0.0;           // [0,1] intensity units
   bool clutter = true;
+  bool board_only_clouds = false;  // clouds cropped to the sheet's returns, without rings
   double seed_radius_m = 0.0;
   std::uint64_t seed = 1;
 };

@@ -15,6 +15,7 @@ namespace {
 struct PredictedBoard {
   Plane plane;
   Vec3 centre = Vec3::Zero();
+  Mat3 normal_covariance = Mat3::Zero();  // the camera's normal's, in the LiDAR frame
 };
 
 PredictedBoard Predict(const CameraBoardObservation& camera, const Pose& cam_from_lidar) {
@@ -29,33 +30,50 @@ PredictedBoard Predict(const CameraBoardObservation& camera, const Pose& cam_fro
     board.plane.distance = -board.plane.distance;
   }
   board.centre = cam_from_lidar.inverse() * camera.cam_from_board.translation();
+  board.normal_covariance =
+      rotation.transpose() * camera.plane_covariance.topLeftCorner<3, 3>() * rotation;
   return board;
 }
 
-// Why the LiDAR board disagrees with the prediction, or "" when it agrees. Tolerances: the
-// options' sigmas of both planes' normal and offset uncertainty, floored.
+// Why the LiDAR board disagrees with the prediction, or "" when it agrees. The tilt is judged in
+// the direction it disagrees: both normals' covariances there (the LiDAR's with its rings'
+// range biases, LidarPlaneFit::ring_bias_covariance), so a strip that few rings cross may tilt
+// more about the rings' direction than a full board, and no more about the other axis. The
+// offset likewise; the options' floors add in quadrature.
 std::string Disagreement(const LidarPlaneFit& lidar, const CameraBoardObservation& camera,
                          const PredictedBoard& predicted, double sheet_diagonal_m,
                          const PipelineOptions& options) {
   const Vec3& lidar_centre = lidar.inlier_centroid;
-  const double angle =
-      std::acos(std::min(1.0, std::abs(lidar.plane.normal.dot(predicted.plane.normal))));
+  const double cosine = lidar.plane.normal.dot(predicted.plane.normal);
+  const double angle = std::acos(std::min(1.0, std::abs(cosine)));
   const double offset = std::abs(predicted.plane.SignedDistance(lidar_centre));
   const double shift = (lidar_centre - predicted.centre).norm();
-  const double sigma_angle = std::sqrt(lidar.covariance.topLeftCorner<3, 3>().trace() +
-                                       camera.plane_covariance.topLeftCorner<3, 3>().trace());
-  const double sigma_offset = std::sqrt(lidar.covariance(3, 3) + camera.plane_covariance(3, 3));
-  const double max_angle =
-      std::max(options.guided_min_angle_deg * kDegToRad, options.guided_max_sigmas * sigma_angle);
-  const double max_offset =
-      std::max(options.guided_min_offset_m, options.guided_max_sigmas * sigma_offset);
+  const Mat4 lidar_covariance = lidar.covariance + lidar.ring_bias_covariance;
+  const Mat3 normal_covariance =
+      lidar_covariance.topLeftCorner<3, 3>() + predicted.normal_covariance;
+  // The direction in which the normals differ (perpendicular to the predicted normal); with none
+  // (they agree exactly) any direction does.
+  Vec3 direction = (cosine < 0 ? -lidar.plane.normal : lidar.plane.normal) - predicted.plane.normal;
+  direction -= direction.dot(predicted.plane.normal) * predicted.plane.normal;
+  const double model_angle_variance =
+      direction.norm() > 1e-12
+          ? std::max(0.0, direction.normalized().dot(normal_covariance * direction.normalized()))
+          : normal_covariance.trace();
+  const double floor_angle = options.guided_floor_sigma_deg * kDegToRad;
+  const double sigma_angle = std::sqrt(model_angle_variance + floor_angle * floor_angle);
+  const double sigma_offset =
+      std::sqrt(lidar_covariance(3, 3) + camera.plane_covariance(3, 3) +
+                options.guided_floor_sigma_m * options.guided_floor_sigma_m);
+  const double max_angle = options.guided_max_sigmas * sigma_angle;
+  const double max_offset = options.guided_max_sigmas * sigma_offset;
   if (angle <= max_angle && offset <= max_offset && shift <= 0.5 * sheet_diagonal_m) return "";
-  char text[200];
+  char text[240];
   std::snprintf(text, sizeof(text),
                 "LiDAR board disagrees with the camera's by %.1f deg, %.0f mm off its plane, "
-                "%.0f mm from its centre (allowed %.1f deg, %.0f mm)",
+                "%.0f mm from its centre (allowed %.1f deg in that direction, %.0f mm; "
+                "%.0f mm from the centre)",
                 angle * kRadToDeg, offset * 1e3, shift * 1e3, max_angle * kRadToDeg,
-                max_offset * 1e3);
+                max_offset * 1e3, 0.5 * sheet_diagonal_m * 1e3);
   return text;
 }
 

@@ -14,9 +14,9 @@ namespace calibench {
 
 bool PipelineOptions::Check(std::string* why) const {
   if (!lidar_plane.Check(why) || !detection.Check(why) || !pnp.Check(why) || !solver.Check(why) ||
-      !board_detection.Check(why))
+      !board_detection.Check(why) || !lidar_geometry.Check(why))
     return false;
-  if (!(guided_max_sigmas > 0 && guided_min_angle_deg >= 0 && guided_min_offset_m >= 0)) {
+  if (!(guided_max_sigmas > 0 && guided_floor_sigma_deg >= 0 && guided_floor_sigma_m >= 0)) {
     if (why) *why = "guided_max_sigmas must be > 0 and the guided floors >= 0";
     return false;
   }
@@ -151,9 +151,18 @@ std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const 
     return std::nullopt;
   }
   std::string fit_failure;
-  auto fit =
-      FitBoardPlane(cloud, region, LidarPlaneOptionsFor(options, dataset.target), &fit_failure);
-  if (fit) return fit;
+  LidarPlaneOptions plane_options = LidarPlaneOptionsFor(options, dataset.target);
+  LidarGeometryVerdict model;
+  if (options.lidar_model)
+    model = {*options.lidar_model, "chosen by the user (--lidar-model)", true};
+  else
+    model = ClassifyLidarGeometry(cloud, options.lidar_geometry);
+  plane_options.geometry = model.geometry;
+  auto fit = FitBoardPlane(cloud, region, plane_options, &fit_failure);
+  if (fit) {
+    fit->lidar_model = model;
+    return fit;
+  }
   *why = "LiDAR: " + fit_failure;
   if (found.source == BoardSource::kSeed || found.source == BoardSource::kCameraGuided)
     *why += std::string(found.source == BoardSource::kSeed ? " (seed" : " (camera's prediction") +

@@ -22,6 +22,10 @@ namespace calibench {
 
 struct PipelineOptions {
   LidarPlaneOptions lidar_plane;
+  // The LiDAR's noise model (LidarPlaneOptions::geometry): judged from each cloud
+  // (ClassifyLidarGeometry) unless the user forces one (--lidar-model).
+  std::optional<LidarGeometry> lidar_model;
+  LidarGeometryOptions lidar_geometry;
   BoardDetectionOptions detection;
   PnpOptions pnp;
   SolverOptions solver;
@@ -40,10 +44,15 @@ struct PipelineOptions {
   bool background_model = true;
   bool camera_guided = true;
   // A LiDAR board whose plane disagrees with the camera's prediction by more than this many
-  // standard deviations (and more than the floors below) is not used.
+  // standard deviations is not used. The σ of the tilt, in the direction the normals differ, and
+  // of the offset: both planes' covariances (the LiDAR's with its rings' range biases,
+  // LidarPlaneFit::ring_bias_covariance, so a strip that few rings cross may tilt more about the
+  // rings' direction than a full board) and, in quadrature, a floor for what neither model holds
+  // (the camera's intrinsics, the sheet's flatness, the beams' footprint): 0.5° and 7.5 mm make
+  // 4σ = 2° and 30 mm on a board whose planes' own σ are small.
   double guided_max_sigmas = 4.0;
-  double guided_min_angle_deg = 2.0;
-  double guided_min_offset_m = 0.03;
+  double guided_floor_sigma_deg = 0.5;
+  double guided_floor_sigma_m = 0.0075;
   bool Check(std::string* why) const;
 };
 
@@ -180,8 +189,8 @@ void CompleteWithCamera(const Dataset& dataset, const std::vector<const PairEntr
                         CalibrationOutcome* outcome);
 
 // Why a pair's LiDAR board disagrees with where its camera board puts it under cam_from_lidar
-// (the gate of CompleteWithCamera: both planes' σ, floored by options.guided_min_angle_deg and
-// guided_min_offset_m), or "" when they agree.
+// (the gate of CompleteWithCamera: options.guided_max_sigmas of both planes' σ with the floors
+// guided_floor_sigma_deg and guided_floor_sigma_m), or "" when they agree.
 std::string BoardDisagreement(const LidarPlaneFit& lidar, const CameraBoardObservation& camera,
                               const Pose& cam_from_lidar, const BoardSpec& target,
                               const PipelineOptions& options);

@@ -1,5 +1,6 @@
 #include "core/lidar_camera/result_io.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -15,6 +16,44 @@ namespace {
 
 json Vec4ToJson(const Vec4& v) { return {v[0], v[1], v[2], v[3]}; }
 
+// Per LiDAR model, the pairs fitted with it (in the pairs' order) and the first one's reason.
+struct ModelGroup {
+  LidarGeometry geometry;
+  std::vector<std::string> pairs;
+  std::string why;
+  bool forced = false;
+};
+
+std::vector<ModelGroup> GroupByLidarModel(const CalibrationOutcome& outcome) {
+  std::vector<ModelGroup> groups;
+  for (const PairFeatures& p : outcome.pairs) {
+    if (!p.lidar) continue;
+    const LidarGeometryVerdict& model = p.lidar->lidar_model;
+    auto it = std::find_if(groups.begin(), groups.end(),
+                           [&](const ModelGroup& g) { return g.geometry == model.geometry; });
+    if (it == groups.end())
+      it = groups.insert(groups.end(), {model.geometry, {}, model.why, model.forced});
+    it->pairs.push_back(p.id);
+  }
+  return groups;
+}
+
+std::string ModelMeaning(LidarGeometry geometry) {
+  return geometry == LidarGeometry::kSpinning
+             ? "planes fitted on the ranges along the rays, with ring biases and board edges"
+             : "planes fitted point-to-plane (isotropic, their own covariance), no ring biases "
+               "or board edges";
+}
+
+json ResidualsAvailable(const CalibrationOutcome& outcome) {
+  const ResidualCounts counts = CountResiduals(outcome);
+  return {{"plane_pairs", counts.plane_pairs},
+          {"edge_pairs", counts.edge_pairs},
+          {"edge_points", counts.edge_points},
+          {"edges_in_model", counts.edges_in_model},
+          {"note", counts.note}};
+}
+
 json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& options,
                   const ResultNames& names) {
   CALIBENCH_CHECK(outcome.solution.has_value());
@@ -23,6 +62,7 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
   root["solver"] = {{"method", SolverMethodName(options.method)},
                     {"iterations", s.iterations},
                     {"converged", s.converged},
+                    {"termination", TerminationToJson(s.termination)},
                     {"cost_history", s.cost_history},
                     {"huber_delta", options.huber_delta},
                     {"board_edge_points", s.num_edge_residuals},
@@ -71,6 +111,16 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
       entry["lidar_plane"] = Vec4ToJson(p.lidar->plane.Coefficients());
       entry["lidar_inliers"] = p.lidar->inliers.size();
       entry["lidar_rms_m"] = p.lidar->rms_m;
+      entry["lidar_model"] = LidarGeometryName(p.lidar->lidar_model.geometry);
+      // What the rings' ends showed of the sheet's edges (why a pair gave no edge points).
+      const BoardEdgeEnds& ends = p.lidar->edge_ends;
+      if (p.lidar->no_edge_search.empty())
+        entry["lidar_ring_ends"] = {{"ends", ends.ends},
+                                    {"edge_points", ends.edge_points},
+                                    {"no_return_beyond_sheet", ends.no_return},
+                                    {"return_not_behind_sheet", ends.not_behind}};
+      else
+        entry["lidar_ring_ends"] = {{"not_searched", p.lidar->no_edge_search}};
     }
     if (p.camera) {
       entry["camera_plane"] = Vec4ToJson(p.camera->plane.Coefficients());
@@ -82,15 +132,111 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
       entry["robust_weight"] = s.robust_weights[solved_index];
       // Accepted, yet weighted as if left out: said, not left to be read off a number.
       entry["down_weighted"] = s.DownWeighted(solved_index);
+      if (solved_index < s.pair_edge_points.size())
+        entry["board_edge_points"] = s.pair_edge_points[solved_index];
       ++solved_index;
     }
     pairs.push_back(entry);
   }
   root["pairs"] = pairs;
+  root["solver"]["residuals_available"] = ResidualsAvailable(outcome);
+  const std::vector<ModelGroup> groups = GroupByLidarModel(outcome);
+  if (!groups.empty()) {
+    // The model most pairs were fitted with leads; every model's count follows.
+    const ModelGroup& main = *std::max_element(
+        groups.begin(), groups.end(),
+        [](const ModelGroup& a, const ModelGroup& b) { return a.pairs.size() < b.pairs.size(); });
+    json counts = json::object();
+    for (const ModelGroup& g : groups) counts[LidarGeometryName(g.geometry)] = g.pairs.size();
+    root["lidar_model"] = {{"geometry", LidarGeometryName(main.geometry)},
+                           {"why", main.why},
+                           {"forced", main.forced},
+                           {"meaning", ModelMeaning(main.geometry)},
+                           {"pairs", counts}};
+  }
   return root;
 }
 
 }  // namespace
+
+namespace {
+
+// Why a solved pair gave no edge point, from what its LiDAR fit observed.
+std::string NoEdgeCause(const PairFeatures& pair, bool down_weighted) {
+  if (down_weighted) return "down-weighted to nothing";
+  if (!pair.lidar->no_edge_search.empty()) return "not searched: " + pair.lidar->no_edge_search;
+  const BoardEdgeEnds& ends = pair.lidar->edge_ends;
+  if (ends.ends == 0) return "no ring holds two board returns";
+  if (ends.no_return == ends.ends) return "no return beyond the sheet at any ring end";
+  if (ends.edge_points > 0) return "its edge points fell outside the model";
+  return "at the ring ends the returns beyond lie in front of or on the board's plane "
+         "(occluders, or a background flush with the board)";
+}
+
+}  // namespace
+
+std::string DescribeLidarModel(const CalibrationOutcome& outcome) {
+  const std::vector<ModelGroup> groups = GroupByLidarModel(outcome);
+  std::string text;
+  for (const ModelGroup& g : groups) {
+    text += text.empty() ? "LiDAR model: " : "; ";
+    text += LidarGeometryName(g.geometry) + " for ";
+    if (groups.size() == 1) {
+      text += "all " + std::to_string(g.pairs.size()) + " pairs";
+    } else {
+      text += std::to_string(g.pairs.size()) + " pairs (";
+      for (size_t k = 0; k < g.pairs.size() && k < 5; ++k) text += (k ? ", " : "") + g.pairs[k];
+      text += g.pairs.size() > 5 ? ", ...)" : ")";
+    }
+    text += " (" + g.why + "): " + ModelMeaning(g.geometry);
+  }
+  return text;
+}
+
+ResidualCounts CountResiduals(const CalibrationOutcome& outcome) {
+  CALIBENCH_CHECK(outcome.solution.has_value());
+  const SolverResult& s = *outcome.solution;
+  ResidualCounts counts;
+  counts.edges_in_model = s.edges_in_model;
+  // Per cause, the pairs without edges and their ring ends.
+  std::vector<std::pair<std::string, std::pair<std::string, int>>> causes;
+  size_t solved_index = 0;
+  for (const PairFeatures& p : outcome.pairs) {
+    if (p.status != PairStatus::kAccepted || solved_index >= s.residuals.size()) continue;
+    const size_t index = solved_index++;
+    ++counts.plane_pairs;
+    const int edges = index < s.pair_edge_points.size() ? s.pair_edge_points[index] : 0;
+    counts.edge_points += edges;
+    counts.edge_pairs += edges > 0;
+    if (edges > 0 || !s.edges_in_model || !p.lidar) continue;
+    const std::string cause = NoEdgeCause(p, s.DownWeighted(index));
+    auto it =
+        std::find_if(causes.begin(), causes.end(), [&](const auto& c) { return c.first == cause; });
+    if (it == causes.end()) it = causes.insert(causes.end(), {cause, {"", 0}});
+    it->second.first += (it->second.first.empty() ? "" : ", ") + p.id;
+    if (!s.DownWeighted(index) && p.lidar->no_edge_search.empty())
+      it->second.second += p.lidar->edge_ends.ends;
+  }
+  if (!s.edges_in_model) {
+    counts.note = "the method (" + SolverMethodName(s.method) +
+                  ") uses the board planes only, no board edges";
+    return counts;
+  }
+  if (causes.empty()) return counts;
+  std::string groups;
+  for (const auto& [cause, pairs] : causes) {
+    groups += (groups.empty() ? "" : "; ") + pairs.first + ": " + cause;
+    if (pairs.second > 0) groups += " (" + std::to_string(pairs.second) + " ring ends)";
+  }
+  if (counts.edge_pairs == 0)
+    counts.note = "board edges unused, no pair gave an edge point (" + groups +
+                  "): nothing shows where the sheet ends, so the pose rests on the planes alone "
+                  "and the translation along the boards comes only from their different tilts";
+  else
+    counts.note = "no edge points in " + std::to_string(counts.plane_pairs - counts.edge_pairs) +
+                  " of " + std::to_string(counts.plane_pairs) + " pairs (" + groups + ")";
+  return counts;
+}
 
 void WriteResult(const std::filesystem::path& path, const CalibrationOutcome& outcome,
                  const SolverOptions& options, const ResultNames& names) {
@@ -151,19 +297,13 @@ void PrintPairs(const CalibrationOutcome& outcome, std::ostringstream& out) {
 // What the weighted model estimated besides the pose: board edges, range offset, widening.
 void PrintModelFigures(const SolverResult& s, std::ostringstream& out) {
   char line[256];
-  if (s.num_edge_residuals > 0) {
-    std::snprintf(line, sizeof(line), "board edges: %d ring crossings of the sheet's edges used",
-                  s.num_edge_residuals);
+  if (s.num_edge_residuals > 0 && s.edge_dilation) {
+    std::snprintf(line, sizeof(line),
+                  "board edges: the LiDAR sees the sheet %+.1f ± %.1f mm larger per side (beam "
+                  "footprint; pairs spread %.1f mm)\n",
+                  s.edge_dilation->value_m * 1e3, s.edge_dilation->sigma_m * 1e3,
+                  s.edge_dilation->spread_m * 1e3);
     out << line;
-    if (s.edge_dilation) {
-      std::snprintf(line, sizeof(line),
-                    "; the LiDAR sees the sheet %+.1f ± %.1f mm larger per side (beam footprint; "
-                    "pairs spread %.1f mm)",
-                    s.edge_dilation->value_m * 1e3, s.edge_dilation->sigma_m * 1e3,
-                    s.edge_dilation->spread_m * 1e3);
-      out << line;
-    }
-    out << "\n";
   }
   if (s.range_offset) {
     const Vec3& c = s.range_offset->correlation_with_translation;
@@ -195,10 +335,9 @@ void PrintModelFigures(const SolverResult& s, std::ostringstream& out) {
 // Iterations, convergence and the observability verdict.
 void PrintConvergence(const SolverResult& s, std::ostringstream& out) {
   char line[256];
-  std::snprintf(line, sizeof(line), "solver: %d iterations, %s, cost %.3e -> %.3e\n", s.iterations,
-                s.converged ? "converged" : "NOT converged", s.cost_history.front(),
+  std::snprintf(line, sizeof(line), "; cost %.3e -> %.3e\n", s.cost_history.front(),
                 s.cost_history.back());
-  out << line;
+  out << "solver: " << s.iterations << " iterations, " << s.termination.Describe() << line;
   if (s.observability.well_constrained) {
     out << "observability: well constrained\n";
   } else {
@@ -220,6 +359,14 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
   }
   const SolverResult& s = *outcome.solution;
   out << FormatTransform(names, s.cam_from_lidar, s.covariance);
+  if (const std::string model = DescribeLidarModel(outcome); !model.empty()) out << model << "\n";
+  const ResidualCounts counts = CountResiduals(outcome);
+  out << "residuals: board planes from " << counts.plane_pairs << " pairs";
+  if (counts.edges_in_model)
+    out << ", board edges from " << counts.edge_pairs << " pairs (" << counts.edge_points
+        << " ring crossings of the sheet's edges)";
+  out << "\n";
+  if (!counts.note.empty()) out << "  " << counts.note << "\n";
   PrintModelFigures(s, out);
   PrintConvergence(s, out);
   return out.str();

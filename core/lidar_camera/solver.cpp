@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "core/base/names.h"
@@ -35,7 +36,8 @@ bool SolverOptions::Check(std::string* why) const {
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
   if (!(negligible_weight >= 0 && negligible_weight < 1))
     return fail("negligible_weight must be in [0, 1)");
-  if (!(step_tolerance > 0)) return fail("step_tolerance must be > 0");
+  if (!(function_tolerance > 0 && gradient_tolerance > 0 && parameter_tolerance > 0))
+    return fail("function_tolerance, gradient_tolerance and parameter_tolerance must be > 0");
   if (!(outlier_gate == 0 || outlier_gate >= 2))
     return fail("outlier_gate must be 0 (off) or at least 2 robust scales");
   if (!(weak_eigenvalue_ratio > 0 && weak_eigenvalue_ratio < 1))
@@ -155,7 +157,10 @@ PlaneAlignmentSolver::PlaneAlignmentSolver(std::vector<PlanePair> pairs,
   iteration_budget_ = options_.max_iterations;
   history_.push_back({0, LinearizeHere().cost, 0.0, cam_from_lidar_, range_offset_m_});
   // Kim et al.'s estimate is the closed form itself: nothing to iterate.
-  if (options_.method == SolverMethod::kKim) done_ = converged_ = true;
+  if (options_.method == SolverMethod::kKim) {
+    done_ = true;
+    termination_.test = TerminationTest::kClosedForm;
+  }
 }
 
 double PlaneAlignmentSolver::HuberDelta() const {
@@ -183,6 +188,7 @@ PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(const Pose& 
                                                                     double range_offset_m) const {
   Linearization lin;
   lin.pair_weights.assign(pairs_.size(), 0.0);
+  lin.pair_edge_points.assign(pairs_.size(), 0);
   if (options_.method == SolverMethod::kWeightedMl) {
     Eigen::Matrix<double, 3, kNumParameters> jacobian =
         Eigen::Matrix<double, 3, kNumParameters>::Zero();
@@ -202,8 +208,10 @@ PlaneAlignmentSolver::Linearization PlaneAlignmentSolver::Linearize(const Pose& 
       lin.cost += RobustCost(mahalanobis);
       lin.weighted_squared_error += weight * mahalanobis * mahalanobis;
       lin.num_residuals += 3;
+      const int edges_before = lin.num_edge_residuals;
       if (options_.use_board_edges && pairs_[i].sheet_half_size_m.minCoeff() > 0)
         LinearizeEdges(cam_from_lidar, range_offset_m, pairs_[i], &lin);
+      lin.pair_edge_points[i] = lin.num_edge_residuals - edges_before;
       lin.pair_gradients.push_back(lin.gradient - gradient_before);
       lin.pair_informations.push_back(lin.information - information_before);
     }
@@ -246,9 +254,15 @@ bool PlaneAlignmentSolver::Step() {
     damped.col(kRangeOffset).setZero();
     gradient[kRangeOffset] = 0.0;
   }
+  const double gradient_max = gradient.cwiseAbs().maxCoeff();
+  if (gradient_max <= options_.gradient_tolerance) {
+    FinishRound({TerminationTest::kGradientTolerance, gradient_max, options_.gradient_tolerance});
+    return !done_;
+  }
   if (damped(kRangeOffset, kRangeOffset) == 0) damped(kRangeOffset, kRangeOffset) = 1.0;
   damped.diagonal().array() += 1e-12 * std::max(1.0, damped.diagonal().maxCoeff());
-  Vec7 delta = -damped.ldlt().solve(gradient);
+  const Vec7 full_step = -damped.ldlt().solve(gradient);
+  Vec7 delta = full_step;
   auto cost_at = [&](const Vec7& step) {
     return Linearize(cam_from_lidar_ * ExpSE3(step.head<6>()), range_offset_m_ + step[kRangeOffset])
         .cost;
@@ -259,25 +273,82 @@ bool PlaneAlignmentSolver::Step() {
     delta *= 0.5;
     cost = cost_at(delta);
   }
-  if (cost <= lin.cost) {
-    cam_from_lidar_ = cam_from_lidar_ * ExpSE3(delta.head<6>());
-    range_offset_m_ += delta[kRangeOffset];
+  const double scale = std::max(lin.cost, std::numeric_limits<double>::min());
+  if (cost > lin.cost) {
+    // Stalled: along the Gauss-Newton direction the cost only rises. Where the step's own
+    // prediction of the decrease (½ gᵀH⁻¹g) is within the function tolerance, the cost is at its
+    // numerical floor. Otherwise the robust weights or an edge point's nearest edge switch close
+    // by, and the linearization points where the cost does not fall: moves of 0.01σ and 0.1σ
+    // along each parameter are tried, the best taken if it lowers the cost; if none does, this is
+    // a minimum at the scale of the pose's uncertainty.
+    const double predicted = -0.5 * gradient.dot(full_step) / scale;
+    if (predicted <= options_.function_tolerance) {
+      history_.push_back(
+          {static_cast<int>(history_.size()), lin.cost, 0.0, cam_from_lidar_, range_offset_m_});
+      FinishRound({TerminationTest::kFunctionTolerance, predicted, options_.function_tolerance});
+      return !done_;
+    }
+    const int redundancy =
+        lin.num_residuals - lin.num_edge_dilations - static_cast<int>(ActiveParameters().size());
+    const double variance_factor = std::max(2.0 * lin.cost / std::max(1, redundancy), 1e-300);
+    const Mat7 covariance = variance_factor * damped.ldlt().solve(Mat7::Identity());
+    Vec7 best_move = Vec7::Zero();
+    double best_cost = lin.cost;
+    for (int k : ActiveParameters())
+      for (double fraction : {0.01, 0.1, -0.01, -0.1}) {
+        Vec7 move = Vec7::Zero();
+        move[k] = fraction * std::sqrt(std::max(covariance(k, k), 0.0));
+        const double moved = cost_at(move);
+        if (moved < best_cost) {
+          best_cost = moved;
+          best_move = move;
+        }
+      }
+    if (best_cost < lin.cost) {
+      cam_from_lidar_ = cam_from_lidar_ * ExpSE3(best_move.head<6>());
+      range_offset_m_ += best_move[kRangeOffset];
+    }
+    history_.push_back({static_cast<int>(history_.size()), best_cost, best_move.norm(),
+                        cam_from_lidar_, range_offset_m_});
+    if (best_cost >= lin.cost)
+      FinishRound({TerminationTest::kLocalMinimum, predicted, options_.function_tolerance});
+    else if (static_cast<int>(history_.size()) > iteration_budget_)
+      FinishRound({TerminationTest::kIterationCap, (lin.cost - best_cost) / scale,
+                   options_.function_tolerance, options_.max_iterations});
+    return !done_;
   }
-  const double step_norm = cost <= lin.cost ? delta.norm() : 0.0;
-  history_.push_back({static_cast<int>(history_.size()), std::min(cost, lin.cost), step_norm,
-                      cam_from_lidar_, range_offset_m_});
-  converged_ = step_norm < options_.step_tolerance ||
-               (lin.cost - cost >= 0 && lin.cost - cost <= 1e-15 * std::max(1.0, lin.cost));
-  done_ = converged_ || static_cast<int>(history_.size()) > iteration_budget_;
-  if (done_ && (GateOutliers() || EstimateVarianceComponents())) {
+  Vec7 x;
+  x << LogSE3(cam_from_lidar_), range_offset_m_;
+  cam_from_lidar_ = cam_from_lidar_ * ExpSE3(delta.head<6>());
+  range_offset_m_ += delta[kRangeOffset];
+  history_.push_back(
+      {static_cast<int>(history_.size()), cost, delta.norm(), cam_from_lidar_, range_offset_m_});
+  const double relative_change = (lin.cost - cost) / scale;
+  const double tolerance = options_.parameter_tolerance;
+  if (delta.norm() <= tolerance * (x.norm() + tolerance))
+    FinishRound(
+        {TerminationTest::kParameterTolerance, delta.norm() / (x.norm() + tolerance), tolerance});
+  else if (relative_change <= options_.function_tolerance)
+    FinishRound(
+        {TerminationTest::kFunctionTolerance, relative_change, options_.function_tolerance});
+  else if (static_cast<int>(history_.size()) > iteration_budget_)
+    FinishRound({TerminationTest::kIterationCap, relative_change, options_.function_tolerance,
+                 options_.max_iterations});
+  return !done_;
+}
+
+void PlaneAlignmentSolver::FinishRound(const Termination& termination) {
+  termination_ = termination;
+  done_ = true;
+  if (GateOutliers() || EstimateVarianceComponents()) {
     // Continue from here without the gated pairs, with a fresh iteration budget; costs before
     // and after are not comparable.
     history_.back().cost = LinearizeHere().cost;
     history_.back().reweighted = true;
-    done_ = converged_ = false;
+    done_ = false;
+    termination_ = {};
     iteration_budget_ = static_cast<int>(history_.size()) + options_.max_iterations;
   }
-  return !done_;
 }
 
 bool PlaneAlignmentSolver::GateOutliers() {

@@ -98,12 +98,22 @@ struct SolverOptions {
   // shows a range offset all the same; one beyond this many standard deviations (and determined
   // within range_offset_max_sigma_m) is reported (SolverResult::unmodelled_range_offset).
   double range_offset_significance = 3.0;
-  int max_iterations = 50;  // Gauss-Newton iterations
+  // Convergence, by Ceres's three tests: the solve (each round of it, see GateOutliers and
+  // EstimateVarianceComponents) stops when the last step changed the cost by at most
+  // function_tolerance of itself, when the largest gradient component is within
+  // gradient_tolerance, or when the step is within parameter_tolerance · (|x| + parameter_
+  // tolerance), x = [Log(cam_from_lidar); b]. At 1e-6 of a whitened cost the pose is within about
+  // 1% of its σ of the minimum. SolverResult::termination says which test ended the solve.
+  double function_tolerance = 1e-6;
+  double gradient_tolerance = 1e-10;
+  double parameter_tolerance = 1e-8;
+  // Gauss-Newton iterations per round: a safety net (a well-posed solve converges in under ten);
+  // reaching it means the solve did not converge, and the summary says so.
+  int max_iterations = 100;
   // A pair whose robust weight at the solution is below this counts for nothing (the outlier
   // gate's pairs have 0, Huber's far tails come close): accepted, but in effect left out, and
   // reported so (the summary, the result's "down_weighted", the workbench's pair list).
   double negligible_weight = 0.05;
-  double step_tolerance = 1e-9;  // stop when |delta| (m, rad) falls below this
   // A direction of the information matrix whose eigenvalue is below this fraction of the largest
   // is reported weak (about 2 degrees of spread of the board normals around it).
   double weak_eigenvalue_ratio = 1e-3;
@@ -136,7 +146,8 @@ struct SolverResult {
   SolverMethod method = SolverMethod::kWeightedMl;  // the method that produced it
   Pose cam_from_lidar = Pose::Identity();
   Mat6 covariance = Mat6::Zero();  // right perturbation of cam_from_lidar, [rho; phi]
-  bool converged = false;
+  bool converged = false;          // termination.Converged()
+  Termination termination;         // which test ended the solve
   int iterations = 0;
   std::vector<double> cost_history;    // one entry per iteration, the initial cost first
   std::vector<Vec4> residuals;         // per pair, Eq. (6) at the solution
@@ -152,7 +163,10 @@ struct SolverResult {
   // offset one Gauss-Newton step from the solution would estimate, with its standard deviation.
   // The pose above does not include it; estimating it would move the pose.
   std::optional<RangeOffsetEstimate> unmodelled_range_offset;
-  int num_edge_residuals = 0;                         // board-edge points used (use_board_edges)
+  int num_edge_residuals = 0;  // board-edge points used (use_board_edges)
+  // Per pair (as robust_weights), its board-edge points used; all 0 where the method uses none.
+  std::vector<int> pair_edge_points;
+  bool edges_in_model = false;  // the method and options use board edges (weighted-ml, edges on)
   std::optional<EdgeDilationEstimate> edge_dilation;  // estimate_edge_dilation, with edges
   // A-posteriori variance factors of the planes' and the edges' residuals (kWeightedMl; 1 = their
   // noise models held; for ca2lib-gn the planes' noise variance itself).
@@ -249,6 +263,7 @@ class PlaneAlignmentSolver {
     std::vector<Vec7> pair_gradients;      // kWeightedMl: each used pair's share of `gradient`
     std::vector<Mat7> pair_informations;   // kWeightedMl: each used pair's share of `information`
     std::vector<double> pair_weights;      // per pair, its planes' robust weight (0 = gated)
+    std::vector<int> pair_edge_points;     // per pair, its edge residuals
     double edge_weighted_squared_error = 0.0;
   };
   Linearization Linearize(const Pose& cam_from_lidar, double range_offset_m) const;
@@ -306,8 +321,12 @@ class PlaneAlignmentSolver {
   double edge_variance_scale_ = 1.0;
   int variance_component_rounds_ = 0;
   std::vector<IterationReport> history_;
+  // Ends the current round with `termination`, unless gating or variance components start
+  // another (then the solve goes on).
+  void FinishRound(const Termination& termination);
+
   bool done_ = false;
-  bool converged_ = false;
+  Termination termination_;
 };
 
 }  // namespace calibench

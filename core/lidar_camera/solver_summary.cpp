@@ -205,7 +205,8 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   SolverResult result;
   result.method = options_.method;
   result.cam_from_lidar = cam_from_lidar_;
-  result.converged = converged_;
+  result.termination = termination_;
+  result.converged = termination_.Converged();
   result.iterations = static_cast<int>(history_.size()) - 1;
   for (const IterationReport& it : history_) result.cost_history.push_back(it.cost);
   for (const PlanePair& pair : pairs_)
@@ -222,6 +223,8 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   const int redundancy =
       lin.num_residuals - lin.num_edge_dilations - static_cast<int>(active.size());
   result.num_edge_residuals = lin.num_edge_residuals;
+  result.pair_edge_points = lin.pair_edge_points;
+  result.edges_in_model = options_.method == SolverMethod::kWeightedMl && options_.use_board_edges;
   result.edge_dilation = DilationOverPairs(lin.pair_dilations_m);
   const double variance_factor = redundancy > 0 ? lin.weighted_squared_error / redundancy : 0.0;
   // The a-posteriori variance factor of each kind of residual against its noise model: the

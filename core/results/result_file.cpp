@@ -41,6 +41,15 @@ json ResultHeaderJson(const ResultNames& names, const Pose& target_from_source,
   return root;
 }
 
+json TerminationToJson(const Termination& termination) {
+  json out = {{"test", TerminationTestName(termination.test)},
+              {"value", termination.value},
+              {"tolerance", termination.tolerance},
+              {"text", termination.Describe()}};
+  if (termination.test == TerminationTest::kIterationCap) out["cap"] = termination.cap;
+  return out;
+}
+
 json PairEntryJson(const std::string& id, PairStatus status, const std::string& reason) {
   return {{"id", id}, {"status", PairStatusName(status)}, {"reason", reason}};
 }

@@ -20,6 +20,10 @@ nlohmann::json ResultHeaderJson(const ResultNames& names, const Pose& target_fro
 // A pair's entry: id, status and reason; the method adds its features.
 nlohmann::json PairEntryJson(const std::string& id, PairStatus status, const std::string& reason);
 
+// Which test ended an iterative solve: {"test": "function_tolerance", "value", "tolerance",
+// "cap" (the iteration cap only), "text": in words}.
+nlohmann::json TerminationToJson(const Termination& termination);
+
 // Writes the document atomically (2-space indented, newline-terminated); IoError naming the file.
 void WriteResultJson(const std::filesystem::path& path, const nlohmann::json& root);
 

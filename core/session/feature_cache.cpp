@@ -12,7 +12,9 @@ using nlohmann::json;
 
 namespace {
 
-constexpr const char* kFeatureCacheFormat = "calibench.features.v1";
+// v2: the LiDAR fits carry their ring-bias covariance, what their rings' ends showed and their
+// noise model.
+constexpr const char* kFeatureCacheFormat = "calibench.features.v2";
 
 // A matrix as its rows, flattened row by row.
 template <typename Matrix>
@@ -61,17 +63,25 @@ json LidarToJson(const LidarPlaneFit& fit) {
   json edges = json::array();
   for (const LidarEdgePoint& e : fit.edge_points)
     edges.push_back({MatrixToJson(e.point), MatrixToJson(e.along_ring), e.sigma_along_m});
-  return {{"plane", PlaneToJson(fit.plane)},
-          {"covariance", MatrixToJson(fit.covariance)},
-          {"inliers", fit.inliers},
-          {"inlier_centroid", MatrixToJson(fit.inlier_centroid)},
-          {"num_candidates", fit.num_candidates},
-          {"grown", fit.grown},
-          {"range_offset_jacobian", MatrixToJson(fit.range_offset_jacobian)},
-          {"edge_points", edges},
-          {"sheet_size_m", MatrixToJson(fit.sheet_size_m)},
-          {"rms_m", fit.rms_m},
-          {"num_rings", fit.num_rings}};
+  return {
+      {"plane", PlaneToJson(fit.plane)},
+      {"covariance", MatrixToJson(fit.covariance)},
+      {"inliers", fit.inliers},
+      {"inlier_centroid", MatrixToJson(fit.inlier_centroid)},
+      {"num_candidates", fit.num_candidates},
+      {"grown", fit.grown},
+      {"range_offset_jacobian", MatrixToJson(fit.range_offset_jacobian)},
+      {"edge_points", edges},
+      {"sheet_size_m", MatrixToJson(fit.sheet_size_m)},
+      {"rms_m", fit.rms_m},
+      {"num_rings", fit.num_rings},
+      {"ring_bias_covariance", MatrixToJson(fit.ring_bias_covariance)},
+      {"edge_ends",
+       {fit.edge_ends.ends, fit.edge_ends.edge_points, fit.edge_ends.no_return,
+        fit.edge_ends.not_behind}},
+      {"no_edge_search", fit.no_edge_search},
+      {"lidar_model",
+       {LidarGeometryName(fit.lidar_model.geometry), fit.lidar_model.why, fit.lidar_model.forced}}};
 }
 
 LidarPlaneFit LidarFromJson(const json& j) {
@@ -93,6 +103,15 @@ LidarPlaneFit LidarFromJson(const json& j) {
   MatrixFromJson(j.at("sheet_size_m"), &fit.sheet_size_m);
   fit.rms_m = j.at("rms_m").get<double>();
   fit.num_rings = j.at("num_rings").get<int>();
+  MatrixFromJson(j.at("ring_bias_covariance"), &fit.ring_bias_covariance);
+  const json& ends = j.at("edge_ends");
+  fit.edge_ends = {ends.at(0).get<int>(), ends.at(1).get<int>(), ends.at(2).get<int>(),
+                   ends.at(3).get<int>()};
+  fit.no_edge_search = j.at("no_edge_search").get<std::string>();
+  const json& model = j.at("lidar_model");
+  const auto geometry = ParseLidarGeometry(model.at(0).get<std::string>());
+  if (!geometry) throw std::invalid_argument("unknown LiDAR model");
+  fit.lidar_model = {*geometry, model.at(1).get<std::string>(), model.at(2).get<bool>()};
   return fit;
 }
 

@@ -35,7 +35,7 @@ bool SessionResult::operator==(const SessionResult& other) const {
          num_edge_residuals == other.num_edge_residuals && edge_dilation == other.edge_dilation &&
          covariance_inflation == other.covariance_inflation &&
          plane_variance_factor == other.plane_variance_factor &&
-         edge_variance_factor == other.edge_variance_factor &&
+         edge_variance_factor == other.edge_variance_factor && termination == other.termination &&
          std::equal(estimate_history.begin(), estimate_history.end(),
                     other.estimate_history.begin(), other.estimate_history.end(),
                     [](const Pose& a, const Pose& b) { return a.matrix() == b.matrix(); });
@@ -58,7 +58,8 @@ SessionResult SessionResultFromSolver(const SolverResult& solver) {
           solver.edge_dilation,
           solver.covariance_inflation,
           solver.plane_variance_factor,
-          solver.edge_variance_factor};
+          solver.edge_variance_factor,
+          solver.termination};
 }
 
 SolverResult SolverResultFromSession(const SessionResult& session, SolverMethod method) {
@@ -78,6 +79,7 @@ SolverResult SolverResultFromSession(const SessionResult& session, SolverMethod 
   r.covariance_inflation = session.covariance_inflation;
   r.plane_variance_factor = session.plane_variance_factor;
   r.edge_variance_factor = session.edge_variance_factor;
+  r.termination = session.termination;
   return r;
 }
 

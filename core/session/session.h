@@ -95,6 +95,7 @@ struct SessionResult {
   double covariance_inflation = 1.0;
   double plane_variance_factor = 1.0;
   double edge_variance_factor = 1.0;
+  Termination termination;  // which test ended the solve (optional in the file)
 
   // Exact value comparison (no tolerance), so a file round trip can be checked with ==.
   bool operator==(const SessionResult& other) const;

@@ -10,6 +10,7 @@
 #include "core/base/names.h"
 #include "core/io/json_fields.h"
 #include "core/io/json_io.h"
+#include "core/results/result_json.h"
 #include "core/session/session.h"
 
 namespace calibench {
@@ -125,6 +126,8 @@ Json ResultToJson(const SessionResult& r) {
   if (r.range_offset) json["lidar_range_offset"] = RangeOffsetToJson(*r.range_offset);
   if (r.unmodelled_range_offset)
     json["unmodelled_lidar_range_offset"] = RangeOffsetToJson(*r.unmodelled_range_offset);
+  if (r.termination.test != TerminationTest::kNone)
+    json["termination"] = TerminationToJson(r.termination);
   if (r.edge_dilation)
     json["board_edge_dilation"] = {{"value_m", r.edge_dilation->value_m},
                                    {"sigma_m", r.edge_dilation->sigma_m},
@@ -285,6 +288,14 @@ void ReadResultExtras(const Fields& f, SessionResult* r) {
     r->range_offset = ReadRangeOffset(f.Object("lidar_range_offset"));
   if (f.Has("unmodelled_lidar_range_offset"))
     r->unmodelled_range_offset = ReadRangeOffset(f.Object("unmodelled_lidar_range_offset"));
+  if (f.Has("termination")) {  // written since the solver says which test ended it
+    const Fields t = f.Object("termination");
+    const std::string name = t.String("test");
+    const auto test = ParseTerminationTest(name);
+    if (!test) t.Fail("test", "'" + name + "' is not a termination test");
+    r->termination = {*test, t.StoredNumber("value"), t.StoredNumber("tolerance"),
+                      t.Has("cap") ? t.Int("cap") : 0};
+  }
   if (f.Has("board_edge_dilation")) {
     const Fields d = f.Object("board_edge_dilation");
     r->edge_dilation = EdgeDilationEstimate{d.StoredNumber("value_m"), d.StoredNumber("sigma_m"),

@@ -133,6 +133,21 @@ bool SheetInLidarFov(const SimOptions& r, const BeamTable& beams, const Pose& li
   return true;
 }
 
+// The cloud a pair ships: the whole scan, or (SimOptions::board_only_clouds) the sheet's returns
+// alone, without rings.
+LidarCloud CloudOf(const SimOptions& r, const LidarScan& scan) {
+  LidarCloud cloud = scan.ToCloud();
+  if (!r.board_only_clouds) return cloud;
+  LidarCloud board;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    if (scan.surface[i] != SimSurface::kBoard) continue;
+    board.points.push_back(cloud.points[i]);
+    if (cloud.HasIntensity()) board.intensity.push_back(cloud.intensity[i]);
+  }
+  board.width = static_cast<int>(board.size());
+  return board;
+}
+
 // The noise-free returns of the board alone (no room).
 LidarScan ScanBoardOnly(const BeamTable& beams, const BoardPrint& print,
                         const Pose& lidar_from_board, double azimuth_offset_rad) {
@@ -358,7 +373,7 @@ SimOptions SimOptionsFromDataset(const Dataset& dataset) {
   const auto lidar = ParseLidarModelName(record.lidar_model);
   if (!lidar)
     throw IoError(dataset.manifest.string() + ": simulation.lidar_model '" + record.lidar_model +
-                  "' is not hdl64, vlp16 or os0-128");
+                  "' is not one of " + LidarModelNames());
   options.lidar = *lidar;
   options.camera = dataset.camera;
   options.board = dataset.target;
@@ -370,6 +385,7 @@ SimOptions SimOptionsFromDataset(const Dataset& dataset) {
   options.lidar_range_offset_m = record.lidar_range_offset_m;
   options.image_noise = record.image_noise;
   options.clutter = record.clutter;
+  options.board_only_clouds = record.board_only_clouds;
   options.seed_radius_m = record.seed_radius_m;
   options.seed = record.seed;
   if (dataset.cam_from_lidar_ground_truth)
@@ -394,7 +410,7 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
   dataset.manifest = root / "dataset.json";
   dataset.camera = r.camera;
   dataset.target = r.board;
-  dataset.lidar_rings = static_cast<int>(beams.elevations_rad.size());
+  dataset.lidar_rings = beams.swept ? 0 : static_cast<int>(beams.elevations_rad.size());
   dataset.cam_from_lidar_ground_truth = r.cam_from_lidar;
   SimulationRecord record;
   record.lidar_model = LidarModelName(r.lidar);
@@ -406,6 +422,7 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
   record.lidar_range_offset_m = r.lidar_range_offset_m;
   record.image_noise = r.image_noise;
   record.clutter = r.clutter;
+  record.board_only_clouds = r.board_only_clouds;
   record.seed_radius_m = r.seed_radius_m;
   record.seed = r.seed;
   dataset.simulation = record;
@@ -426,7 +443,7 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
     scan_options.range_offset_m = r.lidar_range_offset_m;
     scan_options.azimuth_offset_rad = plan.azimuth_offset_rad;
     scan_options.seed = MixSeed(r.seed, k, 1);
-    SavePcd(entry.cloud, SimulateLidarScan(beams, print, scene, scan_options).ToCloud(),
+    SavePcd(entry.cloud, CloudOf(r, SimulateLidarScan(beams, print, scene, scan_options)),
             PcdEncoding::kBinary);
 
     RenderOptions render;
@@ -458,7 +475,7 @@ SimulatedPair SimulatePairAt(const SimOptions& resolved, const Pose& cam_from_bo
   scan_options.range_offset_m = r.lidar_range_offset_m;
   scan_options.azimuth_offset_rad = azimuth_offset;
   scan_options.seed = MixSeed(r.seed, pair_index, 1);
-  pair.cloud = SimulateLidarScan(beams, print, scene, scan_options).ToCloud();
+  pair.cloud = CloudOf(r, SimulateLidarScan(beams, print, scene, scan_options));
   RenderOptions render;
   render.image_noise = r.image_noise;
   render.seed = MixSeed(r.seed, pair_index, 2);

@@ -17,15 +17,25 @@
 
 namespace calibench {
 
-enum class LidarModel { kHdl64, kVlp16, kOs0_128 };
-std::string LidarModelName(LidarModel model);  // "hdl64", "vlp16", "os0-128"
+// Spinning LiDARs (one centre, rings) and a swept single-line laser: a 2D scanner on a rotary
+// stage whose scan plane turns about the stage's vertical axis, its mirror off that axis (the
+// rays start on the moving mirror, not at the frame's origin; no rings), as the SICK LMS400 on a
+// rotary stage of public swept sets.
+enum class LidarModel { kHdl64, kVlp16, kOs0_128, kSwept2d };
+std::string LidarModelName(LidarModel model);  // "hdl64", "vlp16", "os0-128", "swept-2d"
 std::optional<LidarModel> ParseLidarModelName(const std::string& name);
+std::string LidarModelNames();  // "hdl64, vlp16, os0-128, swept-2d", for messages
 
 // A spinning LiDAR's beam table: elevation per ring (radians, ring 0 = lowest) and azimuth bins.
 struct BeamTable {
   std::vector<double> elevations_rad;
   int azimuth_steps = 0;
   double max_range_m = 100.0;
+  // A swept scanner (kSwept2d): elevations are the scanner's beam angles in its scan plane,
+  // azimuth steps the stage's; every ray of a stage step starts at the mirror, this offset
+  // (stage frame at azimuth 0) turned with the stage. Its clouds carry no rings.
+  bool swept = false;
+  Vec3 mirror_offset_m = Vec3::Zero();
 };
 BeamTable MakeBeamTable(LidarModel model);
 
@@ -43,6 +53,9 @@ struct SimOptions {
   double lidar_range_offset_m = 0.0;
   double image_noise = 0.0;  // Gaussian pixel noise, in [0,1] intensity units (Gazebo)
   bool clutter = true;       // floor and walls
+  // Clouds cropped to the returns on the sheet, without rings, as several public sets and some
+  // users' pipelines ship the LiDAR side: no background, nothing beyond the board's edges.
+  bool board_only_clouds = false;
   Pose cam_from_lidar = Pose::Identity();  // ground truth; Identity() = the default mount below
   double seed_radius_m = 0.0;              // lidar_seed radius; 0 = 0.4 * the smaller board side
   std::uint64_t seed = 1;
@@ -122,9 +135,10 @@ struct LidarScan {
   std::vector<float> intensity;     // 0..255
   std::vector<int> ring;            // 0 = lowest beam
   std::vector<SimSurface> surface;  // what each return hit
+  bool has_rings = true;            // false for a swept scanner: its cloud has no ring field
 
   size_t size() const { return points.size(); }
-  // Unorganized cloud (height 1) with intensity and ring.
+  // Unorganized cloud (height 1) with intensity and ring (when it has rings).
   LidarCloud ToCloud() const;
 };
 

@@ -52,23 +52,29 @@ BoardGeometry MakeBoardGeometry(const Pose& lidar_from_board) {
   return g;
 }
 
-// Where a ray from the LiDAR origin meets a rectangle's plane nearer than `nearer_than`: its
-// range and the point in the rectangle's axes; nullopt when parallel, behind or farther.
+// A ray: where it starts (the LiDAR origin, or a swept scanner's mirror) and its unit direction.
+struct Ray {
+  Vec3 origin = Vec3::Zero();
+  Vec3 dir = Vec3::UnitX();
+};
+
+// Where a ray meets a rectangle's plane nearer than `nearer_than`: its range and the point in
+// the rectangle's axes; nullopt when parallel, behind or farther.
 struct PlaneHit {
   double range;
   Vec2 xy;
 };
-std::optional<PlaneHit> HitPlane(const Vec3& dir, const BoardGeometry& g, double nearer_than) {
-  const double denom = g.normal.dot(dir);
+std::optional<PlaneHit> HitPlane(const Ray& ray, const BoardGeometry& g, double nearer_than) {
+  const double denom = g.normal.dot(ray.dir);
   if (std::abs(denom) < 1e-12) return std::nullopt;
-  const double range = g.offset / denom;
+  const double range = (g.offset - g.normal.dot(ray.origin)) / denom;
   if (range <= 0.0 || range >= nearer_than) return std::nullopt;
-  const Vec3 local = range * dir - g.origin;
+  const Vec3 local = ray.origin + range * ray.dir - g.origin;
   return PlaneHit{range, Vec2(g.axis_x.dot(local), g.axis_y.dot(local))};
 }
 
-void IntersectBoard(const Vec3& dir, const BoardGeometry& g, const BoardPrint& print, RayHit* hit) {
-  const auto at = HitPlane(dir, g, hit->range);
+void IntersectBoard(const Ray& ray, const BoardGeometry& g, const BoardPrint& print, RayHit* hit) {
+  const auto at = HitPlane(ray, g, hit->range);
   if (at && print.InSheet(at->xy)) *hit = RayHit{at->range, SimSurface::kBoard, at->xy};
 }
 
@@ -78,22 +84,26 @@ struct PanelGeometry {
   Vec2 half_size;
 };
 
-void IntersectPanel(const Vec3& dir, const PanelGeometry& panel, RayHit* hit) {
-  const auto at = HitPlane(dir, panel.plane, hit->range);
+void IntersectPanel(const Ray& ray, const PanelGeometry& panel, RayHit* hit) {
+  const auto at = HitPlane(ray, panel.plane, hit->range);
   if (at && std::abs(at->xy.x()) <= panel.half_size.x() &&
       std::abs(at->xy.y()) <= panel.half_size.y())
     *hit = RayHit{at->range, SimSurface::kWall, Vec2::Zero()};
 }
 
 // The room: floor z = floor_z (below the sensor) and walls |x| = d, |y| = d around it.
-void IntersectRoom(const Vec3& dir, const LidarScene& scene, RayHit* hit) {
+void IntersectRoom(const Ray& ray, const LidarScene& scene, RayHit* hit) {
   const double d = scene.wall_distance_m;
+  const Vec3& dir = ray.dir;
+  const Vec3& o = ray.origin;
   double wall = std::numeric_limits<double>::infinity();
-  if (dir.x() != 0.0) wall = std::min(wall, d / std::abs(dir.x()));
-  if (dir.y() != 0.0) wall = std::min(wall, d / std::abs(dir.y()));
+  if (dir.x() != 0.0)
+    wall = std::min(wall, (d - std::copysign(o.x(), dir.x())) / std::abs(dir.x()));
+  if (dir.y() != 0.0)
+    wall = std::min(wall, (d - std::copysign(o.y(), dir.y())) / std::abs(dir.y()));
   if (wall < hit->range) *hit = RayHit{wall, SimSurface::kWall, Vec2::Zero()};
   if (dir.z() < 0.0) {
-    const double floor = scene.floor_z_m / dir.z();
+    const double floor = (scene.floor_z_m - o.z()) / dir.z();
     if (floor > 0.0 && floor < hit->range) *hit = RayHit{floor, SimSurface::kFloor, Vec2::Zero()};
   }
 }
@@ -115,7 +125,8 @@ double SurfaceIntensity(const RayHit& hit, const BoardPrint& print) {
 namespace {
 constexpr EnumName<LidarModel> kLidarModelNames[] = {{LidarModel::kHdl64, "hdl64"},
                                                      {LidarModel::kVlp16, "vlp16"},
-                                                     {LidarModel::kOs0_128, "os0-128"}};
+                                                     {LidarModel::kOs0_128, "os0-128"},
+                                                     {LidarModel::kSwept2d, "swept-2d"}};
 }  // namespace
 
 std::string LidarModelName(LidarModel model) { return NameIn(kLidarModelNames, model); }
@@ -123,6 +134,8 @@ std::string LidarModelName(LidarModel model) { return NameIn(kLidarModelNames, m
 std::optional<LidarModel> ParseLidarModelName(const std::string& name) {
   return ValueIn(kLidarModelNames, name);
 }
+
+std::string LidarModelNames() { return NamesIn(kLidarModelNames); }
 
 BeamTable MakeBeamTable(LidarModel model) {
   BeamTable table;
@@ -147,6 +160,16 @@ BeamTable MakeBeamTable(LidarModel model) {
       table.azimuth_steps = 1024;
       table.max_range_m = 50.0;
       break;
+    case LidarModel::kSwept2d:
+      // A SICK LMS400-like scanner (70° fan, 0.2° resolution) turned by a stage in 0.4° steps,
+      // its mirror 10 cm in front of and 5 cm above the stage's axis (the scanner's box sits on
+      // it).
+      table.elevations_rad = LinspaceDeg(-35.0, 35.0, 351);
+      table.azimuth_steps = 900;
+      table.max_range_m = 10.0;
+      table.swept = true;
+      table.mirror_offset_m = Vec3(0.10, 0.0, 0.05);
+      break;
   }
   return table;
 }
@@ -156,7 +179,7 @@ LidarCloud LidarScan::ToCloud() const {
   cloud.points.reserve(points.size());
   for (const Vec3& p : points) cloud.points.push_back(p.cast<float>());
   cloud.intensity = intensity;
-  cloud.ring = ring;
+  if (has_rings) cloud.ring = ring;
   cloud.width = static_cast<int>(points.size());
   cloud.height = 1;
   return cloud;
@@ -179,21 +202,26 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
   std::mt19937_64 rng(options.seed);
   std::normal_distribution<double> unit_normal(0.0, 1.0);
   LidarScan scan;
+  scan.has_rings = !beams.swept;
   for (int step = 0; step < beams.azimuth_steps; ++step) {
     const double azimuth = options.azimuth_offset_rad + 2.0 * M_PI * step / beams.azimuth_steps;
     const double cos_az = std::cos(azimuth), sin_az = std::sin(azimuth);
+    // A swept scanner's rays start on its mirror, which the stage turns with the scan plane.
+    const Vec3& m = beams.mirror_offset_m;
+    const Vec3 origin(cos_az * m.x() - sin_az * m.y(), sin_az * m.x() + cos_az * m.y(), m.z());
     for (int r = 0; r < rings; ++r) {
-      const Vec3 dir(cos_el[r] * cos_az, cos_el[r] * sin_az, sin_el[r]);
+      const Ray ray{origin, Vec3(cos_el[r] * cos_az, cos_el[r] * sin_az, sin_el[r])};
+      const Vec3& dir = ray.dir;
       RayHit hit;
       hit.range = beams.max_range_m;
-      IntersectBoard(dir, board, print, &hit);
-      for (const PanelGeometry& panel : panels) IntersectPanel(dir, panel, &hit);
-      if (scene.clutter) IntersectRoom(dir, scene, &hit);
+      IntersectBoard(ray, board, print, &hit);
+      for (const PanelGeometry& panel : panels) IntersectPanel(ray, panel, &hit);
+      if (scene.clutter) IntersectRoom(ray, scene, &hit);
       if (hit.range >= beams.max_range_m || hit.range < kMinRangeM) continue;
       double range = hit.range + options.range_offset_m;
       if (options.range_noise_m > 0.0) range += options.range_noise_m * unit_normal(rng);
       const double intensity = SurfaceIntensity(hit, print) + kIntensityNoise * unit_normal(rng);
-      scan.points.push_back(range * dir);
+      scan.points.push_back(origin + range * dir);
       scan.intensity.push_back(static_cast<float>(std::clamp(intensity, 0.0, 255.0)));
       scan.ring.push_back(r);
       scan.surface.push_back(hit.surface);

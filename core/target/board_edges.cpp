@@ -35,8 +35,11 @@ std::optional<Vec3> OnPlane(const Plane& plane, const Vec3& x) {
 std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
                                                    const std::vector<int>& inliers,
                                                    const Plane& plane,
-                                                   const BoardEdgeOptions& options) {
+                                                   const BoardEdgeOptions& options,
+                                                   BoardEdgeEnds* ends) {
   std::vector<LidarEdgePoint> edges;
+  BoardEdgeEnds tally;
+  if (ends) *ends = tally;
   if (inliers.size() < 4) return edges;
   const std::vector<int> rings = InferRings(cloud, LidarImageOptions{});
   std::vector<char> is_inlier(cloud.size(), 0);
@@ -78,21 +81,30 @@ std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
     // Each end: the board return and its outer neighbour on the ring.
     for (const auto& [board_k, outer_k] :
          {std::pair{first, first - 1}, std::pair{last, last + 1}}) {
-      if (outer_k < 0 || outer_k >= static_cast<int>(returns.size())) continue;
-      if (std::abs(returns[outer_k].first - returns[board_k].first) > max_gap) continue;
+      ++tally.ends;
+      if (outer_k < 0 || outer_k >= static_cast<int>(returns.size()) ||
+          std::abs(returns[outer_k].first - returns[board_k].first) > max_gap) {
+        ++tally.no_return;
+        continue;
+      }
       const Vec3 board_x = cloud.points[returns[board_k].second].cast<double>();
       const Vec3 outer_x = cloud.points[returns[outer_k].second].cast<double>();
       const auto board_on_plane = OnPlane(plane, board_x);
       const auto outer_on_plane = OnPlane(plane, outer_x);
       if (!board_on_plane || !outer_on_plane) continue;
       // The outer return must have missed the board: well behind the plane along its ray.
-      if (outer_x.norm() - outer_on_plane->norm() < options.min_background_gap_m) continue;
+      if (outer_x.norm() - outer_on_plane->norm() < options.min_background_gap_m) {
+        ++tally.not_behind;
+        continue;
+      }
       const Vec3 gap = *outer_on_plane - *board_on_plane;
       const auto crossing = OnPlane(plane, board_x.normalized() + outer_x.normalized());
       if (!crossing || !(gap.norm() > 0)) continue;
       edges.push_back({*crossing, gap.normalized(), gap.norm() / std::sqrt(12.0)});
     }
   }
+  tally.edge_points = static_cast<int>(edges.size());
+  if (ends) *ends = tally;
   return edges;
 }
 

@@ -34,13 +34,24 @@ struct BoardEdgeOptions {
   bool Check(std::string* why) const;
 };
 
+// What the ring ends of a board said about its edges: how many ends there were, how many gave an
+// edge point, and why the others did not (observed, per end).
+struct BoardEdgeEnds {
+  int ends = 0;         // ends of rings with at least two board returns
+  int edge_points = 0;  // ends that gave an edge point
+  int no_return = 0;    // no return beyond the board on the ring (or one too far in azimuth)
+  int not_behind = 0;   // the return beyond lies in front of or on the board's plane
+  bool operator==(const BoardEdgeEnds&) const = default;
+};
+
 // Ring ends of the inliers of a fitted board plane (n·x + d = 0, LiDAR frame). Uses the cloud's
 // rings (or infers them); a ring whose neighbouring return is missing, occluding or coplanar
-// gives no point at that end.
+// gives no point at that end. `ends` (optional) receives the tally.
 std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
                                                    const std::vector<int>& inliers,
                                                    const Plane& plane,
-                                                   const BoardEdgeOptions& options);
+                                                   const BoardEdgeOptions& options,
+                                                   BoardEdgeEnds* ends = nullptr);
 
 // Residual of one edge point against the sheet (half sizes in metres, board frame as BoardSpec):
 // the signed distance, in the board plane, from the point to the sheet edge nearest to it

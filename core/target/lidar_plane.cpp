@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 #include <set>
 
@@ -28,6 +29,8 @@ bool LidarPlaneOptions::Check(std::string* why) const {
   if (!(sheet_size_m.minCoeff() >= 0) || !sheet_size_m.allFinite())
     return fail("sheet_size_m must be >= 0 (metres; 0 = unknown)");
   if (!edges.Check(why)) return false;
+  if (!(ring_bias_sigma_m >= 0) || !std::isfinite(ring_bias_sigma_m))
+    return fail("ring_bias_sigma_m must be >= 0 (metres; 0 = none)");
   return true;
 }
 
@@ -77,13 +80,58 @@ std::optional<LidarPlaneFit> RefineRangeMl(const LidarCloud& cloud,
   return fit;
 }
 
-// Where the inliers' rays meet the plane, averaged: the board centre when the inliers cover it.
-Vec3 InlierCentre(const LidarCloud& cloud, const LidarPlaneFit& fit) {
+// RefineRangeMl's counterpart for the isotropic model (swept lasers, segments): total least
+// squares, the band redrawn around each plane by point-to-plane distance.
+std::optional<LidarPlaneFit> RefineLeastSquares(const LidarCloud& cloud,
+                                                const std::vector<int>& candidates,
+                                                const LidarPlaneFit& start,
+                                                const LidarPlaneOptions& options) {
+  std::optional<LidarPlaneFit> fit;
+  std::vector<int> inliers = start.inliers;
+  for (int round = 0; round < 4; ++round) {
+    auto ls = FitPlaneLeastSquares(cloud, inliers);
+    if (!ls) break;
+    fit = ls;
+    const double band_m = RangeBand(options, ls->rms_m);
+    std::vector<int> reselected;
+    for (int i : candidates)
+      if (std::abs(ls->plane.SignedDistance(cloud.points[i].cast<double>())) <= band_m)
+        reselected.push_back(i);
+    if (reselected == inliers || reselected.size() < 4) break;
+    inliers = std::move(reselected);
+  }
+  return fit;
+}
+
+// Whether the options fit ranges along rays from the origin (a spinning LiDAR's model).
+bool AlongRays(const LidarPlaneOptions& options) {
+  return options.fit_ranges_ml && options.geometry == LidarGeometry::kSpinning;
+}
+
+// A return's residual against the plane in the options' model: along its ray, or (isotropic)
+// along the normal; and where it lies on the plane.
+std::optional<std::pair<double, Vec3>> ModelResidual(const Plane& plane, const Vec3& x,
+                                                     bool along_rays) {
+  if (!along_rays) {
+    const double distance = plane.SignedDistance(x);
+    return std::make_pair(distance, Vec3(x - distance * plane.normal));
+  }
+  const auto residual = RangeResidual(plane, x);
+  if (!residual) return std::nullopt;
+  return std::make_pair(*residual, Vec3(x - x.normalized() * *residual));
+}
+
+// Where the inliers meet the plane (along their rays, or projected), averaged: the board centre
+// when the inliers cover it.
+Vec3 InlierCentre(const LidarCloud& cloud, const LidarPlaneFit& fit, bool along_rays) {
   Vec3 sum = Vec3::Zero();
   int count = 0;
   for (int i : fit.inliers) {
     const Vec3 x = cloud.points[i].cast<double>();
-    if (const auto range = RangeOnPlane(fit.plane, x)) {
+    if (!along_rays) {
+      sum += x - fit.plane.SignedDistance(x) * fit.plane.normal;
+      ++count;
+    } else if (const auto range = RangeOnPlane(fit.plane, x)) {
       sum += x.normalized() * *range;
       ++count;
     }
@@ -97,23 +145,23 @@ Vec3 InlierCentre(const LidarCloud& cloud, const LidarPlaneFit& fit) {
 // direction and the band only, as for the seed region, so that it does not bias the plane.
 LidarPlaneFit GrowToBoard(const LidarCloud& cloud, LidarPlaneFit fit,
                           const LidarPlaneOptions& options) {
-  Vec3 centre = InlierCentre(cloud, fit);
+  const bool along_rays = AlongRays(options);
+  Vec3 centre = InlierCentre(cloud, fit, along_rays);
   for (int round = 0; round < 4; ++round) {
     const double gate_m = 2.0 * RangeBand(options, fit.rms_m);
     std::vector<int> candidates;
     for (size_t i = 0; i < cloud.size(); ++i) {
-      const Vec3 x = cloud.points[i].cast<double>();
-      const auto residual = RangeResidual(fit.plane, x);
-      if (!residual || std::abs(*residual) > gate_m) continue;
-      const Vec3 on_plane = x - x.normalized() * *residual;
-      if ((on_plane - centre).norm() <= options.grow_radius_m)
+      const auto residual = ModelResidual(fit.plane, cloud.points[i].cast<double>(), along_rays);
+      if (!residual || std::abs(residual->first) > gate_m) continue;
+      if ((residual->second - centre).norm() <= options.grow_radius_m)
         candidates.push_back(static_cast<int>(i));
     }
-    auto grown = RefineRangeMl(cloud, candidates, fit, options);
+    auto grown = along_rays ? RefineRangeMl(cloud, candidates, fit, options)
+                            : RefineLeastSquares(cloud, candidates, fit, options);
     if (!grown || grown->inliers.size() < fit.inliers.size()) break;
     fit = *grown;
     fit.grown = true;
-    const Vec3 next_centre = InlierCentre(cloud, fit);
+    const Vec3 next_centre = InlierCentre(cloud, fit, along_rays);
     const bool settled = (next_centre - centre).norm() < 0.005;
     centre = next_centre;
     if (settled) break;
@@ -323,7 +371,7 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
     if (next_band <= band * 1.05) break;
     band = next_band;
   }
-  if (options.fit_ranges_ml) {
+  if (AlongRays(options)) {
     // The unbiased estimate (see LidarPlaneOptions::fit_ranges_ml). The inlier band is re-drawn
     // around the maximum-likelihood plane in range units (|r − r̂| ≤ max(threshold, 3σ̂_r)): a
     // band around the biased least-squares plane would truncate the range noise on one side and
@@ -338,14 +386,68 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
   if (n < options.min_inlier_fraction * candidates.size())
     return fail("plane explains only " + std::to_string(n) + " of " +
                 std::to_string(candidates.size()) + " selected points");
-  if (options.grow_radius_m > 0 && options.fit_ranges_ml) fit = GrowToBoard(cloud, *fit, options);
-  // Edge points need the whole board's returns: the ends of a brushed patch are not its edges.
-  if (fit->grown && options.sheet_size_m.minCoeff() > 0) {
-    fit->edge_points = ExtractBoardEdgePoints(cloud, fit->inliers, fit->plane, options.edges);
+  const bool spinning = options.geometry == LidarGeometry::kSpinning;
+  if (options.grow_radius_m > 0 && (options.fit_ranges_ml || !spinning))
+    fit = GrowToBoard(cloud, *fit, options);
+  // Edge points need the whole board's returns (the ends of a brushed patch are not its edges)
+  // and rings whose ends they are.
+  if (!spinning) {
+    fit->no_edge_search =
+        "the LiDAR model is " + LidarGeometryName(options.geometry) + ": no rings to end on it";
+  } else if (fit->grown && options.sheet_size_m.minCoeff() > 0) {
+    fit->edge_points =
+        ExtractBoardEdgePoints(cloud, fit->inliers, fit->plane, options.edges, &fit->edge_ends);
     fit->sheet_size_m = options.sheet_size_m;
+  } else {
+    fit->no_edge_search = options.sheet_size_m.minCoeff() > 0
+                              ? "the plane's fit did not grow beyond its selected region"
+                              : "the target gives no sheet size";
   }
   fit->num_rings = DistinctRings(cloud, fit->inliers);
+  if (options.ring_bias_sigma_m > 0 && spinning)
+    fit->ring_bias_covariance =
+        RingBiasCovariance(cloud, fit->inliers, fit->plane, options.ring_bias_sigma_m);
   return fit;
+}
+
+Mat4 RingBiasCovariance(const LidarCloud& cloud, const std::vector<int>& indices,
+                        const Plane& plane, double ring_bias_sigma_m) {
+  if (indices.size() < 4) return Mat4::Zero();
+  // Ring of each return: the cloud's, else elevation clusters.
+  std::vector<int> ring(indices.size(), 0);
+  if (cloud.HasRing()) {
+    for (size_t k = 0; k < indices.size(); ++k) ring[k] = cloud.ring[indices[k]];
+  } else {
+    std::vector<std::pair<double, size_t>> elevations;
+    for (size_t k = 0; k < indices.size(); ++k) {
+      const Vec3 x = cloud.points[indices[k]].cast<double>();
+      elevations.push_back({std::atan2(x.z(), x.head<2>().norm()), k});
+    }
+    std::sort(elevations.begin(), elevations.end());
+    int group = 0;
+    for (size_t j = 0; j < elevations.size(); ++j) {
+      if (j > 0 && elevations[j].first - elevations[j - 1].first > 0.15 * kDegToRad) ++group;
+      ring[elevations[j].second] = group;
+    }
+  }
+  const Eigen::Matrix<double, 3, 2> basis = PlaneTangentBasis(plane.normal);
+  Mat3 normal_matrix = Mat3::Zero();
+  std::map<int, Vec3> per_ring;  // s_r
+  for (size_t k = 0; k < indices.size(); ++k) {
+    const Vec3 x = cloud.points[indices[k]].cast<double>();
+    const double r = x.norm();
+    if (!(r > 0)) continue;
+    const Vec3 a(basis.col(0).dot(x), basis.col(1).dot(x), 1.0);
+    normal_matrix += a * a.transpose();
+    auto [it, added] = per_ring.try_emplace(ring[k], Vec3::Zero());
+    it->second += a * plane.normal.dot(x / r);
+  }
+  Mat3 middle = Mat3::Zero();
+  for (const auto& [r, s] : per_ring) middle += s * s.transpose();
+  const Mat3 inverse = normal_matrix.inverse();
+  if (!inverse.allFinite()) return Mat4::Zero();
+  return TangentToPlaneCovariance(
+      ring_bias_sigma_m * ring_bias_sigma_m * inverse * middle * inverse, plane.normal);
 }
 
 }  // namespace calibench

@@ -9,6 +9,7 @@
 
 #include "core/geometry/geometry.h"
 #include "core/lidar/cloud.h"
+#include "core/lidar/lidar_geometry.h"
 #include "core/lidar/lidar_image.h"
 #include "core/target/board.h"
 #include "core/target/board_edges.h"
@@ -16,6 +17,12 @@
 namespace calibench {
 
 struct LidarPlaneOptions {
+  // The sensor's geometry decides the noise model (core/lidar/lidar_geometry.h): a spinning
+  // LiDAR's planes are fitted on the ranges along its rays (fit_ranges_ml), grown over the board
+  // by ray, with ring biases and board edges; a swept laser's or a segment's by total least
+  // squares (isotropic point-to-plane, the plane's own covariance), grown by distance to the
+  // plane, without ring biases or edges (they have no rings).
+  LidarGeometry geometry = LidarGeometry::kSpinning;
   double ransac_threshold_m = 0.03;  // inlier distance; ~3σ of typical spinning-LiDAR range noise
   int ransac_iterations = 500;       // enough for > 50% inliers with a 1e-9 failure chance
   int min_inliers = 20;              // fewer inliers = no plane (a board needs a few rings)
@@ -35,6 +42,12 @@ struct LidarPlaneOptions {
   // crossings of the sheet's edges (LidarPlaneFit::edge_points). 0 = unknown, no edge points.
   Vec2 sheet_size_m = Vec2::Zero();
   BoardEdgeOptions edges;
+  // A spinning LiDAR's lasers each keep a small range bias after their factory calibration
+  // (metres, 1σ per ring; a few mm on a VLP-16). Such biases are common to a ring's returns, so
+  // they do not average out over the points: a board seen by few rings (a strip) has a tilt about
+  // the rings' direction that is far less certain than its fit's residuals say
+  // (LidarPlaneFit::ring_bias_covariance). 0 = none.
+  double ring_bias_sigma_m = 0.005;
   bool Check(std::string* why) const;
 };
 
@@ -54,9 +67,16 @@ struct LidarPlaneFit {
   Vec4 range_offset_jacobian = Vec4::Zero();
   // Where the rings leave the board (LidarPlaneOptions::sheet_size_m), with that sheet size.
   std::vector<LidarEdgePoint> edge_points;
+  BoardEdgeEnds edge_ends;     // what the rings' ends said (why some gave no edge point)
+  std::string no_edge_search;  // why the edges were not looked for ("" when they were)
   Vec2 sheet_size_m = Vec2::Zero();
-  double rms_m = 0.0;  // point-to-plane RMS of the inliers
-  int num_rings = 0;   // distinct rings among the inliers (0 = the cloud has no rings)
+  // The covariance of (n, d) that per-ring range biases (LidarPlaneOptions::ring_bias_sigma_m)
+  // give the fit, on top of `covariance`: large for a strip's tilt across its few rings, small for
+  // a board that many rings cross. Rings are the cloud's own, else clusters of elevation.
+  Mat4 ring_bias_covariance = Mat4::Zero();
+  LidarGeometryVerdict lidar_model;  // the noise model it was fitted with, and why
+  double rms_m = 0.0;                // point-to-plane RMS of the inliers
+  int num_rings = 0;  // distinct rings among the inliers (0 = the cloud has no rings)
 };
 
 // Points on rays within the cone that a disc of `seed.radius` (metres) around `seed.point`
@@ -71,6 +91,13 @@ std::vector<int> SelectBrushRegion(const LidarImage& image, const std::vector<in
 std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
                                            const std::vector<int>& candidates,
                                            const LidarPlaneOptions& options, std::string* why);
+
+// The (n, d) covariance that a range bias common to each ring's returns (b_r ~ N(0, σ²) along the
+// rays, independent between rings) gives the least-squares plane through `indices`: the sandwich
+// σ² (AᵀA)⁻¹ (Σ_r s_r s_rᵀ) (AᵀA)⁻¹ over the point-to-plane rows a_i, s_r = Σ_{i∈r} a_i (n·u_i).
+// Rings: the cloud's own, else the returns' elevations split at gaps over 0.15°.
+Mat4 RingBiasCovariance(const LidarCloud& cloud, const std::vector<int>& indices,
+                        const Plane& plane, double ring_bias_sigma_m);
 
 // Least-squares (total least squares) plane through points with its (n, d) covariance, the
 // residual variance estimated from the fit. Needs >= 4 points not on a line.

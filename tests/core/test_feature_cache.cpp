@@ -32,7 +32,7 @@ TEST(FeatureCache, ReadsBackWhatItWroteAndDropsWhatNoLongerHolds) {
   failed.reason = "LiDAR board disagrees with the camera's";
   writer.Append(dataset.pairs[2], failed);
   // A line cut short by a kill.
-  std::ofstream(cache, std::ios::app) << R"({"format": "calibench.features.v1", "id": "00)";
+  std::ofstream(cache, std::ios::app) << R"({"format": "calibench.features.v2", "id": "00)";
 
   int skipped = -1;
   auto read = LoadFeatureCache(cache, &skipped);

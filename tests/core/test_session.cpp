@@ -94,6 +94,7 @@ Session FullSession(const fs::path& dataset) {
   r.covariance_inflation = 11.2;
   r.plane_variance_factor = 30.0 / 7;
   r.edge_variance_factor = 1.85;
+  r.termination = {TerminationTest::kIterationCap, 3.0 / 7 * 1e-5, 1e-6, 100};
   s.result = r;
   return s;
 }

@@ -91,7 +91,7 @@ TEST_P(SimulatedCalibration, RecoversTheGroundTruth) {
   // 5–26 mm and 0.15–0.55 deg at N = 10 over this matrix. Bounds: 25 mm and 0.6 deg.
   EXPECT_LT(error.translation_m, 0.025);
   EXPECT_LT(error.rotation_rad, 0.6 * M_PI / 180);
-  EXPECT_TRUE(outcome.solution->converged);
+  EXPECT_TRUE(outcome.solution->converged) << outcome.solution->termination.Describe();
   EXPECT_TRUE(outcome.solution->observability.well_constrained);
 
   // The same files without seeds: the board is detected in every cloud. A detected plane more

@@ -218,10 +218,10 @@ void Workbench::SolutionReadouts(const SolverResult& res, std::vector<Intent>* i
   StdReadout(TranslationStd(res.covariance, res.cam_from_lidar) * 1000.0,
              RotationStdDeg(res.covariance, res.cam_from_lidar));
   SolveExtras(res);
-  ObservabilityReadout(res.observability,
-                       std::to_string(res.iterations) + " iterations, " +
-                           (res.converged ? "converged" : "not converged"),
-                       "NOT well constrained: add pairs with other board tilts");
+  ObservabilityReadout(
+      res.observability,
+      std::to_string(res.iterations) + " iterations, " + res.termination.Describe(),
+      "NOT well constrained: add pairs with other board tilts");
   if (ExportRow(&export_))
     intents->push_back(ExportResult{export_.path, export_.format, export_.frames});
 }

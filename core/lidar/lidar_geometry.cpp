@@ -1,0 +1,180 @@
+#include "core/lidar/lidar_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <unordered_set>
+#include <vector>
+
+#include "core/base/names.h"
+
+namespace calibench {
+namespace {
+
+constexpr EnumName<LidarGeometry> kLidarGeometryNames[] = {{LidarGeometry::kSpinning, "spinning"},
+                                                           {LidarGeometry::kSwept, "swept"},
+                                                           {LidarGeometry::kSegment, "segment"}};
+
+// Elevation clusters of the returns: each one's width and the spacing of their centres, and how
+// far from the origin their rays start: a beam whose rays start a distance s off the origin
+// (perpendicular to it) shows its returns at elevation α + s/r, so the slope of elevation over
+// 1/r within a cluster measures s.
+struct ElevationClusters {
+  int count = 0;
+  double median_width_deg = 0.0;
+  double median_spacing_deg = 0.0;
+  double ray_offset_m = 0.0;  // |s|, 90th percentile over the clusters whose ranges differ enough
+  int offset_clusters = 0;    // those clusters
+};
+
+ElevationClusters ClusterElevations(const LidarCloud& cloud, double gap_deg) {
+  struct Return {
+    double elevation_rad;
+    double inverse_range;
+  };
+  std::vector<Return> returns;
+  returns.reserve(cloud.size());
+  for (const Eigen::Vector3f& p : cloud.points) {
+    if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
+    const double horizontal = std::hypot(double(p.x()), double(p.y()));
+    returns.push_back({std::atan2(double(p.z()), horizontal), 1.0 / p.cast<double>().norm()});
+  }
+  ElevationClusters clusters;
+  if (returns.empty()) return clusters;
+  std::sort(returns.begin(), returns.end(),
+            [](const Return& a, const Return& b) { return a.elevation_rad < b.elevation_rad; });
+  const double gap_rad = gap_deg * kDegToRad;
+  std::vector<double> widths, centres, offsets;
+  size_t first = 0;
+  for (size_t i = 1; i <= returns.size(); ++i) {
+    if (i < returns.size() && returns[i].elevation_rad - returns[i - 1].elevation_rad <= gap_rad)
+      continue;
+    const double low = returns[first].elevation_rad, high = returns[i - 1].elevation_rad;
+    widths.push_back((high - low) * kRadToDeg);
+    centres.push_back(0.5 * (high + low) * kRadToDeg);
+    // How far the cluster's elevation spreads per unit of 1/r it spans: at most |s| for one
+    // beam, 0 for rays from the origin (however far its ranges differ). Clusters whose ranges
+    // span little of 1/r (0.02 /m: 5 m against 8 m) say nothing.
+    double min_u = 1e9, max_u = 0;
+    for (size_t k = first; k < i; ++k) {
+      min_u = std::min(min_u, returns[k].inverse_range);
+      max_u = std::max(max_u, returns[k].inverse_range);
+    }
+    if (i - first >= 20 && max_u - min_u > 0.02) offsets.push_back((high - low) / (max_u - min_u));
+    first = i;
+  }
+  auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  std::vector<double> spacings;
+  for (size_t i = 1; i < centres.size(); ++i) spacings.push_back(centres[i] - centres[i - 1]);
+  clusters.count = static_cast<int>(centres.size());
+  clusters.median_width_deg = median(widths);
+  clusters.median_spacing_deg = median(spacings);
+  // The 90th percentile: a mirror off the axis shows in the beams it offsets most (an offset
+  // forwards and one upwards cancel for some beams), a central sensor in none.
+  if (!offsets.empty()) {
+    const size_t k = offsets.size() * 9 / 10;
+    std::nth_element(offsets.begin(), offsets.begin() + k, offsets.end());
+    clusters.ray_offset_m = offsets[k];
+  }
+  clusters.offset_clusters = static_cast<int>(offsets.size());
+  return clusters;
+}
+
+}  // namespace
+
+std::string LidarGeometryName(LidarGeometry geometry) {
+  return NameIn(kLidarGeometryNames, geometry);
+}
+
+std::optional<LidarGeometry> ParseLidarGeometry(const std::string& name) {
+  return ValueIn(kLidarGeometryNames, name);
+}
+
+std::string LidarGeometryNames() { return NamesIn(kLidarGeometryNames); }
+
+bool LidarGeometryOptions::Check(std::string* why) const {
+  auto fail = [&](const char* message) {
+    if (why) *why = message;
+    return false;
+  };
+  if (!(min_scan_azimuth_deg > 0 && min_scan_azimuth_deg <= 360))
+    return fail("min_scan_azimuth_deg must be in (0, 360] degrees");
+  if (!(ring_gap_deg > 0)) return fail("ring_gap_deg must be > 0 (degrees)");
+  if (!(max_ring_width_fraction > 0 && max_ring_width_fraction < 1))
+    return fail("max_ring_width_fraction must be in (0, 1)");
+  if (min_rings < 2) return fail("min_rings must be >= 2");
+  if (!(max_ray_offset_m > 0)) return fail("max_ray_offset_m must be > 0 (metres)");
+  return true;
+}
+
+double AzimuthCoverageDeg(const LidarCloud& cloud) {
+  constexpr double kCellDeg = 0.5;
+  std::unordered_set<int> cells;
+  for (const Eigen::Vector3f& p : cloud.points) {
+    if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
+    cells.insert(static_cast<int>(
+        std::floor((std::atan2(double(p.y()), double(p.x())) * kRadToDeg + 180.0) / kCellDeg)));
+  }
+  return std::min(360.0, static_cast<double>(cells.size()) * kCellDeg);
+}
+
+LidarGeometryVerdict ClassifyLidarGeometry(const LidarCloud& cloud,
+                                           const LidarGeometryOptions& options) {
+  LidarGeometryVerdict verdict;
+  char text[256];
+  if (cloud.HasRing()) {
+    verdict.geometry = LidarGeometry::kSpinning;
+    verdict.why = "the cloud carries rings: rays from one centre";
+    return verdict;
+  }
+  const double coverage = AzimuthCoverageDeg(cloud);
+  if (coverage < options.min_scan_azimuth_deg) {
+    std::snprintf(text, sizeof(text),
+                  "no rings, and the returns cover only %.0f deg of azimuth: a segment (the board "
+                  "cropped out of a scan), too little to tell how its rays run",
+                  coverage);
+    verdict.geometry = LidarGeometry::kSegment;
+    verdict.why = text;
+    return verdict;
+  }
+  const ElevationClusters clusters = ClusterElevations(cloud, options.ring_gap_deg);
+  const bool cones =
+      clusters.count >= options.min_rings &&
+      clusters.median_width_deg < options.max_ring_width_fraction * clusters.median_spacing_deg;
+  if (cones && clusters.ray_offset_m > options.max_ray_offset_m) {
+    std::snprintf(text, sizeof(text),
+                  "no rings; the returns lie on %d bands of elevation, but each band's elevation "
+                  "moves with the range as from rays that start up to %.1f cm off the origin (90th "
+                  "percentile over %d bands): a swept pattern whose rays do not meet at the "
+                  "origin",
+                  clusters.count, clusters.ray_offset_m * 100, clusters.offset_clusters);
+    verdict.geometry = LidarGeometry::kSwept;
+    verdict.why = text;
+    return verdict;
+  }
+  if (cones) {
+    std::snprintf(text, sizeof(text),
+                  "no ring field, but the returns lie on %d cones of elevation (%.2f deg wide, "
+                  "%.2f deg apart, median; rays within %.1f cm of the origin): rays from one "
+                  "centre",
+                  clusters.count, clusters.median_width_deg, clusters.median_spacing_deg,
+                  clusters.ray_offset_m * 100);
+    verdict.geometry = LidarGeometry::kSpinning;
+    verdict.why = text;
+    return verdict;
+  }
+  std::snprintf(text, sizeof(text),
+                "no rings, and the returns' elevations do not form cones about one centre "
+                "(%d clusters, %.2f deg wide, median, %.0f deg of azimuth): a swept pattern whose "
+                "rays do not meet at the origin",
+                clusters.count, clusters.median_width_deg, coverage);
+  verdict.geometry = LidarGeometry::kSwept;
+  verdict.why = text;
+  return verdict;
+}
+
+}  // namespace calibench

@@ -1,0 +1,54 @@
+// What kind of range sensor a cloud comes from, judged from the cloud alone, and so which noise
+// model its planes get: a spinning LiDAR's returns lie on cones about one centre (its rings), so
+// their noise lies along rays from the origin; a swept single-line laser's rays start on a mirror
+// that moves with the stage, and a board-only segment holds too little to tell. Those two get an
+// isotropic point-to-plane model (the plane's own covariance), and no board edges (no rings).
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "core/lidar/cloud.h"
+
+namespace calibench {
+
+enum class LidarGeometry { kSpinning, kSwept, kSegment };
+std::string LidarGeometryName(LidarGeometry geometry);  // "spinning", "swept", "segment"
+std::optional<LidarGeometry> ParseLidarGeometry(const std::string& name);
+std::string LidarGeometryNames();  // "spinning, swept, segment", for messages
+
+struct LidarGeometryOptions {
+  // Clouds whose returns cover less azimuth than this are segments (a board cropped out of a
+  // spinning LiDAR's 360° or a scanner's 100°+ field).
+  double min_scan_azimuth_deg = 60.0;
+  // Rings from elevations: sorted returns split where consecutive elevations differ by more than
+  // this; the clusters are cones about one centre when each is narrower than
+  // max_ring_width_fraction of the median spacing between them (a spinning LiDAR without a ring
+  // field). A mirror off the axis smears each beam's elevation with the range: no cones.
+  double ring_gap_deg = 0.15;
+  double max_ring_width_fraction = 0.25;
+  int min_rings = 4;
+  // Cones whose elevation moves with the range as from rays starting more than this far off the
+  // origin (metres, 90th percentile over the cones) are a swept scanner's (its mirror off the
+  // stage's axis), not a spinning LiDAR's. The statistic reads low (a band's extent over its
+  // span of 1/r, where bands mix ranges and short spans): on the simulator central sensors read
+  // 0.0 cm and a scanner whose mirror sits 10 cm in front of and 5 cm above the stage's axis
+  // reads 1.5 cm. A real spinning LiDAR without a ring field whose lasers sit off its centre may
+  // read above this: the summary says which model was chosen, --lidar-model overrides.
+  double max_ray_offset_m = 0.01;
+  bool Check(std::string* why) const;
+};
+
+struct LidarGeometryVerdict {
+  LidarGeometry geometry = LidarGeometry::kSpinning;
+  std::string why;      // what in the cloud decided it, in words
+  bool forced = false;  // chosen by the user (--lidar-model), not from the cloud
+};
+
+LidarGeometryVerdict ClassifyLidarGeometry(const LidarCloud& cloud,
+                                           const LidarGeometryOptions& options = {});
+
+// The azimuth the cloud's returns cover (degrees, 0.5° cells occupied), up to 360.
+double AzimuthCoverageDeg(const LidarCloud& cloud);
+
+}  // namespace calibench
