@@ -169,8 +169,8 @@ std::string NoEdgeCause(const PairFeatures& pair, bool down_weighted) {
   if (ends.ends == 0) return "no ring holds two board returns";
   if (ends.no_return == ends.ends) return "no return beyond the sheet at any ring end";
   if (ends.edge_points > 0) return "its edge points fell outside the model";
-  return "at the ring ends the returns beyond lie in front of or on the board's plane "
-         "(occluders, or a background flush with the board)";
+  return "at the ring ends the next return lies in front of or on the board's plane, not behind "
+         "it";
 }
 
 }  // namespace
