@@ -22,7 +22,25 @@ bool HasRingStructure(const LidarCloud& cloud) {
   if (cloud.HasRing() || cloud.IsOrganized()) return true;
   const std::vector<int> rings = InferRings(cloud, LidarImageOptions{});
   std::unordered_set<int> distinct(rings.begin(), rings.end());
-  return distinct.size() >= 8 && distinct.size() <= 256 && cloud.size() / distinct.size() >= 200;
+  if (distinct.size() >= 8 && distinct.size() <= 256 && cloud.size() / distinct.size() >= 200)
+    return true;  // a scan
+  // A segment cut out of a spinning LiDAR's scan (a board-only cloud): a few rings of many
+  // returns each, well apart in elevation (a swept scanner's beams lie a fraction of that apart).
+  if (distinct.size() < 3 || cloud.size() / distinct.size() < 20) return false;
+  std::vector<double> sum(*std::max_element(rings.begin(), rings.end()) + 1, 0.0);
+  std::vector<int> count(sum.size(), 0);
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    sum[rings[i]] += Elevation(cloud.points[i]);
+    ++count[rings[i]];
+  }
+  std::vector<double> elevations;
+  for (size_t r = 0; r < sum.size(); ++r)
+    if (count[r] > 0) elevations.push_back(sum[r] / count[r]);
+  std::sort(elevations.begin(), elevations.end());
+  std::vector<double> steps;
+  for (size_t k = 1; k < elevations.size(); ++k) steps.push_back(elevations[k] - elevations[k - 1]);
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  return steps[steps.size() / 2] >= 0.3 * kDegToRad;
 }
 
 AngularGrid FromRings(const LidarCloud& cloud) {
