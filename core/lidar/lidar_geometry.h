@@ -17,10 +17,12 @@ std::string LidarGeometryName(LidarGeometry geometry);  // "spinning", "swept", 
 std::optional<LidarGeometry> ParseLidarGeometry(const std::string& name);
 std::string LidarGeometryNames();  // "spinning, swept, segment", for messages
 
+// Clouds whose returns cover less azimuth than this are segments, not scans: a board cropped out
+// of a spinning LiDAR's 360° or a scanner's 100°+ field.
+inline constexpr double kSegmentSpanDeg = 60.0;
+
 struct LidarGeometryOptions {
-  // Clouds whose returns cover less azimuth than this are segments (a board cropped out of a
-  // spinning LiDAR's 360° or a scanner's 100°+ field).
-  double min_scan_azimuth_deg = 60.0;
+  double min_scan_azimuth_deg = kSegmentSpanDeg;  // below it a ring-less cloud is a segment
   // Rings from elevations: sorted returns split where consecutive elevations differ by more than
   // this; the clusters are cones about one centre when each is narrower than
   // max_ring_width_fraction of the median spacing between them (a spinning LiDAR without a ring

@@ -199,7 +199,12 @@ ResidualCounts CountResiduals(const CalibrationOutcome& outcome) {
   ResidualCounts counts;
   counts.edges_in_model = s.edges_in_model;
   // Per cause, the pairs without edges and their ring ends.
-  std::vector<std::pair<std::string, std::pair<std::string, int>>> causes;
+  struct Cause {
+    std::string words;
+    std::vector<std::string> pairs;
+    int ring_ends = 0;
+  };
+  std::vector<Cause> causes;
   size_t solved_index = 0;
   for (const PairFeatures& p : outcome.pairs) {
     if (p.status != PairStatus::kAccepted || solved_index >= s.residuals.size()) continue;
@@ -210,12 +215,12 @@ ResidualCounts CountResiduals(const CalibrationOutcome& outcome) {
     counts.edge_pairs += edges > 0;
     if (edges > 0 || !s.edges_in_model || !p.lidar) continue;
     const std::string cause = NoEdgeCause(p, s.DownWeighted(index));
-    auto it =
-        std::find_if(causes.begin(), causes.end(), [&](const auto& c) { return c.first == cause; });
-    if (it == causes.end()) it = causes.insert(causes.end(), {cause, {"", 0}});
-    it->second.first += (it->second.first.empty() ? "" : ", ") + p.id;
+    auto it = std::find_if(causes.begin(), causes.end(),
+                           [&](const Cause& c) { return c.words == cause; });
+    if (it == causes.end()) it = causes.insert(causes.end(), Cause{cause, {}, 0});
+    it->pairs.push_back(p.id);
     if (!s.DownWeighted(index) && p.lidar->no_edge_search.empty())
-      it->second.second += p.lidar->edge_ends.ends;
+      it->ring_ends += p.lidar->edge_ends.ends;
   }
   if (!s.edges_in_model) {
     counts.note = "the method (" + SolverMethodName(s.method) +
@@ -224,9 +229,14 @@ ResidualCounts CountResiduals(const CalibrationOutcome& outcome) {
   }
   if (causes.empty()) return counts;
   std::string groups;
-  for (const auto& [cause, pairs] : causes) {
-    groups += (groups.empty() ? "" : "; ") + pairs.first + ": " + cause;
-    if (pairs.second > 0) groups += " (" + std::to_string(pairs.second) + " ring ends)";
+  for (const Cause& cause : causes) {
+    // The first few pairs by name, the rest counted: a line, not a list of forty.
+    std::string names;
+    for (size_t k = 0; k < cause.pairs.size() && k < 6; ++k)
+      names += (k ? ", " : "") + cause.pairs[k];
+    if (cause.pairs.size() > 6) names += " and " + std::to_string(cause.pairs.size() - 6) + " more";
+    groups += (groups.empty() ? "" : "; ") + names + ": " + cause.words;
+    if (cause.ring_ends > 0) groups += " (" + std::to_string(cause.ring_ends) + " ring ends)";
   }
   if (counts.edge_pairs == 0)
     counts.note = "board edges unused, no pair gave an edge point (" + groups +

@@ -36,6 +36,7 @@ bool SessionResult::operator==(const SessionResult& other) const {
          covariance_inflation == other.covariance_inflation &&
          plane_variance_factor == other.plane_variance_factor &&
          edge_variance_factor == other.edge_variance_factor && termination == other.termination &&
+         notes == other.notes &&
          std::equal(estimate_history.begin(), estimate_history.end(),
                     other.estimate_history.begin(), other.estimate_history.end(),
                     [](const Pose& a, const Pose& b) { return a.matrix() == b.matrix(); });

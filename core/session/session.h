@@ -96,6 +96,9 @@ struct SessionResult {
   double plane_variance_factor = 1.0;
   double edge_variance_factor = 1.0;
   Termination termination;  // which test ended the solve (optional in the file)
+  // The summary's words on the solve's inputs (the LiDAR model, the residuals available), as the
+  // workbench showed them (optional in the file).
+  std::vector<std::string> notes;
 
   // Exact value comparison (no tolerance), so a file round trip can be checked with ==.
   bool operator==(const SessionResult& other) const;

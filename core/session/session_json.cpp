@@ -128,6 +128,7 @@ Json ResultToJson(const SessionResult& r) {
     json["unmodelled_lidar_range_offset"] = RangeOffsetToJson(*r.unmodelled_range_offset);
   if (r.termination.test != TerminationTest::kNone)
     json["termination"] = TerminationToJson(r.termination);
+  if (!r.notes.empty()) json["notes"] = r.notes;
   if (r.edge_dilation)
     json["board_edge_dilation"] = {{"value_m", r.edge_dilation->value_m},
                                    {"sigma_m", r.edge_dilation->sigma_m},
@@ -288,6 +289,11 @@ void ReadResultExtras(const Fields& f, SessionResult* r) {
     r->range_offset = ReadRangeOffset(f.Object("lidar_range_offset"));
   if (f.Has("unmodelled_lidar_range_offset"))
     r->unmodelled_range_offset = ReadRangeOffset(f.Object("unmodelled_lidar_range_offset"));
+  if (f.Has("notes"))  // written since the workbench shows the summary's notes
+    for (const json& note : f.Array("notes")) {
+      if (!note.is_string()) f.Fail("notes", "must hold strings");
+      r->notes.push_back(note.get<std::string>());
+    }
   if (f.Has("termination")) {  // written since the solver says which test ended it
     const Fields t = f.Object("termination");
     const std::string name = t.String("test");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/lidar/cloud.h"
+#include "core/lidar/lidar_geometry.h"  // kSegmentSpanDeg
 
 namespace calibench {
 
@@ -38,9 +39,5 @@ class SceneBackground {
   std::unordered_map<std::int64_t, float> median_;
   std::vector<double> azimuth_span_deg_;  // per cloud: the azimuth its returns cover
 };
-
-// Clouds whose returns cover less azimuth than this (median) are segments, not scans: a board
-// cropped out of a spinning LiDAR's 360° or a scanner's 100°+ field.
-inline constexpr double kSegmentSpanDeg = 60.0;
 
 }  // namespace calibench

@@ -113,6 +113,8 @@ void Controller::Solve() {
   state_.solver.solved_pair_ids.clear();
   for (const PairFeatures& p : outcome.pairs)
     if (p.status == PairStatus::kAccepted) state_.solver.solved_pair_ids.push_back(p.id);
+  for (const std::string& note : {DescribeLidarModel(outcome), CountResiduals(outcome).note})
+    if (!note.empty()) state_.solver.notes.push_back(note);
   RecomputeResiduals();
   SetStatus("solved with " + std::to_string(state_.solver.solved_pair_ids.size()) + " pairs in " +
                 std::to_string(result.iterations) + " iterations" +

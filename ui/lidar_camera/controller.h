@@ -57,6 +57,9 @@ struct SolverView {
   std::vector<IterationReport> iterations;  // recorded by the solver's callback
   std::optional<SolverResult> result;
   std::vector<std::string> solved_pair_ids;  // the pairs behind result->residuals, in order
+  // The CLI summary's words on the solve's inputs: the LiDAR model and why, which residuals the
+  // pairs gave (DescribeLidarModel, CountResiduals); a reopened session's from its file.
+  std::vector<std::string> notes;
   std::string failure;
 };
 

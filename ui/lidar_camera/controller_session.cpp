@@ -210,6 +210,7 @@ void Controller::ApplySessionToState(const Session& session) {
   state_.solver = SolverView{};
   if (session.result) {
     state_.solver.result = SolverResultFromSession(*session.result, session.method);
+    state_.solver.notes = session.result->notes;
     // The recorded convergence, so that the solver panel and the replay look as they did.
     const auto& costs = session.result->cost_history;
     const auto& steps = session.result->step_history;
@@ -254,6 +255,7 @@ void Controller::CommitEdit() {
   session_.result.reset();
   if (state_.solver.result) {
     session_.result = SessionResultFromSolver(*state_.solver.result);
+    session_.result->notes = state_.solver.notes;
     for (const IterationReport& it : state_.solver.iterations) {
       session_.result->step_history.push_back(it.step_norm);
       session_.result->estimate_history.push_back(it.cam_from_lidar);

@@ -65,7 +65,7 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   void MeasurementsPanel(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) override;
   void PairRow(const Snapshot& s, int index, std::vector<Intent>* intents);
   void SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) override;
-  void SolutionReadouts(const SolverResult& result, std::vector<Intent>* intents);
+  void SolutionReadouts(const SolverView& solver, std::vector<Intent>* intents);
   // workbench.cpp
   void View(int index, const Snapshot& s, const Rect& r, std::vector<Intent>* intents) override;
   std::string Opened(const Snapshot& s) const override;

@@ -198,13 +198,14 @@ void Workbench::SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent
   }
   if (!s.solver.failure.empty())
     ImGui::TextColored({1.0f, 0.4f, 0.35f, 1}, "%s", s.solver.failure.c_str());
-  if (s.solver.result) SolutionReadouts(*s.solver.result, intents);
+  if (s.solver.result) SolutionReadouts(s.solver, intents);
   if (PathField("##session", &session_path_, "Save session as"))
     intents->push_back(SaveSessionAs{session_path_});
   ImGui::End();
 }
 
-void Workbench::SolutionReadouts(const SolverResult& res, std::vector<Intent>* intents) {
+void Workbench::SolutionReadouts(const SolverView& solver, std::vector<Intent>* intents) {
+  const SolverResult& res = *solver.result;
   // First, so that it is seen without scrolling: the estimate below leaves it out.
   if (res.unmodelled_range_offset)
     ImGui::TextColored({1.0f, 0.75f, 0.3f, 1},
@@ -218,6 +219,9 @@ void Workbench::SolutionReadouts(const SolverResult& res, std::vector<Intent>* i
   StdReadout(TranslationStd(res.covariance, res.cam_from_lidar) * 1000.0,
              RotationStdDeg(res.covariance, res.cam_from_lidar));
   SolveExtras(res);
+  ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.7f, 0.75f, 0.8f, 1));
+  for (const std::string& note : solver.notes) ImGui::TextWrapped("%s", note.c_str());
+  ImGui::PopStyleColor();
   ObservabilityReadout(
       res.observability,
       std::to_string(res.iterations) + " iterations, " + res.termination.Describe(),
