@@ -91,7 +91,8 @@ CameraVerdict JudgeCameraSide(const ImageU8& image, std::size_t others,
     if (!other) continue;
     verdict.stillness_checked = true;
     if (!StillIn(image, *detection, *other, camera, pose, options)) {
-      verdict.dropped = "board moving (within " + MillisecondsText(options.still_window_s / 2) + ")";
+      verdict.dropped =
+          "board moving (within " + MillisecondsText(options.still_window_s / 2) + ")";
       return verdict;
     }
   }

@@ -54,6 +54,70 @@ json ResidualsAvailable(const CalibrationOutcome& outcome) {
           {"note", counts.note}};
 }
 
+// One entry per pair: status, where its board came from, both planes' figures and, when solved
+// with, its residual, weight and edge points.
+json PairsJson(const CalibrationOutcome& outcome) {
+  const SolverResult& s = *outcome.solution;
+  json pairs = json::array();
+  size_t solved_index = 0;
+  for (const PairFeatures& p : outcome.pairs) {
+    json entry = PairEntryJson(p.id, p.status, p.reason);
+    if (p.board_origin.source != BoardSource::kNone) {
+      entry["lidar_board"] = {{"source", BoardSourceName(p.board_origin.source)},
+                              {"confidence", p.board_origin.confidence}};
+      if (!p.board_origin.detail.empty()) entry["lidar_board"]["found"] = p.board_origin.detail;
+    }
+    if (p.lidar) {
+      entry["lidar_plane"] = Vec4ToJson(p.lidar->plane.Coefficients());
+      entry["lidar_inliers"] = p.lidar->inliers.size();
+      entry["lidar_rms_m"] = p.lidar->rms_m;
+      entry["lidar_model"] = LidarGeometryName(p.lidar->lidar_model.geometry);
+      // What the rings' ends showed of the sheet's edges (why a pair gave no edge points).
+      const BoardEdgeEnds& ends = p.lidar->edge_ends;
+      if (p.lidar->no_edge_search.empty())
+        entry["lidar_ring_ends"] = {{"ends", ends.ends},
+                                    {"edge_points", ends.edge_points},
+                                    {"no_return_beyond_sheet", ends.no_return},
+                                    {"return_not_behind_sheet", ends.not_behind}};
+      else
+        entry["lidar_ring_ends"] = {{"not_searched", p.lidar->no_edge_search}};
+    }
+    if (p.camera) {
+      entry["camera_plane"] = Vec4ToJson(p.camera->plane.Coefficients());
+      entry["camera_corners"] = p.camera->num_corners;
+      entry["reprojection_rms_px"] = p.camera->reprojection_rms_px;
+    }
+    if (p.status == PairStatus::kAccepted && solved_index < s.residuals.size()) {
+      entry["residual"] = Vec4ToJson(s.residuals[solved_index]);
+      entry["robust_weight"] = s.robust_weights[solved_index];
+      // Accepted, yet weighted as if left out: said, not left to be read off a number.
+      entry["down_weighted"] = s.DownWeighted(solved_index);
+      if (solved_index < s.pair_edge_points.size())
+        entry["board_edge_points"] = s.pair_edge_points[solved_index];
+      ++solved_index;
+    }
+    pairs.push_back(entry);
+  }
+  return pairs;
+}
+
+// The model most pairs' planes were fitted with, why, and every model's count; null without fits.
+json LidarModelJson(const CalibrationOutcome& outcome) {
+  const std::vector<ModelGroup> groups = GroupByLidarModel(outcome);
+  if (groups.empty()) return nullptr;
+  // The model most pairs were fitted with leads; every model's count follows.
+  const ModelGroup& main = *std::max_element(
+      groups.begin(), groups.end(),
+      [](const ModelGroup& a, const ModelGroup& b) { return a.pairs.size() < b.pairs.size(); });
+  json counts = json::object();
+  for (const ModelGroup& g : groups) counts[LidarGeometryName(g.geometry)] = g.pairs.size();
+  return {{"geometry", LidarGeometryName(main.geometry)},
+          {"why", main.why},
+          {"forced", main.forced},
+          {"meaning", ModelMeaning(main.geometry)},
+          {"pairs", counts}};
+}
+
 json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& options,
                   const ResultNames& names) {
   CALIBENCH_CHECK(outcome.solution.has_value());
@@ -98,62 +162,9 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
         "not estimated, yet significant in the data (score test at the solution); the pose does "
         "not include it: estimate it (--estimate-range-offset) or correct the clouds";
   }
-  json pairs = json::array();
-  size_t solved_index = 0;
-  for (const PairFeatures& p : outcome.pairs) {
-    json entry = PairEntryJson(p.id, p.status, p.reason);
-    if (p.board_origin.source != BoardSource::kNone) {
-      entry["lidar_board"] = {{"source", BoardSourceName(p.board_origin.source)},
-                              {"confidence", p.board_origin.confidence}};
-      if (!p.board_origin.detail.empty()) entry["lidar_board"]["found"] = p.board_origin.detail;
-    }
-    if (p.lidar) {
-      entry["lidar_plane"] = Vec4ToJson(p.lidar->plane.Coefficients());
-      entry["lidar_inliers"] = p.lidar->inliers.size();
-      entry["lidar_rms_m"] = p.lidar->rms_m;
-      entry["lidar_model"] = LidarGeometryName(p.lidar->lidar_model.geometry);
-      // What the rings' ends showed of the sheet's edges (why a pair gave no edge points).
-      const BoardEdgeEnds& ends = p.lidar->edge_ends;
-      if (p.lidar->no_edge_search.empty())
-        entry["lidar_ring_ends"] = {{"ends", ends.ends},
-                                    {"edge_points", ends.edge_points},
-                                    {"no_return_beyond_sheet", ends.no_return},
-                                    {"return_not_behind_sheet", ends.not_behind}};
-      else
-        entry["lidar_ring_ends"] = {{"not_searched", p.lidar->no_edge_search}};
-    }
-    if (p.camera) {
-      entry["camera_plane"] = Vec4ToJson(p.camera->plane.Coefficients());
-      entry["camera_corners"] = p.camera->num_corners;
-      entry["reprojection_rms_px"] = p.camera->reprojection_rms_px;
-    }
-    if (p.status == PairStatus::kAccepted && solved_index < s.residuals.size()) {
-      entry["residual"] = Vec4ToJson(s.residuals[solved_index]);
-      entry["robust_weight"] = s.robust_weights[solved_index];
-      // Accepted, yet weighted as if left out: said, not left to be read off a number.
-      entry["down_weighted"] = s.DownWeighted(solved_index);
-      if (solved_index < s.pair_edge_points.size())
-        entry["board_edge_points"] = s.pair_edge_points[solved_index];
-      ++solved_index;
-    }
-    pairs.push_back(entry);
-  }
-  root["pairs"] = pairs;
+  root["pairs"] = PairsJson(outcome);
   root["solver"]["residuals_available"] = ResidualsAvailable(outcome);
-  const std::vector<ModelGroup> groups = GroupByLidarModel(outcome);
-  if (!groups.empty()) {
-    // The model most pairs were fitted with leads; every model's count follows.
-    const ModelGroup& main = *std::max_element(
-        groups.begin(), groups.end(),
-        [](const ModelGroup& a, const ModelGroup& b) { return a.pairs.size() < b.pairs.size(); });
-    json counts = json::object();
-    for (const ModelGroup& g : groups) counts[LidarGeometryName(g.geometry)] = g.pairs.size();
-    root["lidar_model"] = {{"geometry", LidarGeometryName(main.geometry)},
-                           {"why", main.why},
-                           {"forced", main.forced},
-                           {"meaning", ModelMeaning(main.geometry)},
-                           {"pairs", counts}};
-  }
+  if (const json model = LidarModelJson(outcome); !model.is_null()) root["lidar_model"] = model;
   return root;
 }
 

@@ -263,60 +263,14 @@ bool PlaneAlignmentSolver::Step() {
   damped.diagonal().array() += 1e-12 * std::max(1.0, damped.diagonal().maxCoeff());
   const Vec7 full_step = -damped.ldlt().solve(gradient);
   Vec7 delta = full_step;
-  auto cost_at = [&](const Vec7& step) {
-    return Linearize(cam_from_lidar_ * ExpSE3(step.head<6>()), range_offset_m_ + step[kRangeOffset])
-        .cost;
-  };
-  double cost = cost_at(delta);
+  double cost = CostAt(delta);
   // Backtracking keeps Gauss-Newton monotone far from the solution (robust weights change).
   for (int halvings = 0; cost > lin.cost && halvings < 10; ++halvings) {
     delta *= 0.5;
-    cost = cost_at(delta);
+    cost = CostAt(delta);
   }
+  if (cost > lin.cost) return StepOutOfStall(lin, damped, gradient.dot(full_step));
   const double scale = std::max(lin.cost, std::numeric_limits<double>::min());
-  if (cost > lin.cost) {
-    // Stalled: along the Gauss-Newton direction the cost only rises. Where the step's own
-    // prediction of the decrease (½ gᵀH⁻¹g) is within the function tolerance, the cost is at its
-    // numerical floor. Otherwise the robust weights or an edge point's nearest edge switch close
-    // by, and the linearization points where the cost does not fall: moves of 0.01σ and 0.1σ
-    // along each parameter are tried, the best taken if it lowers the cost; if none does, this is
-    // a minimum at the scale of the pose's uncertainty.
-    const double predicted = -0.5 * gradient.dot(full_step) / scale;
-    if (predicted <= options_.function_tolerance) {
-      history_.push_back(
-          {static_cast<int>(history_.size()), lin.cost, 0.0, cam_from_lidar_, range_offset_m_});
-      FinishRound({TerminationTest::kFunctionTolerance, predicted, options_.function_tolerance});
-      return !done_;
-    }
-    const int redundancy =
-        lin.num_residuals - lin.num_edge_dilations - static_cast<int>(ActiveParameters().size());
-    const double variance_factor = std::max(2.0 * lin.cost / std::max(1, redundancy), 1e-300);
-    const Mat7 covariance = variance_factor * damped.ldlt().solve(Mat7::Identity());
-    Vec7 best_move = Vec7::Zero();
-    double best_cost = lin.cost;
-    for (int k : ActiveParameters())
-      for (double fraction : {0.01, 0.1, -0.01, -0.1}) {
-        Vec7 move = Vec7::Zero();
-        move[k] = fraction * std::sqrt(std::max(covariance(k, k), 0.0));
-        const double moved = cost_at(move);
-        if (moved < best_cost) {
-          best_cost = moved;
-          best_move = move;
-        }
-      }
-    if (best_cost < lin.cost) {
-      cam_from_lidar_ = cam_from_lidar_ * ExpSE3(best_move.head<6>());
-      range_offset_m_ += best_move[kRangeOffset];
-    }
-    history_.push_back({static_cast<int>(history_.size()), best_cost, best_move.norm(),
-                        cam_from_lidar_, range_offset_m_});
-    if (best_cost >= lin.cost)
-      FinishRound({TerminationTest::kLocalMinimum, predicted, options_.function_tolerance});
-    else if (static_cast<int>(history_.size()) > iteration_budget_)
-      FinishRound({TerminationTest::kIterationCap, (lin.cost - best_cost) / scale,
-                   options_.function_tolerance, options_.max_iterations});
-    return !done_;
-  }
   Vec7 x;
   x << LogSE3(cam_from_lidar_), range_offset_m_;
   cam_from_lidar_ = cam_from_lidar_ * ExpSE3(delta.head<6>());
@@ -334,6 +288,57 @@ bool PlaneAlignmentSolver::Step() {
   else if (static_cast<int>(history_.size()) > iteration_budget_)
     FinishRound({TerminationTest::kIterationCap, relative_change, options_.function_tolerance,
                  options_.max_iterations});
+  return !done_;
+}
+
+double PlaneAlignmentSolver::CostAt(const Vec7& step) const {
+  return Linearize(cam_from_lidar_ * ExpSE3(step.head<6>()), range_offset_m_ + step[kRangeOffset])
+      .cost;
+}
+
+bool PlaneAlignmentSolver::StepOutOfStall(const Linearization& lin, const Mat7& damped,
+                                          double gradient_dot_step) {
+  const double scale = std::max(lin.cost, std::numeric_limits<double>::min());
+  // Stalled: along the Gauss-Newton direction the cost only rises. Where the step's own
+  // prediction of the decrease (½ gᵀH⁻¹g) is within the function tolerance, the cost is at its
+  // numerical floor. Otherwise the robust weights or an edge point's nearest edge switch close
+  // by, and the linearization points where the cost does not fall: moves of 0.01σ and 0.1σ
+  // along each parameter are tried, the best taken if it lowers the cost; if none does, this is
+  // a minimum at the scale of the pose's uncertainty.
+  const double predicted = -0.5 * gradient_dot_step / scale;
+  if (predicted <= options_.function_tolerance) {
+    history_.push_back(
+        {static_cast<int>(history_.size()), lin.cost, 0.0, cam_from_lidar_, range_offset_m_});
+    FinishRound({TerminationTest::kFunctionTolerance, predicted, options_.function_tolerance});
+    return !done_;
+  }
+  const int redundancy =
+      lin.num_residuals - lin.num_edge_dilations - static_cast<int>(ActiveParameters().size());
+  const double variance_factor = std::max(2.0 * lin.cost / std::max(1, redundancy), 1e-300);
+  const Mat7 covariance = variance_factor * damped.ldlt().solve(Mat7::Identity());
+  Vec7 best_move = Vec7::Zero();
+  double best_cost = lin.cost;
+  for (int k : ActiveParameters())
+    for (double fraction : {0.01, 0.1, -0.01, -0.1}) {
+      Vec7 move = Vec7::Zero();
+      move[k] = fraction * std::sqrt(std::max(covariance(k, k), 0.0));
+      const double moved = CostAt(move);
+      if (moved < best_cost) {
+        best_cost = moved;
+        best_move = move;
+      }
+    }
+  if (best_cost < lin.cost) {
+    cam_from_lidar_ = cam_from_lidar_ * ExpSE3(best_move.head<6>());
+    range_offset_m_ += best_move[kRangeOffset];
+  }
+  history_.push_back({static_cast<int>(history_.size()), best_cost, best_move.norm(),
+                      cam_from_lidar_, range_offset_m_});
+  if (best_cost >= lin.cost)
+    FinishRound({TerminationTest::kLocalMinimum, predicted, options_.function_tolerance});
+  else if (static_cast<int>(history_.size()) > iteration_budget_)
+    FinishRound({TerminationTest::kIterationCap, (lin.cost - best_cost) / scale,
+                 options_.function_tolerance, options_.max_iterations});
   return !done_;
 }
 

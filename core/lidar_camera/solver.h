@@ -321,6 +321,11 @@ class PlaneAlignmentSolver {
   double edge_variance_scale_ = 1.0;
   int variance_component_rounds_ = 0;
   std::vector<IterationReport> history_;
+  // The cost after `step` from the current estimate (right perturbation; the offset's entry).
+  double CostAt(const Vec7& step) const;
+  // Step's way on where no part of the Gauss-Newton step lowers the cost (its linearization at
+  // `lin`, damped information `damped`, gᵀδ of the full step); the return as Step's.
+  bool StepOutOfStall(const Linearization& lin, const Mat7& damped, double gradient_dot_step);
   // Ends the current round with `termination`, unless gating or variance components start
   // another (then the solve goes on).
   void FinishRound(const Termination& termination);

@@ -133,21 +133,6 @@ bool SheetInLidarFov(const SimOptions& r, const BeamTable& beams, const Pose& li
   return true;
 }
 
-// The cloud a pair ships: the whole scan, or (SimOptions::board_only_clouds) the sheet's returns
-// alone, without rings.
-LidarCloud CloudOf(const SimOptions& r, const LidarScan& scan) {
-  LidarCloud cloud = scan.ToCloud();
-  if (!r.board_only_clouds) return cloud;
-  LidarCloud board;
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    if (scan.surface[i] != SimSurface::kBoard) continue;
-    board.points.push_back(cloud.points[i]);
-    if (cloud.HasIntensity()) board.intensity.push_back(cloud.intensity[i]);
-  }
-  board.width = static_cast<int>(board.size());
-  return board;
-}
-
 // The noise-free returns of the board alone (no room).
 LidarScan ScanBoardOnly(const BeamTable& beams, const BoardPrint& print,
                         const Pose& lidar_from_board, double azimuth_offset_rad) {
@@ -443,7 +428,8 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
     scan_options.range_offset_m = r.lidar_range_offset_m;
     scan_options.azimuth_offset_rad = plan.azimuth_offset_rad;
     scan_options.seed = MixSeed(r.seed, k, 1);
-    SavePcd(entry.cloud, CloudOf(r, SimulateLidarScan(beams, print, scene, scan_options)),
+    SavePcd(entry.cloud,
+            SimulateLidarScan(beams, print, scene, scan_options).ToCloud(r.board_only_clouds),
             PcdEncoding::kBinary);
 
     RenderOptions render;
@@ -475,7 +461,7 @@ SimulatedPair SimulatePairAt(const SimOptions& resolved, const Pose& cam_from_bo
   scan_options.range_offset_m = r.lidar_range_offset_m;
   scan_options.azimuth_offset_rad = azimuth_offset;
   scan_options.seed = MixSeed(r.seed, pair_index, 1);
-  pair.cloud = CloudOf(r, SimulateLidarScan(beams, print, scene, scan_options));
+  pair.cloud = SimulateLidarScan(beams, print, scene, scan_options).ToCloud(r.board_only_clouds);
   RenderOptions render;
   render.image_noise = r.image_noise;
   render.seed = MixSeed(r.seed, pair_index, 2);

@@ -138,8 +138,9 @@ struct LidarScan {
   bool has_rings = true;            // false for a swept scanner: its cloud has no ring field
 
   size_t size() const { return points.size(); }
-  // Unorganized cloud (height 1) with intensity and ring (when it has rings).
-  LidarCloud ToCloud() const;
+  // Unorganized cloud (height 1) with intensity and ring (when it has rings); board_only: the
+  // sheet's returns alone, without rings (SimOptions::board_only_clouds).
+  LidarCloud ToCloud(bool board_only = false) const;
 };
 
 // Casts every beam × azimuth step (firing order: azimuth outer, rings inner) and keeps the nearest

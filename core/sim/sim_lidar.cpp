@@ -174,13 +174,15 @@ BeamTable MakeBeamTable(LidarModel model) {
   return table;
 }
 
-LidarCloud LidarScan::ToCloud() const {
+LidarCloud LidarScan::ToCloud(bool board_only) const {
   LidarCloud cloud;
-  cloud.points.reserve(points.size());
-  for (const Vec3& p : points) cloud.points.push_back(p.cast<float>());
-  cloud.intensity = intensity;
-  if (has_rings) cloud.ring = ring;
-  cloud.width = static_cast<int>(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (board_only && surface[i] != SimSurface::kBoard) continue;
+    cloud.points.push_back(points[i].cast<float>());
+    cloud.intensity.push_back(intensity[i]);
+    if (has_rings && !board_only) cloud.ring.push_back(ring[i]);
+  }
+  cloud.width = static_cast<int>(cloud.size());
   cloud.height = 1;
   return cloud;
 }

@@ -316,6 +316,30 @@ int DistinctRings(const LidarCloud& cloud, const std::vector<int>& indices) {
   return static_cast<int>(rings.size());
 }
 
+// The fit's extent as the sensor shows it: the rings' crossings of the sheet's edges (or why they
+// were not looked for), its rings and their range biases' covariance (spinning LiDARs only).
+void AddBoardExtent(const LidarCloud& cloud, const LidarPlaneOptions& options, LidarPlaneFit* fit) {
+  const bool spinning = options.geometry == LidarGeometry::kSpinning;
+  // Edge points need the whole board's returns (the ends of a brushed patch are not its edges)
+  // and rings whose ends they are.
+  if (!spinning) {
+    fit->no_edge_search =
+        "the LiDAR model is " + LidarGeometryName(options.geometry) + ": no rings to end on it";
+  } else if (fit->grown && options.sheet_size_m.minCoeff() > 0) {
+    fit->edge_points =
+        ExtractBoardEdgePoints(cloud, fit->inliers, fit->plane, options.edges, &fit->edge_ends);
+    fit->sheet_size_m = options.sheet_size_m;
+  } else {
+    fit->no_edge_search = options.sheet_size_m.minCoeff() > 0
+                              ? "the plane's fit did not grow beyond its selected region"
+                              : "the target gives no sheet size";
+  }
+  fit->num_rings = DistinctRings(cloud, fit->inliers);
+  if (options.ring_bias_sigma_m > 0 && spinning)
+    fit->ring_bias_covariance =
+        RingBiasCovariance(cloud, fit->inliers, fit->plane, options.ring_bias_sigma_m);
+}
+
 }  // namespace
 
 std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
@@ -389,24 +413,7 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
   const bool spinning = options.geometry == LidarGeometry::kSpinning;
   if (options.grow_radius_m > 0 && (options.fit_ranges_ml || !spinning))
     fit = GrowToBoard(cloud, *fit, options);
-  // Edge points need the whole board's returns (the ends of a brushed patch are not its edges)
-  // and rings whose ends they are.
-  if (!spinning) {
-    fit->no_edge_search =
-        "the LiDAR model is " + LidarGeometryName(options.geometry) + ": no rings to end on it";
-  } else if (fit->grown && options.sheet_size_m.minCoeff() > 0) {
-    fit->edge_points =
-        ExtractBoardEdgePoints(cloud, fit->inliers, fit->plane, options.edges, &fit->edge_ends);
-    fit->sheet_size_m = options.sheet_size_m;
-  } else {
-    fit->no_edge_search = options.sheet_size_m.minCoeff() > 0
-                              ? "the plane's fit did not grow beyond its selected region"
-                              : "the target gives no sheet size";
-  }
-  fit->num_rings = DistinctRings(cloud, fit->inliers);
-  if (options.ring_bias_sigma_m > 0 && spinning)
-    fit->ring_bias_covariance =
-        RingBiasCovariance(cloud, fit->inliers, fit->plane, options.ring_bias_sigma_m);
+  AddBoardExtent(cloud, options, &*fit);
   return fit;
 }
 
