@@ -64,6 +64,7 @@ bool IsLrfManifest(const std::string& path);
 int RunGui(int argc, char** argv);
 int RunRender(int argc, char** argv);
 int RunExport(int argc, char** argv);
+int RunTarget(int argc, char** argv);
 int RunImport(int argc, char** argv);
 // --board of `import` and `gui`: a preset's name or a target.json file; empty = nullopt (the
 // target.json beside the recording, else the preset that fits its images). Throws

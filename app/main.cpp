@@ -41,6 +41,8 @@ constexpr Command kCommands[] = {
      "turn a ROS 1 .bag or ROS 2 .db3 / .mcap recording into a dataset folder (--list: topics)"},
     {"export", calibench::app::RunExport,
      "write a result as URDF, ROS 1 / ROS 2 static TF, OpenCV YAML, Autoware, Kalibr or 4x4 text"},
+    {"target", calibench::app::RunTarget,
+     "a printable board at exact scale (PDF/SVG, 100 mm ruler) and its target.json"},
     {"sweep", calibench::app::RunSweep,
      "the paper's Table 1 protocol: error vs. number of pairs and noise on simulated data"},
 };

@@ -14,6 +14,7 @@
 #include "core/camera/camera.h"
 #include "core/io/dataset.h"
 #include "core/lidar/cloud.h"
+#include "core/target/board_print.h"
 
 namespace calibench {
 
@@ -76,31 +77,6 @@ Pose DefaultCamFromLidar();
 // A3 checkerboard, 16 pairs at 1.2-3 m).
 // Throws std::invalid_argument naming the known presets for any other name.
 SimOptions SimPreset(const std::string& name);
-
-// The printed sheet as a reflectance map in the board frame (BoardSpec): 0 = black ink,
-// 1 = white paper. Checkerboards are analytic (top-left square black, like OpenCV's ChArUco);
-// ChArUco boards sample OpenCV 4.6's CharucoBoard::draw() texture (nearest texel, so that square
-// edges stay exact). Throws std::invalid_argument for an unknown ChArUco dictionary.
-class BoardPrint {
- public:
-  explicit BoardPrint(const BoardSpec& board);
-  const BoardSpec& board() const { return board_; }
-  // Whether a board-frame point (metres, z = 0) lies on the sheet.
-  bool InSheet(const Vec2& xy) const {
-    return std::abs(xy.x()) <= half_sheet_.x() && std::abs(xy.y()) <= half_sheet_.y();
-  }
-  // Reflectance at a point of the sheet (board frame, metres); 1 on the white margin.
-  double Reflectance(const Vec2& xy) const;
-
- private:
-  BoardSpec board_;
-  Vec2 half_sheet_;                    // metres
-  Vec2 half_pattern_;                  // metres
-  std::vector<std::uint8_t> texture_;  // ChArUco only: grey, row 0 at y = -pattern height / 2
-  int texture_width_ = 0;
-  int texture_height_ = 0;
-  double texels_per_metre_ = 0.0;
-};
 
 // What a simulated sweep can hit, in the LiDAR frame: one board and, with clutter, a floor and the
 // four walls of a square room centred on the LiDAR (walls and floor unbounded).

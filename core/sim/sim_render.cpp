@@ -1,59 +1,19 @@
-// The printed board (BoardPrint) and its supersampled camera rendering.
+// The printed board (core/target/board_print.h) in a supersampled camera rendering.
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include "core/sim/sim.h"
-#include "core/target/charuco_board.h"
 
 namespace calibench {
 namespace {
 
-constexpr int kTexelsPerSquare = 100;  // ChArUco texture resolution
 constexpr double kInkGrey = 20.0;      // rendered grey of black ink (0..255)
 constexpr double kPaperGrey = 235.0;   // white paper, below 255 so that noise does not clip
 // Bearings are unprojected exactly on a grid of this pitch (pixels) and interpolated in between:
 // the interpolation error is below 0.005 px for the cameras we simulate (measured), and Newton per
 // sample would cost ~0.5 us.
 constexpr int kNodeStep = 4;
-
-}  // namespace
-
-BoardPrint::BoardPrint(const BoardSpec& board)
-    : board_(board),
-      half_sheet_(0.5 * board.SheetWidth(), 0.5 * board.SheetHeight()),
-      half_pattern_(0.5 * board.PatternWidth(), 0.5 * board.PatternHeight()) {
-  CALIBENCH_CHECK(board.square_size > 0.0 && board.SquaresX() > 0 && board.SquaresY() > 0);
-  if (board.type != BoardType::kCharuco) return;
-  const auto cv_board =
-      MakeCharucoBoard(board, 1.0f, static_cast<float>(board.marker_size / board.square_size));
-  cv::Mat image;
-  cv_board->draw(cv::Size(board.cols * kTexelsPerSquare, board.rows * kTexelsPerSquare), image, 0,
-                 1);
-  CALIBENCH_CHECK(image.type() == CV_8UC1 && image.isContinuous());
-  texture_width_ = image.cols;
-  texture_height_ = image.rows;
-  texture_.assign(image.data, image.data + image.total());
-  texels_per_metre_ = kTexelsPerSquare / board.square_size;
-}
-
-double BoardPrint::Reflectance(const Vec2& xy) const {
-  if (std::abs(xy.x()) > half_pattern_.x() || std::abs(xy.y()) > half_pattern_.y()) return 1.0;
-  if (board_.type == BoardType::kCheckerboard) {
-    // Square (0, 0), top left, is black, as on OpenCV's ChArUco drawing.
-    const auto [i, j] = PatternSquareAt(board_, xy);
-    return (i + j) % 2 == 0 ? 0.0 : 1.0;
-  }
-  const int col =
-      std::clamp(static_cast<int>(std::floor((xy.x() + half_pattern_.x()) * texels_per_metre_)), 0,
-                 texture_width_ - 1);
-  const int row =
-      std::clamp(static_cast<int>(std::floor((xy.y() + half_pattern_.y()) * texels_per_metre_)), 0,
-                 texture_height_ - 1);
-  return texture_[static_cast<size_t>(row) * texture_width_ + col] / 255.0;
-}
-
-namespace {
 
 struct PixelBox {
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // [x0, x1) × [y0, y1)
