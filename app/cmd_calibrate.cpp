@@ -13,13 +13,15 @@ int RunCalibrate(int argc, char** argv) {
       "Calibrate a 3D LiDAR to a camera from board planes (Ca²Lib plane-to-plane "
       "Gauss-Newton with a Huber kernel).",
       "calibench calibrate"};
-  std::string dataset_path, session_path, out_path;
+  std::string dataset_path, session_path, out_path, report_path;
   AddDatasetOption(app, &dataset_path, "a LiDAR-camera dataset");
   app.add_option("--session", session_path,
                  "a workbench session (calibench.session.json): its brushes, rejections and "
                  "solver choices are used, so the result is the workbench's; its dataset unless "
                  "--dataset is given");
   app.add_option("--out,-o", out_path, "result file (calibench.result.v1)");
+  app.add_option("--report", report_path,
+                 "also write the HTML report (as `calibench report`) of this solve");
   PipelineFlags flags;
   AddPipelineFlags(app, flags);
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
@@ -40,7 +42,15 @@ int RunCalibrate(int argc, char** argv) {
     return kUsage;
   }
   const Dataset dataset = LoadDataset(dataset_path);
-  return CalibrateAndReport(dataset, flags.options, out_path, nullptr, edits);
+  CalibrationOutcome outcome;
+  const int code = CalibrateAndReport(dataset, flags.options, out_path, &outcome, edits);
+  if (report_path.empty() || !outcome.solution) return code;
+  ReportRequest request;
+  request.out_path = report_path;
+  request.session_path = session_path;
+  request.result_file = out_path;
+  const int written = WriteReport(dataset, outcome, flags.options, request);
+  return code != kOk ? code : written;
 }
 
 }  // namespace calibench::app

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/report/report_html.h"
 #include "core/target/board.h"
 
 namespace CLI {
@@ -93,5 +94,24 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
                    const std::string& save_session);
 // `demo` on a machine without a display: solve and write the workbench and each view as PNG.
 int RenderDemoViews(const std::string& dataset, const std::string& out_dir);
+// The report's pictures, drawn headless by the workbench (cmd_ui.cpp): a 3D overview and, per
+// pair, the camera view with the LiDAR points coloured over it. Empty with *why when there is no
+// headless OpenGL.
+std::vector<ReportFigure> RenderReportFigures(const std::string& dataset,
+                                              const std::string& session, std::string* why);
+int RunReport(int argc, char** argv);
+// What a report is written from, besides the pipeline's outcome.
+struct ReportRequest {
+  std::string out_path;
+  std::string session_path;  // the workbench session, when the data came from one
+  std::string result_file;   // the result reported on ("" when written with the solve)
+  bool renders = true;       // draw the views headless
+  ReportOptions options;
+  std::vector<std::string> notes;  // shown at the top
+};
+// `report` and `calibrate --report`: analyses the outcome, draws the views, writes the HTML
+// atomically; kOk (an unreadable asset throws IoError).
+int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
+                const PipelineOptions& options, const ReportRequest& request);
 
 }  // namespace calibench::app

@@ -41,6 +41,9 @@ constexpr Command kCommands[] = {
      "turn a ROS 1 .bag or ROS 2 .db3 / .mcap recording into a dataset folder (--list: topics)"},
     {"export", calibench::app::RunExport,
      "write a result as URDF, ROS 1 / ROS 2 static TF, OpenCV YAML, Autoware, Kalibr or 4x4 text"},
+    {"report", calibench::app::RunReport,
+     "a self-contained HTML report of a result: both directions, sigma, per-pair residuals, "
+     "held-out cross-validation, plots and views"},
     {"target", calibench::app::RunTarget,
      "a printable board at exact scale (PDF/SVG, 100 mm ruler) and its target.json"},
     {"sweep", calibench::app::RunSweep,

@@ -143,16 +143,39 @@ ImageU8 LoadImage(const std::filesystem::path& path, const LoadLimits& limits) {
   return image;
 }
 
-void SaveImage(const std::filesystem::path& path, const ImageU8& image) {
+namespace {
+
+void CheckWritable(const ImageU8& image, const std::string& what) {
   const bool consistent =
       image.width > 0 && image.height > 0 &&
       (image.channels == 1 || image.channels == 3 || image.channels == 4) &&
       image.data.size() == static_cast<size_t>(image.width) * image.height * image.channels;
   if (!consistent) {
-    throw IoError("cannot write image '" + path.string() + "': the image is empty or its size (" +
+    throw IoError("cannot write image '" + what + "': the image is empty or its size (" +
                   std::to_string(image.width) + "x" + std::to_string(image.height) + "x" +
                   std::to_string(image.channels) + ") does not match its data");
   }
+}
+
+}  // namespace
+
+std::string EncodeImage(const ImageU8& image, const std::string& extension) {
+  CheckWritable(image, "in memory as " + extension);
+  const cv::Mat mat(image.height, image.width, CV_8UC(image.channels),
+                    const_cast<std::uint8_t*>(image.data.data()));
+  std::vector<std::uint8_t> bytes;
+  bool encoded = false;
+  try {
+    encoded = cv::imencode(extension, mat, bytes);
+  } catch (const cv::Exception& e) {
+    throw IoError("cannot encode an image as '" + extension + "': " + e.err);
+  }
+  if (!encoded) throw IoError("cannot encode an image as '" + extension + "'");
+  return std::string(bytes.begin(), bytes.end());
+}
+
+void SaveImage(const std::filesystem::path& path, const ImageU8& image) {
+  CheckWritable(image, path.string());
   // A header over the caller's pixels; imwrite only reads them.
   const cv::Mat mat(image.height, image.width, CV_8UC(image.channels),
                     const_cast<std::uint8_t*>(image.data.data()));

@@ -35,5 +35,8 @@ ImageU8 LoadImage(const std::filesystem::path& path, const LoadLimits& limits = 
 ImageU8 ResizeImage(const ImageU8& image, int max_width);
 // Writes PNG/JPG by extension. Throws IoError naming the file.
 void SaveImage(const std::filesystem::path& path, const ImageU8& image);
+// The image as the bytes of a file of that type (extension ".png" or ".jpg"; channels as
+// SaveImage takes them). Throws IoError when the image is inconsistent or cannot be encoded.
+std::string EncodeImage(const ImageU8& image, const std::string& extension);
 
 }  // namespace calibench

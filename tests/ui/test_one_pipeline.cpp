@@ -3,8 +3,10 @@
 // bit, because both run core/lidar_camera/pipeline.h's steps.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "core/io/dataset.h"
 #include "core/lidar_camera/pipeline.h"
@@ -14,6 +16,7 @@
 #include "tests/test_support.h"
 #include "tests/ui/ui_fixture.h"
 #include "ui/lidar_camera/controller.h"
+#include "ui/lidar_camera/report_job.h"
 
 namespace calibench::ui {
 namespace {
@@ -107,6 +110,39 @@ TEST(OnePipeline, CalibrateWithTheSessionFlagMatchesTheWorkbench) {
   ExpectIdentical(cli.cam_from_source.matrix(), gui.solver.result->cam_from_lidar.matrix(),
                   "cam_from_lidar");
   ExpectIdentical(cli.covariance, gui.solver.result->covariance, "covariance");
+}
+
+// File → Report… runs `calibench report` on the autosaved session: the report carries the
+// workbench's rejection and its result; a session without a result is refused, in words.
+TEST(OnePipeline, TheWorkbenchsReportIsTheCommandLinesOnTheSession) {
+  const auto dir = test::TempDir("one_pipeline_report");
+  const auto session_path = dir / "calibench.session.json";
+  Controller controller;
+  const Snapshot gui = EditedAndSolved(controller, session_path);
+  ASSERT_TRUE(gui.solver.result) << gui.solver.failure;
+  {
+    ReportJob job(test::CalibenchExe(), session_path, dir / "report.html");
+    while (!job.Done()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ASSERT_EQ(job.exit_code(), 0) << job.output();
+    EXPECT_NE(job.output().find("wrote " + (dir / "report.html").string()), std::string::npos);
+    // No note that the result differs from the re-solve: the session's options were used.
+    EXPECT_EQ(job.output().find("differs from a re-solve"), std::string::npos) << job.output();
+  }
+  const std::string html = test::ReadFileBytes(dir / "report.html");
+  const std::string rejected = "<tr data-pair=\"" + gui.pairs[2].id + "\"";
+  const size_t row = html.find(rejected);
+  ASSERT_NE(row, std::string::npos);
+  EXPECT_NE(html.substr(row, 200).find("rejected"), std::string::npos) << html.substr(row, 200);
+
+  Session unsolved = LoadSession(session_path);
+  unsolved.result.reset();
+  SaveSession(dir / "unsolved.session.json", unsolved);
+  ReportJob refused(test::CalibenchExe(), dir / "unsolved.session.json", dir / "none.html");
+  while (!refused.Done()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_NE(refused.exit_code(), 0);
+  EXPECT_NE(refused.output().find("the session has no result yet"), std::string::npos)
+      << refused.output();
+  EXPECT_FALSE(std::filesystem::exists(dir / "none.html"));
 }
 
 TEST(OnePipeline, RenderSolveAndCalibrateWriteTheSameTransform) {

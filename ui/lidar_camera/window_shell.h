@@ -22,6 +22,7 @@ namespace calibench::ui {
 
 class Workbench;
 struct ImportJob;  // a recording importing on its thread (window_shell.cpp)
+class ReportJob;   // File → Report… (report_job.h)
 
 struct ShellOptions {
   PipelineOptions pipeline;
@@ -69,6 +70,8 @@ class WindowShell {
   void FileMenu();
   void BoardMenu();  // the board of recordings opened from the menu
   void ExportMenu();
+  void ReportMenuItem();  // File → Report…: `calibench report` on the saved session
+  void ReportPopups();
   void Popups();
   // Opens what a finished import wrote; true while an import runs.
   bool PollImport();
@@ -82,6 +85,9 @@ class WindowShell {
   RecentFiles recent_;
   FileBrowser browser_;
   std::unique_ptr<ImportJob> import_;
+  std::unique_ptr<ReportJob> report_;
+  std::string report_message_;  // the last report's outcome, shown once in a popup
+  bool show_report_ = false;
   std::optional<BagImportSummary> last_import_;
   std::optional<std::filesystem::path> pending_open_;  // chosen during a frame, opened at the next
   std::string error_;

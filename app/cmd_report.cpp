@@ -1,0 +1,163 @@
+// calibench report (and calibrate --report): the pipeline's outcome analysed (core/report), the
+// workbench's views drawn headless, one self-contained HTML file written atomically.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "app/pipeline_flags.h"
+#include "core/base/atomic_file.h"
+#include "core/io/assets.h"
+#include "core/io/dataset.h"
+#include "core/results/result_file.h"
+#include "core/session/session.h"
+
+namespace calibench::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string NowUtc() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+bool IsSessionFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  return head.find("calibench.session.v1") != std::string::npos;
+}
+
+// The solver method a result file records (its "solver"."method"), "" when it names none.
+std::string ResultMethod(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  const auto result = nlohmann::json::parse(in, nullptr, false);
+  if (result.is_discarded() || !result.contains("solver") || !result["solver"].is_object())
+    return "";
+  return result["solver"].value("method", "");
+}
+
+}  // namespace
+
+int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
+                const PipelineOptions& options, const ReportRequest& request) {
+  const CalibrationReport report = AnalyseCalibration(dataset, outcome, options, request.options);
+  ReportProvenance provenance;
+  provenance.source = request.session_path.empty() ? dataset.manifest.string()
+                                                   : request.session_path + " (session of " +
+                                                         dataset.manifest.string() + ")";
+  provenance.result_file = request.result_file;
+  provenance.created_utc = NowUtc();
+  provenance.calibench_version = CALIBENCH_VERSION;
+  provenance.notes = request.notes;
+  std::vector<ReportFigure> figures;
+  if (request.renders) {
+    std::string why;
+    figures = RenderReportFigures(request.session_path.empty() ? dataset.manifest.string() : "",
+                                  request.session_path, &why);
+    if (!why.empty()) {
+      std::fprintf(stderr, "calibench report: %s; the report has no views\n", why.c_str());
+      provenance.notes.push_back("No views: " + why + ".");
+    }
+  }
+  const ReportAssets assets = LoadReportAssets(FindAsset("report"));
+  WriteFileAtomically(request.out_path, ReportHtml(report, provenance, figures, assets));
+  std::printf("wrote %s (%zu pairs, %zu views)%s%s\n", request.out_path.c_str(),
+              report.pairs.size(), figures.size(), report.cross_validation ? ": " : "",
+              report.cross_validation ? report.cross_validation->verdict.c_str() : "");
+  if (!report.distrust.empty()) std::printf("%s\n", report.distrust.c_str());
+  return kOk;
+}
+
+int RunReport(int argc, char** argv) {
+  CLI::App app{
+      "Write a self-contained HTML report of a LiDAR-camera result: both directions with sigma, "
+      "the method and the data's provenance, export snippets, one row per pair (residuals, "
+      "weight, leave-one-out influence), held-out cross-validation with a verdict, plots, and "
+      "the workbench's views. The pairs are extracted and solved again with the same pipeline.",
+      "calibench report"};
+  std::string result_path, dataset_path, session_path;
+  ReportRequest request;
+  bool no_renders = false, no_cross_validation = false;
+  app.add_option("--result,-r", result_path,
+                 "calibench.result.v1 file (or a session with a result)")
+      ->required();
+  AddDatasetOption(app, &dataset_path, "the dataset the result was computed from");
+  app.add_option("--session", session_path,
+                 "the workbench session it came from (its brushes, rejections and options)");
+  app.add_option("--out,-o", request.out_path, "report.html")->required();
+  app.add_flag("--no-views", no_renders, "leave out the rendered views (no OpenGL needed)");
+  app.add_flag("--no-cross-validation", no_cross_validation,
+               "skip the leave-one-out re-solves (influence, held-out errors)");
+  PipelineFlags flags;
+  AddPipelineFlags(app, flags);
+  if (const auto code = ParseFlags(app, argc, argv)) return *code;
+  if (!app.count("--method")) {
+    const std::string method = ResultMethod(result_path);
+    if (!method.empty()) flags.method = method;  // the result's own method, unless overridden
+  }
+  std::string why;
+  if (!FinalizePipelineFlags(flags, &why)) {
+    std::fprintf(stderr, "calibench report: %s\n", why.c_str());
+    return kUsage;
+  }
+  request.renders = !no_renders;
+  request.options.cross_validate = !no_cross_validation;
+  request.result_file = result_path;
+  if (session_path.empty() && IsSessionFile(result_path)) session_path = result_path;
+  PairEdits edits;
+  std::optional<Pose> reported;
+  if (!session_path.empty()) {
+    const Session session = LoadSession(session_path);
+    if (dataset_path.empty()) dataset_path = session.dataset.string();
+    ApplySessionOptions(session, &flags.options);
+    edits = EditsFromSession(session);
+    if (session_path == result_path && session.result) reported = session.result->cam_from_lidar;
+  }
+  if (!reported) {
+    if (IsSessionFile(result_path))
+      throw IoError(result_path + ": the session has no result yet (solve it in the workbench)");
+    reported = LoadResult(result_path).cam_from_source;
+  }
+  if (dataset_path.empty()) {
+    std::fprintf(stderr, "calibench report: give --dataset or --session (the result's data)\n");
+    return kUsage;
+  }
+  request.session_path = session_path;
+  const Dataset dataset = LoadDataset(dataset_path);
+  const CalibrationOutcome outcome =
+      CalibrateDataset(dataset, flags.options, StderrProgress("extracted"), edits);
+  if (!outcome.solution) {
+    std::fprintf(stderr, "calibench report: the data gives no calibration: %s\n",
+                 outcome.failure.c_str());
+    return kNoCalibration;
+  }
+  // The figures are the re-solve's: say so when it is not the result's pose.
+  const Pose& solved = outcome.solution->cam_from_lidar;
+  const double moved_mm = 1000.0 * (solved.translation() - reported->translation()).norm();
+  const double turned_deg =
+      Eigen::AngleAxisd(solved.linear().transpose() * reported->linear()).angle() * kRadToDeg;
+  if (moved_mm > 0.1 || turned_deg > 0.01) {
+    char note[512];
+    std::snprintf(note, sizeof(note),
+                  "%s differs from a re-solve of this data with these options by %.1f mm and "
+                  "%.3f deg: the result, per-pair figures and views below are the re-solve's. "
+                  "Pass the options calibrate was run with (or its session).",
+                  result_path.c_str(), moved_mm, turned_deg);
+    request.notes.push_back(note);
+    std::fprintf(stderr, "calibench report: %s\n", note);
+  }
+  return WriteReport(dataset, outcome, flags.options, request);
+}
+
+}  // namespace calibench::app

@@ -1,0 +1,53 @@
+// Calibench report plots: Chart.js (Debian's libjs-chart.js, inlined above) over REPORT.
+(function () {
+  if (typeof Chart === "undefined") return;
+  Chart.defaults.animation = false;  // drawn at once: printing and screenshots see the plots
+  Chart.defaults.font.family = "DejaVu Sans, sans-serif";
+  const solved = REPORT.pairs.filter(p => p.solved);
+  const ids = solved.map(p => p.id);
+  const colour = p => (p.disagrees ? "#c0392b" : "#3b6ea5");
+  function chart(id, config) {
+    const canvas = document.getElementById(id);
+    if (!canvas) return;
+    config.options = Object.assign({ responsive: true, maintainAspectRatio: false }, config.options);
+    new Chart(canvas, config);
+  }
+  const title = text => ({ display: true, text: text });
+  chart("residuals", {
+    type: "bar",
+    data: { labels: ids, datasets: [
+      { label: "plane angle [deg]", data: solved.map(p => p.angle_deg), backgroundColor: "#3b6ea5", yAxisID: "a" },
+      { label: "held out [deg]", data: solved.map(p => p.heldout_angle_deg), backgroundColor: "#9db7d5", yAxisID: "a" },
+      { label: "plane offset [mm]", data: solved.map(p => p.distance_mm), backgroundColor: "#d98c2b", yAxisID: "d", type: "line", showLine: false, pointRadius: 3 },
+      { label: "held out offset [mm]", data: solved.map(p => p.heldout_distance_mm), backgroundColor: "#c0392b", borderColor: "#c0392b", yAxisID: "d", type: "line", showLine: false, pointRadius: 3, pointStyle: "triangle" } ] },
+    options: { plugins: { title: title("Residuals per pair: training and held out") },
+               scales: { a: { position: "left", title: title("deg") }, d: { position: "right", title: title("mm"), grid: { drawOnChartArea: false } } } } });
+  chart("weights", {
+    type: "bar",
+    data: { labels: ids, datasets: [{ label: "robust weight", data: solved.map(p => p.weight), backgroundColor: solved.map(colour) }] },
+    options: { plugins: { title: title("Robust weight per pair") }, scales: { y: { min: 0, max: 1.05 } } } });
+  chart("convergence", {
+    type: "line",
+    data: { labels: REPORT.cost.map((_, i) => i), datasets: [{ label: "cost", data: REPORT.cost, borderColor: "#3b6ea5", pointRadius: 2 }] },
+    options: { plugins: { title: title("Solver convergence") }, scales: { x: { title: title("iteration") }, y: { type: "logarithmic", title: title("cost") } } } });
+  const axes = ["x", "y", "z"], palette = ["#c0392b", "#3a8d3a", "#3b6ea5"];
+  const sigmaSets = [];
+  axes.forEach((a, i) => sigmaSets.push({ label: "σ t" + a + " [mm]", data: REPORT.sigma.map(s => s.t_mm[i]), borderColor: palette[i], yAxisID: "t", pointRadius: 2 }));
+  axes.forEach((a, i) => sigmaSets.push({ label: "σ r" + a + " [deg]", data: REPORT.sigma.map(s => s.r_deg[i]), borderColor: palette[i], borderDash: [5, 4], yAxisID: "r", pointRadius: 2 }));
+  chart("sigma", {
+    type: "line",
+    data: { labels: REPORT.sigma.map(s => s.pairs), datasets: sigmaSets },
+    options: { plugins: { title: title("σ as pairs accumulate (capture order)") },
+               scales: { x: { title: title("pairs") }, t: { type: "logarithmic", position: "left", title: title("mm") }, r: { type: "logarithmic", position: "right", title: title("deg"), grid: { drawOnChartArea: false } } } } });
+  const [w, h] = REPORT.image_size;
+  chart("coverage-image", {
+    type: "scatter",
+    data: { datasets: [{ label: "board centre in the image", data: solved.filter(p => p.image).map(p => ({ x: p.image[0], y: p.image[1], id: p.id })), backgroundColor: solved.filter(p => p.image).map(colour), pointRadius: 5 }] },
+    options: { plugins: { title: title("Coverage: the image (" + w + " x " + h + " px)"), tooltip: { callbacks: { label: c => c.raw.id } } },
+               scales: { x: { min: 0, max: w, title: title("u [px]") }, y: { min: 0, max: h, reverse: true, title: title("v [px]") } } } });
+  chart("coverage-lidar", {
+    type: "scatter",
+    data: { datasets: [{ label: "board centre seen from the LiDAR", data: solved.filter(p => p.lidar).map(p => ({ x: p.lidar[0], y: p.lidar[1], id: p.id })), backgroundColor: solved.filter(p => p.lidar).map(colour), pointRadius: 5 }] },
+    options: { plugins: { title: title("Coverage: the LiDAR's field"), tooltip: { callbacks: { label: c => c.raw.id } } },
+               scales: { x: { reverse: true, title: title("azimuth [deg] (left is +)") }, y: { title: title("elevation [deg]") } } } });
+})();

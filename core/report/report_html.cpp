@@ -1,0 +1,331 @@
+// ReportHtml: the report's body written here, its look and plots in assets/report/.
+#include "core/report/report_html.h"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/results/export.h"
+
+namespace calibench {
+namespace {
+
+using nlohmann::json;
+
+std::string Escape(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+std::string Base64(const std::string& bytes) {
+  static constexpr char kTable[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    const size_t n = std::min<size_t>(3, bytes.size() - i);
+    std::uint32_t v = 0;
+    for (size_t k = 0; k < 3; ++k)
+      v = (v << 8) | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
+    for (size_t k = 0; k < 4; ++k) out += k <= n ? kTable[(v >> (18 - 6 * k)) & 63] : '=';
+  }
+  return out;
+}
+
+std::string Num(double value, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.*f", digits, value);
+  return text;
+}
+
+std::string Opt(const std::optional<double>& value, int digits) {
+  return value ? Num(*value, digits) : "&ndash;";
+}
+
+std::string ReadText(const std::filesystem::path& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path.string() + ": cannot read " + what);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Fills {{name}} placeholders of the template in one pass: inserted text is never scanned again.
+std::string FillTemplate(const std::string& tpl, const std::map<std::string, std::string>& values) {
+  std::string out;
+  size_t at = 0;
+  while (true) {
+    const size_t open = tpl.find("{{", at);
+    const size_t close = open == std::string::npos ? open : tpl.find("}}", open);
+    if (close == std::string::npos) break;
+    out.append(tpl, at, open - at);
+    const auto value = values.find(tpl.substr(open + 2, close - open - 2));
+    out += value != values.end() ? value->second : tpl.substr(open, close + 2 - open);
+    at = close + 2;
+  }
+  out.append(tpl, at, std::string::npos);
+  return out;
+}
+
+std::string MatrixTable(const Pose& pose) {
+  std::string html = "<table class=\"matrix\">";
+  for (int r = 0; r < 3; ++r) {
+    html += "<tr>";
+    for (int c = 0; c < 3; ++c) html += "<td>" + Num(pose.linear()(r, c), 6) + "</td>";
+    html += "<td class=\"t\">" + Num(pose.translation()(r), 6) + "</td></tr>";
+  }
+  return html + "<tr><td>0</td><td>0</td><td>0</td><td class=\"t\">1</td></tr></table>";
+}
+
+std::string DirectionCard(const std::string& name, const std::string& meaning, const Pose& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  return "<div class=\"card\"><h3><code>" + name + "</code></h3><p class=\"meaning\">" + meaning +
+         "</p>" + MatrixTable(pose) + "<p>translation [m]: " + Num(pose.translation().x(), 6) +
+         " " + Num(pose.translation().y(), 6) + " " + Num(pose.translation().z(), 6) +
+         "<br>quaternion x y z w: " + Num(q.x(), 6) + " " + Num(q.y(), 6) + " " + Num(q.z(), 6) +
+         " " + Num(q.w(), 6) + "</p></div>";
+}
+
+std::string ResultSection(const CalibrationReport& r) {
+  std::string html = "<section id=\"result\"><h2>Result</h2><div class=\"cards\">";
+  html += DirectionCard("cam_from_lidar",
+                        "maps LiDAR points into the camera frame: p_cam = R p_lidar + t",
+                        r.cam_from_lidar);
+  html += DirectionCard("lidar_from_cam",
+                        "maps camera points into the LiDAR frame: p_lidar = R p_cam + t (t is the "
+                        "camera's position in the LiDAR frame)",
+                        r.cam_from_lidar.inverse());
+  html +=
+      "</div><table class=\"sigma\"><tr><th>standard deviation (camera axes)</th><th>x</th>"
+      "<th>y</th><th>z</th></tr><tr><td>translation [mm]</td>";
+  for (int i = 0; i < 3; ++i) html += "<td>" + Num(r.sigma_t_mm[i], 2) + "</td>";
+  html += "</tr><tr><td>rotation [deg]</td>";
+  for (int i = 0; i < 3; ++i) html += "<td>" + Num(r.sigma_r_deg[i], 3) + "</td>";
+  html += "</tr></table><p>Solver: " + Escape(r.termination) + ". Options: " + Escape(r.options) +
+          ".</p><details><summary>The terminal's summary</summary><pre>" + Escape(r.summary) +
+          "</pre></details>";
+  const ExportFrames frames;
+  const std::string urdf =
+      ExportCalibration(ExportFormat::kUrdf, r.cam_from_lidar, frames, "this report").text;
+  const std::string ros2 =
+      ExportCalibration(ExportFormat::kRos2Tf, r.cam_from_lidar, frames, "this report").command;
+  html +=
+      "<h3>Export</h3><p>URDF joint (<code>calibench export --format urdf</code>):</p><pre "
+      "class=\"snippet\">" +
+      Escape(urdf) + "</pre><p>ROS 2 static transform:</p><pre class=\"snippet\">" + Escape(ros2) +
+      "</pre></section>";
+  return html;
+}
+
+std::string PairTable(const CalibrationReport& r) {
+  std::string html =
+      "<section id=\"pairs\"><h2>Pairs</h2><table class=\"pairs\"><thead><tr><th>pair</th>"
+      "<th>status</th><th>LiDAR board from</th><th>plane angle [deg]</th><th>plane offset "
+      "[mm]</th><th>edge points / RMS [mm]</th><th>weight</th><th>without it: moves [mm / "
+      "deg]</th><th>held out: angle [deg] / offset [mm] / "
+      "sigma</th><th>remark</th></tr></thead><tbody>";
+  for (const PairReportRow& p : r.pairs) {
+    const bool worst = p.disagrees || p.down_weighted || !p.remark.empty();
+    html += "<tr data-pair=\"" + Escape(p.id) + "\"" +
+            (p.disagrees ? " class=\"disagrees\""
+             : worst     ? " class=\"worst\""
+                         : "") +
+            "><td>" + Escape(p.id) + "</td><td>" + PairStatusName(p.status) +
+            (p.reason.empty() ? "" : "<br><small>" + Escape(p.reason) + "</small>") + "</td><td>" +
+            BoardSourceName(p.origin.source) +
+            (p.origin.source == BoardSource::kNone ? "" : " " + Num(p.origin.confidence, 2)) +
+            "</td><td>" + Opt(p.plane_angle_deg, 3) + "</td><td>" + Opt(p.plane_distance_mm, 1) +
+            "</td><td>" +
+            (p.solved ? std::to_string(p.edge_points) + " / " + Opt(p.edge_rms_mm, 1) : "&ndash;") +
+            "</td><td>" + (p.solved ? Num(p.weight, 2) : "&ndash;") + "</td><td>" +
+            Opt(p.influence_mm, 2) + " / " + Opt(p.influence_deg, 3) + "</td><td>" +
+            Opt(p.heldout_angle_deg, 3) + " / " + Opt(p.heldout_distance_mm, 1) + " / " +
+            Opt(p.heldout_sigmas, 1) + "</td><td>" + Escape(p.remark) + "</td></tr>";
+  }
+  return html + "</tbody></table></section>";
+}
+
+std::string CrossValidationSection(const CalibrationReport& r) {
+  std::string html = "<section id=\"cross-validation\"><h2>Held-out cross-validation</h2>";
+  if (!r.cross_validation)
+    return html + "<p>Not computed: " + Escape(r.cross_validation_skipped) + ".</p></section>";
+  const CrossValidation& cv = *r.cross_validation;
+  return html + "<p class=\"verdict " + (cv.disagreeing.empty() ? "good" : "bad") +
+         "\">Verdict: " + Escape(cv.verdict) + ".</p><p>Leave-one-out over " +
+         std::to_string(cv.folds) +
+         " pairs: each pair is left out, the rest solved, and the left-out pair's board plane "
+         "predicted. Training residuals are at the full solution.</p><table class=\"sigma\"><tr>"
+         "<th></th><th>plane angle RMS [deg]</th><th>plane offset RMS [mm]</th></tr><tr><td>"
+         "training</td><td>" +
+         Num(cv.train_rms_angle_deg, 3) + "</td><td>" + Num(cv.train_rms_distance_mm, 2) +
+         "</td></tr><tr><td>held out</td><td>" + Num(cv.heldout_rms_angle_deg, 3) + "</td><td>" +
+         Num(cv.heldout_rms_distance_mm, 2) + "</td></tr></table></section>";
+}
+
+std::string FiguresSection(const std::vector<ReportFigure>& figures) {
+  if (figures.empty()) return "";
+  std::string html = "<section id=\"views\"><h2>Views</h2><div class=\"figures\">";
+  for (const ReportFigure& f : figures) {
+    html += "<figure" +
+            (f.pair_id.empty() ? std::string(" class=\"overview\"")
+                               : " data-figure-pair=\"" + Escape(f.pair_id) + "\"") +
+            "><img alt=\"" + Escape(f.title) + "\" src=\"data:" + f.mime + ";base64," +
+            Base64(f.bytes) + "\"><figcaption>" + Escape(f.title) + "</figcaption></figure>";
+  }
+  return html + "</div></section>";
+}
+
+json ChartData(const CalibrationReport& r) {
+  json pairs = json::array();
+  for (const PairReportRow& p : r.pairs) {
+    json row = {{"id", p.id},
+                {"status", PairStatusName(p.status)},
+                {"solved", p.solved},
+                {"weight", p.weight},
+                {"disagrees", p.disagrees}};
+    auto put = [&](const char* key, const std::optional<double>& v) {
+      row[key] = v ? json(*v) : json(nullptr);
+    };
+    put("angle_deg", p.plane_angle_deg), put("distance_mm", p.plane_distance_mm);
+    put("heldout_angle_deg", p.heldout_angle_deg),
+        put("heldout_distance_mm", p.heldout_distance_mm);
+    put("heldout_sigmas", p.heldout_sigmas);
+    if (p.image_centre_px) row["image"] = {p.image_centre_px->x(), p.image_centre_px->y()};
+    if (p.lidar_azimuth_elevation_deg)
+      row["lidar"] = {p.lidar_azimuth_elevation_deg->x(), p.lidar_azimuth_elevation_deg->y()};
+    pairs.push_back(row);
+  }
+  json sigma = json::array();
+  for (const SigmaStep& s : r.sigma_history)
+    sigma.push_back({{"pairs", s.pairs},
+                     {"t_mm", {s.sigma_t_mm.x(), s.sigma_t_mm.y(), s.sigma_t_mm.z()}},
+                     {"r_deg", {s.sigma_r_deg.x(), s.sigma_r_deg.y(), s.sigma_r_deg.z()}}});
+  return {{"pairs", pairs},
+          {"cost", r.cost_history},
+          {"sigma", sigma},
+          {"image_size", {r.image_width, r.image_height}}};
+}
+
+}  // namespace
+
+ReportAssets LoadReportAssets(const std::filesystem::path& report_dir,
+                              const std::filesystem::path& chart_js) {
+  ReportAssets assets;
+  assets.html_template = ReadText(report_dir / "report.html", "the report's template");
+  assets.style = ReadText(report_dir / "report.css", "the report's style");
+  assets.script = ReadText(report_dir / "report.js", "the report's plots");
+  assets.chart_js = ReadText(chart_js, "Chart.js (apt-get install libjs-chart.js)");
+  return assets;
+}
+
+std::string CoverageGaps(const CalibrationReport& r) {
+  static constexpr std::array<const char*, 3> kRows = {"top", "middle", "bottom"};
+  static constexpr std::array<const char*, 3> kCols = {"left", "centre", "right"};
+  bool seen[3][3] = {};
+  double az_min = 1e9, az_max = -1e9, el_min = 1e9, el_max = -1e9;
+  for (const PairReportRow& p : r.pairs) {
+    if (!p.solved) continue;
+    if (p.image_centre_px && r.image_width > 0 && r.image_height > 0) {
+      const int c = std::clamp(static_cast<int>(3 * p.image_centre_px->x() / r.image_width), 0, 2);
+      const int row =
+          std::clamp(static_cast<int>(3 * p.image_centre_px->y() / r.image_height), 0, 2);
+      seen[row][c] = true;
+    }
+    if (p.lidar_azimuth_elevation_deg) {
+      az_min = std::min(az_min, p.lidar_azimuth_elevation_deg->x());
+      az_max = std::max(az_max, p.lidar_azimuth_elevation_deg->x());
+      el_min = std::min(el_min, p.lidar_azimuth_elevation_deg->y());
+      el_max = std::max(el_max, p.lidar_azimuth_elevation_deg->y());
+    }
+  }
+  std::string empty;
+  for (int row = 0; row < 3; ++row)
+    for (int c = 0; c < 3; ++c)
+      if (!seen[row][c])
+        empty +=
+            (empty.empty() ? "" : ", ") +
+            (row == 1 && c == 1 ? std::string("centre") : std::string(kRows[row]) + " " + kCols[c]);
+  std::string words;
+  if (!empty.empty()) words = "no board centre in the image's " + empty + ".";
+  if (az_max >= az_min && az_max - az_min < 20.0)
+    words += std::string(words.empty() ? "" : " ") + "The boards span only " +
+             Num(az_max - az_min, 0) + " deg of the LiDAR's azimuth.";
+  if (el_max >= el_min && el_max - el_min < 20.0)
+    words += std::string(words.empty() ? "" : " ") + "The boards span only " +
+             Num(el_max - el_min, 0) + " deg of the LiDAR's elevation.";
+  return words;
+}
+
+std::string ReportHtml(const CalibrationReport& report, const ReportProvenance& provenance,
+                       const std::vector<ReportFigure>& figures, const ReportAssets& assets) {
+  int accepted = 0, solved = 0;
+  for (const PairReportRow& p : report.pairs) {
+    accepted += p.status == PairStatus::kAccepted;
+    solved += p.solved;
+  }
+  std::string body = "<header><h1>Calibench calibration report</h1><table class=\"provenance\">";
+  auto fact = [&](const std::string& name, const std::string& value) {
+    if (!value.empty()) body += "<tr><th>" + name + "</th><td>" + Escape(value) + "</td></tr>";
+  };
+  fact("source", provenance.source);
+  fact("result", provenance.result_file);
+  fact("pairs", std::to_string(report.pairs.size()) + " (" + std::to_string(accepted) +
+                    " accepted, " + std::to_string(solved) + " in the solve)");
+  fact("options", report.options);
+  fact("written", provenance.created_utc);
+  fact("Calibench", provenance.calibench_version);
+  body += "</table>";
+  for (const std::string& note : provenance.notes)
+    body += "<p class=\"verdict bad\">" + Escape(note) + "</p>";
+  if (!report.distrust.empty())
+    body += "<p class=\"verdict bad\">" + Escape(report.distrust) + "</p>";
+  body += "</header>";
+  body += ResultSection(report) + CrossValidationSection(report);
+  const std::string gaps = CoverageGaps(report);
+  body +=
+      "<section id=\"plots\"><h2>Plots</h2><div class=\"plots\">"
+      "<div class=\"plot\"><canvas id=\"residuals\"></canvas></div>"
+      "<div class=\"plot\"><canvas id=\"weights\"></canvas></div>"
+      "<div class=\"plot\"><canvas id=\"convergence\"></canvas></div>"
+      "<div class=\"plot\"><canvas id=\"sigma\"></canvas></div>"
+      "<div class=\"plot\"><canvas id=\"coverage-image\"></canvas></div>"
+      "<div class=\"plot\"><canvas id=\"coverage-lidar\"></canvas></div></div>"
+      "<p class=\"coverage\">Coverage: " +
+      Escape(gaps.empty() ? "the boards cover the image's 3 x 3 grid and a wide LiDAR field."
+                          : gaps + " More poses there would help.") +
+      "</p></section>";
+  body += PairTable(report) + FiguresSection(figures);
+  std::string data = ChartData(report).dump();
+  for (size_t at = data.find("</"); at != std::string::npos; at = data.find("</", at + 3))
+    data.replace(at, 2, "<\\/");  // never close the <script> early
+  return FillTemplate(assets.html_template, {{"title", "Calibench calibration report"},
+                                             {"style", assets.style},
+                                             {"chart_js", assets.chart_js},
+                                             {"data", data},
+                                             {"script", assets.script},
+                                             {"body", body}});
+}
+
+}  // namespace calibench

@@ -1,0 +1,53 @@
+// The calibration report as one self-contained HTML file: styles, scripts (Debian's Chart.js,
+// inlined) and pictures (data: URIs) inside, so that it opens anywhere without a network.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/report/calibration_report.h"
+
+namespace calibench {
+
+// A picture in the report: the workbench's views drawn headless (ui/), as PNG or JPEG bytes.
+struct ReportFigure {
+  std::string title;
+  std::string pair_id;  // the pair it shows; "" for an overview
+  std::string bytes;    // the encoded image
+  std::string mime;     // "image/png" or "image/jpeg"
+};
+
+// Where the report's data came from: what a reviewer needs to find it again.
+struct ReportProvenance {
+  std::string source;       // the dataset, folder, recording or session
+  std::string result_file;  // "" when the report comes with the solve itself
+  std::string created_utc;  // ISO 8601
+  std::string calibench_version;
+  std::vector<std::string> notes;  // shown at the top (e.g. the result differs from a re-solve)
+};
+
+// The report's template, style and scripts (assets/report/) and Chart.js.
+struct ReportAssets {
+  std::string html_template;  // placeholders {{title}} {{style}} {{chart_js}} {{data}}
+                              // {{script}} {{body}}
+  std::string style;
+  std::string script;  // draws the plots from the data
+  std::string chart_js;
+};
+
+// Reads report.html, report.css and report.js from `report_dir` and Chart.js from `chart_js`
+// (Debian's libjs-chart.js). Throws IoError naming the missing file and the package.
+ReportAssets LoadReportAssets(
+    const std::filesystem::path& report_dir,
+    const std::filesystem::path& chart_js = "/usr/share/javascript/chart.js/chart.min.js");
+
+std::string ReportHtml(const CalibrationReport& report, const ReportProvenance& provenance,
+                       const std::vector<ReportFigure>& figures, const ReportAssets& assets);
+
+// Where more poses would help, in words: the cells of a 3 x 3 image grid ("top left" ... "bottom
+// right") where no board centre lies, and a LiDAR field the boards span narrowly (azimuth or
+// elevation under 20 degrees). "" when the boards cover both.
+std::string CoverageGaps(const CalibrationReport& report);
+
+}  // namespace calibench
