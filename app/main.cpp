@@ -8,6 +8,7 @@
 #include "app/commands.h"
 #include "core/base/allocator.h"
 #include "core/base/types.h"
+#include "core/io/assets.h"
 
 namespace {
 
@@ -86,6 +87,11 @@ int main(int argc, char** argv) {
   }
   if (!std::strcmp(argv[1], "--version") || !std::strcmp(argv[1], "version")) {
     std::printf("calibench %s\n", CALIBENCH_VERSION);
+    try {
+      std::printf("assets: %s\n", calibench::FindAsset("report").parent_path().c_str());
+    } catch (const calibench::IoError& e) {
+      std::printf("assets: none found (%s)\n", e.what());
+    }
     return calibench::app::kOk;
   }
   if (!std::strcmp(argv[1], "help")) {

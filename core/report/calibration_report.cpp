@@ -315,7 +315,7 @@ CalibrationReport AnalyseCalibration(const Dataset& dataset, const CalibrationOu
       row.down_weighted = s.DownWeighted(k);
       const PlaneError e = PlaneErrorAt(s.cam_from_lidar, *p.lidar, *p.camera);
       row.plane_angle_deg = e.angle_deg, row.plane_distance_mm = e.distance_mm;
-      row.edge_points = k < s.pair_edge_points.size() ? s.pair_edge_points[k] : 0;
+      row.edge_points = static_cast<int>(p.lidar->edge_points.size());
       row.edge_rms_mm = EdgeRmsMm(s.cam_from_lidar, *p.lidar, *p.camera, dataset.target);
     }
     report.pairs.push_back(std::move(row));

@@ -38,7 +38,8 @@ struct PairReportRow {
   bool down_weighted = false;
   // Training residuals at the solution: the angle between the LiDAR plane carried into the
   // camera and the camera's plane (degrees), and their offset (mm, signed along the camera's
-  // normal); the board-edge crossings' RMS distance to the sheet's edges (mm) and their count.
+  // normal); the LiDAR's board-edge crossings (ring ends on the sheet's edge) and their RMS
+  // distance to the edges the camera's board pose puts there (mm; beam footprint included).
   std::optional<double> plane_angle_deg, plane_distance_mm;
   int edge_points = 0;
   std::optional<double> edge_rms_mm;

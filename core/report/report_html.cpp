@@ -143,7 +143,7 @@ std::string PairTable(const CalibrationReport& r) {
   std::string html =
       "<section id=\"pairs\"><h2>Pairs</h2><table class=\"pairs\"><thead><tr><th>pair</th>"
       "<th>status</th><th>LiDAR board from</th><th>plane angle [deg]</th><th>plane offset "
-      "[mm]</th><th>edge points / RMS [mm]</th><th>weight</th><th>without it: moves [mm / "
+      "[mm]</th><th>edge crossings / RMS [mm]</th><th>weight</th><th>without it: moves [mm / "
       "deg]</th><th>held out: angle [deg] / offset [mm] / "
       "sigma</th><th>remark</th></tr></thead><tbody>";
   for (const PairReportRow& p : r.pairs) {

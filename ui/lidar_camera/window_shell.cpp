@@ -2,19 +2,43 @@
 
 #include <imgui.h>
 
+#include <algorithm>
 #include <atomic>
 #include <fstream>
 #include <mutex>
 #include <sstream>
 #include <thread>
 
+#include "core/io/assets.h"
 #include "core/io/bag.h"
+#include "core/io/dataset.h"
 #include "core/results/export.h"
 #include "ui/lidar_camera/report_job.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/widgets/error_popup.h"
 
 namespace calibench::ui {
+
+namespace {
+
+// assets/targets/*.json by name, in name order; the built-in presets when the folder is missing.
+std::vector<std::pair<std::string, BoardSpec>> TargetPresets() {
+  std::vector<std::pair<std::string, BoardSpec>> presets;
+  try {
+    for (const auto& entry : std::filesystem::directory_iterator(FindAsset("targets")))
+      if (entry.path().extension() == ".json")
+        presets.emplace_back(entry.path().stem().string(), LoadTargetFile(entry.path()));
+  } catch (const IoError&) {
+    presets.clear();
+    for (const char* name : {"a3", "a4", "charuco-a3", "charuco-a4", "paper"})
+      presets.emplace_back(name, BoardPreset(name));
+  }
+  std::sort(presets.begin(), presets.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  return presets;
+}
+
+}  // namespace
 namespace fs = std::filesystem;
 
 // A recording importing on its own thread; the window shows its progress and opens the dataset
@@ -250,12 +274,12 @@ void WindowShell::BoardMenu() {
   if (ImGui::MenuItem("automatic", nullptr, !options_.board)) options_.board.reset();
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("the target.json beside the recording, else the preset that fits the images");
-  for (const char* preset : {"a3", "a4", "charuco-a3", "charuco-a4", "paper"}) {
-    const BoardSpec board = BoardPreset(preset);
+  // The presets Calibench ships (assets/targets/*.json; a board dropped there shows up too).
+  for (const auto& [name, board] : TargetPresets()) {
     const bool chosen = options_.board && board.type == options_.board->type &&
                         board.cols == options_.board->cols && board.rows == options_.board->rows &&
                         board.square_size == options_.board->square_size;
-    if (ImGui::MenuItem(preset, nullptr, chosen)) options_.board = board;
+    if (ImGui::MenuItem(name.c_str(), nullptr, chosen)) options_.board = board;
   }
   ImGui::TextDisabled("or --board FILE on the command line");
   ImGui::EndMenu();

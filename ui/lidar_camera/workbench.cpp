@@ -14,7 +14,9 @@ bool ParseLayout(const std::string& name, Layout* layout) {
   return ParseLayoutName(name, {"workbench", "lidar", "camera", "3d"}, layout);
 }
 
-Workbench::Workbench() : WorkbenchFrame(0.45f), gl_(std::make_unique<Gl>()) {}
+Workbench::Workbench()
+    : WorkbenchFrame(LoadLayoutShares("lidar_camera", {0.58f, 0.45f})),
+      gl_(std::make_unique<Gl>()) {}
 
 Workbench::~Workbench() = default;
 

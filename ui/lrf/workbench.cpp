@@ -237,7 +237,8 @@ bool ParseLrfLayout(const std::string& name, LrfLayout* layout) {
   return ParseLayoutName(name, {"workbench", "scan", "depth", "3d"}, layout);
 }
 
-LrfWorkbench::LrfWorkbench() : WorkbenchFrame(0.5f), gl_(std::make_unique<Gl>()) {}
+LrfWorkbench::LrfWorkbench()
+    : WorkbenchFrame(LoadLayoutShares("lrf", {0.58f, 0.5f})), gl_(std::make_unique<Gl>()) {}
 
 LrfWorkbench::~LrfWorkbench() = default;
 

@@ -30,8 +30,7 @@ class WorkbenchFrame {
                             double seconds_since_last_frame, float top = 0.0f) {
     std::vector<Intent> intents;
     replay_.Advance(s.solver.iterations.size(), seconds_since_last_frame);
-    const FrameRects frame =
-        ArrangeFrame(static_cast<int>(layout), width, height, measurements_share_, top);
+    const FrameRects frame = ArrangeFrame(static_cast<int>(layout), width, height, shares_, top);
     for (int view = 0; view < 3; ++view)
       if (frame.Shows(view)) View(view, s, frame.views[view], &intents);
     if (!frame.panels()) return intents;
@@ -43,8 +42,8 @@ class WorkbenchFrame {
   }
 
  protected:
-  // measurements_share: of the display's width, for the measurements list.
-  explicit WorkbenchFrame(float measurements_share) : measurements_share_(measurements_share) {}
+  // shares: the proportions of the frame (LoadLayoutShares: assets/workbench/layout.json).
+  explicit WorkbenchFrame(const LayoutShares& shares) : shares_(shares) {}
   SolverReplay& replay() { return replay_; }
   const SolverReplay& replay() const { return replay_; }
 
@@ -60,7 +59,7 @@ class WorkbenchFrame {
   virtual void HandleKeys(const Snapshot& s, std::vector<Intent>* intents) = 0;
 
   SolverReplay replay_;
-  float measurements_share_;
+  LayoutShares shares_;
 };
 
 }  // namespace calibench::ui

@@ -34,10 +34,21 @@ struct FrameRects {
   bool panels() const { return alone < 0; }  // the panels, the status line and the keys
 };
 
-// The frame of a layout (its enum value) on a width x height display; the measurements list takes
-// measurements_share of the width.
-FrameRects ArrangeFrame(int layout, int width, int height, float measurements_share);
+// A workbench's proportions: the views' share of the height (above the panels) and the
+// measurements list's share of the width (beside the solver panel).
+struct LayoutShares {
+  float views_height = 0.58f;
+  float measurements_width = 0.45f;
+};
+// The shares of `workbench` ("lidar_camera" or "lrf") in assets/workbench/layout.json (found
+// beside the binary, core/io/assets.h); `defaults` where the file or the entry is missing (said
+// once on stderr). Throws IoError naming the file when it is malformed or a share is outside
+// [0.2, 0.8].
+LayoutShares LoadLayoutShares(const std::string& workbench, const LayoutShares& defaults);
+
+// The frame of a layout (its enum value) on a width x height display.
+FrameRects ArrangeFrame(int layout, int width, int height, const LayoutShares& shares);
 // The same below a strip of `top` pixels (the window's menu bar).
-FrameRects ArrangeFrame(int layout, int width, int height, float measurements_share, float top);
+FrameRects ArrangeFrame(int layout, int width, int height, const LayoutShares& shares, float top);
 
 }  // namespace calibench::ui
