@@ -63,7 +63,9 @@ Raster RasteriseSvg(const fs::path& svg, const Vec2& sheet_mm) {
   const fs::path png = svg.parent_path() / (svg.stem().string() + "_svg.png");
   std::string output;
   EXPECT_EQ(
+      // Its own profile: tests run in parallel, and two Chromiums never share one.
       RunCommand("chromium --headless --no-sandbox --disable-gpu --hide-scrollbars "
+                 "--user-data-dir='" + (svg.parent_path() / "chromium").string() + "' "
                  "--force-device-scale-factor=3 --window-size=" +
                      std::to_string(width) + "," + std::to_string(height) + " --screenshot='" +
                      png.string() + "' 'file://" + fs::absolute(svg).string() + "'",
