@@ -1,12 +1,71 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
+#include "core/base/atomic_file.h"
 #include "core/io/dataset.h"
 #include "core/session/session.h"
 
 namespace calibench::app {
+
+namespace {
+
+// --estimate-intrinsics: the pairs' images calibrate the camera first; said on stdout.
+int EstimateDatasetIntrinsics(const std::string& model, Dataset* dataset,
+                              std::optional<IntrinsicsResult>* result) {
+  IntrinsicsOptions options;
+  if (model == "fisheye") {
+    options.model = CameraModelType::kKannalaBrandt;
+  } else if (model != "pinhole") {
+    std::fprintf(stderr, "calibench calibrate: --intrinsics-model must be pinhole or fisheye\n");
+    return kUsage;
+  }
+  std::vector<IntrinsicsImageFile> files;
+  for (const PairEntry& pair : dataset->pairs) files.push_back({pair.id, pair.image});
+  try {
+    *result = EstimateIntrinsicsFromImages(files, dataset->target, options);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "calibench calibrate: --estimate-intrinsics: %s\n", e.what());
+    return kNoCalibration;
+  }
+  std::printf("intrinsics estimated from the pairs' images (--estimate-intrinsics%s):\n%s\n",
+              dataset->missing_camera_file.empty()
+                  ? ("; " + (dataset->manifest / "camera.yaml").string() + " is not used").c_str()
+                  : "",
+              FormatIntrinsics(**result).c_str());
+  dataset->camera = (*result)->camera;
+  return kOk;
+}
+
+// The result says that its camera was estimated, and how well.
+void AddIntrinsicsToResult(const std::string& path, const IntrinsicsResult& r) {
+  std::ifstream in(path);
+  nlohmann::json result = nlohmann::json::parse(in);
+  const CameraModel& c = r.camera;
+  int used = 0;
+  for (const IntrinsicsImage& image : r.images) used += image.used;
+  result["intrinsics"] = {
+      {"estimated", true},
+      {"model", c.type == CameraModelType::kKannalaBrandt ? "kannala-brandt" : "pinhole-radtan"},
+      {"image_size", {c.width, c.height}},
+      {"fx", c.fx},
+      {"fy", c.fy},
+      {"cx", c.cx},
+      {"cy", c.cy},
+      {"distortion", c.distortion},
+      {"parameter_names", r.parameter_names},
+      {"sigmas", r.sigmas},
+      {"rms_px", r.rms_px},
+      {"images_used", used},
+      {"images", static_cast<int>(r.images.size())},
+      {"verdict", r.verdict}};
+  WriteFileAtomically(path, result.dump(2) + "\n");
+}
+
+}  // namespace
 
 int RunCalibrate(int argc, char** argv) {
   CLI::App app{
@@ -20,6 +79,14 @@ int RunCalibrate(int argc, char** argv) {
                  "solver choices are used, so the result is the workbench's; its dataset unless "
                  "--dataset is given");
   app.add_option("--out,-o", out_path, "result file (calibench.result.v1)");
+  bool estimate_intrinsics = false;
+  std::string intrinsics_model = "pinhole";
+  app.add_flag("--estimate-intrinsics", estimate_intrinsics,
+               "estimate the camera's intrinsics from the pairs' images first (as `calibench "
+               "intrinsics`), instead of reading camera.yaml");
+  app.add_option("--intrinsics-model", intrinsics_model,
+                 "with --estimate-intrinsics: pinhole | fisheye")
+      ->capture_default_str();
   app.add_option("--report", report_path,
                  "also write the HTML report (as `calibench report`) of this solve");
   PipelineFlags flags;
@@ -41,9 +108,25 @@ int RunCalibrate(int argc, char** argv) {
     std::fprintf(stderr, "calibench calibrate: give --dataset or --session\n");
     return kUsage;
   }
-  const Dataset dataset = LoadDataset(dataset_path);
+  Dataset dataset = LoadDataset(dataset_path, CameraFile::kOptional);
+  std::optional<IntrinsicsResult> intrinsics;
+  if (!dataset.missing_camera_file.empty() && !estimate_intrinsics) {
+    std::fprintf(stderr,
+                 "calibench calibrate: %s is missing: the camera's intrinsics go there (OpenCV "
+                 "YAML, ROS camera_info or a Kalibr camchain); or pass --estimate-intrinsics to "
+                 "estimate them from the pairs' images first\n",
+                 dataset.missing_camera_file.c_str());
+    return kInputError;
+  }
+  if (estimate_intrinsics) {
+    if (const int code = EstimateDatasetIntrinsics(intrinsics_model, &dataset, &intrinsics);
+        code != kOk)
+      return code;
+  }
   CalibrationOutcome outcome;
   const int code = CalibrateAndReport(dataset, flags.options, out_path, &outcome, edits);
+  if (intrinsics && outcome.solution && !out_path.empty())
+    AddIntrinsicsToResult(out_path, *intrinsics);
   if (report_path.empty() || !outcome.solution) return code;
   ReportRequest request;
   request.out_path = report_path;

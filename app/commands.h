@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/intrinsics/intrinsics.h"
 #include "core/report/report_html.h"
 #include "core/target/board.h"
 
@@ -66,6 +67,13 @@ int RunGui(int argc, char** argv);
 int RunRender(int argc, char** argv);
 int RunExport(int argc, char** argv);
 int RunTarget(int argc, char** argv);
+int RunIntrinsics(int argc, char** argv);
+// `intrinsics` and `calibrate --estimate-intrinsics`: the board detected in each image, then
+// CalibrateIntrinsics; the images without a board are listed as not used. Throws
+// std::invalid_argument when too few images show the board, IoError for unreadable files.
+IntrinsicsResult EstimateIntrinsicsFromImages(const std::vector<IntrinsicsImageFile>& files,
+                                              const BoardSpec& board,
+                                              const IntrinsicsOptions& options);
 int RunImport(int argc, char** argv);
 // --board of `import` and `gui`: a preset's name or a target.json file; empty = nullopt (the
 // target.json beside the recording, else the preset that fits its images). Throws

@@ -45,6 +45,9 @@ constexpr Command kCommands[] = {
     {"report", calibench::app::RunReport,
      "a self-contained HTML report of a result: both directions, sigma, per-pair residuals, "
      "held-out cross-validation, plots and views"},
+    {"intrinsics", calibench::app::RunIntrinsics,
+     "the camera's intrinsics from board images (OpenCV calibrateCamera / fisheye): RMS, sigma, "
+     "coverage and the stop rule"},
     {"target", calibench::app::RunTarget,
      "a printable board at exact scale (PDF/SVG, 100 mm ruler) and its target.json"},
     {"sweep", calibench::app::RunSweep,

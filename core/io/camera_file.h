@@ -2,6 +2,8 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
+#include <string>
 
 #include "core/camera/camera.h"
 
@@ -28,5 +30,17 @@ CameraModel CameraFromCameraInfo(const std::string& distortion_model, int width,
 // LoadCameraFile and ROS's camera_info_manager read). Throws IoError naming the file.
 void SaveCameraInfoYaml(const std::filesystem::path& path, const CameraModel& camera,
                         const std::string& camera_name);
+
+// The forms a camera file is written in (each read back by LoadCameraFile).
+enum class CameraFileFormat { kRosCameraInfo, kOpenCv, kKalibr };
+std::optional<CameraFileFormat> ParseCameraFileFormat(
+    const std::string& name);  // ros|opencv|kalibr
+
+// Writes the camera (with its image size) atomically: a ROS camera_info YAML
+// (SaveCameraInfoYaml), an OpenCV FileStorage YAML (%YAML:1.0, camera_matrix,
+// distortion_coefficients, distortion_model) or a Kalibr camchain (cam0). Throws IoError naming
+// the file, also when the format cannot hold the model (Kalibr's radtan has no k3).
+void SaveCameraFile(const std::filesystem::path& path, const CameraModel& camera,
+                    CameraFileFormat format, const std::string& camera_name = "camera");
 
 }  // namespace calibench

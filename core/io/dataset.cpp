@@ -81,8 +81,8 @@ Dataset LoadManifest(const fs::path& manifest) {
 }
 
 // Folder shorthand: clouds/ and images/ paired by file stem, camera.yaml, target.json.
-Dataset LoadFolder(const fs::path& dir) {
-  Dataset dataset = LoadFolderSetup(dir);
+Dataset LoadFolder(const fs::path& dir, CameraFile camera) {
+  Dataset dataset = LoadFolderSetup(dir, camera);
   auto list = [&](const char* sub) {
     std::map<std::string, fs::path, NaturalOrder> by_stem;  // pose2 before pose10
     if (!fs::is_directory(dir / sub)) Fail(dir, std::string("folder dataset has no ") + sub + "/");
@@ -108,16 +108,24 @@ Dataset LoadFolder(const fs::path& dir) {
 
 }  // namespace
 
-Dataset LoadFolderSetup(const fs::path& dir) {
+Dataset LoadFolderSetup(const fs::path& dir, CameraFile camera) {
   Dataset dataset;
   dataset.manifest = dir;
   const fs::path camera_file = dir / "camera.yaml";
   const fs::path target_file = dir / "target.json";
-  if (!fs::exists(camera_file))
-    Fail(dir, "folder dataset has no camera.yaml (and no dataset.json)");
+  const bool has_camera = fs::exists(camera_file);
+  if (!has_camera && camera == CameraFile::kRequired)
+    Fail(dir,
+         "folder dataset has no camera.yaml (and no dataset.json): put the camera's intrinsics "
+         "there (OpenCV YAML, ROS camera_info or a Kalibr camchain), or estimate them from the "
+         "images (`calibench intrinsics`, `calibrate --estimate-intrinsics`)");
   if (!fs::exists(target_file))
     Fail(dir, "folder dataset has no target.json (and no dataset.json)");
-  dataset.camera = LoadCameraFile(camera_file);
+  if (has_camera) {
+    dataset.camera = LoadCameraFile(camera_file);
+  } else {
+    dataset.missing_camera_file = camera_file;
+  }
   dataset.target = LoadTargetFile(target_file);
   return dataset;
 }
@@ -128,9 +136,9 @@ BoardSpec LoadTargetFile(const fs::path& path) {
   return json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
 }
 
-Dataset LoadDataset(const fs::path& path) {
+Dataset LoadDataset(const fs::path& path, CameraFile camera) {
   const DatasetSource source = ResolveDataset(path, DatasetKind::kLidarCamera);
-  return source.folder_form ? LoadFolder(fs::absolute(source.path))
+  return source.folder_form ? LoadFolder(fs::absolute(source.path), camera)
                             : LoadManifest(fs::absolute(source.path));
 }
 

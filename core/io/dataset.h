@@ -46,16 +46,24 @@ struct Dataset {
   std::vector<PairEntry> pairs;
   std::optional<Pose> cam_from_lidar_ground_truth;
   std::optional<SimulationRecord> simulation;
+  // LoadDataset(path, CameraFile::kOptional) of a folder without camera.yaml: the file that is
+  // missing (`camera` is then empty); empty when the camera was read.
+  std::filesystem::path missing_camera_file;
 };
+
+// Whether a folder dataset must bring its camera.yaml (`calibrate --estimate-intrinsics` and
+// `intrinsics` read folders without one).
+enum class CameraFile { kRequired, kOptional };
 
 // Loads a manifest file, or a folder with clouds/ + images/ (paired by stem), camera.yaml and
 // target.json. Relative paths resolve against the manifest's folder. Throws IoError naming the
 // file and the problem; validates the camera and the target.
-Dataset LoadDataset(const std::filesystem::path& path);
+Dataset LoadDataset(const std::filesystem::path& path, CameraFile camera = CameraFile::kRequired);
 
 // The folder form's camera (camera.yaml) and target (target.json) without its pairs: a capture
 // that has not written any yet (`calibench watch`). Throws IoError like LoadDataset.
-Dataset LoadFolderSetup(const std::filesystem::path& dir);
+Dataset LoadFolderSetup(const std::filesystem::path& dir,
+                        CameraFile camera = CameraFile::kRequired);
 
 // A target file: the board spec at the top level or under "target" (target.json, a manifest).
 // Throws IoError naming the file.

@@ -164,6 +164,9 @@ struct PrintCase {
   std::string extension;
 };
 
+// ctest names the case, not its bytes.
+void PrintTo(const PrintCase& c, std::ostream* os) { *os << c.name; }
+
 class TargetPrint : public ::testing::TestWithParam<PrintCase> {};
 
 TEST_P(TargetPrint, OpenCvFindsThePatternAtTheRequestedScale) {
