@@ -50,6 +50,9 @@ struct Fit {
   std::vector<double> view_rms;  // per used view
   double rms = 0.0;
   std::vector<double> sigmas;  // fx fy cx cy, distortion
+  // Fisheye: views (indices into the fitted views) the refit could not start from; the caller
+  // drops them and fits again.
+  std::vector<size_t> beyond_start;
 };
 
 Fit FitPinhole(const CvViews& v, const cv::Size& size, const IntrinsicsOptions& o) {
@@ -144,21 +147,12 @@ Fit FitFisheye(const CvViews& v, const cv::Size& size) {
         finite &= std::isfinite(p.x) && std::isfinite(p.y) && cv::norm(p) < 5.7;  // tan 80 deg
       if (finite) usable.push_back(i);
     }
-    calibrate(usable, &fit, cv::fisheye::CALIB_USE_INTRINSIC_GUESS);
     if (usable.size() < all.size()) {
-      // The rest are posed under the refined camera for their errors (kept in the fit's order).
-      std::vector<cv::Mat> rvecs(all.size()), tvecs(all.size());
-      for (size_t k = 0; k < usable.size(); ++k)
-        rvecs[usable[k]] = fit.rvecs[k], tvecs[usable[k]] = fit.tvecs[k];
-      for (const size_t i : all) {
-        if (!rvecs[i].empty()) continue;
-        std::vector<cv::Point2f> normalized;
-        cv::fisheye::undistortPoints(v.image[i], normalized, fit.K, fit.D);
-        cv::solvePnP(v.object[i], normalized, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), rvecs[i],
-                     tvecs[i]);
-      }
-      fit.rvecs = rvecs, fit.tvecs = tvecs;
+      for (const size_t i : all)
+        if (!std::binary_search(usable.begin(), usable.end(), i)) fit.beyond_start.push_back(i);
+      return fit;
     }
+    calibrate(all, &fit, cv::fisheye::CALIB_USE_INTRINSIC_GUESS);
   } else {
     calibrate(all, &fit, 0);
   }
@@ -326,6 +320,21 @@ IntrinsicsResult CalibrateIntrinsics(const std::vector<IntrinsicsView>& views, i
       fit = fisheye ? FitFisheye(cv_views, size) : FitPinhole(cv_views, size, options);
     } catch (const cv::Exception& e) {
       throw std::invalid_argument(std::string("OpenCV could not calibrate: ") + e.err);
+    }
+    if (!fit.beyond_start.empty()) {
+      std::vector<size_t> kept;
+      for (size_t k = 0; k < used.size(); ++k) {
+        if (!std::binary_search(fit.beyond_start.begin(), fit.beyond_start.end(), k)) {
+          kept.push_back(used[k]);
+          continue;
+        }
+        result.images[used[k]].used = false;
+        result.images[used[k]].reason =
+            "corners past 80 deg off axis under the first fit: fisheye::calibrate cannot start "
+            "its poses from them";
+      }
+      used = kept;
+      continue;
     }
     for (size_t k = 0; k < used.size(); ++k) result.images[used[k]].rms_px = fit.view_rms[k];
     const double limit = std::max(1.0, options.reject_factor * Median(fit.view_rms));

@@ -65,8 +65,10 @@ Raster RasteriseSvg(const fs::path& svg, const Vec2& sheet_mm) {
   EXPECT_EQ(
       // Its own profile: tests run in parallel, and two Chromiums never share one.
       RunCommand("chromium --headless --no-sandbox --disable-gpu --hide-scrollbars "
-                 "--user-data-dir='" + (svg.parent_path() / "chromium").string() + "' "
-                 "--force-device-scale-factor=3 --window-size=" +
+                 "--user-data-dir='" +
+                     (svg.parent_path() / "chromium").string() +
+                     "' "
+                     "--force-device-scale-factor=3 --window-size=" +
                      std::to_string(width) + "," + std::to_string(height) + " --screenshot='" +
                      png.string() + "' 'file://" + fs::absolute(svg).string() + "'",
                  &output),
