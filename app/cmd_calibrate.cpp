@@ -17,12 +17,14 @@ namespace {
 int EstimateDatasetIntrinsics(const std::string& model, Dataset* dataset,
                               std::optional<IntrinsicsResult>* result) {
   IntrinsicsOptions options;
-  if (model == "fisheye") {
-    options.model = CameraModelType::kKannalaBrandt;
-  } else if (model != "pinhole") {
-    std::fprintf(stderr, "calibench calibrate: --intrinsics-model must be pinhole or fisheye\n");
+  const auto camera_model = ParseIntrinsicsModel(model);
+  if (!camera_model) {
+    std::fprintf(stderr,
+                 "calibench calibrate: --intrinsics-model must be pinhole or fisheye, got '%s'\n",
+                 model.c_str());
     return kUsage;
   }
+  options.model = *camera_model;
   std::vector<IntrinsicsImageFile> files;
   for (const PairEntry& pair : dataset->pairs) files.push_back({pair.id, pair.image});
   try {
@@ -97,13 +99,7 @@ int RunCalibrate(int argc, char** argv) {
     std::fprintf(stderr, "calibench calibrate: %s\n", why.c_str());
     return kUsage;
   }
-  PairEdits edits;
-  if (!session_path.empty()) {
-    const Session session = LoadSession(session_path);
-    if (dataset_path.empty()) dataset_path = session.dataset.string();
-    ApplySessionOptions(session, &flags.options);
-    edits = EditsFromSession(session);
-  }
+  const PairEdits edits = ApplySessionFlag(session_path, &dataset_path, &flags.options);
   if (dataset_path.empty()) {
     std::fprintf(stderr, "calibench calibrate: give --dataset or --session\n");
     return kUsage;

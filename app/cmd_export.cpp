@@ -15,22 +15,6 @@ namespace calibench::app {
 
 namespace {
 
-// cam_from_lidar (or cam_from_lrf) of a calibench.result.v1 file or of a session's last solve.
-Pose CalibrationOf(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string head(4096, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<size_t>(in.gcount()));
-  if (head.find("calibench.session.v1") == std::string::npos)
-    return LoadResult(path).cam_from_source;
-  const Session session = LoadSession(path);
-  if (!session.result)
-    throw IoError(path.string() +
-                  ": the session has no result yet (press Run in the workbench, "
-                  "or `calibench calibrate --session`)");
-  return session.result->cam_from_lidar;
-}
-
 std::string FormatNames() {
   std::string names;
   for (const ExportFormat format : AllExportFormats())
@@ -39,6 +23,16 @@ std::string FormatNames() {
 }
 
 }  // namespace
+
+Pose CalibrationOf(const std::filesystem::path& path) {
+  if (!IsSessionFile(path)) return LoadResult(path).cam_from_source;
+  const Session session = LoadSession(path);
+  if (!session.result)
+    throw IoError(path.string() +
+                  ": the session has no result yet (press Run in the workbench, "
+                  "or `calibench calibrate --session`)");
+  return session.result->cam_from_lidar;
+}
 
 int RunExport(int argc, char** argv) {
   CLI::App app{

@@ -70,6 +70,12 @@ ImageSet ImagesOf(const fs::path& path, const std::string& board_flag) {
 
 }  // namespace
 
+std::optional<CameraModelType> ParseIntrinsicsModel(const std::string& name) {
+  if (name == "pinhole") return CameraModelType::kPinholeRadTan;
+  if (name == "fisheye") return CameraModelType::kKannalaBrandt;
+  return std::nullopt;
+}
+
 IntrinsicsResult EstimateIntrinsicsFromImages(const std::vector<IntrinsicsImageFile>& files,
                                               const BoardSpec& board,
                                               const IntrinsicsOptions& options) {
@@ -107,13 +113,13 @@ int RunIntrinsics(int argc, char** argv) {
       ->capture_default_str();
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
   IntrinsicsOptions options;
-  if (model == "fisheye") {
-    options.model = CameraModelType::kKannalaBrandt;
-  } else if (model != "pinhole") {
+  const auto camera_model = ParseIntrinsicsModel(model);
+  if (!camera_model) {
     std::fprintf(stderr, "calibench intrinsics: --model must be pinhole or fisheye, got '%s'\n",
                  model.c_str());
     return kUsage;
   }
+  options.model = *camera_model;
   options.estimate_k3 = !fix_k3;
   const auto file_format = ParseCameraFileFormat(format);
   if (!file_format) {

@@ -30,14 +30,6 @@ std::string NowUtc() {
   return text;
 }
 
-bool IsSessionFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string head(4096, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<size_t>(in.gcount()));
-  return head.find("calibench.session.v1") != std::string::npos;
-}
-
 // The solver method a result file records (its "solver"."method"), "" when it names none.
 std::string ResultMethod(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -115,20 +107,8 @@ int RunReport(int argc, char** argv) {
   request.options.cross_validate = !no_cross_validation;
   request.result_file = result_path;
   if (session_path.empty() && IsSessionFile(result_path)) session_path = result_path;
-  PairEdits edits;
-  std::optional<Pose> reported;
-  if (!session_path.empty()) {
-    const Session session = LoadSession(session_path);
-    if (dataset_path.empty()) dataset_path = session.dataset.string();
-    ApplySessionOptions(session, &flags.options);
-    edits = EditsFromSession(session);
-    if (session_path == result_path && session.result) reported = session.result->cam_from_lidar;
-  }
-  if (!reported) {
-    if (IsSessionFile(result_path))
-      throw IoError(result_path + ": the session has no result yet (solve it in the workbench)");
-    reported = LoadResult(result_path).cam_from_source;
-  }
+  const Pose reported = CalibrationOf(result_path);
+  const PairEdits edits = ApplySessionFlag(session_path, &dataset_path, &flags.options);
   if (dataset_path.empty()) {
     std::fprintf(stderr, "calibench report: give --dataset or --session (the result's data)\n");
     return kUsage;
@@ -144,9 +124,9 @@ int RunReport(int argc, char** argv) {
   }
   // The figures are the re-solve's: say so when it is not the result's pose.
   const Pose& solved = outcome.solution->cam_from_lidar;
-  const double moved_mm = 1000.0 * (solved.translation() - reported->translation()).norm();
+  const double moved_mm = 1000.0 * (solved.translation() - reported.translation()).norm();
   const double turned_deg =
-      Eigen::AngleAxisd(solved.linear().transpose() * reported->linear()).angle() * kRadToDeg;
+      Eigen::AngleAxisd(solved.linear().transpose() * reported.linear()).angle() * kRadToDeg;
   if (moved_mm > 0.1 || turned_deg > 0.01) {
     char note[512];
     std::snprintf(note, sizeof(note),

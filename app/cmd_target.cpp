@@ -57,6 +57,77 @@ void CheckTargetJsonFree(const fs::path& path, const std::string& text) {
                   "name another file with --target-json");
 }
 
+// The pattern flags of `target`, as given.
+struct PatternFlags {
+  std::string type = "checkerboard", preset, square, marker, dictionary = "DICT_4X4_50";
+  bool type_given = false;
+  std::vector<int> inner_corners, squares;
+};
+
+// The board the flags describe (a preset, with the flags given overriding it); nullopt with *why
+// naming the flag that is wrong or missing.
+std::optional<BoardSpec> BoardFromPatternFlags(const PatternFlags& f, std::string* why) {
+  BoardSpec board;
+  if (!f.preset.empty()) {
+    try {
+      board = BoardPreset(f.preset);
+    } catch (const std::invalid_argument& e) {
+      *why = std::string("--preset: ") + e.what();
+      return std::nullopt;
+    }
+  }
+  if (f.preset.empty() || f.type_given) {
+    if (f.type != "checkerboard" && f.type != "charuco") {
+      *why = "--type must be checkerboard or charuco, got '" + f.type + "'";
+      return std::nullopt;
+    }
+    board.type = f.type == "charuco" ? BoardType::kCharuco : BoardType::kCheckerboard;
+  }
+  const bool checker = board.type == BoardType::kCheckerboard;
+  if (!f.inner_corners.empty() && !f.squares.empty()) {
+    *why = "give --inner-corners or --squares, not both";
+    return std::nullopt;
+  }
+  if (!f.inner_corners.empty()) {
+    if (!checker) {
+      *why = "a ChArUco board is given by --squares C R, not --inner-corners";
+      return std::nullopt;
+    }
+    board.cols = f.inner_corners[0], board.rows = f.inner_corners[1];
+  } else if (!f.squares.empty()) {
+    board.cols = checker ? f.squares[0] - 1 : f.squares[0];
+    board.rows = checker ? f.squares[1] - 1 : f.squares[1];
+  } else if (f.preset.empty()) {
+    *why = checker ? "the pattern: --inner-corners C R (or --squares C R)"
+                   : "the pattern: --squares C R";
+    return std::nullopt;
+  }
+  if (!f.square.empty()) {
+    const auto size = ParseLength(f.square, why);
+    if (!size) {
+      *why = "--square-size: " + *why;
+      return std::nullopt;
+    }
+    board.square_size = *size;
+  } else if (f.preset.empty()) {
+    *why = "the square's side: --square-size (0.04 or 40mm)";
+    return std::nullopt;
+  }
+  if (checker) return board;
+  board.dictionary = f.dictionary;
+  if (!f.marker.empty()) {
+    const auto size = ParseLength(f.marker, why);
+    if (!size) {
+      *why = "--marker-size: " + *why;
+      return std::nullopt;
+    }
+    board.marker_size = *size;
+  } else if (f.preset.empty() || !f.square.empty()) {
+    board.marker_size = 0.75 * board.square_size;
+  }
+  return board;
+}
+
 }  // namespace
 
 int RunTarget(int argc, char** argv) {
@@ -66,20 +137,21 @@ int RunTarget(int argc, char** argv) {
       "(board_size = the sheet). ChArUco boards are OpenCV's for the same parameters. Lengths "
       "are metres or carry a unit: 0.04, 40mm, 4cm.",
       "calibench target"};
-  std::string type = "checkerboard", square_text, marker_text, dictionary = "DICT_4X4_50";
-  std::string paper_name = "a4", orientation_name = "auto", out, target_json, preset;
-  std::vector<int> inner_corners, squares;
-  app.add_option("--type", type, "checkerboard | charuco")->capture_default_str();
-  app.add_option("--preset", preset,
+  PatternFlags pattern;
+  std::string paper_name = "a4", orientation_name = "auto", out, target_json;
+  app.add_option("--type", pattern.type, "checkerboard | charuco")->capture_default_str();
+  app.add_option("--preset", pattern.preset,
                  "start from a named board (a3, a4, charuco-a3, charuco-a4); other flags override "
                  "its pattern");
-  app.add_option("--inner-corners", inner_corners, "checkerboard: inner corners C R")->expected(2);
-  app.add_option("--squares", squares, "charuco: squares C R (checkerboard: C-1 R-1 corners)")
+  app.add_option("--inner-corners", pattern.inner_corners, "checkerboard: inner corners C R")
       ->expected(2);
-  app.add_option("--square-size", square_text, "side of one square (0.04, 40mm)");
-  app.add_option("--marker-size", marker_text,
+  app.add_option("--squares", pattern.squares,
+                 "charuco: squares C R (checkerboard: C-1 R-1 corners)")
+      ->expected(2);
+  app.add_option("--square-size", pattern.square, "side of one square (0.04, 40mm)");
+  app.add_option("--marker-size", pattern.marker,
                  "charuco: side of one marker (default 0.75 of the square)");
-  app.add_option("--dictionary", dictionary, "charuco: OpenCV's ArUco dictionary")
+  app.add_option("--dictionary", pattern.dictionary, "charuco: OpenCV's ArUco dictionary")
       ->capture_default_str();
   app.add_option("--paper", paper_name, PaperNames())->capture_default_str();
   app.add_option("--orientation", orientation_name,
@@ -89,57 +161,15 @@ int RunTarget(int argc, char** argv) {
   app.add_option("--target-json", target_json,
                  "where the matching target file goes (default: target.json beside --out)");
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
+  pattern.type_given = app.count("--type") > 0;
 
   auto usage = [](const std::string& why) {
     std::fprintf(stderr, "calibench target: %s\n", why.c_str());
     return kUsage;
   };
-  BoardSpec board;
-  try {
-    if (!preset.empty()) board = BoardPreset(preset);
-  } catch (const std::invalid_argument& e) {
-    return usage(std::string("--preset: ") + e.what());
-  }
-  if (preset.empty() || app.count("--type")) {
-    if (type == "checkerboard") {
-      board.type = BoardType::kCheckerboard;
-    } else if (type == "charuco") {
-      board.type = BoardType::kCharuco;
-    } else {
-      return usage("--type must be checkerboard or charuco, got '" + type + "'");
-    }
-  }
-  const bool checker = board.type == BoardType::kCheckerboard;
-  if (!inner_corners.empty() && !squares.empty())
-    return usage("give --inner-corners or --squares, not both");
-  if (!inner_corners.empty()) {
-    if (!checker) return usage("a ChArUco board is given by --squares C R, not --inner-corners");
-    board.cols = inner_corners[0], board.rows = inner_corners[1];
-  } else if (!squares.empty()) {
-    board.cols = checker ? squares[0] - 1 : squares[0];
-    board.rows = checker ? squares[1] - 1 : squares[1];
-  } else if (preset.empty()) {
-    return usage(checker ? "the pattern: --inner-corners C R (or --squares C R)"
-                         : "the pattern: --squares C R");
-  }
   std::string why;
-  if (!square_text.empty()) {
-    const auto size = ParseLength(square_text, &why);
-    if (!size) return usage("--square-size: " + why);
-    board.square_size = *size;
-  } else if (preset.empty()) {
-    return usage("the square's side: --square-size (0.04 or 40mm)");
-  }
-  if (!checker) {
-    board.dictionary = dictionary;
-    if (!marker_text.empty()) {
-      const auto size = ParseLength(marker_text, &why);
-      if (!size) return usage("--marker-size: " + why);
-      board.marker_size = *size;
-    } else if (preset.empty() || !square_text.empty()) {
-      board.marker_size = 0.75 * board.square_size;
-    }
-  }
+  const std::optional<BoardSpec> board = BoardFromPatternFlags(pattern, &why);
+  if (!board) return usage(why);
   TargetSheetOptions options;
   const auto paper = ParsePaperName(paper_name);
   const auto orientation = ParseSheetOrientation(orientation_name);
@@ -152,7 +182,7 @@ int RunTarget(int argc, char** argv) {
 
   TargetSheet sheet;
   try {
-    sheet = LayoutTargetSheet(board, options);
+    sheet = LayoutTargetSheet(*board, options);
   } catch (const std::invalid_argument& e) {
     return usage(e.what());
   }

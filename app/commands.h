@@ -2,6 +2,7 @@
 // returns the process exit code (see ExitCode).
 #pragma once
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -66,11 +67,17 @@ bool IsLrfManifest(const std::string& path);
 int RunGui(int argc, char** argv);
 int RunRender(int argc, char** argv);
 int RunExport(int argc, char** argv);
+// cam_from_lidar (or cam_from_lrf) of a calibench.result.v1 file or of a session's last solve
+// (`export`, `report`). Throws IoError naming the file, also for a session without a result.
+Pose CalibrationOf(const std::filesystem::path& path);
 int RunTarget(int argc, char** argv);
 int RunIntrinsics(int argc, char** argv);
 // `intrinsics` and `calibrate --estimate-intrinsics`: the board detected in each image, then
 // CalibrateIntrinsics; the images without a board are listed as not used. Throws
 // std::invalid_argument when too few images show the board, IoError for unreadable files.
+// "pinhole" -> pinhole-radtan, "fisheye" -> kannala-brandt (--model of `intrinsics`,
+// --intrinsics-model of `calibrate`); nullopt for other names.
+std::optional<CameraModelType> ParseIntrinsicsModel(const std::string& name);
 IntrinsicsResult EstimateIntrinsicsFromImages(const std::vector<IntrinsicsImageFile>& files,
                                               const BoardSpec& board,
                                               const IntrinsicsOptions& options);

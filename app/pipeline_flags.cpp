@@ -7,6 +7,7 @@
 
 #include "app/commands.h"
 #include "core/lidar_camera/result_io.h"
+#include "core/session/session.h"
 
 namespace calibench::app {
 
@@ -128,6 +129,15 @@ ProgressCallback StderrProgress(const std::string& verb) {
     if (tty && done == total) std::fprintf(stderr, "\n");
     std::fflush(stderr);
   };
+}
+
+PairEdits ApplySessionFlag(const std::string& session_path, std::string* dataset_path,
+                           PipelineOptions* options) {
+  if (session_path.empty()) return {};
+  const Session session = LoadSession(session_path);
+  if (dataset_path->empty()) *dataset_path = session.dataset.string();
+  ApplySessionOptions(session, options);
+  return EditsFromSession(session);
 }
 
 int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,

@@ -23,6 +23,12 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection =
 // Applies the string flags; false with *why when they are malformed or the options fail Check.
 bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why);
 
+// --session of `calibrate` and `report`: the workbench session's solver choices applied to
+// *options, its dataset into *dataset_path (unless one was given), and its brushes and
+// rejections as the pipeline's edits; nothing when session_path is empty. Throws IoError.
+PairEdits ApplySessionFlag(const std::string& session_path, std::string* dataset_path,
+                           PipelineOptions* options);
+
 // Prints "[k/n] pair ID" progress to stderr (one line per pair when stderr is not a terminal).
 ProgressCallback StderrProgress(const std::string& verb);
 

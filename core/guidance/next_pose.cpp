@@ -8,6 +8,7 @@
 #include <limits>
 #include <map>
 
+#include "core/base/statistics.h"
 #include "core/estimation/uncertainty.h"
 #include "core/sim/crlb.h"
 
@@ -46,13 +47,6 @@ bool GuidanceOptions::Check(std::string* why) const {
 }
 
 namespace {
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  return values[mid];
-}
 
 // The sheet's corners in BoardSpec's frame.
 std::vector<Vec3> SheetCorners(const BoardSpec& board) {

@@ -10,6 +10,8 @@
 #include <opencv2/calib3d.hpp>
 #include <stdexcept>
 
+#include "core/base/statistics.h"
+
 namespace calibench {
 namespace {
 
@@ -173,9 +175,47 @@ Fit FitFisheye(const CvViews& v, const cv::Size& size) {
   return fit;
 }
 
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
+// Drops the views at positions k of `used` whose reason(k) is not empty, saying why in their
+// image entries; true when any was dropped.
+template <typename Reason>
+bool DropViews(const Reason& reason, std::vector<size_t>* used,
+               std::vector<IntrinsicsImage>* images) {
+  std::vector<size_t> kept;
+  for (size_t k = 0; k < used->size(); ++k) {
+    const std::string why = reason(k);
+    if (why.empty()) {
+      kept.push_back((*used)[k]);
+      continue;
+    }
+    (*images)[(*used)[k]].used = false;
+    (*images)[(*used)[k]].reason = why;
+  }
+  const bool dropped = kept.size() < used->size();
+  *used = std::move(kept);
+  return dropped;
+}
+
+// The fitted camera, its parameters in order with their σ, and the RMS into *result.
+void FillCamera(const Fit& fit, CameraModelType model, int width, int height,
+                IntrinsicsResult* result) {
+  const bool fisheye = model == CameraModelType::kKannalaBrandt;
+  CameraModel& camera = result->camera;
+  camera.type = model;
+  camera.width = width, camera.height = height;
+  camera.fx = fit.K.at<double>(0, 0), camera.fy = fit.K.at<double>(1, 1);
+  camera.cx = fit.K.at<double>(0, 2), camera.cy = fit.K.at<double>(1, 2);
+  const int coefficients = fisheye ? 4 : 5;
+  for (int i = 0; i < coefficients; ++i) camera.distortion.push_back(fit.D.at<double>(i));
+  result->rms_px = fit.rms;
+  result->parameter_names = {"fx", "fy", "cx", "cy"};
+  for (const char* name : fisheye ? std::vector<const char*>{"k1", "k2", "k3", "k4"}
+                                  : std::vector<const char*>{"k1", "k2", "p1", "p2", "k3"})
+    result->parameter_names.push_back(name);
+  result->parameters = {camera.fx, camera.fy, camera.cx, camera.cy};
+  result->parameters.insert(result->parameters.end(), camera.distortion.begin(),
+                            camera.distortion.end());
+  result->sigmas = fit.sigmas;
+  result->sigmas.resize(result->parameters.size(), 0.0);
 }
 
 std::string Percent(double value) {
@@ -315,62 +355,35 @@ IntrinsicsResult CalibrateIntrinsics(const std::vector<IntrinsicsView>& views, i
       throw std::invalid_argument("intrinsics need " + std::to_string(options.min_images) +
                                   " images with the board, " + std::to_string(used.size()) +
                                   " usable");
-    const CvViews cv_views = ToCv(views, used);
     try {
+      const CvViews cv_views = ToCv(views, used);
       fit = fisheye ? FitFisheye(cv_views, size) : FitPinhole(cv_views, size, options);
     } catch (const cv::Exception& e) {
       throw std::invalid_argument(std::string("OpenCV could not calibrate: ") + e.err);
     }
     if (!fit.beyond_start.empty()) {
-      std::vector<size_t> kept;
-      for (size_t k = 0; k < used.size(); ++k) {
-        if (!std::binary_search(fit.beyond_start.begin(), fit.beyond_start.end(), k)) {
-          kept.push_back(used[k]);
-          continue;
-        }
-        result.images[used[k]].used = false;
-        result.images[used[k]].reason =
-            "corners past 80 deg off axis under the first fit: fisheye::calibrate cannot start "
-            "its poses from them";
-      }
-      used = kept;
+      DropViews(
+          [&](size_t k) {
+            return std::binary_search(fit.beyond_start.begin(), fit.beyond_start.end(), k)
+                       ? "corners past 80 deg off axis under the first fit: fisheye::calibrate "
+                         "cannot start its poses from them"
+                       : std::string();
+          },
+          &used, &result.images);
       continue;
     }
     for (size_t k = 0; k < used.size(); ++k) result.images[used[k]].rms_px = fit.view_rms[k];
     const double limit = std::max(1.0, options.reject_factor * Median(fit.view_rms));
-    std::vector<size_t> kept;
-    for (size_t k = 0; k < used.size(); ++k) {
-      if (fit.view_rms[k] <= limit || round >= options.max_rounds) {
-        kept.push_back(used[k]);
-        continue;
-      }
-      IntrinsicsImage& image = result.images[used[k]];
-      image.used = false;
+    const auto too_far = [&](size_t k) {
+      if (fit.view_rms[k] <= limit) return std::string();
       char text[128];
       std::snprintf(text, sizeof(text), "corner RMS %.2f px > %.2f px (%.0fx the median image)",
                     fit.view_rms[k], limit, options.reject_factor);
-      image.reason = text;
-    }
-    if (kept.size() == used.size()) break;
-    used = kept;
+      return std::string(text);
+    };
+    if (round >= options.max_rounds || !DropViews(too_far, &used, &result.images)) break;
   }
-  CameraModel& camera = result.camera;
-  camera.type = options.model;
-  camera.width = width, camera.height = height;
-  camera.fx = fit.K.at<double>(0, 0), camera.fy = fit.K.at<double>(1, 1);
-  camera.cx = fit.K.at<double>(0, 2), camera.cy = fit.K.at<double>(1, 2);
-  const int coefficients = fisheye ? 4 : 5;
-  for (int i = 0; i < coefficients; ++i) camera.distortion.push_back(fit.D.at<double>(i));
-  result.rms_px = fit.rms;
-  result.parameter_names = {"fx", "fy", "cx", "cy"};
-  for (const char* name : fisheye ? std::vector<const char*>{"k1", "k2", "k3", "k4"}
-                                  : std::vector<const char*>{"k1", "k2", "p1", "p2", "k3"})
-    result.parameter_names.push_back(name);
-  result.parameters = {camera.fx, camera.fy, camera.cx, camera.cy};
-  result.parameters.insert(result.parameters.end(), camera.distortion.begin(),
-                           camera.distortion.end());
-  result.sigmas = fit.sigmas;
-  result.sigmas.resize(result.parameters.size(), 0.0);
+  FillCamera(fit, options.model, width, height, &result);
   std::vector<IntrinsicsView> used_views;
   for (const size_t i : used) used_views.push_back(views[i]);
   result.coverage = MeasureCoverage(used_views, width, height, options);

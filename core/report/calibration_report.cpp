@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/base/parallel.h"
+#include "core/base/statistics.h"
 #include "core/estimation/uncertainty.h"
 #include "core/lidar_camera/result_io.h"
 
@@ -101,12 +102,6 @@ std::optional<SolverResult> SolveSubset(const std::vector<PairFeatures>& pairs,
 double RotationAngleDeg(const Mat3& a, const Mat3& b) {
   const double cosine = std::clamp(0.5 * ((a.transpose() * b).trace() - 1.0), -1.0, 1.0);
   return std::acos(cosine) * kRadToDeg;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 // Whether `value` stands out of `others`: beyond their median by `sigmas` robust standard

@@ -127,6 +127,14 @@ PairEdits EditsFromSession(const Session& session) {
   return edits;
 }
 
+bool IsSessionFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  return head.find("calibench.session.v1") != std::string::npos;
+}
+
 Session LoadSession(const std::filesystem::path& path) {
   std::error_code error;
   const auto status = std::filesystem::status(path, error);

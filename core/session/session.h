@@ -155,6 +155,10 @@ Session SessionFromJson(const std::string& text, const std::filesystem::path& so
 
 // Reads a session file; never writes it. Throws IoError naming the file and the problem.
 Session LoadSession(const std::filesystem::path& path);
+// Whether the file is a session (its first 4 KB name calibench.session.v1): what `export`,
+// `report` and the workbench's Open tell a session from a result or a manifest by. False for a
+// file that cannot be read.
+bool IsSessionFile(const std::filesystem::path& path);
 
 // Writes atomically (temporary + rename); throws IoError naming the file.
 void SaveSession(const std::filesystem::path& path, const Session& session);

@@ -8,8 +8,8 @@
 namespace calibench {
 namespace {
 
-constexpr double kInkGrey = 20.0;      // rendered grey of black ink (0..255)
-constexpr double kPaperGrey = 235.0;   // white paper, below 255 so that noise does not clip
+constexpr double kInkGrey = 20.0;     // rendered grey of black ink (0..255)
+constexpr double kPaperGrey = 235.0;  // white paper, below 255 so that noise does not clip
 // Bearings are unprojected exactly on a grid of this pitch (pixels) and interpolated in between:
 // the interpolation error is below 0.005 px for the cameras we simulate (measured), and Newton per
 // sample would cost ~0.5 us.

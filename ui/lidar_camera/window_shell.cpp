@@ -61,13 +61,8 @@ struct ImportJob {
 OpenKind KindOfPath(const fs::path& path) {
   if (LooksLikeBag(path)) return OpenKind::kRecording;
   std::error_code error;
-  if (fs::is_regular_file(path, error) && path.extension() == ".json") {
-    std::ifstream in(path, std::ios::binary);
-    std::string head(4096, '\0');
-    in.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(in.gcount()));
-    if (head.find("calibench.session.v1") != std::string::npos) return OpenKind::kSession;
-  }
+  if (fs::is_regular_file(path, error) && path.extension() == ".json" && IsSessionFile(path))
+    return OpenKind::kSession;
   return OpenKind::kDataset;
 }
 
@@ -275,7 +270,8 @@ void WindowShell::BoardMenu() {
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("the target.json beside the recording, else the preset that fits the images");
   // The presets Calibench ships (assets/targets/*.json; a board dropped there shows up too).
-  for (const auto& [name, board] : TargetPresets()) {
+  if (presets_.empty()) presets_ = TargetPresets();
+  for (const auto& [name, board] : presets_) {
     const bool chosen = options_.board && board.type == options_.board->type &&
                         board.cols == options_.board->cols && board.rows == options_.board->rows &&
                         board.square_size == options_.board->square_size;

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/io/bag_import.h"
@@ -86,6 +87,8 @@ class WindowShell {
   FileBrowser browser_;
   std::unique_ptr<ImportJob> import_;
   std::unique_ptr<ReportJob> report_;
+  // The board presets (assets/targets), read when the menu first opens, not every frame.
+  std::vector<std::pair<std::string, BoardSpec>> presets_;
   std::string report_message_;  // the last report's outcome, shown once in a popup
   bool show_report_ = false;
   std::optional<BagImportSummary> last_import_;
