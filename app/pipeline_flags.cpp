@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "core/lidar_camera/joint_intrinsics.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/session/session.h"
 
@@ -38,6 +39,16 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
                  "none): estimated, a prior on it; left out, the bias it could cause is in the "
                  "reported σ")
       ->capture_default_str();
+  app.add_flag("--refine-intrinsics{focal}", flags.refine_intrinsics,
+               "estimate the camera's intrinsics with the extrinsic in one joint problem "
+               "(corners, LiDAR planes and edges), then pose every pair under them: focal "
+               "(fx fy, the default: what the LiDAR's distances tell) | pinhole (+ cx cy) | all "
+               "(+ the distortion), as --refine-intrinsics=all; the result gets an "
+               "\"intrinsics\" entry with both cameras");
+  app.add_flag_callback(
+      "--ignore-intrinsics-covariance", [&o] { o.propagate_intrinsics = false; },
+      "leave the camera file's intrinsics covariance (intrinsics_covariance) out of the "
+      "extrinsic's sigma (it is carried into it by default)");
   app.add_flag_callback(
       "--no-jackknife", [&o] { o.solver.jackknife_covariance = false; },
       "weighted-ml: do not widen the reported covariance to the leave-one-pair-out spread");
@@ -83,6 +94,16 @@ bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {
       return false;
     }
     flags.options.lidar_model = *model;
+  }
+  if (!flags.refine_intrinsics.empty()) {
+    const auto which = ParseIntrinsicsToRefine(flags.refine_intrinsics);
+    if (!which) {
+      *why = "--refine-intrinsics must be focal, pinhole or all, not '" + flags.refine_intrinsics +
+             "'";
+      return false;
+    }
+    flags.options.refine_intrinsics = true;
+    flags.options.intrinsics_to_refine = *which;
   }
   if (!flags.pairs.empty()) {
     std::stringstream ss(flags.pairs);

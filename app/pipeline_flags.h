@@ -15,6 +15,7 @@ struct PipelineFlags {
   std::string method = "weighted-ml";
   double range_offset_prior_mm = 0.0;  // SolverOptions::range_offset_prior_sigma_m, in mm
   std::string lidar_model;             // PipelineOptions::lidar_model; "" = from the clouds
+  std::string refine_intrinsics;       // --refine-intrinsics[=focal|pinhole|all]; "" = off
 };
 
 // with_selection adds --pairs and --initial-guess (not wanted where pairs are simulated).

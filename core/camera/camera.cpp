@@ -1,5 +1,6 @@
 #include "core/camera/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -256,6 +257,22 @@ bool AllFinite(const CameraModel& c) {
   return std::isfinite(c.fx) && std::isfinite(c.fy) && std::isfinite(c.cx) && std::isfinite(c.cy);
 }
 
+// An n x n row-major covariance that is finite, symmetric and has a non-negative diagonal (empty
+// is valid: unknown).
+bool CovarianceValid(const std::vector<double>& c, size_t n) {
+  if (c.empty()) return true;
+  for (size_t i = 0; i < n; ++i) {
+    if (!(c[i * n + i] >= 0)) return false;
+    for (size_t j = 0; j < n; ++j) {
+      // Symmetric to the precision a file's 17 digits and an inversion keep.
+      const double a = c[i * n + j], b = c[j * n + i];
+      const double scale = std::sqrt(std::abs(c[i * n + i] * c[j * n + j]));
+      if (!std::isfinite(a) || std::abs(a - b) > 1e-6 * scale) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 std::string CameraModelName(CameraModelType type) {
@@ -283,11 +300,41 @@ bool CameraModel::Check(std::string* why) const {
     problem << "focal lengths must be positive, got fx=" << fx << " fy=" << fy;
   } else if (width <= 0 || height <= 0) {
     problem << "image size must be positive, got " << width << "x" << height;
+  } else if (!covariance.empty() && covariance.size() != (4 + n) * (4 + n)) {
+    problem << "the intrinsics' covariance needs " << (4 + n) << "x" << (4 + n)
+            << " values (fx fy cx cy and the distortion), got " << covariance.size();
+  } else if (!CovarianceValid(covariance, 4 + n)) {
+    problem << "the intrinsics' covariance must be finite and symmetric with a non-negative "
+               "diagonal";
   } else {
     return true;
   }
   if (why) *why = problem.str();
   return false;
+}
+
+std::vector<double> IntrinsicParameters(const CameraModel& camera) {
+  std::vector<double> parameters = {camera.fx, camera.fy, camera.cx, camera.cy};
+  parameters.insert(parameters.end(), camera.distortion.begin(), camera.distortion.end());
+  return parameters;
+}
+
+std::vector<std::string> IntrinsicParameterNames(const CameraModel& camera) {
+  std::vector<std::string> names = {"fx", "fy", "cx", "cy"};
+  static const char* const kRadTan[] = {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"};
+  for (size_t i = 0; i < camera.distortion.size(); ++i)
+    names.push_back(camera.type == CameraModelType::kKannalaBrandt ? "k" + std::to_string(i + 1)
+                                                                   : kRadTan[i % 8]);
+  return names;
+}
+
+void SetIntrinsicParameters(const std::vector<double>& parameters, CameraModel* camera) {
+  CALIBENCH_CHECK(parameters.size() == 4 + camera->distortion.size());
+  camera->fx = parameters[0];
+  camera->fy = parameters[1];
+  camera->cx = parameters[2];
+  camera->cy = parameters[3];
+  std::copy(parameters.begin() + 4, parameters.end(), camera->distortion.begin());
 }
 
 std::optional<Vec2> CameraModel::Project(const Vec3& point_in_cam,

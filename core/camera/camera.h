@@ -25,6 +25,10 @@ struct CameraModel {
   double fx = 0, fy = 0, cx = 0, cy = 0;  // pixels
   // pinhole-radtan: 4, 5 or 8 values; kannala-brandt: exactly 4.
   std::vector<double> distortion;
+  // Covariance of the intrinsic parameters [fx fy cx cy distortion...] (IntrinsicParameters'
+  // order), row-major, as a calibration estimated it; empty = unknown. The extrinsic's σ carries
+  // it when present (AddIntrinsicsUncertainty).
+  std::vector<double> covariance;
 
   // False (with the reason) for a wrong coefficient count, non-positive focal length or size,
   // or non-finite values.
@@ -44,5 +48,12 @@ struct CameraModel {
            pixel.x() <= width - 0.5 - margin_px && pixel.y() <= height - 0.5 - margin_px;
   }
 };
+
+// The intrinsic parameters as one vector: fx fy cx cy, then the distortion coefficients.
+std::vector<double> IntrinsicParameters(const CameraModel& camera);
+// Names in that order ("fx" ... "k1" "k2" "p1" "p2" "k3" ..., or "k1".."k4" for a fisheye).
+std::vector<std::string> IntrinsicParameterNames(const CameraModel& camera);
+// Sets the parameters from such a vector (its size must be 4 + distortion.size()).
+void SetIntrinsicParameters(const std::vector<double>& parameters, CameraModel* camera);
 
 }  // namespace calibench

@@ -1,6 +1,6 @@
 // CalibrateIntrinsics: OpenCV's calibrateCamera / fisheye::calibrate with reject-and-refit, the
-// parameters' σ (OpenCV's for pinhole; from the Jacobian's Schur complement for fisheye, which
-// OpenCV does not report), and the stop rule in words.
+// parameters' covariance (from the Jacobian's Schur complement; OpenCV reports σ for the pinhole
+// only, and no correlations), and the stop rule in words.
 #include "core/intrinsics/intrinsics.h"
 
 #include <Eigen/Dense>
@@ -51,11 +51,63 @@ struct Fit {
   std::vector<cv::Mat> rvecs, tvecs;
   std::vector<double> view_rms;  // per used view
   double rms = 0.0;
-  std::vector<double> sigmas;  // fx fy cx cy, distortion
+  Eigen::MatrixXd covariance;  // of fx fy cx cy, distortion (IntrinsicsCovariance)
   // Fisheye: views (indices into the fitted views) the refit could not start from; the caller
   // drops them and fits again.
   std::vector<size_t> beyond_start;
 };
+
+// The covariance of [fx fy cx cy distortion...] from the projection's Jacobian (OpenCV's
+// projectPoints / fisheye::projectPoints): the intrinsics' block of the normal matrix with every
+// view's pose eliminated (Schur complement), scaled by the residuals' variance, as calibrateCamera
+// does for its σ (which it reports as standard deviations only; the correlations matter where the
+// covariance is propagated into the extrinsic). A parameter held fixed (k3 with --fix-k3) has a
+// zero row and column.
+Eigen::MatrixXd IntrinsicsCovariance(const CvViews& v, const Fit& fit, bool fisheye, bool fix_k3) {
+  const int n = fisheye ? 8 : 9;
+  // Each parameter's column in OpenCV's Jacobian, and the pose's six columns.
+  std::vector<int> parameter_column, parameter_index;
+  for (int i = 0; i < n; ++i) {
+    if (!fisheye && fix_k3 && i == 8) continue;
+    parameter_index.push_back(i);
+    parameter_column.push_back(fisheye ? i : 6 + i);  // pinhole: rvec tvec f c dist
+  }
+  const int first_pose_column = fisheye ? 8 : 0;
+  const int m = static_cast<int>(parameter_index.size());
+  Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(m, m);
+  double squared = 0.0;
+  int residuals = 0;
+  for (size_t i = 0; i < v.object.size(); ++i) {
+    std::vector<cv::Point2f> projected;
+    cv::Mat jacobian;
+    if (fisheye)
+      cv::fisheye::projectPoints(v.object[i], projected, fit.rvecs[i], fit.tvecs[i], fit.K, fit.D,
+                                 0.0, jacobian);
+    else
+      cv::projectPoints(v.object[i], fit.rvecs[i], fit.tvecs[i], fit.K, fit.D, projected, jacobian);
+    jacobian.convertTo(jacobian, CV_64F);
+    Eigen::MatrixXd A(jacobian.rows, m), B(jacobian.rows, 6);
+    for (int r = 0; r < jacobian.rows; ++r) {
+      for (int c = 0; c < m; ++c) A(r, c) = jacobian.at<double>(r, parameter_column[c]);
+      for (int c = 0; c < 6; ++c) B(r, c) = jacobian.at<double>(r, first_pose_column + c);
+    }
+    const Eigen::Matrix<double, 6, 6> C = B.transpose() * B;
+    reduced += A.transpose() * A - (A.transpose() * B) * C.ldlt().solve(B.transpose() * A);
+    for (size_t k = 0; k < projected.size(); ++k) {
+      const cv::Point2f d = v.image[i][k] - projected[k];
+      squared += d.x * d.x + d.y * d.y;
+    }
+    residuals += 2 * static_cast<int>(projected.size());
+  }
+  const int dof = residuals - m - 6 * static_cast<int>(v.object.size());
+  const double variance = dof > 0 ? squared / dof : 0.0;
+  Eigen::MatrixXd covariance = variance * reduced.inverse();
+  covariance = (0.5 * (covariance + covariance.transpose())).eval();
+  Eigen::MatrixXd full = Eigen::MatrixXd::Zero(n, n);
+  for (int a = 0; a < m; ++a)
+    for (int b = 0; b < m; ++b) full(parameter_index[a], parameter_index[b]) = covariance(a, b);
+  return full;
+}
 
 Fit FitPinhole(const CvViews& v, const cv::Size& size, const IntrinsicsOptions& o) {
   Fit fit;
@@ -66,40 +118,8 @@ Fit FitPinhole(const CvViews& v, const cv::Size& size, const IntrinsicsOptions& 
       per_view, flags,
       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-12));
   for (int i = 0; i < per_view.rows; ++i) fit.view_rms.push_back(per_view.at<double>(i));
-  for (int i = 0; i < 9; ++i) fit.sigmas.push_back(std_intrinsics.at<double>(i));
+  fit.covariance = IntrinsicsCovariance(v, fit, /*fisheye=*/false, !o.estimate_k3);
   return fit;
-}
-
-// σ of [fx fy cx cy k1..k4] from fisheye::projectPoints' Jacobian: the intrinsics' block of the
-// normal matrix with every view's pose eliminated (Schur complement), scaled by the residuals'
-// variance, as calibrateCamera does for the pinhole.
-std::vector<double> FisheyeSigmas(const CvViews& v, const Fit& fit) {
-  Eigen::Matrix<double, 8, 8> reduced = Eigen::Matrix<double, 8, 8>::Zero();
-  double squared = 0.0;
-  int residuals = 0;
-  for (size_t i = 0; i < v.object.size(); ++i) {
-    std::vector<cv::Point2f> projected;
-    cv::Mat jacobian;
-    cv::fisheye::projectPoints(v.object[i], projected, fit.rvecs[i], fit.tvecs[i], fit.K, fit.D,
-                               0.0, jacobian);
-    Eigen::MatrixXd J(jacobian.rows, 14);
-    for (int r = 0; r < jacobian.rows; ++r)
-      for (int c = 0; c < 14; ++c) J(r, c) = jacobian.at<double>(r, c);
-    const Eigen::MatrixXd A = J.leftCols(8), B = J.middleCols(8, 6);
-    const Eigen::Matrix<double, 6, 6> C = B.transpose() * B;
-    reduced += A.transpose() * A - (A.transpose() * B) * C.ldlt().solve(B.transpose() * A);
-    for (size_t k = 0; k < projected.size(); ++k) {
-      const cv::Point2f d = v.image[i][k] - projected[k];
-      squared += d.x * d.x + d.y * d.y;
-    }
-    residuals += 2 * static_cast<int>(projected.size());
-  }
-  const int dof = residuals - 8 - 6 * static_cast<int>(v.object.size());
-  const double variance = dof > 0 ? squared / dof : 0.0;
-  const Eigen::Matrix<double, 8, 8> covariance = variance * reduced.inverse();
-  std::vector<double> sigmas;
-  for (int i = 0; i < 8; ++i) sigmas.push_back(std::sqrt(std::max(0.0, covariance(i, i))));
-  return sigmas;
 }
 
 // fisheye::calibrate starts from f = max(w, h) / pi and no distortion, and its first poses come
@@ -171,7 +191,7 @@ Fit FitFisheye(const CvViews& v, const cv::Size& size) {
     corners += v.image[i].size();
   }
   fit.rms = std::sqrt(squared / corners);
-  fit.sigmas = FisheyeSigmas(v, fit);
+  fit.covariance = IntrinsicsCovariance(v, fit, /*fisheye=*/true, false);
   return fit;
 }
 
@@ -214,8 +234,11 @@ void FillCamera(const Fit& fit, CameraModelType model, int width, int height,
   result->parameters = {camera.fx, camera.fy, camera.cx, camera.cy};
   result->parameters.insert(result->parameters.end(), camera.distortion.begin(),
                             camera.distortion.end());
-  result->sigmas = fit.sigmas;
-  result->sigmas.resize(result->parameters.size(), 0.0);
+  const Eigen::Index n = fit.covariance.rows();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    result->sigmas.push_back(std::sqrt(std::max(0.0, fit.covariance(i, i))));
+    for (Eigen::Index j = 0; j < n; ++j) camera.covariance.push_back(fit.covariance(i, j));
+  }
 }
 
 std::string Percent(double value) {

@@ -304,6 +304,11 @@ CameraModel Interpret(const YAML::Node& root, bool opencv_file) {
         "cannot tell the format: none of camera_matrix (OpenCV, ROS camera_calibration),"
         " K (ROS CameraInfo) or cam0 (Kalibr) is present");
   }
+  // Calibench's own key (every format): the covariance of [fx fy cx cy distortion...] that
+  // `calibench intrinsics` estimated; other tools ignore it.
+  const YAML::Node& holder = Find(root, "cam0") ? *Find(root, "cam0") : root;
+  if (const std::optional<YAML::Node> covariance = Find(holder, "intrinsics_covariance"))
+    camera.covariance = Numbers(*covariance, "intrinsics_covariance");
   // The size may be absent (0 = unknown); everything else must already be valid.
   CameraModel sized = camera;
   if (sized.width == 0) sized.width = 1;
@@ -375,6 +380,10 @@ void SaveCameraInfoYaml(const std::filesystem::path& path, const CameraModel& ca
   matrix("rectification_matrix", 3, 3, {1, 0, 0, 0, 1, 0, 0, 0, 1});
   matrix("projection_matrix", 3, 4,
          {camera.fx, 0, camera.cx, 0, 0, camera.fy, camera.cy, 0, 0, 0, 1, 0});
+  if (!camera.covariance.empty()) {
+    const int n = static_cast<int>(4 + camera.distortion.size());
+    matrix("intrinsics_covariance", n, n, camera.covariance);
+  }
   out << YAML::EndMap;
   WriteFileAtomically(path, std::string(out.c_str()) + "\n");
 }

@@ -33,7 +33,11 @@ std::string OpenCvYaml(const CameraModel& c) {
          "\ndistortion_model: " + (fisheye ? "equidistant" : "plumb_bob") + "\n" +
          OpenCvMatrix("camera_matrix", 3, 3, {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1}) +
          OpenCvMatrix("distortion_coefficients", 1, static_cast<int>(c.distortion.size()),
-                      c.distortion);
+                      c.distortion) +
+         (c.covariance.empty()
+              ? ""
+              : OpenCvMatrix("intrinsics_covariance", static_cast<int>(4 + c.distortion.size()),
+                             static_cast<int>(4 + c.distortion.size()), c.covariance));
 }
 
 std::string KalibrYaml(const std::filesystem::path& path, const CameraModel& c,
@@ -59,6 +63,14 @@ std::string KalibrYaml(const std::filesystem::path& path, const CameraModel& c,
   out << YAML::Key << "resolution" << YAML::Value << YAML::Flow
       << std::vector<int>{c.width, c.height};
   out << YAML::Key << "rostopic" << YAML::Value << topic;
+  if (!c.covariance.empty()) {
+    // fx fy cx cy k1 k2 p1 p2 (k3, zero, left out as above).
+    const size_t n = 4 + c.distortion.size(), kept = 4 + coefficients.size();
+    std::vector<double> covariance;
+    for (size_t i = 0; i < kept; ++i)
+      for (size_t j = 0; j < kept; ++j) covariance.push_back(c.covariance[i * n + j]);
+    out << YAML::Key << "intrinsics_covariance" << YAML::Value << YAML::Flow << covariance;
+  }
   out << YAML::EndMap << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

@@ -96,6 +96,8 @@ CameraModel ParseInlineCamera(const Fields& node) {
   camera.type = *type;
   GetPinhole(node, &camera);
   camera.distortion = node.Get<std::vector<double>>("distortion");
+  if (node.Has("intrinsics_covariance"))
+    camera.covariance = node.Get<std::vector<double>>("intrinsics_covariance");
   return camera;
 }
 
@@ -216,6 +218,7 @@ json CameraToJson(const CameraModel& c) {
   json camera = PinholeToJson(c);
   camera["model"] = CameraModelName(c.type);
   camera["distortion"] = c.distortion;
+  if (!c.covariance.empty()) camera["intrinsics_covariance"] = c.covariance;
   return camera;
 }
 

@@ -9,6 +9,7 @@
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
 #include "core/lidar/cloud.h"
+#include "core/lidar_camera/joint_intrinsics.h"
 
 namespace calibench {
 
@@ -294,6 +295,10 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
   CalibrationOutcome outcome = SolveFromFeatures(std::move(features), options);
   outcome.background_note = background_note;
   if (options.camera_guided) CompleteWithCamera(dataset, selected, options, edits, &outcome);
+  if (outcome.solution && options.refine_intrinsics)
+    RefineIntrinsics(dataset.camera, options, &outcome);
+  else if (outcome.solution && options.propagate_intrinsics)
+    AddIntrinsicsUncertainty(outcome.pairs, dataset.camera, options, &*outcome.solution);
   return outcome;
 }
 

@@ -20,6 +20,14 @@
 
 namespace calibench {
 
+// Which intrinsics --refine-intrinsics estimates (core/lidar_camera/joint_intrinsics.h says why
+// the focal length alone is the default).
+enum class IntrinsicsToRefine {
+  kFocal,    // fx fy
+  kPinhole,  // fx fy cx cy
+  kAll,      // fx fy cx cy and the distortion (k3 only where the camera uses it)
+};
+
 struct PipelineOptions {
   LidarPlaneOptions lidar_plane;
   // The LiDAR's noise model (LidarPlaneOptions::geometry): judged from each cloud
@@ -53,6 +61,13 @@ struct PipelineOptions {
   double guided_max_sigmas = 4.0;
   double guided_floor_sigma_deg = 0.5;
   double guided_floor_sigma_m = 0.0075;
+  // The camera's intrinsics estimated with the extrinsic in one joint problem (corners, LiDAR
+  // planes and edges; core/lidar_camera/joint_intrinsics.h), every pair then posed under them.
+  bool refine_intrinsics = false;
+  IntrinsicsToRefine intrinsics_to_refine = IntrinsicsToRefine::kFocal;
+  // The extrinsic's covariance includes the intrinsics' (the camera file's, or the refined
+  // camera's), propagated through the solve (AddIntrinsicsUncertainty).
+  bool propagate_intrinsics = true;
   bool Check(std::string* why) const;
 };
 
@@ -155,12 +170,28 @@ struct PairEdit {
 };
 using PairEdits = std::map<std::string, PairEdit>;  // by pair id
 
+// What --refine-intrinsics did: the camera before and after (with the refined parameters'
+// covariance), how the joint problem went, or why it could not run.
+struct IntrinsicsRefinement {
+  CameraModel before, after;
+  std::vector<bool> refined;  // per IntrinsicParameters entry: estimated (false: held fixed)
+  Pose joint_cam_from_lidar = Pose::Identity();  // the joint problem's own extrinsic
+  double corner_rms_px = 0.0;
+  double corner_sigma_px = 0.0;
+  double plane_variance_factor = 1.0;
+  int pairs = 0, corners = 0, edge_points = 0;
+  int iterations = 0;
+  bool converged = false;
+  std::string failure;  // why the refinement did not run ("" when it did)
+};
+
 struct CalibrationOutcome {
   std::vector<PairFeatures> pairs;
   std::optional<SolverResult> solution;  // absent when no calibration could be computed
   std::string failure;                   // why `solution` is absent
   Pose initial_cam_from_lidar = Pose::Identity();
   std::string background_note;  // why no background model was used, when one was wanted
+  std::optional<IntrinsicsRefinement> intrinsics_refinement;  // PipelineOptions::refine_intrinsics
 };
 
 // Loads the pair's files and extracts both planes (the steps above; the hint is the pair's edited
@@ -195,7 +226,9 @@ std::string BoardDisagreement(const LidarPlaneFit& lidar, const CameraBoardObser
                               const Pose& cam_from_lidar, const BoardSpec& target,
                               const PipelineOptions& options);
 
-// Extracts every selected pair (in parallel with options.threads) and solves.
+// Extracts every selected pair (in parallel with options.threads) and solves; with
+// options.refine_intrinsics refines the camera with the extrinsic (RefineIntrinsics), else adds the
+// camera's intrinsics covariance, when it has one, to the extrinsic's (AddIntrinsicsUncertainty).
 CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,
                                     const ProgressCallback& progress = {},
                                     const PairEdits& edits = {});

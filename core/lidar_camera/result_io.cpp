@@ -118,6 +118,48 @@ json LidarModelJson(const CalibrationOutcome& outcome) {
           {"pairs", counts}};
 }
 
+json CameraParametersJson(const CameraModel& camera) {
+  json parameters = json::object();
+  const std::vector<std::string> names = IntrinsicParameterNames(camera);
+  const std::vector<double> values = IntrinsicParameters(camera);
+  for (size_t i = 0; i < names.size(); ++i) parameters[names[i]] = values[i];
+  return parameters;
+}
+
+// --refine-intrinsics: both cameras, the refined parameters' σ and covariance, how it went.
+json RefinementJson(const IntrinsicsRefinement& r) {
+  json out = {{"refined", r.failure.empty()},
+              {"model", CameraModelName(r.before.type)},
+              {"image_size", {r.before.width, r.before.height}},
+              {"before", CameraParametersJson(r.before)}};
+  if (!r.failure.empty()) {
+    out["failure"] = r.failure;
+    return out;
+  }
+  const std::vector<std::string> names = IntrinsicParameterNames(r.after);
+  const size_t n = names.size();
+  json sigmas = json::object(), held = json::array();
+  for (size_t i = 0; i < n; ++i) {
+    if (i < r.refined.size() && r.refined[i])
+      sigmas[names[i]] = std::sqrt(std::max(0.0, r.after.covariance[i * n + i]));
+    else
+      held.push_back(names[i]);
+  }
+  out["after"] = CameraParametersJson(r.after);
+  out["sigmas"] = sigmas;
+  out["held"] = held;
+  out["parameter_names"] = names;
+  out["covariance"] = r.after.covariance;
+  out["corner_rms_px"] = r.corner_rms_px;
+  out["corner_sigma_px"] = r.corner_sigma_px;
+  out["pairs"] = r.pairs;
+  out["corners"] = r.corners;
+  out["edge_points"] = r.edge_points;
+  out["iterations"] = r.iterations;
+  out["converged"] = r.converged;
+  return out;
+}
+
 json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& options,
                   const ResultNames& names) {
   CALIBENCH_CHECK(outcome.solution.has_value());
@@ -162,6 +204,21 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
         "not estimated, yet significant in the data (score test at the solution); the pose does "
         "not include it: estimate it (--estimate-range-offset) or correct the clouds";
   }
+  if (!s.intrinsics_covariance.isZero(0.0)) {
+    json matrix = json::array();
+    for (int r = 0; r < 6; ++r) {
+      json row = json::array();
+      for (int c = 0; c < 6; ++c) row.push_back(s.intrinsics_covariance(r, c));
+      matrix.push_back(row);
+    }
+    root["covariance_from_intrinsics"] = {
+        {"covariance_6x6", matrix},
+        {"meaning",
+         "the part of covariance_6x6 that the camera's intrinsics' covariance contributes "
+         "(propagated through the solve; same convention); more pairs do not shrink it"}};
+  }
+  if (outcome.intrinsics_refinement)
+    root["intrinsics"] = RefinementJson(*outcome.intrinsics_refinement);
   root["pairs"] = PairsJson(outcome);
   root["solver"]["residuals_available"] = ResidualsAvailable(outcome);
   if (const json model = LidarModelJson(outcome); !model.is_null()) root["lidar_model"] = model;
@@ -353,6 +410,49 @@ void PrintModelFigures(const SolverResult& s, std::ostringstream& out) {
   }
 }
 
+// What the camera's intrinsics did: refined with the extrinsic, or their covariance carried.
+void PrintIntrinsics(const CalibrationOutcome& outcome, std::ostringstream& out) {
+  char line[320];
+  const SolverResult& s = *outcome.solution;
+  if (const auto& r = outcome.intrinsics_refinement) {
+    if (!r->failure.empty()) {
+      out << "intrinsics NOT refined: " << r->failure << " (the camera file's are used)\n";
+    } else {
+      const std::vector<std::string> names = IntrinsicParameterNames(r->after);
+      const std::vector<double> before = IntrinsicParameters(r->before);
+      const std::vector<double> after = IntrinsicParameters(r->after);
+      const size_t n = after.size();
+      std::snprintf(line, sizeof(line),
+                    "intrinsics refined with the extrinsic (--refine-intrinsics): %d pairs, %d "
+                    "corners, %d edge points, %d iterations%s; corner RMS %.3f px\n",
+                    r->pairs, r->corners, r->edge_points, r->iterations,
+                    r->converged ? "" : " (NOT converged)", r->corner_rms_px);
+      out << line;
+      for (size_t i = 0; i < n; ++i) {
+        if (i < r->refined.size() && !r->refined[i]) {
+          std::snprintf(line, sizeof(line), "  %-3s %12.6g (held)\n", names[i].c_str(), after[i]);
+        } else {
+          const double sigma = std::sqrt(std::max(0.0, r->after.covariance[i * n + i]));
+          std::snprintf(line, sizeof(line), "  %-3s %12.6g -> %12.6g +- %.3g  (moved %.1f sigma)\n",
+                        names[i].c_str(), before[i], after[i], sigma,
+                        sigma > 0 ? std::abs(after[i] - before[i]) / sigma : 0.0);
+        }
+        out << line;
+      }
+    }
+  }
+  if (!s.intrinsics_covariance.isZero(0.0)) {
+    const Vec3 t = s.intrinsics_covariance.diagonal().head<3>().cwiseSqrt() * 1e3;
+    const Vec3 r = s.intrinsics_covariance.diagonal().tail<3>().cwiseSqrt() * 180.0 / M_PI;
+    std::snprintf(line, sizeof(line),
+                  "the intrinsics' covariance is in the std above: alone it gives translation "
+                  "[mm] %.2f %.2f %.2f, rotation [deg] %.3f %.3f %.3f (more pairs do not shrink "
+                  "it)\n",
+                  t.x(), t.y(), t.z(), r.x(), r.y(), r.z());
+    out << line;
+  }
+}
+
 // Iterations, convergence and the observability verdict.
 void PrintConvergence(const SolverResult& s, std::ostringstream& out) {
   char line[256];
@@ -389,6 +489,7 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
   out << "\n";
   if (!counts.note.empty()) out << "  " << counts.note << "\n";
   PrintModelFigures(s, out);
+  PrintIntrinsics(outcome, out);
   PrintConvergence(s, out);
   return out.str();
 }

@@ -191,6 +191,9 @@ struct SolverResult {
   // noise says), so the reported covariance is the jackknife's, widened for the few pairs.
   bool jackknife_widened = false;
   std::string jackknife_skipped;  // why it did not run, in words ("" when it ran)
+  // The part of `covariance` that the camera's intrinsics' covariance contributes (zero: none
+  // known; AddIntrinsicsUncertainty): it does not shrink with more pairs.
+  Mat6 intrinsics_covariance = Mat6::Zero();
 };
 
 // The LiDAR plane the board really has under a range offset b: the fitted one moved back by

@@ -14,7 +14,7 @@ namespace {
 
 // v2: the LiDAR fits carry their ring-bias covariance, what their rings' ends showed and their
 // noise model.
-constexpr const char* kFeatureCacheFormat = "calibench.features.v2";
+constexpr const char* kFeatureCacheFormat = "calibench.features.v3";
 
 // A matrix as its rows, flattened row by row.
 template <typename Matrix>
@@ -115,6 +115,29 @@ LidarPlaneFit LidarFromJson(const json& j) {
   return fit;
 }
 
+// Per corner [id, u, v, x, y, z]: the pixel and the board point.
+json CornersToJson(const BoardDetection& corners) {
+  json all = json::array();
+  for (size_t k = 0; k < corners.pixels.size(); ++k) {
+    const Vec2& u = corners.pixels[k];
+    const Vec3& p = corners.board_points[k];
+    all.push_back(
+        {k < corners.ids.size() ? corners.ids[k] : -1, u.x(), u.y(), p.x(), p.y(), p.z()});
+  }
+  return all;
+}
+
+BoardDetection CornersFromJson(const json& j) {
+  BoardDetection corners;
+  for (const json& c : j) {
+    corners.ids.push_back(c.at(0).get<int>());
+    corners.pixels.emplace_back(c.at(1).get<double>(), c.at(2).get<double>());
+    corners.board_points.emplace_back(c.at(3).get<double>(), c.at(4).get<double>(),
+                                      c.at(5).get<double>());
+  }
+  return corners;
+}
+
 json CameraToJson(const CameraBoardObservation& camera) {
   return {{"cam_from_board", MatrixToJson(camera.cam_from_board.matrix())},
           {"pose_covariance", MatrixToJson(camera.pose_covariance)},
@@ -122,7 +145,8 @@ json CameraToJson(const CameraBoardObservation& camera) {
           {"plane_covariance", MatrixToJson(camera.plane_covariance)},
           {"reprojection_rms_px", camera.reprojection_rms_px},
           {"corner_sigma_px", camera.corner_sigma_px},
-          {"num_corners", camera.num_corners}};
+          {"num_corners", camera.num_corners},
+          {"corners", CornersToJson(camera.corners)}};
 }
 
 CameraBoardObservation CameraFromJson(const json& j) {
@@ -136,6 +160,7 @@ CameraBoardObservation CameraFromJson(const json& j) {
   camera.reprojection_rms_px = j.at("reprojection_rms_px").get<double>();
   camera.corner_sigma_px = j.at("corner_sigma_px").get<double>();
   camera.num_corners = j.at("num_corners").get<int>();
+  camera.corners = CornersFromJson(j.at("corners"));
   return camera;
 }
 

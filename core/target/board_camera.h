@@ -68,6 +68,10 @@ struct CameraBoardObservation {
   double reprojection_rms_px = 0.0;
   double corner_sigma_px = 0.0;  // estimated from the residuals (floored), used for covariances
   int num_corners = 0;
+  // The corners the pose was solved from: what the joint refinement of the intrinsics and the
+  // propagation of their covariance pose again under another camera (core/lidar_camera/
+  // joint_intrinsics.h).
+  BoardDetection corners;
 };
 
 struct PnpOptions {

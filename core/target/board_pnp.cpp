@@ -195,6 +195,7 @@ std::optional<CameraBoardObservation> EstimateBoardPose(const CameraModel& camer
   CameraBoardObservation obs;
   obs.cam_from_board = pose;
   obs.num_corners = n;
+  obs.corners = detection;
   obs.reprojection_rms_px = std::sqrt(lin->ssr / n);
   if (obs.reprojection_rms_px > options.max_rms_px) {
     *why = "reprojection RMS " + std::to_string(obs.reprojection_rms_px) + " px exceeds " +

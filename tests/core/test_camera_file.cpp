@@ -384,3 +384,49 @@ TEST(CameraFileTest, DeepNestingIsRefusedBeforeParsing) {
 
 }  // namespace
 }  // namespace calibench
+
+namespace calibench {
+namespace {
+
+// The intrinsics' covariance (`calibench intrinsics` writes it; the extrinsic's σ carries it) goes
+// through every format the writer knows and back, exactly; OpenCV reads our OpenCV file.
+TEST(CameraFileCovariance, RoundTripsInEveryFormat) {
+  const auto dir = test::TempDir("camera_file_covariance");
+  CameraModel camera;
+  camera.width = 1440, camera.height = 1080;
+  camera.fx = 1001.25, camera.fy = 1000.5, camera.cx = 720.125, camera.cy = 539.75;
+  camera.distortion = {-0.1, 0.05, 0.0005, -0.0003};
+  const int n = 8;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      camera.covariance.push_back(i == j ? 0.5 + i : 0.01 * (i + 1) * (j + 1) / 64.0);
+  for (const auto& [format, name] : {std::pair{CameraFileFormat::kRosCameraInfo, "ros.yaml"},
+                                     std::pair{CameraFileFormat::kOpenCv, "opencv.yaml"},
+                                     std::pair{CameraFileFormat::kKalibr, "kalibr.yaml"}}) {
+    SaveCameraFile(dir / name, camera, format, "cam");
+    const CameraModel back = LoadCameraFile(dir / name);
+    EXPECT_EQ(back.covariance, camera.covariance) << name;
+    EXPECT_EQ(back.fx, camera.fx) << name;
+  }
+  cv::FileStorage storage((dir / "opencv.yaml").string(), cv::FileStorage::READ);
+  cv::Mat covariance;
+  storage["intrinsics_covariance"] >> covariance;
+  ASSERT_EQ(covariance.rows, n);
+  EXPECT_EQ(covariance.at<double>(2, 3), camera.covariance[2 * n + 3]);
+
+  // A covariance of the wrong size, or not symmetric, names the file and the problem.
+  Write(dir / "bad.yaml",
+        "image_width: 640\nimage_height: 480\ncamera_matrix: {rows: 3, cols: 3, data: [500, 0, "
+        "320, 0, 500, 240, 0, 0, 1]}\ndistortion_model: plumb_bob\ndistortion_coefficients: "
+        "{rows: 1, cols: 5, data: [0, 0, 0, 0, 0]}\nintrinsics_covariance: [1, 0, 0, 1]\n");
+  try {
+    LoadCameraFile(dir / "bad.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("9x9"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace calibench

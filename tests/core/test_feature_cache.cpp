@@ -32,7 +32,7 @@ TEST(FeatureCache, ReadsBackWhatItWroteAndDropsWhatNoLongerHolds) {
   failed.reason = "LiDAR board disagrees with the camera's";
   writer.Append(dataset.pairs[2], failed);
   // A line cut short by a kill.
-  std::ofstream(cache, std::ios::app) << R"({"format": "calibench.features.v2", "id": "00)";
+  std::ofstream(cache, std::ios::app) << R"({"format": "calibench.features.v3", "id": "00)";
 
   int skipped = -1;
   auto read = LoadFeatureCache(cache, &skipped);
@@ -47,6 +47,11 @@ TEST(FeatureCache, ReadsBackWhatItWroteAndDropsWhatNoLongerHolds) {
   EXPECT_EQ(back.lidar->edge_points.size(), written[0].lidar->edge_points.size());
   EXPECT_EQ(back.camera->cam_from_board.matrix(), written[0].camera->cam_from_board.matrix());
   EXPECT_EQ(back.camera->pose_covariance, written[0].camera->pose_covariance);
+  // The corners come back exactly (the joint refinement of the intrinsics poses them again).
+  ASSERT_FALSE(written[0].camera->corners.pixels.empty());
+  EXPECT_EQ(back.camera->corners.pixels, written[0].camera->corners.pixels);
+  EXPECT_EQ(back.camera->corners.board_points, written[0].camera->corners.board_points);
+  EXPECT_EQ(back.camera->corners.ids, written[0].camera->corners.ids);
   EXPECT_EQ(back.board_origin.source, written[0].board_origin.source);
   EXPECT_EQ(read.at(dataset.pairs[2].id).features.status, PairStatus::kFailed);
   EXPECT_EQ(read.at(dataset.pairs[2].id).features.reason, failed.reason);
