@@ -31,6 +31,14 @@ int RunAdvise(int argc, char** argv) {
   app.add_option("--max-distance", options.max_distance_m,
                  "farthest usable board distance from the camera [m] (default: from the data)");
   app.add_flag("--json", json, "print exactly one JSON object on stdout");
+  std::string intrinsics_model = "pinhole";
+  app.add_flag("--estimate-intrinsics", options.estimate_intrinsics,
+               "the camera's intrinsics are being calibrated from these pairs too (no camera "
+               "file needed): the meter includes them (sigma, RMS, coverage; done only once they "
+               "are good) and the next pose also puts corners where the image has none");
+  app.add_option("--intrinsics-model", intrinsics_model,
+                 "with --estimate-intrinsics: pinhole | fisheye")
+      ->capture_default_str();
   double lrf_threshold_mm = 10.0;
   app.add_option("--error-threshold-mm", lrf_threshold_mm,
                  "LRF datasets: Algorithm 1's threshold on the newest observation's Eq. (12) "
@@ -70,7 +78,15 @@ int RunAdvise(int argc, char** argv) {
     std::fprintf(stderr, "calibench advise: %s\n", why.c_str());
     return kUsage;
   }
-  const Dataset dataset = LoadDataset(dataset_path);
+  Dataset dataset = LoadDataset(
+      dataset_path, options.estimate_intrinsics ? CameraFile::kOptional : CameraFile::kRequired);
+  if (options.estimate_intrinsics) {
+    std::optional<IntrinsicsResult> first;
+    if (const int code = EstimateDatasetIntrinsics("advise", intrinsics_model, &dataset, &first,
+                                                   json ? stderr : stdout);
+        code != kOk)
+      return code;
+  }
   const CalibrationOutcome outcome =
       CalibrateDataset(dataset, options.pipeline, StderrProgress("extracted"));
   bool input_error = false;

@@ -13,35 +13,6 @@ namespace calibench::app {
 
 namespace {
 
-// --estimate-intrinsics: the pairs' images calibrate the camera first; said on stdout.
-int EstimateDatasetIntrinsics(const std::string& model, Dataset* dataset,
-                              std::optional<IntrinsicsResult>* result) {
-  IntrinsicsOptions options;
-  const auto camera_model = ParseIntrinsicsModel(model);
-  if (!camera_model) {
-    std::fprintf(stderr,
-                 "calibench calibrate: --intrinsics-model must be pinhole or fisheye, got '%s'\n",
-                 model.c_str());
-    return kUsage;
-  }
-  options.model = *camera_model;
-  std::vector<IntrinsicsImageFile> files;
-  for (const PairEntry& pair : dataset->pairs) files.push_back({pair.id, pair.image});
-  try {
-    *result = EstimateIntrinsicsFromImages(files, dataset->target, options);
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "calibench calibrate: --estimate-intrinsics: %s\n", e.what());
-    return kNoCalibration;
-  }
-  std::printf("intrinsics estimated from the pairs' images (--estimate-intrinsics%s):\n%s\n",
-              dataset->missing_camera_file.empty()
-                  ? ("; " + (dataset->manifest / "camera.yaml").string() + " is not used").c_str()
-                  : "",
-              FormatIntrinsics(**result).c_str());
-  dataset->camera = (*result)->camera;
-  return kOk;
-}
-
 // The result says that its camera was estimated, and how well.
 void AddIntrinsicsToResult(const std::string& path, const IntrinsicsResult& r) {
   std::ifstream in(path);
@@ -115,7 +86,8 @@ int RunCalibrate(int argc, char** argv) {
     return kInputError;
   }
   if (estimate_intrinsics) {
-    if (const int code = EstimateDatasetIntrinsics(intrinsics_model, &dataset, &intrinsics);
+    if (const int code =
+            EstimateDatasetIntrinsics("calibrate", intrinsics_model, &dataset, &intrinsics);
         code != kOk)
       return code;
   }

@@ -143,4 +143,32 @@ int RunIntrinsics(int argc, char** argv) {
   return kOk;
 }
 
+// --estimate-intrinsics: the pairs' images calibrate the camera first; said on stdout.
+int EstimateDatasetIntrinsics(const char* command, const std::string& model, Dataset* dataset,
+                              std::optional<IntrinsicsResult>* result, std::FILE* out) {
+  IntrinsicsOptions options;
+  const auto camera_model = ParseIntrinsicsModel(model);
+  if (!camera_model) {
+    std::fprintf(stderr, "calibench %s: --intrinsics-model must be pinhole or fisheye, got '%s'\n",
+                 command, model.c_str());
+    return kUsage;
+  }
+  options.model = *camera_model;
+  std::vector<IntrinsicsImageFile> files;
+  for (const PairEntry& pair : dataset->pairs) files.push_back({pair.id, pair.image});
+  try {
+    *result = EstimateIntrinsicsFromImages(files, dataset->target, options);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "calibench %s: --estimate-intrinsics: %s\n", command, e.what());
+    return kNoCalibration;
+  }
+  std::fprintf(out, "intrinsics estimated from the pairs' images (--estimate-intrinsics%s):\n%s\n",
+               dataset->missing_camera_file.empty()
+                   ? ("; " + (dataset->manifest / "camera.yaml").string() + " is not used").c_str()
+                   : "",
+               FormatIntrinsics(**result).c_str());
+  dataset->camera = (*result)->camera;
+  return kOk;
+}
+
 }  // namespace calibench::app

@@ -437,6 +437,11 @@ int RunWatch(int argc, char** argv) {
                "one JSON object per line: {\"event\": \"pair\", ...} per pair, {\"event\": "
                "\"solve\", ...advise --json's fields} per solve");
   app.add_flag("--exit-when-done", flags.exit_when_done, "end when the stop rule says done");
+  app.add_flag("--estimate-intrinsics", options.advise.estimate_intrinsics,
+               "the camera's intrinsics are being calibrated from these pairs too: the meter "
+               "includes them (done only once they are good: sigma, RMS, corners near every "
+               "border) and the next pose also puts corners where the image has none (the "
+               "camera file is the starting guess)");
   app.add_option("--idle-exit", flags.idle_exit_s,
                  "end after this many seconds without new data [s] (0 = never)")
       ->capture_default_str();

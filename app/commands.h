@@ -2,6 +2,7 @@
 // returns the process exit code (see ExitCode).
 #pragma once
 
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -78,6 +79,10 @@ int RunIntrinsics(int argc, char** argv);
 // "pinhole" -> pinhole-radtan, "fisheye" -> kannala-brandt (--model of `intrinsics`,
 // --intrinsics-model of `calibrate`); nullopt for other names.
 std::optional<CameraModelType> ParseIntrinsicsModel(const std::string& name);
+// --estimate-intrinsics of `calibrate` and `advise`: the pairs' images calibrate the camera
+// (model pinhole | fisheye) into dataset->camera, said on `out`; an exit code (kOk or why not).
+int EstimateDatasetIntrinsics(const char* command, const std::string& model, Dataset* dataset,
+                              std::optional<IntrinsicsResult>* result, std::FILE* out = stdout);
 IntrinsicsResult EstimateIntrinsicsFromImages(const std::vector<IntrinsicsImageFile>& files,
                                               const BoardSpec& board,
                                               const IntrinsicsOptions& options);

@@ -1,11 +1,13 @@
 #include "core/guidance/advise.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "core/guidance/meter_json.h"
 #include "core/io/cloud_io.h"
@@ -69,6 +71,22 @@ std::vector<LidarCloud> RingClouds(const Dataset& dataset, const std::vector<Pai
   return clouds;
 }
 
+// The camera from every pair's corners (those the pipeline posed: the board found), as
+// `calibench intrinsics` would calibrate it.
+void EstimateIntrinsicsFromPairs(const CameraModel& camera, const std::vector<PairFeatures>& pairs,
+                                 const IntrinsicsOptions& options, CaptureAdvice* advice) {
+  std::vector<IntrinsicsView> views;
+  for (const PairFeatures& p : pairs)
+    if (p.camera && !p.camera->corners.pixels.empty()) views.push_back({p.id, p.camera->corners});
+  IntrinsicsOptions wanted = options;
+  wanted.model = camera.type;
+  try {
+    advice->intrinsics = CalibrateIntrinsics(views, camera.width, camera.height, wanted);
+  } catch (const std::invalid_argument& e) {
+    advice->intrinsics_failure = e.what();
+  }
+}
+
 }  // namespace
 
 CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& outcome,
@@ -118,6 +136,20 @@ CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& ou
   }
   if (advice.solution)
     advice.state = JudgeCapture(*advice.solution, advice.pairs_used, options.goal, options.stop);
+  GuidanceOptions guidance = options.guidance;
+  if (options.estimate_intrinsics) {
+    EstimateIntrinsicsFromPairs(dataset.camera, pairs, options.intrinsics, &advice);
+    if (advice.intrinsics)
+      guidance.intrinsics_cells_to_cover =
+          EmptyCells(advice.intrinsics->coverage, dataset.camera.width, dataset.camera.height);
+    if (!guidance.intrinsics_cells_to_cover.empty()) {
+      // Board centres nearer the image's edges, where the empty cells are.
+      guidance.image_columns = std::max(guidance.image_columns, 5);
+      guidance.image_rows = std::max(guidance.image_rows, 5);
+      guidance.distance_steps = std::max(guidance.distance_steps, 6);
+    }
+    if (advice.state && !(advice.intrinsics && advice.intrinsics->good)) advice.state->done = false;
+  }
   if (advice.state && advice.state->done) return advice;
   const std::vector<LidarCloud> clouds = RingClouds(dataset, pairs, options.clouds_for_beams);
   std::vector<const LidarCloud*> cloud_views;
@@ -136,7 +168,7 @@ CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& ou
   // Guidance needs a solution that fixes all six degrees of freedom.
   std::optional<SolverResult> usable = advice.solution;
   if (usable && !usable->observability.well_constrained) usable.reset();
-  advice.next = NextBestPose(*sensors, usable, seen, options.goal, options.guidance,
+  advice.next = NextBestPose(*sensors, usable, seen, options.goal, guidance,
                              options.pipeline.solver, &advice.next_failure);
   return advice;
 }
@@ -178,6 +210,24 @@ std::string CaptureAdviceJson(const CaptureAdvice& advice) {
                      {"findings", findings}});
   }
   out["pairs"] = pairs;
+  if (advice.intrinsics) {
+    const IntrinsicsResult& r = *advice.intrinsics;
+    nlohmann::json parameters = nlohmann::json::object(), sigmas = nlohmann::json::object();
+    for (size_t i = 0; i < r.parameter_names.size(); ++i) {
+      parameters[r.parameter_names[i]] = r.parameters[i];
+      sigmas[r.parameter_names[i]] = r.sigmas[i];
+    }
+    out["intrinsics"] = {{"good", r.good},
+                         {"verdict", r.verdict},
+                         {"rms_px", r.rms_px},
+                         {"parameters", parameters},
+                         {"sigmas", sigmas},
+                         {"cells_covered", r.coverage.cells_covered},
+                         {"border_covered", r.coverage.border_covered},
+                         {"missing", r.coverage.missing}};
+  } else if (!advice.intrinsics_failure.empty()) {
+    out["intrinsics"] = {{"good", false}, {"failure", advice.intrinsics_failure}};
+  }
   return out.dump();
 }
 
@@ -195,6 +245,18 @@ std::string FormatCaptureAdvice(const CaptureAdvice& advice) {
   } else {
     out += std::to_string(advice.pairs_used) +
            " pairs accepted: no calibration yet (at least 3 with differently tilted boards)\n";
+  }
+  if (advice.intrinsics) {
+    const IntrinsicsResult& r = *advice.intrinsics;
+    char text[200];
+    std::snprintf(text, sizeof(text),
+                  "intrinsics (estimated from the pairs): fx %.1f +- %.2f, fy %.1f +- %.2f, cx "
+                  "%.1f +- %.2f, cy %.1f +- %.2f px, RMS %.2f px: ",
+                  r.parameters[0], r.sigmas[0], r.parameters[1], r.sigmas[1], r.parameters[2],
+                  r.sigmas[2], r.parameters[3], r.sigmas[3], r.rms_px);
+    out += text + r.verdict + "\n";
+  } else if (!advice.intrinsics_failure.empty()) {
+    out += "intrinsics not estimated yet: " + advice.intrinsics_failure + "\n";
   }
   if (advice.next) {
     out += "next pose: " + advice.next->words + "\n";

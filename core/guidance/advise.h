@@ -10,6 +10,7 @@
 #include "core/guidance/next_pose.h"
 #include "core/guidance/preflight.h"
 #include "core/guidance/stop_rule.h"
+#include "core/intrinsics/intrinsics.h"
 #include "core/io/dataset.h"
 #include "core/lidar_camera/pipeline.h"
 
@@ -24,6 +25,11 @@ struct AdviseOptions {
   double min_distance_m = 0.0;  // usable board distance from the camera; 0 = from the data
   double max_distance_m = 0.0;
   int clouds_for_beams = 8;  // accepted pairs' clouds read to learn the LiDAR's rings
+  // The camera's intrinsics are being estimated from the same pairs (`--estimate-intrinsics`):
+  // the meter includes them (σ per parameter, RMS, coverage: IntrinsicsResult::good) and the
+  // next pose also covers the image cells without corners.
+  bool estimate_intrinsics = false;
+  IntrinsicsOptions intrinsics;
   bool Check(std::string* why) const;
 };
 
@@ -42,6 +48,10 @@ struct CaptureAdvice {
   std::vector<PairAdvice> pairs;
   std::optional<PoseSuggestion> next;  // absent when done, or when nothing feasible was found
   std::string next_failure;            // why `next` is absent while not done
+  // AdviseOptions::estimate_intrinsics: the camera from the pairs' corners, or why not; the
+  // capture is done (state->done) only once they are good too.
+  std::optional<IntrinsicsResult> intrinsics;
+  std::string intrinsics_failure;
 };
 
 // From a dataset and its calibration (CalibrateDataset with options.pipeline).
@@ -52,7 +62,9 @@ CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& ou
 // cam_from_lidar (4x4 nested rows, null without a solution), sigma_t_mm, sigma_r_deg, goal
 // {t_mm, r_deg}, done, trustworthy, trust_note, weakest, next (null when done, else
 // {lidar_from_board, cam_from_board, words, predicted_sigma_t_mm, predicted_sigma_r_deg}) and
-// pairs [{name, status, reason, findings [{check, severity, words}]}].
+// pairs [{name, status, reason, findings [{check, severity, words}]}]; with estimate_intrinsics,
+// intrinsics {good, verdict, rms_px, parameters {name: value}, sigmas {name: σ}, cells_covered,
+// border_covered, missing [words]} or {failure}.
 std::string CaptureAdviceJson(const CaptureAdvice& advice);
 
 // The same for people: the state line, the pairs with findings, the next pose in words.

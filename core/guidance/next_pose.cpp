@@ -43,6 +43,7 @@ bool GuidanceOptions::Check(std::string* why) const {
     return *why = "the candidate grid needs at least one step in each dimension", false;
   if (yaw_deg.empty() || pitch_deg.empty() || roll_deg.empty())
     return *why = "the candidate tilts must not be empty", false;
+  if (!(intrinsics_cover_weight >= 0)) return *why = "intrinsics_cover_weight must be >= 0", false;
   return true;
 }
 
@@ -394,6 +395,19 @@ Mat6 InformationDiscount(const SolverResult& solution) {
          widening.eigenvectors().transpose() * root_inverse;
 }
 
+// How many of the cells the intrinsics still need a candidate puts board corners in.
+int CellsCovered(const SensorGeometry& sensors, const Pose& cam_from_board,
+                 const std::vector<Eigen::AlignedBox2d>& cells) {
+  if (cells.empty()) return 0;
+  std::vector<char> hit(cells.size(), 0);
+  for (const Vec3& corner : BoardCornerPoints(sensors.board)) {
+    const auto pixel = sensors.camera.Project(cam_from_board * corner);
+    if (!pixel) continue;
+    for (size_t k = 0; k < cells.size(); ++k) hit[k] |= cells[k].contains(*pixel);
+  }
+  return static_cast<int>(std::count(hit.begin(), hit.end(), 1));
+}
+
 std::pair<double, double> StarterScore(const Candidate& c, const std::vector<Pose>& seen) {
   if (seen.empty()) return {c.turn_deg + c.off_axis, c.off_centre_m};
   double nearest = 1e9;
@@ -425,6 +439,7 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
   const std::vector<Candidate> grid = CandidateGrid(sensors, options);
   std::optional<PoseSuggestion> best;
   std::pair<double, double> best_score(std::numeric_limits<double>::infinity(), 0.0);
+  std::vector<std::pair<PoseSuggestion, double>> feasible;  // with its tie-breaker
   std::string last_reason;
   for (const Candidate& c : grid) {
     if (NearAHeldBoard(c.cam_from_board, seen, options)) continue;
@@ -464,11 +479,29 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
     } else {
       score = StarterScore(c, seen);
     }
+    if (!options.intrinsics_cells_to_cover.empty())
+      suggestion.intrinsics_cells_covered =
+          CellsCovered(sensors, c.cam_from_board, options.intrinsics_cells_to_cover);
     suggestion.score = score.first;
-    if (score.first < best_score.first - 1e-12 ||
-        (score.first <= best_score.first + 1e-12 && score.second < best_score.second)) {
-      best_score = score;
-      best = std::move(suggestion);
+    feasible.push_back({std::move(suggestion), score.second});
+  }
+  // The intrinsics want corners where none are yet: a candidate costs up to
+  // intrinsics_cover_weight more for the share of the most any candidate covers that it leaves.
+  int most_covered = 0;
+  for (const auto& [s, tie] : feasible)
+    most_covered = std::max(most_covered, s.intrinsics_cells_covered);
+  for (auto& [suggestion, tie] : feasible) {
+    if (most_covered > 0) {
+      const double left =
+          1.0 - static_cast<double>(suggestion.intrinsics_cells_covered) / most_covered;
+      suggestion.score = cam_from_lidar
+                             ? suggestion.score * (1.0 + options.intrinsics_cover_weight * left)
+                             : suggestion.score + options.intrinsics_cover_weight * left;
+    }
+    if (suggestion.score < best_score.first - 1e-12 ||
+        (suggestion.score <= best_score.first + 1e-12 && tie < best_score.second)) {
+      best_score = {suggestion.score, tie};
+      best = suggestion;
     }
   }
   if (!best) {
@@ -478,6 +511,10 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
     return std::nullopt;
   }
   best->words = DescribeBoardPose(sensors.camera, best->cam_from_board);
+  if (best->intrinsics_cells_covered > 0)
+    best->words += "; it puts corners in " + std::to_string(best->intrinsics_cells_covered) +
+                   " of the " + std::to_string(options.intrinsics_cells_to_cover.size()) +
+                   " image cells the intrinsics still lack";
   return best;
 }
 

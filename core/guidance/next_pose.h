@@ -65,6 +65,12 @@ struct GuidanceOptions {
   // Candidates this close to a board already held (camera frame) are not suggested again.
   double repeat_distance_m = 0.15;
   double repeat_angle_deg = 10.0;
+  // While the camera's intrinsics are being estimated: the image cells that still lack corners
+  // (EmptyCells, pixels), where the distortion must be seen. A candidate's score is multiplied
+  // by 1 + intrinsics_cover_weight · (1 − its cells / the most cells any candidate covers) (with
+  // a solution; without one, that is added): the best-covering keeps its score.
+  std::vector<Eigen::AlignedBox2d> intrinsics_cells_to_cover;
+  double intrinsics_cover_weight = 1.0;
   bool Check(std::string* why) const;
 };
 
@@ -103,6 +109,8 @@ struct PoseSuggestion {
   Vec3 predicted_sigma_t_mm = Vec3::Zero();  // after adding this pose (with a solution)
   Vec3 predicted_sigma_r_deg = Vec3::Zero();
   double score = 0.0;  // Σ (predicted σ / goal)² over the six axes (lower is better)
+  // Of GuidanceOptions::intrinsics_cells_to_cover, the cells this pose puts corners in.
+  int intrinsics_cells_covered = 0;
   Feasibility feasibility;
   std::string words;
 };

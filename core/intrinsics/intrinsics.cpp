@@ -354,6 +354,21 @@ IntrinsicsCoverage MeasureCoverage(const std::vector<IntrinsicsView>& views, int
   return c;
 }
 
+std::vector<Eigen::AlignedBox2d> EmptyCells(const IntrinsicsCoverage& coverage, int width,
+                                            int height) {
+  std::vector<Eigen::AlignedBox2d> cells;
+  for (int j = 0; j < coverage.rows; ++j) {
+    for (int i = 0; i < coverage.columns; ++i) {
+      if (coverage.counts[static_cast<size_t>(j * coverage.columns + i)] > 0) continue;
+      const double cell_w = static_cast<double>(width) / coverage.columns;
+      const double cell_h = static_cast<double>(height) / coverage.rows;
+      // As MeasureCoverage counts: cell i holds x in [i w / columns, (i + 1) w / columns).
+      cells.emplace_back(Vec2(i * cell_w, j * cell_h), Vec2((i + 1) * cell_w, (j + 1) * cell_h));
+    }
+  }
+  return cells;
+}
+
 IntrinsicsResult CalibrateIntrinsics(const std::vector<IntrinsicsView>& views, int width,
                                      int height, const IntrinsicsOptions& options) {
   std::string why;

@@ -82,6 +82,11 @@ IntrinsicsResult CalibrateIntrinsics(const std::vector<IntrinsicsView>& views, i
 IntrinsicsCoverage MeasureCoverage(const std::vector<IntrinsicsView>& views, int width, int height,
                                    const IntrinsicsOptions& options);
 
+// The cells of `coverage` without a corner, as pixel boxes of a width x height image (what the
+// next pose should put corners in, core/guidance).
+std::vector<Eigen::AlignedBox2d> EmptyCells(const IntrinsicsCoverage& coverage, int width,
+                                            int height);
+
 // An image file to calibrate from, by name (the pair id or the file's name).
 struct IntrinsicsImageFile {
   std::string name;

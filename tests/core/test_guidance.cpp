@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <set>
 
 #include "core/estimation/uncertainty.h"
 #include "core/guidance/next_pose.h"
@@ -308,6 +309,66 @@ TEST(GuidanceNextPose, WithoutASolutionItSuggestsACameraFeasiblePose) {
   EXPECT_GT((second->cam_from_board.translation() - first->cam_from_board.translation()).norm() +
                 RotationAngle(second->cam_from_board.linear(), first->cam_from_board.linear()),
             0.3);
+}
+
+// While the intrinsics are estimated, the next pose also puts corners where the image has none
+// (here: the right quarter of the image, the two right columns of an 8x6 grid; the outermost
+// column alone a board reaches, whole and seen by 4 rings, only between about 2 and 3 m).
+TEST(GuidanceNextPose, ItAlsoCoversTheImageCellsTheIntrinsicsLack) {
+  const SensorGeometry sensors = Vlp16Sensors();
+  const Pose cam_from_lidar = DefaultCamFromLidar();
+  SolverOptions solver;
+  std::vector<PlanePair> pairs;
+  std::vector<Pose> seen;
+  for (const Pose& pose : {FacingBoard(Vec3(0, 0, 1.6), 10), FacingBoard(Vec3(0.1, 0, 2.0), -10),
+                           FacingBoard(Vec3(-0.1, 0.05, 2.2), 15)}) {
+    PredictedReturns returns;
+    ASSERT_TRUE(CheckFeasible(sensors, cam_from_lidar, pose, GuidanceOptions{}, &returns).feasible);
+    pairs.push_back(PlannedPair(sensors, cam_from_lidar, pose, returns));
+    seen.push_back(pose);
+  }
+  SolverResult solution;
+  solution.cam_from_lidar = cam_from_lidar;
+  solution.covariance = ExpectedPoseInformation(pairs, cam_from_lidar, solver).inverse();
+  const double w = sensors.camera.width, h = sensors.camera.height;
+  GuidanceOptions options;
+  options.image_columns = options.image_rows = 5;
+  for (int i = 6; i < 8; ++i)
+    for (int j = 0; j < 6; ++j)
+      options.intrinsics_cells_to_cover.emplace_back(Vec2(w * i / 8, h * j / 6),
+                                                     Vec2(w * (i + 1) / 8, h * (j + 1) / 6));
+  auto cells_hit = [&](const Pose& cam_from_board) {
+    std::set<int> hit;
+    for (const Vec3& corner : BoardCornerPoints(sensors.board)) {
+      const auto pixel = sensors.camera.Project(cam_from_board * corner);
+      if (!pixel) continue;
+      for (size_t k = 0; k < options.intrinsics_cells_to_cover.size(); ++k)
+        if (options.intrinsics_cells_to_cover[k].contains(*pixel)) hit.insert(static_cast<int>(k));
+    }
+    return static_cast<int>(hit.size());
+  };
+  std::string why;
+  const auto next =
+      NextBestPose(sensors, solution, seen, CaptureGoal{2.0, 0.05}, options, solver, &why);
+  ASSERT_TRUE(next) << why;
+  EXPECT_GE(next->intrinsics_cells_covered, 1);
+  EXPECT_EQ(next->intrinsics_cells_covered, cells_hit(next->cam_from_board));
+  EXPECT_NE(next->words.find("image cells the intrinsics still lack"), std::string::npos)
+      << next->words;
+  // Without the intrinsics' wish the suggestion stays where the extrinsic gains most: it covers
+  // fewer of those cells.
+  GuidanceOptions extrinsic_only = options;
+  extrinsic_only.intrinsics_cells_to_cover.clear();
+  const auto plain =
+      NextBestPose(sensors, solution, seen, CaptureGoal{2.0, 0.05}, extrinsic_only, solver, &why);
+  ASSERT_TRUE(plain) << why;
+  EXPECT_LT(cells_hit(plain->cam_from_board), next->intrinsics_cells_covered);
+  EXPECT_EQ(plain->words.find("intrinsics"), std::string::npos);
+  // Without a solution too.
+  const auto starter =
+      NextBestPose(sensors, std::nullopt, {}, CaptureGoal{}, options, solver, &why);
+  ASSERT_TRUE(starter) << why;
+  EXPECT_GE(starter->intrinsics_cells_covered, 1);
 }
 
 TEST(GuidanceWords, DescribeWhatTheGeometryIs) {

@@ -143,8 +143,9 @@ TEST(IntrinsicsReal, OpenCvCharucoAgreesWithOpenCvsCalibrateCameraCharuco) {
   as_opencv.correct_charuco_offset = false;
   ExpectAgree(Ours(images, board, as_opencv), K, rms, "charuco, OpenCV's corners");
   // Our corners (OpenCV 4.6's half-pixel offset removed, refined over the marker-free margin)
-  // differ by a fraction of a pixel; 4 views leave the focal length uncertain by ~4 % (1 σ), so
-  // the two calibrations agree within their own σ, not to 0.2 %.
+  // differ by a fraction of a pixel; 4 views leave the focal length uncertain by ~2 % (1 σ), so
+  // the two calibrations agree within twice their own σ (they are not the same data), not to
+  // 0.2 %.
   const IntrinsicsResult ours = Ours(images, board);
   std::printf("charuco, our corners: fx %.3f (sigma %.2f) fy %.3f cx %.3f cy %.3f (sigma %.2f)\n",
               ours.camera.fx, ours.sigmas[0], ours.camera.fy, ours.camera.cx, ours.camera.cy,
@@ -152,7 +153,7 @@ TEST(IntrinsicsReal, OpenCvCharucoAgreesWithOpenCvsCalibrateCameraCharuco) {
   const std::vector<double> opencv = {K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2),
                                       K.at<double>(1, 2)};
   for (int i = 0; i < 4; ++i)
-    EXPECT_LT(std::abs(ours.parameters[i] - opencv[i]), ours.sigmas[i]) << i;
+    EXPECT_LT(std::abs(ours.parameters[i] - opencv[i]), 2 * ours.sigmas[i]) << i;
 }
 
 // A simulated calibration set's own images give its camera back.
@@ -275,6 +276,29 @@ TEST(IntrinsicsCli, CalibrateWithoutACameraFile) {
               dr);
   EXPECT_LT(dt, 0.01);
   EXPECT_LT(dr, 0.3);
+
+  // `advise` while the intrinsics are being estimated: the meter includes them (not done while
+  // they are not good), and the next pose also puts corners where the image has none.
+  const std::string advise = CalibenchExe() + " advise --dataset " + folder.string();
+  EXPECT_EQ(RunCommand(advise + " --json", &output), 2) << output;  // no camera file
+  ASSERT_EQ(RunCommand("(" + advise + " --estimate-intrinsics --json 2>/dev/null)", &output), 0)
+      << output;
+  const auto advice = nlohmann::json::parse(output);  // exactly one object on stdout
+  ASSERT_TRUE(advice.contains("intrinsics")) << advice.dump(1);
+  const auto& in_meter = advice["intrinsics"];
+  EXPECT_NEAR(in_meter["parameters"]["fx"].get<double>(), dataset.camera.fx,
+              0.003 * dataset.camera.fx);
+  EXPECT_GT(in_meter["sigmas"]["fx"].get<double>(), 0.0);
+  std::printf("advise --estimate-intrinsics: %s\n", in_meter["verdict"].get<std::string>().c_str());
+  if (!in_meter["good"].get<bool>()) {
+    EXPECT_FALSE(advice["done"].get<bool>());
+    ASSERT_FALSE(advice["next"].is_null()) << advice.dump(1);
+    if (in_meter["cells_covered"].get<double>() < 1.0) {
+      EXPECT_NE(advice["next"]["words"].get<std::string>().find("the intrinsics still lack"),
+                std::string::npos)
+          << advice["next"]["words"];
+    }
+  }
 }
 
 }  // namespace
