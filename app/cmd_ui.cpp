@@ -227,7 +227,7 @@ int RunGui(int argc, char** argv) {
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
                    bool solve, const std::string& view, int width, int height,
                    const std::string& out, const std::string& backend_name,
-                   const std::string& save_session) {
+                   const std::string& save_session, bool intrinsics) {
   gfx::HeadlessBackend backend;
   const ui::HeadlessShot shot{pair, solve, width, height};
   const bool lrf = !dataset.empty() && IsLrfManifest(dataset);
@@ -248,8 +248,15 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
   if (!OpenInput(controller, dataset, session, "render",
                  ui::Controller::ExistingSession::kInMemory))
     return kUsage;
-  const auto picture =
-      ui::RenderShot<ui::Workbench, ui::SelectPair, ui::RunSolver>(controller, layout, shot);
+  if (intrinsics) {
+    // The camera-intrinsics window over the workbench, with the estimate from the loaded pairs.
+    controller.WaitIdle();
+    const auto& dataset_camera = controller.GetSnapshot().dataset->camera;
+    controller.Apply(ui::EstimateIntrinsics{dataset_camera.type});
+  }
+  const auto picture = ui::RenderShot<ui::Workbench, ui::SelectPair, ui::RunSolver>(
+      controller, layout, shot,
+      [intrinsics](ui::Workbench& workbench) { workbench.set_intrinsics_open(intrinsics); });
   const int code =
       SaveShot(picture, shot, view, out, controller.GetSnapshot().dataset_path.string(), *context);
   if (code != kOk || save_session.empty()) return code;
@@ -355,9 +362,14 @@ int RunRender(int argc, char** argv) {
   app.add_option("--save-session", save_session,
                  "write the session (with --solve, its result) to this file; render writes no "
                  "session otherwise and leaves the one beside the dataset alone");
+  bool intrinsics = false;
+  app.add_flag("--intrinsics", intrinsics,
+               "LiDAR-camera: open the camera-intrinsics window, estimated from the loaded pairs "
+               "(coverage map, per-image error, sigma)");
   int width = 0, height = 0;
   if (const auto code = ParseFlags(app, argc, argv, size, "render", &width, &height)) return *code;
-  return RenderHeadless(dataset, session, pair, solve, view, width, height, out, gl, save_session);
+  return RenderHeadless(dataset, session, pair, solve, view, width, height, out, gl, save_session,
+                        intrinsics);
 }
 
 }  // namespace calibench::app

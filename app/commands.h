@@ -107,11 +107,12 @@ struct GuiWindowFlags {
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
                  const std::string& screenshot, const GuiWindowFlags& quit = {});
 // Shared by `render` and `demo`: draws one view (or the workbench) headless into a PNG; with
-// save_session, writes the session there (a failure is an error).
+// save_session, writes the session there (a failure is an error); with intrinsics, the
+// camera-intrinsics window open over it, estimated from the loaded pairs.
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
                    bool solve, const std::string& view, int width, int height,
                    const std::string& out, const std::string& backend_name,
-                   const std::string& save_session);
+                   const std::string& save_session, bool intrinsics = false);
 // `demo` on a machine without a display: solve and write the workbench and each view as PNG.
 int RenderDemoViews(const std::string& dataset, const std::string& out_dir);
 // The report's pictures, drawn headless by the workbench (cmd_ui.cpp): a 3D overview and, per

@@ -305,3 +305,59 @@ TEST_F(WorkbenchRender, ASavedAndReopenedSessionRendersIdentically) {
 
 }  // namespace
 }  // namespace calibench::ui
+
+namespace calibench::ui {
+namespace {
+
+// Issue "Camera intrinsics", item 5: the workbench estimates the intrinsics from the loaded pairs
+// (the step `calibench intrinsics` runs), shows the coverage map and the per-image error, and
+// writes them beside the dataset on request.
+TEST_F(WorkbenchRender, TheIntrinsicsWindowEstimatesShowsAndSaves) {
+  const auto dir = test::TempDir("intrinsics_window");
+  std::filesystem::copy(test::UiDataset().parent_path(), dir / "set",
+                        std::filesystem::copy_options::recursive);
+  Controller controller;
+  controller.OpenDataset(dir / "set" / test::UiDataset().filename(), dir / "s.json");
+  const Snapshot loaded = Loaded(controller);
+  int with_corners = 0;
+  for (const PairView& pair : loaded.pairs) with_corners += pair.detection.has_value();
+  ASSERT_GE(with_corners, 3);
+  controller.Apply(EstimateIntrinsics{loaded.dataset->camera.type});
+  const Snapshot estimated = Loaded(controller);
+  ASSERT_TRUE(estimated.intrinsics) << estimated.intrinsics_failure;
+  const IntrinsicsResult& r = *estimated.intrinsics;
+  const CameraModel& truth = loaded.dataset->camera;  // the simulator's camera
+  EXPECT_NEAR(r.camera.fx, truth.fx, 0.03 * truth.fx);
+  EXPECT_NEAR(r.camera.cx, truth.cx, 0.03 * truth.cx);
+  EXPECT_EQ(static_cast<int>(r.images.size()), with_corners);
+  EXPECT_NE(estimated.status_line.find("intrinsics: fx"), std::string::npos)
+      << estimated.status_line;
+  // Four pairs do not cover the image: the verdict says so, and the map shows empty cells.
+  EXPECT_FALSE(r.good);
+  EXPECT_LT(r.coverage.border_covered, 1.0);
+
+  // The window drawn over the workbench: its empty cells in the map's red.
+  Workbench workbench;
+  workbench.set_intrinsics_open(true);
+  const ImageU8 shot =
+      RenderWorkbenchHeadless(controller, workbench, *host_, Layout::kWorkbench, 1400, 900, 4);
+  SaveImage(dir / "intrinsics_window.png", shot);
+  int red = 0;
+  for (int i = 0; i < shot.width * shot.height; ++i) {
+    const std::uint8_t* p = &shot.data[static_cast<size_t>(i) * shot.channels];
+    red += p[1] == 40 && ((p[2] == 150 && p[0] == 35) || (p[0] == 150 && p[2] == 35));
+  }
+  EXPECT_GT(red, 1000) << "no empty coverage cell drawn; see " << (dir / "intrinsics_window.png");
+
+  // Saved beside the dataset, with its covariance; the dataset's camera stays as it was.
+  controller.Apply(SaveIntrinsics{"camera.estimated.yaml", CameraFileFormat::kOpenCv});
+  const Snapshot saved = Loaded(controller);
+  ASSERT_EQ(saved.intrinsics_saved, dir / "set/camera.estimated.yaml") << saved.status_line;
+  const CameraModel back = LoadCameraFile(saved.intrinsics_saved);
+  EXPECT_EQ(back.fx, r.camera.fx);
+  EXPECT_EQ(back.covariance, r.camera.covariance);
+  EXPECT_EQ(saved.dataset->camera.fx, truth.fx);
+}
+
+}  // namespace
+}  // namespace calibench::ui

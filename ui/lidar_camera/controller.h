@@ -16,6 +16,8 @@
 #include "core/base/file_lock.h"
 #include "core/base/image.h"
 #include "core/camera/undistort.h"
+#include "core/intrinsics/intrinsics.h"
+#include "core/io/camera_file.h"
 #include "core/io/dataset.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
@@ -88,6 +90,12 @@ struct Snapshot : SnapshotHeader {
   bool estimate_range_offset = false;  // weighted-ml only
   bool can_undo = false, can_redo = false;
   int loading_done = 0, loading_total = 0;
+  // The camera's intrinsics estimated from the loaded pairs' corners (EstimateIntrinsics), what
+  // the intrinsics window shows: coverage, per-image error, σ, the verdict; or why not.
+  std::shared_ptr<const IntrinsicsResult> intrinsics;
+  std::string intrinsics_failure;
+  bool intrinsics_running = false;
+  std::filesystem::path intrinsics_saved;  // where SaveIntrinsics last wrote them
 };
 
 // What the user asked for. Panels return these; Controller::Apply carries them out.
@@ -145,9 +153,20 @@ struct SaveSessionAs {
 };
 struct Undo {};
 struct Redo {};
-using Intent = std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush,
-                            DetectBoardAgain, PaintPoints, RunSolver, ResetSolver, SetSolverOptions,
-                            SetView, ExportResult, SaveSessionAs, Undo, Redo>;
+// The camera's intrinsics from every loaded pair's board corners (as `calibench intrinsics`),
+// on the worker; the dataset's camera is not changed.
+struct EstimateIntrinsics {
+  CameraModelType model = CameraModelType::kPinholeRadTan;
+};
+// Writes the estimated intrinsics as a camera file (a relative path goes beside the dataset).
+struct SaveIntrinsics {
+  std::filesystem::path path;
+  CameraFileFormat format = CameraFileFormat::kRosCameraInfo;
+};
+using Intent =
+    std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush, DetectBoardAgain,
+                 PaintPoints, RunSolver, ResetSolver, SetSolverOptions, SetView, ExportResult,
+                 SaveSessionAs, Undo, Redo, EstimateIntrinsics, SaveIntrinsics>;
 
 class Controller : public ControllerState<Snapshot> {
  public:
@@ -273,5 +292,9 @@ template <>
 void Controller::Handle(const Undo&);
 template <>
 void Controller::Handle(const Redo&);
+template <>
+void Controller::Handle(const EstimateIntrinsics&);  // controller_intrinsics.cpp
+template <>
+void Controller::Handle(const SaveIntrinsics&);
 
 }  // namespace calibench::ui

@@ -41,6 +41,8 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   // The 3D view's left drag paints the board on the points instead of orbiting (the "brush"
   // checkbox of its toolbar).
   void set_scene_brush(bool on) { scene_brush_ = on; }
+  // The camera-intrinsics window (its button in the solver panel; `render --intrinsics`).
+  void set_intrinsics_open(bool on) { intrinsics_open_ = on; }
 
  private:
   // LiDAR view (workbench_lidar.cpp).
@@ -66,6 +68,9 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   void PairRow(const Snapshot& s, int index, std::vector<Intent>* intents);
   void SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) override;
   void SolutionReadouts(const SolverView& solver, std::vector<Intent>* intents);
+  // The camera-intrinsics window (workbench_intrinsics.cpp): estimate from the loaded pairs, the
+  // coverage map, the per-image error, σ and the verdict, save beside the dataset.
+  void IntrinsicsWindow(const Snapshot& s, std::vector<Intent>* intents);
   // workbench.cpp
   void View(int index, const Snapshot& s, const Rect& r, std::vector<Intent>* intents) override;
   std::string Opened(const Snapshot& s) const override;
@@ -90,6 +95,10 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   ImageRect lidar_image_rect_;
   ImageRect scene_image_rect_;
   bool scene_brush_ = false;
+  bool intrinsics_open_ = false;
+  int intrinsics_model_ = -1;  // 0 pinhole, 1 fisheye; -1 = the dataset camera's
+  int intrinsics_format_ = 0;  // ros, opencv, kalibr
+  std::string intrinsics_path_ = "camera.estimated.yaml";
   std::uint64_t scene_frame_key_ = 0;  // what the 3D framebuffer last showed
   std::uint64_t lidar_key_ = ~0ull, camera_key_ = ~0ull, scene_key_ = ~0ull;
 };

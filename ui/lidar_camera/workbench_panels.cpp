@@ -191,6 +191,12 @@ void Workbench::SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent
       replay().Buttons(s.solver.iterations.size(), s.solver.running);
   if (request.run) intents->push_back(RunSolver{});
   if (request.reset) intents->push_back(ResetSolver{});
+  ImGui::SameLine();
+  if (ImGui::Button("Camera intrinsics...")) intrinsics_open_ = !intrinsics_open_;
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "estimate the camera's intrinsics from the loaded pairs: coverage, per-image "
+        "error, sigma");
   if (!s.solver.iterations.empty()) {
     replay().CostPlot(s.solver.iterations, ImVec2(r.w * 0.45f, 70));
     ImGui::SameLine();
@@ -202,6 +208,7 @@ void Workbench::SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent
   if (PathField("##session", &session_path_, "Save session as"))
     intents->push_back(SaveSessionAs{session_path_});
   ImGui::End();
+  if (intrinsics_open_) IntrinsicsWindow(s, intents);
 }
 
 void Workbench::SolutionReadouts(const SolverView& solver, std::vector<Intent>* intents) {

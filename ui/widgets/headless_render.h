@@ -4,6 +4,7 @@
 // would show.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -31,9 +32,11 @@ struct HeadlessShot {
 // Waits for the controller's work, selects the shot's pair and solves when asked (SelectPair and
 // RunSolver: the method's intents), waits again and draws a fresh workbench in `layout`, a few
 // frames (ImGui sizes tables and windows on the first ones). nullopt when no pair has the id.
+// `prepare` (optional) sets the fresh workbench's view-local state before it draws.
 template <typename Workbench, typename SelectPair, typename RunSolver, typename Controller,
           typename Layout>
-std::optional<ImageU8> RenderShot(Controller& controller, Layout layout, const HeadlessShot& shot) {
+std::optional<ImageU8> RenderShot(Controller& controller, Layout layout, const HeadlessShot& shot,
+                                  const std::function<void(Workbench&)>& prepare = {}) {
   controller.WaitIdle();
   if (!shot.pair_id.empty()) {
     const int index = FindPair(controller.GetSnapshot(), shot.pair_id);
@@ -44,6 +47,7 @@ std::optional<ImageU8> RenderShot(Controller& controller, Layout layout, const H
   controller.WaitIdle();
   ImGuiHost host(nullptr);
   Workbench workbench;
+  if (prepare) prepare(workbench);
   return RenderWorkbenchHeadless(controller, workbench, host, layout, shot.width, shot.height,
                                  /*frames=*/4);
 }
