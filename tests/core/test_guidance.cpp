@@ -162,23 +162,28 @@ TEST(GuidanceFeasibility, PredictedReturnsMatchTheSimulatorsScan) {
   }
 }
 
+// Three boards, all frontal near the image centre (planned pairs, as the solver would see them):
+// the translation along the view is well fixed, the rest weakly.
+void ThreeFrontalBoards(const SensorGeometry& sensors, const Pose& cam_from_lidar,
+                        std::vector<PlanePair>* pairs, std::vector<Pose>* seen) {
+  for (const Pose& pose : {FacingBoard(Vec3(0, 0, 1.6), 10), FacingBoard(Vec3(0.1, 0, 2.0), -10),
+                           FacingBoard(Vec3(-0.1, 0.05, 2.2), 15)}) {
+    PredictedReturns returns;
+    const Feasibility f = CheckFeasible(sensors, cam_from_lidar, pose, GuidanceOptions{}, &returns);
+    ASSERT_TRUE(f.feasible) << f.why;
+    pairs->push_back(PlannedPair(sensors, cam_from_lidar, pose, returns));
+    seen->push_back(pose);
+  }
+}
+
 TEST(GuidanceNextPose, TheSuggestionIsFeasibleAndShrinksTheWeakestDirection) {
   const SensorGeometry sensors = Vlp16Sensors();
   const Pose cam_from_lidar = DefaultCamFromLidar();
   GuidanceOptions options;
   SolverOptions solver;
-  // Three boards, all frontal near the image centre: the translation along the view is well
-  // fixed, the rest weakly.
   std::vector<PlanePair> pairs;
   std::vector<Pose> seen;
-  for (const Pose& pose : {FacingBoard(Vec3(0, 0, 1.6), 10), FacingBoard(Vec3(0.1, 0, 2.0), -10),
-                           FacingBoard(Vec3(-0.1, 0.05, 2.2), 15)}) {
-    PredictedReturns returns;
-    const Feasibility f = CheckFeasible(sensors, cam_from_lidar, pose, options, &returns);
-    ASSERT_TRUE(f.feasible) << f.why;
-    pairs.push_back(PlannedPair(sensors, cam_from_lidar, pose, returns));
-    seen.push_back(pose);
-  }
+  ASSERT_NO_FATAL_FAILURE(ThreeFrontalBoards(sensors, cam_from_lidar, &pairs, &seen));
   SolverResult solution;
   solution.cam_from_lidar = cam_from_lidar;
   solution.covariance = ExpectedPoseInformation(pairs, cam_from_lidar, solver).inverse();
@@ -320,13 +325,7 @@ TEST(GuidanceNextPose, ItAlsoCoversTheImageCellsTheIntrinsicsLack) {
   SolverOptions solver;
   std::vector<PlanePair> pairs;
   std::vector<Pose> seen;
-  for (const Pose& pose : {FacingBoard(Vec3(0, 0, 1.6), 10), FacingBoard(Vec3(0.1, 0, 2.0), -10),
-                           FacingBoard(Vec3(-0.1, 0.05, 2.2), 15)}) {
-    PredictedReturns returns;
-    ASSERT_TRUE(CheckFeasible(sensors, cam_from_lidar, pose, GuidanceOptions{}, &returns).feasible);
-    pairs.push_back(PlannedPair(sensors, cam_from_lidar, pose, returns));
-    seen.push_back(pose);
-  }
+  ASSERT_NO_FATAL_FAILURE(ThreeFrontalBoards(sensors, cam_from_lidar, &pairs, &seen));
   SolverResult solution;
   solution.cam_from_lidar = cam_from_lidar;
   solution.covariance = ExpectedPoseInformation(pairs, cam_from_lidar, solver).inverse();
