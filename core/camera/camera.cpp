@@ -273,6 +273,23 @@ bool CovarianceValid(const std::vector<double>& c, size_t n) {
   return true;
 }
 
+// The unit bearing of a pixel (CameraModel::Unproject without its Jacobian).
+std::optional<Vec3> UnprojectBearing(const CameraModel& camera, const Vec2& pixel) {
+  const Vec2 distorted((pixel.x() - camera.cx) / camera.fx, (pixel.y() - camera.cy) / camera.fy);
+  if (!distorted.allFinite()) return std::nullopt;
+  if (camera.type == CameraModelType::kPinholeRadTan) {
+    const std::optional<Vec2> p = UndistortRadTan(camera, distorted);
+    if (!p) return std::nullopt;
+    return Vec3(p->x(), p->y(), 1.0).normalized();
+  }
+  const double theta_d = distorted.norm();
+  if (theta_d == 0) return Vec3(0, 0, 1);
+  const std::optional<double> theta = UndistortTheta(camera, theta_d);
+  if (!theta) return std::nullopt;
+  const Vec2 direction = distorted / theta_d;
+  return Vec3(std::sin(*theta) * direction.x(), std::sin(*theta) * direction.y(), std::cos(*theta));
+}
+
 }  // namespace
 
 std::string CameraModelName(CameraModelType type) {
@@ -344,20 +361,22 @@ std::optional<Vec2> CameraModel::Project(const Vec3& point_in_cam,
              : ProjectFisheye(*this, point_in_cam, d_pixel_d_point);
 }
 
-std::optional<Vec3> CameraModel::Unproject(const Vec2& pixel) const {
-  const Vec2 distorted((pixel.x() - cx) / fx, (pixel.y() - cy) / fy);
-  if (!distorted.allFinite()) return std::nullopt;
-  if (type == CameraModelType::kPinholeRadTan) {
-    const std::optional<Vec2> p = UndistortRadTan(*this, distorted);
-    if (!p) return std::nullopt;
-    return Vec3(p->x(), p->y(), 1.0).normalized();
-  }
-  const double theta_d = distorted.norm();
-  if (theta_d == 0) return Vec3(0, 0, 1);
-  const std::optional<double> theta = UndistortTheta(*this, theta_d);
-  if (!theta) return std::nullopt;
-  const Vec2 direction = distorted / theta_d;
-  return Vec3(std::sin(*theta) * direction.x(), std::sin(*theta) * direction.y(), std::cos(*theta));
+std::optional<Vec3> CameraModel::Unproject(const Vec2& pixel,
+                                           Eigen::Matrix<double, 3, 2>* d_bearing_d_pixel) const {
+  const std::optional<Vec3> bearing = UnprojectBearing(*this, pixel);
+  if (!bearing || !d_bearing_d_pixel) return bearing;
+  // The bearing b moves so that Project(b) follows the pixel and b stays unit: J db = dp with
+  // J = dProject/dpoint at b, and bᵀ db = 0. The 3x3 system [J; bᵀ] is regular wherever Project
+  // is (its Jacobian's null space is b itself: moving along the ray does not move the pixel).
+  Eigen::Matrix<double, 2, 3> project_jacobian;
+  if (!Project(*bearing, &project_jacobian)) return std::nullopt;
+  Mat3 system;
+  system.topRows<2>() = project_jacobian;
+  system.row(2) = bearing->transpose();
+  Eigen::Matrix<double, 3, 2> right = Eigen::Matrix<double, 3, 2>::Zero();
+  right.topRows<2>().setIdentity();
+  *d_bearing_d_pixel = system.partialPivLu().solve(right);
+  return bearing;
 }
 
 }  // namespace calibench

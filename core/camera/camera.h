@@ -41,7 +41,9 @@ struct CameraModel {
 
   // Unit bearing vector in the camera frame for a pixel (inverse of Project up to scale), by
   // Newton iteration on the distortion. nullopt if the iteration does not converge.
-  std::optional<Vec3> Unproject(const Vec2& pixel) const;
+  // d_bearing_d_pixel, if given, receives the 3x2 Jacobian of the unit bearing.
+  std::optional<Vec3> Unproject(const Vec2& pixel,
+                                Eigen::Matrix<double, 3, 2>* d_bearing_d_pixel = nullptr) const;
 
   bool InImage(const Vec2& pixel, double margin_px = 0.0) const {
     return pixel.x() >= -0.5 + margin_px && pixel.y() >= -0.5 + margin_px &&

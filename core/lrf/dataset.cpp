@@ -383,9 +383,9 @@ DepthImage LoadDepthCloud(const fs::path& path, const DepthIntrinsics& intrinsic
   depth.intrinsics = intrinsics;
   depth.depth_m.assign(static_cast<size_t>(intrinsics.width) * intrinsics.height, 0.0f);
   for (const Eigen::Vector3f& p : cloud.points) {
-    if (!(p.z() > 0)) continue;
-    const long u = std::lround(intrinsics.fx * p.x() / p.z() + intrinsics.cx);
-    const long v = std::lround(intrinsics.fy * p.y() / p.z() + intrinsics.cy);
+    const auto pixel = intrinsics.Project(p.cast<double>());
+    if (!pixel) continue;
+    const long u = std::lround(pixel->x()), v = std::lround(pixel->y());
     if (u < 0 || v < 0 || u >= intrinsics.width || v >= intrinsics.height) continue;
     float& z = depth.depth_m[static_cast<size_t>(v) * intrinsics.width + u];
     if (z == 0.0f || p.z() < z) z = p.z();  // nearest wins: the surface the camera would see

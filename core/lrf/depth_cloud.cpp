@@ -24,7 +24,7 @@ DepthCloud BackProject(const DepthImage& depth, const DepthRegion& region, int s
       if (!std::isfinite(z) || z <= 0.0 || z > max_depth_m) continue;
       const int cell = gv * cloud.grid_width + gu;
       cloud.point_of_cell[cell] = static_cast<int>(cloud.points.size());
-      cloud.points.emplace_back((u - k.cx) * z / k.fx, (v - k.cy) * z / k.fy, z);
+      cloud.points.push_back(k.Unproject(Vec2(static_cast<double>(u), static_cast<double>(v)), z));
       cloud.pixel_u.push_back(u);
       cloud.pixel_v.push_back(v);
       cloud.cell.push_back(cell);

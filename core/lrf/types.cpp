@@ -35,6 +35,23 @@ bool DepthIntrinsics::Check(std::string* why) const {
   return true;
 }
 
+std::optional<Vec2> DepthIntrinsics::Project(const Vec3& point,
+                                             Eigen::Matrix<double, 2, 3>* d_pixel_d_point) const {
+  if (!(point.z() > 0)) return std::nullopt;
+  const double inverse_z = 1.0 / point.z();
+  const Vec2 pixel(fx * point.x() * inverse_z + cx, fy * point.y() * inverse_z + cy);
+  if (d_pixel_d_point)
+    *d_pixel_d_point << fx * inverse_z, 0, -fx * point.x() * inverse_z * inverse_z,  //
+        0, fy * inverse_z, -fy * point.y() * inverse_z * inverse_z;
+  return pixel;
+}
+
+Vec3 DepthIntrinsics::Unproject(const Vec2& pixel, double z,
+                                Eigen::Matrix<double, 3, 2>* d_point_d_pixel) const {
+  if (d_point_d_pixel) *d_point_d_pixel << z / fx, 0, 0, z / fy, 0, 0;
+  return Vec3((pixel.x() - cx) / fx * z, (pixel.y() - cy) / fy * z, z);
+}
+
 bool ThreeFaceTarget::Check(std::string* why) const {
   const double values[] = {base_width, base_height, tent_half_width, apex_y, foot_y, ridge_height};
   if (!std::all_of(std::begin(values), std::end(values), [](double v) { return std::isfinite(v); }))

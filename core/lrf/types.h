@@ -19,6 +19,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,15 @@ struct DepthIntrinsics {
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;  // pixels
   double depth_scale = 0.001;                     // metres per PNG unit
   bool Check(std::string* why) const;
+
+  // The pinhole projection (a depth camera publishes its depth rectified: no distortion) of a
+  // camera-frame point (metres) to pixels; nullopt at z <= 0. d_pixel_d_point: the 2x3 Jacobian.
+  std::optional<Vec2> Project(const Vec3& point,
+                              Eigen::Matrix<double, 2, 3>* d_pixel_d_point = nullptr) const;
+  // The camera-frame point seen at `pixel` with depth z (along the optical axis, metres), the
+  // inverse of Project; d_point_d_pixel: its 3x2 Jacobian at that depth.
+  Vec3 Unproject(const Vec2& pixel, double z,
+                 Eigen::Matrix<double, 3, 2>* d_point_d_pixel = nullptr) const;
 };
 
 // A depth frame: z (metres, along the optical axis) per pixel, row-major; 0 = no data.

@@ -196,7 +196,7 @@ LaserScan RenderScan(const LrfSimOptions& options, const Scene& scene, Rng* rng,
 
 // Unit ray of pixel (u, v) in its own camera frame.
 Vec3 PixelRay(const DepthIntrinsics& in, int u, int v) {
-  return Vec3((u - in.cx) / in.fx, (v - in.cy) / in.fy, 1.0).normalized();
+  return in.Unproject(Vec2(static_cast<double>(u), static_cast<double>(v)), 1.0).normalized();
 }
 
 // Depth image of a camera at left_from_camera; noise σ_z = z² σ_disp / (f b) (paper Eq. (3):
@@ -270,8 +270,9 @@ bool GeometryValid(const LrfSimOptions& options, const Pose& cam_from_target) {
   for (const Vec3& corner : corners) {
     const Vec3 p = cam_from_target * corner;
     if (p.z() < 0.2 || p.z() > options.depth.max_depth_m) return false;
-    const double u = in.fx * p.x() / p.z() + in.cx, v = in.fy * p.y() / p.z() + in.cy;
-    if (u < 2 || v < 2 || u > in.width - 3 || v > in.height - 3) return false;
+    const Vec2 pixel = *in.Project(p);  // z > 0 here
+    if (pixel.x() < 2 || pixel.y() < 2 || pixel.x() > in.width - 3 || pixel.y() > in.height - 3)
+      return false;
     for (const Plane& plane : clutter)
       if (plane.SignedDistance(p) < 0.05) return false;
   }
@@ -320,10 +321,10 @@ bool CoverageValid(const LrfSimOptions& options, const Pose& cam_from_target) {
   double u_min = in.width, u_max = 0, v_min = in.height, v_max = 0;
   for (const Vec3& corner :
        {Vec3(-hw, -hh, 0), Vec3(hw, -hh, 0), Vec3(hw, hh, 0), Vec3(-hw, hh, 0), target.C()}) {
-    const Vec3 p = cam_from_target * corner;
-    const double u = in.fx * p.x() / p.z() + in.cx, v = in.fy * p.y() / p.z() + in.cy;
-    u_min = std::min(u_min, u), u_max = std::max(u_max, u);
-    v_min = std::min(v_min, v), v_max = std::max(v_max, v);
+    const auto pixel = in.Project(cam_from_target * corner);
+    if (!pixel) return false;  // GeometryValid put the target in front; never here
+    u_min = std::min(u_min, pixel->x()), u_max = std::max(u_max, pixel->x());
+    v_min = std::min(v_min, pixel->y()), v_max = std::max(v_max, pixel->y());
   }
   int pixels[3] = {0, 0, 0};
   for (int v = std::max(0, int(v_min)); v <= std::min(in.height - 1, int(v_max) + 1); ++v) {

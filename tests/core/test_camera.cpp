@@ -336,5 +336,46 @@ TEST(CameraModelTest, AnalyticJacobianMatchesCentralDifferences) {
   ExpectJacobianMatchesNumeric(WideFisheyeCamera(), RandomFisheyePoints(1e-4, 9e-3, 200, &rng));
 }
 
+// Unproject's Jacobian (the unit bearing against the pixel) against central differences, and
+// Project ∘ Unproject's chain: J_project · J_unproject = I (a pixel moved is the pixel moved).
+void ExpectUnprojectJacobian(const CameraModel& c, const std::vector<Vec3>& points) {
+  int checked = 0;
+  for (const Vec3& point : points) {
+    const auto pixel = c.Project(point);
+    if (!pixel) continue;
+    Eigen::Matrix<double, 3, 2> analytic;
+    const auto bearing = c.Unproject(*pixel, &analytic);
+    if (!bearing) continue;
+    Eigen::Matrix<double, 3, 2> numeric;
+    bool ok = true;
+    for (int k = 0; k < 2 && ok; ++k) {
+      Vec2 step = Vec2::Zero();
+      step[k] = 1e-3;
+      const auto plus = c.Unproject(*pixel + step), minus = c.Unproject(*pixel - step);
+      ok = plus && minus;
+      if (ok) numeric.col(k) = (*plus - *minus) / 2e-3;
+    }
+    if (!ok) continue;
+    EXPECT_TRUE(test::MatrixNear(analytic, numeric, 1e-7 + 1e-5 * numeric.norm()))
+        << "pixel " << pixel->transpose();
+    Eigen::Matrix<double, 2, 3> project;
+    ASSERT_TRUE(c.Project(*bearing, &project));
+    EXPECT_TRUE(test::MatrixNear(project * analytic, Eigen::Matrix2d::Identity(), 1e-6));
+    EXPECT_NEAR(bearing->dot(analytic.col(0)), 0.0, 1e-9);  // stays unit
+    ++checked;
+  }
+  EXPECT_GT(checked, static_cast<int>(points.size()) / 2);
+}
+
+TEST(CameraModelTest, UnprojectJacobianMatchesCentralDifferences) {
+  std::mt19937 rng(4);
+  for (const CameraModel& c : PinholeCameras()) {
+    SCOPED_TRACE("distortion count " + std::to_string(c.distortion.size()));
+    ExpectUnprojectJacobian(c, RandomPinholePoints(c, 300, &rng));
+  }
+  ExpectUnprojectJacobian(Vlp16Camera(), RandomFisheyePoints(0.0, 1.15, 300, &rng));
+  ExpectUnprojectJacobian(WideFisheyeCamera(), RandomFisheyePoints(0.05, 1.5, 300, &rng));
+}
+
 }  // namespace
 }  // namespace calibench

@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <random>
 
 #include "core/io/cloud_io.h"
 #include "core/lidar/cloud.h"
@@ -310,6 +311,46 @@ TEST(LrfDataset, BadManifestsThrowNamingTheManifest) {
   const LrfDataset loaded = LoadLrfDataset(dir / "missingfile.json");
   EXPECT_EQ(loaded.pairs.size(), d.pairs.size());
   ExpectIoErrorNaming([&] { LoadLaserScan(loaded.pairs[1].scan); }, dir / "scans/0009.json");
+}
+
+}  // namespace
+}  // namespace calibench
+
+namespace calibench {
+namespace {
+
+// The depth camera's one projection: Project and Unproject invert each other, their Jacobians
+// are the derivatives, and a point behind the camera has no pixel.
+TEST(DepthIntrinsicsProjection, ProjectAndUnprojectAreInversesWithTheirJacobians) {
+  DepthIntrinsics k;
+  k.width = 640, k.height = 480, k.fx = 525.5, k.fy = 524.0, k.cx = 319.2, k.cy = 241.7;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> lateral(-1.5, 1.5), depth(0.3, 6.0);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 point(lateral(rng), lateral(rng), depth(rng));
+    Eigen::Matrix<double, 2, 3> project;
+    const auto pixel = k.Project(point, &project);
+    ASSERT_TRUE(pixel);
+    Eigen::Matrix<double, 3, 2> unproject;
+    EXPECT_TRUE(test::MatrixNear(k.Unproject(*pixel, point.z(), &unproject), point, 1e-12));
+    Eigen::Matrix<double, 2, 3> numeric_project;
+    Eigen::Matrix<double, 3, 2> numeric_unproject;
+    for (int c = 0; c < 3; ++c) {
+      Vec3 step = Vec3::Zero();
+      step[c] = 1e-6;
+      numeric_project.col(c) = (*k.Project(point + step) - *k.Project(point - step)) / 2e-6;
+    }
+    for (int c = 0; c < 2; ++c) {
+      Vec2 step = Vec2::Zero();
+      step[c] = 1e-3;
+      numeric_unproject.col(c) =
+          (k.Unproject(*pixel + step, point.z()) - k.Unproject(*pixel - step, point.z())) / 2e-3;
+    }
+    EXPECT_TRUE(test::MatrixNear(project, numeric_project, 1e-4));
+    EXPECT_TRUE(test::MatrixNear(unproject, numeric_unproject, 1e-9));
+  }
+  EXPECT_FALSE(k.Project(Vec3(0.1, 0.2, -1.0)));
+  EXPECT_FALSE(k.Project(Vec3(0.1, 0.2, 0.0)));
 }
 
 }  // namespace

@@ -104,9 +104,8 @@ ImageU8 ComposeDepthPicture(const DepthImage& depth, const DepthFeatures& featur
 // camera model (checkerboard).
 std::optional<Vec2> ProjectToImage(const LrfDataset& dataset, const Vec3& x) {
   if (dataset.target_type == LrfTargetType::kCheckerboard) return dataset.camera.Project(x);
-  if (x.z() < 0.05) return std::nullopt;
-  const DepthIntrinsics& k = dataset.depth_camera;
-  return Vec2(k.fx * x.x() / x.z() + k.cx, k.fy * x.y() / x.z() + k.cy);
+  if (x.z() < 0.05) return std::nullopt;  // nearer than any depth camera sees
+  return dataset.depth_camera.Project(x);
 }
 
 Vec3 OnScanPlane(const Vec2& p) { return Vec3(p.x(), p.y(), 0.0); }
@@ -203,7 +202,7 @@ DepthCloud BackProject(const LrfPairFeatures& pair) {
     for (int u = 0; u < k.width; u += stride) {
       const double z = depth.At(u, v);
       if (z <= 0) continue;
-      const Vec3 x((u - k.cx) / k.fx * z, (v - k.cy) / k.fy * z, z);
+      const Vec3 x = k.Unproject(Vec2(static_cast<double>(u), static_cast<double>(v)), z);
       const int face = faces ? (*faces)[static_cast<size_t>(v) * k.width + u] : -1;
       cloud.positions.push_back(x.cast<float>());
       cloud.all_sum += x;
