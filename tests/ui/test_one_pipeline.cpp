@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
@@ -110,6 +111,35 @@ TEST(OnePipeline, CalibrateWithTheSessionFlagMatchesTheWorkbench) {
   ExpectIdentical(cli.cam_from_source.matrix(), gui.solver.result->cam_from_lidar.matrix(),
                   "cam_from_lidar");
   ExpectIdentical(cli.covariance, gui.solver.result->covariance, "covariance");
+}
+
+// A camera file with its intrinsics' covariance: the workbench's σ carries it as `calibrate`'s
+// does (AddIntrinsicsUncertainty after the solve, in both), to the bit.
+TEST(OnePipeline, TheIntrinsicsCovarianceIsInTheWorkbenchsSigmaAsInTheCommandLines) {
+  const auto dir = test::TempDir("one_pipeline_intrinsics");
+  std::filesystem::copy(test::UiDataset().parent_path(), dir / "set",
+                        std::filesystem::copy_options::recursive);
+  const auto manifest = dir / "set" / test::UiDataset().filename();
+  nlohmann::json root;
+  std::ifstream(manifest) >> root;
+  std::vector<double> covariance(81, 0.0);
+  const double sigma[] = {3.0, 3.0, 2.0, 2.0, 0.002, 0.004, 0.0003, 0.0003, 0.0};
+  for (int i = 0; i < 9; ++i) covariance[i * 9 + i] = sigma[i] * sigma[i];
+  root["camera"]["intrinsics_covariance"] = covariance;
+  std::ofstream(manifest) << root.dump(1);
+
+  Controller controller;
+  controller.OpenDataset(manifest, dir / "s.json");
+  controller.WaitIdle();
+  controller.Apply(RunSolver{});
+  const Snapshot gui = Loaded(controller);
+  ASSERT_TRUE(gui.solver.result) << gui.solver.failure;
+  EXPECT_FALSE(gui.solver.result->intrinsics_covariance.isZero(0.0));
+  const CalibrationOutcome cli = CalibrateDataset(LoadDataset(manifest), PipelineOptions{});
+  ASSERT_TRUE(cli.solution) << cli.failure;
+  ExpectIdentical(gui.solver.result->covariance, cli.solution->covariance, "covariance");
+  ExpectIdentical(gui.solver.result->intrinsics_covariance, cli.solution->intrinsics_covariance,
+                  "intrinsics_covariance");
 }
 
 // File → Report… runs `calibench report` on the autosaved session: the report carries the

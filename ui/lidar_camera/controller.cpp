@@ -10,6 +10,7 @@
 #include "core/base/atomic_file.h"
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
+#include "core/lidar_camera/joint_intrinsics.h"
 #include "core/lidar_camera/result_io.h"
 
 namespace calibench::ui {
@@ -85,21 +86,26 @@ SolverOptions Controller::SolverOptionsFromState() const {
 void Controller::Solve() {
   std::vector<PairFeatures> features;
   PipelineOptions options;
+  CameraModel camera;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     for (const PairView& pair : state_.pairs) features.push_back(FeaturesOf(pair));
     options = PipelineOptionsFromState();
+    if (state_.dataset) camera = state_.dataset->camera;
     state_.solver = SolverView{};
     state_.solver.running = true;
     ++state_.generation;
   }
   // The CLI's solve (SolveFromFeatures), watched iteration by iteration.
-  const CalibrationOutcome outcome =
+  CalibrationOutcome outcome =
       SolveFromFeatures(std::move(features), options, [this](const IterationReport& it) {
         std::lock_guard<std::mutex> lock(mutex_);
         state_.solver.iterations.push_back(it);
         ++state_.generation;
       });
+  // As CalibrateDataset: the camera file's intrinsics covariance is in the σ.
+  if (outcome.solution && options.propagate_intrinsics)
+    AddIntrinsicsUncertainty(outcome.pairs, camera, options, &*outcome.solution);
   std::lock_guard<std::mutex> lock(mutex_);
   state_.solver.running = false;
   if (!outcome.solution) {
