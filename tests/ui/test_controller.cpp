@@ -441,3 +441,51 @@ TEST(Controller, AReadOnlyDatasetFolderOpensAndSaysItCannotSave) {
 
 }  // namespace
 }  // namespace calibench::ui
+
+namespace calibench::ui {
+namespace {
+
+// The meter after a solve is the stop rule's verdict (as `advise` judges) on the workbench's
+// result: σ per axis from its covariance, the weakest axis against an editable goal, not done
+// with fewer pairs than the rule trusts; one history point per solve at a number of pairs.
+TEST(Controller, TheMeterJudgesTheSolveAgainstTheGoal) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), test::TempDir("controller_meter") / "s.json");
+  controller.WaitIdle();
+  EXPECT_FALSE(controller.GetSnapshot().meter);
+  controller.Apply(RunSolver{});
+  Snapshot s = Loaded(controller);
+  ASSERT_TRUE(s.solver.result && s.meter);
+  const CaptureState expected = JudgeCapture(*s.solver.result, 4, CaptureGoal{}, StopRuleOptions{});
+  EXPECT_EQ(s.meter->sigma_t_mm, expected.sigma_t_mm);
+  EXPECT_EQ(s.meter->sigma_r_deg, expected.sigma_r_deg);
+  EXPECT_EQ(s.meter->pairs_used, 4);
+  EXPECT_FALSE(s.meter->done);  // four pairs: the σ is not trusted yet
+  EXPECT_FALSE(s.meter->trustworthy);
+  ASSERT_EQ(s.meter_history.size(), 1u);
+  EXPECT_EQ(s.meter_history[0].pairs, 4);
+  // A goal no σ meets: the weakest axis named; a loose one: met (still not done: four pairs).
+  controller.Apply(SetGoal{CaptureGoal{0.001, 0.0001}});
+  s = Loaded(controller);
+  EXPECT_FALSE(s.meter->goal_met);
+  EXPECT_FALSE(s.meter->weakest.empty());
+  controller.Apply(SetGoal{CaptureGoal{100.0, 10.0}});
+  s = Loaded(controller);
+  EXPECT_TRUE(s.meter->goal_met);
+  EXPECT_FALSE(s.meter->done);
+  // A bad goal is refused in words, the old one kept.
+  controller.Apply(SetGoal{CaptureGoal{-1.0, 0.1}});
+  s = Loaded(controller);
+  EXPECT_TRUE(s.status_is_error);
+  EXPECT_EQ(s.goal.translation_mm, 100.0);
+  // Solving again at the same number of pairs replaces the point; one fewer pair adds one.
+  controller.Apply(RunSolver{});
+  controller.Apply(SetPairStatus{0, PairStatus::kRejected});
+  controller.Apply(RunSolver{});
+  s = Loaded(controller);
+  ASSERT_EQ(s.meter_history.size(), 2u);
+  EXPECT_EQ(s.meter_history[1].pairs, 3);
+}
+
+}  // namespace
+}  // namespace calibench::ui

@@ -122,6 +122,7 @@ void Controller::Solve() {
   for (const std::string& note : {DescribeLidarModel(outcome), CountResiduals(outcome).note})
     if (!note.empty()) state_.solver.notes.push_back(note);
   RecomputeResiduals();
+  JudgeMeter(/*record=*/true);
   SetStatus("solved with " + std::to_string(state_.solver.solved_pair_ids.size()) + " pairs in " +
                 std::to_string(result.iterations) + " iterations" +
                 (result.observability.well_constrained ? "" : " (NOT well constrained)"),
@@ -232,6 +233,7 @@ void Controller::Handle(const ResetSolver&) {
   state_.solver = SolverView{};
   state_.reprojection.reset();
   RecomputeResiduals();
+  JudgeMeter(/*record=*/false);
   CommitEdit();
 }
 

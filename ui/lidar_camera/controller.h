@@ -16,6 +16,7 @@
 #include "core/base/file_lock.h"
 #include "core/base/image.h"
 #include "core/camera/undistort.h"
+#include "core/guidance/stop_rule.h"
 #include "core/intrinsics/intrinsics.h"
 #include "core/io/camera_file.h"
 #include "core/io/dataset.h"
@@ -72,6 +73,13 @@ struct Reprojection {
   std::vector<bool> visible;
 };
 
+// The meter after each solve: σ per camera axis at that many pairs.
+struct MeterPoint {
+  int pairs = 0;
+  Vec3 sigma_t_mm = Vec3::Zero();
+  Vec3 sigma_r_deg = Vec3::Zero();
+};
+
 struct Snapshot : SnapshotHeader {
   std::filesystem::path dataset_path;
   std::filesystem::path session_path;  // empty: the session lives in memory only (render)
@@ -96,6 +104,11 @@ struct Snapshot : SnapshotHeader {
   std::string intrinsics_failure;
   bool intrinsics_running = false;
   std::filesystem::path intrinsics_saved;  // where SaveIntrinsics last wrote them
+  // The meter (core/guidance's stop rule, as `advise` and `watch` judge): σ per direction against
+  // the user's goal, the weakest in words, done; its history over the solves.
+  CaptureGoal goal;
+  std::optional<CaptureState> meter;
+  std::vector<MeterPoint> meter_history;
 };
 
 // What the user asked for. Panels return these; Controller::Apply carries them out.
@@ -153,6 +166,10 @@ struct SaveSessionAs {
 };
 struct Undo {};
 struct Redo {};
+// The user's goal for the meter (σ per axis).
+struct SetGoal {
+  CaptureGoal goal;
+};
 // The camera's intrinsics from every loaded pair's board corners (as `calibench intrinsics`),
 // on the worker; the dataset's camera is not changed.
 struct EstimateIntrinsics {
@@ -166,7 +183,7 @@ struct SaveIntrinsics {
 using Intent =
     std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush, DetectBoardAgain,
                  PaintPoints, RunSolver, ResetSolver, SetSolverOptions, SetView, ExportResult,
-                 SaveSessionAs, Undo, Redo, EstimateIntrinsics, SaveIntrinsics>;
+                 SaveSessionAs, Undo, Redo, EstimateIntrinsics, SaveIntrinsics, SetGoal>;
 
 class Controller : public ControllerState<Snapshot> {
  public:
@@ -224,6 +241,9 @@ class Controller : public ControllerState<Snapshot> {
   // (state_.solver.result must be set); call with mutex_ held.
   SolverResult ResultForCurrentPairs() const;
   void RecomputeResiduals();  // call with mutex_ held
+  // The meter from the current result and goal; `record` adds the point to the history (a solve).
+  // Call with mutex_ held.
+  void JudgeMeter(bool record);
   // session <- state, history + autosave; call with mutex_ held. Within an open brush stroke the
   // history's last step is amended, so that one stroke is one undo step.
   void CommitEdit();
@@ -296,5 +316,7 @@ template <>
 void Controller::Handle(const EstimateIntrinsics&);  // controller_intrinsics.cpp
 template <>
 void Controller::Handle(const SaveIntrinsics&);
+template <>
+void Controller::Handle(const SetGoal&);  // controller_meter.cpp
 
 }  // namespace calibench::ui

@@ -75,7 +75,8 @@ void Controller::OnAllPairsLoaded() {
   for (const std::string& warning : load_warnings_) loaded_line += "; " + warning;
   SetStatus(loaded_line, !load_warnings_.empty());
   load_warnings_.clear();
-  // A reopened session with a result shows its reprojection again.
+  // A reopened session with a result shows its reprojection and its meter again.
+  if (state_.solver.result && !state_.meter) JudgeMeter(/*record=*/true);
   const int selected = state_.selected;
   if (state_.solver.result) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
 }

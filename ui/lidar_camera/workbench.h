@@ -68,6 +68,8 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   void PairRow(const Snapshot& s, int index, std::vector<Intent>* intents);
   void SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) override;
   void SolutionReadouts(const SolverView& solver, std::vector<Intent>* intents);
+  // The meter: σ per axis against the goal, the weakest in words, done (workbench_meter.cpp).
+  void MeterRows(const Snapshot& s, std::vector<Intent>* intents);
   // The camera-intrinsics window (workbench_intrinsics.cpp): estimate from the loaded pairs, the
   // coverage map, the per-image error, σ and the verdict, save beside the dataset.
   void IntrinsicsWindow(const Snapshot& s, std::vector<Intent>* intents);

@@ -197,6 +197,7 @@ void Workbench::SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent
     ImGui::SetTooltip(
         "estimate the camera's intrinsics from the loaded pairs: coverage, per-image "
         "error, sigma");
+  MeterRows(s, intents);
   if (!s.solver.iterations.empty()) {
     replay().CostPlot(s.solver.iterations, ImVec2(r.w * 0.45f, 70));
     ImGui::SameLine();

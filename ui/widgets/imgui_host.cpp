@@ -35,7 +35,11 @@ void ApplyThemeAndFont() {
   ImGuiIO& io = ImGui::GetIO();
   io.IniFilename = nullptr;  // layout comes from code, not from imgui.ini
   const char* kFont = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-  if (std::filesystem::exists(kFont)) io.Fonts->AddFontFromFileTTF(kFont, 15.0f);
+  // Latin-1, Greek (σ in the core's messages), punctuation (— …), arrows and math (≤ ²): what the
+  // words from core/ use; ImGui's default range is Latin-1 alone and shows '?' for the rest.
+  static const ImWchar kRanges[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0x2010, 0x205E,
+                                    0x2190, 0x21FF, 0x2200, 0x22FF, 0};
+  if (std::filesystem::exists(kFont)) io.Fonts->AddFontFromFileTTF(kFont, 15.0f, nullptr, kRanges);
 }
 
 ImGuiHost::ImGuiHost(GLFWwindow* window) : windowed_(window != nullptr) {

@@ -1,0 +1,42 @@
+// The workbench's meter: the solve's σ per camera axis against the user's goal, judged by the
+// stop rule `advise` and `watch` use (core/guidance), with its history over the solves.
+#include <algorithm>
+
+#include "ui/lidar_camera/controller.h"
+
+namespace calibench::ui {
+
+void Controller::JudgeMeter(bool record) {
+  if (!state_.solver.result) {
+    state_.meter.reset();
+    return;
+  }
+  // The pairs the solve used; a reopened session's result: the pairs accepted in it.
+  int pairs = static_cast<int>(state_.solver.solved_pair_ids.size());
+  if (pairs == 0)
+    pairs = static_cast<int>(
+        std::count_if(state_.pairs.begin(), state_.pairs.end(),
+                      [](const PairView& p) { return p.status == PairStatus::kAccepted; }));
+  state_.meter = JudgeCapture(*state_.solver.result, pairs, state_.goal, StopRuleOptions{});
+  if (!record) return;
+  const MeterPoint point{pairs, state_.meter->sigma_t_mm, state_.meter->sigma_r_deg};
+  // One point per number of pairs: a solve again at the same count replaces it.
+  if (!state_.meter_history.empty() && state_.meter_history.back().pairs == pairs)
+    state_.meter_history.back() = point;
+  else
+    state_.meter_history.push_back(point);
+}
+
+template <>
+void Controller::Handle(const SetGoal& request) {
+  std::string why;
+  if (!request.goal.Check(&why)) {
+    SetStatus("goal: " + why, true);
+    return;
+  }
+  state_.goal = request.goal;
+  JudgeMeter(/*record=*/false);
+  ++state_.generation;
+}
+
+}  // namespace calibench::ui

@@ -1,0 +1,75 @@
+// The meter in the solver panel: σ per camera axis as a bar against the user's goal (editable),
+// the weakest direction in words, done when the stop rule says so, and σ over the solves.
+#include <imgui.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "ui/lidar_camera/workbench.h"
+
+namespace calibench::ui {
+namespace {
+
+const ImVec4 kUnder(0.45f, 0.85f, 0.45f, 1), kOver(1.0f, 0.55f, 0.35f, 1);
+
+// One axis: its σ as a share of the goal (the bar full at twice the goal), green under it.
+void SigmaBar(const char* axis, double sigma, double goal, const char* unit) {
+  const double ratio = sigma / goal;
+  char label[48];
+  std::snprintf(label, sizeof(label), unit[0] == 'm' ? "%s %.2f %s" : "%s %.3f %s", axis, sigma,
+                unit);
+  ImGui::PushStyleColor(ImGuiCol_PlotHistogram, ratio <= 1.0 ? kUnder : kOver);
+  ImGui::ProgressBar(static_cast<float>(std::min(1.0, 0.5 * ratio)), ImVec2(118, 0), label);
+  ImGui::PopStyleColor();
+}
+
+}  // namespace
+
+void Workbench::MeterRows(const Snapshot& s, std::vector<Intent>* intents) {
+  CaptureGoal goal = s.goal;
+  ImGui::TextUnformatted("goal (1 sigma per axis):");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(70);
+  ImGui::InputDouble("mm", &goal.translation_mm, 0, 0, "%.2f");
+  const bool mm_done = ImGui::IsItemDeactivatedAfterEdit();
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(70);
+  ImGui::InputDouble("deg", &goal.rotation_deg, 0, 0, "%.3f");
+  if (mm_done || ImGui::IsItemDeactivatedAfterEdit()) intents->push_back(SetGoal{goal});
+  if (!s.meter) return;
+  const CaptureState& m = *s.meter;
+  ImGui::SameLine();
+  if (m.done)
+    ImGui::TextColored(kUnder, "DONE: every sigma under the goal and trusted (%d pairs)",
+                       m.pairs_used);
+  else
+    ImGui::TextColored(kOver, "not done (%d pairs)", m.pairs_used);
+  static const char* const kAxes[] = {"t x", "t y", "t z", "r x", "r y", "r z"};
+  for (int i = 0; i < 6; ++i) {
+    if (i > 0) ImGui::SameLine();
+    if (i < 3)
+      SigmaBar(kAxes[i], m.sigma_t_mm[i], s.goal.translation_mm, "mm");
+    else
+      SigmaBar(kAxes[i], m.sigma_r_deg[i - 3], s.goal.rotation_deg, "deg");
+  }
+  ImGui::PushTextWrapPos(0);
+  if (!m.goal_met) ImGui::TextColored(kOver, "weakest: %s", m.weakest.c_str());
+  if (!m.trustworthy) ImGui::TextDisabled("sigma not final: %s", m.trust_note.c_str());
+  ImGui::PopTextWrapPos();
+  // The worst σ/goal over the six axes, solve by solve: the capture's progress.
+  if (s.meter_history.size() >= 2) {
+    std::vector<float> worst;
+    for (const MeterPoint& p : s.meter_history)
+      worst.push_back(static_cast<float>(std::max(p.sigma_t_mm.maxCoeff() / s.goal.translation_mm,
+                                                  p.sigma_r_deg.maxCoeff() / s.goal.rotation_deg)));
+    char overlay[64];
+    std::snprintf(overlay, sizeof(overlay), "worst sigma / goal: %d to %d pairs",
+                  s.meter_history.front().pairs, s.meter_history.back().pairs);
+    ImGui::PlotLines("##meter_history", worst.data(), static_cast<int>(worst.size()), 0, overlay,
+                     0.0f, std::max(2.0f, *std::max_element(worst.begin(), worst.end())),
+                     ImVec2(360, 40));
+  }
+}
+
+}  // namespace calibench::ui
