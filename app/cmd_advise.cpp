@@ -12,6 +12,40 @@
 
 namespace calibench::app {
 
+namespace {
+
+// The LiDAR-camera dataset's advice (with --estimate-intrinsics, its camera from its images
+// first), printed as text or one JSON object.
+int AdviseLidarCamera(const std::string& dataset_path, const AdviseOptions& options,
+                      const std::string& intrinsics_model, bool json) {
+  Dataset dataset = LoadDataset(
+      dataset_path, options.estimate_intrinsics ? CameraFile::kOptional : CameraFile::kRequired);
+  if (options.estimate_intrinsics) {
+    std::optional<IntrinsicsResult> first;
+    if (const int code = EstimateDatasetIntrinsics("advise", intrinsics_model, &dataset, &first,
+                                                   json ? stderr : stdout);
+        code != kOk)
+      return code;
+  }
+  const CalibrationOutcome outcome =
+      CalibrateDataset(dataset, options.pipeline, StderrProgress("extracted"));
+  bool input_error = false;
+  for (const PairFeatures& p : outcome.pairs) input_error |= p.input_error;
+  const CaptureAdvice advice = AdviseCapture(dataset, outcome, options);
+  if (json)
+    std::printf("%s\n", CaptureAdviceJson(advice).c_str());
+  else
+    std::printf("%s", FormatCaptureAdvice(advice).c_str());
+  if (input_error) {
+    std::fprintf(stderr, "calibench advise: some pair files of %s could not be read (see above)\n",
+                 dataset.manifest.string().c_str());
+    return kInputError;
+  }
+  return kOk;
+}
+
+}  // namespace
+
 int RunAdvise(int argc, char** argv) {
   CLI::App app{
       "Say whether the dataset's poses are enough for the goal (1σ per axis, with a σ that "
@@ -78,30 +112,7 @@ int RunAdvise(int argc, char** argv) {
     std::fprintf(stderr, "calibench advise: %s\n", why.c_str());
     return kUsage;
   }
-  Dataset dataset = LoadDataset(
-      dataset_path, options.estimate_intrinsics ? CameraFile::kOptional : CameraFile::kRequired);
-  if (options.estimate_intrinsics) {
-    std::optional<IntrinsicsResult> first;
-    if (const int code = EstimateDatasetIntrinsics("advise", intrinsics_model, &dataset, &first,
-                                                   json ? stderr : stdout);
-        code != kOk)
-      return code;
-  }
-  const CalibrationOutcome outcome =
-      CalibrateDataset(dataset, options.pipeline, StderrProgress("extracted"));
-  bool input_error = false;
-  for (const PairFeatures& p : outcome.pairs) input_error |= p.input_error;
-  const CaptureAdvice advice = AdviseCapture(dataset, outcome, options);
-  if (json)
-    std::printf("%s\n", CaptureAdviceJson(advice).c_str());
-  else
-    std::printf("%s", FormatCaptureAdvice(advice).c_str());
-  if (input_error) {
-    std::fprintf(stderr, "calibench advise: some pair files of %s could not be read (see above)\n",
-                 dataset.manifest.string().c_str());
-    return kInputError;
-  }
-  return kOk;
+  return AdviseLidarCamera(dataset_path, options, intrinsics_model, json);
 }
 
 }  // namespace calibench::app

@@ -87,18 +87,16 @@ void EstimateIntrinsicsFromPairs(const CameraModel& camera, const std::vector<Pa
   }
 }
 
-}  // namespace
-
-CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& outcome,
-                            const AdviseOptions& options) {
-  CaptureAdvice advice;
-  advice.goal = options.goal;
-  // Pre-flight, pair by pair in capture order, against the pairs before it. A pair a check
-  // rejects leaves the solve, with the finding as its reason.
+// Pre-flight, pair by pair in capture order, against the pairs before it: each pair's findings
+// into advice->pairs; a pair a check rejects leaves the solve, with the finding as its reason.
+// Returns the pairs as judged; *rejected_any says whether one was rejected.
+std::vector<PairFeatures> PreflightPairs(const Dataset& dataset, const CalibrationOutcome& outcome,
+                                         const AdviseOptions& options, CaptureAdvice* advice,
+                                         bool* rejected_any) {
   std::vector<PairFeatures> pairs = outcome.pairs;
   std::vector<PairFeatures> earlier;
   const std::map<std::string, double> stamp_offsets = StampOffsets(dataset);
-  bool rejected_any = false;
+  *rejected_any = false;
   for (PairFeatures& p : pairs) {
     PairAdvice pair;
     pair.id = p.id;
@@ -116,13 +114,25 @@ CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& ou
       if (f.severity != PreflightSeverity::kReject || p.status != PairStatus::kAccepted) continue;
       p.status = PairStatus::kRejected;
       p.reason = "pre-flight: " + f.words;
-      rejected_any = true;
+      *rejected_any = true;
     }
     pair.status = p.status;
     pair.reason = p.reason;
-    advice.pairs.push_back(std::move(pair));
+    advice->pairs.push_back(std::move(pair));
     earlier.push_back(p);
   }
+  return pairs;
+}
+
+}  // namespace
+
+CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& outcome,
+                            const AdviseOptions& options) {
+  CaptureAdvice advice;
+  advice.goal = options.goal;
+  bool rejected_any = false;
+  const std::vector<PairFeatures> pairs =
+      PreflightPairs(dataset, outcome, options, &advice, &rejected_any);
   advice.solution = outcome.solution;
   if (rejected_any) {
     const CalibrationOutcome again = SolveFromFeatures(pairs, options.pipeline);

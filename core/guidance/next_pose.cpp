@@ -6,9 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <map>
 
-#include "core/base/statistics.h"
 #include "core/estimation/uncertainty.h"
 #include "core/sim/crlb.h"
 
@@ -85,71 +83,6 @@ std::pair<double, double> GoalScore(const Mat6& covariance, const Pose& cam_from
 }
 
 }  // namespace
-
-BeamTable LearnBeamTable(const std::vector<const LidarCloud*>& clouds) {
-  std::map<int, std::vector<double>> elevations;
-  std::vector<double> gaps;
-  for (const LidarCloud* cloud : clouds) {
-    if (!cloud || !cloud->HasRing()) continue;
-    std::map<int, std::vector<double>> azimuths;
-    for (size_t i = 0; i < cloud->size(); ++i) {
-      const Eigen::Vector3f& p = cloud->points[i];
-      if (!p.allFinite() || p.squaredNorm() < 1e-6f) continue;
-      elevations[cloud->ring[i]].push_back(std::atan2(p.z(), std::hypot(p.x(), p.y())));
-      azimuths[cloud->ring[i]].push_back(std::atan2(p.y(), p.x()));
-    }
-    for (auto& [ring, values] : azimuths) {
-      if (values.size() < 20) continue;
-      std::sort(values.begin(), values.end());
-      for (size_t k = 1; k < values.size(); ++k)
-        if (values[k] - values[k - 1] > 1e-5) gaps.push_back(values[k] - values[k - 1]);
-    }
-  }
-  BeamTable table;
-  for (auto& [ring, values] : elevations)
-    if (values.size() >= 20) table.elevations_rad.push_back(Median(values));
-  std::sort(table.elevations_rad.begin(), table.elevations_rad.end());
-  const double gap = Median(gaps);
-  table.azimuth_steps = gap > 0 ? static_cast<int>(std::lround(2 * M_PI / gap)) : 0;
-  return table;
-}
-
-std::optional<SensorGeometry> LearnSensorGeometry(const CameraModel& camera, const BoardSpec& board,
-                                                  const BeamTable& lidar,
-                                                  const std::vector<PairFeatures>& pairs,
-                                                  std::string* why) {
-  std::vector<double> distances, range_rms, corner_sigmas;
-  for (const PairFeatures& p : pairs) {
-    if (p.status != PairStatus::kAccepted || !p.lidar || !p.camera) continue;
-    distances.push_back(p.camera->cam_from_board.translation().norm());
-    range_rms.push_back(p.lidar->rms_m);
-    corner_sigmas.push_back(p.camera->corner_sigma_px);
-  }
-  if (distances.empty()) {
-    *why = "no accepted pair yet: the distances and the sensors' noise are learnt from the data";
-    return std::nullopt;
-  }
-  if (lidar.elevations_rad.size() < 2 || lidar.azimuth_steps < 1) {
-    *why = "the clouds carry no ring numbers: the LiDAR's beams cannot be learnt";
-    return std::nullopt;
-  }
-  SensorGeometry sensors;
-  sensors.camera = camera;
-  sensors.board = board;
-  sensors.lidar = lidar;
-  const auto [nearest, farthest] = std::minmax_element(distances.begin(), distances.end());
-  double low = *nearest * 0.9, high = *farthest * 1.1;
-  if (high - low < 1.0) {
-    const double centre = 0.5 * (low + high);
-    low = centre - 0.5;
-    high = centre + 0.5;
-  }
-  sensors.min_distance_m = std::max({low, *nearest - 0.5, 0.3});
-  sensors.max_distance_m = std::max(high, sensors.min_distance_m + 0.5);
-  sensors.range_sigma_m = std::max(Median(range_rms), 1e-3);
-  sensors.corner_sigma_px = std::max(Median(corner_sigmas), 0.05);
-  return sensors;
-}
 
 PredictedReturns PredictBoardReturns(const SensorGeometry& sensors, const Pose& lidar_from_board) {
   PredictedReturns out;
@@ -419,6 +352,32 @@ std::pair<double, double> StarterScore(const Candidate& c, const std::vector<Pos
   return {-nearest, c.off_centre_m};
 }
 
+// The feasible candidate (with its tie-breaker) of the lowest score, after the intrinsics' wish
+// for corners where none are yet: a candidate costs up to cover_weight more (times its score with
+// a solution, added without) for the share of the most any candidate covers that it leaves.
+std::optional<PoseSuggestion> LowestScore(std::vector<std::pair<PoseSuggestion, double>>* feasible,
+                                          bool with_solution, double cover_weight) {
+  int most_covered = 0;
+  for (const auto& [s, tie] : *feasible)
+    most_covered = std::max(most_covered, s.intrinsics_cells_covered);
+  std::optional<PoseSuggestion> best;
+  std::pair<double, double> best_score(std::numeric_limits<double>::infinity(), 0.0);
+  for (auto& [suggestion, tie] : *feasible) {
+    if (most_covered > 0) {
+      const double left =
+          1.0 - static_cast<double>(suggestion.intrinsics_cells_covered) / most_covered;
+      suggestion.score = with_solution ? suggestion.score * (1.0 + cover_weight * left)
+                                       : suggestion.score + cover_weight * left;
+    }
+    if (suggestion.score < best_score.first - 1e-12 ||
+        (suggestion.score <= best_score.first + 1e-12 && tie < best_score.second)) {
+      best_score = {suggestion.score, tie};
+      best = suggestion;
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
@@ -437,8 +396,6 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
   }
   const Mat6 discount = solution ? InformationDiscount(*solution) : Mat6::Identity();
   const std::vector<Candidate> grid = CandidateGrid(sensors, options);
-  std::optional<PoseSuggestion> best;
-  std::pair<double, double> best_score(std::numeric_limits<double>::infinity(), 0.0);
   std::vector<std::pair<PoseSuggestion, double>> feasible;  // with its tie-breaker
   std::string last_reason;
   for (const Candidate& c : grid) {
@@ -485,25 +442,8 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
     suggestion.score = score.first;
     feasible.push_back({std::move(suggestion), score.second});
   }
-  // The intrinsics want corners where none are yet: a candidate costs up to
-  // intrinsics_cover_weight more for the share of the most any candidate covers that it leaves.
-  int most_covered = 0;
-  for (const auto& [s, tie] : feasible)
-    most_covered = std::max(most_covered, s.intrinsics_cells_covered);
-  for (auto& [suggestion, tie] : feasible) {
-    if (most_covered > 0) {
-      const double left =
-          1.0 - static_cast<double>(suggestion.intrinsics_cells_covered) / most_covered;
-      suggestion.score = cam_from_lidar
-                             ? suggestion.score * (1.0 + options.intrinsics_cover_weight * left)
-                             : suggestion.score + options.intrinsics_cover_weight * left;
-    }
-    if (suggestion.score < best_score.first - 1e-12 ||
-        (suggestion.score <= best_score.first + 1e-12 && tie < best_score.second)) {
-      best_score = {suggestion.score, tie};
-      best = suggestion;
-    }
-  }
+  std::optional<PoseSuggestion> best =
+      LowestScore(&feasible, cam_from_lidar.has_value(), options.intrinsics_cover_weight);
   if (!best) {
     *why = "none of the " + std::to_string(grid.size()) +
            " candidate board poses is feasible or new" +

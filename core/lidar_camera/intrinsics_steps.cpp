@@ -11,6 +11,41 @@
 
 namespace calibench {
 
+std::string IntrinsicsToRefineName(IntrinsicsToRefine which) {
+  switch (which) {
+    case IntrinsicsToRefine::kFocal:
+      return "focal";
+    case IntrinsicsToRefine::kPinhole:
+      return "pinhole";
+    case IntrinsicsToRefine::kAll:
+      return "all";
+  }
+  return "focal";
+}
+
+std::optional<IntrinsicsToRefine> ParseIntrinsicsToRefine(const std::string& name) {
+  for (const auto which :
+       {IntrinsicsToRefine::kFocal, IntrinsicsToRefine::kPinhole, IntrinsicsToRefine::kAll})
+    if (IntrinsicsToRefineName(which) == name) return which;
+  return std::nullopt;
+}
+
+bool JointIntrinsicsOptions::Check(std::string* why) const {
+  if (!(huber_delta > 0)) {
+    *why = "huber_delta must be positive";
+    return false;
+  }
+  if (max_iterations < 1 || variance_rounds < 0) {
+    *why = "max_iterations must be at least 1 and variance_rounds not negative";
+    return false;
+  }
+  if (!(function_tolerance > 0)) {
+    *why = "function_tolerance must be positive";
+    return false;
+  }
+  return true;
+}
+
 void PoseCornersAgain(const CameraModel& camera, const PnpOptions& pnp,
                       std::vector<PairFeatures>* pairs) {
   for (PairFeatures& f : *pairs) {
@@ -109,7 +144,10 @@ void RefineIntrinsics(const CameraModel& camera, const PipelineOptions& options,
   std::vector<std::string> used_before;
   for (int round = 0; round < 3; ++round) {
     try {
-      joint = RefineIntrinsicsJointly(outcome->pairs, *current.solution, camera, options.solver,
+      // The solve's own pairs (its weights index them; a pair the last camera could not pose is
+      // out), started from their poses; the camera file's values start the intrinsics and, with
+      // its covariance, are the prior.
+      joint = RefineIntrinsicsJointly(current.pairs, *current.solution, camera, options.solver,
                                       joint_options);
     } catch (const std::invalid_argument& e) {
       refinement.failure = e.what();

@@ -54,6 +54,7 @@ class JointProblem {
                double edge_floor_sigma_m, const JointIntrinsicsOptions& options)
       : pairs_(std::move(pairs)),
         camera_(camera),
+        start_intrinsics_(IntrinsicParameters(camera)),
         active_(std::move(active)),
         edge_floor_sigma_m_(edge_floor_sigma_m),
         options_(options) {
@@ -254,7 +255,7 @@ class JointProblem {
   double Step(int local) const {
     const int m = static_cast<int>(active_.size());
     if (local >= m) return 1e-6;
-    const double value = std::abs(IntrinsicParameters(camera_)[active_[local]]);
+    const double value = std::abs(start_intrinsics_[active_[local]]);
     return 1e-6 * std::max(value, active_[local] < 4 ? 1.0 : 0.01);
   }
   double PriorCost(const State& state) const {
@@ -265,6 +266,7 @@ class JointProblem {
 
   std::vector<JointPair> pairs_;
   CameraModel camera_;
+  std::vector<double> start_intrinsics_;  // IntrinsicParameters(camera_): the steps' scale
   std::vector<int> active_;
   double edge_floor_sigma_m_;
   JointIntrinsicsOptions options_;
@@ -371,42 +373,80 @@ void VarianceFactors(const JointProblem::Linearization& lin, double factors[kGro
   }
 }
 
+// The camera file's own estimate, where it has a covariance, as a prior on the active parameters.
+void SetCameraPrior(const CameraModel& camera, const std::vector<int>& active, const State& state,
+                    JointProblem* problem) {
+  if (camera.covariance.empty()) return;
+  const int m = static_cast<int>(active.size());
+  const Eigen::Index n = static_cast<Eigen::Index>(state.intrinsics.size());
+  const Eigen::Map<const Eigen::MatrixXd> full(camera.covariance.data(), n, n);
+  Eigen::MatrixXd sub(m, m);
+  for (int a = 0; a < m; ++a)
+    for (int b = 0; b < m; ++b) sub(a, b) = full(active[a], active[b]);
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(sub);
+  if (ldlt.info() == Eigen::Success && ldlt.isPositive() && sub.diagonal().minCoeff() > 0)
+    problem->SetPrior(ldlt.solve(Eigen::MatrixXd::Identity(m, m)),
+                      problem->ActiveIntrinsics(state));
+}
+
+// Minimize, then rounds of variance components (each group's noise scaled to its residuals) while
+// a factor moves by more than 5 %; true when the last minimisation converged.
+bool MinimizeWithVarianceComponents(const JointIntrinsicsOptions& options, JointProblem* problem,
+                                    State* state, int* iterations) {
+  bool converged = Minimize(*problem, options, state, iterations);
+  for (int round = 0; round < options.variance_rounds; ++round) {
+    double factors[kGroups];
+    VarianceFactors(problem->Linearize(*state), factors);
+    bool changed = false;
+    for (const double f : factors) changed |= std::abs(f - 1.0) > 0.05;
+    if (!changed) break;
+    problem->SetScales(problem->CornerSigma() * std::sqrt(factors[kCorners]),
+                       problem->PlaneFactor() * factors[kPlanes],
+                       problem->EdgeFactor() * factors[kEdges]);
+    converged = Minimize(*problem, options, state, iterations);
+  }
+  return converged;
+}
+
+// The solution into *result: the refined camera with the marginal covariance of its active
+// parameters (the weights hold the noise), the extrinsic with its marginal, the corner RMS.
+void FillResult(const JointProblem& problem, const State& state, const CameraModel& camera,
+                const std::vector<int>& active, JointIntrinsicsResult* result) {
+  const int m = static_cast<int>(active.size());
+  const JointProblem::Linearization lin = problem.Linearize(state);
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(lin.information);
+  const Eigen::MatrixXd covariance =
+      ldlt.solve(Eigen::MatrixXd::Identity(problem.Size(), problem.Size()).leftCols(m + 6))
+          .topRows(m + 6);
+  result->camera = camera;
+  SetIntrinsicParameters(state.intrinsics, &result->camera);
+  const size_t n = state.intrinsics.size();
+  result->camera.covariance.assign(n * n, 0.0);
+  result->refined.assign(n, false);
+  for (int a = 0; a < m; ++a) {
+    result->refined[active[a]] = true;
+    for (int b = 0; b < m; ++b)
+      result->camera.covariance[active[a] * n + active[b]] =
+          0.5 * (covariance(a, b) + covariance(b, a));
+  }
+  result->cam_from_lidar = state.cam_from_lidar;
+  result->cam_from_lidar_covariance = covariance.block(m, m, 6, 6);
+  result->corner_sigma_px = problem.CornerSigma();
+  result->plane_variance_factor = problem.PlaneFactor();
+  result->edge_variance_factor = problem.EdgeFactor();
+  double squared = 0.0;
+  for (size_t i = 0; i < problem.Pairs().size(); ++i) {
+    const JointPair& p = problem.Pairs()[i];
+    for (size_t c = 0; c < p.corners.pixels.size(); ++c) {
+      const auto pixel =
+          result->camera.Project(state.cam_from_board[i] * p.corners.board_points[c]);
+      if (pixel) squared += (*pixel - p.corners.pixels[c]).squaredNorm();
+    }
+  }
+  result->corner_rms_px = std::sqrt(squared / std::max(1, result->corners));
+}
+
 }  // namespace
-
-std::string IntrinsicsToRefineName(IntrinsicsToRefine which) {
-  switch (which) {
-    case IntrinsicsToRefine::kFocal:
-      return "focal";
-    case IntrinsicsToRefine::kPinhole:
-      return "pinhole";
-    case IntrinsicsToRefine::kAll:
-      return "all";
-  }
-  return "focal";
-}
-
-std::optional<IntrinsicsToRefine> ParseIntrinsicsToRefine(const std::string& name) {
-  for (const auto which :
-       {IntrinsicsToRefine::kFocal, IntrinsicsToRefine::kPinhole, IntrinsicsToRefine::kAll})
-    if (IntrinsicsToRefineName(which) == name) return which;
-  return std::nullopt;
-}
-
-bool JointIntrinsicsOptions::Check(std::string* why) const {
-  if (!(huber_delta > 0)) {
-    *why = "huber_delta must be positive";
-    return false;
-  }
-  if (max_iterations < 1 || variance_rounds < 0) {
-    *why = "max_iterations must be at least 1 and variance_rounds not negative";
-    return false;
-  }
-  if (!(function_tolerance > 0)) {
-    *why = "function_tolerance must be positive";
-    return false;
-  }
-  return true;
-}
 
 JointIntrinsicsResult RefineIntrinsicsJointly(const std::vector<PairFeatures>& pairs,
                                               const SolverResult& solution,
@@ -435,19 +475,7 @@ JointIntrinsicsResult RefineIntrinsicsJointly(const std::vector<PairFeatures>& p
   state.dilation_m.assign(joint.size(),
                           solution.edge_dilation ? solution.edge_dilation->value_m : 0.0);
   JointProblem problem(std::move(joint), camera, active, solver.edge_floor_sigma_m, options);
-  const int m = static_cast<int>(active.size());
-  if (!camera.covariance.empty()) {
-    // The camera file's own estimate as a prior on the parameters it has a covariance for.
-    const Eigen::Index n = static_cast<Eigen::Index>(IntrinsicParameters(camera).size());
-    const Eigen::Map<const Eigen::MatrixXd> full(camera.covariance.data(), n, n);
-    Eigen::MatrixXd sub(m, m);
-    for (int a = 0; a < m; ++a)
-      for (int b = 0; b < m; ++b) sub(a, b) = full(active[a], active[b]);
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(sub);
-    if (ldlt.info() == Eigen::Success && ldlt.isPositive() && sub.diagonal().minCoeff() > 0)
-      problem.SetPrior(ldlt.solve(Eigen::MatrixXd::Identity(m, m)),
-                       problem.ActiveIntrinsics(state));
-  }
+  SetCameraPrior(camera, active, state, &problem);
   std::vector<double> corner_sigmas;
   for (const PairFeatures& f : pairs)
     if (f.camera && f.camera->corner_sigma_px > 0)
@@ -455,50 +483,8 @@ JointIntrinsicsResult RefineIntrinsicsJointly(const std::vector<PairFeatures>& p
   problem.SetScales(corner_sigmas.empty() ? 0.3 : Median(corner_sigmas), 1.0,
                     solution.edge_variance_factor > 0 ? solution.edge_variance_factor : 1.0);
 
-  result.converged = Minimize(problem, options, &state, &result.iterations);
-  for (int round = 0; round < options.variance_rounds; ++round) {
-    double factors[kGroups];
-    VarianceFactors(problem.Linearize(state), factors);
-    bool changed = false;
-    for (const double f : factors) changed |= std::abs(f - 1.0) > 0.05;
-    if (!changed) break;
-    problem.SetScales(problem.CornerSigma() * std::sqrt(factors[kCorners]),
-                      problem.PlaneFactor() * factors[kPlanes],
-                      problem.EdgeFactor() * factors[kEdges]);
-    result.converged = Minimize(problem, options, &state, &result.iterations);
-  }
-
-  // The marginal covariances of the intrinsics and the extrinsic (the weights hold the noise).
-  const JointProblem::Linearization lin = problem.Linearize(state);
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(lin.information);
-  const Eigen::MatrixXd covariance =
-      ldlt.solve(Eigen::MatrixXd::Identity(problem.Size(), problem.Size()).leftCols(m + 6))
-          .topRows(m + 6);
-  result.camera = camera;
-  SetIntrinsicParameters(state.intrinsics, &result.camera);
-  const size_t n = state.intrinsics.size();
-  result.camera.covariance.assign(n * n, 0.0);
-  result.refined.assign(n, false);
-  for (int a = 0; a < m; ++a) {
-    result.refined[active[a]] = true;
-    for (int b = 0; b < m; ++b)
-      result.camera.covariance[active[a] * n + active[b]] =
-          0.5 * (covariance(a, b) + covariance(b, a));
-  }
-  result.cam_from_lidar = state.cam_from_lidar;
-  result.cam_from_lidar_covariance = covariance.block(m, m, 6, 6);
-  result.corner_sigma_px = problem.CornerSigma();
-  result.plane_variance_factor = problem.PlaneFactor();
-  result.edge_variance_factor = problem.EdgeFactor();
-  double squared = 0.0;
-  for (size_t i = 0; i < problem.Pairs().size(); ++i) {
-    const JointPair& p = problem.Pairs()[i];
-    for (size_t c = 0; c < p.corners.pixels.size(); ++c) {
-      const auto pixel = result.camera.Project(state.cam_from_board[i] * p.corners.board_points[c]);
-      if (pixel) squared += (*pixel - p.corners.pixels[c]).squaredNorm();
-    }
-  }
-  result.corner_rms_px = std::sqrt(squared / std::max(1, result.corners));
+  result.converged = MinimizeWithVarianceComponents(options, &problem, &state, &result.iterations);
+  FillResult(problem, state, camera, active, &result);
   return result;
 }
 

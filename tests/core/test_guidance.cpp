@@ -162,10 +162,12 @@ TEST(GuidanceFeasibility, PredictedReturnsMatchTheSimulatorsScan) {
   }
 }
 
-// Three boards, all frontal near the image centre (planned pairs, as the solver would see them):
-// the translation along the view is well fixed, the rest weakly.
+// Three boards, all frontal near the image centre (planned pairs, as the solver would see them),
+// and the solution they would give: the translation along the view is well fixed, the rest
+// weakly.
 void ThreeFrontalBoards(const SensorGeometry& sensors, const Pose& cam_from_lidar,
-                        std::vector<PlanePair>* pairs, std::vector<Pose>* seen) {
+                        const SolverOptions& solver, std::vector<PlanePair>* pairs,
+                        std::vector<Pose>* seen, SolverResult* solution) {
   for (const Pose& pose : {FacingBoard(Vec3(0, 0, 1.6), 10), FacingBoard(Vec3(0.1, 0, 2.0), -10),
                            FacingBoard(Vec3(-0.1, 0.05, 2.2), 15)}) {
     PredictedReturns returns;
@@ -174,6 +176,8 @@ void ThreeFrontalBoards(const SensorGeometry& sensors, const Pose& cam_from_lida
     pairs->push_back(PlannedPair(sensors, cam_from_lidar, pose, returns));
     seen->push_back(pose);
   }
+  solution->cam_from_lidar = cam_from_lidar;
+  solution->covariance = ExpectedPoseInformation(*pairs, cam_from_lidar, solver).inverse();
 }
 
 TEST(GuidanceNextPose, TheSuggestionIsFeasibleAndShrinksTheWeakestDirection) {
@@ -183,10 +187,9 @@ TEST(GuidanceNextPose, TheSuggestionIsFeasibleAndShrinksTheWeakestDirection) {
   SolverOptions solver;
   std::vector<PlanePair> pairs;
   std::vector<Pose> seen;
-  ASSERT_NO_FATAL_FAILURE(ThreeFrontalBoards(sensors, cam_from_lidar, &pairs, &seen));
   SolverResult solution;
-  solution.cam_from_lidar = cam_from_lidar;
-  solution.covariance = ExpectedPoseInformation(pairs, cam_from_lidar, solver).inverse();
+  ASSERT_NO_FATAL_FAILURE(
+      ThreeFrontalBoards(sensors, cam_from_lidar, solver, &pairs, &seen, &solution));
   const CaptureGoal goal{2.0, 0.05};
   std::string why;
   const auto next = NextBestPose(sensors, solution, seen, goal, options, solver, &why);
@@ -325,10 +328,9 @@ TEST(GuidanceNextPose, ItAlsoCoversTheImageCellsTheIntrinsicsLack) {
   SolverOptions solver;
   std::vector<PlanePair> pairs;
   std::vector<Pose> seen;
-  ASSERT_NO_FATAL_FAILURE(ThreeFrontalBoards(sensors, cam_from_lidar, &pairs, &seen));
   SolverResult solution;
-  solution.cam_from_lidar = cam_from_lidar;
-  solution.covariance = ExpectedPoseInformation(pairs, cam_from_lidar, solver).inverse();
+  ASSERT_NO_FATAL_FAILURE(
+      ThreeFrontalBoards(sensors, cam_from_lidar, solver, &pairs, &seen, &solution));
   const double w = sensors.camera.width, h = sensors.camera.height;
   GuidanceOptions options;
   options.image_columns = options.image_rows = 5;
