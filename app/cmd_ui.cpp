@@ -72,6 +72,12 @@ ui::WindowOptions WindowOptionsOf(int width, int height, const char* title,
   options.capture_last_frame = !screenshot.empty();
   options.quit_after_seconds = quit.after_seconds;
   options.test_drops = quit.test_drops;
+  options.frame_log = quit.frame_log;
+  if (!screenshot.empty()) {
+    options.screenshot_every_s = quit.screenshot_every_s;
+    const std::filesystem::path shot(screenshot);
+    options.screenshots_prefix = (shot.parent_path() / shot.stem()).string();
+  }
   return options;
 }
 
@@ -99,8 +105,9 @@ int FinishWindow(const ui::WindowRun& run, const std::string& screenshot) {
     SaveImage(screenshot, *run.last_frame);
     std::printf("wrote %s\n", screenshot.c_str());
   }
-  std::printf("frames drawn: %d (%d with nothing moving for a second)\n", run.stats.frames,
-              run.stats.quiet_frames);
+  std::printf(
+      "frames drawn: %d (%d with nothing moving for a second); longest %.1f ms, %d over 50 ms\n",
+      run.stats.frames, run.stats.quiet_frames, run.stats.max_frame_ms, run.stats.slow_frames);
   return kOk;
 }
 
@@ -173,9 +180,12 @@ int RunGuiWindow(const std::string& dataset, const std::string& session, int wid
     std::fprintf(stderr, "calibench gui: --board: %s\n", e.what());
     return kUsage;
   }
+  options.auto_solve = !quit.no_auto_solve;
   ui::WindowShell shell(options);
   // The window resumes the session beside the dataset (or, with --fresh, backs it up first).
-  if (!session.empty()) {
+  if (!quit.watch.empty()) {
+    shell.WatchFolder(quit.watch);
+  } else if (!session.empty()) {
     shell.OpenSession(session);
   } else if (!dataset.empty()) {
     shell.OpenDataset(dataset, quit.fresh ? ui::Controller::ExistingSession::kStartFresh
@@ -206,6 +216,17 @@ int RunGui(int argc, char** argv) {
   app.add_option("--test-drop", quit.test_drops,
                  "deliver this path to the window's drop callback after the first frames (tests)")
       ->group("");
+  app.add_option("--watch", quit.watch,
+                 "a folder a capture fills (camera.yaml, target.json, clouds/, images/): pairs "
+                 "join the list as they land, each detected, checked and solved; the meter and "
+                 "the ghost board (where to hold the board next) follow");
+  app.add_flag("--no-auto-solve", quit.no_auto_solve,
+               "solve only on F5 / Run (by default the workbench solves once the pairs are "
+               "detected and after every new or changed pair)");
+  app.add_option("--screenshot-every", quit.screenshot_every_s,
+                 "with --screenshot: also write a frame every S seconds to <screenshot>_<n>.png");
+  app.add_option("--frame-log", quit.frame_log,
+                 "write one line per frame: seconds since the start and the frame's milliseconds");
   app.add_option("--size", size, "window size WxH")->capture_default_str();
   app.add_option("--screenshot", screenshot, "write the last frame to this PNG");
   app.add_flag("--fresh", quit.fresh,
@@ -233,7 +254,8 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
   const bool lrf = !dataset.empty() && IsLrfManifest(dataset);
   ui::Layout layout;
   if (!lrf && !ui::ParseLayout(view, &layout)) {
-    std::fprintf(stderr, "calibench render: --view must be lidar, camera, 3d or workbench\n");
+    std::fprintf(stderr,
+                 "calibench render: --view must be lidar, camera, 3d, guide or workbench\n");
     return kUsage;
   }
   if (!gfx::ParseHeadlessBackend(backend_name, &backend)) {
@@ -251,8 +273,8 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
   if (intrinsics) {
     // The camera-intrinsics window over the workbench, with the estimate from the loaded pairs.
     controller.WaitIdle();
-    const auto& dataset_camera = controller.GetSnapshot().dataset->camera;
-    controller.Apply(ui::EstimateIntrinsics{dataset_camera.type});
+    const CameraModelType model = controller.GetSnapshot().dataset->camera.type;
+    controller.Apply(ui::EstimateIntrinsics{model});
   }
   const auto picture = ui::RenderShot<ui::Workbench, ui::SelectPair, ui::RunSolver>(
       controller, layout, shot,
@@ -353,7 +375,9 @@ int RunRender(int argc, char** argv) {
   app.add_option("--pair", pair, "pair id to show (default: the session's selection)");
   app.add_flag("--solve", solve, "run the solver before drawing");
   app.add_option("--view", view,
-                 "lidar | camera | 3d | workbench (LRF datasets: scan | depth | 3d | workbench)")
+                 "lidar | camera | 3d | workbench | guide (the camera and 3D views with the ghost "
+                 "board where to hold the board next, and the meter; with --solve) (LRF "
+                 "datasets: scan | depth | 3d | workbench)")
       ->capture_default_str();
   app.add_option("--size", size, "WxH")->capture_default_str();
   app.add_option("--out,-o", out, "PNG file")->required();

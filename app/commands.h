@@ -102,6 +102,10 @@ struct GuiWindowFlags {
   std::string board;   // --board: the board in imported recordings (preset or target.json; empty =
                        // automatic)
   std::vector<std::string> test_drops;  // --test-drop: paths dropped onto the window (tests)
+  std::string watch;                    // --watch: a folder a capture fills, followed live
+  std::string frame_log;                // --frame-log: per-frame times to this file
+  double screenshot_every_s = 0.0;      // --screenshot-every: also <screenshot stem>_<n>.png
+  bool no_auto_solve = false;           // --no-auto-solve: solve only on F5 / Run
 };
 // Shared by `gui` and `demo`: opens the workbench window on a dataset or session.
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,

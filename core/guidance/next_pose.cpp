@@ -458,4 +458,25 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
   return best;
 }
 
+SuggestionMatch MatchSuggestion(const Pose& cam_from_board, const PoseSuggestion& suggestion,
+                                const GuidanceOptions& options) {
+  SuggestionMatch match;
+  match.offset_m = (cam_from_board.translation() - suggestion.cam_from_board.translation()).norm();
+  const double cosine =
+      cam_from_board.linear().col(2).dot(suggestion.cam_from_board.linear().col(2));
+  match.angle_deg = std::acos(std::clamp(cosine, -1.0, 1.0)) * kRadToDeg;
+  match.matches =
+      match.offset_m <= options.repeat_distance_m && match.angle_deg <= options.repeat_angle_deg;
+  char tolerance[80] = "";
+  if (!match.matches)
+    std::snprintf(tolerance, sizeof(tolerance), " (within %.0f mm and %.0f deg counts)",
+                  options.repeat_distance_m * 1e3, options.repeat_angle_deg);
+  char text[200];
+  std::snprintf(text, sizeof(text), "%s the ghost board: %.0f mm from it, tilted %.0f deg%s",
+                match.matches ? "matches" : "does not match", match.offset_m * 1e3, match.angle_deg,
+                tolerance);
+  match.words = text;
+  return match;
+}
+
 }  // namespace calibench

@@ -139,4 +139,17 @@ std::string TooOblique(const char* sensor, double angle_deg, double max_deg);
 // edge nearer), keep it upright".
 std::string DescribeBoardPose(const CameraModel& camera, const Pose& cam_from_board);
 
+// A board held (cam_from_board, BoardSpec frame) against the pose suggested for it: it matches
+// within options.repeat_distance_m of the suggested centre and options.repeat_angle_deg between
+// the normals (the tolerance within which the suggestion counts as taken and is not suggested
+// again). `words` say by how much, either way.
+struct SuggestionMatch {
+  bool matches = false;
+  double offset_m = 0.0;
+  double angle_deg = 0.0;
+  std::string words;
+};
+SuggestionMatch MatchSuggestion(const Pose& cam_from_board, const PoseSuggestion& suggestion,
+                                const GuidanceOptions& options);
+
 }  // namespace calibench

@@ -181,13 +181,8 @@ void SetStatusFromFeatures(PairFeatures* features, const std::string& lidar_fail
   features->reason = usable ? "" : (!features->lidar ? lidar_failure : "camera: " + camera_failure);
 }
 
-namespace {
-
-// The region hint for a pair: the user's brush where one was painted (checked against the
-// image layout it was painted on), else the manifest's seed. nullopt with *why for a brush that
-// does not fit this cloud's image.
-std::optional<BoardHint> HintFor(const PairEntry& pair, const PairEdit& edit,
-                                 const LidarImage* image, std::string* why) {
+std::optional<BoardHint> BoardHintFor(const PairEntry& pair, const PairEdit& edit,
+                                      const LidarImage* image, std::string* why) {
   if (!edit.brush_pixels) return BoardHint{.seed = pair.lidar_seed};
   if (image->rows != edit.brush_rows || image->columns != edit.brush_columns) {
     *why = "the brush was painted on a " + std::to_string(edit.brush_rows) + "x" +
@@ -199,8 +194,6 @@ std::optional<BoardHint> HintFor(const PairEntry& pair, const PairEdit& edit,
   hint.detect = false;  // the user's brush, even an erased one, is the word
   return hint;
 }
-
-}  // namespace
 
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
                                  const PipelineOptions& options, const PairEdit& edit,
@@ -218,7 +211,7 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
   std::optional<LidarImage> image;
   if (edit.brush_pixels) image = ProjectById(inputs->cloud, LidarImageOptions{});
   std::string lidar_failure;
-  if (auto hint = HintFor(pair, edit, image ? &*image : nullptr, &lidar_failure)) {
+  if (auto hint = BoardHintFor(pair, edit, image ? &*image : nullptr, &lidar_failure)) {
     hint->background = background;
     features.lidar = ExtractLidarFeatures(dataset, inputs->cloud, *hint, options, &lidar_failure,
                                           &features.board_origin);
@@ -257,10 +250,18 @@ std::optional<SceneBackground> BuildSceneBackground(const std::vector<const Pair
     } catch (const IoError&) {  // the pair itself reports it when it is extracted
     }
   });
-  SceneBackground background;
+  std::vector<const LidarCloud*> read;
   for (const auto& cloud : clouds)
-    if (cloud) background.Add(*cloud);
+    if (cloud) read.push_back(&*cloud);
+  std::optional<SceneBackground> background = SceneBackgroundOf(read, why);
   if (kept) *kept = std::move(clouds);
+  return background;
+}
+
+std::optional<SceneBackground> SceneBackgroundOf(const std::vector<const LidarCloud*>& clouds,
+                                                 std::string* why) {
+  SceneBackground background;
+  for (const LidarCloud* cloud : clouds) background.Add(*cloud);
   if (!background.Finish(why)) return std::nullopt;
   return background;
 }
@@ -292,9 +293,19 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
       [&](int finished, size_t i) {
         if (progress) progress(finished, static_cast<int>(selected.size()), selected[i]->id);
       });
-  CalibrationOutcome outcome = SolveFromFeatures(std::move(features), options);
+  CalibrationOutcome outcome =
+      SolveExtractedPairs(dataset, selected, std::move(features), options, edits);
   outcome.background_note = background_note;
-  if (options.camera_guided) CompleteWithCamera(dataset, selected, options, edits, &outcome);
+  return outcome;
+}
+
+CalibrationOutcome SolveExtractedPairs(const Dataset& dataset,
+                                       const std::vector<const PairEntry*>& pairs,
+                                       std::vector<PairFeatures> features,
+                                       const PipelineOptions& options, const PairEdits& edits,
+                                       const IterationCallback& on_iteration) {
+  CalibrationOutcome outcome = SolveFromFeatures(std::move(features), options, on_iteration);
+  if (options.camera_guided) CompleteWithCamera(dataset, pairs, options, edits, &outcome);
   if (outcome.solution && options.refine_intrinsics)
     RefineIntrinsics(dataset.camera, options, &outcome);
   else if (outcome.solution && options.propagate_intrinsics)

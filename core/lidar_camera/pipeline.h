@@ -170,6 +170,13 @@ struct PairEdit {
 };
 using PairEdits = std::map<std::string, PairEdit>;  // by pair id
 
+// The hint for a pair as the user left it (`edit`): a painted brush (checked against the
+// image layout it was painted on), else the manifest's seed, else detection. nullopt with *why
+// for a brush that does not fit this cloud's image. The one rule of `calibrate`, `watch` and the
+// workbench (whose "detect again" passes the pair without its seed).
+std::optional<BoardHint> BoardHintFor(const PairEntry& pair, const PairEdit& edit,
+                                      const LidarImage* image, std::string* why);
+
 // What --refine-intrinsics did: the camera before and after (with the refined parameters'
 // covariance), how the joint problem went, or why it could not run.
 struct IntrinsicsRefinement {
@@ -210,6 +217,10 @@ std::optional<SceneBackground> BuildSceneBackground(
     const std::vector<const PairEntry*>& pairs, int threads, std::string* why,
     std::vector<std::optional<LidarCloud>>* clouds = nullptr);
 
+// The same over clouds already read (in pair order), as the workbench holds them.
+std::optional<SceneBackground> SceneBackgroundOf(const std::vector<const LidarCloud*>& clouds,
+                                                 std::string* why);
+
 // Camera-guided completion (options.camera_guided): with a first solution, predicts every pair's
 // board in the LiDAR frame from its camera pose, drops LiDAR boards that disagree with it (the
 // pair fails, saying by how much) and looks again for the board at the prediction where the LiDAR
@@ -226,14 +237,24 @@ std::string BoardDisagreement(const LidarPlaneFit& lidar, const CameraBoardObser
                               const Pose& cam_from_lidar, const BoardSpec& target,
                               const PipelineOptions& options);
 
+using IterationCallback = std::function<void(const IterationReport&)>;
+
+// The steps after extraction, as `calibrate`, `watch` and the workbench all run them: the solve
+// (SolveFromFeatures, on_iteration watching it), camera-guided completion (options.camera_guided;
+// `pairs` are the entries behind `features`, index by index), then the intrinsics
+// (RefineIntrinsics with options.refine_intrinsics and `camera`, else AddIntrinsicsUncertainty).
+CalibrationOutcome SolveExtractedPairs(const Dataset& dataset,
+                                       const std::vector<const PairEntry*>& pairs,
+                                       std::vector<PairFeatures> features,
+                                       const PipelineOptions& options, const PairEdits& edits = {},
+                                       const IterationCallback& on_iteration = {});
+
 // Extracts every selected pair (in parallel with options.threads) and solves; with
 // options.refine_intrinsics refines the camera with the extrinsic (RefineIntrinsics), else adds the
 // camera's intrinsics covariance, when it has one, to the extrinsic's (AddIntrinsicsUncertainty).
 CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,
                                     const ProgressCallback& progress = {},
                                     const PairEdits& edits = {});
-
-using IterationCallback = std::function<void(const IterationReport&)>;
 
 // Solves from already extracted features; pairs not kAccepted are ignored. Pairs with a
 // (lidar, camera) plane and status kPending count as accepted. on_iteration (optional) sees every

@@ -60,15 +60,13 @@ const CaptureAdvice& CaptureJob::Solve() {
   // Warm start: the last solution is a better start than the closed form, and the same minimum.
   if (last_solution_ && !pipeline.initial_cam_from_lidar)
     pipeline.initial_cam_from_lidar = last_solution_->cam_from_lidar;
-  CalibrationOutcome outcome = SolveFromFeatures(pairs_, pipeline);
-  if (pipeline.camera_guided && outcome.solution) {
-    std::vector<const PairEntry*> entries;
-    for (const PairEntry& pair : dataset_.pairs) entries.push_back(&pair);
-    CompleteWithCamera(dataset_, entries, pipeline, PairEdits{}, &outcome);
-    // A board found at the camera's prediction stays found; one the camera disagrees with is
-    // looked at again after the next pair.
-    pairs_ = outcome.pairs;
-  }
+  // The steps `calibrate` runs after extraction (solve, camera-guided completion, intrinsics).
+  std::vector<const PairEntry*> entries;
+  for (const PairEntry& pair : dataset_.pairs) entries.push_back(&pair);
+  CalibrationOutcome outcome = SolveExtractedPairs(dataset_, entries, pairs_, pipeline);
+  // A board found at the camera's prediction stays found; one the camera disagrees with is
+  // looked at again after the next pair.
+  if (pipeline.camera_guided && outcome.solution) pairs_ = outcome.pairs;
   if (outcome.solution) last_solution_ = outcome.solution;
   AdviseOptions advise = options_.advise;
   advise.pipeline = pipeline;

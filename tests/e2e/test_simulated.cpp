@@ -10,10 +10,13 @@
 #include "core/io/cloud_io.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/sim/sim.h"
+#include "tests/sim_scenes.h"
 #include "tests/test_support.h"
 
 namespace calibench {
 namespace {
+
+using test::TrueBoardPlanes;
 
 // An A3 sheet. The fisheye camera (fx = 450 px) needs fewer, larger ChArUco squares than the
 // "charuco-a3" preset so that its 4x4 markers stay decodable (about 15 px wide) at 2 m.
@@ -27,20 +30,6 @@ BoardSpec A3Board(BoardType type, bool fisheye) {
     b.marker_size = 0.064;
   }
   return b;
-}
-
-// The true board plane of every pair in the LiDAR frame (normal towards the LiDAR), by pair id.
-std::map<std::string, Plane> TrueBoardPlanes(const Dataset& dataset) {
-  const std::vector<Pose> cam_from_board = SampleBoardPoses(SimOptionsFromDataset(dataset));
-  const Pose lidar_from_cam = dataset.cam_from_lidar_ground_truth->inverse();
-  std::map<std::string, Plane> planes;
-  for (size_t i = 0; i < dataset.pairs.size(); ++i) {
-    const Pose lidar_from_board = lidar_from_cam * cam_from_board.at(i);
-    Vec3 normal = lidar_from_board.linear().col(2);
-    if (normal.dot(lidar_from_board.translation()) > 0) normal = -normal;
-    planes[dataset.pairs[i].id] = Plane{normal, -normal.dot(lidar_from_board.translation())};
-  }
-  return planes;
 }
 
 using Param = std::tuple<LidarModel, bool /*fisheye*/, BoardType>;
@@ -136,42 +125,8 @@ TEST_P(SimulatedCalibration, RecoversTheGroundTruth) {
 // A pair whose cloud holds a second, identical sheet: detection cannot tell the two apart and
 // fails naming both; the camera's prediction from the other pairs' solution finds the right one.
 TEST(CameraGuidedCompletion, ResolvesTwoBoardsInOneCloudWithTheCameraPrediction) {
-  SimOptions sim = SimPreset("default");
-  sim.lidar = LidarModel::kOs0_128;
-  sim.num_pairs = 10;
-  sim.lidar_range_noise_m = 0.005;
-  sim.seed = 23;
-  Dataset dataset = SimulateDataset(sim, test::TempDir("camera_guided"));
-  for (PairEntry& pair : dataset.pairs) pair.lidar_seed.reset();
+  const Dataset dataset = test::CompletionMattersScene(test::TempDir("camera_guided"));
   const auto truth = TrueBoardPlanes(dataset);
-  // The decoy: a sheet of the board's size facing the LiDAR, away from the board (opposite
-  // azimuth), cast with the same beams and appended to pair 3's cloud.
-  const PairEntry& victim = dataset.pairs[3];
-  LidarCloud cloud = LoadCloud(victim.cloud);
-  Vec3 board_dir = -truth.at(victim.id).normal;
-  const double azimuth = std::atan2(board_dir.y(), board_dir.x()) + M_PI / 2;
-  ScenePanel decoy;
-  const Vec3 centre(2.2 * std::cos(azimuth), 2.2 * std::sin(azimuth), 0.0);
-  const Vec3 z = Vec3(centre.x(), centre.y(), 0).normalized(), y = -Vec3::UnitZ();
-  decoy.lidar_from_panel.linear() << y.cross(z), y, z;
-  decoy.lidar_from_panel.translation() = centre;
-  decoy.size_m = Vec2(dataset.target.SheetWidth(), dataset.target.SheetHeight());
-  LidarScene scene;
-  scene.clutter = false;
-  scene.lidar_from_board.translation() = Vec3(0, 0, 500);  // the print itself: out of reach
-  scene.panels.push_back(decoy);
-  LidarScanOptions scan_options;
-  scan_options.range_noise_m = 0.005;
-  const LidarCloud extra =
-      SimulateLidarScan(MakeBeamTable(sim.lidar), BoardPrint(dataset.target), scene, scan_options)
-          .ToCloud();
-  ASSERT_GT(extra.size(), 100u);
-  cloud.points.insert(cloud.points.end(), extra.points.begin(), extra.points.end());
-  cloud.intensity.insert(cloud.intensity.end(), extra.intensity.begin(), extra.intensity.end());
-  cloud.ring.insert(cloud.ring.end(), extra.ring.begin(), extra.ring.end());
-  cloud.width = static_cast<int>(cloud.size());
-  SavePcd(victim.cloud, cloud);
-
   PipelineOptions without_guidance;
   without_guidance.camera_guided = false;
   const CalibrationOutcome alone = CalibrateDataset(dataset, without_guidance);

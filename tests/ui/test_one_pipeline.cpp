@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -14,6 +15,7 @@
 #include "core/lidar_camera/result_io.h"
 #include "core/results/result_file.h"
 #include "core/session/session.h"
+#include "tests/sim_scenes.h"
 #include "tests/test_support.h"
 #include "tests/ui/ui_fixture.h"
 #include "ui/lidar_camera/controller.h"
@@ -111,6 +113,55 @@ TEST(OnePipeline, CalibrateWithTheSessionFlagMatchesTheWorkbench) {
   ExpectIdentical(cli.cam_from_source.matrix(), gui.solver.result->cam_from_lidar.matrix(),
                   "cam_from_lidar");
   ExpectIdentical(cli.covariance, gui.solver.result->covariance, "covariance");
+}
+
+// A scene where camera-guided completion decides a pair (tests/sim_scenes.h: a board-sized decoy
+// sheet beside the board in pair 3's cloud, so that detection fails it naming both): the
+// workbench's solve completes it as `calibrate` does, a second solve starts again from detection,
+// and the session it saved calibrates on the command line to the same transform.
+TEST(OnePipeline, CameraGuidedCompletionRunsInTheWorkbenchAsInCalibrate) {
+  const auto dir = test::TempDir("one_pipeline_completion");
+  const Dataset dataset = test::CompletionMattersScene(dir / "set");
+  PipelineOptions without_completion;
+  without_completion.camera_guided = false;
+  const CalibrationOutcome alone = CalibrateDataset(dataset, without_completion);
+  const CalibrationOutcome cli = CalibrateDataset(dataset, PipelineOptions{});
+  ASSERT_TRUE(alone.solution && cli.solution) << alone.failure << cli.failure;
+  // Completion matters here: without it pair 3 is lost and the transform is another.
+  ASSERT_EQ(alone.pairs[3].status, PairStatus::kFailed);
+  ASSERT_EQ(cli.pairs[3].status, PairStatus::kAccepted) << cli.pairs[3].reason;
+  ASSERT_EQ(cli.pairs[3].board_origin.source, BoardSource::kCameraGuided);
+  const double moved_m =
+      (alone.solution->cam_from_lidar.translation() - cli.solution->cam_from_lidar.translation())
+          .norm();
+  EXPECT_GT(moved_m, 1e-6);
+  std::printf("completion moves the translation by %.3f mm\n", moved_m * 1e3);
+
+  const auto session_path = dir / "calibench.session.json";
+  Controller controller;
+  controller.OpenDataset(dataset.manifest, session_path);
+  controller.WaitIdle();
+  EXPECT_EQ(controller.GetSnapshot().pairs[3].status, PairStatus::kFailed);  // detection alone
+  for (int solve = 0; solve < 2; ++solve) {  // the second starts from detection again
+    controller.Apply(RunSolver{});
+    const Snapshot gui = Loaded(controller);
+    ASSERT_TRUE(gui.solver.result) << gui.solver.failure;
+    EXPECT_EQ(gui.pairs[3].status, PairStatus::kAccepted) << gui.pairs[3].reason;
+    EXPECT_EQ(gui.pairs[3].board_origin.source, BoardSource::kCameraGuided);
+    const Mat4 difference =
+        gui.solver.result->cam_from_lidar.matrix() - cli.solution->cam_from_lidar.matrix();
+    EXPECT_LT(difference.cwiseAbs().maxCoeff(), 1e-9) << "solve " << solve;
+  }
+  const auto out = dir / "result.json";
+  std::string output;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --session " +
+                                 session_path.string() + " --out " + out.string(),
+                             &output),
+            0)
+      << output;
+  const Mat4 difference =
+      LoadResult(out).cam_from_source.matrix() - cli.solution->cam_from_lidar.matrix();
+  EXPECT_LT(difference.cwiseAbs().maxCoeff(), 1e-9);
 }
 
 // A camera file with its intrinsics' covariance: the workbench's σ carries it as `calibrate`'s

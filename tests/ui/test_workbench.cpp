@@ -51,6 +51,8 @@ TEST_F(WorkbenchRender, GoldenViewsBeforeAndAfterASolve) {
   ExpectMatchesGolden(Render(controller, Layout::kCameraOnly, 480, 300), "camera_after");
   ExpectMatchesGolden(Render(controller, Layout::kSceneOnly, 480, 300), "scene_after");
   ExpectMatchesGolden(Render(controller, Layout::kWorkbench, 1280, 720), "workbench_after");
+  // `render --view guide`: the camera and 3D views with the ghost board over the meter.
+  ExpectMatchesGolden(Render(controller, Layout::kGuide, 1280, 720), "guide_after");
 }
 
 // One frame with the given input; returns the intents the panels produced (not yet applied).

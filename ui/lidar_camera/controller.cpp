@@ -17,7 +17,10 @@ namespace calibench::ui {
 
 Controller::Controller(PipelineOptions options) : pipeline_(std::move(options)) {}
 
-Controller::~Controller() { StopWorker(); }
+Controller::~Controller() {
+  StopWatching();
+  StopWorker();
+}
 
 bool Controller::SolvesWith(const PairView& pair) {
   return pair.status == PairStatus::kAccepted && pair.lidar && pair.camera;
@@ -83,35 +86,96 @@ SolverOptions Controller::SolverOptionsFromState() const {
   return options;
 }
 
+PairFeatures Controller::FeaturesAsDetected(const PairView& pair) {
+  if (!pair.before_completion) return FeaturesOf(pair);
+  PairView detected = pair;
+  detected.lidar = pair.before_completion->lidar;
+  detected.board_origin = pair.before_completion->board_origin;
+  detected.lidar_failure = pair.before_completion->lidar_failure;
+  PairFeatures features = FeaturesOf(detected);
+  if (features.status != PairStatus::kRejected)
+    SetStatusFromFeatures(&features, detected.lidar_failure, detected.camera_failure);
+  return features;
+}
+
+void Controller::ApplyCompletion(const std::vector<PairFeatures>& solved) {
+  for (size_t i = 0; i < solved.size() && i < state_.pairs.size(); ++i) {
+    PairView& pair = state_.pairs[i];
+    const PairFeatures& after = solved[i];
+    const bool same_board = after.lidar.has_value() == pair.lidar.has_value() &&
+                            (!after.lidar || after.lidar->inliers == pair.lidar->inliers);
+    if (same_board && after.status == pair.status && after.reason == pair.reason) continue;
+    if (!pair.before_completion)
+      pair.before_completion = PairView::AsDetected{pair.lidar, pair.board_origin,
+                                                    pair.lidar_failure, pair.brush_pixels};
+    pair.lidar = after.lidar;
+    pair.board_origin = after.board_origin;
+    pair.status = after.status;
+    pair.reason = after.reason;
+    pair.lidar_failure = after.lidar ? "" : after.reason;
+    // A board found at the camera's prediction shows as a detected one.
+    if (after.lidar && after.board_origin.source == BoardSource::kCameraGuided &&
+        pair.lidar_image) {
+      pair.brush_pixels.clear();
+      for (int k : after.lidar->inliers)
+        if (pair.lidar_image->pixel_of_point[k] >= 0)
+          pair.brush_pixels.push_back(pair.lidar_image->pixel_of_point[k]);
+      std::sort(pair.brush_pixels.begin(), pair.brush_pixels.end());
+      pair.brush_pixels.erase(std::unique(pair.brush_pixels.begin(), pair.brush_pixels.end()),
+                              pair.brush_pixels.end());
+      pair.brush_detected = true;
+    }
+  }
+}
+
 void Controller::Solve() {
   std::vector<PairFeatures> features;
   PipelineOptions options;
-  CameraModel camera;
+  Dataset dataset;
+  PairEdits edits;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (const PairView& pair : state_.pairs) features.push_back(FeaturesOf(pair));
+    if (!state_.dataset) return;
+    dataset = *state_.dataset;
+    for (const PairView& pair : state_.pairs) {
+      features.push_back(FeaturesAsDetected(pair));
+      // A painted brush is the user's word: completion leaves the pair alone (as with
+      // `calibrate --session`, whose edits hold the brush).
+      if (pair.brush_edited) edits[pair.id].brush_pixels = pair.brush_pixels;
+    }
     options = PipelineOptionsFromState();
-    if (state_.dataset) camera = state_.dataset->camera;
     state_.solver = SolverView{};
     state_.solver.running = true;
     ++state_.generation;
   }
-  // The CLI's solve (SolveFromFeatures), watched iteration by iteration.
-  CalibrationOutcome outcome =
-      SolveFromFeatures(std::move(features), options, [this](const IterationReport& it) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        state_.solver.iterations.push_back(it);
-        ++state_.generation;
-      });
-  // As CalibrateDataset: the camera file's intrinsics covariance is in the σ.
-  if (outcome.solution && options.propagate_intrinsics)
-    AddIntrinsicsUncertainty(outcome.pairs, camera, options, &*outcome.solution);
+  std::vector<const PairEntry*> entries;
+  for (const PairEntry& entry : dataset.pairs) entries.push_back(&entry);
+  // The CLI's steps after extraction (solve, camera-guided completion, the intrinsics' σ),
+  // the solve watched iteration by iteration.
+  CalibrationOutcome outcome = SolveExtractedPairs(dataset, entries, std::move(features), options,
+                                                   edits, [this](const IterationReport& it) {
+                                                     std::lock_guard<std::mutex> lock(mutex_);
+                                                     state_.solver.iterations.push_back(it);
+                                                     ++state_.generation;
+                                                   });
   std::lock_guard<std::mutex> lock(mutex_);
   state_.solver.running = false;
+  // Pairs added meanwhile (a watched folder) are not in this solve; the next one has them.
+  if (outcome.pairs.size() <= state_.pairs.size()) ApplyCompletion(outcome.pairs);
   if (!outcome.solution) {
     state_.solver.iterations.clear();
     state_.solver.failure = outcome.failure;
-    SetStatus("no calibration: " + outcome.failure, true);
+    const int usable = static_cast<int>(
+        std::count_if(outcome.pairs.begin(), outcome.pairs.end(), [](const PairFeatures& p) {
+          return p.status == PairStatus::kAccepted && p.lidar && p.camera;
+        }));
+    // Too few pairs yet is no error while a capture is followed: it says how many are needed.
+    if (!watching_.empty() && usable < options.min_pairs)
+      SetStatus("solving once " + std::to_string(options.min_pairs) + " pairs are usable (" +
+                    std::to_string(usable) + " so far)",
+                false);
+    else
+      SetStatus("no calibration: " + outcome.failure, true);
     return;
   }
   const SolverResult& result = *outcome.solution;
@@ -130,6 +194,8 @@ void Controller::Solve() {
   CommitEdit();
   const int selected = state_.selected;
   if (selected >= 0) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
+  // Pre-flight and the next pose (the ghost board) from this solve.
+  worker_.Enqueue([this, outcome = std::move(outcome), options] { Advise(outcome, options); });
 }
 
 void Controller::ComputeReprojection(int index) {
@@ -183,6 +249,7 @@ void Controller::EnsureSelectedImage() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!StillSelected(path)) return;
   state_.selected_image = image;
+  state_.selected_image_pair = state_.pairs[state_.selected].id;
   state_.selected_undistorted = undistorted;
   ++state_.generation;
 }
@@ -194,6 +261,8 @@ bool Controller::ValidPair(int index) const {
 template <>
 void Controller::Handle(const SelectPair& select) {
   if (!ValidPair(select.index) || select.index == state_.selected) return;
+  // Following a capture: looking at an older pair stops following; the newest resumes it.
+  follow_newest_ = select.index + 1 == static_cast<int>(state_.pairs.size());
   state_.selected = select.index;
   state_.selected_image.reset();
   state_.selected_undistorted.reset();
@@ -218,9 +287,10 @@ void Controller::Handle(const SetPairStatus& status) {
   pair.status = status.status;
   pair.reason = status.status == PairStatus::kRejected ? kRejectedByUser : "";
   SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
-                (state_.solver.result ? "; press Run to re-solve" : ""),
+                (state_.solver.result && !auto_solve_ ? "; press Run to re-solve" : ""),
             false);
   CommitEdit();
+  RequestSolve();
 }
 
 template <>

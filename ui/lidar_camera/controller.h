@@ -4,22 +4,27 @@
 // No GL, GLFW or ImGui here: the controller is driven by tests without a window.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
+#include <thread>
 #include <variant>
 #include <vector>
 
 #include "core/base/file_lock.h"
 #include "core/base/image.h"
 #include "core/camera/undistort.h"
+#include "core/guidance/advise.h"
 #include "core/guidance/stop_rule.h"
 #include "core/intrinsics/intrinsics.h"
 #include "core/io/camera_file.h"
 #include "core/io/dataset.h"
+#include "core/io/folder_watch.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
 #include "core/lidar_camera/pipeline.h"
@@ -53,6 +58,19 @@ struct PairView : PairHeader {
   std::string camera_failure;
   std::optional<Vec4> residual;  // after a solve
   double robust_weight = 1.0;
+  // Camera-guided completion (run by every solve, as `calibrate` runs it) replaced or dropped the
+  // LiDAR board: what detection had found, which the next solve starts from again.
+  struct AsDetected {
+    std::optional<LidarPlaneFit> lidar;
+    BoardOrigin board_origin;
+    std::string lidar_failure;
+    std::vector<int> brush_pixels;
+  };
+  std::optional<AsDetected> before_completion;
+  bool awaiting_detection = false;  // loaded, its board to be found once the background allows
+  // Pre-flight's findings after the last solve (core/guidance/preflight.h), as `advise` lists
+  // them; a pair it would reject says why on its row.
+  std::vector<PreflightFinding> findings;
 };
 
 struct SolverView {
@@ -89,6 +107,9 @@ struct Snapshot : SnapshotHeader {
   int selected = -1;
   std::shared_ptr<const ImageU8> selected_image;  // full-resolution camera image of `selected`
   std::shared_ptr<const UndistortedView> selected_undistorted;  // the same, distortion removed
+  // The pair those images show: a followed capture keeps the last pair's up until the newest
+  // pair's is decoded (the camera view then draws no overlays on it).
+  std::string selected_image_pair;
   SolverView solver;
   std::shared_ptr<const Reprojection> reprojection;
   ViewState view;
@@ -109,6 +130,16 @@ struct Snapshot : SnapshotHeader {
   CaptureGoal goal;
   std::optional<CaptureState> meter;
   std::vector<MeterPoint> meter_history;
+  // Where to hold the board next (`advise` after every solve): the ghost board in the camera and
+  // 3D views, with its words; or why there is none (done, or no feasible pose).
+  std::optional<PoseSuggestion> next_pose;
+  std::string next_pose_failure;
+  // The newest pair against the ghost shown when it was taken (MatchGhost), in words.
+  std::string ghost_match;
+  bool ghost_matched = false;
+  // A folder being followed (WatchFolder): pairs join the list as they land.
+  std::filesystem::path watching;
+  bool auto_solve = false;
 };
 
 // What the user asked for. Panels return these; Controller::Apply carries them out.
@@ -209,17 +240,46 @@ class Controller : public ControllerState<Snapshot> {
   enum class ExistingSession { kReplace, kResume, kStartFresh, kInMemory };
   void OpenDataset(const std::filesystem::path& dataset, std::filesystem::path session_path = {},
                    ExistingSession existing = ExistingSession::kReplace);
+  // The same for a dataset already read (a followed capture's, before it has pairs).
+  void OpenLoadedDataset(const Dataset& dataset, std::filesystem::path session_path,
+                         ExistingSession existing);
   // save = false: the session file is read, never locked or written (render).
   void OpenSession(const std::filesystem::path& session, bool save = true);
 
   void Apply(const Intent& intent);
 
+  // Solves by itself once the pairs are detected and after every new or changed pair (the
+  // window; tests and renders solve when asked). F5 / Run stays.
+  void SetAutoSolve(bool on);
+  // Follows a folder that a capture fills (the folder form: camera.yaml, target.json, clouds/,
+  // images/; core/io/folder_watch.h) on a thread: waits for its camera and target, opens it
+  // (resuming the session beside it), then adds each pair as it lands — loaded, detected and, with
+  // auto-solve, solved as the others. Pre-flight's rejections apply to the pairs as `watch`
+  // applies them. Stops with StopWatching or the controller.
+  void WatchFolder(const std::filesystem::path& folder, FolderWatchOptions options = {});
+  void StopWatching();
+  // One pair more, loaded and detected on the worker (a watched folder; any thread).
+  void AddPair(const PairEntry& entry);
+
  private:
+  void WatchLoop(std::filesystem::path folder, FolderWatchOptions options);
+  // Enqueues a solve unless one is queued already (auto-solve; call with mutex_ held).
+  void RequestSolve();
+  // After a solve (worker): pre-flight and the next pose from `outcome` (AdviseCapture).
+  void Advise(const CalibrationOutcome& outcome, const PipelineOptions& options);
+  // The same for a reopened session's result, over the pairs as detected again (worker).
+  void AdviseFromState();
   void LoadAllPairs();
   void LoadPair(int index);
   // After the last pair loaded (mutex_ held): detection, the status line with what loading
   // noted or refused, the reopened session's reprojection.
   void OnAllPairsLoaded();
+  // Whether the pairs count as loaded (detection and solving may go on): all of them, or in a
+  // followed capture every pair it opened with. Call with mutex_ held.
+  bool PairsSettled() const;
+  // Whether the views move to pair `index` once it is loaded: a followed capture's newest pair,
+  // unless the user chose an older one. Call with mutex_ held.
+  bool FollowsTo(int index) const;
   void RefitLidar(int index);
   // Once every pair is loaded: the background model over their clouds, then detection for the
   // pairs without a seed or a brush (worker thread).
@@ -228,7 +288,11 @@ class Controller : public ControllerState<Snapshot> {
   SolverOptions SolverOptionsFromState() const;          // the user's choices over pipeline_.solver
   PipelineOptions PipelineOptionsFromState() const;      // pipeline_ with those solver choices
   static PairFeatures FeaturesOf(const PairView& pair);  // the pipeline's view of a pair
-  static bool SolvesWith(const PairView& pair);          // accepted, with both planes
+  // The same before camera-guided completion: what every solve starts from.
+  static PairFeatures FeaturesAsDetected(const PairView& pair);
+  // The solve's pairs back into the view: completion's boards and verdicts. Call with mutex_ held.
+  void ApplyCompletion(const std::vector<PairFeatures>& solved);
+  static bool SolvesWith(const PairView& pair);  // accepted, with both planes
   void ComputeReprojection(int index);
   // A relative path the user typed (export, save as) goes next to the session, never into the
   // folder the program was started from. Call with mutex_ held.
@@ -276,9 +340,20 @@ class Controller : public ControllerState<Snapshot> {
   std::optional<FileLock> session_lock_;  // held while session_path is open for editing
   PipelineOptions pipeline_;
   std::string open_note_;  // how the session was opened, for the status line once loaded (mutex_)
-  std::vector<std::string> load_warnings_;     // what loading refused, for the status line (mutex_)
-  std::optional<SceneBackground> background_;  // worker thread only (DetectWithBackground)
-  bool stroke_open_ = false;  // BrushStroke / PaintPoints dabs since the last EndStroke
+  std::vector<std::string> load_warnings_;  // what loading refused, for the status line (mutex_)
+  // The scene's background over the loaded clouds (DetectWithBackground; worker thread only,
+  // reset by Open): the pairs whose clouds are in it, and whether it is usable (Finish).
+  SceneBackground background_;
+  std::set<int> in_background_;
+  bool background_usable_ = false;
+  bool stroke_open_ = false;          // BrushStroke / PaintPoints dabs since the last EndStroke
+  bool auto_solve_ = false;           // mutex_
+  std::filesystem::path watching_;    // the folder WatchFolder follows (set before its thread)
+  bool solve_queued_ = false;         // mutex_
+  bool follow_newest_ = true;         // a followed capture's views move to each new pair (mutex_)
+  bool opened_pairs_loaded_ = false;  // every pair Open started with has loaded (mutex_)
+  std::thread watch_thread_;
+  std::atomic<bool> stop_watch_{false};
 };
 
 // The handlers (controller.cpp, controller_pairs.cpp, controller_session.cpp).

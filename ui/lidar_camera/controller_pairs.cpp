@@ -9,6 +9,7 @@
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
 #include "core/lidar_camera/result_io.h"
+#include "core/session/capture_job.h"
 #include "ui/lidar_camera/controller.h"
 
 namespace calibench::ui {
@@ -75,10 +76,26 @@ void Controller::OnAllPairsLoaded() {
   for (const std::string& warning : load_warnings_) loaded_line += "; " + warning;
   SetStatus(loaded_line, !load_warnings_.empty());
   load_warnings_.clear();
-  // A reopened session with a result shows its reprojection and its meter again.
-  if (state_.solver.result && !state_.meter) JudgeMeter(/*record=*/true);
+  // A reopened session with a result shows its reprojection, its meter and (once its boards are
+  // found again) its next pose again.
+  if (state_.solver.result && !state_.meter) {
+    JudgeMeter(/*record=*/true);
+    worker_.Enqueue([this] { AdviseFromState(); });
+  }
   const int selected = state_.selected;
   if (state_.solver.result) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
+}
+
+bool Controller::FollowsTo(int index) const {
+  return !watching_.empty() && follow_newest_ && index > state_.selected &&
+         index + 1 == static_cast<int>(state_.pairs.size());
+}
+
+bool Controller::PairsSettled() const {
+  // A followed capture is never all loaded (the next pair may land while this one is read):
+  // once the pairs it opened with are in, each new pair counts as soon as it is.
+  return state_.loading_done == state_.loading_total ||
+         (opened_pairs_loaded_ && !watching_.empty());
 }
 
 void Controller::LoadPair(int index) {
@@ -104,7 +121,7 @@ void Controller::LoadPair(int index) {
   bool selected = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    selected = index == state_.selected;
+    selected = index == state_.selected || FollowsTo(index);
   }
   if (inputs) {
     auto cloud = std::make_shared<LidarCloud>(std::move(inputs->cloud));
@@ -135,6 +152,14 @@ void Controller::LoadPair(int index) {
     pair = std::move(loaded);
     ++state_.loading_done;
     ++state_.generation;
+    // Following a capture, the views move to the newest pair once it is loaded (not before:
+    // they would show nothing meanwhile), unless the user looks at an older one.
+    if (FollowsTo(index)) {
+      state_.selected = index;
+      state_.reprojection.reset();  // the last image stays up until this one's is decoded
+      worker_.Enqueue([this] { EnsureSelectedImage(); });
+      worker_.Enqueue([this, index] { ComputeReprojection(index); });
+    }
     if (!brush_dropped.empty()) {
       session_.pairs[index].brush.reset();
       session_.pairs[index].brush_from_seed = false;
@@ -147,40 +172,66 @@ void Controller::LoadPair(int index) {
     refit_now = pair.cloud && !detects && index == state_.selected &&
                 state_.loading_done < state_.loading_total;
     if (pair.cloud && !detects && !refit_now) worker_.Enqueue([this, index] { RefitLidar(index); });
-    if (pair.cloud && detects)
-      pair.lidar_failure = "finding the board once every pair is loaded ...";
+    if (pair.cloud && detects) {
+      pair.lidar_failure = PairsSettled() ? "finding the board ..."
+                                          : "finding the board once every pair is loaded ...";
+      pair.awaiting_detection = true;
+    }
+    // The newest pair against the ghost board that was shown while it was taken.
+    if (pair.camera && state_.next_pose && !state_.watching.empty()) {
+      const SuggestionMatch match =
+          MatchSuggestion(pair.camera->cam_from_board, *state_.next_pose, GuidanceOptions{});
+      state_.ghost_match = "pair " + pair.id + " " + match.words;
+      state_.ghost_matched = match.matches;
+    }
     if (!pair.cloud) {
       pair.status = PairStatus::kFailed;
       pair.reason = pair.camera_failure;
     }
-    if (state_.loading_done == state_.loading_total) OnAllPairsLoaded();
+    if (state_.loading_done == state_.loading_total) opened_pairs_loaded_ = true;
+    if (PairsSettled()) OnAllPairsLoaded();
   }
   if (refit_now) RefitLidar(index);
 }
 
 void Controller::DetectWithBackground() {
-  std::vector<std::shared_ptr<const LidarCloud>> clouds;
-  std::vector<int> detect;
+  std::vector<std::pair<int, std::shared_ptr<const LidarCloud>>> clouds;  // by pair index
+  std::vector<int> awaiting, detected_before;                             // pairs left to detection
   {
     std::lock_guard<std::mutex> lock(mutex_);
     for (size_t i = 0; i < state_.pairs.size(); ++i) {
       const PairView& pair = state_.pairs[i];
       if (!pair.cloud) continue;
-      clouds.push_back(pair.cloud);
-      if (!pair.brush_from_seed && !pair.brush_edited) detect.push_back(static_cast<int>(i));
+      clouds.emplace_back(static_cast<int>(i), pair.cloud);
+      if (pair.brush_from_seed || pair.brush_edited) continue;
+      (pair.awaiting_detection ? awaiting : detected_before).push_back(static_cast<int>(i));
     }
   }
-  background_.reset();
-  if (!detect.empty() && pipeline_.background_model) {
-    SceneBackground background;
-    for (const auto& cloud : clouds) background.Add(*cloud);
+  if (awaiting.empty()) return;
+  // The background over the clouds in pair order (as CalibrateDataset's over the dataset's); a
+  // capture that grows adds each new cloud until the model has enough (CaptureJobOptions'
+  // max_background_clouds: the static scene does not change after that).
+  const bool had_background = background_usable_;
+  if (pipeline_.background_model) {
+    bool added = false;
+    for (const auto& [index, cloud] : clouds) {
+      if (background_.clouds() >= CaptureJobOptions{}.max_background_clouds) break;
+      if (!in_background_.insert(index).second) continue;
+      background_.Add(*cloud);
+      added = true;
+    }
     std::string why;
-    if (background.Finish(&why)) {
-      background_ = std::move(background);
-    } else {
+    if (added) background_usable_ = background_.Finish(&why);
+    if (added && !background_usable_ && background_.clouds() >= 3) {
       std::lock_guard<std::mutex> lock(mutex_);
       SetStatus("board detection without a background model: " + why, false);
     }
+  }
+  std::vector<int> detect = awaiting;
+  // The model exists only now: the boards found without it are looked for again with it.
+  if (background_usable_ && !had_background) {
+    detect.insert(detect.end(), detected_before.begin(), detected_before.end());
+    std::sort(detect.begin(), detect.end());
   }
   for (int index : detect) RefitLidar(index);
   // Loading is over: what its transient buffers took goes back (core/base/allocator.h).
@@ -194,11 +245,9 @@ void Controller::RefitLidar(int index) {
   bool brush_from_seed = false;
   bool brush_edited = false;
   Dataset dataset;
-  std::optional<LidarSeed> seed;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     dataset = *state_.dataset;
-    seed = dataset.pairs[index].lidar_seed;
     cloud = state_.pairs[index].cloud;
     image = state_.pairs[index].lidar_image;
     brush = state_.pairs[index].brush_pixels;
@@ -206,26 +255,32 @@ void Controller::RefitLidar(int index) {
     brush_edited = state_.pairs[index].brush_edited;
   }
   if (!cloud || !image) return;
-  // The same choice of region as `calibench calibrate`: the seed itself while the brush only
-  // pictures it; once painted (or erased), the brush.
-  BoardHint hint;
-  hint.image = image.get();
-  // Seed, else the user's brush (an erased one means "no board here"), else detection.
-  if (brush_from_seed)
-    hint.seed = seed;
-  else if (brush_edited)
-    hint.brush_pixels = &brush;
-  hint.detect = !brush_edited;
-  hint.background = background_ ? &*background_ : nullptr;  // written on this thread only
+  // The same choice of region as `calibench calibrate` (BoardHintFor): once painted (or erased),
+  // the brush; else the seed while the brush only pictures it; else detection.
+  PairEntry entry = dataset.pairs[index];
+  if (!brush_from_seed) entry.lidar_seed.reset();  // "detect again" forgot it
+  PairEdit edit;
+  if (brush_edited) {
+    edit.brush_pixels = brush;
+    edit.brush_rows = image->rows;
+    edit.brush_columns = image->columns;
+  }
   std::string why;
   BoardOrigin origin;
-  const std::optional<LidarPlaneFit> fit =
-      ExtractLidarFeatures(dataset, *cloud, hint, pipeline_, &why, &origin);
+  std::optional<BoardHint> hint = BoardHintFor(entry, edit, image.get(), &why);
+  std::optional<LidarPlaneFit> fit;
+  if (hint) {
+    // Written on this thread only.
+    hint->background = background_usable_ ? &background_ : nullptr;
+    fit = ExtractLidarFeatures(dataset, *cloud, *hint, pipeline_, &why, &origin);
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   PairView& pair = state_.pairs[index];
   if (pair.brush_pixels != brush) return;  // a newer stroke queued its own refit
   pair.lidar = fit;
   pair.lidar_failure = fit ? "" : why;
+  pair.before_completion.reset();  // detected anew: the next solve completes it again
+  pair.awaiting_detection = false;
   pair.board_origin = origin;
   // A detected board shows as the brush (in its own colour) until the user edits it.
   if (origin.source == BoardSource::kDetected) {
@@ -246,9 +301,10 @@ void Controller::RefitLidar(int index) {
     pair.reason = features.reason;
   }
   ++state_.generation;
-  if (state_.loading_done == state_.loading_total) {
+  if (PairsSettled()) {
     RecomputeResiduals();
     CommitEdit();
+    RequestSolve();
   }
 }
 

@@ -56,7 +56,11 @@ std::pair<Session, Dataset> LoadSessionAndDataset(const std::filesystem::path& s
 
 void Controller::OpenDataset(const std::filesystem::path& dataset_path,
                              std::filesystem::path session_path, ExistingSession existing) {
-  const Dataset dataset = LoadDataset(dataset_path);
+  OpenLoadedDataset(LoadDataset(dataset_path), std::move(session_path), existing);
+}
+
+void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path session_path,
+                                   ExistingSession existing) {
   Session session = NewSession(dataset);
   session.dataset = dataset.manifest;
   if (existing == ExistingSession::kInMemory) {
@@ -158,6 +162,8 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     else if (session_path.empty() || !session_lock_ || session_lock_->locked() != session_path)
       session_lock_.reset();
     state_ = Snapshot{};
+    state_.auto_solve = auto_solve_;
+    state_.watching = watching_;
     state_.dataset = dataset;
     state_.dataset_path = dataset.manifest;
     state_.session_path = session_path;
@@ -165,6 +171,10 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     for (size_t i = 0; i < dataset.pairs.size(); ++i) state_.pairs[i].id = dataset.pairs[i].id;
     state_.loading_total = static_cast<int>(dataset.pairs.size());
     load_warnings_.clear();
+    background_ = SceneBackground{};
+    background_usable_ = false;
+    in_background_.clear();
+    opened_pairs_loaded_ = dataset.pairs.empty();
     open_note_ = note;
     session_ = std::move(session);
     ApplySessionToState(session_);
@@ -313,7 +323,11 @@ void Controller::Restore(const std::optional<Session>& restored) {
   if (!restored) return;
   std::vector<std::vector<int>> before;
   for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
-  session_ = *restored;
+  // Pairs that joined since that step (a watched folder) stay as they are.
+  Session session = *restored;
+  for (size_t i = session.pairs.size(); i < session_.pairs.size(); ++i)
+    session.pairs.push_back(session_.pairs[i]);
+  session_ = std::move(session);
   ApplySessionToState(session_);
   RecomputeResiduals();
   Autosave();

@@ -67,9 +67,7 @@ OpenKind KindOfPath(const fs::path& path) {
 }
 
 WindowShell::WindowShell(ShellOptions options)
-    : options_(std::move(options)),
-      controller_(std::make_unique<Controller>(options_.pipeline)),
-      recent_(options_.recent_file) {
+    : options_(std::move(options)), controller_(NewController()), recent_(options_.recent_file) {
   if (!recent_.load_error().empty()) {
     error_ = "the list of recent sessions was not read: " + recent_.load_error();
     show_error_ = true;
@@ -93,16 +91,28 @@ void WindowShell::Remember(const fs::path& session) {
   }
 }
 
+std::unique_ptr<Controller> WindowShell::NewController() const {
+  auto controller = std::make_unique<Controller>(options_.pipeline);
+  controller->SetAutoSolve(options_.auto_solve);
+  return controller;
+}
+
 void WindowShell::OpenDataset(const fs::path& dataset, Controller::ExistingSession existing) {
-  auto opened = std::make_unique<Controller>(options_.pipeline);
+  auto opened = NewController();
   opened->OpenDataset(dataset, {}, existing);
   Replace(std::move(opened));
 }
 
 void WindowShell::OpenSession(const fs::path& session) {
-  auto opened = std::make_unique<Controller>(options_.pipeline);
+  auto opened = NewController();
   opened->OpenSession(session);
   Replace(std::move(opened));
+}
+
+void WindowShell::WatchFolder(const fs::path& folder) {
+  auto watching = NewController();
+  watching->WatchFolder(folder);  // opens the folder once its camera and target are there
+  Replace(std::move(watching));
 }
 
 void WindowShell::ImportRecording(const fs::path& recording) {
@@ -207,9 +217,9 @@ WindowRun WindowShell::Run(const WindowOptions& options) {
   const auto window = Window::Open(options, &run.why);
   if (!window) return run;
   run.opened = true;
-  run.last_frame = window->Run([&](int width, int height, double seconds) {
-    return Frame(*window, width, height, seconds);
-  });
+  run.last_frame = window->Run(
+      [&](int width, int height, double seconds) { return Frame(*window, width, height, seconds); },
+      [&] { return controller_->Generation() != drawn_generation_; });
   run.stats = window->stats();
   if (import_) FinishImport();  // a closed window does not abandon an import half-written
   return run;
@@ -217,14 +227,18 @@ WindowRun WindowShell::Run(const WindowOptions& options) {
 
 bool WindowShell::Frame(Window& window, int width, int height, double seconds) {
   if (pending_open_) OpenFromUser(*std::exchange(pending_open_, std::nullopt));
+  if (pending_watch_) WatchFolder(*std::exchange(pending_watch_, std::nullopt));
   for (const std::string& dropped : window.TakeDroppedPaths()) pending_open_ = dropped;
   const bool importing = PollImport();  // may open a dataset, replacing the workbench
   if (!workbench_) workbench_ = std::make_unique<Workbench>();
   const float top = MenuBar();
   const Snapshot snapshot = controller_->GetSnapshot();
+  drawn_generation_ = snapshot.generation;
   const auto intents = workbench_->Frame(snapshot, width, height, Layout::kWorkbench, seconds, top);
   for (const Intent& intent : intents) controller_->Apply(intent);
-  if (const auto chosen = browser_.Draw()) pending_open_ = *chosen;
+  if (const auto chosen = browser_.Draw())
+    (std::exchange(choosing_watch_, false) ? pending_watch_ : pending_open_) = *chosen;
+  if (!browser_.IsOpen()) choosing_watch_ = false;
   Popups();
   if (quit_) window.RequestClose();
   return importing || report_ != nullptr || !intents.empty() || workbench_->Animating(snapshot) ||
@@ -248,6 +262,10 @@ void WindowShell::FileMenu() {
     browser_.Open(here, "Open dataset, session or recording");
   if (ImGui::MenuItem("Open recording (.bag .db3 .mcap)...", nullptr, false, !import_))
     browser_.Open(here, "Open a recording to import");
+  if (ImGui::MenuItem("Watch folder (a capture being written)...")) {
+    browser_.Open(here, "Watch a folder that a capture fills");
+    choosing_watch_ = true;
+  }
   if (ImGui::BeginMenu("Recent sessions")) {
     const auto recent = recent_.Paths();
     if (recent.empty()) ImGui::TextDisabled("none yet");
@@ -283,6 +301,7 @@ void WindowShell::BoardMenu() {
 
 void WindowShell::ExportMenu() {
   const Snapshot snapshot = controller_->GetSnapshot();
+  drawn_generation_ = snapshot.generation;
   if (!ImGui::BeginMenu("Export", snapshot.solver.result.has_value())) return;
   ImGui::TextDisabled("next to the session; the solver panel names frames and files");
   if (ImGui::MenuItem("calibench result (result.json)"))
@@ -297,6 +316,7 @@ void WindowShell::ExportMenu() {
 
 void WindowShell::ReportMenuItem() {
   const Snapshot snapshot = controller_->GetSnapshot();
+  drawn_generation_ = snapshot.generation;
   const bool ready = snapshot.solver.result && !snapshot.session_path.empty() && !report_;
   if (!ImGui::MenuItem("Report... (calibench_report.html beside the session)", nullptr, false,
                        ready))

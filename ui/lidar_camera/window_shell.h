@@ -32,6 +32,7 @@ struct ShellOptions {
   std::optional<BoardSpec> board;
   BagImportOptions import;
   std::filesystem::path recent_file = DefaultRecentFilesPath();
+  bool auto_solve = true;  // every controller solves by itself (Controller::SetAutoSolve)
 };
 
 // What a path is to the workbench.
@@ -53,6 +54,8 @@ class WindowShell {
   void ImportRecording(const std::filesystem::path& recording);
   // What the File menu, Recent and a drop do: any kind of path; failures go to the popup.
   void OpenFromUser(const std::filesystem::path& path);
+  // Follows a folder that a capture fills (Controller::WatchFolder; File → Watch folder…).
+  void WatchFolder(const std::filesystem::path& folder);
 
   // Runs the window until the user closes it.
   WindowRun Run(const WindowOptions& options);
@@ -78,6 +81,7 @@ class WindowShell {
   bool PollImport();
   // Replaces the controller with one that opened `path`; the old one stays on failure.
   void Replace(std::unique_ptr<Controller> opened);
+  std::unique_ptr<Controller> NewController() const;  // with the options' pipeline, auto-solve
   void Remember(const std::filesystem::path& session);
 
   ShellOptions options_;
@@ -92,7 +96,10 @@ class WindowShell {
   std::string report_message_;  // the last report's outcome, shown once in a popup
   bool show_report_ = false;
   std::optional<BagImportSummary> last_import_;
-  std::optional<std::filesystem::path> pending_open_;  // chosen during a frame, opened at the next
+  std::optional<std::filesystem::path> pending_open_;   // chosen during a frame, opened at the next
+  std::optional<std::filesystem::path> pending_watch_;  // the same, to be watched
+  std::uint64_t drawn_generation_ = 0;  // the controller's state the last frame showed
+  bool choosing_watch_ = false;         // the browser is open for File → Watch folder…
   std::string error_;
   bool show_error_ = false;
   bool show_import_summary_ = false;

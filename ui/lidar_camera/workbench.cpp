@@ -11,7 +11,8 @@
 namespace calibench::ui {
 
 bool ParseLayout(const std::string& name, Layout* layout) {
-  return ParseLayoutName(name, {"workbench", "lidar", "camera", "3d"}, layout);
+  static_assert(static_cast<int>(Layout::kGuide) == kGuideLayout);
+  return ParseLayoutName(name, {"workbench", "lidar", "camera", "3d", "guide"}, layout);
 }
 
 Workbench::Workbench()

@@ -21,8 +21,9 @@ namespace calibench::ui {
 
 struct CameraShown;  // what the camera view shows in a frame (workbench_gl.h)
 
-enum class Layout { kWorkbench, kLidarOnly, kCameraOnly, kSceneOnly };
-// "workbench", "lidar", "camera", "3d"; false for others.
+// kGuide: the camera and 3D views (with the ghost board) over the solver panel (with the meter).
+enum class Layout { kWorkbench, kLidarOnly, kCameraOnly, kSceneOnly, kGuide };
+// "workbench", "lidar", "camera", "3d", "guide"; false for others.
 bool ParseLayout(const std::string& name, Layout* layout);
 
 class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
@@ -70,6 +71,7 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   void SolutionReadouts(const SolverView& solver, std::vector<Intent>* intents);
   // The meter: σ per axis against the goal, the weakest in words, done (workbench_meter.cpp).
   void MeterRows(const Snapshot& s, std::vector<Intent>* intents);
+  void GuideRows(const Snapshot& s);  // the next pose in words, the ghost's match
   // The camera-intrinsics window (workbench_intrinsics.cpp): estimate from the loaded pairs, the
   // coverage map, the per-image error, σ and the verdict, save beside the dataset.
   void IntrinsicsWindow(const Snapshot& s, std::vector<Intent>* intents);
@@ -97,6 +99,7 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   ImageRect lidar_image_rect_;
   ImageRect scene_image_rect_;
   bool scene_brush_ = false;
+  int listed_selection_ = -1;  // the selection the measurements list last showed
   bool intrinsics_open_ = false;
   int intrinsics_model_ = -1;  // 0 pinhole, 1 fisheye; -1 = the dataset camera's
   int intrinsics_format_ = 0;  // ros, opencv, kalibr

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/lidar/colormap.h"
+#include "ui/lidar_camera/ghost.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/lidar_camera/workbench_gl.h"
 #include "ui/widgets/toolbar.h"
@@ -52,22 +53,23 @@ void UploadReprojection(const Snapshot& s, const PairView& pair, const CameraSho
   renderer->Upload(positions, cache.colors);
 }
 
-// The sheet's outline (edges subdivided: lenses bend them) and the board's axes.
+// The sheet's outline (SheetOutlinePixels) on the screen.
+std::vector<ImVec2> ScreenOutline(const BoardSpec& board, const Pose& cam_from_board,
+                                  const CameraShown& shown) {
+  std::vector<ImVec2> outline;
+  for (const Vec2& px : SheetOutlinePixels(*shown.model, board, cam_from_board))
+    outline.push_back(shown.at.ToScreen(px));
+  return outline;
+}
+
+// The sheet's outline and the board's axes.
 void DrawBoard(ImDrawList* draw, const BoardSpec& board, const Pose& cam_from_board,
                const CameraShown& shown) {
-  const double hw = board.SheetWidth() / 2, hh = board.SheetHeight() / 2;
-  const Vec3 corners[4] = {{-hw, -hh, 0}, {hw, -hh, 0}, {hw, hh, 0}, {-hw, hh, 0}};
-  std::vector<ImVec2> outline;
-  for (int e = 0; e < 4; ++e)
-    for (int k = 0; k < 16; ++k) {
-      const Vec3 p = corners[e] + (corners[(e + 1) % 4] - corners[e]) * (k / 16.0);
-      if (const auto px = shown.model->Project(cam_from_board * p))
-        outline.push_back(shown.at.ToScreen(*px));
-    }
+  const std::vector<ImVec2> outline = ScreenOutline(board, cam_from_board, shown);
   if (outline.size() > 2)
     draw->AddPolyline(outline.data(), static_cast<int>(outline.size()), IM_COL32(80, 200, 255, 255),
                       ImDrawFlags_Closed, 2.0f);
-  const double axis = 0.5 * std::min(hw, hh);
+  const double axis = 0.25 * std::min(board.SheetWidth(), board.SheetHeight());
   const auto o = shown.model->Project(cam_from_board * Vec3::Zero());
   const ImU32 axis_colors[3] = {IM_COL32(255, 60, 60, 255), IM_COL32(60, 255, 60, 255),
                                 IM_COL32(80, 120, 255, 255)};
@@ -76,6 +78,29 @@ void DrawBoard(ImDrawList* draw, const BoardSpec& board, const Pose& cam_from_bo
     if (const auto px = shown.model->Project(tip))
       draw->AddLine(shown.at.ToScreen(*o), shown.at.ToScreen(*px), axis_colors[a], 2.0f);
   }
+}
+
+// The ghost board: where `advise` says to hold the board next, a translucent sheet with a dashed
+// look (its outline drawn twice) and a label.
+void DrawGhost(ImDrawList* draw, const Snapshot& s, const CameraShown& shown) {
+  if (!s.next_pose || !s.solver.result) return;
+  const std::vector<ImVec2> outline =
+      ScreenOutline(s.dataset->target, s.next_pose->cam_from_board, shown);
+  if (outline.size() < 3) return;
+  const ImU32 fill = IM_COL32(120, 255, 140, 70), edge = IM_COL32(120, 255, 140, 230);
+  draw->AddConvexPolyFilled(outline.data(), static_cast<int>(outline.size()), fill);
+  draw->AddPolyline(outline.data(), static_cast<int>(outline.size()), edge, ImDrawFlags_Closed,
+                    2.5f);
+  // The label above the ghost's top, kept inside the view.
+  ImVec2 top = outline.front();
+  for (const ImVec2& p : outline)
+    if (p.y < top.y) top = p;
+  const char* label = "next pose: hold the board here";
+  const ImVec2 size = ImGui::CalcTextSize(label);
+  const float x = std::clamp(top.x - size.x / 2, shown.at.origin.x + 4,
+                             shown.at.origin.x + shown.at.size.x - size.x - 4);
+  const float y = std::max(top.y - size.y - 4, shown.at.origin.y + 4);
+  draw->AddText(ImVec2(x, y), edge, label);
 }
 
 // Over the picture: the detected corners, the board or why there is none.
@@ -92,6 +117,7 @@ void DrawCameraOverlays(const Snapshot& s, const PairView& pair, const CameraSho
   else
     draw->AddText(ImVec2(origin.x + 12, origin.y + 12), IM_COL32(255, 90, 80, 255),
                   ("board not found: " + pair.camera_failure).c_str());
+  DrawGhost(draw, s, shown);
   draw->PopClipRect();
 }
 
@@ -115,7 +141,12 @@ void Workbench::CameraView(const Snapshot& s, const Rect& r, std::vector<Intent>
   DrawCameraTarget(s, *pair, shown, view);
   FramebufferImage(gl_->camera_target, shown.at.size);
   const bool hovered = ImGui::IsItemHovered();
-  DrawCameraOverlays(s, *pair, shown);
+  if (s.selected_image_pair == pair->id)
+    DrawCameraOverlays(s, *pair, shown);
+  else  // the previous pair's picture while this one's is decoded
+    ImGui::GetWindowDrawList()->AddText(ImVec2(shown.at.origin.x + 12, shown.at.origin.y + 12),
+                                        IM_COL32(230, 230, 230, 255),
+                                        ("loading " + pair->id + " ...").c_str());
   if (hovered) {
     camera_image_.HandleMouse(shown.at);
     if (!s.solver.result)
@@ -170,7 +201,8 @@ ViewState Workbench::CameraToolbar(const Snapshot& s, const PairView& pair,
 
 void Workbench::DrawCameraTarget(const Snapshot& s, const PairView& pair, const CameraShown& shown,
                                  const ViewState& view) {
-  const bool show_points = s.reprojection && s.reprojection->pair_id == pair.id && s.solver.result;
+  const bool show_points = s.reprojection && s.reprojection->pair_id == pair.id &&
+                           s.solver.result && s.selected_image_pair == pair.id;
   const std::uint64_t key = CameraTargetKey(shown, show_points ? s.reprojection.get() : nullptr,
                                             view, camera_image_.Key());
   if (key == camera_key_) return;
@@ -191,6 +223,23 @@ void Workbench::DrawCameraTarget(const Snapshot& s, const PairView& pair, const 
   UploadReprojection(s, pair, shown, &gl_->camera_points_shown, &gl_->camera_points);
   gl_->camera_points.Draw(gfx::Matrix4f::Identity(), static_cast<float>(view.point_size_px),
                           static_cast<float>(view.point_opacity));
+}
+
+}  // namespace calibench::ui
+
+namespace calibench::ui {
+
+std::vector<Vec2> SheetOutlinePixels(const CameraModel& camera, const BoardSpec& board,
+                                     const Pose& cam_from_board, int steps) {
+  const double hw = board.SheetWidth() / 2, hh = board.SheetHeight() / 2;
+  const Vec3 corners[4] = {{-hw, -hh, 0}, {hw, -hh, 0}, {hw, hh, 0}, {-hw, hh, 0}};
+  std::vector<Vec2> outline;
+  for (int e = 0; e < 4; ++e)
+    for (int k = 0; k < steps; ++k) {
+      const Vec3 p = corners[e] + (corners[(e + 1) % 4] - corners[e]) * (double(k) / steps);
+      if (const auto px = camera.Project(cam_from_board * p)) outline.push_back(*px);
+    }
+  return outline;
 }
 
 }  // namespace calibench::ui

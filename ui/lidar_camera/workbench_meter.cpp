@@ -37,7 +37,7 @@ void Workbench::MeterRows(const Snapshot& s, std::vector<Intent>* intents) {
   ImGui::SetNextItemWidth(70);
   ImGui::InputDouble("deg", &goal.rotation_deg, 0, 0, "%.3f");
   if (mm_done || ImGui::IsItemDeactivatedAfterEdit()) intents->push_back(SetGoal{goal});
-  if (!s.meter) return;
+  if (!s.meter) return GuideRows(s);
   const CaptureState& m = *s.meter;
   ImGui::SameLine();
   if (m.done)
@@ -70,6 +70,24 @@ void Workbench::MeterRows(const Snapshot& s, std::vector<Intent>* intents) {
                      0.0f, std::max(2.0f, *std::max_element(worst.begin(), worst.end())),
                      ImVec2(360, 40));
   }
+  GuideRows(s);
+}
+
+// Where to hold the board next (the ghost board in the camera and 3D views) in `advise`'s
+// words, and whether the newest pair matched the ghost shown when it was taken.
+void Workbench::GuideRows(const Snapshot& s) {
+  ImGui::PushTextWrapPos(0);
+  if (!s.watching.empty())
+    ImGui::TextDisabled("watching %s: %d pairs so far", s.watching.string().c_str(),
+                        static_cast<int>(s.pairs.size()));
+  if (s.next_pose)
+    ImGui::TextColored(ImVec4(0.47f, 1.0f, 0.55f, 1), "next pose (the green ghost board): %s",
+                       s.next_pose->words.c_str());
+  else if (!s.next_pose_failure.empty())
+    ImGui::TextDisabled("next pose: %s", s.next_pose_failure.c_str());
+  if (!s.ghost_match.empty())
+    ImGui::TextColored(s.ghost_matched ? kUnder : kOver, "%s", s.ghost_match.c_str());
+  ImGui::PopTextWrapPos();
 }
 
 }  // namespace calibench::ui

@@ -133,12 +133,27 @@ void Workbench::MeasurementsPanel(const Snapshot& s, const Rect& r, std::vector<
                        {"weight", 50},
                        {"details"}})) {
     for (int i = 0; i < static_cast<int>(s.pairs.size()); ++i) PairRow(s, i, intents);
+    listed_selection_ = s.selected;
     ImGui::EndTable();
   }
   ImGui::End();
 }
 
 // Thumbnail, id (selects the pair), status, residual, robust weight, what the pair gave.
+namespace {
+
+// The finding that matters most (a rejection before a weakness), or null.
+const PreflightFinding* WorstFinding(const std::vector<PreflightFinding>& findings) {
+  const PreflightFinding* worst = nullptr;
+  for (const PreflightFinding& f : findings)
+    if (!worst ||
+        (f.severity == PreflightSeverity::kReject && worst->severity != PreflightSeverity::kReject))
+      worst = &f;
+  return worst;
+}
+
+}  // namespace
+
 void Workbench::PairRow(const Snapshot& s, int index, std::vector<Intent>* intents) {
   const PairView& pair = s.pairs[index];
   ImGui::TableNextRow(0, kThumbHeight);
@@ -155,6 +170,9 @@ void Workbench::PairRow(const Snapshot& s, int index, std::vector<Intent>* inten
   ImGui::TableNextColumn();
   if (PairSelectable(index, pair.id, index == s.selected, kThumbHeight))
     intents->push_back(SelectPair{index});
+  // A selection made elsewhere (keys, a followed capture's newest pair) scrolls into view.
+  if (index == s.selected && s.selected != listed_selection_ && !ImGui::IsItemVisible())
+    ImGui::SetScrollHereY(1.0f);
   ImGui::TableNextColumn();
   PairStatusText(pair.status, pair.loaded ? PairStatusName(pair.status) : "loading");
   ImGui::TableNextColumn();
@@ -177,6 +195,16 @@ void Workbench::PairRow(const Snapshot& s, int index, std::vector<Intent>* inten
     ImGui::PopStyleColor();
   } else if (!pair.reason.empty()) {
     ImGui::TextWrapped("%s", pair.reason.c_str());
+  } else if (const PreflightFinding* finding = WorstFinding(pair.findings)) {
+    // Pre-flight's word on an accepted pair (rejections apply by themselves only while a
+    // capture is followed; on a dataset the user decides).
+    ImGui::PushStyleColor(ImGuiCol_Text, finding->severity == PreflightSeverity::kReject
+                                             ? ImVec4(1.0f, 0.55f, 0.3f, 1)
+                                             : ImVec4(0.95f, 0.85f, 0.4f, 1));
+    ImGui::TextWrapped("pre-flight%s: %s",
+                       finding->severity == PreflightSeverity::kReject ? " would reject" : "",
+                       finding->words.c_str());
+    ImGui::PopStyleColor();
   } else if (pair.lidar && pair.camera) {
     ImGui::TextDisabled("%zu inliers, %.1f mm | %d corners, %.2f px", pair.lidar->inliers.size(),
                         pair.lidar->rms_m * 1e3, pair.camera->num_corners,

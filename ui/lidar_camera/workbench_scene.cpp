@@ -167,6 +167,8 @@ void Workbench::SceneView(const Snapshot& s, const Rect& r, std::vector<Intent>*
   frame_key.Mix(view_projection.data(), sizeof(float) * 16);
   frame_key.Mix(&v.point_size_px, sizeof(double));
   if (estimate) frame_key.Mix(estimate->matrix().data(), sizeof(double) * 16);
+  if (s.next_pose && s.next_pose->lidar_from_board)
+    frame_key.Mix(s.next_pose->lidar_from_board->matrix().data(), sizeof(double) * 16);
   if (frame_key.value() != scene_frame_key_ || gl_->scene_target.width() != tw ||
       gl_->scene_target.height() != th) {
     scene_frame_key_ = frame_key.value();
@@ -251,6 +253,18 @@ void Workbench::DrawScene(const Snapshot& s, const PairView& pair,
       quads.AddRectangle(lidar_from_cam * pair.camera->cam_from_board,
                          s.dataset->target.SheetWidth(), s.dataset->target.SheetHeight(),
                          {255, 150, 40, 110});
+  }
+  // The ghost board: where to hold the board next (advise's lidar_from_board).
+  if (s.next_pose && s.next_pose->lidar_from_board) {
+    const Pose& ghost = *s.next_pose->lidar_from_board;
+    const double w = s.dataset->target.SheetWidth(), h = s.dataset->target.SheetHeight();
+    quads.AddRectangle(ghost, w, h, {120, 255, 140, 90});
+    const gfx::Rgba edge{120, 255, 140, 255};
+    const Vec3 corners[4] = {ghost * Vec3(-w / 2, -h / 2, 0), ghost * Vec3(w / 2, -h / 2, 0),
+                             ghost * Vec3(w / 2, h / 2, 0), ghost * Vec3(-w / 2, h / 2, 0)};
+    for (int k = 0; k < 4; ++k) lines.Add(corners[k], corners[(k + 1) % 4], edge);
+    // Its normal, from the sheet towards where the sensors are.
+    lines.Add(ghost.translation(), ghost * Vec3(0, 0, 0.3), edge);
   }
   gl_->scene_target.Resize(tw, th);
   gl_->scene_target.Clear(0.08f, 0.08f, 0.1f, 1.0f);

@@ -46,6 +46,11 @@ class ControllerState {
     copy.busy = worker_.Busy();
     return copy;
   }
+  // The change counter alone (cheap: a window polls it to redraw when a thread changed the state).
+  std::uint64_t Generation() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return state_.generation;
+  }
   // Blocks until the worker has no queued or running job (tests, headless renders).
   void WaitIdle() { worker_.WaitIdle(); }
 

@@ -1,8 +1,15 @@
 #include "ui/state/work_queue.h"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <exception>
 
 namespace calibench::ui {
+namespace {
+constexpr int kJobNiceness = 10;  // 0 normal .. 19 lowest
+}  // namespace
 
 WorkQueue::WorkQueue(std::function<void(const std::string&)> on_error)
     : on_error_(std::move(on_error)), worker_([this] { Loop(); }) {}
@@ -48,6 +55,10 @@ bool WorkQueue::Busy() const {
 }
 
 void WorkQueue::Loop() {
+  // Below the window's thread: on a machine with few cores (and software OpenGL drawing on them)
+  // the frames come first, the jobs take what is left. Threads the jobs start inherit it.
+  // (Linux: the nice value is per thread; a failure leaves the default, which only costs frames.)
+  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kJobNiceness);
   for (;;) {
     std::function<void()> job;
     {

@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
+#include <memory>
 
+#include "core/io/image_io.h"
 #include "ui/gfx/context.h"
 #include "ui/gfx/framebuffer.h"
 #include "ui/widgets/imgui_host.h"
@@ -34,12 +37,14 @@ void Window::RequestClose() { context_->RequestClose(); }
 namespace {
 constexpr double kAnimationFrameS = 1.0 / 60;  // frame period while the workbench animates
 constexpr double kIdleWakeS = 1.0;             // wakes to check for close; draws nothing
+constexpr double kChangePollS = 0.1;           // wakes to poll Run's `changed`
 constexpr double kTypingFrameS = 0.25;         // redraws a focused text field's cursor
 constexpr int kSettleFrames = 3;  // after input or an animation: hover, popups and layout settle
 constexpr double kQuietS = 1.0;   // FrameStats::quiet_frames: nothing moved for this long
 }  // namespace
 
-std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& frame) {
+std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& frame,
+                                   const std::function<bool()>& changed) {
   using Clock = std::chrono::steady_clock;
   auto since = [](Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
@@ -47,11 +52,17 @@ std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& 
   std::optional<ImageU8> last_picture;
   gfx::Framebuffer target;
   const auto start = Clock::now();
-  auto last_draw = start, last_change = start;
+  auto last_draw = start, last_change = start, last_shot = start;
+  int shots = 0;
   const bool back_to_back = options_.quit_after_frames > 0;
   bool animating = true;  // the first frames lay the workbench out
   int settle = kSettleFrames;
   std::uint64_t seen_events = context_->EventCount();
+  // One line per frame: seconds since the start, milliseconds the frame took (drawn and shown),
+  // "shot" when it also wrote a screenshot.
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> frame_log(
+      options_.frame_log.empty() ? nullptr : std::fopen(options_.frame_log.c_str(), "w"),
+      [](std::FILE* f) { return f ? std::fclose(f) : 0; });
   while (!context_->ShouldClose()) {
     const bool typing = ImGui::GetIO().WantTextInput;
     if (back_to_back || settle > 0)
@@ -59,8 +70,10 @@ std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& 
     else if (animating)
       context_->WaitEvents(std::max(1e-3, kAnimationFrameS - since(last_draw)));
     else
-      context_->WaitEvents(typing ? std::max(1e-3, kTypingFrameS - since(last_draw)) : kIdleWakeS);
+      context_->WaitEvents(typing ? std::max(1e-3, kTypingFrameS - since(last_draw))
+                                  : (changed ? kChangePollS : kIdleWakeS));
     if (options_.quit_after_seconds > 0 && since(start) >= options_.quit_after_seconds) break;
+    if (changed && changed()) settle = std::max(settle, 1);
     if (context_->EventCount() != seen_events) {
       seen_events = context_->EventCount();
       settle = kSettleFrames;
@@ -84,8 +97,10 @@ std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& 
     last_draw = Clock::now();
     if (since(last_change) >= kQuietS) ++stats_.quiet_frames;
     ++stats_.frames;
+    const auto frame_start = Clock::now();
     host_->DrawFrame(target, width, height, seconds,
                      [&] { animating = frame(width, height, seconds); });
+    double frame_ms = 1e3 * since(frame_start);  // drawn, then shown below (not the captures)
     animating = animating || !options_.test_drops.empty();
     if (animating) {
       settle = kSettleFrames;
@@ -93,10 +108,24 @@ std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& 
     } else if (settle > 0) {
       --settle;
     }
+    const bool shot =
+        options_.screenshot_every_s > 0 && since(last_shot) >= options_.screenshot_every_s;
+    if (shot) {
+      last_shot = Clock::now();
+      SaveImage(options_.screenshots_prefix + "_" + std::to_string(++shots) + ".png",
+                target.ReadPixels());
+    }
     const bool last_frame = back_to_back && stats_.frames >= options_.quit_after_frames;
     if (options_.capture_last_frame && (last_frame || options_.quit_after_seconds > 0))
       last_picture = target.ReadPixels();
+    const auto present_start = Clock::now();
     context_->Present(target);
+    frame_ms += 1e3 * since(present_start);
+    stats_.max_frame_ms = std::max(stats_.max_frame_ms, frame_ms);
+    if (stats_.frames > kSettleFrames && frame_ms > 50.0) ++stats_.slow_frames;
+    // A frame that also wrote a screenshot says so (the capture is not in its time).
+    if (frame_log)
+      std::fprintf(frame_log.get(), "%.3f %.2f%s\n", since(start), frame_ms, shot ? " shot" : "");
     if (last_frame) break;
   }
   return last_picture;

@@ -30,6 +30,13 @@ struct WindowOptions {
   // Delivered through the window's drop callback once the first frames are drawn, one path per
   // frame, as a window system would (tests of drag and drop); frames keep coming until all are.
   std::vector<std::string> test_drops;
+  // When set: one line per frame to this file, "<seconds since start> <milliseconds>" (how long
+  // the frame took to draw and show: a frozen GUI shows as long frames).
+  std::string frame_log;
+  // > 0: every this many seconds, the next frame drawn is also written to
+  // `<screenshots_prefix>_<n>.png` (n from 1): what a capture session looked like as it went.
+  double screenshot_every_s = 0.0;
+  std::string screenshots_prefix;
 };
 
 // What a window run drew: every frame, and those drawn when nothing had moved for a second (no
@@ -37,6 +44,8 @@ struct WindowOptions {
 struct FrameStats {
   int frames = 0;
   int quiet_frames = 0;
+  double max_frame_ms = 0.0;  // the longest frame, drawn and shown
+  int slow_frames = 0;        // frames over 50 ms after the first (which lay the window out)
 };
 
 // The window, its GL context (current) and its ImGui host.
@@ -55,7 +64,10 @@ class Window {
   // workbench animates (at most 60 per second), and every quarter second while a text field
   // takes typing (its cursor blinks); otherwise the loop sleeps in the window system.
   // Returns the last frame's picture with capture_last_frame.
-  std::optional<ImageU8> Run(const std::function<bool(int, int, double)>& frame);
+  // changed (optional): whether what the window shows changed since the last frame without
+  // input (a thread following a capture); polled every tenth of a second while idle.
+  std::optional<ImageU8> Run(const std::function<bool(int, int, double)>& frame,
+                             const std::function<bool()>& changed = {});
   const FrameStats& stats() const { return stats_; }
   // Files and folders dropped onto the window since the last call (call from `frame`).
   std::vector<std::string> TakeDroppedPaths();

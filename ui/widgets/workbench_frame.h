@@ -34,7 +34,7 @@ class WorkbenchFrame {
     for (int view = 0; view < 3; ++view)
       if (frame.Shows(view)) View(view, s, frame.views[view], &intents);
     if (!frame.panels()) return intents;
-    MeasurementsPanel(s, frame.measurements, &intents);
+    if (frame.measurements_shown()) MeasurementsPanel(s, frame.measurements, &intents);
     SolverPanel(s, frame.solver, &intents);
     StatusLine(frame.status, s.busy, s.status_is_error, s.status_line, Opened(s));
     HandleKeys(s, &intents);

@@ -53,6 +53,15 @@ FrameRects ArrangeFrame(int layout, int width, int height, const LayoutShares& s
 FrameRects ArrangeFrame(int layout, int width, int height, const LayoutShares& shares) {
   const float w = static_cast<float>(width), h = static_cast<float>(height);
   FrameRects frame;
+  if (layout == kGuideLayout) {
+    const float status_h = ImGui::GetFrameHeightWithSpacing() + 8;
+    const float top_h = std::floor((h - status_h) * 0.62f), half = std::floor(w / 2);
+    frame.guide = true;
+    frame.views = {Rect{0, 0, 0, 0}, Rect{0, 0, half, top_h}, Rect{half, 0, w - half, top_h}};
+    frame.solver = {0, top_h, w, h - status_h - top_h};
+    frame.status = {0, h - status_h, w, status_h};
+    return frame;
+  }
   if (layout > 0) {
     frame.alone = layout - 1;
     frame.views[frame.alone] = {0, 0, w, h};

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <string>
+#include <vector>
 
 #include "ui/widgets/view_window.h"
 
@@ -12,7 +13,7 @@ namespace calibench::ui {
 
 // The layouts' names in the order of a workbench's layout enum: the whole workbench, then each
 // view alone, left to right (e.g. "workbench", "lidar", "camera", "3d").
-using LayoutNames = std::array<const char*, 4>;
+using LayoutNames = std::vector<const char*>;
 
 // Sets *layout to the enum value named `name`; false (and *layout untouched) for other names.
 template <typename Layout>
@@ -25,13 +26,20 @@ bool ParseLayoutName(const std::string& name, const LayoutNames& names, Layout* 
   return false;
 }
 
+// The layout number of the guide arrangement (after the whole workbench, 0, and the three views
+// alone, 1 to 3): camera and 3D views over the solver panel, what `render --view guide` draws.
+constexpr int kGuideLayout = 4;
+
 // Where each part of one frame goes, screen pixels.
 struct FrameRects {
   std::array<Rect, 3> views;  // left to right
   int alone = -1;             // the view shown alone, -1: the whole workbench
   Rect measurements, solver, status;
-  bool Shows(int view) const { return alone < 0 || alone == view; }
+  // The guide (kGuideLayout): the second and third views side by side over the solver panel.
+  bool guide = false;
+  bool Shows(int view) const { return guide ? view > 0 : alone < 0 || alone == view; }
   bool panels() const { return alone < 0; }  // the panels, the status line and the keys
+  bool measurements_shown() const { return alone < 0 && !guide; }
 };
 
 // A workbench's proportions: the views' share of the height (above the panels) and the

@@ -1,0 +1,156 @@
+// The workbench as the on-site cockpit: the ghost board (where `advise` says to hold the board
+// next) drawn where advise's pose projects, and a folder followed while a capture fills it —
+// pairs join as they land, solved by themselves, ending where `calibrate` ends on the finished
+// folder.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "core/base/names.h"
+#include "core/geometry/geometry.h"
+#include "core/io/dataset.h"
+#include "core/results/result_file.h"
+#include "core/session/session.h"
+#include "tests/acfr_manifest.h"
+#include "tests/test_support.h"
+#include "tests/ui/ui_fixture.h"
+#include "tests/watch_stream.h"
+#include "ui/lidar_camera/controller.h"
+#include "ui/lidar_camera/ghost.h"
+
+namespace calibench::ui {
+namespace {
+namespace fs = std::filesystem;
+
+// The sheet's four corners in the board frame (the shown and the BoardSpec frames share them).
+std::vector<Vec3> SheetCorners(const BoardSpec& board) {
+  const double hw = board.SheetWidth() / 2, hh = board.SheetHeight() / 2;
+  return {{-hw, -hh, 0}, {hw, -hh, 0}, {hw, hh, 0}, {-hw, hh, 0}};
+}
+
+TEST(Guide, TheGhostBoardInTheCameraViewLiesWhereAdvisesPoseProjects) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), {}, Controller::ExistingSession::kInMemory);
+  controller.WaitIdle();
+  controller.Apply(RunSolver{});
+  const Snapshot s = Loaded(controller);
+  ASSERT_TRUE(s.solver.result) << s.solver.failure;
+  ASSERT_TRUE(s.next_pose) << s.next_pose_failure;
+
+  // `calibench advise --json` on the same dataset, a process of its own.
+  std::string output;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " advise --dataset " +
+                                 test::UiDataset().string() + " --json",
+                             &output),
+            0)
+      << output;
+  // Its one JSON object (progress lines on stderr come first here: RunCommand merges them).
+  const size_t object = output.find("\n{");
+  ASSERT_NE(object, std::string::npos) << output;
+  const nlohmann::json advice = nlohmann::json::parse(output.substr(object + 1));
+  ASSERT_FALSE(advice["next"].is_null()) << output;
+  const Pose lidar_from_board = test::PoseFromRows(advice["next"]["lidar_from_board"]);
+  const Pose cam_from_lidar = test::PoseFromRows(advice["cam_from_lidar"]);
+  EXPECT_EQ(advice["next"]["words"], s.next_pose->words);
+
+  // The outline the camera view draws starts each edge at a corner (SheetOutlinePixels).
+  const int steps = 16;
+  const std::vector<Vec2> outline =
+      SheetOutlinePixels(s.dataset->camera, s.dataset->target, s.next_pose->cam_from_board, steps);
+  ASSERT_EQ(outline.size(), 4u * steps);
+  for (const Vec3& corner : SheetCorners(s.dataset->target)) {
+    const auto expected = s.dataset->camera.Project(cam_from_lidar * lidar_from_board * corner);
+    ASSERT_TRUE(expected);
+    double nearest = 1e9;
+    for (int k = 0; k < 4; ++k)
+      nearest = std::min(nearest, (outline[k * steps] - *expected).norm());
+    EXPECT_LT(nearest, 0.5) << "corner at " << expected->transpose();
+  }
+}
+
+// As a capture script writes a file: under a temporary name, then renamed into place.
+void WriteLikeACapture(const fs::path& from, const fs::path& to) {
+  fs::create_directories(to.parent_path());
+  const fs::path part = to.string() + ".part";
+  fs::copy_file(from, part, fs::copy_options::overwrite_existing);
+  fs::rename(part, to);
+}
+
+TEST(Guide, AFolderFollowedWhileTheRealCaptureFillsItEndsWhereCalibrateEnds) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  const fs::path root = test::TempDir("guide_watch");
+  const fs::path source =
+      test::WriteAcfrFolder(shared / "datasets/acfr-vlp16-chessboard", root / "source");
+  const fs::path watched = root / "watched";
+  fs::create_directories(watched);
+  Controller controller;
+  controller.SetAutoSolve(true);
+  controller.WatchFolder(watched);  // empty: it waits for the camera and the target
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_NE(controller.GetSnapshot().status_line.find("waiting for camera.yaml"), std::string::npos)
+      << controller.GetSnapshot().status_line;
+  fs::copy_file(source / "camera.yaml", watched / "camera.yaml");
+  fs::copy_file(source / "target.json", watched / "target.json");
+  std::vector<std::string> stems;
+  for (const auto& entry : fs::directory_iterator(source / "clouds"))
+    stems.push_back(entry.path().stem());
+  std::sort(stems.begin(), stems.end(), NaturalOrder{});
+  for (const std::string& stem : stems) {
+    for (const char* sub : {"clouds", "images"})
+      for (const auto& entry : fs::directory_iterator(source / sub))
+        if (entry.path().stem() == stem)
+          WriteLikeACapture(entry.path(), watched / sub / entry.path().filename());
+    // Slower than a pair's processing (a user takes seconds per pose), so that every pair
+    // is solved with as it lands.
+    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  }
+  // Until every pair is in, loaded and solved with.
+  Snapshot s;
+  for (int wait = 0; wait < 600; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    s = controller.GetSnapshot();
+    if (s.pairs.size() == stems.size() && s.loading_done == s.loading_total && !s.busy &&
+        s.solver.result && s.solver.solved_pair_ids.size() + 3 >= stems.size())
+      break;
+  }
+  controller.StopWatching();
+  controller.WaitIdle();
+  s = controller.GetSnapshot();
+  ASSERT_EQ(s.pairs.size(), stems.size()) << s.status_line;
+  ASSERT_TRUE(s.solver.result) << s.solver.failure << "; " << s.status_line;
+  int accepted = 0;
+  for (const PairView& pair : s.pairs) accepted += pair.status == PairStatus::kAccepted;
+  EXPECT_GE(accepted, 37) << s.status_line;
+  // The meter followed the capture: one point per solve that added pairs.
+  ASSERT_TRUE(s.meter);
+  std::printf("meter: %zu points, %d to %d pairs\n", s.meter_history.size(),
+              s.meter_history.front().pairs, s.meter_history.back().pairs);
+  // (Pairs that land while the worker is busy are solved with together: on a loaded machine
+  // fewer points than pairs.)
+  ASSERT_GE(s.meter_history.size(), 8u);
+  EXPECT_GT(s.meter_history.back().pairs, s.meter_history.front().pairs);
+  EXPECT_TRUE(s.next_pose || !s.next_pose_failure.empty());
+
+  std::string out;
+  const fs::path result = root / "result.json";
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " + watched.string() +
+                                 " --out " + result.string(),
+                             &out),
+            0)
+      << out;
+  const PoseError difference =
+      ComputePoseError(s.solver.result->cam_from_lidar, LoadResult(result).cam_from_source);
+  std::printf("workbench watch against calibrate: %.3f mm, %.4f deg; %d of %zu accepted\n",
+              difference.translation_m * 1e3, difference.rotation_rad * kRadToDeg, accepted,
+              stems.size());
+  EXPECT_LT(difference.translation_m, 0.002);
+  EXPECT_LT(difference.rotation_rad * kRadToDeg, 0.02);
+  // The session beside the capture holds every pair.
+  EXPECT_EQ(LoadSession(watched / "calibench.session.json").pairs.size(), stems.size());
+}
+
+}  // namespace
+}  // namespace calibench::ui
