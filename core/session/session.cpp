@@ -153,6 +153,21 @@ Session LoadSession(const std::filesystem::path& path) {
   return SessionFromJson(text.str(), path);
 }
 
+SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_path) {
+  Session session = LoadSession(session_path);
+  Dataset dataset = LoadDataset(session.dataset);
+  if (session.pairs.size() != dataset.pairs.size())
+    throw IoError(session_path.string() + ": the session has " +
+                  std::to_string(session.pairs.size()) + " pairs but " + dataset.manifest.string() +
+                  " has " + std::to_string(dataset.pairs.size()));
+  for (size_t i = 0; i < dataset.pairs.size(); ++i)
+    if (session.pairs[i].id != dataset.pairs[i].id)
+      throw IoError(session_path.string() + ": pair " + std::to_string(i) + " is '" +
+                    session.pairs[i].id + "' in the session but '" + dataset.pairs[i].id +
+                    "' in the dataset");
+  return {std::move(session), std::move(dataset)};
+}
+
 void SaveSession(const std::filesystem::path& path, const Session& session) {
   WriteFileAtomically(path, SessionToJson(session, path));
 }

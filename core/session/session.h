@@ -155,6 +155,14 @@ Session SessionFromJson(const std::string& text, const std::filesystem::path& so
 
 // Reads a session file; never writes it. Throws IoError naming the file and the problem.
 Session LoadSession(const std::filesystem::path& path);
+// A session with the dataset it names, checked to be that dataset's: the same pairs in the same
+// order (a session's edits and view are by pair; reopened on other pairs they would mislabel).
+// Throws IoError naming the session, the manifest and the first difference.
+struct SessionWithDataset {
+  Session session;
+  Dataset dataset;
+};
+SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_path);
 // Whether the file is a session (its first 4 KB name calibench.session.v1): what `export`,
 // `report` and the workbench's Open tell a session from a result or a manifest by. False for a
 // file that cannot be read.

@@ -18,6 +18,7 @@
 #include "ui/gfx/gl_api.h"  // first GL header of this file: glGetError for the checks
 #include "ui/gfx/point_splat.h"
 #include "ui/gfx/renderers.h"
+#include "ui/gfx/scene_layers.h"
 
 namespace calibench::gfx {
 namespace {
@@ -211,6 +212,58 @@ TEST(GfxRender, KnownSceneHasExpectedPixels) {
       }
     }
   }
+}
+
+// The same scene as named layers (gfx::SceneLayers, what both workbenches' 3D views draw): the
+// same pixels with every layer shown; a hidden layer leaves the background (or what is behind)
+// where it was, and showing it again brings it back.
+TEST(GfxSceneLayers, DrawsTheSceneAndHidesALayerByName) {
+  CALIBENCH_REQUIRE_GL_CONTEXT(context, HeadlessBackend::kEgl);
+  Framebuffer target;
+  const ImageU8 reference = RenderScene(&target, 0, PointDrawing::kGlPoints);
+  PointRenderer points;
+  points.set_drawing(PointDrawing::kGlPoints);
+  points.Upload(kPoints, kPointColors);
+  SceneLayers layers;
+  auto fill = [&] {
+    layers.Clear();
+    SceneLayers::Layer& cloud = layers["points"];
+    cloud.points = &points;
+    cloud.point_size_px = kPointSize;
+    layers["line"].lines.Add(kLine[0].cast<double>(), kLine[1].cast<double>(), {255, 0, 255, 255});
+    layers["triangle"].triangles.vertices = kTriangle;
+    layers["triangle"].triangles.colors = {kTriangleColor, kTriangleColor, kTriangleColor};
+  };
+  auto draw = [&] {
+    target.Resize(kWidth, kHeight);
+    target.Clear(kClear[0], kClear[1], kClear[2], 1.0f);
+    ImageTexture color_image, grey_image;  // as RenderScene draws them, under the layers
+    color_image.Upload(ColorImage(), false);
+    grey_image.Upload(GreyImage(), false);
+    color_image.Draw(0.5f, -1.0f, 1.0f, -0.5f);
+    grey_image.Draw(-1.0f, -1.0f, -0.5f, -0.5f);
+    fill();
+    layers.Draw(SceneViewProjection());
+    return target.ReadPixels();
+  };
+  const ImageU8 all = draw();
+  EXPECT_EQ(all.data, reference.data);
+  const Eigen::Vector3i background(153, 102, 51);
+  const Eigen::Vector2i inside = ExpectedPixel({-2.2f, 0.9f, 1.0f});
+  const Eigen::Vector2i line_at = ExpectedPixel({0, -1, 0});
+  layers.SetVisible("triangle", false);
+  layers.SetVisible("line", false);
+  const ImageU8 hidden = draw();
+  EXPECT_TRUE(ColorNear(hidden, inside.x(), inside.y(), background, 0));
+  for (int dy = -1; dy <= 1; ++dy)
+    EXPECT_FALSE(ColorNear(hidden, line_at.x(), line_at.y() + dy, {255, 0, 255}, 0));
+  const Eigen::Vector2i first_point = ExpectedPixel(kPoints[0]);
+  EXPECT_TRUE(ColorNear(hidden, first_point.x(), first_point.y(),
+                        {kPointColors[0].b, kPointColors[0].g, kPointColors[0].r}, 0));
+  EXPECT_NE(layers.VisibilityKey(), 0u);
+  layers.SetVisible("triangle", true);
+  layers.SetVisible("line", true);
+  EXPECT_EQ(draw().data, reference.data);
 }
 
 // A dense cloud drawn as GL_POINTS or splatted in software (point_splat.h) into a viewport that

@@ -34,26 +34,6 @@ std::filesystem::path BackUpSession(const std::filesystem::path& path) {
 
 }  // namespace
 
-namespace {
-
-// The session in `path`, checked against the dataset it names. Throws IoError.
-std::pair<Session, Dataset> LoadSessionAndDataset(const std::filesystem::path& session_path) {
-  Session session = LoadSession(session_path);  // throws IoError; never rewrites the file
-  Dataset dataset = LoadDataset(session.dataset);
-  if (session.pairs.size() != dataset.pairs.size())
-    throw IoError(session_path.string() + ": the session has " +
-                  std::to_string(session.pairs.size()) + " pairs but " + dataset.manifest.string() +
-                  " has " + std::to_string(dataset.pairs.size()));
-  for (size_t i = 0; i < dataset.pairs.size(); ++i)
-    if (session.pairs[i].id != dataset.pairs[i].id)
-      throw IoError(session_path.string() + ": pair " + std::to_string(i) + " is '" +
-                    session.pairs[i].id + "' in the session but '" + dataset.pairs[i].id +
-                    "' in the dataset");
-  return {std::move(session), std::move(dataset)};
-}
-
-}  // namespace
-
 void Controller::OpenDataset(const std::filesystem::path& dataset_path,
                              std::filesystem::path session_path, ExistingSession existing) {
   OpenLoadedDataset(LoadDataset(dataset_path), std::move(session_path), existing);
@@ -95,7 +75,7 @@ void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path
 
 void Controller::OpenSession(const std::filesystem::path& session_path, bool save) {
   if (!save) {
-    auto [session, dataset] = LoadSessionAndDataset(session_path);
+    auto [session, dataset] = LoadSessionWithDataset(session_path);
     Open(dataset, std::move(session), {}, "", std::nullopt);
     return;
   }
@@ -132,7 +112,7 @@ bool Controller::ResumeBackup(const std::filesystem::path& session_path, const s
     const std::filesystem::path backup = SessionBackupPath(session_path, n);
     if (!std::filesystem::exists(backup)) continue;
     try {
-      auto [session, dataset] = LoadSessionAndDataset(backup);
+      auto [session, dataset] = LoadSessionWithDataset(backup);
       const std::string kept = BackUpSession(session_path).string();
       Open(dataset, std::move(session), session_path,
            note + "resumed its newest backup that opens, " + backup.string() +
@@ -148,7 +128,7 @@ bool Controller::ResumeBackup(const std::filesystem::path& session_path, const s
 
 void Controller::OpenSessionFile(const std::filesystem::path& session_path, const std::string& note,
                                  std::optional<FileLock>* lock) {
-  auto [session, dataset] = LoadSessionAndDataset(session_path);
+  auto [session, dataset] = LoadSessionWithDataset(session_path);
   Open(dataset, std::move(session), session_path, note, std::move(*lock));
 }
 

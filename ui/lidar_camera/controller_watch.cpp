@@ -50,6 +50,8 @@ void Controller::RequestSolve() {
 void Controller::WatchFolder(const std::filesystem::path& folder, FolderWatchOptions options) {
   StopWatching();
   stop_watch_ = false;
+  // Pairs land while the user looks: the window's frames before the pairs' processing.
+  worker_.LowerPriority();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     watching_ = std::filesystem::absolute(folder);

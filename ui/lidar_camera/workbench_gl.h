@@ -10,6 +10,7 @@
 
 #include "ui/gfx/framebuffer.h"
 #include "ui/gfx/renderers.h"
+#include "ui/gfx/scene_layers.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/widgets/zoom_pan_image.h"
 
@@ -34,9 +35,8 @@ struct Workbench::Gl {
   ShownReprojection camera_points_shown;
   gfx::Framebuffer scene_target;
   gfx::PointRenderer scene_points;
-  float scene_floor_z = -1.5f;  // metres, LiDAR frame; from the shown cloud
-  gfx::LineRenderer scene_lines;
-  gfx::TriangleRenderer scene_quads;
+  float scene_floor_z = -1.5f;    // metres, LiDAR frame; from the shown cloud
+  gfx::SceneLayers scene_layers;  // grid, frames, cloud, boards, ghost (DrawScene)
   std::map<std::string, std::unique_ptr<gfx::ImageTexture>> thumbnails;
 };
 

@@ -11,6 +11,7 @@
 #include "ui/lidar_camera/workbench.h"
 #include "ui/lidar_camera/workbench_gl.h"
 #include "ui/widgets/frame_key.h"
+#include "ui/widgets/layer_toggles.h"
 #include "ui/widgets/orbit_camera.h"
 
 namespace calibench::ui {
@@ -68,8 +69,10 @@ std::array<Vec3, 4> InlierExtent(const LidarCloud& cloud, const LidarPlaneFit& f
 }
 
 // "camera colours", the brush, and what the view shows otherwise; the mouse's use.
-void SceneToolbar(const Snapshot& s, bool* camera_colors, bool* brush) {
+void SceneToolbar(const Snapshot& s, bool* camera_colors, bool* brush, gfx::SceneLayers* layers) {
   static const char* kColorings[] = {"intensity", "range", "ring"};
+  LayerToggles(layers);
+  ImGui::SameLine();
   ImGui::Checkbox("camera colours", camera_colors);
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("colour the cloud from the camera image (after a solve)");
@@ -149,7 +152,7 @@ void Workbench::SceneView(const Snapshot& s, const Rect& r, std::vector<Intent>*
   }
   const bool can_use_camera =
       s.reprojection && s.reprojection->pair_id == pair->id && s.selected_image && s.solver.result;
-  SceneToolbar(s, &scene_camera_colors_, &scene_brush_);
+  SceneToolbar(s, &scene_camera_colors_, &scene_brush_, &gl_->scene_layers);
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const int tw = std::max(1, static_cast<int>(avail.x)),
             th = std::max(1, static_cast<int>(avail.y));
@@ -169,6 +172,8 @@ void Workbench::SceneView(const Snapshot& s, const Rect& r, std::vector<Intent>*
   if (estimate) frame_key.Mix(estimate->matrix().data(), sizeof(double) * 16);
   if (s.next_pose && s.next_pose->lidar_from_board)
     frame_key.Mix(s.next_pose->lidar_from_board->matrix().data(), sizeof(double) * 16);
+  const std::uint64_t shown_layers = gl_->scene_layers.VisibilityKey();
+  frame_key.Mix(&shown_layers, sizeof(shown_layers));
   if (frame_key.value() != scene_frame_key_ || gl_->scene_target.width() != tw ||
       gl_->scene_target.height() != th) {
     scene_frame_key_ = frame_key.value();
@@ -235,44 +240,49 @@ void Workbench::DrawScene(const Snapshot& s, const PairView& pair,
                           const gfx::Matrix4f& view_projection, const Pose* estimate, int tw,
                           int th) {
   const LidarCloud& cloud = *pair.cloud;
-  // Lines: ground grid, LiDAR axes, camera axes at the displayed estimate.
-  gfx::LineBatch lines;
+  gfx::SceneLayers& layers = gl_->scene_layers;
+  layers.Clear();
+  // The ground grid, the LiDAR's frame, its cloud and board; the camera's frame and board at the
+  // displayed estimate; the ghost board (where to hold the board next).
+  gfx::LineBatch& grid = layers["grid"].lines;
   const double floor_z = gl_->scene_floor_z;
   for (int k = -10; k <= 10; ++k) {
-    const gfx::Rgba grid{70, 70, 78, 255};
-    lines.Add({k * 1.0, -10, floor_z}, {k * 1.0, 10, floor_z}, grid);
-    lines.Add({-10, k * 1.0, floor_z}, {10, k * 1.0, floor_z}, grid);
+    const gfx::Rgba color{70, 70, 78, 255};
+    grid.Add({k * 1.0, -10, floor_z}, {k * 1.0, 10, floor_z}, color);
+    grid.Add({-10, k * 1.0, floor_z}, {10, k * 1.0, floor_z}, color);
   }
-  lines.AddAxes(Pose::Identity(), 0.5);
-  gfx::TriangleBatch quads;
-  if (pair.lidar) quads.AddQuad(InlierExtent(cloud, *pair.lidar), {60, 140, 255, 110});
+  layers["LiDAR frame"].lines.AddAxes(Pose::Identity(), 0.5);
+  gfx::SceneLayers::Layer& points = layers["LiDAR points"];
+  points.points = &gl_->scene_points;
+  points.point_size_px = static_cast<float>(s.view.point_size_px);
+  gfx::SceneLayers::Layer& lidar_board = layers["LiDAR board"];
+  if (pair.lidar)
+    lidar_board.triangles.AddQuad(InlierExtent(cloud, *pair.lidar), {60, 140, 255, 110});
+  gfx::SceneLayers::Layer& camera = layers["camera"];
   if (estimate) {
     const Pose lidar_from_cam = estimate->inverse();
-    lines.AddAxes(lidar_from_cam, 0.3);
+    camera.lines.AddAxes(lidar_from_cam, 0.3);
     if (pair.camera)
-      quads.AddRectangle(lidar_from_cam * pair.camera->cam_from_board,
-                         s.dataset->target.SheetWidth(), s.dataset->target.SheetHeight(),
-                         {255, 150, 40, 110});
+      camera.triangles.AddRectangle(lidar_from_cam * pair.camera->cam_from_board,
+                                    s.dataset->target.SheetWidth(), s.dataset->target.SheetHeight(),
+                                    {255, 150, 40, 110});
   }
-  // The ghost board: where to hold the board next (advise's lidar_from_board).
+  gfx::SceneLayers::Layer& ghost = layers["ghost board"];
   if (s.next_pose && s.next_pose->lidar_from_board) {
-    const Pose& ghost = *s.next_pose->lidar_from_board;
+    const Pose& lidar_from_board = *s.next_pose->lidar_from_board;
     const double w = s.dataset->target.SheetWidth(), h = s.dataset->target.SheetHeight();
-    quads.AddRectangle(ghost, w, h, {120, 255, 140, 90});
+    ghost.triangles.AddRectangle(lidar_from_board, w, h, {120, 255, 140, 90});
     const gfx::Rgba edge{120, 255, 140, 255};
-    const Vec3 corners[4] = {ghost * Vec3(-w / 2, -h / 2, 0), ghost * Vec3(w / 2, -h / 2, 0),
-                             ghost * Vec3(w / 2, h / 2, 0), ghost * Vec3(-w / 2, h / 2, 0)};
-    for (int k = 0; k < 4; ++k) lines.Add(corners[k], corners[(k + 1) % 4], edge);
+    const Vec3 corners[4] = {
+        lidar_from_board * Vec3(-w / 2, -h / 2, 0), lidar_from_board * Vec3(w / 2, -h / 2, 0),
+        lidar_from_board * Vec3(w / 2, h / 2, 0), lidar_from_board * Vec3(-w / 2, h / 2, 0)};
+    for (int k = 0; k < 4; ++k) ghost.lines.Add(corners[k], corners[(k + 1) % 4], edge);
     // Its normal, from the sheet towards where the sensors are.
-    lines.Add(ghost.translation(), ghost * Vec3(0, 0, 0.3), edge);
+    ghost.lines.Add(lidar_from_board.translation(), lidar_from_board * Vec3(0, 0, 0.3), edge);
   }
   gl_->scene_target.Resize(tw, th);
   gl_->scene_target.Clear(0.08f, 0.08f, 0.1f, 1.0f);
-  gl_->scene_lines.Upload(lines.vertices, lines.colors);
-  gl_->scene_lines.Draw(view_projection);
-  gl_->scene_points.Draw(view_projection, static_cast<float>(s.view.point_size_px));
-  gl_->scene_quads.Upload(quads.vertices, quads.colors);
-  gl_->scene_quads.Draw(view_projection);
+  layers.Draw(view_projection);
 }
 
 }  // namespace calibench::ui

@@ -10,8 +10,10 @@
 #include "core/lrf/result_io.h"
 #include "ui/gfx/framebuffer.h"
 #include "ui/gfx/renderers.h"
+#include "ui/gfx/scene_layers.h"
 #include "ui/lrf/workbench_draw.h"
 #include "ui/widgets/frame_key.h"
+#include "ui/widgets/layer_toggles.h"
 #include "ui/widgets/pair_review.h"
 #include "ui/widgets/path_field.h"
 #include "ui/widgets/solution_readouts.h"
@@ -23,8 +25,7 @@ struct LrfWorkbench::Gl {
   gfx::ImageTexture picture;  // depth picture or RGB image of the selected pair
   gfx::Framebuffer scene_target;
   gfx::PointRenderer cloud_points, scan_points;
-  gfx::LineRenderer scene_lines;
-  gfx::TriangleRenderer scene_board;
+  gfx::SceneLayers scene_layers;       // grid, frames, depth cloud, scan, board (DrawScene)
   const void* cloud_source = nullptr;  // the features the cloud was built from
   Vec3 scene_center = Vec3(0, 0, 2);   // orbit target, camera frame (metres)
   double floor_y = 1.0;                // camera y of the grid (y down), metres
@@ -319,39 +320,43 @@ void LrfWorkbench::UploadDepthCloud(const LrfPairFeatures& pair) {
 void LrfWorkbench::DrawScene(const LrfSnapshot& s, const LrfPairFeatures& pair,
                              const gfx::Matrix4f& view_projection, const Pose* estimate, int tw,
                              int th) {
-  gfx::LineBatch lines;
+  gfx::SceneLayers& layers = gl_->scene_layers;
+  layers.Clear();
   // A 0.5 m grid on the floor (camera y points down), around and behind the target.
+  gfx::LineBatch& grid = layers["grid"].lines;
   const Vec3& c = gl_->scene_center;
   const double x0 = std::round(c.x()) - 4, z1 = std::ceil(c.z()) + 3, y = gl_->floor_y;
-  const gfx::Rgba grid{62, 62, 70, 255};
-  for (int k = 0; k <= 16; ++k) lines.Add({x0 + 0.5 * k, y, 0}, {x0 + 0.5 * k, y, z1}, grid);
-  for (int k = 0; k <= 2 * z1; ++k) lines.Add({x0, y, 0.5 * k}, {x0 + 8, y, 0.5 * k}, grid);
-  lines.AddAxes(Pose::Identity(), 0.3);         // the camera
-  if (estimate) lines.AddAxes(*estimate, 0.3);  // the LRF at the estimate
-  gfx::TriangleBatch board;
-  if (pair.camera)
-    board.AddRectangle(pair.camera->cam_from_board, s.dataset->board.SheetWidth(),
-                       s.dataset->board.SheetHeight(), {255, 150, 40, 110});
+  const gfx::Rgba color{62, 62, 70, 255};
+  for (int k = 0; k <= 16; ++k) grid.Add({x0 + 0.5 * k, y, 0}, {x0 + 0.5 * k, y, z1}, color);
+  for (int k = 0; k <= 2 * z1; ++k) grid.Add({x0, y, 0.5 * k}, {x0 + 8, y, 0.5 * k}, color);
+  gfx::LineBatch& frames = layers["frames"].lines;
+  frames.AddAxes(Pose::Identity(), 0.3);         // the camera
+  if (estimate) frames.AddAxes(*estimate, 0.3);  // the LRF at the estimate
+  layers["depth cloud"].points = &gl_->cloud_points;
   std::vector<Eigen::Vector3f> scan;
   if (estimate)
     for (size_t i = 0; i < pair.scan.ranges.size(); ++i)
       if (pair.scan.Valid(i) && pair.scan.ranges[i] < 15.0)
         scan.push_back((*estimate * OnScanPlane(pair.scan.Point(i))).cast<float>());
+  gl_->scan_points.Upload(scan, std::vector<gfx::Rgba>(scan.size(), gfx::Rgba{255, 225, 40, 255}));
+  gfx::SceneLayers::Layer& scan_layer = layers["scan"];
+  scan_layer.points = &gl_->scan_points;
+  scan_layer.point_size_px = 4.0f;
+  if (pair.camera)
+    layers["board"].triangles.AddRectangle(pair.camera->cam_from_board,
+                                           s.dataset->board.SheetWidth(),
+                                           s.dataset->board.SheetHeight(), {255, 150, 40, 110});
   gl_->scene_target.Resize(tw, th);
   gl_->scene_target.Clear(0.08f, 0.08f, 0.1f, 1.0f);
-  gl_->scene_lines.Upload(lines.vertices, lines.colors);
-  gl_->scene_lines.Draw(view_projection);
-  gl_->cloud_points.Draw(view_projection, 2.0f);
-  gl_->scan_points.Upload(scan, std::vector<gfx::Rgba>(scan.size(), gfx::Rgba{255, 225, 40, 255}));
-  gl_->scan_points.Draw(view_projection, 4.0f);
-  gl_->scene_board.Upload(board.vertices, board.colors);
-  gl_->scene_board.Draw(view_projection);
+  layers.Draw(view_projection);
 }
 
 void LrfWorkbench::SceneView(const LrfSnapshot& s, const Rect& r) {
   const LrfPairFeatures* pair = BeginPairView("3D (camera frame)", s, r);
   if (!pair) return ImGui::End();
   const Pose* estimate = DisplayedEstimate(s);
+  LayerToggles(&gl_->scene_layers);
+  ImGui::SameLine();
   ImGui::TextDisabled(estimate ? "cloud by face; yellow: the scan at the estimate. drag: orbit, "
                                  "wheel: zoom"
                                : "cloud by face; run the solver to move the scan in. drag: orbit");
@@ -369,6 +374,8 @@ void LrfWorkbench::SceneView(const LrfSnapshot& s, const Rect& r) {
   FrameKey key(reinterpret_cast<std::uintptr_t>(pair));
   key.Mix(view_projection.data(), sizeof(float) * 16);
   if (estimate) key.Mix(estimate->matrix().data(), sizeof(double) * 16);
+  const std::uint64_t shown_layers = gl_->scene_layers.VisibilityKey();
+  key.Mix(&shown_layers, sizeof(shown_layers));
   if (key.value() != scene_key_ || gl_->scene_target.width() != tw ||
       gl_->scene_target.height() != th) {
     scene_key_ = key.value();

@@ -54,11 +54,12 @@ bool WorkQueue::Busy() const {
   return !queue_.empty() || running_jobs_ > 0;
 }
 
+void WorkQueue::LowerPriority() {
+  // On the worker itself: Linux's nice value is per thread, and threads it starts inherit it.
+  Enqueue([] { setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kJobNiceness); });
+}
+
 void WorkQueue::Loop() {
-  // Below the window's thread: on a machine with few cores (and software OpenGL drawing on them)
-  // the frames come first, the jobs take what is left. Threads the jobs start inherit it.
-  // (Linux: the nice value is per thread; a failure leaves the default, which only costs frames.)
-  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kJobNiceness);
   for (;;) {
     std::function<void()> job;
     {

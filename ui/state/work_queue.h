@@ -30,6 +30,10 @@ class WorkQueue {
   void WaitIdle();
   // True while a job is queued or running.
   bool Busy() const;
+  // From the next job on, the worker runs below normal priority (and the threads its jobs start):
+  // on a machine with few cores the window's frames come first (a followed capture). Linux only
+  // does it per thread; elsewhere, or refused, nothing changes.
+  void LowerPriority();
 
  private:
   void Loop();
