@@ -56,6 +56,17 @@ Snapshot EditedAndSolved(Controller& controller, const std::filesystem::path& se
   return Loaded(controller);
 }
 
+// `calibench calibrate --session` on what the workbench autosaved, its result read back (the
+// JSON writer keeps every double exactly); the command's output in *output.
+LoadedResult CalibrateSession(const std::filesystem::path& session_path, std::string* output) {
+  const auto out = session_path.parent_path() / "calibrated_from_session.json";
+  const int code = test::RunCommand(test::CalibenchExe() + " calibrate --session " +
+                                        session_path.string() + " --out " + out.string(),
+                                    output);
+  EXPECT_EQ(code, 0) << *output;
+  return LoadResult(out);
+}
+
 TEST(OnePipeline, WorkbenchAndCalibrateAgreeBitForBit) {
   const auto dir = test::TempDir("one_pipeline");
   const auto session_path = dir / "calibench.session.json";
@@ -100,15 +111,9 @@ TEST(OnePipeline, CalibrateWithTheSessionFlagMatchesTheWorkbench) {
   const Snapshot gui = EditedAndSolved(controller, session_path);
   ASSERT_TRUE(gui.solver.result) << gui.solver.failure;
 
-  const auto out = dir / "result.json";
   std::string output;
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --session " +
-                                 session_path.string() + " --out " + out.string(),
-                             &output),
-            0)
-      << output;
+  const LoadedResult cli = CalibrateSession(session_path, &output);
   EXPECT_NE(output.find("rejected"), std::string::npos) << output;
-  const LoadedResult cli = LoadResult(out);
   // Through the result file's text: the JSON writer keeps every double exactly.
   ExpectIdentical(cli.cam_from_source.matrix(), gui.solver.result->cam_from_lidar.matrix(),
                   "cam_from_lidar");
@@ -152,15 +157,9 @@ TEST(OnePipeline, CameraGuidedCompletionRunsInTheWorkbenchAsInCalibrate) {
         gui.solver.result->cam_from_lidar.matrix() - cli.solution->cam_from_lidar.matrix();
     EXPECT_LT(difference.cwiseAbs().maxCoeff(), 1e-9) << "solve " << solve;
   }
-  const auto out = dir / "result.json";
   std::string output;
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --session " +
-                                 session_path.string() + " --out " + out.string(),
-                             &output),
-            0)
-      << output;
-  const Mat4 difference =
-      LoadResult(out).cam_from_source.matrix() - cli.solution->cam_from_lidar.matrix();
+  const Mat4 difference = CalibrateSession(session_path, &output).cam_from_source.matrix() -
+                          cli.solution->cam_from_lidar.matrix();
   EXPECT_LT(difference.cwiseAbs().maxCoeff(), 1e-9);
 }
 
