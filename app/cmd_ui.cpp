@@ -184,7 +184,7 @@ int RunGuiWindow(const std::string& dataset, const std::string& session, int wid
   ui::WindowShell shell(options);
   // The window resumes the session beside the dataset (or, with --fresh, backs it up first).
   if (!quit.watch.empty()) {
-    shell.WatchFolder(quit.watch);
+    shell.Watch(quit.watch);
   } else if (!session.empty()) {
     shell.OpenSession(session);
   } else if (!dataset.empty()) {
@@ -217,9 +217,10 @@ int RunGui(int argc, char** argv) {
                  "deliver this path to the window's drop callback after the first frames (tests)")
       ->group("");
   app.add_option("--watch", quit.watch,
-                 "a folder a capture fills (camera.yaml, target.json, clouds/, images/): pairs "
-                 "join the list as they land, each detected, checked and solved; the meter and "
-                 "the ghost board (where to hold the board next) follow");
+                 "a folder a capture fills (camera.yaml, target.json, clouds/, images/) or a "
+                 "recording being written (.bag, .mcap, .db3, a rosbag2 folder; its pairs go to "
+                 "<recording>.dataset as import writes them): pairs join the list as they land, "
+                 "each detected, checked and solved; the meter and the ghost board follow");
   app.add_flag("--no-auto-solve", quit.no_auto_solve,
                "solve only on F5 / Run (by default the workbench solves once the pairs are "
                "detected and after every new or changed pair)");

@@ -330,23 +330,6 @@ class Watch {
   std::map<std::string, std::pair<bool, std::string>> reported_;  // verdicts said, by pair
 };
 
-// A recording rather than a folder form: a file that starts like one (or is named like one and is
-// not there yet), or a rosbag2 folder (metadata.yaml, or .mcap / .db3 files in it).
-bool IsRecording(const fs::path& source) {
-  std::error_code error;
-  const std::string extension = source.extension().string();
-  if (extension == ".bag" || extension == ".mcap" || extension == ".db3") return true;
-  if (fs::is_regular_file(source, error)) return LooksLikeBag(source);
-  if (!fs::is_directory(source, error)) return false;
-  if (fs::exists(source / "metadata.yaml", error)) return true;
-  if (fs::exists(source / "clouds", error) || fs::exists(source / "images", error)) return false;
-  for (const fs::directory_entry& entry : fs::directory_iterator(source, error)) {
-    const std::string file_extension = entry.path().extension().string();
-    if (file_extension == ".mcap" || file_extension == ".db3") return true;
-  }
-  return false;
-}
-
 // `watch` on a recording: import's board, camera and topic flags, pairs written to --out.
 int WatchRecording(WatchFlags* flags, const CaptureJobOptions& options, const std::string& board,
                    const std::string& out, const std::string& camera_file, EventStream& stream) {
@@ -470,7 +453,7 @@ int RunWatch(int argc, char** argv) {
     return kUsage;
   }
   EventStream stream(flags.json_lines);
-  if (IsRecording(flags.source))
+  if (IsRecordingSource(flags.source))
     return WatchRecording(&flags, options, board, out, camera_file, stream);
   return WatchFolder(&flags, options, stream);
 }

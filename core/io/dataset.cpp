@@ -9,6 +9,7 @@
 #include "core/base/atomic_file.h"
 #include "core/base/names.h"
 #include "core/geometry/geometry.h"
+#include "core/io/assets.h"
 #include "core/io/camera_file.h"
 #include "core/io/dataset_source.h"
 #include "core/io/json_io.h"
@@ -179,6 +180,22 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
                           {"lidar_range_offset_m", r.lidar_range_offset_m}};
   }
   WriteFileAtomically(manifest_path, root.dump(2) + "\n");
+}
+
+std::vector<std::pair<std::string, BoardSpec>> ShippedTargetPresets() {
+  std::vector<std::pair<std::string, BoardSpec>> presets;
+  try {
+    for (const auto& entry : std::filesystem::directory_iterator(FindAsset("targets")))
+      if (entry.path().extension() == ".json")
+        presets.emplace_back(entry.path().stem().string(), LoadTargetFile(entry.path()));
+  } catch (const IoError&) {
+    presets.clear();
+    for (const char* name : {"a3", "a4", "charuco-a3", "charuco-a4", "paper"})
+      presets.emplace_back(name, BoardPreset(name));
+  }
+  std::sort(presets.begin(), presets.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  return presets;
 }
 
 }  // namespace calibench

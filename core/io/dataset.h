@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/base/types.h"
@@ -64,6 +65,10 @@ Dataset LoadDataset(const std::filesystem::path& path, CameraFile camera = Camer
 // that has not written any yet (`calibench watch`). Throws IoError like LoadDataset.
 Dataset LoadFolderSetup(const std::filesystem::path& dir,
                         CameraFile camera = CameraFile::kRequired);
+
+// The board presets shipped as assets/targets/*.json, by name in name order; the built-in
+// presets when that folder is missing (what the workbench's Board menu lists).
+std::vector<std::pair<std::string, BoardSpec>> ShippedTargetPresets();
 
 // A target file: the board spec at the top level or under "target" (target.json, a manifest).
 // Throws IoError naming the file.

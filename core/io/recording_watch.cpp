@@ -146,4 +146,22 @@ std::optional<Dataset> GrowingRecording::Setup() const {
   return setup;
 }
 
+bool IsRecordingSource(const std::filesystem::path& source) {
+  std::error_code error;
+  const std::string extension = source.extension().string();
+  if (extension == ".bag" || extension == ".mcap" || extension == ".db3") return true;
+  if (std::filesystem::is_regular_file(source, error)) return LooksLikeBag(source);
+  if (!std::filesystem::is_directory(source, error)) return false;
+  if (std::filesystem::exists(source / "metadata.yaml", error)) return true;
+  if (std::filesystem::exists(source / "clouds", error) ||
+      std::filesystem::exists(source / "images", error))
+    return false;
+  for (const std::filesystem::directory_entry& entry :
+       std::filesystem::directory_iterator(source, error)) {
+    const std::string file_extension = entry.path().extension().string();
+    if (file_extension == ".mcap" || file_extension == ".db3") return true;
+  }
+  return false;
+}
+
 }  // namespace calibench

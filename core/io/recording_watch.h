@@ -16,6 +16,11 @@
 
 namespace calibench {
 
+// Whether `source` is a recording rather than a folder in the folder form: a file that starts
+// like one (or is named like one and is not there yet), or a rosbag2 folder (metadata.yaml, or
+// .mcap / .db3 files in it). What `watch` and `gui --watch` tell the two by.
+bool IsRecordingSource(const std::filesystem::path& source);
+
 struct RecordingUpdate {
   std::vector<PairEntry> pairs;    // new, in the order found
   std::vector<std::string> notes;  // what was chosen or is awaited, in words

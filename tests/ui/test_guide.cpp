@@ -15,6 +15,8 @@
 #include "core/results/result_file.h"
 #include "core/session/session.h"
 #include "tests/acfr_manifest.h"
+#include "tests/bag_writers.h"
+#include "tests/sim_recording.h"
 #include "tests/test_support.h"
 #include "tests/ui/ui_fixture.h"
 #include "tests/watch_stream.h"
@@ -150,6 +152,56 @@ TEST(Guide, AFolderFollowedWhileTheRealCaptureFillsItEndsWhereCalibrateEnds) {
   EXPECT_LT(difference.rotation_rad * kRadToDeg, 0.02);
   // The session beside the capture holds every pair.
   EXPECT_EQ(LoadSession(watched / "calibench.session.json").pairs.size(), stems.size());
+}
+
+// A recording (an MCAP as `ros2 bag record` writes it) followed in the workbench: its pairs join
+// as `watch` finds them (one per hold), written to the dataset folder, solved by themselves near
+// the truth and where `calibrate` on that folder ends.
+TEST(Guide, ARecordingFollowedInTheWorkbenchGivesItsHoldsAndTheTruth) {
+  const fs::path dir = test::TempDir("guide_recording");
+  const test::SimRecordingOptions options = test::SmallSimRecording(6);
+  auto writer = test::OpenMcapWriter(dir / "capture.mcap", "ros2", "lz4", /*summary=*/true);
+  const test::SimRecordingTruth truth =
+      test::WriteSimRecording(writer.get(), MessageEncoding::kCdr, options);
+  writer->Close();
+  Controller controller;
+  controller.SetAutoSolve(true);
+  controller.WatchRecording(dir / "capture.mcap", dir / "capture.dataset", truth.board, {});
+  Snapshot s;
+  std::uint64_t seen = 0;
+  for (int wait = 0; wait < 600; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    s = controller.GetSnapshot();
+    const bool settled = s.pairs.size() == 6 && s.loading_done == s.loading_total && !s.busy &&
+                         s.solver.result && s.generation == seen;
+    if (settled) break;
+    seen = s.generation;
+  }
+  controller.StopWatching();
+  controller.WaitIdle();
+  s = controller.GetSnapshot();
+  ASSERT_EQ(s.pairs.size(), 6u) << s.status_line;
+  ASSERT_TRUE(s.solver.result) << s.solver.failure << "; " << s.status_line;
+  const PoseError to_truth =
+      ComputePoseError(s.solver.result->cam_from_lidar, truth.cam_from_lidar);
+  std::string out;
+  const fs::path result = dir / "result.json";
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
+                                 (dir / "capture.dataset").string() + " --out " + result.string(),
+                             &out),
+            0)
+      << out;
+  const PoseError to_calibrate =
+      ComputePoseError(s.solver.result->cam_from_lidar, LoadResult(result).cam_from_source);
+  std::printf(
+      "recording in the workbench: %.2f mm, %.3f deg from the truth; %.3f mm, %.4f deg "
+      "from calibrate on its folder\n",
+      to_truth.translation_m * 1e3, to_truth.rotation_rad * kRadToDeg,
+      to_calibrate.translation_m * 1e3, to_calibrate.rotation_rad * kRadToDeg);
+  EXPECT_LT(to_truth.translation_m, 0.02);
+  EXPECT_LT(to_truth.rotation_rad * kRadToDeg, 0.5);
+  EXPECT_LT(to_calibrate.translation_m, 0.001);
+  EXPECT_LT(to_calibrate.rotation_rad * kRadToDeg, 0.05);
 }
 
 }  // namespace

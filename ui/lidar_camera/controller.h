@@ -19,16 +19,13 @@
 #include "core/base/file_lock.h"
 #include "core/base/image.h"
 #include "core/camera/undistort.h"
-#include "core/guidance/advise.h"
-#include "core/guidance/stop_rule.h"
-#include "core/intrinsics/intrinsics.h"
+#include "core/guidance/advise.h"  // with the pipeline, the stop rule, the intrinsics
 #include "core/io/camera_file.h"
-#include "core/io/dataset.h"
 #include "core/io/folder_watch.h"
+#include "core/io/recording_watch.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
 #include "core/lidar_camera/pipeline.h"
-#include "core/lidar_camera/solver.h"
 #include "core/reproject/reproject.h"
 #include "core/results/export.h"
 #include "core/session/session.h"
@@ -257,12 +254,18 @@ class Controller : public ControllerState<Snapshot> {
   // auto-solve, solved as the others. Pre-flight's rejections apply to the pairs as `watch`
   // applies them. Stops with StopWatching or the controller.
   void WatchFolder(const std::filesystem::path& folder, FolderWatchOptions options = {});
+  // The same for a recording being written (.bag, .mcap, .db3, a rosbag2 folder): its pairs
+  // chosen as `import` and `watch` choose them (core/io/recording_watch.h) and written to `out`
+  // (the folder form), which opens once the first pair tells the camera and the board.
+  void WatchRecording(const std::filesystem::path& recording, const std::filesystem::path& out,
+                      std::optional<BoardSpec> board, BagImportOptions options);
   void StopWatching();
   // One pair more, loaded and detected on the worker (a watched folder; any thread).
   void AddPair(const PairEntry& entry);
 
  private:
   void WatchLoop(std::filesystem::path folder, FolderWatchOptions options);
+  void WatchRecordingLoop(GrowingRecording* recording);
   // Enqueues a solve unless one is queued already (auto-solve; call with mutex_ held).
   void RequestSolve();
   // After a solve (worker): pre-flight and the next pose from `outcome` (AdviseCapture).

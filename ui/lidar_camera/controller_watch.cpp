@@ -60,6 +60,65 @@ void Controller::WatchFolder(const std::filesystem::path& folder, FolderWatchOpt
   watch_thread_ = std::thread([this, options, folder = watching_] { WatchLoop(folder, options); });
 }
 
+void Controller::WatchRecording(const std::filesystem::path& recording,
+                                const std::filesystem::path& out, std::optional<BoardSpec> board,
+                                BagImportOptions options) {
+  StopWatching();
+  stop_watch_ = false;
+  worker_.LowerPriority();
+  options.max_pairs = 0;  // a capture has no cap: every hold is a pair
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    watching_ = std::filesystem::absolute(recording);
+    state_.watching = watching_;
+  }
+  watch_thread_ = std::thread([this, recording, out, board, options] {
+    std::error_code error;
+    std::filesystem::create_directories(out, error);
+    GrowingRecording growing(std::filesystem::absolute(recording), out, board, options);
+    WatchRecordingLoop(&growing);
+  });
+}
+
+void Controller::WatchRecordingLoop(GrowingRecording* recording) {
+  bool opened = false;
+  while (!stop_watch_) {
+    RecordingUpdate update;
+    try {
+      update = recording->Poll();
+    } catch (const IoError& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      SetStatus(std::string("cannot watch: ") + e.what(), true);
+      return;
+    }
+    if (!update.notes.empty()) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      SetStatus(update.notes.back(), false);
+    }
+    // The dataset folder opens with the first pair: the recording tells its camera and board.
+    if (!opened && !update.pairs.empty()) {
+      try {
+        OpenLoadedDataset(*recording->Setup(), {}, ExistingSession::kResume);
+      } catch (const IoError& e) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        SetStatus(std::string("cannot watch: ") + e.what(), true);
+        return;
+      }
+      opened = true;
+    }
+    for (const PairEntry& pair : update.pairs) AddPair(pair);
+    if (update.closed) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      SetStatus("the recording was closed by its recorder; its " +
+                    std::to_string(state_.pairs.size()) + " pairs are in " +
+                    recording->OutDir().string(),
+                false);
+      return;
+    }
+    std::this_thread::sleep_for(kPollPeriod);
+  }
+}
+
 void Controller::StopWatching() {
   stop_watch_ = true;
   if (watch_thread_.joinable()) watch_thread_.join();

@@ -9,7 +9,6 @@
 #include <sstream>
 #include <thread>
 
-#include "core/io/assets.h"
 #include "core/io/bag.h"
 #include "core/io/dataset.h"
 #include "core/results/export.h"
@@ -19,26 +18,6 @@
 
 namespace calibench::ui {
 
-namespace {
-
-// assets/targets/*.json by name, in name order; the built-in presets when the folder is missing.
-std::vector<std::pair<std::string, BoardSpec>> TargetPresets() {
-  std::vector<std::pair<std::string, BoardSpec>> presets;
-  try {
-    for (const auto& entry : std::filesystem::directory_iterator(FindAsset("targets")))
-      if (entry.path().extension() == ".json")
-        presets.emplace_back(entry.path().stem().string(), LoadTargetFile(entry.path()));
-  } catch (const IoError&) {
-    presets.clear();
-    for (const char* name : {"a3", "a4", "charuco-a3", "charuco-a4", "paper"})
-      presets.emplace_back(name, BoardPreset(name));
-  }
-  std::sort(presets.begin(), presets.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
-  return presets;
-}
-
-}  // namespace
 namespace fs = std::filesystem;
 
 // A recording importing on its own thread; the window shows its progress and opens the dataset
@@ -109,9 +88,13 @@ void WindowShell::OpenSession(const fs::path& session) {
   Replace(std::move(opened));
 }
 
-void WindowShell::WatchFolder(const fs::path& folder) {
+void WindowShell::Watch(const fs::path& source) {
   auto watching = NewController();
-  watching->WatchFolder(folder);  // opens the folder once its camera and target are there
+  // Each opens its dataset folder once the camera and the target are known.
+  if (IsRecordingSource(source))
+    watching->WatchRecording(source, DefaultImportFolder(source), options_.board, options_.import);
+  else
+    watching->WatchFolder(source);
   Replace(std::move(watching));
 }
 
@@ -227,7 +210,7 @@ WindowRun WindowShell::Run(const WindowOptions& options) {
 
 bool WindowShell::Frame(Window& window, int width, int height, double seconds) {
   if (pending_open_) OpenFromUser(*std::exchange(pending_open_, std::nullopt));
-  if (pending_watch_) WatchFolder(*std::exchange(pending_watch_, std::nullopt));
+  if (pending_watch_) Watch(*std::exchange(pending_watch_, std::nullopt));
   for (const std::string& dropped : window.TakeDroppedPaths()) pending_open_ = dropped;
   const bool importing = PollImport();  // may open a dataset, replacing the workbench
   if (!workbench_) workbench_ = std::make_unique<Workbench>();
@@ -262,8 +245,8 @@ void WindowShell::FileMenu() {
     browser_.Open(here, "Open dataset, session or recording");
   if (ImGui::MenuItem("Open recording (.bag .db3 .mcap)...", nullptr, false, !import_))
     browser_.Open(here, "Open a recording to import");
-  if (ImGui::MenuItem("Watch folder (a capture being written)...")) {
-    browser_.Open(here, "Watch a folder that a capture fills");
+  if (ImGui::MenuItem("Watch a capture being written...")) {
+    browser_.Open(here, "Watch a capture folder or a recording being written");
     choosing_watch_ = true;
   }
   if (ImGui::BeginMenu("Recent sessions")) {
@@ -288,7 +271,7 @@ void WindowShell::BoardMenu() {
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("the target.json beside the recording, else the preset that fits the images");
   // The presets Calibench ships (assets/targets/*.json; a board dropped there shows up too).
-  if (presets_.empty()) presets_ = TargetPresets();
+  if (presets_.empty()) presets_ = ShippedTargetPresets();
   for (const auto& [name, board] : presets_) {
     const bool chosen = options_.board && board.type == options_.board->type &&
                         board.cols == options_.board->cols && board.rows == options_.board->rows &&

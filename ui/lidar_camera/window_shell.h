@@ -54,8 +54,9 @@ class WindowShell {
   void ImportRecording(const std::filesystem::path& recording);
   // What the File menu, Recent and a drop do: any kind of path; failures go to the popup.
   void OpenFromUser(const std::filesystem::path& path);
-  // Follows a folder that a capture fills (Controller::WatchFolder; File → Watch folder…).
-  void WatchFolder(const std::filesystem::path& folder);
+  // Follows a capture folder or a recording being written (Controller::WatchFolder /
+  // WatchRecording; File → Watch a capture…).
+  void Watch(const std::filesystem::path& source);
 
   // Runs the window until the user closes it.
   WindowRun Run(const WindowOptions& options);
