@@ -81,6 +81,72 @@ void WriteLikeACapture(const fs::path& from, const fs::path& to) {
   fs::rename(part, to);
 }
 
+// The capture's stems in natural order; a pair copied in as a capture script writes it.
+std::vector<std::string> CaptureStems(const fs::path& source) {
+  std::vector<std::string> stems;
+  for (const auto& entry : fs::directory_iterator(source / "clouds"))
+    stems.push_back(entry.path().stem());
+  std::sort(stems.begin(), stems.end(), NaturalOrder{});
+  return stems;
+}
+void CopyCapturedPair(const fs::path& source, const fs::path& watched, const std::string& stem) {
+  for (const char* sub : {"clouds", "images"})
+    for (const auto& entry : fs::directory_iterator(source / sub))
+      if (entry.path().stem() == stem)
+        WriteLikeACapture(entry.path(), watched / sub / entry.path().filename());
+}
+
+// The controller once `pairs` pairs are in, loaded, solved with and nothing changes any more.
+Snapshot WaitUntilSettled(Controller& controller, size_t pairs) {
+  Snapshot s;
+  std::uint64_t seen = 0;
+  for (int wait = 0; wait < 600; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    s = controller.GetSnapshot();
+    if (s.pairs.size() == pairs && s.loading_done == s.loading_total && !s.busy &&
+        s.solver.result && s.generation == seen)
+      break;
+    seen = s.generation;
+  }
+  return s;
+}
+
+// A capture that grew while the workbench was closed: watching it again resumes its session (the
+// user's rejection stays, no backup is made) and the pairs written since join as new.
+TEST(Guide, WatchingAGrownCaptureAgainResumesItsSessionAndAddsTheNewPairs) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  const fs::path root = test::TempDir("guide_resume");
+  const fs::path source =
+      test::WriteAcfrFolder(shared / "datasets/acfr-vlp16-chessboard", root / "source");
+  const fs::path watched = root / "watched";
+  fs::create_directories(watched);
+  fs::copy_file(source / "camera.yaml", watched / "camera.yaml");
+  fs::copy_file(source / "target.json", watched / "target.json");
+  const std::vector<std::string> stems = CaptureStems(source);
+  for (size_t i = 0; i < 8; ++i) CopyCapturedPair(source, watched, stems[i]);
+  {
+    Controller first;
+    first.SetAutoSolve(true);
+    first.WatchFolder(watched);
+    ASSERT_EQ(WaitUntilSettled(first, 8).pairs.size(), 8u);
+    first.Apply(SetPairStatus{2, PairStatus::kRejected});
+    first.StopWatching();
+    first.WaitIdle();
+  }
+  for (size_t i = 8; i < 12; ++i) CopyCapturedPair(source, watched, stems[i]);
+  Controller again;
+  again.SetAutoSolve(true);
+  again.WatchFolder(watched);
+  const Snapshot s = WaitUntilSettled(again, 12);
+  again.StopWatching();
+  ASSERT_EQ(s.pairs.size(), 12u) << s.status_line;
+  EXPECT_EQ(s.pairs[2].status, PairStatus::kRejected);
+  EXPECT_EQ(s.pairs[2].reason, kRejectedByUser);
+  for (size_t i = 0; i < 12; ++i) EXPECT_EQ(s.pairs[i].id, stems[i]);
+  for (const auto& entry : fs::directory_iterator(watched))
+    EXPECT_NE(entry.path().extension(), ".bak") << entry.path() << ": the session was not resumed";
+}
+
 TEST(Guide, AFolderFollowedWhileTheRealCaptureFillsItEndsWhereCalibrateEnds) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
   const fs::path root = test::TempDir("guide_watch");
@@ -96,31 +162,17 @@ TEST(Guide, AFolderFollowedWhileTheRealCaptureFillsItEndsWhereCalibrateEnds) {
       << controller.GetSnapshot().status_line;
   fs::copy_file(source / "camera.yaml", watched / "camera.yaml");
   fs::copy_file(source / "target.json", watched / "target.json");
-  std::vector<std::string> stems;
-  for (const auto& entry : fs::directory_iterator(source / "clouds"))
-    stems.push_back(entry.path().stem());
-  std::sort(stems.begin(), stems.end(), NaturalOrder{});
+  const std::vector<std::string> stems = CaptureStems(source);
   for (const std::string& stem : stems) {
-    for (const char* sub : {"clouds", "images"})
-      for (const auto& entry : fs::directory_iterator(source / sub))
-        if (entry.path().stem() == stem)
-          WriteLikeACapture(entry.path(), watched / sub / entry.path().filename());
+    CopyCapturedPair(source, watched, stem);
     // Slower than a pair's processing (a user takes seconds per pose), so that every pair
     // is solved with as it lands.
     std::this_thread::sleep_for(std::chrono::milliseconds(400));
   }
-  // Until every pair is in, loaded and solved with.
-  Snapshot s;
-  for (int wait = 0; wait < 600; ++wait) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    s = controller.GetSnapshot();
-    if (s.pairs.size() == stems.size() && s.loading_done == s.loading_total && !s.busy &&
-        s.solver.result && s.solver.solved_pair_ids.size() + 3 >= stems.size())
-      break;
-  }
+  WaitUntilSettled(controller, stems.size());
   controller.StopWatching();
   controller.WaitIdle();
-  s = controller.GetSnapshot();
+  const Snapshot s = controller.GetSnapshot();
   ASSERT_EQ(s.pairs.size(), stems.size()) << s.status_line;
   ASSERT_TRUE(s.solver.result) << s.solver.failure << "; " << s.status_line;
   int accepted = 0;
@@ -167,19 +219,10 @@ TEST(Guide, ARecordingFollowedInTheWorkbenchGivesItsHoldsAndTheTruth) {
   Controller controller;
   controller.SetAutoSolve(true);
   controller.WatchRecording(dir / "capture.mcap", dir / "capture.dataset", truth.board, {});
-  Snapshot s;
-  std::uint64_t seen = 0;
-  for (int wait = 0; wait < 600; ++wait) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    s = controller.GetSnapshot();
-    const bool settled = s.pairs.size() == 6 && s.loading_done == s.loading_total && !s.busy &&
-                         s.solver.result && s.generation == seen;
-    if (settled) break;
-    seen = s.generation;
-  }
+  WaitUntilSettled(controller, 6);
   controller.StopWatching();
   controller.WaitIdle();
-  s = controller.GetSnapshot();
+  const Snapshot s = controller.GetSnapshot();
   ASSERT_EQ(s.pairs.size(), 6u) << s.status_line;
   ASSERT_TRUE(s.solver.result) << s.solver.failure << "; " << s.status_line;
   const PoseError to_truth =

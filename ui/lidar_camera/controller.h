@@ -55,8 +55,7 @@ struct PairView : PairHeader {
   std::string camera_failure;
   std::optional<Vec4> residual;  // after a solve
   double robust_weight = 1.0;
-  // Camera-guided completion (run by every solve, as `calibrate` runs it) replaced or dropped the
-  // LiDAR board: what detection had found, which the next solve starts from again.
+  // What detection had found where completion (every solve's) replaced or dropped the board.
   struct AsDetected {
     std::optional<LidarPlaneFit> lidar;
     BoardOrigin board_origin;
@@ -65,8 +64,7 @@ struct PairView : PairHeader {
   };
   std::optional<AsDetected> before_completion;
   bool awaiting_detection = false;  // loaded, its board to be found once the background allows
-  // Pre-flight's findings after the last solve (core/guidance/preflight.h), as `advise` lists
-  // them; a pair it would reject says why on its row.
+  // Pre-flight's findings after the last solve, as `advise` lists them (shown on its row).
   std::vector<PreflightFinding> findings;
 };
 
@@ -104,8 +102,7 @@ struct Snapshot : SnapshotHeader {
   int selected = -1;
   std::shared_ptr<const ImageU8> selected_image;  // full-resolution camera image of `selected`
   std::shared_ptr<const UndistortedView> selected_undistorted;  // the same, distortion removed
-  // The pair those images show: a followed capture keeps the last pair's up until the newest
-  // pair's is decoded (the camera view then draws no overlays on it).
+  // The pair they show (a followed capture's last one until the newest pair's is decoded).
   std::string selected_image_pair;
   SolverView solver;
   std::shared_ptr<const Reprojection> reprojection;
@@ -266,6 +263,9 @@ class Controller : public ControllerState<Snapshot> {
  private:
   void WatchLoop(std::filesystem::path folder, FolderWatchOptions options);
   void WatchRecordingLoop(GrowingRecording* recording);
+  // The session an earlier watch left, when its pairs are the first of the folder's (the capture
+  // grew while the workbench was closed): opened over them, edits kept; false otherwise.
+  bool ResumeGrownCapture(Dataset dataset);
   // Enqueues a solve unless one is queued already (auto-solve; call with mutex_ held).
   void RequestSolve();
   // After a solve (worker): pre-flight and the next pose from `outcome` (AdviseCapture).

@@ -146,7 +146,7 @@ void Controller::WatchLoop(std::filesystem::path folder, FolderWatchOptions opti
     Dataset dataset = LoadFolderSetup(folder);
     if (HasFolderPairs(folder)) dataset = LoadDataset(folder);
     dataset.manifest = folder;
-    OpenLoadedDataset(dataset, {}, ExistingSession::kResume);
+    if (!ResumeGrownCapture(dataset)) OpenLoadedDataset(dataset, {}, ExistingSession::kResume);
   } catch (const IoError& e) {
     std::lock_guard<std::mutex> lock(mutex_);
     SetStatus(std::string("cannot watch: ") + e.what(), true);
@@ -170,6 +170,32 @@ void Controller::WatchLoop(std::filesystem::path folder, FolderWatchOptions opti
     }
     std::this_thread::sleep_for(kPollPeriod);
   }
+}
+
+bool Controller::ResumeGrownCapture(Dataset dataset) {
+  const std::filesystem::path session_path = dataset.manifest / "calibench.session.json";
+  std::error_code error;
+  if (!std::filesystem::exists(session_path, error)) return false;
+  Session saved;
+  try {
+    saved = LoadSession(session_path);
+  } catch (const IoError&) {
+    return false;  // the usual resume says why and keeps it as a backup
+  }
+  const size_t known = saved.pairs.size();
+  if (known >= dataset.pairs.size() ||
+      !std::filesystem::equivalent(saved.dataset, dataset.manifest, error))
+    return false;
+  for (size_t i = 0; i < known; ++i)
+    if (saved.pairs[i].id != dataset.pairs[i].id) return false;
+  dataset.pairs.resize(known);
+  std::string note;
+  std::optional<FileLock> lock = LockSession(session_path, &note);  // throws: open elsewhere
+  Open(dataset, std::move(saved), session_path,
+       "resumed the session in " + session_path.string() + " (" + std::to_string(known) +
+           " pairs; the ones written since join as new)" + (note.empty() ? "" : "; " + note),
+       std::move(lock));
+  return true;
 }
 
 void Controller::AddPair(const PairEntry& entry) {
