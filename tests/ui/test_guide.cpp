@@ -96,6 +96,24 @@ void CopyCapturedPair(const fs::path& source, const fs::path& watched, const std
         WriteLikeACapture(entry.path(), watched / sub / entry.path().filename());
 }
 
+// The real ACFR capture (its folder form, linked) and an empty folder to watch beside it.
+struct Capture {
+  fs::path root, source, watched;
+};
+Capture StartCapture(const fs::path& shared, const std::string& name) {
+  Capture capture;
+  capture.root = test::TempDir(name);
+  capture.source =
+      test::WriteAcfrFolder(shared / "datasets/acfr-vlp16-chessboard", capture.root / "source");
+  capture.watched = capture.root / "watched";
+  fs::create_directories(capture.watched);
+  return capture;
+}
+void CopySetup(const Capture& capture) {
+  fs::copy_file(capture.source / "camera.yaml", capture.watched / "camera.yaml");
+  fs::copy_file(capture.source / "target.json", capture.watched / "target.json");
+}
+
 // The controller once `pairs` pairs are in, loaded, solved with and nothing changes any more.
 Snapshot WaitUntilSettled(Controller& controller, size_t pairs) {
   Snapshot s;
@@ -115,13 +133,9 @@ Snapshot WaitUntilSettled(Controller& controller, size_t pairs) {
 // user's rejection stays, no backup is made) and the pairs written since join as new.
 TEST(Guide, WatchingAGrownCaptureAgainResumesItsSessionAndAddsTheNewPairs) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
-  const fs::path root = test::TempDir("guide_resume");
-  const fs::path source =
-      test::WriteAcfrFolder(shared / "datasets/acfr-vlp16-chessboard", root / "source");
-  const fs::path watched = root / "watched";
-  fs::create_directories(watched);
-  fs::copy_file(source / "camera.yaml", watched / "camera.yaml");
-  fs::copy_file(source / "target.json", watched / "target.json");
+  const Capture capture = StartCapture(shared, "guide_resume");
+  const fs::path &source = capture.source, &watched = capture.watched;
+  CopySetup(capture);
   const std::vector<std::string> stems = CaptureStems(source);
   for (size_t i = 0; i < 8; ++i) CopyCapturedPair(source, watched, stems[i]);
   {
@@ -149,19 +163,15 @@ TEST(Guide, WatchingAGrownCaptureAgainResumesItsSessionAndAddsTheNewPairs) {
 
 TEST(Guide, AFolderFollowedWhileTheRealCaptureFillsItEndsWhereCalibrateEnds) {
   CALIBENCH_REQUIRE_SHARED_DIR(shared);
-  const fs::path root = test::TempDir("guide_watch");
-  const fs::path source =
-      test::WriteAcfrFolder(shared / "datasets/acfr-vlp16-chessboard", root / "source");
-  const fs::path watched = root / "watched";
-  fs::create_directories(watched);
+  const Capture capture = StartCapture(shared, "guide_watch");
+  const fs::path &root = capture.root, &source = capture.source, &watched = capture.watched;
   Controller controller;
   controller.SetAutoSolve(true);
   controller.WatchFolder(watched);  // empty: it waits for the camera and the target
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   EXPECT_NE(controller.GetSnapshot().status_line.find("waiting for camera.yaml"), std::string::npos)
       << controller.GetSnapshot().status_line;
-  fs::copy_file(source / "camera.yaml", watched / "camera.yaml");
-  fs::copy_file(source / "target.json", watched / "target.json");
+  CopySetup(capture);
   const std::vector<std::string> stems = CaptureStems(source);
   for (const std::string& stem : stems) {
     CopyCapturedPair(source, watched, stem);
