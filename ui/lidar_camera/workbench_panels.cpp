@@ -231,7 +231,10 @@ void Workbench::SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent
     ImGui::SameLine();
     IterationsTable(s.solver.iterations, replay().Shown(s.solver.iterations.size()));
   }
-  if (!s.solver.failure.empty())
+  // While a capture is followed, too few pairs yet is where every capture starts, not an error.
+  if (!s.solver.failure.empty() && !s.watching.empty() && !s.status_is_error)
+    ImGui::TextDisabled("%s", s.solver.failure.c_str());
+  else if (!s.solver.failure.empty())
     ImGui::TextColored({1.0f, 0.4f, 0.35f, 1}, "%s", s.solver.failure.c_str());
   if (s.solver.result) SolutionReadouts(s.solver, intents);
   if (PathField("##session", &session_path_, "Save session as"))
