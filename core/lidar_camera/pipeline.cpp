@@ -250,18 +250,10 @@ std::optional<SceneBackground> BuildSceneBackground(const std::vector<const Pair
     } catch (const IoError&) {  // the pair itself reports it when it is extracted
     }
   });
-  std::vector<const LidarCloud*> read;
-  for (const auto& cloud : clouds)
-    if (cloud) read.push_back(&*cloud);
-  std::optional<SceneBackground> background = SceneBackgroundOf(read, why);
-  if (kept) *kept = std::move(clouds);
-  return background;
-}
-
-std::optional<SceneBackground> SceneBackgroundOf(const std::vector<const LidarCloud*>& clouds,
-                                                 std::string* why) {
   SceneBackground background;
-  for (const LidarCloud* cloud : clouds) background.Add(*cloud);
+  for (const auto& cloud : clouds)
+    if (cloud) background.Add(*cloud);
+  if (kept) *kept = std::move(clouds);
   if (!background.Finish(why)) return std::nullopt;
   return background;
 }

@@ -217,10 +217,6 @@ std::optional<SceneBackground> BuildSceneBackground(
     const std::vector<const PairEntry*>& pairs, int threads, std::string* why,
     std::vector<std::optional<LidarCloud>>* clouds = nullptr);
 
-// The same over clouds already read (in pair order), as the workbench holds them.
-std::optional<SceneBackground> SceneBackgroundOf(const std::vector<const LidarCloud*>& clouds,
-                                                 std::string* why);
-
 // Camera-guided completion (options.camera_guided): with a first solution, predicts every pair's
 // board in the LiDAR frame from its camera pose, drops LiDAR boards that disagree with it (the
 // pair fails, saying by how much) and looks again for the board at the prediction where the LiDAR

@@ -261,12 +261,14 @@ class Controller : public ControllerState<Snapshot> {
   void AddPair(const PairEntry& entry);
 
  private:
+  // Starts following `source` with `loop` on the watch thread (the one that ran stops first).
+  void Follow(const std::filesystem::path& source, std::function<void()> loop);
   void WatchLoop(std::filesystem::path folder, FolderWatchOptions options);
   void WatchRecordingLoop(GrowingRecording* recording);
   // The session an earlier watch left, when its pairs are the first of the folder's (the capture
   // grew while the workbench was closed): opened over them, edits kept; false otherwise.
   bool ResumeGrownCapture(Dataset dataset);
-  // Enqueues a solve unless one is queued already (auto-solve; call with mutex_ held).
+  // Enqueues a solve unless one is queued (auto-solve; mutex_ held).
   void RequestSolve();
   // After a solve (worker): pre-flight and the next pose from `outcome` (AdviseCapture).
   void Advise(const CalibrationOutcome& outcome, const PipelineOptions& options);
@@ -277,15 +279,13 @@ class Controller : public ControllerState<Snapshot> {
   // After the last pair loaded (mutex_ held): detection, the status line with what loading
   // noted or refused, the reopened session's reprojection.
   void OnAllPairsLoaded();
-  // Whether the pairs count as loaded (detection and solving may go on): all of them, or in a
-  // followed capture every pair it opened with. Call with mutex_ held.
+  // All pairs loaded, or in a followed capture those it opened with (mutex_ held).
   bool PairsSettled() const;
-  // Whether the views move to pair `index` once it is loaded: a followed capture's newest pair,
-  // unless the user chose an older one. Call with mutex_ held.
+  // A followed capture's views move to its newest pair `index` once loaded (mutex_ held).
   bool FollowsTo(int index) const;
+  void OnLivePairLoaded(int index);  // LoadPair's part for a followed capture (mutex_ held)
   void RefitLidar(int index);
-  // Once every pair is loaded: the background model over their clouds, then detection for the
-  // pairs without a seed or a brush (worker thread).
+  // The background model over the loaded clouds, then detection where no seed or brush is.
   void DetectWithBackground();
   void Solve();
   SolverOptions SolverOptionsFromState() const;          // the user's choices over pipeline_.solver

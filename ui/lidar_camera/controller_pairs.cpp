@@ -99,20 +99,19 @@ bool Controller::PairsSettled() const {
 }
 
 void Controller::LoadPair(int index) {
-  PairEntry entry;
   Dataset dataset;
   std::vector<int> saved_brush;
   std::optional<BrushMask> saved_mask;
   bool painted = false;  // the session holds a brush the user painted (or erased)
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    entry = state_.dataset->pairs[index];
     dataset = *state_.dataset;
     saved_brush = state_.pairs[index].brush_pixels;
     const PairState& saved = session_.pairs[index];
     painted = saved.brush.has_value() && !saved.brush_from_seed;
     saved_mask = saved.brush;
   }
+  const PairEntry& entry = dataset.pairs[index];
   std::string brush_dropped;  // why the session's brush does not fit this pair's cloud
   // The pipeline's own steps (core/lidar_camera/pipeline.h), as `calibench calibrate` runs them.
   PairView loaded;
@@ -152,14 +151,7 @@ void Controller::LoadPair(int index) {
     pair = std::move(loaded);
     ++state_.loading_done;
     ++state_.generation;
-    // Following a capture, the views move to the newest pair once it is loaded (not before:
-    // they would show nothing meanwhile), unless the user looks at an older one.
-    if (FollowsTo(index)) {
-      state_.selected = index;
-      state_.reprojection.reset();  // the last image stays up until this one's is decoded
-      worker_.Enqueue([this] { EnsureSelectedImage(); });
-      worker_.Enqueue([this, index] { ComputeReprojection(index); });
-    }
+    OnLivePairLoaded(index);  // a followed capture: follow it, match it against the ghost
     if (!brush_dropped.empty()) {
       session_.pairs[index].brush.reset();
       session_.pairs[index].brush_from_seed = false;
@@ -176,13 +168,6 @@ void Controller::LoadPair(int index) {
       pair.lidar_failure = PairsSettled() ? "finding the board ..."
                                           : "finding the board once every pair is loaded ...";
       pair.awaiting_detection = true;
-    }
-    // The newest pair against the ghost board that was shown while it was taken.
-    if (pair.camera && state_.next_pose && !state_.watching.empty()) {
-      const SuggestionMatch match =
-          MatchSuggestion(pair.camera->cam_from_board, *state_.next_pose, GuidanceOptions{});
-      state_.ghost_match = "pair " + pair.id + " " + match.words;
-      state_.ghost_matched = match.matches;
     }
     if (!pair.cloud) {
       pair.status = PairStatus::kFailed;

@@ -2,6 +2,7 @@
 // capture fills (pairs join the list as they land), and after every solve `advise`'s pre-flight
 // findings and next pose (the ghost board), with whether the newest pair matched the ghost.
 #include <chrono>
+#include <functional>
 #include <set>
 
 #include "ui/lidar_camera/controller.h"
@@ -47,35 +48,33 @@ void Controller::RequestSolve() {
   });
 }
 
-void Controller::WatchFolder(const std::filesystem::path& folder, FolderWatchOptions options) {
+void Controller::Follow(const std::filesystem::path& source, std::function<void()> loop) {
   StopWatching();
   stop_watch_ = false;
   // Pairs land while the user looks: the window's frames before the pairs' processing.
   worker_.LowerPriority();
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    watching_ = std::filesystem::absolute(folder);
+    watching_ = std::filesystem::absolute(source);
     state_.watching = watching_;
   }
-  watch_thread_ = std::thread([this, options, folder = watching_] { WatchLoop(folder, options); });
+  watch_thread_ = std::thread(std::move(loop));
+}
+
+void Controller::WatchFolder(const std::filesystem::path& folder, FolderWatchOptions options) {
+  Follow(folder, [this, options, folder = std::filesystem::absolute(folder)] {
+    WatchLoop(folder, options);
+  });
 }
 
 void Controller::WatchRecording(const std::filesystem::path& recording,
                                 const std::filesystem::path& out, std::optional<BoardSpec> board,
                                 BagImportOptions options) {
-  StopWatching();
-  stop_watch_ = false;
-  worker_.LowerPriority();
   options.max_pairs = 0;  // a capture has no cap: every hold is a pair
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    watching_ = std::filesystem::absolute(recording);
-    state_.watching = watching_;
-  }
-  watch_thread_ = std::thread([this, recording, out, board, options] {
+  Follow(recording, [this, recording = std::filesystem::absolute(recording), out, board, options] {
     std::error_code error;
     std::filesystem::create_directories(out, error);
-    GrowingRecording growing(std::filesystem::absolute(recording), out, board, options);
+    GrowingRecording growing(recording, out, board, options);
     WatchRecordingLoop(&growing);
   });
 }
@@ -196,6 +195,25 @@ bool Controller::ResumeGrownCapture(Dataset dataset) {
            " pairs; the ones written since join as new)" + (note.empty() ? "" : "; " + note),
        std::move(lock));
   return true;
+}
+
+void Controller::OnLivePairLoaded(int index) {
+  const PairView& pair = state_.pairs[index];
+  // The views move to the newest pair once it is loaded (not before: they would show nothing
+  // meanwhile), unless the user looks at an older one.
+  if (FollowsTo(index)) {
+    state_.selected = index;
+    state_.reprojection.reset();  // the last image stays up until this one's is decoded
+    worker_.Enqueue([this] { EnsureSelectedImage(); });
+    worker_.Enqueue([this, index] { ComputeReprojection(index); });
+  }
+  // The newest pair against the ghost board that was shown while it was taken.
+  if (pair.camera && state_.next_pose && !watching_.empty()) {
+    const SuggestionMatch match =
+        MatchSuggestion(pair.camera->cam_from_board, *state_.next_pose, GuidanceOptions{});
+    state_.ghost_match = "pair " + pair.id + " " + match.words;
+    state_.ghost_matched = match.matches;
+  }
 }
 
 void Controller::AddPair(const PairEntry& entry) {

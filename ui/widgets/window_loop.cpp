@@ -41,28 +41,66 @@ constexpr double kChangePollS = 0.1;           // wakes to poll Run's `changed`
 constexpr double kTypingFrameS = 0.25;         // redraws a focused text field's cursor
 constexpr int kSettleFrames = 3;  // after input or an animation: hover, popups and layout settle
 constexpr double kQuietS = 1.0;   // FrameStats::quiet_frames: nothing moved for this long
+using Clock = std::chrono::steady_clock;
+double SecondsSince(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// What a window run records besides drawing: each frame's time (FrameStats, and one line per
+// frame in WindowOptions::frame_log: seconds since the start, milliseconds drawn and shown,
+// "shot" when it also wrote a screenshot) and a screenshot every screenshot_every_s.
+class FrameRecorder {
+ public:
+  FrameRecorder(const WindowOptions& options, FrameStats* stats)
+      : options_(options),
+        stats_(*stats),
+        log_(options.frame_log.empty() ? nullptr : std::fopen(options.frame_log.c_str(), "w")) {}
+  ~FrameRecorder() {
+    if (log_) std::fclose(log_);
+  }
+  FrameRecorder(const FrameRecorder&) = delete;
+  FrameRecorder& operator=(const FrameRecorder&) = delete;
+
+  // Writes `<screenshots_prefix>_<n>.png` when one is due; true when it did.
+  bool Screenshot(const gfx::Framebuffer& target) {
+    if (options_.screenshot_every_s <= 0 || SecondsSince(last_shot_) < options_.screenshot_every_s)
+      return false;
+    last_shot_ = Clock::now();
+    SaveImage(options_.screenshots_prefix + "_" + std::to_string(++shots_) + ".png",
+              target.ReadPixels());
+    return true;
+  }
+  // A frame drawn and shown in frame_ms (the captures not counted).
+  void Record(double frame_ms, bool shot) {
+    stats_.max_frame_ms = std::max(stats_.max_frame_ms, frame_ms);
+    if (stats_.frames > kSettleFrames && frame_ms > 50.0) ++stats_.slow_frames;
+    if (log_)
+      std::fprintf(log_, "%.3f %.2f%s\n", SecondsSince(start_), frame_ms, shot ? " shot" : "");
+  }
+
+ private:
+  const WindowOptions& options_;
+  FrameStats& stats_;
+  std::FILE* log_;
+  const Clock::time_point start_ = Clock::now();
+  Clock::time_point last_shot_ = start_;
+  int shots_ = 0;
+};
+
 }  // namespace
 
 std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& frame,
                                    const std::function<bool()>& changed) {
-  using Clock = std::chrono::steady_clock;
-  auto since = [](Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-  };
+  const auto since = SecondsSince;
   std::optional<ImageU8> last_picture;
   gfx::Framebuffer target;
+  FrameRecorder recorder(options_, &stats_);
   const auto start = Clock::now();
-  auto last_draw = start, last_change = start, last_shot = start;
-  int shots = 0;
+  auto last_draw = start, last_change = start;
   const bool back_to_back = options_.quit_after_frames > 0;
   bool animating = true;  // the first frames lay the workbench out
   int settle = kSettleFrames;
   std::uint64_t seen_events = context_->EventCount();
-  // One line per frame: seconds since the start, milliseconds the frame took (drawn and shown),
-  // "shot" when it also wrote a screenshot.
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> frame_log(
-      options_.frame_log.empty() ? nullptr : std::fopen(options_.frame_log.c_str(), "w"),
-      [](std::FILE* f) { return f ? std::fclose(f) : 0; });
   while (!context_->ShouldClose()) {
     const bool typing = ImGui::GetIO().WantTextInput;
     if (back_to_back || settle > 0)
@@ -100,7 +138,7 @@ std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& 
     const auto frame_start = Clock::now();
     host_->DrawFrame(target, width, height, seconds,
                      [&] { animating = frame(width, height, seconds); });
-    double frame_ms = 1e3 * since(frame_start);  // drawn, then shown below (not the captures)
+    const double frame_ms = 1e3 * since(frame_start);  // drawn; shown below (not the captures)
     animating = animating || !options_.test_drops.empty();
     if (animating) {
       settle = kSettleFrames;
@@ -108,24 +146,13 @@ std::optional<ImageU8> Window::Run(const std::function<bool(int, int, double)>& 
     } else if (settle > 0) {
       --settle;
     }
-    const bool shot =
-        options_.screenshot_every_s > 0 && since(last_shot) >= options_.screenshot_every_s;
-    if (shot) {
-      last_shot = Clock::now();
-      SaveImage(options_.screenshots_prefix + "_" + std::to_string(++shots) + ".png",
-                target.ReadPixels());
-    }
+    const bool shot = recorder.Screenshot(target);
     const bool last_frame = back_to_back && stats_.frames >= options_.quit_after_frames;
     if (options_.capture_last_frame && (last_frame || options_.quit_after_seconds > 0))
       last_picture = target.ReadPixels();
     const auto present_start = Clock::now();
     context_->Present(target);
-    frame_ms += 1e3 * since(present_start);
-    stats_.max_frame_ms = std::max(stats_.max_frame_ms, frame_ms);
-    if (stats_.frames > kSettleFrames && frame_ms > 50.0) ++stats_.slow_frames;
-    // A frame that also wrote a screenshot says so (the capture is not in its time).
-    if (frame_log)
-      std::fprintf(frame_log.get(), "%.3f %.2f%s\n", since(start), frame_ms, shot ? " shot" : "");
+    recorder.Record(frame_ms + 1e3 * since(present_start), shot);
     if (last_frame) break;
   }
   return last_picture;
