@@ -9,6 +9,7 @@
 #include "core/guidance/lrf_meter.h"
 #include "core/io/dataset.h"
 #include "core/lrf/dataset.h"
+#include "core/session/calibration_job.h"
 
 namespace calibench::app {
 
@@ -27,11 +28,14 @@ int AdviseLidarCamera(const std::string& dataset_path, const AdviseOptions& opti
         code != kOk)
       return code;
   }
-  const CalibrationOutcome outcome =
-      CalibrateDataset(dataset, options.pipeline, StderrProgress("extracted"));
+  // The job every front end runs (core/session/calibration_job.h), all pairs at once.
+  CalibrationJobOptions job_options;
+  job_options.advise = options;
+  CalibrationJob job(dataset, job_options, {}, {.detected = StderrProgress("extracted")});
+  job.DetectAll();
   bool input_error = false;
-  for (const PairFeatures& p : outcome.pairs) input_error |= p.input_error;
-  const CaptureAdvice advice = AdviseCapture(dataset, outcome, options);
+  for (const PairFeatures& p : job.Solve().pairs) input_error |= p.input_error;
+  const CaptureAdvice& advice = job.Advise();
   if (json)
     std::printf("%s\n", CaptureAdviceJson(advice).c_str());
   else

@@ -1,7 +1,7 @@
 // `calibench watch`: follows a capture while it is written (a folder in the folder form that a
 // capture script fills, or a recording that rosbag / ros2 bag / an MCAP logger is writing), pair
 // by pair: detect, pre-flight, accept or reject, solve again, σ against the goal, the next pose
-// (core/session/capture_job.h over core/io/folder_watch.h or core/io/recording_watch.h).
+// (core/session/calibration_job.h over core/io/capture_feed.h: a folder or a recording).
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
@@ -14,10 +14,10 @@
 #include "app/pipeline_flags.h"
 #include "core/guidance/stop_rule.h"
 #include "core/io/camera_file.h"
+#include "core/io/capture_feed.h"
 #include "core/io/dataset_source.h"
-#include "core/io/folder_watch.h"
 #include "core/io/recording_watch.h"
-#include "core/session/capture_job.h"
+#include "core/session/calibration_job.h"
 #include "core/session/feature_cache.h"
 #include "core/session/session.h"
 
@@ -149,10 +149,11 @@ class FeatureCacheKeeper {
     return note;
   }
   // Appends the job's pairs that are new or changed since written; the failures, in words.
-  std::vector<std::string> Record(const CaptureJob& job) {
+  std::vector<std::string> Record(const CalibrationJob& job) {
     std::vector<std::string> failures;
-    for (size_t i = 0; i < job.pairs().size(); ++i) {
-      const PairFeatures& features = job.pairs()[i];
+    const std::vector<PairFeatures> detected = job.DetectedPairs();
+    for (size_t i = 0; i < detected.size(); ++i) {
+      const PairFeatures& features = detected[i];
       std::string& written = written_[features.id];
       if (written == StateOf(features)) continue;
       try {
@@ -180,65 +181,12 @@ class FeatureCacheKeeper {
   int resumed_ = 0;
 };
 
-// Where the pairs come from: the folder a capture script fills, or a recording being written.
-class PairFeed {
- public:
-  virtual ~PairFeed() = default;
-  // New complete pairs and what went wrong with others; notes go to `stream`.
-  virtual std::vector<FolderEvent> Poll(double now, EventStream& stream) = 0;
-  // The camera and the target, once known.
-  virtual std::optional<Dataset> Setup() const = 0;
-  // The source says nothing more will come (a recording closed by its recorder).
-  virtual bool Closed() const { return false; }
-  // The folder the session describes.
-  virtual fs::path DatasetFolder() const = 0;
-};
-
-class FolderFeed final : public PairFeed {
- public:
-  FolderFeed(Dataset setup, const WatchFlags& flags)
-      : setup_(std::move(setup)), folder_(fs::absolute(flags.source), flags.folder) {}
-  std::vector<FolderEvent> Poll(double now, EventStream&) override { return folder_.Poll(now); }
-  std::optional<Dataset> Setup() const override { return setup_; }
-  fs::path DatasetFolder() const override { return folder_.folder(); }
-
- private:
-  Dataset setup_;
-  GrowingFolder folder_;
-};
-
-class RecordingFeed final : public PairFeed {
- public:
-  explicit RecordingFeed(const WatchFlags& flags)
-      : recording_(fs::absolute(flags.source), flags.out, flags.board, flags.import) {}
-  std::vector<FolderEvent> Poll(double, EventStream& stream) override {
-    const RecordingUpdate update = recording_.Poll();
-    for (const std::string& note : update.notes) stream.Note("note", "", note);
-    closed_ = update.closed;
-    std::vector<FolderEvent> events;
-    for (const PairEntry& pair : update.pairs) {
-      FolderEvent event;
-      event.stem = pair.id;
-      event.pair = pair;
-      events.push_back(std::move(event));
-    }
-    return events;
-  }
-  std::optional<Dataset> Setup() const override { return recording_.Setup(); }
-  bool Closed() const override { return closed_; }
-  fs::path DatasetFolder() const override { return recording_.OutDir(); }
-
- private:
-  GrowingRecording recording_;
-  bool closed_ = false;
-};
-
 // The watch loop: look, add the completed pairs, solve, say what changed, save; until idle or
 // done.
 class Watch {
  public:
-  Watch(std::unique_ptr<PairFeed> feed, const CaptureJobOptions& options, const WatchFlags& flags,
-        fs::path session_path, EventStream* stream)
+  Watch(std::unique_ptr<CaptureFeed> feed, const CalibrationJobOptions& options,
+        const WatchFlags& flags, fs::path session_path, EventStream* stream)
       : flags_(flags),
         options_(options),
         session_path_(std::move(session_path)),
@@ -252,11 +200,13 @@ class Watch {
     for (;;) {
       const double now = SteadySeconds();
       bool added = false;
-      for (const FolderEvent& event : feed_->Poll(now, stream_)) {
+      const FeedUpdate update = feed_->Poll(now);
+      for (const std::string& note : update.notes) stream_.Note("note", "", note);
+      for (const FolderEvent& event : update.events) {
         last_activity = now;
         if (event.kind == FolderEvent::Kind::kPairComplete) {
           // The job starts with the first pair: a recording's camera and board are known then.
-          if (!job_) job_.emplace(*feed_->Setup(), options_);
+          if (!job_) StartJob();
           job_->AddPair(event.pair, cache_.Earlier(event.pair));
           added = true;
         } else {
@@ -268,7 +218,7 @@ class Watch {
         stream_.Note("end", "", "done: the goal is met with a σ that can be trusted");
         return kOk;
       }
-      if (feed_->Closed()) {
+      if (update.closed) {
         stream_.Note("end", "", "the recording was closed by its recorder");
         return kOk;
       }
@@ -283,12 +233,22 @@ class Watch {
   }
 
  private:
+  // The job over the feed's camera and board; the pairs it already holds join as new ones.
+  void StartJob() {
+    Dataset setup = *feed_->Setup();
+    std::vector<PairEntry> known = std::move(setup.pairs);
+    setup.pairs.clear();
+    job_.emplace(std::move(setup), options_);
+    for (const PairEntry& pair : known) job_->AddPair(pair, cache_.Earlier(pair));
+  }
+
   // Solves, then says the verdicts that changed and the solve, and saves; true when the watch
   // should end (--exit-when-done and done). `looked_s`: when the new pairs were seen complete.
   bool SolveAndReport(double looked_s) {
     if (const std::string note = cache_.ResumedNote(); !note.empty())
       stream_.Note("resumed", "", note);
-    const CaptureAdvice& advice = job_->Solve();
+    job_->Solve();
+    const CaptureAdvice& advice = job_->Advise();
     for (const std::string& failure : cache_.Record(*job_)) stream_.Note("error", "", failure);
     ReportVerdicts(advice);
     nlohmann::json solve = nlohmann::json::parse(CaptureAdviceJson(advice));
@@ -320,19 +280,20 @@ class Watch {
   }
 
   const WatchFlags& flags_;
-  CaptureJobOptions options_;
+  CalibrationJobOptions options_;
   fs::path session_path_;
   EventStream& stream_;
   Autosaver autosaver_;
   FeatureCacheKeeper cache_;
-  std::unique_ptr<PairFeed> feed_;
-  std::optional<CaptureJob> job_;
+  std::unique_ptr<CaptureFeed> feed_;
+  std::optional<CalibrationJob> job_;
   std::map<std::string, std::pair<bool, std::string>> reported_;  // verdicts said, by pair
 };
 
 // `watch` on a recording: import's board, camera and topic flags, pairs written to --out.
-int WatchRecording(WatchFlags* flags, const CaptureJobOptions& options, const std::string& board,
-                   const std::string& out, const std::string& camera_file, EventStream& stream) {
+int WatchRecording(WatchFlags* flags, const CalibrationJobOptions& options,
+                   const std::string& board, const std::string& out, const std::string& camera_file,
+                   EventStream& stream) {
   try {
     flags->board = BoardFromFlag(board);
   } catch (const std::invalid_argument& e) {
@@ -345,12 +306,13 @@ int WatchRecording(WatchFlags* flags, const CaptureJobOptions& options, const st
   fs::create_directories(flags->out);
   const fs::path session_path =
       flags->session.empty() ? flags->out / "calibench.session.json" : fs::path(flags->session);
-  Watch watch(std::make_unique<RecordingFeed>(*flags), options, *flags, session_path, &stream);
+  Watch watch(FollowRecording(flags->source, flags->out, flags->board, flags->import), options,
+              *flags, session_path, &stream);
   return watch.Run();
 }
 
 // `watch` on a folder in the folder form (or a manifest's folder).
-int WatchFolder(WatchFlags* flags_in, const CaptureJobOptions& options, EventStream& stream) {
+int WatchFolder(WatchFlags* flags_in, const CalibrationJobOptions& options, EventStream& stream) {
   WatchFlags& flags = *flags_in;
   std::error_code error;
   if (fs::is_regular_file(flags.source, error)) {  // a manifest, named: its folder is watched
@@ -374,8 +336,8 @@ int WatchFolder(WatchFlags* flags_in, const CaptureJobOptions& options, EventStr
   const fs::path session_path = flags.session.empty()
                                     ? fs::path(flags.source) / "calibench.session.json"
                                     : fs::path(flags.session);
-  Watch watch(std::make_unique<FolderFeed>(std::move(*setup), flags), options, flags, session_path,
-              &stream);
+  Watch watch(FollowFolder(std::move(*setup), flags.source, flags.folder), options, flags,
+              session_path, &stream);
   return watch.Run();
 }
 
@@ -391,7 +353,7 @@ int RunWatch(int argc, char** argv) {
       "where to hold the board next, per pair.",
       "calibench watch"};
   WatchFlags flags;
-  CaptureJobOptions options;
+  CalibrationJobOptions options;
   app.add_option("source", flags.source,
                  "the folder the capture writes (the folder form, or a folder holding a "
                  "LiDAR-camera manifest of any name; or that manifest itself), or the recording "
@@ -448,6 +410,7 @@ int RunWatch(int argc, char** argv) {
     return kUsage;
   }
   options.advise.pipeline = pipeline.options;
+  options.warm_start = true;  // each solve from the last: the capture grows by one pair
   if (!options.Check(&why)) {
     std::fprintf(stderr, "calibench watch: %s\n", why.c_str());
     return kUsage;

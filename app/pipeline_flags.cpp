@@ -8,6 +8,7 @@
 #include "app/commands.h"
 #include "core/lidar_camera/joint_intrinsics.h"
 #include "core/lidar_camera/result_io.h"
+#include "core/session/calibration_job.h"
 #include "core/session/session.h"
 
 namespace calibench::app {
@@ -164,8 +165,12 @@ PairEdits ApplySessionFlag(const std::string& session_path, std::string* dataset
 int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
                        const std::string& out_path, CalibrationOutcome* outcome_out,
                        const PairEdits& edits) {
-  CalibrationOutcome outcome =
-      CalibrateDataset(dataset, options, StderrProgress("extracted"), edits);
+  // The job every front end runs (core/session/calibration_job.h), all pairs at once.
+  CalibrationJobOptions job_options;
+  job_options.advise.pipeline = options;
+  CalibrationJob job(dataset, job_options, edits, {.detected = StderrProgress("extracted")});
+  job.DetectAll();
+  CalibrationOutcome outcome = job.Solve();
   std::printf("%s", FormatSummary(outcome).c_str());
   bool input_error = false;
   for (const PairFeatures& p : outcome.pairs) input_error |= p.input_error;

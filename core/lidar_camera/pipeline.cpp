@@ -258,18 +258,25 @@ std::optional<SceneBackground> BuildSceneBackground(const std::vector<const Pair
   return background;
 }
 
-CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,
-                                    const ProgressCallback& progress, const PairEdits& edits) {
+std::vector<const PairEntry*> SelectedPairs(const Dataset& dataset,
+                                            const PipelineOptions& options) {
   std::vector<const PairEntry*> selected;
   const std::set<std::string> wanted(options.pair_ids.begin(), options.pair_ids.end());
   for (const PairEntry& pair : dataset.pairs)
     if (wanted.empty() || wanted.count(pair.id)) selected.push_back(&pair);
+  return selected;
+}
 
+std::vector<PairFeatures> ExtractDatasetPairs(const Dataset& dataset,
+                                              const std::vector<const PairEntry*>& selected,
+                                              const PipelineOptions& options,
+                                              const ProgressCallback& progress,
+                                              const PairEdits& edits,
+                                              std::string* background_note) {
   std::optional<SceneBackground> background;
-  std::string background_note;
   std::vector<std::optional<LidarCloud>> clouds;  // read once, for the background and the pair
   if (options.detect_board && options.background_model && AnyPairToDetect(selected, edits))
-    background = BuildSceneBackground(selected, options.threads, &background_note, &clouds);
+    background = BuildSceneBackground(selected, options.threads, background_note, &clouds);
 
   std::vector<PairFeatures> features(selected.size());
   ParallelFor(
@@ -285,6 +292,15 @@ CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOption
       [&](int finished, size_t i) {
         if (progress) progress(finished, static_cast<int>(selected.size()), selected[i]->id);
       });
+  return features;
+}
+
+CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,
+                                    const ProgressCallback& progress, const PairEdits& edits) {
+  const std::vector<const PairEntry*> selected = SelectedPairs(dataset, options);
+  std::string background_note;
+  std::vector<PairFeatures> features =
+      ExtractDatasetPairs(dataset, selected, options, progress, edits, &background_note);
   CalibrationOutcome outcome =
       SolveExtractedPairs(dataset, selected, std::move(features), options, edits);
   outcome.background_note = background_note;

@@ -245,6 +245,19 @@ CalibrationOutcome SolveExtractedPairs(const Dataset& dataset,
                                        const PipelineOptions& options, const PairEdits& edits = {},
                                        const IterationCallback& on_iteration = {});
 
+// The dataset's pairs that options.pair_ids selects (every pair when it is empty), in order.
+std::vector<const PairEntry*> SelectedPairs(const Dataset& dataset, const PipelineOptions& options);
+
+// Extracts the selected pairs as `calibrate` does: the background model over all their clouds
+// first (where a pair is left to detection), then every pair's planes in parallel
+// (options.threads), `progress` after each. *background_note says why no background model was
+// used, when one was wanted.
+std::vector<PairFeatures> ExtractDatasetPairs(const Dataset& dataset,
+                                              const std::vector<const PairEntry*>& selected,
+                                              const PipelineOptions& options,
+                                              const ProgressCallback& progress,
+                                              const PairEdits& edits, std::string* background_note);
+
 // Extracts every selected pair (in parallel with options.threads) and solves; with
 // options.refine_intrinsics refines the camera with the extrinsic (RefineIntrinsics), else adds the
 // camera's intrinsics covariance, when it has one, to the extrinsic's (AddIntrinsicsUncertainty).

@@ -99,7 +99,6 @@ Session NewSession(const Dataset& dataset) {
     pair.id = entry.id;
     session.pairs.push_back(pair);
   }
-  if (!session.pairs.empty()) session.view.selected_pair = session.pairs.front().id;
   return session;
 }
 

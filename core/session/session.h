@@ -1,6 +1,7 @@
 // The workbench's editable state as plain data and a file (calibench.session.v1): per-pair
-// status and brush masks, solver options, what the views showed, and the last solve; undo/redo
-// history and an autosaver. Reopening a saved session restores exactly what was on screen.
+// status and brush masks, solver options, the last solve, and what the views showed (opaque here:
+// the workbench's); undo/redo history and an autosaver. Reopening a saved session restores
+// exactly what was on screen.
 #pragma once
 
 #include <array>
@@ -42,34 +43,6 @@ struct PairState {
 
   bool operator==(const PairState&) const = default;
 };
-
-enum class CameraImageMode { kRaw, kUndistorted };
-// How LiDAR points hidden from the camera are removed in the camera view.
-enum class VisibilityMode { kHpr, kZBuffer, kNone };
-
-// What the three views showed. Angles radians, distances metres, sizes pixels.
-struct ViewState {
-  std::string selected_pair;  // pair id; empty = none selected
-  LidarChannel lidar_channel = LidarChannel::kIntensity;
-  CameraImageMode camera_image = CameraImageMode::kUndistorted;
-  VisibilityMode visibility = VisibilityMode::kHpr;
-  double hpr_radius_exponent = 2.5;  // Katz R = max_dist * 10^x; HprOptions' default
-  double point_size_px = 2.0;        // rendered point diameter, pixels
-  double point_opacity = 1.0;        // [0, 1]
-  // 3D view: orbit camera about `orbit_target` (LiDAR frame, metres).
-  double orbit_yaw_rad = 0.0;     // about the LiDAR z axis, 0 = looking along +x
-  double orbit_pitch_rad = 0.35;  // elevation above the xy plane (about 20 degrees)
-  double orbit_distance_m = 5.0;  // close enough to see the boards and both sensor frames
-  std::array<double, 3> orbit_target = {1.5, 0.0, 0.0};  // in front of the LiDAR
-  double brush_radius_px = 6.0;                          // circle brush on the LiDAR image, pixels
-
-  bool operator==(const ViewState&) const = default;
-};
-
-// "intensity" / "range" / "ring", "raw" / "undistorted", "hpr" / "zbuffer" / "none".
-std::string LidarChannelName(LidarChannel channel);
-std::string CameraImageModeName(CameraImageMode mode);
-std::string VisibilityModeName(VisibilityMode mode);
 
 // The part of a SolverResult the session keeps. Per-pair residuals and weights are not kept: they
 // follow from the pairs' planes at cam_from_lidar.
@@ -118,7 +91,9 @@ struct Session {
   bool estimate_range_offset = false;  // weighted-ml: LiDAR range offset (see SolverOptions)
   int max_iterations = SolverOptions{}.max_iterations;                 // Gauss-Newton iterations
   double ransac_threshold_m = LidarPlaneOptions{}.ransac_threshold_m;  // LiDAR plane inliers
-  ViewState view;
+  // What the workbench's views showed (ui/state/view_state.h reads and writes it): the file's
+  // "view" object as JSON text, which core keeps as it is and never reads.
+  std::string view_json = "{}";
   std::optional<SessionResult> result;  // the last solve, if any
 
   bool operator==(const Session&) const = default;
@@ -128,7 +103,8 @@ struct Session {
 // normal, no trailing separator. Use it when setting Session::dataset from a user's path.
 std::filesystem::path NormalizeSessionPath(const std::filesystem::path& path);
 
-// One pending PairState per dataset pair, the first pair selected, default options.
+// One pending PairState per dataset pair, default options, an empty view (the workbench then
+// selects the first pair).
 Session NewSession(const Dataset& dataset);
 
 // Copies the session's solver and RANSAC options into pipeline options (the range offset only

@@ -27,15 +27,6 @@ constexpr int kVersion = 1;
 constexpr long long kMaxImagePixels = 1LL << 26;
 constexpr char kDirection[] = "x_in_cam = cam_from_lidar * x_in_lidar (camera from LiDAR)";
 
-constexpr EnumName<LidarChannel> kChannelNames[] = {{LidarChannel::kIntensity, "intensity"},
-                                                    {LidarChannel::kRange, "range"},
-                                                    {LidarChannel::kRing, "ring"}};
-constexpr EnumName<CameraImageMode> kImageModeNames[] = {
-    {CameraImageMode::kRaw, "raw"}, {CameraImageMode::kUndistorted, "undistorted"}};
-constexpr EnumName<VisibilityMode> kVisibilityNames[] = {{VisibilityMode::kHpr, "hpr"},
-                                                         {VisibilityMode::kZBuffer, "zbuffer"},
-                                                         {VisibilityMode::kNone, "none"}};
-
 // ---- writing ----
 
 // JSON has no NaN/inf; a session holding one must still load, so they become strings.
@@ -67,19 +58,11 @@ Json BrushToJson(const BrushMask& mask) {
   return {{"image_rows", mask.rows}, {"image_columns", mask.columns}, {"pixel_runs", runs}};
 }
 
-Json ViewToJson(const ViewState& v) {
-  return {{"selected_pair", v.selected_pair},
-          {"lidar_channel", LidarChannelName(v.lidar_channel)},
-          {"camera_image", CameraImageModeName(v.camera_image)},
-          {"visibility", VisibilityModeName(v.visibility)},
-          {"hpr_radius_exponent", Number(v.hpr_radius_exponent)},
-          {"point_size_px", Number(v.point_size_px)},
-          {"point_opacity", Number(v.point_opacity)},
-          {"orbit_yaw_rad", Number(v.orbit_yaw_rad)},
-          {"orbit_pitch_rad", Number(v.orbit_pitch_rad)},
-          {"orbit_distance_m", Number(v.orbit_distance_m)},
-          {"orbit_target_m", Numbers(v.orbit_target.data(), 3)},
-          {"brush_radius_px", Number(v.brush_radius_px)}};
+// The workbench's view as it gave it (an object; anything else is a programming error).
+Json ViewObject(const std::string& view_json) {
+  Json view = Json::parse(view_json);
+  CALIBENCH_CHECK(view.is_object());
+  return view;
 }
 
 Json Rows(const Eigen::MatrixXd& m) {
@@ -228,26 +211,6 @@ Vec3 ReadVec3(const Fields& f, const std::string& key) {
               StoredNumberAt(values[2], f, key));
 }
 
-ViewState ReadView(const Fields& f) {
-  ViewState v;
-  v.selected_pair = f.String("selected_pair");
-  v.lidar_channel = f.Name("lidar_channel", kChannelNames);
-  v.camera_image = f.Name("camera_image", kImageModeNames);
-  v.visibility = f.Name("visibility", kVisibilityNames);
-  v.hpr_radius_exponent = f.StoredNumber("hpr_radius_exponent");
-  v.point_size_px = f.Positive("point_size_px");
-  v.point_opacity = f.StoredNumber("point_opacity");
-  if (!(v.point_opacity >= 0.0 && v.point_opacity <= 1.0))
-    f.Fail("point_opacity", "must lie in [0, 1]");
-  v.orbit_yaw_rad = f.StoredNumber("orbit_yaw_rad");
-  v.orbit_pitch_rad = f.StoredNumber("orbit_pitch_rad");
-  v.orbit_distance_m = f.Positive("orbit_distance_m");
-  const Vec3 target = ReadVec3(f, "orbit_target_m");
-  v.orbit_target = {target.x(), target.y(), target.z()};
-  v.brush_radius_px = f.Positive("brush_radius_px");
-  return v;
-}
-
 template <int N>
 Eigen::Matrix<double, N, N> ReadSquare(const json& value, const Fields& f, const std::string& key) {
   const std::string what = f.Path(key) + " (" + std::to_string(N) + "x" + std::to_string(N) + ")";
@@ -390,20 +353,13 @@ Session ReadSession(const json& root, const std::filesystem::path& source_path) 
       if (s.pairs[j].id == s.pairs[i].id)
         json_io::FailAt(source_path, where + ".id", "\"" + s.pairs[i].id + "\" appears twice");
   }
-  s.view = ReadView(f.Object("view"));
-  if (!s.view.selected_pair.empty() &&
-      std::none_of(s.pairs.begin(), s.pairs.end(),
-                   [&](const PairState& p) { return p.id == s.view.selected_pair; }))
-    f.Object("view").Fail("selected_pair", "\"" + s.view.selected_pair + "\" is not a pair");
+  f.Object("view");  // an object; what it holds is the workbench's (ui/state/view_state.h)
+  s.view_json = f.At("view").dump();
   if (f.Has("result")) s.result = ReadResult(f.Object("result"));
   return s;
 }
 
 }  // namespace
-
-std::string LidarChannelName(LidarChannel channel) { return NameIn(kChannelNames, channel); }
-std::string CameraImageModeName(CameraImageMode mode) { return NameIn(kImageModeNames, mode); }
-std::string VisibilityModeName(VisibilityMode mode) { return NameIn(kVisibilityNames, mode); }
 
 std::string SessionToJson(const Session& session, const std::filesystem::path& session_path) {
   CALIBENCH_CHECK(!session.dataset.empty() && session.version == kVersion);
@@ -424,7 +380,7 @@ std::string SessionToJson(const Session& session, const std::filesystem::path& s
                  {"max_iterations", session.max_iterations},
                  {"ransac_threshold_m", Number(session.ransac_threshold_m)}}},
                {"pairs", pairs},
-               {"view", ViewToJson(session.view)},
+               {"view", ViewObject(session.view_json)},
                {"result", session.result ? ResultToJson(*session.result) : Json(nullptr)}};
   std::string text;
   Pretty(root, 0, &text);

@@ -15,7 +15,7 @@
 #include "core/lrf/depth_planes.h"
 #include "core/lrf/scan_lines.h"
 #include "core/lrf/solver.h"
-#include "core/session/capture_job.h"
+#include "core/session/calibration_job.h"
 #include "core/sim/lrf_sim.h"
 #include "core/sim/sim.h"
 #include "core/target/board_camera.h"
@@ -228,7 +228,7 @@ void BM_CalibrateReal40Pairs2Threads(benchmark::State& state) {
 }
 BENCHMARK(BM_CalibrateReal40Pairs2Threads)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
-// `watch`'s step for one new pair (core/session/capture_job.h): the real ACFR capture's first
+// `watch`'s step for one new pair (core/session/calibration_job.h): the real ACFR capture's first
 // state.range(0) - 1 pairs already in the job, then the next pair read, detected, solved with the
 // others from the last solution, checked and advised. The job is copied outside the timing.
 void BM_WatchIncrementalStep(benchmark::State& state) {
@@ -241,15 +241,19 @@ void BM_WatchIncrementalStep(benchmark::State& state) {
   Dataset all = LoadDataset(folder);
   const int before = static_cast<int>(state.range(0)) - 1;
   Dataset setup = all;
-  setup.pairs.assign(all.pairs.begin(), all.pairs.begin() + before);
-  CaptureJob prepared(setup, CaptureJobOptions{});
+  setup.pairs.clear();
+  CalibrationJobOptions options;
+  options.warm_start = true;  // as `watch` runs it
+  CalibrationJob prepared(setup, options);
+  for (int i = 0; i < before; ++i) prepared.AddPair(all.pairs[i]);
   prepared.Solve();
   for (auto _ : state) {
     state.PauseTiming();
-    CaptureJob job = prepared;
+    CalibrationJob job = prepared;
     state.ResumeTiming();
     job.AddPair(all.pairs[before]);
-    benchmark::DoNotOptimize(job.Solve());
+    job.Solve();
+    benchmark::DoNotOptimize(job.Advise());
   }
   state.SetLabel("pair " + std::to_string(before + 1) + " of a real VLP-16 + 1920x1208 capture");
 }

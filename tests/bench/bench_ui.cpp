@@ -107,7 +107,7 @@ void BM_WorkbenchFrameAfterEdit1600x900(benchmark::State& state) {
   int edit = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    ViewState view = controller.GetSnapshot().view;
+    ui::ViewState view = controller.GetSnapshot().view;
     ++edit;
     if (state.range(0) == 0) {
       view.orbit_yaw_rad += 0.05;

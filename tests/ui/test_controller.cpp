@@ -159,7 +159,9 @@ TEST(Controller, EveryEditAutosavesAndTheSessionReopensExactly) {
     saved = LoadSession(session_path);
   }
   EXPECT_EQ(saved.pairs[3].status, PairStatus::kRejected);
-  EXPECT_EQ(saved.view.selected_pair, "0001");
+  std::vector<std::string> ids;
+  for (const PairState& pair : saved.pairs) ids.push_back(pair.id);
+  EXPECT_EQ(ViewFromJson(saved.view_json, session_path, ids).selected_pair, "0001");
   ASSERT_TRUE(saved.result);
   Controller reopened;
   reopened.OpenSession(session_path);

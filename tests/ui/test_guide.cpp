@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -226,13 +227,13 @@ TEST(Guide, ARecordingFollowedInTheWorkbenchGivesItsHoldsAndTheTruth) {
   const test::SimRecordingTruth truth =
       test::WriteSimRecording(writer.get(), MessageEncoding::kCdr, options);
   writer->Close();
-  Controller controller;
-  controller.SetAutoSolve(true);
-  controller.WatchRecording(dir / "capture.mcap", dir / "capture.dataset", truth.board, {});
-  WaitUntilSettled(controller, 6);
-  controller.StopWatching();
-  controller.WaitIdle();
-  const Snapshot s = controller.GetSnapshot();
+  auto controller = std::make_unique<Controller>();
+  controller->SetAutoSolve(true);
+  controller->WatchRecording(dir / "capture.mcap", dir / "capture.dataset", truth.board, {});
+  WaitUntilSettled(*controller, 6);
+  controller->StopWatching();
+  controller->WaitIdle();
+  const Snapshot s = controller->GetSnapshot();
   ASSERT_EQ(s.pairs.size(), 6u) << s.status_line;
   ASSERT_TRUE(s.solver.result) << s.solver.failure << "; " << s.status_line;
   const PoseError to_truth =
@@ -255,6 +256,23 @@ TEST(Guide, ARecordingFollowedInTheWorkbenchGivesItsHoldsAndTheTruth) {
   EXPECT_LT(to_truth.rotation_rad * kRadToDeg, 0.5);
   EXPECT_LT(to_calibrate.translation_m, 0.001);
   EXPECT_LT(to_calibrate.rotation_rad * kRadToDeg, 0.05);
+
+  // Watched again (the workbench was closed): the recording is read again and the session the
+  // first watch left resumes over the same pairs, the user's rejection kept, no backup made.
+  controller->Apply(SetPairStatus{1, PairStatus::kRejected});
+  controller->WaitIdle();
+  controller.reset();  // closes the session (and its lock)
+  Controller again;
+  again.SetAutoSolve(true);
+  again.WatchRecording(dir / "capture.mcap", dir / "capture.dataset", truth.board, {});
+  const Snapshot resumed = WaitUntilSettled(again, 6);
+  again.StopWatching();
+  ASSERT_EQ(resumed.pairs.size(), 6u) << resumed.status_line;
+  for (size_t i = 0; i < 6; ++i) EXPECT_EQ(resumed.pairs[i].id, s.pairs[i].id);
+  EXPECT_EQ(resumed.pairs[1].status, PairStatus::kRejected);
+  EXPECT_EQ(resumed.pairs[1].reason, kRejectedByUser);
+  for (const auto& entry : fs::directory_iterator(dir / "capture.dataset"))
+    EXPECT_NE(entry.path().extension(), ".bak") << entry.path() << ": the session was not resumed";
 }
 
 }  // namespace

@@ -86,28 +86,14 @@ SolverOptions Controller::SolverOptionsFromState() const {
   return options;
 }
 
-PairFeatures Controller::FeaturesAsDetected(const PairView& pair) {
-  if (!pair.before_completion) return FeaturesOf(pair);
-  PairView detected = pair;
-  detected.lidar = pair.before_completion->lidar;
-  detected.board_origin = pair.before_completion->board_origin;
-  detected.lidar_failure = pair.before_completion->lidar_failure;
-  PairFeatures features = FeaturesOf(detected);
-  if (features.status != PairStatus::kRejected)
-    SetStatusFromFeatures(&features, detected.lidar_failure, detected.camera_failure);
-  return features;
-}
-
 void Controller::ApplyCompletion(const std::vector<PairFeatures>& solved) {
   for (size_t i = 0; i < solved.size() && i < state_.pairs.size(); ++i) {
     PairView& pair = state_.pairs[i];
     const PairFeatures& after = solved[i];
+    if (pair.awaiting_detection) continue;  // its board is still to be found
     const bool same_board = after.lidar.has_value() == pair.lidar.has_value() &&
                             (!after.lidar || after.lidar->inliers == pair.lidar->inliers);
     if (same_board && after.status == pair.status && after.reason == pair.reason) continue;
-    if (!pair.before_completion)
-      pair.before_completion = PairView::AsDetected{pair.lidar, pair.board_origin,
-                                                    pair.lidar_failure, pair.brush_pixels};
     pair.lidar = after.lidar;
     pair.board_origin = after.board_origin;
     pair.status = after.status;
@@ -129,35 +115,18 @@ void Controller::ApplyCompletion(const std::vector<PairFeatures>& solved) {
 }
 
 void Controller::Solve() {
-  std::vector<PairFeatures> features;
-  PipelineOptions options;
-  Dataset dataset;
-  PairEdits edits;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!state_.dataset) return;
-    dataset = *state_.dataset;
-    for (const PairView& pair : state_.pairs) {
-      features.push_back(FeaturesAsDetected(pair));
-      // A painted brush is the user's word: completion leaves the pair alone (as with
-      // `calibrate --session`, whose edits hold the brush).
-      if (pair.brush_edited) edits[pair.id].brush_pixels = pair.brush_pixels;
-    }
-    options = PipelineOptionsFromState();
+    if (!state_.dataset || !job_) return;
     state_.solver = SolverView{};
     state_.solver.running = true;
     ++state_.generation;
   }
-  std::vector<const PairEntry*> entries;
-  for (const PairEntry& entry : dataset.pairs) entries.push_back(&entry);
-  // The CLI's steps after extraction (solve, camera-guided completion, the intrinsics' σ),
-  // the solve watched iteration by iteration.
-  CalibrationOutcome outcome = SolveExtractedPairs(dataset, entries, std::move(features), options,
-                                                   edits, [this](const IterationReport& it) {
-                                                     std::lock_guard<std::mutex> lock(mutex_);
-                                                     state_.solver.iterations.push_back(it);
-                                                     ++state_.generation;
-                                                   });
+  SyncJobDecisions();
+  // The job's solve from what detection found: the CLI's steps after extraction (solve,
+  // camera-guided completion, the intrinsics' σ), watched iteration by iteration (its events).
+  CalibrationOutcome outcome = job_->Solve();
+  const PipelineOptions& options = job_->options().advise.pipeline;
   std::lock_guard<std::mutex> lock(mutex_);
   state_.solver.running = false;
   // Pairs added meanwhile (a watched folder) are not in this solve; the next one has them.
@@ -195,7 +164,7 @@ void Controller::Solve() {
   const int selected = state_.selected;
   if (selected >= 0) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
   // Pre-flight and the next pose (the ghost board) from this solve.
-  worker_.Enqueue([this, outcome = std::move(outcome), options] { Advise(outcome, options); });
+  worker_.Enqueue([this] { Advise(); });
 }
 
 void Controller::ComputeReprojection(int index) {

@@ -19,19 +19,18 @@
 #include "core/base/file_lock.h"
 #include "core/base/image.h"
 #include "core/camera/undistort.h"
-#include "core/guidance/advise.h"  // with the pipeline, the stop rule, the intrinsics
 #include "core/io/camera_file.h"
-#include "core/io/folder_watch.h"
-#include "core/io/recording_watch.h"
+#include "core/io/capture_feed.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/reproject/reproject.h"
 #include "core/results/export.h"
-#include "core/session/session.h"
+#include "core/session/calibration_job.h"  // the job, with the guidance and the session
 #include "core/target/board_camera.h"
 #include "core/target/lidar_plane.h"
 #include "ui/state/controller_state.h"
+#include "ui/state/view_state.h"
 
 namespace calibench::ui {
 
@@ -55,14 +54,6 @@ struct PairView : PairHeader {
   std::string camera_failure;
   std::optional<Vec4> residual;  // after a solve
   double robust_weight = 1.0;
-  // What detection had found where completion (every solve's) replaced or dropped the board.
-  struct AsDetected {
-    std::optional<LidarPlaneFit> lidar;
-    BoardOrigin board_origin;
-    std::string lidar_failure;
-    std::vector<int> brush_pixels;
-  };
-  std::optional<AsDetected> before_completion;
   bool awaiting_detection = false;  // loaded, its board to be found once the background allows
   // Pre-flight's findings after the last solve, as `advise` lists them (shown on its row).
   std::vector<PreflightFinding> findings;
@@ -261,20 +252,24 @@ class Controller : public ControllerState<Snapshot> {
   void AddPair(const PairEntry& entry);
 
  private:
-  // Starts following `source` with `loop` on the watch thread (the one that ran stops first).
-  void Follow(const std::filesystem::path& source, std::function<void()> loop);
-  void WatchLoop(std::filesystem::path folder, FolderWatchOptions options);
-  void WatchRecordingLoop(GrowingRecording* recording);
-  // The session an earlier watch left, when its pairs are the first of the folder's (the capture
-  // grew while the workbench was closed): opened over them, edits kept; false otherwise.
+  // Follows `source` on the watch thread: the feed make_feed gives (null: nothing to follow),
+  // through FollowLoop (the one that ran stops first).
+  void Follow(const std::filesystem::path& source,
+              std::function<std::unique_ptr<CaptureFeed>()> make_feed);
+  // Opens the feed's dataset once its first look caught up (resuming an earlier watch's session),
+  // then adds each pair as it lands.
+  void FollowLoop(CaptureFeed* feed);
+  // The session an earlier watch left, when its pairs are the first of `dataset`'s (a capture that
+  // grew while the workbench was closed, a recording read again): opened over them, edits kept.
   bool ResumeGrownCapture(Dataset dataset);
   // Enqueues a solve unless one is queued (auto-solve; mutex_ held).
   void RequestSolve();
-  // After a solve (worker): pre-flight and the next pose from `outcome` (AdviseCapture).
-  void Advise(const CalibrationOutcome& outcome, const PipelineOptions& options);
+  // After a solve (worker): pre-flight and the next pose (the job's Advise), at `at` if given.
+  void Advise(const std::optional<SolverResult>& at = std::nullopt);
   // The same for a reopened session's result, over the pairs as detected again (worker).
   void AdviseFromState();
-  void LoadAllPairs();
+  // The user's rejections and brushes (as the views hold them) into the job (worker).
+  void SyncJobDecisions();
   void LoadPair(int index);
   // After the last pair loaded (mutex_ held): detection, the status line with what loading
   // noted or refused, the reopened session's reprojection.
@@ -291,8 +286,6 @@ class Controller : public ControllerState<Snapshot> {
   SolverOptions SolverOptionsFromState() const;          // the user's choices over pipeline_.solver
   PipelineOptions PipelineOptionsFromState() const;      // pipeline_ with those solver choices
   static PairFeatures FeaturesOf(const PairView& pair);  // the pipeline's view of a pair
-  // The same before camera-guided completion: what every solve starts from.
-  static PairFeatures FeaturesAsDetected(const PairView& pair);
   // The solve's pairs back into the view: completion's boards and verdicts. Call with mutex_ held.
   void ApplyCompletion(const std::vector<PairFeatures>& solved);
   static bool SolvesWith(const PairView& pair);  // accepted, with both planes
@@ -344,11 +337,9 @@ class Controller : public ControllerState<Snapshot> {
   PipelineOptions pipeline_;
   std::string open_note_;  // how the session was opened, for the status line once loaded (mutex_)
   std::vector<std::string> load_warnings_;  // what loading refused, for the status line (mutex_)
-  // The scene's background over the loaded clouds (DetectWithBackground; worker thread only,
-  // reset by Open): the pairs whose clouds are in it, and whether it is usable (Finish).
-  SceneBackground background_;
-  std::set<int> in_background_;
-  bool background_usable_ = false;
+  // The pipeline job (core/session/calibration_job.h) over the opened dataset: detection with
+  // the background, the solve, guidance. Worker thread only; made anew by Open.
+  std::optional<CalibrationJob> job_;
   bool stroke_open_ = false;          // BrushStroke / PaintPoints dabs since the last EndStroke
   bool auto_solve_ = false;           // mutex_
   std::filesystem::path watching_;    // the folder WatchFolder follows (set before its thread)

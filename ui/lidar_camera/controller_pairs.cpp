@@ -9,7 +9,6 @@
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
 #include "core/lidar_camera/result_io.h"
-#include "core/session/capture_job.h"
 #include "ui/lidar_camera/controller.h"
 
 namespace calibench::ui {
@@ -112,11 +111,14 @@ void Controller::LoadPair(int index) {
     saved_mask = saved.brush;
   }
   const PairEntry& entry = dataset.pairs[index];
+  // The job knows the pairs in the order they load (a followed capture's arrive one by one).
+  while (job_->size() <= index) job_->AppendPair(dataset.pairs[job_->size()]);
   std::string brush_dropped;  // why the session's brush does not fit this pair's cloud
-  // The pipeline's own steps (core/lidar_camera/pipeline.h), as `calibench calibrate` runs them.
+  // The job reads the pair and finds the board in its image, as for `calibench calibrate`.
   PairView loaded;
   std::string why;
-  auto inputs = LoadPairInputs(dataset, entry, &why);
+  CameraFeatures camera;  // the job's camera side, its corners shown in the camera view
+  auto inputs = job_->ReadPair(index, &camera, &why);
   bool selected = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -126,7 +128,6 @@ void Controller::LoadPair(int index) {
     auto cloud = std::make_shared<LidarCloud>(std::move(inputs->cloud));
     auto lidar_image = std::make_shared<LidarImage>(ProjectById(*cloud, LidarImageOptions{}));
     loaded.thumbnail = std::make_shared<ImageU8>(ResizeImage(inputs->image, kThumbnailWidth));
-    CameraFeatures camera = ExtractCameraFeatures(dataset, inputs->image, pipeline_);
     loaded.detection = std::move(camera.detection);
     loaded.camera = std::move(camera.observation);
     loaded.camera_failure = camera.failure;
@@ -193,28 +194,19 @@ void Controller::DetectWithBackground() {
     }
   }
   if (awaiting.empty()) return;
-  // The background over the clouds in pair order (as CalibrateDataset's over the dataset's); a
-  // capture that grows adds each new cloud until the model has enough (CaptureJobOptions'
-  // max_background_clouds: the static scene does not change after that).
-  const bool had_background = background_usable_;
-  if (pipeline_.background_model) {
-    bool added = false;
-    for (const auto& [index, cloud] : clouds) {
-      if (background_.clouds() >= CaptureJobOptions{}.max_background_clouds) break;
-      if (!in_background_.insert(index).second) continue;
-      background_.Add(*cloud);
-      added = true;
-    }
-    std::string why;
-    if (added) background_usable_ = background_.Finish(&why);
-    if (added && !background_usable_ && background_.clouds() >= 3) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      SetStatus("board detection without a background model: " + why, false);
-    }
+  // The job's background over the clouds in pair order (as `calibrate`'s over the dataset's); a
+  // capture that grows adds each new cloud until the model has enough.
+  bool became_usable = false;
+  const int before = job_->background_clouds();
+  for (const auto& [index, cloud] : clouds) became_usable |= job_->AddToBackground(index, *cloud);
+  if (job_->background_clouds() > before && !job_->background_usable() &&
+      job_->background_clouds() >= 3) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    SetStatus("board detection without a background model: " + job_->background_note(), false);
   }
   std::vector<int> detect = awaiting;
   // The model exists only now: the boards found without it are looked for again with it.
-  if (background_usable_ && !had_background) {
+  if (became_usable) {
     detect.insert(detect.end(), detected_before.begin(), detected_before.end());
     std::sort(detect.begin(), detect.end());
   }
@@ -229,59 +221,43 @@ void Controller::RefitLidar(int index) {
   std::vector<int> brush;
   bool brush_from_seed = false;
   bool brush_edited = false;
-  Dataset dataset;
+  std::string id;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    dataset = *state_.dataset;
     cloud = state_.pairs[index].cloud;
     image = state_.pairs[index].lidar_image;
     brush = state_.pairs[index].brush_pixels;
     brush_from_seed = state_.pairs[index].brush_from_seed;
     brush_edited = state_.pairs[index].brush_edited;
+    id = state_.pairs[index].id;
   }
   if (!cloud || !image) return;
-  // The same choice of region as `calibench calibrate` (BoardHintFor): once painted (or erased),
-  // the brush; else the seed while the brush only pictures it; else detection.
-  PairEntry entry = dataset.pairs[index];
-  if (!brush_from_seed) entry.lidar_seed.reset();  // "detect again" forgot it
-  PairEdit edit;
-  if (brush_edited) {
-    edit.brush_pixels = brush;
-    edit.brush_rows = image->rows;
-    edit.brush_columns = image->columns;
-  }
-  std::string why;
-  BoardOrigin origin;
-  std::optional<BoardHint> hint = BoardHintFor(entry, edit, image.get(), &why);
-  std::optional<LidarPlaneFit> fit;
-  if (hint) {
-    // Written on this thread only.
-    hint->background = background_usable_ ? &background_ : nullptr;
-    fit = ExtractLidarFeatures(dataset, *cloud, *hint, pipeline_, &why, &origin);
-  }
+  // The same choice of region as `calibench calibrate` (the job's BoardHintFor): once painted
+  // (or erased), the brush; else the seed while the brush only pictures it ("detect again"
+  // forgot it); else detection.
+  job_->SetBrush(id, brush_edited ? std::optional(PairEdit{brush, image->rows, image->columns})
+                                  : std::nullopt);
+  const PairFeatures features = job_->DetectLidar(index, *cloud, image.get(), brush_from_seed);
   std::lock_guard<std::mutex> lock(mutex_);
   PairView& pair = state_.pairs[index];
   if (pair.brush_pixels != brush) return;  // a newer stroke queued its own refit
-  pair.lidar = fit;
-  pair.lidar_failure = fit ? "" : why;
-  pair.before_completion.reset();  // detected anew: the next solve completes it again
+  pair.lidar = features.lidar;
+  pair.lidar_failure = features.lidar ? "" : features.reason;
   pair.awaiting_detection = false;
-  pair.board_origin = origin;
+  pair.board_origin = features.board_origin;
   // A detected board shows as the brush (in its own colour) until the user edits it.
-  if (origin.source == BoardSource::kDetected) {
+  if (features.board_origin.source == BoardSource::kDetected) {
     pair.brush_pixels.clear();
-    if (fit)
-      for (int i : fit->inliers)
+    if (features.lidar)
+      for (int i : features.lidar->inliers)
         if (pair.lidar_image->pixel_of_point[i] >= 0)
           pair.brush_pixels.push_back(pair.lidar_image->pixel_of_point[i]);
     std::sort(pair.brush_pixels.begin(), pair.brush_pixels.end());
     pair.brush_detected = true;
   }
   // A pair with both planes is usable and accepted unless the user rejected it; one that lost a
-  // plane fails with the reason.
+  // plane fails with the reason (the job's verdict from both sides).
   if (pair.status != PairStatus::kRejected) {
-    PairFeatures features = FeaturesOf(pair);
-    SetStatusFromFeatures(&features, pair.lidar_failure, pair.camera_failure);
     pair.status = features.status;
     pair.reason = features.reason;
   }

@@ -134,6 +134,11 @@ void Controller::OpenSessionFile(const std::filesystem::path& session_path, cons
 
 void Controller::Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
                       const std::string& note, std::optional<FileLock> session_lock) {
+  // The view is the workbench's to read (core keeps it as text): a malformed one is the file's
+  // error, said before anything changes.
+  std::vector<std::string> ids;
+  for (const PairState& pair : session.pairs) ids.push_back(pair.id);
+  ViewFromJson(session.view_json, session_path.empty() ? dataset.manifest : session_path, ids);
   WaitIdle();
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -151,13 +156,23 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     for (size_t i = 0; i < dataset.pairs.size(); ++i) state_.pairs[i].id = dataset.pairs[i].id;
     state_.loading_total = static_cast<int>(dataset.pairs.size());
     load_warnings_.clear();
-    background_ = SceneBackground{};
-    background_usable_ = false;
-    in_background_.clear();
     opened_pairs_loaded_ = dataset.pairs.empty();
     open_note_ = note;
     session_ = std::move(session);
     ApplySessionToState(session_);
+    // The pipeline job over the dataset's pairs as they load (LoadPair appends them), with the
+    // session's options; every solver iteration shows as it happens.
+    CalibrationJobOptions job_options;
+    job_options.advise.pipeline = pipeline_;
+    job_options.advise.pipeline.pair_ids.clear();  // the workbench shows every pair
+    Dataset setup = dataset;
+    setup.pairs.clear();
+    job_.emplace(std::move(setup), job_options, PairEdits{},
+                 JobEvents{.iteration = [this](const IterationReport& it) {
+                   std::lock_guard<std::mutex> lock(mutex_);
+                   state_.solver.iterations.push_back(it);
+                   ++state_.generation;
+                 }});
     history_.Reset(session_);
     autosaver_ = session_path.empty() ? nullptr : std::make_unique<Autosaver>(session_path);
     SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
@@ -180,7 +195,13 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
 
 void Controller::ApplySessionToState(const Session& session) {
   ApplySessionOptions(session, &pipeline_);
-  state_.view = session.view;
+  std::vector<std::string> ids;
+  for (const PairState& pair : session.pairs) ids.push_back(pair.id);
+  try {
+    state_.view = ViewFromJson(session.view_json, state_.session_path, ids);
+  } catch (const IoError&) {  // Open checked it; undo restores views this controller wrote
+    state_.view = ViewState{};
+  }
   state_.method = session.method;
   state_.huber_delta = session.huber_delta;
   state_.max_iterations = session.max_iterations;
@@ -195,7 +216,7 @@ void Controller::ApplySessionToState(const Session& session) {
   }
   state_.selected = -1;
   for (size_t i = 0; i < state_.pairs.size(); ++i)
-    if (state_.pairs[i].id == session.view.selected_pair) state_.selected = static_cast<int>(i);
+    if (state_.pairs[i].id == state_.view.selected_pair) state_.selected = static_cast<int>(i);
   if (state_.selected < 0 && !state_.pairs.empty()) state_.selected = 0;
   state_.solver = SolverView{};
   if (session.result) {
@@ -221,7 +242,7 @@ void Controller::CommitEdit() {
   const bool had_selected =
       state_.selected >= 0 && state_.selected < static_cast<int>(state_.pairs.size());
   state_.view.selected_pair = had_selected ? state_.pairs[state_.selected].id : "";
-  session_.view = state_.view;
+  session_.view_json = ViewToJson(state_.view);
   session_.method = state_.method;
   session_.huber_delta = state_.huber_delta;
   session_.max_iterations = state_.max_iterations;

@@ -15,17 +15,10 @@ double SteadySeconds() {
 }
 
 constexpr auto kPollPeriod = std::chrono::milliseconds(200);
-
-// Whether clouds/ and images/ share a stem (the folder form has a pair to load).
-bool HasFolderPairs(const std::filesystem::path& folder) {
-  std::error_code error;
-  std::set<std::string> clouds;
-  for (const auto& entry : std::filesystem::directory_iterator(folder / "clouds", error))
-    clouds.insert(entry.path().stem().string());
-  for (const auto& entry : std::filesystem::directory_iterator(folder / "images", error))
-    if (clouds.count(entry.path().stem().string())) return true;
-  return false;
-}
+// How long the first look at a feed lasts at least: longer than a folder's settle time (0.3 s by
+// default) plus a poll, so that every pair there when following started has been reported before
+// the dataset opens (and an earlier watch's session resumes over all of them).
+constexpr double kFirstLookSeconds = 1.0;
 
 }  // namespace
 
@@ -48,7 +41,8 @@ void Controller::RequestSolve() {
   });
 }
 
-void Controller::Follow(const std::filesystem::path& source, std::function<void()> loop) {
+void Controller::Follow(const std::filesystem::path& source,
+                        std::function<std::unique_ptr<CaptureFeed>()> make_feed) {
   StopWatching();
   stop_watch_ = false;
   // Pairs land while the user looks: the window's frames before the pairs' processing.
@@ -58,12 +52,37 @@ void Controller::Follow(const std::filesystem::path& source, std::function<void(
     watching_ = std::filesystem::absolute(source);
     state_.watching = watching_;
   }
-  watch_thread_ = std::thread(std::move(loop));
+  watch_thread_ = std::thread([this, make_feed = std::move(make_feed)] {
+    std::unique_ptr<CaptureFeed> feed = make_feed();
+    if (feed) FollowLoop(feed.get());
+  });
 }
 
 void Controller::WatchFolder(const std::filesystem::path& folder, FolderWatchOptions options) {
   Follow(folder, [this, options, folder = std::filesystem::absolute(folder)] {
-    WatchLoop(folder, options);
+    // The capture's camera and target first (a capture script may write them after starting).
+    bool said = false;
+    for (;;) {
+      if (stop_watch_) return std::unique_ptr<CaptureFeed>();
+      std::error_code error;
+      if (std::filesystem::exists(folder / "camera.yaml", error) &&
+          std::filesystem::exists(folder / "target.json", error))
+        break;
+      if (!said) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        SetStatus("watching " + folder.string() + ": waiting for camera.yaml and target.json",
+                  false);
+        said = true;
+      }
+      std::this_thread::sleep_for(kPollPeriod);
+    }
+    try {
+      return FollowFolder(LoadFolderSetup(folder), folder, options);
+    } catch (const IoError& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      SetStatus(std::string("cannot watch: ") + e.what(), true);
+      return std::unique_ptr<CaptureFeed>();
+    }
   });
 }
 
@@ -71,46 +90,66 @@ void Controller::WatchRecording(const std::filesystem::path& recording,
                                 const std::filesystem::path& out, std::optional<BoardSpec> board,
                                 BagImportOptions options) {
   options.max_pairs = 0;  // a capture has no cap: every hold is a pair
-  Follow(recording, [this, recording = std::filesystem::absolute(recording), out, board, options] {
+  Follow(recording, [recording = std::filesystem::absolute(recording), out, board, options] {
     std::error_code error;
     std::filesystem::create_directories(out, error);
-    GrowingRecording growing(recording, out, board, options);
-    WatchRecordingLoop(&growing);
+    return FollowRecording(recording, out, board, options);
   });
 }
 
-void Controller::WatchRecordingLoop(GrowingRecording* recording) {
+void Controller::FollowLoop(CaptureFeed* feed) {
   bool opened = false;
+  std::vector<PairEntry> read_before_open;  // the pairs read until the reader caught up
+  const double first_look_s = SteadySeconds();
   while (!stop_watch_) {
-    RecordingUpdate update;
+    FeedUpdate update;
     try {
-      update = recording->Poll();
+      update = feed->Poll(SteadySeconds());
     } catch (const IoError& e) {
       std::lock_guard<std::mutex> lock(mutex_);
       SetStatus(std::string("cannot watch: ") + e.what(), true);
       return;
     }
-    if (!update.notes.empty()) {
+    std::vector<PairEntry> pairs;
+    {
       std::lock_guard<std::mutex> lock(mutex_);
-      SetStatus(update.notes.back(), false);
+      if (!update.notes.empty()) SetStatus(update.notes.back(), false);
+      for (const FolderEvent& event : update.events)
+        if (event.kind == FolderEvent::Kind::kPairComplete)
+          pairs.push_back(event.pair);
+        else
+          SetStatus(event.stem + ": " + event.reason, true);
     }
-    // The dataset folder opens with the first pair: the recording tells its camera and board.
-    if (!opened && !update.pairs.empty()) {
+    // The dataset opens once the first look has caught up with what is there (and the camera and
+    // the board are known: a recording tells them with its first pair): a session an earlier
+    // watch left is resumed over the pairs read again, the ones written since join as new.
+    if (!opened) {
+      read_before_open.insert(read_before_open.end(), pairs.begin(), pairs.end());
+      const bool caught_up =
+          (pairs.empty() && SteadySeconds() - first_look_s >= kFirstLookSeconds) || update.closed;
+      if (!feed->Setup() || !caught_up) {
+        std::this_thread::sleep_for(kPollPeriod);
+        continue;
+      }
       try {
-        OpenLoadedDataset(*recording->Setup(), {}, ExistingSession::kResume);
+        Dataset read = *feed->Setup();
+        read.manifest = feed->DatasetFolder();
+        read.pairs = read_before_open;
+        if (!ResumeGrownCapture(read)) OpenLoadedDataset(read, {}, ExistingSession::kResume);
       } catch (const IoError& e) {
         std::lock_guard<std::mutex> lock(mutex_);
         SetStatus(std::string("cannot watch: ") + e.what(), true);
         return;
       }
       opened = true;
+      pairs = std::move(read_before_open);  // those a resumed session did not know join now
     }
-    for (const PairEntry& pair : update.pairs) AddPair(pair);
+    for (const PairEntry& pair : pairs) AddPair(pair);
     if (update.closed) {
       std::lock_guard<std::mutex> lock(mutex_);
       SetStatus("the recording was closed by its recorder; its " +
                     std::to_string(state_.pairs.size()) + " pairs are in " +
-                    recording->OutDir().string(),
+                    feed->DatasetFolder().string(),
                 false);
       return;
     }
@@ -121,54 +160,6 @@ void Controller::WatchRecordingLoop(GrowingRecording* recording) {
 void Controller::StopWatching() {
   stop_watch_ = true;
   if (watch_thread_.joinable()) watch_thread_.join();
-}
-
-void Controller::WatchLoop(std::filesystem::path folder, FolderWatchOptions options) {
-  // The capture's camera and target first (a capture script may write them after starting).
-  bool said = false;
-  for (;;) {
-    if (stop_watch_) return;
-    std::error_code error;
-    if (std::filesystem::exists(folder / "camera.yaml", error) &&
-        std::filesystem::exists(folder / "target.json", error))
-      break;
-    if (!said) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      SetStatus("watching " + folder.string() + ": waiting for camera.yaml and target.json", false);
-      said = true;
-    }
-    std::this_thread::sleep_for(kPollPeriod);
-  }
-  try {
-    // The pairs already there, and the session of an earlier watch, resumed; before the first
-    // pair lands, the camera and the target alone.
-    Dataset dataset = LoadFolderSetup(folder);
-    if (HasFolderPairs(folder)) dataset = LoadDataset(folder);
-    dataset.manifest = folder;
-    if (!ResumeGrownCapture(dataset)) OpenLoadedDataset(dataset, {}, ExistingSession::kResume);
-  } catch (const IoError& e) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    SetStatus(std::string("cannot watch: ") + e.what(), true);
-    return;
-  }
-  GrowingFolder growing(folder, options);
-  {
-    std::set<std::string> known;
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (const PairView& pair : state_.pairs) known.insert(pair.id);
-    growing.MarkCompleted(known);
-  }
-  while (!stop_watch_) {
-    for (const FolderEvent& event : growing.Poll(SteadySeconds())) {
-      if (event.kind == FolderEvent::Kind::kPairComplete) {
-        AddPair(event.pair);
-      } else {
-        std::lock_guard<std::mutex> lock(mutex_);
-        SetStatus(event.stem + ": " + event.reason, true);
-      }
-    }
-    std::this_thread::sleep_for(kPollPeriod);
-  }
 }
 
 bool Controller::ResumeGrownCapture(Dataset dataset) {
@@ -182,7 +173,7 @@ bool Controller::ResumeGrownCapture(Dataset dataset) {
     return false;  // the usual resume says why and keeps it as a backup
   }
   const size_t known = saved.pairs.size();
-  if (known >= dataset.pairs.size() ||
+  if (known > dataset.pairs.size() ||
       !std::filesystem::equivalent(saved.dataset, dataset.manifest, error))
     return false;
   for (size_t i = 0; i < known; ++i)
@@ -234,33 +225,54 @@ void Controller::AddPair(const PairEntry& entry) {
   worker_.Enqueue([this, index] { LoadPair(index); });  // selects it when it follows (FollowsTo)
 }
 
-void Controller::AdviseFromState() {
-  CalibrationOutcome outcome;
-  PipelineOptions options;
+void Controller::SyncJobDecisions() {
+  struct Decision {
+    std::string id;
+    bool rejected;
+    std::string reason;
+    std::optional<PairEdit> brush;
+  };
+  std::vector<Decision> decisions;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!state_.solver.result || state_.next_pose) return;
-    for (const PairView& pair : state_.pairs) outcome.pairs.push_back(FeaturesOf(pair));
-    outcome.solution = ResultForCurrentPairs();
-    options = PipelineOptionsFromState();
+    for (size_t i = 0; i < state_.pairs.size() && static_cast<int>(i) < job_->size(); ++i) {
+      const PairView& pair = state_.pairs[i];
+      Decision decision{pair.id, pair.status == PairStatus::kRejected, pair.reason, std::nullopt};
+      // A painted brush is the user's word: completion leaves the pair alone (as with
+      // `calibrate --session`, whose edits hold the brush).
+      if (pair.brush_edited && pair.lidar_image)
+        decision.brush =
+            PairEdit{pair.brush_pixels, pair.lidar_image->rows, pair.lidar_image->columns};
+      decisions.push_back(std::move(decision));
+    }
+    job_->SetSolverOptions(SolverOptionsFromState());
+    job_->SetGoal(state_.goal);
   }
-  Advise(outcome, options);
+  for (const Decision& decision : decisions) {
+    job_->SetRejected(decision.id, decision.rejected, decision.reason);
+    job_->SetBrush(decision.id, decision.brush);
+  }
 }
 
-void Controller::Advise(const CalibrationOutcome& outcome, const PipelineOptions& pipeline) {
-  AdviseOptions options;
-  Dataset dataset;
+void Controller::AdviseFromState() {
+  std::optional<SolverResult> at;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!state_.dataset) return;
-    options.goal = state_.goal;
-    dataset = *state_.dataset;
+    if (!job_ || !state_.solver.result || state_.next_pose) return;
+    at = ResultForCurrentPairs();
   }
-  options.pipeline = pipeline;
-  // The solve's pairs (a watched folder may have added some since).
-  if (dataset.pairs.size() < outcome.pairs.size()) return;
-  dataset.pairs.resize(outcome.pairs.size());
-  const CaptureAdvice advice = AdviseCapture(dataset, outcome, options);
+  SyncJobDecisions();
+  Advise(at);
+}
+
+void Controller::Advise(const std::optional<SolverResult>& at) {
+  if (!job_) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    job_->SetGoal(state_.goal);
+  }
+  // The job's solve (pairs that joined since are judged after the next solve).
+  const CaptureAdvice& advice = job_->Advise(at);
   std::lock_guard<std::mutex> lock(mutex_);
   state_.next_pose = advice.next;
   state_.next_pose_failure = advice.state && advice.state->done

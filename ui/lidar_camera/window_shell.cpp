@@ -11,6 +11,7 @@
 
 #include "core/io/bag.h"
 #include "core/io/dataset.h"
+#include "core/io/recording_watch.h"
 #include "core/results/export.h"
 #include "ui/lidar_camera/report_job.h"
 #include "ui/lidar_camera/workbench.h"

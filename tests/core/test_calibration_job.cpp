@@ -1,0 +1,149 @@
+// The pipeline job (core/session/calibration_job.h) that `calibrate`, `advise`, `watch` and the
+// workbench drive: fed all at once, pair by pair or step by step, it ends where `calibrate` ends,
+// and the user's rejections and brushes are its word.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "core/lidar/lidar_image.h"
+#include "core/session/calibration_job.h"
+#include "tests/sim_scenes.h"
+#include "tests/test_support.h"
+
+namespace calibench {
+namespace {
+
+void ExpectSamePose(const Pose& a, const Pose& b, double tolerance, const std::string& what) {
+  EXPECT_LE((a.matrix() - b.matrix()).cwiseAbs().maxCoeff(), tolerance) << what;
+}
+
+// The workbench's order: every pair's files decoded once, the camera side first, then every cloud
+// into the background, then each LiDAR board.
+CalibrationJob StepByStep(const Dataset& dataset, const CalibrationJobOptions& options) {
+  Dataset setup = dataset;
+  setup.pairs.clear();
+  CalibrationJob job(setup, options);
+  std::vector<LidarCloud> clouds;
+  for (const PairEntry& entry : dataset.pairs) {
+    const int index = job.AppendPair(entry);
+    std::string why;
+    CameraFeatures camera;
+    auto inputs = job.ReadPair(index, &camera, &why);
+    EXPECT_TRUE(inputs && camera.observation) << why << camera.failure;
+    clouds.push_back(std::move(inputs->cloud));
+  }
+  for (size_t i = 0; i < clouds.size(); ++i) job.AddToBackground(static_cast<int>(i), clouds[i]);
+  for (size_t i = 0; i < clouds.size(); ++i) {
+    const LidarImage image = ProjectById(clouds[i], LidarImageOptions{});
+    job.DetectLidar(static_cast<int>(i), clouds[i], &image);
+  }
+  return job;
+}
+
+// On the scene where camera-guided completion decides pair 3 (tests/sim_scenes.h).
+TEST(CalibrationJob, FedAllAtOncePairByPairOrStepByStepItEndsWhereCalibrateEnds) {
+  const auto dir = test::TempDir("calibration_job");
+  const Dataset dataset = test::CompletionMattersScene(dir / "set");
+  const CalibrationOutcome cli = CalibrateDataset(dataset, PipelineOptions{});
+  ASSERT_TRUE(cli.solution) << cli.failure;
+  ASSERT_EQ(cli.pairs[3].board_origin.source, BoardSource::kCameraGuided);
+
+  int progress_calls = 0;
+  CalibrationJob batch(dataset, {}, {},
+                       {.detected = [&](int, int, const std::string&) { ++progress_calls; }});
+  batch.DetectAll();
+  const CalibrationOutcome& all = batch.Solve();
+  ASSERT_TRUE(all.solution) << all.failure;
+  EXPECT_EQ(progress_calls, static_cast<int>(dataset.pairs.size()));
+  // The same steps in the same order: bit for bit.
+  ExpectSamePose(all.solution->cam_from_lidar, cli.solution->cam_from_lidar, 0.0, "all at once");
+  EXPECT_EQ(all.solution->covariance, cli.solution->covariance);
+  EXPECT_EQ(all.pairs[3].board_origin.source, BoardSource::kCameraGuided);
+  // Every solve starts from detection: a second one is the first again.
+  ExpectSamePose(batch.Solve().solution->cam_from_lidar, cli.solution->cam_from_lidar, 0.0,
+                 "solved again");
+
+  CalibrationJob steps = StepByStep(dataset, {});
+  const CalibrationOutcome& stepped = steps.Solve();
+  ASSERT_TRUE(stepped.solution) << stepped.failure;
+  ExpectSamePose(stepped.solution->cam_from_lidar, cli.solution->cam_from_lidar, 1e-12,
+                 "step by step");
+  EXPECT_EQ(stepped.pairs[3].board_origin.source, BoardSource::kCameraGuided);
+
+  // Pair by pair as a capture grows: the early pairs are detected before the background model
+  // exists, and each solve starts from the last one.
+  Dataset setup = dataset;
+  setup.pairs.clear();
+  CalibrationJobOptions growing;
+  growing.warm_start = true;
+  CalibrationJob live(setup, growing);
+  for (const PairEntry& entry : dataset.pairs) {
+    live.AddPair(entry);
+    live.Solve();
+  }
+  const CalibrationOutcome& last = *live.outcome();
+  ASSERT_TRUE(last.solution) << last.failure;
+  const PoseError apart =
+      ComputePoseError(last.solution->cam_from_lidar, cli.solution->cam_from_lidar);
+  std::printf("pair by pair against calibrate: %.6f mm, %.6f deg\n", apart.translation_m * 1e3,
+              apart.rotation_rad * kRadToDeg);
+  EXPECT_LT(apart.translation_m, 1e-6);
+  EXPECT_LT(apart.rotation_rad * kRadToDeg, 1e-5);
+  for (size_t i = 0; i < dataset.pairs.size(); ++i)
+    EXPECT_EQ(last.pairs[i].status, cli.pairs[i].status) << dataset.pairs[i].id;
+
+  // Guidance after the solve judges the solve's pairs; the session holds their verdicts.
+  const CaptureAdvice& advice = live.Advise();
+  ASSERT_EQ(advice.pairs.size(), dataset.pairs.size());
+  ASSERT_TRUE(advice.state);
+  const Session session = live.ToSession(dir / "set");
+  ASSERT_EQ(session.pairs.size(), dataset.pairs.size());
+  for (size_t i = 0; i < dataset.pairs.size(); ++i)
+    EXPECT_EQ(session.pairs[i].status, advice.pairs[i].status);
+  ASSERT_TRUE(session.result);
+  ExpectSamePose(session.result->cam_from_lidar, last.solution->cam_from_lidar, 0.0, "session");
+}
+
+TEST(CalibrationJob, TheUsersRejectionsAndBrushesAreItsWord) {
+  const auto dir = test::TempDir("calibration_job_edits");
+  const Dataset dataset = test::CompletionMattersScene(dir / "set");
+  PairEdits edits;
+  edits[dataset.pairs[0].id].rejected = true;
+  const CalibrationOutcome cli = CalibrateDataset(dataset, PipelineOptions{}, {}, edits);
+  ASSERT_TRUE(cli.solution) << cli.failure;
+
+  CalibrationJob job = StepByStep(dataset, {});
+  job.SetRejected(dataset.pairs[0].id, true);
+  const CalibrationOutcome rejected = job.Solve();
+  ASSERT_TRUE(rejected.solution) << rejected.failure;
+  EXPECT_EQ(rejected.pairs[0].status, PairStatus::kRejected);
+  EXPECT_EQ(rejected.pairs[0].reason, kRejectedByUser);
+  ExpectSamePose(rejected.solution->cam_from_lidar, cli.solution->cam_from_lidar, 1e-12,
+                 "pair 0 rejected");
+  // Taken back: the pair is accepted again from its planes.
+  job.SetRejected(dataset.pairs[0].id, false);
+  EXPECT_EQ(job.Solve().pairs[0].status, PairStatus::kAccepted);
+
+  // A brush erased to nothing is the user's word that pair 1 has no board: it fails, and
+  // camera-guided completion leaves it alone (as `calibrate --session` with that brush).
+  std::string why;
+  auto inputs = LoadPairInputs(dataset, dataset.pairs[1], &why);
+  ASSERT_TRUE(inputs) << why;
+  const LidarImage image = ProjectById(inputs->cloud, LidarImageOptions{});
+  const PairEdit erased{std::vector<int>{}, image.rows, image.columns};
+  job.SetBrush(dataset.pairs[1].id, erased);
+  EXPECT_FALSE(job.DetectLidar(1, inputs->cloud, &image).lidar);
+  const CalibrationOutcome& brushed = job.Solve();
+  EXPECT_EQ(brushed.pairs[1].status, PairStatus::kFailed);
+  EXPECT_FALSE(brushed.pairs[1].lidar);
+  PairEdits erased_edits;
+  erased_edits[dataset.pairs[1].id] = erased;
+  const CalibrationOutcome cli_erased =
+      CalibrateDataset(dataset, PipelineOptions{}, {}, erased_edits);
+  ASSERT_TRUE(cli_erased.solution && brushed.solution);
+  ExpectSamePose(brushed.solution->cam_from_lidar, cli_erased.solution->cam_from_lidar, 1e-12,
+                 "pair 1 erased");
+}
+
+}  // namespace
+}  // namespace calibench
