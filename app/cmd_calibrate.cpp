@@ -7,6 +7,8 @@
 #include "app/pipeline_flags.h"
 #include "core/base/atomic_file.h"
 #include "core/io/dataset.h"
+#include "core/io/rig_folder.h"
+#include "core/lidar_camera/rig.h"
 #include "core/session/session.h"
 
 namespace calibench::app {
@@ -36,6 +38,25 @@ void AddIntrinsicsToResult(const std::string& path, const IntrinsicsResult& r) {
       {"images", static_cast<int>(r.images.size())},
       {"verdict", r.verdict}};
   WriteFileAtomically(path, result.dump(2) + "\n");
+}
+
+// A rig folder (cameras/, images/<camera>/): every camera, then the rig solve
+// (core/lidar_camera/rig.h); the summary printed, the rig's result written to out_path.
+int CalibrateRigFolder(const std::string& folder, const PipelineOptions& options,
+                       const std::string& out_path) {
+  const RigFolder rig = LoadRigFolder(folder);
+  const RigOutcome outcome = CalibrateRig(rig, options, StderrProgress("extracted"));
+  std::printf("%s", FormatRigSummary(outcome).c_str());
+  if (!outcome.joint) {
+    std::fprintf(stderr, "calibench: no calibration for the rig %s: %s\n", folder.c_str(),
+                 outcome.failure.c_str());
+    return kNoCalibration;
+  }
+  if (!out_path.empty()) {
+    WriteRigResult(out_path, outcome);
+    std::printf("wrote %s\n", out_path.c_str());
+  }
+  return kOk;
 }
 
 }  // namespace
@@ -75,6 +96,7 @@ int RunCalibrate(int argc, char** argv) {
     std::fprintf(stderr, "calibench calibrate: give --dataset or --session\n");
     return kUsage;
   }
+  if (IsRigFolder(dataset_path)) return CalibrateRigFolder(dataset_path, flags.options, out_path);
   Dataset dataset = LoadDataset(dataset_path, CameraFile::kOptional);
   std::optional<IntrinsicsResult> intrinsics;
   if (!dataset.missing_camera_file.empty() && !estimate_intrinsics) {

@@ -137,6 +137,10 @@ BoardSpec LoadTargetFile(const fs::path& path) {
   return json_io::ParseTarget(target.Has("target") ? target.Object("target") : target);
 }
 
+void SaveTargetFile(const fs::path& path, const BoardSpec& board) {
+  WriteFileAtomically(path, json_io::TargetToJson(board).dump(2) + "\n");
+}
+
 Dataset LoadDataset(const fs::path& path, CameraFile camera) {
   const DatasetSource source = ResolveDataset(path, DatasetKind::kLidarCamera);
   return source.folder_form ? LoadFolder(fs::absolute(source.path), camera)

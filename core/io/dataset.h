@@ -73,6 +73,8 @@ std::vector<std::pair<std::string, BoardSpec>> ShippedTargetPresets();
 // A target file: the board spec at the top level or under "target" (target.json, a manifest).
 // Throws IoError naming the file.
 BoardSpec LoadTargetFile(const std::filesystem::path& path);
+// Writes the board as a target file (target.json) atomically; throws IoError naming the file.
+void SaveTargetFile(const std::filesystem::path& path, const BoardSpec& board);
 
 // Writes a manifest; paths are written relative to the manifest's folder when they lie under it.
 void SaveDataset(const std::filesystem::path& manifest_path, const Dataset& dataset);

@@ -1,0 +1,42 @@
+// A rig of one LiDAR and several cameras calibrated together: each camera's pairs through the
+// single-camera pipeline (CalibrateDataset: detection, its solve, completion), then the rig solve
+// over every capture (core/lidar_camera/rig_solver.h), where a board two cameras saw at once ties
+// them to each other. The result holds every camera's cam_from_lidar with its σ and the cameras'
+// relative poses.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/io/rig_folder.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/rig_solver.h"
+
+namespace calibench {
+
+struct RigOutcome {
+  std::vector<std::string> camera_names;
+  std::vector<CalibrationOutcome> single;  // each camera alone, as `calibrate` on its pairs
+  std::optional<RigSolution> joint;        // the rig solve, started from the single solutions
+  std::string failure;                     // why `joint` is absent
+  int shared_captures = 0;                 // captures two or more cameras saw the board in
+};
+
+// Calibrates every camera of the rig, then the rig. A camera whose own solve fails leaves the
+// rig without a joint solution (failure says which and why).
+RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
+                        const ProgressCallback& progress = {});
+
+// The rig's result file (format calibench.rig.v1): "cameras": {"<camera>": {"cam_from_lidar":
+// 4x4, "sigma_translation_mm", "sigma_rotation_deg" (camera axes), "covariance" (6x6, right
+// perturbation [rho; phi]), "pairs", "single_camera": {"cam_from_lidar", σ}}}, and
+// "camera_from_camera": {"<to>_from_<from>": {"matrix", σ}} for every ordered pair after the first
+// camera. Throws IoError naming the file when it cannot be written.
+void WriteRigResult(const std::filesystem::path& path, const RigOutcome& outcome);
+
+// Per camera: the joint pose and σ next to the single-camera ones; the relative poses.
+std::string FormatRigSummary(const RigOutcome& outcome);
+
+}  // namespace calibench

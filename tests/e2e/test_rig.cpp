@@ -1,0 +1,78 @@
+// A rig of one LiDAR and two cameras — a pinhole and a fisheye turned 60° aside, their fields
+// overlapping partly — simulated in the rig's folder form and calibrated in one command:
+// each camera within the single-camera bar, and the cameras' relative pose from the rig solve
+// next to the one composed from the two single-camera results.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/geometry/geometry.h"
+#include "core/sim/rig_sim.h"
+#include "tests/test_support.h"
+
+namespace calibench {
+namespace {
+
+Pose PoseFromRows(const nlohmann::json& rows) {
+  Pose pose = Pose::Identity();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = rows[r][c].get<double>();
+  return pose;
+}
+
+TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
+  const auto dir = test::TempDir("rig_two_cameras");
+  RigSimOptions sim;
+  sim.base = SimPreset("default");
+  sim.base.min_distance_m = 1.2;
+  sim.base.max_distance_m = 2.5;
+  sim.base.lidar_range_noise_m = 0.005;
+  sim.base.image_noise = 0.005;
+  sim.base.seed = 23;
+  sim.num_captures = 30;
+  const RigSimTruth truth = SimulateRigFolder(sim, dir / "rig");
+  std::printf("%d captures, %d seen by both cameras\n", sim.num_captures, truth.shared_captures);
+  ASSERT_GE(truth.shared_captures, 4);
+
+  std::string out;
+  const auto result_path = dir / "rig.json";
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
+                                 (dir / "rig").string() + " --out " + result_path.string(),
+                             &out),
+            0)
+      << out;
+  std::printf("%s", out.c_str());
+  const nlohmann::json result = nlohmann::json::parse(std::ifstream(result_path));
+  EXPECT_EQ(result["format"], "calibench.rig.v1");
+  ASSERT_TRUE(result["cameras"].contains("cam0") && result["cameras"].contains("cam1"));
+  Pose joint[2], single[2];
+  for (int c = 0; c < 2; ++c) {
+    const nlohmann::json& camera = result["cameras"]["cam" + std::to_string(c)];
+    joint[c] = PoseFromRows(camera["cam_from_lidar"]);
+    single[c] = PoseFromRows(camera["single_camera"]["matrix"]);
+    EXPECT_EQ(camera["sigma_translation_mm"].size(), 3u);
+    const PoseError e = ComputePoseError(joint[c], truth.cam_from_lidar[c]);
+    const PoseError s = ComputePoseError(single[c], truth.cam_from_lidar[c]);
+    std::printf("cam%d: rig %.2f mm %.3f deg, alone %.2f mm %.3f deg from the truth\n", c,
+                e.translation_m * 1e3, e.rotation_rad * 180 / M_PI, s.translation_m * 1e3,
+                s.rotation_rad * 180 / M_PI);
+    // The single-camera bar (tests/e2e/test_simulated.cpp): 25 mm and 0.6 deg.
+    EXPECT_LT(e.translation_m, 0.025) << c;
+    EXPECT_LT(e.rotation_rad, 0.6 * M_PI / 180) << c;
+  }
+  const Pose true_relative = truth.cam_from_lidar[1] * truth.cam_from_lidar[0].inverse();
+  const Pose written = PoseFromRows(result["camera_from_camera"]["cam1_from_cam0"]["matrix"]);
+  EXPECT_LT((written.matrix() - (joint[1] * joint[0].inverse()).matrix()).norm(), 1e-9);
+  const PoseError rig = ComputePoseError(written, true_relative);
+  const PoseError composed = ComputePoseError(single[1] * single[0].inverse(), true_relative);
+  std::printf("cam1_from_cam0: rig %.2f mm %.3f deg, composed %.2f mm %.3f deg from the truth\n",
+              rig.translation_m * 1e3, rig.rotation_rad * 180 / M_PI, composed.translation_m * 1e3,
+              composed.rotation_rad * 180 / M_PI);
+  EXPECT_LT(rig.translation_m, 0.025);
+  EXPECT_LT(rig.rotation_rad, 0.6 * M_PI / 180);
+}
+
+}  // namespace
+}  // namespace calibench
