@@ -7,6 +7,7 @@
 
 #include "app/commands.h"
 #include "core/base/atomic_file.h"
+#include "core/lidar_camera/rig.h"
 #include "core/results/export.h"
 #include "core/results/result_file.h"
 #include "core/session/session.h"
@@ -20,6 +21,30 @@ std::string FormatNames() {
   for (const ExportFormat format : AllExportFormats())
     names += (names.empty() ? "" : " | ") + ExportFormatName(format);
   return names;
+}
+
+// A rig result (calibench.rig.v1): its tree, each camera's frame named after the camera.
+int ExportRigResult(const std::string& result, ExportFormat format, const ExportFrames& frames,
+                    const std::string& out) {
+  std::vector<RigExportCamera> cameras;
+  for (const auto& [name, cam_from_lidar] : LoadRigResult(result))
+    cameras.push_back({name, cam_from_lidar});
+  ExportedCalibration exported;
+  try {
+    exported = ExportRig(format, cameras, frames, std::filesystem::path(result).filename());
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "calibench export: %s\n", e.what());
+    return kUsage;
+  }
+  const std::filesystem::path path =
+      out.empty() ? std::filesystem::absolute(result).parent_path() / DefaultExportFileName(format)
+                  : std::filesystem::path(out);
+  WriteFileAtomically(path, exported.text);
+  std::printf("wrote %s (%s): %zu cameras in '%s', camera frames %s\n", path.c_str(),
+              ExportFormatName(format).c_str(), cameras.size(), frames.lidar.c_str(),
+              CameraFrameName(frames.camera_frame).c_str());
+  if (!exported.command.empty()) std::printf("%s\n", exported.command.c_str());
+  return kOk;
 }
 
 }  // namespace
@@ -73,6 +98,7 @@ int RunExport(int argc, char** argv) {
     return kUsage;
   }
   frames.camera_frame = *camera;
+  if (IsRigResultFile(result)) return ExportRigResult(result, *format, frames, out);
   const Pose cam_from_lidar = CalibrationOf(result);
   const ExportedCalibration exported =
       ExportCalibration(*format, cam_from_lidar, frames, std::filesystem::path(result).filename());

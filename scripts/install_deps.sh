@@ -10,7 +10,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libglfw3-dev libimgui-dev libegl-dev libgl-dev libgles-dev libosmesa6-dev
   xvfb xauth fonts-dejavu-core
-  libcairo2-dev libjs-chart.js chromium poppler-utils
+  libcairo2-dev libjs-chart.js chromium poppler-utils liburdfdom-tools
 )
 # Only for the robustness scripts: scripts/fuzz.sh (libFuzzer) and scripts/sanitize.sh (valgrind).
 case "${1:-}" in

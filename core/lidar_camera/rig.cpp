@@ -1,6 +1,7 @@
 #include "core/lidar_camera/rig.h"
 
 #include <cstdio>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -114,6 +115,42 @@ void WriteRigResult(const std::filesystem::path& path, const RigOutcome& outcome
                      {"iterations", joint.iterations},
                      {"converged", joint.converged}};
   WriteFileAtomically(path, root.dump(2) + "\n");
+}
+
+std::vector<std::pair<std::string, Pose>> LoadRigResult(const std::filesystem::path& path) {
+  std::ifstream file(path);
+  if (!file) throw IoError(path.string() + ": cannot open the rig result");
+  nlohmann::json root;
+  try {
+    root = nlohmann::json::parse(file);
+  } catch (const nlohmann::json::exception& e) {
+    throw IoError(path.string() + ": not a valid rig result (JSON): " + e.what());
+  }
+  if (!root.is_object() || root.value("format", "") != "calibench.rig.v1" ||
+      !root.contains("cameras") || !root["cameras"].is_object())
+    throw IoError(path.string() + ": not a Calibench rig result (format calibench.rig.v1)");
+  std::vector<std::pair<std::string, Pose>> cameras;
+  for (const auto& [name, camera] : root["cameras"].items()) {
+    const nlohmann::json& rows = camera["cam_from_lidar"];
+    Pose pose = Pose::Identity();
+    try {
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = rows.at(r).at(c).get<double>();
+    } catch (const nlohmann::json::exception&) {
+      throw IoError(path.string() + ": cameras." + name + ".cam_from_lidar: not a 4x4 matrix");
+    }
+    cameras.emplace_back(name, pose);
+  }
+  if (cameras.empty()) throw IoError(path.string() + ": the rig result holds no camera");
+  return cameras;
+}
+
+bool IsRigResultFile(const std::filesystem::path& path) {
+  std::ifstream file(path);
+  std::string head(4096, '\0');
+  file.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(file.gcount()));
+  return head.find("calibench.rig.v1") != std::string::npos;
 }
 
 std::string FormatRigSummary(const RigOutcome& outcome) {

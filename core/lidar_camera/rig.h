@@ -36,6 +36,12 @@ RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
 // camera. Throws IoError naming the file when it cannot be written.
 void WriteRigResult(const std::filesystem::path& path, const RigOutcome& outcome);
 
+// A rig result file's cameras (name, cam_from_lidar), in the file's order; throws IoError naming
+// the file for anything else.
+std::vector<std::pair<std::string, Pose>> LoadRigResult(const std::filesystem::path& path);
+// Whether the file is a rig result (its first 4 KB name calibench.rig.v1).
+bool IsRigResultFile(const std::filesystem::path& path);
+
 // Per camera: the joint pose and σ next to the single-camera ones; the relative poses.
 std::string FormatRigSummary(const RigOutcome& outcome);
 

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 
 namespace calibench {
@@ -307,6 +308,67 @@ ExportedCalibration ExportCalibration(ExportFormat format, const Pose& cam_from_
       return Txt(pose, frames, source);
   }
   return Txt(pose, frames, source);
+}
+
+ExportedCalibration ExportRig(ExportFormat format, const std::vector<RigExportCamera>& cameras,
+                              const ExportFrames& frames, const std::string& source) {
+  if (format != ExportFormat::kUrdf && format != ExportFormat::kRos1Tf &&
+      format != ExportFormat::kRos2Tf)
+    throw std::invalid_argument("a rig's tree exports as urdf, ros1-tf or ros2-tf; " +
+                                ExportFormatName(format) + " holds one transform");
+  // Each camera as the single-camera formats write it, then joined into one file.
+  std::vector<ExportedCalibration> parts;
+  std::vector<ExportFrames> per_camera;
+  for (const RigExportCamera& camera : cameras) {
+    ExportFrames f = frames;
+    f.camera = camera.frame;
+    f.camera_is_parent = false;
+    per_camera.push_back(f);
+    parts.push_back(ExportCalibration(format, camera.cam_from_lidar, f, source));
+  }
+  std::vector<std::string> header = {
+      "Calibench rig calibration" + (source.empty() ? "" : " from " + source) + ": the pose of " +
+          "each camera in '" + frames.lidar + "' (x_in_" + frames.lidar + " = " + frames.lidar +
+          "_from_<camera> * x_in_<camera>)",
+      "The camera frames are " + CameraFrameWords(frames.camera_frame)};
+  ExportedCalibration tree;
+  if (format == ExportFormat::kUrdf) {
+    tree.text = "<?xml version=\"1.0\"?>\n<!--\n" + Commented(header, "  ") +
+                "  Each joint's origin is that pose (xyz in metres, rpy in radians: "
+                "R = Rz(yaw) Ry(pitch) Rx(roll)).\n-->\n<robot name=\"calibench_rig\">\n" +
+                "  <link name=\"" + frames.lidar + "\"/>\n";
+    for (size_t c = 0; c < cameras.size(); ++c) {
+      const TransformText t = TextOf(ParentFromChild(cameras[c].cam_from_lidar, per_camera[c]));
+      tree.text += "  <link name=\"" + cameras[c].frame + "\"/>\n";
+      tree.text += "  <joint name=\"" + JointName(per_camera[c]) + "\" type=\"fixed\">\n";
+      tree.text += "    <parent link=\"" + frames.lidar + "\"/>\n";
+      tree.text += "    <child link=\"" + cameras[c].frame + "\"/>\n";
+      tree.text += "    <origin xyz=\"" + t.x + " " + t.y + " " + t.z + "\" rpy=\"" + t.roll + " " +
+                   t.pitch + " " + t.yaw + "\"/>\n  </joint>\n";
+    }
+    tree.text += "</robot>\n";
+    return tree;
+  }
+  // The launch files: one publisher per camera, the body of each single-camera file.
+  const bool ros1 = format == ExportFormat::kRos1Tf;
+  const std::string open = ros1 ? "<node " : "        Node(";
+  const std::string close = ros1 ? "/>\n" : "        ),\n";
+  std::string body;
+  for (const ExportedCalibration& part : parts) {
+    const size_t begin = part.text.find(open);
+    const size_t end = part.text.find(close, begin);
+    CALIBENCH_CHECK(begin != std::string::npos && end != std::string::npos);
+    body += (ros1 ? "  " : "") + part.text.substr(begin, end + close.size() - begin);
+    tree.command += (tree.command.empty() ? "" : "\n") + part.command;
+  }
+  tree.text =
+      ros1 ? "<launch>\n  <!--\n" + Commented(header, "    ") + "  -->\n" + body + "</launch>\n"
+           : Commented(header, "# ") +
+                 "\nfrom launch import LaunchDescription\nfrom launch_ros.actions import "
+                 "Node\n\n\ndef generate_launch_description():\n    return "
+                 "LaunchDescription([\n" +
+                 body + "    ])\n";
+  return tree;
 }
 
 Vec3 RollPitchYaw(const Mat3& r) {

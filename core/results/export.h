@@ -63,6 +63,17 @@ struct ExportedCalibration {
 ExportedCalibration ExportCalibration(ExportFormat format, const Pose& cam_from_lidar,
                                       const ExportFrames& frames, const std::string& source);
 
+// A rig's transform tree: the LiDAR (frames.lidar) the parent of every camera, each camera's
+// frame named by `frame` (frames.camera and camera_is_parent are not used). URDF (a joint per
+// camera), ROS 1 and ROS 2 static transforms (a publisher per camera); the other formats hold one
+// transform and throw std::invalid_argument saying which formats hold a tree.
+struct RigExportCamera {
+  std::string frame;
+  Pose cam_from_lidar;
+};
+ExportedCalibration ExportRig(ExportFormat format, const std::vector<RigExportCamera>& cameras,
+                              const ExportFrames& frames, const std::string& source);
+
 // What an exported file (any format above) holds.
 struct ImportedTransform {
   std::optional<ExportFormat> format;  // nullopt: a calibench result (cam_from_lidar)

@@ -72,6 +72,36 @@ TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
               composed.rotation_rad * 180 / M_PI);
   EXPECT_LT(rig.translation_m, 0.025);
   EXPECT_LT(rig.rotation_rad, 0.6 * M_PI / 180);
+
+  // The tree a robot loads: a URDF with a joint per camera, which urdfdom's parser accepts, and
+  // whose joints read back as the rig's poses; the ROS 2 launch file with a publisher per camera.
+  const auto urdf = dir / "rig.urdf";
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " export --result " + result_path.string() +
+                                 " --format urdf --parent-frame velodyne --out " + urdf.string(),
+                             &out),
+            0)
+      << out;
+  ASSERT_EQ(test::RunCommand("check_urdf " + urdf.string(), &out), 0)
+      << out << "(check_urdf comes with Debian's liburdfdom-tools: scripts/install_deps.sh)";
+  EXPECT_NE(out.find("root Link: velodyne has 2 child(ren)"), std::string::npos) << out;
+  EXPECT_NE(out.find("child(1):  cam0"), std::string::npos) << out;
+  EXPECT_NE(out.find("child(2):  cam1"), std::string::npos) << out;
+  const auto launch = dir / "rig.launch.py";
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " export --result " + result_path.string() +
+                                 " --format ros2-tf --out " + launch.string(),
+                             &out),
+            0)
+      << out;
+  std::ifstream launch_file(launch);
+  const std::string text((std::istreambuf_iterator<char>(launch_file)), {});
+  EXPECT_NE(text.find("\"--child-frame-id\", \"cam0\""), std::string::npos) << text;
+  EXPECT_NE(text.find("\"--child-frame-id\", \"cam1\""), std::string::npos) << text;
+  // A format that holds one transform says so.
+  EXPECT_NE(test::RunCommand(test::CalibenchExe() + " export --result " + result_path.string() +
+                                 " --format kalibr --out " + (dir / "k.yaml").string(),
+                             &out),
+            0);
+  EXPECT_NE(out.find("holds one transform"), std::string::npos) << out;
 }
 
 }  // namespace
