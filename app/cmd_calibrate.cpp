@@ -67,7 +67,9 @@ int RunCalibrate(int argc, char** argv) {
       "Gauss-Newton with a Huber kernel).",
       "calibench calibrate"};
   std::string dataset_path, session_path, out_path, report_path;
-  AddDatasetOption(app, &dataset_path, "a LiDAR-camera dataset");
+  AddDatasetOption(app, &dataset_path,
+                   "a LiDAR-camera dataset, or a rig folder (cameras/<camera>.yaml, "
+                   "images/<camera>/<stem>, clouds/<stem>): every camera, then the rig");
   app.add_option("--session", session_path,
                  "a workbench session (calibench.session.json): its brushes, rejections and "
                  "solver choices are used, so the result is the workbench's; its dataset unless "
