@@ -10,12 +10,16 @@
 #include <tuple>
 
 #include "app/commands.h"
+#include "app/pipeline_flags.h"
 #include "core/io/bag.h"
 #include "core/io/bag_import.h"
 #include "core/io/camera_file.h"
 #include "core/io/dataset.h"
 #include "core/io/json_io.h"
+#include "core/io/rig_folder.h"
+#include "core/io/rig_import.h"
 #include "core/io/ros_messages.h"
+#include "core/lidar_camera/rig.h"
 
 namespace calibench::app {
 namespace fs = std::filesystem;
@@ -126,6 +130,31 @@ std::optional<BoardSpec> BoardFromFlag(const std::string& board) {
   return BoardPreset(board);
 }
 
+// `import --camera-topic A --camera-topic B`: the rig's folder form, then (--calibrate) the rig.
+int ImportRigFolder(const std::string& bag_path, const std::string& out,
+                    const std::optional<BoardSpec>& board, const BagImportOptions& options,
+                    const std::vector<std::string>& topics, bool calibrate) {
+  const RigImportSummary summary = ImportRig(bag_path, out, board, options, topics, ProgressBar());
+  for (size_t c = 0; c < summary.cameras.size(); ++c) {
+    std::printf("camera %s (%s):\n", summary.camera_names[c].c_str(), topics[c].c_str());
+    PrintSummary(summary.cameras[c], options);
+  }
+  std::printf("rig folder %s: %d captures, %d seen by two or more cameras\n", out.c_str(),
+              summary.captures, summary.shared_captures);
+  if (!calibrate) return kOk;
+  const RigOutcome outcome = CalibrateRig(LoadRigFolder(out), PipelineOptions{});
+  std::printf("%s", FormatRigSummary(outcome).c_str());
+  if (!outcome.joint) {
+    std::fprintf(stderr, "calibench: no calibration for the rig %s: %s\n", out.c_str(),
+                 outcome.failure.c_str());
+    return kNoCalibration;
+  }
+  const fs::path result = fs::path(out) / "rig.json";
+  WriteRigResult(result, outcome);
+  std::printf("wrote %s\n", result.c_str());
+  return kOk;
+}
+
 int RunImport(int argc, char** argv) {
   CLI::App app{
       "Turn a recording into a dataset folder (binary PCD + PNG + camera.yaml + dataset.json): "
@@ -152,6 +181,16 @@ int RunImport(int argc, char** argv) {
                  "Image or CompressedImage topic (default: the only one)");
   app.add_option("--camera-info-topic", options.camera_info_topic,
                  "CameraInfo topic (default: the one beside the image topic)");
+  std::vector<std::string> camera_topics;
+  bool calibrate = false;
+  app.add_option("--camera-topic", camera_topics,
+                 "a rig: one Image or CompressedImage topic per camera (repeat the flag); the "
+                 "folder is then the rig's form (images/<camera>/, cameras/<camera>.yaml), each "
+                 "camera named after its topic")
+      ->excludes("--image-topic");
+  app.add_flag("--calibrate", calibrate,
+               "then calibrate the folder written (a rig: every camera, then the rig) and write "
+               "result.json (rig.json for a rig) into it");
   app.add_option("--camera", camera_file,
                  "intrinsics file instead of the recording's CameraInfo (OpenCV, ROS or Kalibr)");
   AddSelectionFlags(app, &options);
@@ -177,6 +216,8 @@ int RunImport(int argc, char** argv) {
     return kUsage;
   }
   if (out.empty()) out = DefaultImportFolder(bag_path).string();
+  if (!camera_topics.empty())
+    return ImportRigFolder(bag_path, out, board_spec, options, camera_topics, calibrate);
   const auto start = std::chrono::steady_clock::now();
   const BagImportSummary summary = ImportBag(bag_path, out, board_spec, options, ProgressBar());
   const double seconds =
@@ -189,7 +230,9 @@ int RunImport(int argc, char** argv) {
     std::fprintf(stderr, " (the recording spans %.1f s: %.2fx its length)",
                  summary.recording_seconds, seconds / summary.recording_seconds);
   std::fprintf(stderr, "\n");
-  return kOk;
+  if (!calibrate) return kOk;
+  return CalibrateAndReport(LoadDataset(out), PipelineOptions{},
+                            (fs::path(out) / "result.json").string());
 }
 
 }  // namespace calibench::app

@@ -94,6 +94,15 @@ SimRecordingTruth PlanSimRecording(const SimRecordingOptions& options) {
   truth.camera = resolved.camera;
   truth.board = resolved.board;
   truth.cam_from_lidar = resolved.cam_from_lidar;
+  if (options.second_camera_yaw_deg != 0.0) {
+    Pose lidar_from_second = resolved.cam_from_lidar.inverse();
+    lidar_from_second.linear() =
+        Eigen::AngleAxisd(options.second_camera_yaw_deg * M_PI / 180.0, Vec3::UnitZ())
+            .toRotationMatrix() *
+        lidar_from_second.linear();
+    lidar_from_second.translation() += Vec3(0.0, 0.20, 0.0);
+    truth.second_cam_from_lidar = lidar_from_second.inverse();
+  }
   const auto hold = static_cast<std::int64_t>(options.hold_s * kSecond);
   const auto move = static_cast<std::int64_t>(options.move_s * kSecond);
   for (int i = 0; i < options.poses; ++i) {
@@ -117,7 +126,7 @@ SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding enc
   RenderOptions still_render;  // once per hold, then noise per frame
   RenderOptions moving_render;
   moving_render.supersampling = 1;
-  std::vector<ImageU8> held_images(options.poses);
+  std::vector<ImageU8> held_images(options.poses), held_second(options.poses);
 
   const auto cloud_period = static_cast<std::int64_t>(kSecond / options.cloud_hz);
   const auto image_period = static_cast<std::int64_t>(kSecond / options.image_hz);
@@ -154,11 +163,32 @@ SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding enc
         image = RenderBoardImage(truth.camera, truth.board, BoardAt(truth, t), moving_render);
       }
       const std::int64_t received = t + 15'000'000;
+      const std::string first = truth.second_cam_from_lidar ? "cam0" : "camera";
       writer->Add(
-          {"/camera/image_raw", "sensor_msgs/Image", received,
-           SerializeImage(image, image.channels == 1 ? "mono8" : "bgr8", t, "camera", encoding)});
-      writer->Add({"/camera/camera_info", "sensor_msgs/CameraInfo", received,
-                   SerializeCameraInfo(truth.camera, t, "camera", encoding)});
+          {"/" + first + "/image_raw", "sensor_msgs/Image", received,
+           SerializeImage(image, image.channels == 1 ? "mono8" : "bgr8", t, first, encoding)});
+      writer->Add({"/" + first + "/camera_info", "sensor_msgs/CameraInfo", received,
+                   SerializeCameraInfo(truth.camera, t, first, encoding)});
+      truth.messages += 2;
+      if (!truth.second_cam_from_lidar) continue;
+      // The rig's second camera, triggered with the first: the same board from its mount.
+      const Pose second_from_board =
+          *truth.second_cam_from_lidar * truth.cam_from_lidar.inverse() * BoardAt(truth, t);
+      ImageU8 second;
+      if (pose >= 0) {
+        if (held_second[pose].empty())
+          held_second[pose] =
+              RenderBoardImage(truth.camera, truth.board, second_from_board, still_render);
+        second = WithNoise(held_second[pose], &rng);
+        if (pose > 0) held_second[pose - 1] = ImageU8{};
+      } else {
+        second = RenderBoardImage(truth.camera, truth.board, second_from_board, moving_render);
+      }
+      writer->Add(
+          {"/cam1/image_raw", "sensor_msgs/Image", received,
+           SerializeImage(second, second.channels == 1 ? "mono8" : "bgr8", t, "cam1", encoding)});
+      writer->Add({"/cam1/camera_info", "sensor_msgs/CameraInfo", received,
+                   SerializeCameraInfo(truth.camera, t, "cam1", encoding)});
       truth.messages += 2;
     }
   }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/base/types.h"
@@ -26,6 +27,10 @@ struct SimRecordingOptions {
   double lidar_range_noise_m = 0.01;                  // a VLP-16's
   double min_distance_m = 1.5, max_distance_m = 4.0;  // board centre from the camera
   std::uint64_t seed = 7;
+  // A rig: a second camera like the first, turned this far to the left about the LiDAR's z axis
+  // (degrees) and 20 cm to the left; the topics are then /cam0/... and /cam1/... (0 = one
+  // camera on /camera/...).
+  double second_camera_yaw_deg = 0.0;
 };
 
 struct SimRecordingTruth {
@@ -34,7 +39,8 @@ struct SimRecordingTruth {
   CameraModel camera;
   BoardSpec board;
   Pose cam_from_lidar;
-  double seconds = 0.0;  // the recording's length
+  std::optional<Pose> second_cam_from_lidar;  // the rig's second camera (same model)
+  double seconds = 0.0;                       // the recording's length
   std::int64_t messages = 0;
 };
 

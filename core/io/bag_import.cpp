@@ -173,6 +173,7 @@ class Importer {
       entry.image = fs::absolute(out_dir_ / "images" / (id + ".png"));
       dataset.pairs.push_back(entry);
       summary_.pair_ids.push_back(id);
+      summary_.pair_cloud_stamps_ns.push_back(pair.cloud_stamp_ns);
       pairs.push_back({{"id", id},
                        {"cloud_stamp_ns", pair.cloud_stamp_ns},
                        {"image_stamp_ns", pair.image_stamp_ns}});

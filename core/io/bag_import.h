@@ -38,13 +38,14 @@ struct BagImportOptions : PairSelectionOptions {
 struct BagImportSummary {
   std::string format;  // the reader's description of the file
   std::string cloud_topic, image_topic, camera_source;
-  std::int64_t clouds = 0;             // messages on the cloud topic
-  std::int64_t images = 0;             // messages on the image topic
-  int tries = 0;                       // sweeps tried (the LiDAR saw the board held still)
-  int images_searched = 0;             // images searched for the board
-  int boards_seen = 0;                 // of those, the board found
-  std::vector<std::string> pair_ids;   // written, in time order
-  std::map<std::string, int> dropped;  // reason -> clouds dropped for it
+  std::int64_t clouds = 0;            // messages on the cloud topic
+  std::int64_t images = 0;            // messages on the image topic
+  int tries = 0;                      // sweeps tried (the LiDAR saw the board held still)
+  int images_searched = 0;            // images searched for the board
+  int boards_seen = 0;                // of those, the board found
+  std::vector<std::string> pair_ids;  // written, in time order
+  std::vector<std::int64_t> pair_cloud_stamps_ns;  // each written pair's sweep, as pair_ids
+  std::map<std::string, int> dropped;              // reason -> clouds dropped for it
   // Kept pairs with no other image within the stillness window (a camera as slow as the
   // window): their stillness is unknown.
   int kept_without_stillness_check = 0;

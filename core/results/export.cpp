@@ -312,10 +312,10 @@ ExportedCalibration ExportCalibration(ExportFormat format, const Pose& cam_from_
 
 ExportedCalibration ExportRig(ExportFormat format, const std::vector<RigExportCamera>& cameras,
                               const ExportFrames& frames, const std::string& source) {
-  if (format != ExportFormat::kUrdf && format != ExportFormat::kRos1Tf &&
-      format != ExportFormat::kRos2Tf)
-    throw std::invalid_argument("a rig's tree exports as urdf, ros1-tf or ros2-tf; " +
-                                ExportFormatName(format) + " holds one transform");
+  if (format == ExportFormat::kOpenCvYaml || format == ExportFormat::kTxt)
+    throw std::invalid_argument(
+        "a rig's tree exports as urdf, ros1-tf, ros2-tf, autoware or kalibr; " +
+        ExportFormatName(format) + " holds one transform");
   // Each camera as the single-camera formats write it, then joined into one file.
   std::vector<ExportedCalibration> parts;
   std::vector<ExportFrames> per_camera;
@@ -347,6 +347,43 @@ ExportedCalibration ExportRig(ExportFormat format, const std::vector<RigExportCa
                    t.pitch + " " + t.yaw + "\"/>\n  </joint>\n";
     }
     tree.text += "</robot>\n";
+    return tree;
+  }
+  if (format == ExportFormat::kAutoware) {
+    // sensor_kit_calibration.yaml: the LiDAR's block with a child per camera.
+    tree.text = Commented(header, "# ") +
+                "# Autoware's sensor_kit_calibration.yaml form: <parent>: <child>: x y z (m),\n"
+                "# roll pitch yaw (rad, R = Rz(yaw) Ry(pitch) Rx(roll)).\n" +
+                frames.lidar + ":\n";
+    for (size_t c = 0; c < cameras.size(); ++c) {
+      const TransformText t = TextOf(ParentFromChild(cameras[c].cam_from_lidar, per_camera[c]));
+      tree.text += "  " + cameras[c].frame + ":\n    x: " + t.x + "\n    y: " + t.y +
+                   "\n    z: " + t.z + "\n    roll: " + t.roll + "\n    pitch: " + t.pitch +
+                   "\n    yaw: " + t.yaw + "\n";
+    }
+    return tree;
+  }
+  if (format == ExportFormat::kKalibr) {
+    // A camchain: cam<n> with T_cam_lidar, and from cam1 on T_cn_cnm1 (cam n from cam n-1), as
+    // Kalibr's multi-camera chains hold them.
+    tree.text = Commented(header, "# ") +
+                "# Kalibr's naming: T_a_b maps b into a (x_in_a = T_a_b * x_in_b): T_cam_lidar is "
+                "<camera>_from_" +
+                frames.lidar + ", T_cn_cnm1 the camera from the one before it.\n";
+    for (size_t c = 0; c < cameras.size(); ++c) {
+      const Pose cam_from_lidar =
+          ParentFromChild(cameras[c].cam_from_lidar, per_camera[c]).inverse();
+      tree.text += "cam" + std::to_string(c) + ":\n  T_cam_lidar:\n" +
+                   MatrixRows(cam_from_lidar.matrix(), "  ");
+      if (c > 0) {
+        const Pose previous =
+            ParentFromChild(cameras[c - 1].cam_from_lidar, per_camera[c - 1]).inverse();
+        tree.text +=
+            "  T_cn_cnm1:\n" + MatrixRows((cam_from_lidar * previous.inverse()).matrix(), "  ");
+      }
+      tree.text += "  rostopic_frame: " + cameras[c].frame + "\n  parent_frame: " + frames.lidar +
+                   "\n  camera_frame: " + CameraFrameName(frames.camera_frame) + "\n";
+    }
     return tree;
   }
   // The launch files: one publisher per camera, the body of each single-camera file.

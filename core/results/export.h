@@ -65,8 +65,9 @@ ExportedCalibration ExportCalibration(ExportFormat format, const Pose& cam_from_
 
 // A rig's transform tree: the LiDAR (frames.lidar) the parent of every camera, each camera's
 // frame named by `frame` (frames.camera and camera_is_parent are not used). URDF (a joint per
-// camera), ROS 1 and ROS 2 static transforms (a publisher per camera); the other formats hold one
-// transform and throw std::invalid_argument saying which formats hold a tree.
+// camera), ROS 1 and ROS 2 static transforms (a publisher per camera), Autoware's
+// sensor_kit_calibration.yaml (a child per camera) and a Kalibr camchain (cam<n> with T_cam_lidar
+// and T_cn_cnm1); OpenCV YAML and txt hold one transform and throw std::invalid_argument.
 struct RigExportCamera {
   std::string frame;
   Pose cam_from_lidar;

@@ -9,7 +9,10 @@
 #include <nlohmann/json.hpp>
 
 #include "core/geometry/geometry.h"
+#include "core/io/dataset.h"
 #include "core/sim/rig_sim.h"
+#include "tests/bag_writers.h"
+#include "tests/sim_recording.h"
 #include "tests/test_support.h"
 
 namespace calibench {
@@ -96,12 +99,71 @@ TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
   const std::string text((std::istreambuf_iterator<char>(launch_file)), {});
   EXPECT_NE(text.find("\"--child-frame-id\", \"cam0\""), std::string::npos) << text;
   EXPECT_NE(text.find("\"--child-frame-id\", \"cam1\""), std::string::npos) << text;
-  // A format that holds one transform says so.
+  // Autoware's sensor kit file and a Kalibr camchain hold the tree too; a format that holds one
+  // transform says so.
+  for (const char* format : {"autoware", "kalibr"}) {
+    const auto file = dir / (std::string(format) + ".yaml");
+    ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " export --result " + result_path.string() +
+                                   " --format " + format + " --out " + file.string(),
+                               &out),
+              0)
+        << out;
+    std::ifstream in(file);
+    const std::string yaml((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_NE(yaml.find(std::string(format) == "kalibr" ? "T_cn_cnm1" : "  cam1:"),
+              std::string::npos)
+        << yaml;
+  }
   EXPECT_NE(test::RunCommand(test::CalibenchExe() + " export --result " + result_path.string() +
-                                 " --format kalibr --out " + (dir / "k.yaml").string(),
+                                 " --format opencv-yaml --out " + (dir / "o.yaml").string(),
                              &out),
             0);
   EXPECT_NE(out.find("holds one transform"), std::string::npos) << out;
+}
+
+// A recording with two camera topics (an MCAP as `ros2 bag record` writes it: a VLP-16 and two
+// cameras, the second turned 25° aside) imported into the rig's folder form and calibrated in one
+// command; the tree it exports loads in urdfdom.
+TEST(Rig, ARecordingWithTwoCameraTopicsIsImportedAndCalibratedInOneCommand) {
+  const auto dir = test::TempDir("rig_recording");
+  test::SimRecordingOptions options = test::SmallSimRecording(10);
+  options.second_camera_yaw_deg = 25.0;
+  auto writer = test::OpenMcapWriter(dir / "rig.mcap", "ros2", "lz4", /*summary=*/true);
+  const test::SimRecordingTruth truth =
+      test::WriteSimRecording(writer.get(), MessageEncoding::kCdr, options);
+  writer->Close();
+  SaveTargetFile(dir / "target.json", truth.board);  // the board, kept beside the recording
+  std::string out;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " import " + (dir / "rig.mcap").string() +
+                                 " --camera-topic /cam0/image_raw --camera-topic /cam1/image_raw"
+                                 " --out " +
+                                 (dir / "rig").string() + " --calibrate",
+                             &out),
+            0)
+      << out;
+  std::printf("%s", out.c_str());
+  const nlohmann::json result = nlohmann::json::parse(std::ifstream(dir / "rig" / "rig.json"));
+  const Pose truths[2] = {truth.cam_from_lidar, *truth.second_cam_from_lidar};
+  for (int c = 0; c < 2; ++c) {
+    const std::string name = "cam" + std::to_string(c);
+    ASSERT_TRUE(result["cameras"].contains(name)) << result.dump(2);
+    const PoseError e =
+        ComputePoseError(PoseFromRows(result["cameras"][name]["cam_from_lidar"]), truths[c]);
+    std::printf("%s from the recording: %.2f mm, %.3f deg from the truth\n", name.c_str(),
+                e.translation_m * 1e3, e.rotation_rad * 180 / M_PI);
+    EXPECT_LT(e.translation_m, 0.025) << name;
+    EXPECT_LT(e.rotation_rad, 0.6 * M_PI / 180) << name;
+  }
+  EXPECT_GE(result["shared_captures"].get<int>(), 1);
+  const auto urdf = dir / "rig.urdf";
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " export --result " +
+                                 (dir / "rig" / "rig.json").string() + " --format urdf --out " +
+                                 urdf.string(),
+                             &out),
+            0)
+      << out;
+  ASSERT_EQ(test::RunCommand("check_urdf " + urdf.string(), &out), 0) << out;
+  EXPECT_NE(out.find("root Link: lidar has 2 child(ren)"), std::string::npos) << out;
 }
 
 }  // namespace
