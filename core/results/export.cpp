@@ -8,63 +8,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/results/export_text.h"
+
 namespace calibench {
 
+using namespace export_text;
+
 namespace {
-
-std::string Number(double value) {
-  if (value == 0.0) value = 0.0;  // no "-0"
-  char buffer[40];
-  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
-  return buffer;
-}
-
-std::string Numbers(std::initializer_list<double> values, const char* separator) {
-  std::string out;
-  for (const double value : values) out += (out.empty() ? "" : separator) + Number(value);
-  return out;
-}
-
-std::string CameraFrameWords(CameraFrame frame) {
-  return frame == CameraFrame::kOptical
-             ? "optical (z forward, x right, y down: the camera's image axes)"
-             : "link (REP 103: x forward, y left, z up)";
-}
-
-// The header every file carries, one line per entry, for the format's comment syntax.
-std::vector<std::string> HeaderLines(const ExportFrames& frames, const std::string& source) {
-  const std::string& parent = frames.parent();
-  const std::string& child = frames.child();
-  return {"Calibench extrinsic calibration" + (source.empty() ? "" : " from " + source),
-          "The pose of '" + child + "' in '" + parent + "': x_in_" + parent + " = " + parent +
-              "_from_" + child + " * x_in_" + child + " (a point in " + child +
-              " coordinates mapped into " + parent + " coordinates)",
-          "The camera frame '" + frames.camera + "' is " + CameraFrameWords(frames.camera_frame)};
-}
-
-std::string Commented(const std::vector<std::string>& lines, const std::string& prefix) {
-  std::string out;
-  for (const std::string& line : lines) out += prefix + line + "\n";
-  return out;
-}
-
-struct TransformText {
-  std::string x, y, z, qx, qy, qz, qw, roll, pitch, yaw;
-};
-
-TransformText TextOf(const Pose& parent_from_child) {
-  const Vec3 t = parent_from_child.translation();
-  Eigen::Quaterniond q(parent_from_child.rotation());
-  q.normalize();
-  if (q.w() < 0) q.coeffs() *= -1.0;  // one of the two equal quaternions, always the same
-  const Vec3 rpy = RollPitchYaw(parent_from_child.rotation());
-  return {Number(t.x()), Number(t.y()), Number(t.z()),   Number(q.x()),   Number(q.y()),
-          Number(q.z()), Number(q.w()), Number(rpy.x()), Number(rpy.y()), Number(rpy.z())};
-}
-
-std::string JointName(const ExportFrames& frames) {
-  return frames.parent() + "_to_" + frames.child();
-}
 
 ExportedCalibration Urdf(const Pose& pose, const ExportFrames& frames, const std::string& source) {
   const TransformText t = TextOf(pose);
@@ -126,14 +76,6 @@ ExportedCalibration Ros2Tf(const Pose& pose, const ExportFrames& frames,
   text += "            name=\"" + JointName(frames) + "\",\n";
   text += "            arguments=[\n" + list + "            ],\n        ),\n    ])\n";
   return {text, command};
-}
-
-std::string MatrixRows(const Mat4& m, const char* indent) {
-  std::string out;
-  for (int r = 0; r < 4; ++r)
-    out +=
-        std::string(indent) + "- [" + Numbers({m(r, 0), m(r, 1), m(r, 2), m(r, 3)}, ", ") + "]\n";
-  return out;
 }
 
 ExportedCalibration OpenCvYaml(const Pose& pose, const ExportFrames& frames,
@@ -308,104 +250,6 @@ ExportedCalibration ExportCalibration(ExportFormat format, const Pose& cam_from_
       return Txt(pose, frames, source);
   }
   return Txt(pose, frames, source);
-}
-
-ExportedCalibration ExportRig(ExportFormat format, const std::vector<RigExportCamera>& cameras,
-                              const ExportFrames& frames, const std::string& source) {
-  if (format == ExportFormat::kOpenCvYaml || format == ExportFormat::kTxt)
-    throw std::invalid_argument(
-        "a rig's tree exports as urdf, ros1-tf, ros2-tf, autoware or kalibr; " +
-        ExportFormatName(format) + " holds one transform");
-  // Each camera as the single-camera formats write it, then joined into one file.
-  std::vector<ExportedCalibration> parts;
-  std::vector<ExportFrames> per_camera;
-  for (const RigExportCamera& camera : cameras) {
-    ExportFrames f = frames;
-    f.camera = camera.frame;
-    f.camera_is_parent = false;
-    per_camera.push_back(f);
-    parts.push_back(ExportCalibration(format, camera.cam_from_lidar, f, source));
-  }
-  std::vector<std::string> header = {
-      "Calibench rig calibration" + (source.empty() ? "" : " from " + source) + ": the pose of " +
-          "each camera in '" + frames.lidar + "' (x_in_" + frames.lidar + " = " + frames.lidar +
-          "_from_<camera> * x_in_<camera>)",
-      "The camera frames are " + CameraFrameWords(frames.camera_frame)};
-  ExportedCalibration tree;
-  if (format == ExportFormat::kUrdf) {
-    tree.text = "<?xml version=\"1.0\"?>\n<!--\n" + Commented(header, "  ") +
-                "  Each joint's origin is that pose (xyz in metres, rpy in radians: "
-                "R = Rz(yaw) Ry(pitch) Rx(roll)).\n-->\n<robot name=\"calibench_rig\">\n" +
-                "  <link name=\"" + frames.lidar + "\"/>\n";
-    for (size_t c = 0; c < cameras.size(); ++c) {
-      const TransformText t = TextOf(ParentFromChild(cameras[c].cam_from_lidar, per_camera[c]));
-      tree.text += "  <link name=\"" + cameras[c].frame + "\"/>\n";
-      tree.text += "  <joint name=\"" + JointName(per_camera[c]) + "\" type=\"fixed\">\n";
-      tree.text += "    <parent link=\"" + frames.lidar + "\"/>\n";
-      tree.text += "    <child link=\"" + cameras[c].frame + "\"/>\n";
-      tree.text += "    <origin xyz=\"" + t.x + " " + t.y + " " + t.z + "\" rpy=\"" + t.roll + " " +
-                   t.pitch + " " + t.yaw + "\"/>\n  </joint>\n";
-    }
-    tree.text += "</robot>\n";
-    return tree;
-  }
-  if (format == ExportFormat::kAutoware) {
-    // sensor_kit_calibration.yaml: the LiDAR's block with a child per camera.
-    tree.text = Commented(header, "# ") +
-                "# Autoware's sensor_kit_calibration.yaml form: <parent>: <child>: x y z (m),\n"
-                "# roll pitch yaw (rad, R = Rz(yaw) Ry(pitch) Rx(roll)).\n" +
-                frames.lidar + ":\n";
-    for (size_t c = 0; c < cameras.size(); ++c) {
-      const TransformText t = TextOf(ParentFromChild(cameras[c].cam_from_lidar, per_camera[c]));
-      tree.text += "  " + cameras[c].frame + ":\n    x: " + t.x + "\n    y: " + t.y +
-                   "\n    z: " + t.z + "\n    roll: " + t.roll + "\n    pitch: " + t.pitch +
-                   "\n    yaw: " + t.yaw + "\n";
-    }
-    return tree;
-  }
-  if (format == ExportFormat::kKalibr) {
-    // A camchain: cam<n> with T_cam_lidar, and from cam1 on T_cn_cnm1 (cam n from cam n-1), as
-    // Kalibr's multi-camera chains hold them.
-    tree.text = Commented(header, "# ") +
-                "# Kalibr's naming: T_a_b maps b into a (x_in_a = T_a_b * x_in_b): T_cam_lidar is "
-                "<camera>_from_" +
-                frames.lidar + ", T_cn_cnm1 the camera from the one before it.\n";
-    for (size_t c = 0; c < cameras.size(); ++c) {
-      const Pose cam_from_lidar =
-          ParentFromChild(cameras[c].cam_from_lidar, per_camera[c]).inverse();
-      tree.text += "cam" + std::to_string(c) + ":\n  T_cam_lidar:\n" +
-                   MatrixRows(cam_from_lidar.matrix(), "  ");
-      if (c > 0) {
-        const Pose previous =
-            ParentFromChild(cameras[c - 1].cam_from_lidar, per_camera[c - 1]).inverse();
-        tree.text +=
-            "  T_cn_cnm1:\n" + MatrixRows((cam_from_lidar * previous.inverse()).matrix(), "  ");
-      }
-      tree.text += "  rostopic_frame: " + cameras[c].frame + "\n  parent_frame: " + frames.lidar +
-                   "\n  camera_frame: " + CameraFrameName(frames.camera_frame) + "\n";
-    }
-    return tree;
-  }
-  // The launch files: one publisher per camera, the body of each single-camera file.
-  const bool ros1 = format == ExportFormat::kRos1Tf;
-  const std::string open = ros1 ? "<node " : "        Node(";
-  const std::string close = ros1 ? "/>\n" : "        ),\n";
-  std::string body;
-  for (const ExportedCalibration& part : parts) {
-    const size_t begin = part.text.find(open);
-    const size_t end = part.text.find(close, begin);
-    CALIBENCH_CHECK(begin != std::string::npos && end != std::string::npos);
-    body += (ros1 ? "  " : "") + part.text.substr(begin, end + close.size() - begin);
-    tree.command += (tree.command.empty() ? "" : "\n") + part.command;
-  }
-  tree.text =
-      ros1 ? "<launch>\n  <!--\n" + Commented(header, "    ") + "  -->\n" + body + "</launch>\n"
-           : Commented(header, "# ") +
-                 "\nfrom launch import LaunchDescription\nfrom launch_ros.actions import "
-                 "Node\n\n\ndef generate_launch_description():\n    return "
-                 "LaunchDescription([\n" +
-                 body + "    ])\n";
-  return tree;
 }
 
 Vec3 RollPitchYaw(const Mat3& r) {
