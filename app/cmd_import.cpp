@@ -188,6 +188,12 @@ int RunImport(int argc, char** argv) {
                  "folder is then the rig's form (images/<camera>/, cameras/<camera>.yaml), each "
                  "camera named after its topic")
       ->excludes("--image-topic");
+  bool all_cameras = false;
+  app.add_flag("--all-cameras", all_cameras,
+               "a rig: every image topic with a CameraInfo beside it is a camera (as "
+               "--camera-topic for each)")
+      ->excludes("--image-topic")
+      ->excludes("--camera-topic");
   app.add_flag("--calibrate", calibrate,
                "then calibrate the folder written (a rig: every camera, then the rig) and write "
                "result.json (rig.json for a rig) into it");
@@ -216,6 +222,14 @@ int RunImport(int argc, char** argv) {
     return kUsage;
   }
   if (out.empty()) out = DefaultImportFolder(bag_path).string();
+  if (all_cameras) {
+    camera_topics = CameraTopicsWithInfo(*OpenBag(bag_path));
+    if (camera_topics.empty()) {
+      std::fprintf(stderr, "calibench import: %s: no image topic has a CameraInfo beside it\n",
+                   bag_path.c_str());
+      return kInputError;
+    }
+  }
   if (!camera_topics.empty())
     return ImportRigFolder(bag_path, out, board_spec, options, camera_topics, calibrate);
   const auto start = std::chrono::steady_clock::now();

@@ -62,6 +62,10 @@ struct BagImportSummary {
 // IoError naming the file and listing the candidates when the choice is ambiguous or impossible.
 void ChooseTopics(const BagReader& bag, BagImportOptions* options);
 
+// A rig's cameras in a recording: every image topic with a CameraInfo beside it (same
+// namespace), a raw topic's /compressed republish counted once. What `import --all-cameras` takes.
+std::vector<std::string> CameraTopicsWithInfo(const BagReader& bag);
+
 // Where an import of `bag` goes unless the user says otherwise: "<bag name>.dataset" beside it,
 // or, when that folder cannot be written (a recording on a read-only medium), the same name
 // under $XDG_DATA_HOME/calibench/imports (else ~/.local/share/calibench/imports).

@@ -125,4 +125,21 @@ void ChooseTopics(const BagReader& bag, BagImportOptions* options) {
   ChooseOne(bag, infos, "CameraInfo", "--camera-info-topic", &options->camera_info_topic);
 }
 
+std::vector<std::string> CameraTopicsWithInfo(const BagReader& bag) {
+  std::vector<std::string> images = TopicsOfType(bag, IsImageType);
+  std::erase_if(images, [&](const std::string& name) {
+    return name.ends_with("/compressed") &&
+           std::find(images.begin(), images.end(), Namespace(name)) != images.end();
+  });
+  const std::vector<std::string> infos =
+      TopicsOfType(bag, [](const std::string& t) { return t == kCameraInfoType; });
+  std::erase_if(images, [&](const std::string& image) {
+    return std::none_of(infos.begin(), infos.end(), [&](const std::string& info) {
+      return Namespace(info) == Namespace(image) ||
+             (image.ends_with("/compressed") && Namespace(info) == Namespace(Namespace(image)));
+    });
+  });
+  return images;
+}
+
 }  // namespace calibench

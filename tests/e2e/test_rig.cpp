@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/geometry/geometry.h"
+#include "core/io/bag.h"
+#include "core/io/bag_import.h"
 #include "core/io/dataset.h"
 #include "core/sim/rig_sim.h"
 #include "tests/bag_writers.h"
@@ -133,6 +135,9 @@ TEST(Rig, ARecordingWithTwoCameraTopicsIsImportedAndCalibratedInOneCommand) {
       test::WriteSimRecording(writer.get(), MessageEncoding::kCdr, options);
   writer->Close();
   SaveTargetFile(dir / "target.json", truth.board);  // the board, kept beside the recording
+  // Both cameras are found by themselves: the image topics with a CameraInfo beside them.
+  EXPECT_EQ(CameraTopicsWithInfo(*OpenBag(dir / "rig.mcap")),
+            (std::vector<std::string>{"/cam0/image_raw", "/cam1/image_raw"}));
   std::string out;
   ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " import " + (dir / "rig.mcap").string() +
                                  " --camera-topic /cam0/image_raw --camera-topic /cam1/image_raw"
