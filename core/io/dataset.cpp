@@ -115,6 +115,10 @@ Dataset LoadFolderSetup(const fs::path& dir, CameraFile camera) {
   const fs::path camera_file = dir / "camera.yaml";
   const fs::path target_file = dir / "target.json";
   const bool has_camera = fs::exists(camera_file);
+  if (!has_camera && fs::is_directory(dir / "cameras"))
+    Fail(dir,
+         "a rig folder (cameras/<camera>.yaml, images/<camera>/): `calibench calibrate --dataset` "
+         "calibrates every camera and the rig; this command takes one camera's dataset for now");
   if (!has_camera && camera == CameraFile::kRequired)
     Fail(dir,
          "folder dataset has no camera.yaml (and no dataset.json): put the camera's intrinsics "

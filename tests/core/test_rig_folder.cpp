@@ -50,6 +50,14 @@ TEST(RigFolder, EachCameraIsADatasetOfTheCapturesItHasAFrameOf) {
   EXPECT_EQ(rig.cameras[1].pairs[0].image, dir / "images" / "cam1" / "0001.png");
   EXPECT_EQ(rig.cameras[1].pairs[0].cloud, dir / "clouds" / "0001.pcd");
   EXPECT_EQ(rig.cameras[1].camera.type, CameraModelType::kKannalaBrandt);
+  // The commands that take one camera say what a rig folder is and which command takes it.
+  try {
+    LoadDataset(dir);
+    ADD_FAILURE() << "a rig folder read as one camera's dataset";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("a rig folder"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("calibench calibrate --dataset"), std::string::npos);
+  }
 }
 
 void ExpectRejected(const fs::path& dir, const std::string& problem) {
