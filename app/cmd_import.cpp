@@ -130,10 +130,62 @@ std::optional<BoardSpec> BoardFromFlag(const std::string& board) {
   return BoardPreset(board);
 }
 
-// `import --camera-topic A --camera-topic B`: the rig's folder form, then (--calibrate) the rig.
+// The rig's flags and --calibrate.
+struct RigFlags {
+  std::vector<std::string> camera_topics;
+  bool all_cameras = false;
+  bool calibrate = false;
+};
+
+void AddRigFlags(CLI::App& app, RigFlags* rig) {
+  app.add_option("--camera-topic", rig->camera_topics,
+                 "a rig: one Image or CompressedImage topic per camera (repeat the flag); the "
+                 "folder is then the rig's form (images/<camera>/, cameras/<camera>.yaml), each "
+                 "camera named after its topic")
+      ->excludes("--image-topic");
+  app.add_flag("--all-cameras", rig->all_cameras,
+               "a rig: every image topic with a CameraInfo beside it is a camera (as "
+               "--camera-topic for each)")
+      ->excludes("--image-topic")
+      ->excludes("--camera-topic");
+  app.add_flag("--calibrate", rig->calibrate,
+               "then calibrate the folder written (a rig: every camera, then the rig) and write "
+               "result.json (rig.json for a rig) into it");
+}
+
+// One camera: the dataset folder, how fast, then (--calibrate) its calibration.
+int ImportOneCamera(const std::string& bag_path, const std::string& out,
+                    const std::optional<BoardSpec>& board, const BagImportOptions& options,
+                    bool calibrate) {
+  const auto start = std::chrono::steady_clock::now();
+  const BagImportSummary summary = ImportBag(bag_path, out, board, options, ProgressBar());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  PrintSummary(summary, options);
+  // The last line of a log: what came out and how fast, against the recording's own length.
+  std::fprintf(stderr, "imported %zu pairs from %.0f MB in %.1f s", summary.pair_ids.size(),
+               summary.bytes_read / 1e6, seconds);
+  if (summary.recording_seconds > 0)
+    std::fprintf(stderr, " (the recording spans %.1f s: %.2fx its length)",
+                 summary.recording_seconds, seconds / summary.recording_seconds);
+  std::fprintf(stderr, "\n");
+  if (!calibrate) return kOk;
+  return CalibrateAndReport(LoadDataset(out), PipelineOptions{},
+                            (fs::path(out) / "result.json").string());
+}
+
+// A rig (--camera-topic A --camera-topic B, or --all-cameras): the rig's folder form, then
+// (--calibrate) every camera and the rig.
 int ImportRigFolder(const std::string& bag_path, const std::string& out,
                     const std::optional<BoardSpec>& board, const BagImportOptions& options,
-                    const std::vector<std::string>& topics, bool calibrate) {
+                    const RigFlags& flags) {
+  const std::vector<std::string> topics =
+      flags.all_cameras ? CameraTopicsWithInfo(*OpenBag(bag_path)) : flags.camera_topics;
+  if (topics.empty()) {
+    std::fprintf(stderr, "calibench import: %s: no image topic has a CameraInfo beside it\n",
+                 bag_path.c_str());
+    return kInputError;
+  }
   const RigImportSummary summary = ImportRig(bag_path, out, board, options, topics, ProgressBar());
   for (size_t c = 0; c < summary.cameras.size(); ++c) {
     std::printf("camera %s (%s):\n", summary.camera_names[c].c_str(), topics[c].c_str());
@@ -141,7 +193,7 @@ int ImportRigFolder(const std::string& bag_path, const std::string& out,
   }
   std::printf("rig folder %s: %d captures, %d seen by two or more cameras\n", out.c_str(),
               summary.captures, summary.shared_captures);
-  if (!calibrate) return kOk;
+  if (!flags.calibrate) return kOk;
   const RigOutcome outcome = CalibrateRig(LoadRigFolder(out), PipelineOptions{});
   std::printf("%s", FormatRigSummary(outcome).c_str());
   if (!outcome.joint) {
@@ -181,22 +233,8 @@ int RunImport(int argc, char** argv) {
                  "Image or CompressedImage topic (default: the only one)");
   app.add_option("--camera-info-topic", options.camera_info_topic,
                  "CameraInfo topic (default: the one beside the image topic)");
-  std::vector<std::string> camera_topics;
-  bool calibrate = false;
-  app.add_option("--camera-topic", camera_topics,
-                 "a rig: one Image or CompressedImage topic per camera (repeat the flag); the "
-                 "folder is then the rig's form (images/<camera>/, cameras/<camera>.yaml), each "
-                 "camera named after its topic")
-      ->excludes("--image-topic");
-  bool all_cameras = false;
-  app.add_flag("--all-cameras", all_cameras,
-               "a rig: every image topic with a CameraInfo beside it is a camera (as "
-               "--camera-topic for each)")
-      ->excludes("--image-topic")
-      ->excludes("--camera-topic");
-  app.add_flag("--calibrate", calibrate,
-               "then calibrate the folder written (a rig: every camera, then the rig) and write "
-               "result.json (rig.json for a rig) into it");
+  RigFlags rig;
+  AddRigFlags(app, &rig);
   app.add_option("--camera", camera_file,
                  "intrinsics file instead of the recording's CameraInfo (OpenCV, ROS or Kalibr)");
   AddSelectionFlags(app, &options);
@@ -222,31 +260,8 @@ int RunImport(int argc, char** argv) {
     return kUsage;
   }
   if (out.empty()) out = DefaultImportFolder(bag_path).string();
-  if (all_cameras) {
-    camera_topics = CameraTopicsWithInfo(*OpenBag(bag_path));
-    if (camera_topics.empty()) {
-      std::fprintf(stderr, "calibench import: %s: no image topic has a CameraInfo beside it\n",
-                   bag_path.c_str());
-      return kInputError;
-    }
-  }
-  if (!camera_topics.empty())
-    return ImportRigFolder(bag_path, out, board_spec, options, camera_topics, calibrate);
-  const auto start = std::chrono::steady_clock::now();
-  const BagImportSummary summary = ImportBag(bag_path, out, board_spec, options, ProgressBar());
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  PrintSummary(summary, options);
-  // The last line of a log: what came out and how fast, against the recording's own length.
-  std::fprintf(stderr, "imported %zu pairs from %.0f MB in %.1f s", summary.pair_ids.size(),
-               summary.bytes_read / 1e6, seconds);
-  if (summary.recording_seconds > 0)
-    std::fprintf(stderr, " (the recording spans %.1f s: %.2fx its length)",
-                 summary.recording_seconds, seconds / summary.recording_seconds);
-  std::fprintf(stderr, "\n");
-  if (!calibrate) return kOk;
-  return CalibrateAndReport(LoadDataset(out), PipelineOptions{},
-                            (fs::path(out) / "result.json").string());
+  if (rig.all_cameras || !rig.camera_topics.empty())
+    return ImportRigFolder(bag_path, out, board_spec, options, rig);
+  return ImportOneCamera(bag_path, out, board_spec, options, rig.calibrate);
 }
-
 }  // namespace calibench::app

@@ -1,5 +1,6 @@
 #include "core/lidar_camera/rig.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -7,17 +8,13 @@
 
 #include "core/base/atomic_file.h"
 #include "core/estimation/uncertainty.h"
+#include "core/io/json_fields.h"
+#include "core/io/json_io.h"
 
 namespace calibench {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-Json Matrix4(const Pose& pose) {
-  Json rows = Json::array();
-  for (int r = 0; r < 4; ++r) rows.push_back({pose(r, 0), pose(r, 1), pose(r, 2), pose(r, 3)});
-  return rows;
-}
 
 Json Matrix6(const Mat6& m) {
   Json rows = Json::array();
@@ -31,11 +28,27 @@ Json Matrix6(const Mat6& m) {
 
 Json Vector3(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
-// The pose with its σ in its own axes (translation mm, rotation deg).
-Json PoseWithSigma(const Pose& pose, const Mat6& covariance) {
-  return {{"matrix", Matrix4(pose)},
+// The pose (under `key`) with its σ in its own axes (translation mm, rotation deg).
+Json PoseWithSigma(const char* key, const Pose& pose, const Mat6& covariance) {
+  return {{key, json_io::MatrixToJson(pose.matrix())},
           {"sigma_translation_mm", Vector3(1e3 * TranslationStd(covariance, pose))},
           {"sigma_rotation_deg", Vector3(RotationStdDeg(covariance, pose))}};
+}
+
+// "σ t = [..] mm, σ r = [..] deg" of the pose in its own axes.
+std::string SigmaText(const Pose& pose, const Mat6& covariance) {
+  const Vec3 st = 1e3 * TranslationStd(covariance, pose), sr = RotationStdDeg(covariance, pose);
+  char text[128];
+  std::snprintf(text, sizeof(text), "σ t = [%.2f %.2f %.2f] mm, σ r = [%.3f %.3f %.3f] deg", st.x(),
+                st.y(), st.z(), sr.x(), sr.y(), sr.z());
+  return text;
+}
+
+std::string TranslationText(const Pose& pose) {
+  char text[96];
+  std::snprintf(text, sizeof(text), "t = [%.4f %.4f %.4f] m", pose.translation().x(),
+                pose.translation().y(), pose.translation().z());
+  return text;
 }
 
 }  // namespace
@@ -89,12 +102,10 @@ void WriteRigResult(const std::filesystem::path& path, const RigOutcome& outcome
     int pairs = 0;
     for (const PairFeatures& p : outcome.single[c].pairs)
       pairs += p.status == PairStatus::kAccepted;
-    Json camera = PoseWithSigma(joint.cam_from_lidar[c], covariance);
-    camera["cam_from_lidar"] = camera["matrix"];
-    camera.erase("matrix");
+    Json camera = PoseWithSigma("cam_from_lidar", joint.cam_from_lidar[c], covariance);
     camera["covariance"] = Matrix6(covariance);
     camera["pairs"] = pairs;
-    camera["single_camera"] = PoseWithSigma(single.cam_from_lidar, single.covariance);
+    camera["single_camera"] = PoseWithSigma("matrix", single.cam_from_lidar, single.covariance);
     cameras[outcome.camera_names[c]] = camera;
   }
   Json relative = Json::object();
@@ -103,7 +114,7 @@ void WriteRigResult(const std::filesystem::path& path, const RigOutcome& outcome
       const RelativePose pose =
           CameraFromCamera(joint, static_cast<int>(to), static_cast<int>(from));
       relative[outcome.camera_names[to] + "_from_" + outcome.camera_names[from]] =
-          PoseWithSigma(pose.to_from_from, pose.covariance);
+          PoseWithSigma("matrix", pose.to_from_from, pose.covariance);
     }
   const Json root = {{"format", "calibench.rig.v1"},
                      {"reference", "lidar"},
@@ -118,31 +129,21 @@ void WriteRigResult(const std::filesystem::path& path, const RigOutcome& outcome
 }
 
 std::vector<std::pair<std::string, Pose>> LoadRigResult(const std::filesystem::path& path) {
-  std::ifstream file(path);
-  if (!file) throw IoError(path.string() + ": cannot open the rig result");
-  nlohmann::json root;
-  try {
-    root = nlohmann::json::parse(file);
-  } catch (const nlohmann::json::exception& e) {
-    throw IoError(path.string() + ": not a valid rig result (JSON): " + e.what());
+  const nlohmann::json root = json_io::ReadJson(path);
+  const json_io::Fields fields(root, path);
+  json_io::CheckFormat(fields, "calibench.rig.v1");
+  fields.Object("cameras");  // an object, else the error names it
+  std::vector<std::pair<std::string, Pose>> poses;
+  for (const auto& [name, camera] : fields.At("cameras").items()) {
+    const json_io::Fields entry(camera, path, "cameras." + name);
+    poses.emplace_back(name, json_io::PoseFromJson(entry.At("cam_from_lidar"), path,
+                                                   entry.Path("cam_from_lidar")));
   }
-  if (!root.is_object() || root.value("format", "") != "calibench.rig.v1" ||
-      !root.contains("cameras") || !root["cameras"].is_object())
-    throw IoError(path.string() + ": not a Calibench rig result (format calibench.rig.v1)");
-  std::vector<std::pair<std::string, Pose>> cameras;
-  for (const auto& [name, camera] : root["cameras"].items()) {
-    const nlohmann::json& rows = camera["cam_from_lidar"];
-    Pose pose = Pose::Identity();
-    try {
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = rows.at(r).at(c).get<double>();
-    } catch (const nlohmann::json::exception&) {
-      throw IoError(path.string() + ": cameras." + name + ".cam_from_lidar: not a 4x4 matrix");
-    }
-    cameras.emplace_back(name, pose);
-  }
-  if (cameras.empty()) throw IoError(path.string() + ": the rig result holds no camera");
-  return cameras;
+  if (poses.empty()) throw IoError(path.string() + ": the rig result holds no camera");
+  // The writer's order (the folder's natural order), not the parser's alphabetical one.
+  std::sort(poses.begin(), poses.end(),
+            [](const auto& a, const auto& b) { return NaturalOrder{}(a.first, b.first); });
+  return poses;
 }
 
 bool IsRigResultFile(const std::filesystem::path& path) {
@@ -155,45 +156,26 @@ bool IsRigResultFile(const std::filesystem::path& path) {
 
 std::string FormatRigSummary(const RigOutcome& outcome) {
   std::string text;
-  char line[512];
   for (size_t c = 0; c < outcome.camera_names.size(); ++c) {
     const CalibrationOutcome& single = outcome.single[c];
-    std::snprintf(line, sizeof(line), "camera %s:%s\n", outcome.camera_names[c].c_str(),
-                  single.solution ? "" : (" no calibration: " + single.failure).c_str());
-    text += line;
+    text += "camera " + outcome.camera_names[c] + ":" +
+            (single.solution ? "" : " no calibration: " + single.failure) + "\n";
     if (!outcome.joint || !single.solution) continue;
     const Pose& pose = outcome.joint->cam_from_lidar[c];
-    const Mat6 covariance = outcome.joint->covariance.block<6, 6>(6 * c, 6 * c);
-    const Vec3 t = pose.translation(), st = 1e3 * TranslationStd(covariance, pose);
-    const Vec3 sr = RotationStdDeg(covariance, pose);
-    std::snprintf(line, sizeof(line),
-                  "  cam_from_lidar t = [%.4f %.4f %.4f] m, σ t = [%.2f %.2f %.2f] mm, "
-                  "σ r = [%.3f %.3f %.3f] deg (rig solve)\n",
-                  t.x(), t.y(), t.z(), st.x(), st.y(), st.z(), sr.x(), sr.y(), sr.z());
-    text += line;
-    const Vec3 st1 =
-        1e3 * TranslationStd(single.solution->covariance, single.solution->cam_from_lidar);
-    const Vec3 sr1 = RotationStdDeg(single.solution->covariance, single.solution->cam_from_lidar);
-    std::snprintf(line, sizeof(line),
-                  "  alone: σ t = [%.2f %.2f %.2f] mm, σ r = [%.3f %.3f %.3f] deg\n", st1.x(),
-                  st1.y(), st1.z(), sr1.x(), sr1.y(), sr1.z());
-    text += line;
+    text += "  cam_from_lidar " + TranslationText(pose) + ", " +
+            SigmaText(pose, outcome.joint->covariance.block<6, 6>(6 * c, 6 * c)) + " (rig solve)\n";
+    text += "  alone: " + SigmaText(single.solution->cam_from_lidar, single.solution->covariance) +
+            "\n";
   }
   if (!outcome.joint) return text + "no rig solution: " + outcome.failure + "\n";
   for (size_t to = 1; to < outcome.camera_names.size(); ++to)
     for (size_t from = 0; from < to; ++from) {
       const RelativePose pose =
           CameraFromCamera(*outcome.joint, static_cast<int>(to), static_cast<int>(from));
-      const Vec3 t = pose.to_from_from.translation();
-      const Vec3 st = 1e3 * TranslationStd(pose.covariance, pose.to_from_from);
-      const Vec3 sr = RotationStdDeg(pose.covariance, pose.to_from_from);
-      std::snprintf(line, sizeof(line),
-                    "%s_from_%s: t = [%.4f %.4f %.4f] m, σ t = [%.2f %.2f %.2f] mm, σ r = "
-                    "[%.3f %.3f %.3f] deg (%d captures shared)\n",
-                    outcome.camera_names[to].c_str(), outcome.camera_names[from].c_str(), t.x(),
-                    t.y(), t.z(), st.x(), st.y(), st.z(), sr.x(), sr.y(), sr.z(),
-                    outcome.shared_captures);
-      text += line;
+      text += outcome.camera_names[to] + "_from_" + outcome.camera_names[from] + ": " +
+              TranslationText(pose.to_from_from) + ", " +
+              SigmaText(pose.to_from_from, pose.covariance) + " (" +
+              std::to_string(outcome.shared_captures) + " captures shared)\n";
     }
   return text;
 }

@@ -279,6 +279,9 @@ class Controller : public ControllerState<Snapshot> {
   // A followed capture's views move to its newest pair `index` once loaded (mutex_ held).
   bool FollowsTo(int index) const;
   void OnLivePairLoaded(int index);  // LoadPair's part for a followed capture (mutex_ held)
+  // After pair `index` loaded (mutex_ held): its board refitted from its brush or seed (true:
+  // now, by the caller, as the selected pair), or left to detection; a pair without a cloud fails.
+  bool ScheduleBoard(int index, bool painted);
   void RefitLidar(int index);
   // The background model over the loaded clouds, then detection where no seed or brush is.
   void DetectWithBackground();

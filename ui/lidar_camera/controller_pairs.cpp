@@ -159,25 +159,32 @@ void Controller::LoadPair(int index) {
       load_warnings_.push_back(brush_dropped);
       SetStatus(brush_dropped, true);
     }
-    // Detection waits for every cloud: the background model over them keeps static board-sized
-    // panels out (as CalibrateDataset does).
-    const bool detects = !pair.brush_from_seed && !painted;
-    refit_now = pair.cloud && !detects && index == state_.selected &&
-                state_.loading_done < state_.loading_total;
-    if (pair.cloud && !detects && !refit_now) worker_.Enqueue([this, index] { RefitLidar(index); });
-    if (pair.cloud && detects) {
-      pair.lidar_failure = PairsSettled() ? "finding the board ..."
-                                          : "finding the board once every pair is loaded ...";
-      pair.awaiting_detection = true;
-    }
-    if (!pair.cloud) {
-      pair.status = PairStatus::kFailed;
-      pair.reason = pair.camera_failure;
-    }
+    refit_now = ScheduleBoard(index, painted);
     if (state_.loading_done == state_.loading_total) opened_pairs_loaded_ = true;
     if (PairsSettled()) OnAllPairsLoaded();
   }
   if (refit_now) RefitLidar(index);
+}
+
+bool Controller::ScheduleBoard(int index, bool painted) {
+  PairView& pair = state_.pairs[index];
+  if (!pair.cloud) {
+    pair.status = PairStatus::kFailed;
+    pair.reason = pair.camera_failure;
+    return false;
+  }
+  // Detection waits for every cloud: the background model over them keeps static board-sized
+  // panels out (as CalibrateDataset does).
+  if (!pair.brush_from_seed && !painted) {
+    pair.lidar_failure = PairsSettled() ? "finding the board ..."
+                                        : "finding the board once every pair is loaded ...";
+    pair.awaiting_detection = true;
+    return false;
+  }
+  // A brush or seed: the selected pair's plane comes before the other pairs load.
+  if (index == state_.selected && state_.loading_done < state_.loading_total) return true;
+  worker_.Enqueue([this, index] { RefitLidar(index); });
+  return false;
 }
 
 void Controller::DetectWithBackground() {
