@@ -40,15 +40,27 @@ void AddIntrinsicsToResult(const std::string& path, const IntrinsicsResult& r) {
   WriteFileAtomically(path, result.dump(2) + "\n");
 }
 
-// A rig folder (cameras/, images/<camera>/): every camera, then the rig solve
-// (core/lidar_camera/rig.h); the summary printed, the rig's result written to out_path.
-int CalibrateRigFolder(const std::string& folder, const PipelineOptions& options,
-                       const std::string& out_path) {
-  const RigFolder rig = LoadRigFolder(folder);
-  const RigOutcome outcome = CalibrateRig(rig, options, StderrProgress("extracted"));
+// A rig (its folder or manifest): every camera, then the rig solve (core/lidar_camera/rig.h),
+// each camera with the edits of its session among `sessions`; the summary printed, the rig's
+// result written to out_path, its report to report_path.
+int CalibrateRigDataset(const std::string& path, const std::vector<std::string>& sessions,
+                        const PipelineOptions& options, const std::string& out_path,
+                        const std::string& report_path) {
+  const RigFolder rig = LoadRig(path);
+  RigEdits edits;
+  for (const std::string& session_path : sessions) {
+    const Session session = LoadSession(session_path);
+    if (session.camera.empty() ||
+        NormalizeSessionPath(session.dataset) != NormalizeSessionPath(rig.folder))
+      throw IoError(session_path + ": not a session of a camera of the rig " +
+                    rig.folder.string() + " (its dataset is " + session.dataset.string() + ")");
+    RigCameraIndex(rig, session.camera);  // a camera the rig has
+    edits[session.camera] = EditsFromSession(session);
+  }
+  const RigOutcome outcome = CalibrateRig(rig, options, StderrProgress("extracted"), edits);
   std::printf("%s", FormatRigSummary(outcome).c_str());
   if (!outcome.joint) {
-    std::fprintf(stderr, "calibench: no calibration for the rig %s: %s\n", folder.c_str(),
+    std::fprintf(stderr, "calibench: no calibration for the rig %s: %s\n", path.c_str(),
                  outcome.failure.c_str());
     return kNoCalibration;
   }
@@ -56,7 +68,11 @@ int CalibrateRigFolder(const std::string& folder, const PipelineOptions& options
     WriteRigResult(out_path, outcome);
     std::printf("wrote %s\n", out_path.c_str());
   }
-  return kOk;
+  if (report_path.empty()) return kOk;
+  ReportRequest request;
+  request.out_path = report_path;
+  request.result_file = out_path;
+  return WriteRigReport(rig, outcome, options, request);
 }
 
 }  // namespace
@@ -66,14 +82,19 @@ int RunCalibrate(int argc, char** argv) {
       "Calibrate a 3D LiDAR to a camera from board planes (Ca²Lib plane-to-plane "
       "Gauss-Newton with a Huber kernel).",
       "calibench calibrate"};
-  std::string dataset_path, session_path, out_path, report_path;
+  std::string dataset_path, out_path, report_path, camera;
+  std::vector<std::string> sessions;
   AddDatasetOption(app, &dataset_path,
-                   "a LiDAR-camera dataset, or a rig folder (cameras/<camera>.yaml, "
-                   "images/<camera>/<stem>, clouds/<stem>): every camera, then the rig");
-  app.add_option("--session", session_path,
+                   "a LiDAR-camera dataset, or a rig (a folder with cameras/<camera>.yaml, "
+                   "images/<camera>/<stem>, clouds/<stem>; or a manifest naming \"cameras\"): "
+                   "every camera, then the rig (calibench.rig.v1)");
+  app.add_option("--session", sessions,
                  "a workbench session (calibench.session.json): its brushes, rejections and "
                  "solver choices are used, so the result is the workbench's; its dataset unless "
-                 "--dataset is given");
+                 "--dataset is given. A rig takes one per camera (calibench.session.<camera>.json)");
+  app.add_option("--camera", camera,
+                 "with a rig: calibrate this camera alone (a calibench.result.v1, as for one "
+                 "camera's dataset)");
   app.add_option("--out,-o", out_path, "result file (calibench.result.v1)");
   bool estimate_intrinsics = false;
   std::string intrinsics_model = "pinhole";
@@ -93,13 +114,28 @@ int RunCalibrate(int argc, char** argv) {
     std::fprintf(stderr, "calibench calibrate: %s\n", why.c_str());
     return kUsage;
   }
-  const PairEdits edits = ApplySessionFlag(session_path, &dataset_path, &flags.options);
+  if (dataset_path.empty() && !sessions.empty())
+    dataset_path = LoadSession(sessions.front()).dataset.string();
   if (dataset_path.empty()) {
     std::fprintf(stderr, "calibench calibrate: give --dataset or --session\n");
     return kUsage;
   }
-  if (IsRigFolder(dataset_path)) return CalibrateRigFolder(dataset_path, flags.options, out_path);
-  Dataset dataset = LoadDataset(dataset_path, CameraFile::kOptional);
+  const bool rig = IsRig(dataset_path);
+  if (rig && camera.empty())
+    return CalibrateRigDataset(dataset_path, sessions, flags.options, out_path, report_path);
+  if (sessions.size() > 1) {
+    std::fprintf(stderr, "calibench calibrate: one --session for one camera (several: a rig's)\n");
+    return kUsage;
+  }
+  if (!rig && !camera.empty()) {
+    std::fprintf(stderr, "calibench calibrate: --camera: %s is not a rig\n",
+                 dataset_path.c_str());
+    return kUsage;
+  }
+  const std::string session_path = sessions.empty() ? "" : sessions.front();
+  const PairEdits edits = ApplySessionFlag(session_path, &dataset_path, &flags.options);
+  Dataset dataset =
+      rig ? LoadRigCamera(dataset_path, camera) : LoadDataset(dataset_path, CameraFile::kOptional);
   std::optional<IntrinsicsResult> intrinsics;
   if (!dataset.missing_camera_file.empty() && !estimate_intrinsics) {
     std::fprintf(stderr,

@@ -4,6 +4,7 @@
 
 #include "app/commands.h"
 #include "app/sim_flags.h"
+#include "core/sim/rig_sim.h"
 #include "core/sim/sim.h"
 
 namespace calibench::app {
@@ -116,12 +117,34 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--out,-o", out_dir, "output folder")->required();
   SimFlags flags;
   AddSimFlags(app, flags);
+  bool rig = false;
+  double second_yaw_deg = RigSimOptions{}.second_camera_yaw_deg;
+  app.add_flag("--rig", rig,
+               "a rig instead: the camera (cam0) and a fisheye (cam1) turned aside, in the rig's "
+               "folder form (cameras/, images/<camera>/, clouds/, target.json; --pairs captures)");
+  app.add_option("--second-camera-yaw", second_yaw_deg,
+                 "with --rig: how far cam1 is turned to the left of cam0 (degrees)")
+      ->capture_default_str();
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
   SimOptions options;
   std::string why;
   if (!BuildSimOptions(flags, &options, &why)) {
     std::fprintf(stderr, "calibench simulate: %s\n", why.c_str());
     return kUsage;
+  }
+  if (rig) {
+    RigSimOptions rig_options;
+    rig_options.base = options;
+    rig_options.num_captures = options.num_pairs;
+    rig_options.second_camera_yaw_deg = second_yaw_deg;
+    if (!rig_options.Check(&why)) {
+      std::fprintf(stderr, "calibench simulate: --rig: %s\n", why.c_str());
+      return kUsage;
+    }
+    const RigSimTruth truth = SimulateRigFolder(rig_options, out_dir);
+    std::printf("wrote a rig of 2 cameras, %d captures (%d seen by both), to %s\n",
+                rig_options.num_captures, truth.shared_captures, out_dir.c_str());
+    return kOk;
   }
   const Dataset dataset = SimulateDataset(options, out_dir);
   std::printf("wrote %zu pairs (%s, %s camera) to %s\n", dataset.pairs.size(),

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "app/commands.h"
+#include "core/lidar_camera/rig.h"
 #include "core/base/image.h"
 #include "core/io/bag.h"
 #include "core/io/image_io.h"
@@ -49,11 +50,12 @@ std::optional<int> ParseFlags(CLI::App& app, int argc, char** argv, const std::s
 bool OpenInput(
     ui::Controller& controller, const std::string& dataset, const std::string& session,
     const char* command,
-    ui::Controller::ExistingSession existing = ui::Controller::ExistingSession::kReplace) {
+    ui::Controller::ExistingSession existing = ui::Controller::ExistingSession::kReplace,
+    const std::string& camera = "") {
   if (!session.empty()) {
     controller.OpenSession(session, existing != ui::Controller::ExistingSession::kInMemory);
   } else if (!dataset.empty()) {
-    controller.OpenDataset(dataset, {}, existing);
+    controller.OpenDataset(dataset, {}, existing, camera);
   } else {
     std::fprintf(stderr, "calibench %s: give --dataset or --session\n", command);
     return false;
@@ -188,8 +190,10 @@ int RunGuiWindow(const std::string& dataset, const std::string& session, int wid
   } else if (!session.empty()) {
     shell.OpenSession(session);
   } else if (!dataset.empty()) {
-    shell.OpenDataset(dataset, quit.fresh ? ui::Controller::ExistingSession::kStartFresh
-                                          : ui::Controller::ExistingSession::kResume);
+    shell.OpenDataset(dataset,
+                      quit.fresh ? ui::Controller::ExistingSession::kStartFresh
+                                 : ui::Controller::ExistingSession::kResume,
+                      quit.camera);
   } else if (!quit.bag.empty()) {
     OpenBag(quit.bag);  // a file that is no recording is refused here, before a window opens
     shell.ImportRecording(quit.bag);
@@ -221,6 +225,9 @@ int RunGui(int argc, char** argv) {
                  "recording being written (.bag, .mcap, .db3, a rosbag2 folder; its pairs go to "
                  "<recording>.dataset as import writes them): pairs join the list as they land, "
                  "each detected, checked and solved; the meter and the ghost board follow");
+  app.add_option("--camera", quit.camera,
+                 "with a rig (a folder with cameras/, or a manifest naming \"cameras\"): the "
+                 "camera to open first (default: the first); the workbench switches between them");
   app.add_flag("--no-auto-solve", quit.no_auto_solve,
                "solve only on F5 / Run (by default the workbench solves once the pairs are "
                "detected and after every new or changed pair)");
@@ -249,7 +256,7 @@ int RunGui(int argc, char** argv) {
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
                    bool solve, const std::string& view, int width, int height,
                    const std::string& out, const std::string& backend_name,
-                   const std::string& save_session, bool intrinsics) {
+                   const std::string& save_session, bool intrinsics, const std::string& camera) {
   gfx::HeadlessBackend backend;
   const ui::HeadlessShot shot{pair, solve, width, height};
   const bool lrf = !dataset.empty() && IsLrfManifest(dataset);
@@ -269,8 +276,9 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
   ui::Controller controller;
   // Render draws; it leaves session files alone (a dataset's session may be an hour of work).
   if (!OpenInput(controller, dataset, session, "render",
-                 ui::Controller::ExistingSession::kInMemory))
+                 ui::Controller::ExistingSession::kInMemory, camera))
     return kUsage;
+  controller.WaitRig();  // a rig's other cameras: their frustums and meter rows
   if (intrinsics) {
     // The camera-intrinsics window over the workbench, with the estimate from the loaded pairs.
     controller.WaitIdle();
@@ -321,7 +329,8 @@ int RenderDemoViews(const std::string& dataset, const std::string& out_dir) {
 }
 
 std::vector<ReportFigure> RenderReportFigures(const std::string& dataset,
-                                              const std::string& session, std::string* why) {
+                                              const std::string& session, std::string* why,
+                                              const std::string& camera, const RigOutcome* rig) {
   std::string no_context;
   const auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &no_context);
   if (!context) {
@@ -329,12 +338,14 @@ std::vector<ReportFigure> RenderReportFigures(const std::string& dataset,
     return {};
   }
   ui::Controller controller;
+  if (rig) controller.CarryRig(std::make_shared<const RigOutcome>(*rig));
   // In memory: a report leaves the session beside the dataset as it is.
   if (!session.empty()) {
     controller.OpenSession(session, false);
   } else {
-    controller.OpenDataset(dataset, {}, ui::Controller::ExistingSession::kInMemory);
+    controller.OpenDataset(dataset, {}, ui::Controller::ExistingSession::kInMemory, camera);
   }
+  controller.WaitRig();
   controller.WaitIdle();
   controller.Apply(ui::RunSolver{});
   controller.WaitIdle();
@@ -343,7 +354,10 @@ std::vector<ReportFigure> RenderReportFigures(const std::string& dataset,
   {
     ui::Workbench workbench;
     figures.push_back(
-        {"3D overview: the LiDAR cloud, the boards and the camera", "",
+        {camera.empty() ? "3D overview: the LiDAR cloud, the boards and the camera"
+                        : "3D overview: the LiDAR cloud, the boards and the rig's cameras (" +
+                              camera + " in orange)",
+         "",
          EncodeImage(ui::RenderWorkbenchHeadless(controller, workbench, host,
                                                  ui::Layout::kSceneOnly, 1200, 560, 4),
                      ".png"),
@@ -387,6 +401,11 @@ int RunRender(int argc, char** argv) {
   app.add_option("--save-session", save_session,
                  "write the session (with --solve, its result) to this file; render writes no "
                  "session otherwise and leaves the one beside the dataset alone");
+  std::string camera;
+  app.add_option("--camera", camera,
+                 "with a rig (a folder with cameras/, or a manifest naming \"cameras\"): the "
+                 "camera to draw (default: the first); the others show in the strip, the meter "
+                 "and the 3D view");
   bool intrinsics = false;
   app.add_flag("--intrinsics", intrinsics,
                "LiDAR-camera: open the camera-intrinsics window, estimated from the loaded pairs "
@@ -394,7 +413,7 @@ int RunRender(int argc, char** argv) {
   int width = 0, height = 0;
   if (const auto code = ParseFlags(app, argc, argv, size, "render", &width, &height)) return *code;
   return RenderHeadless(dataset, session, pair, solve, view, width, height, out, gl, save_session,
-                        intrinsics);
+                        intrinsics, camera);
 }
 
 }  // namespace calibench::app

@@ -17,6 +17,11 @@ class App;
 class Option;
 }  // namespace CLI
 
+namespace calibench {
+struct RigFolder;   // core/io/rig_folder.h
+struct RigOutcome;  // core/lidar_camera/rig.h
+}  // namespace calibench
+
 namespace calibench::app {
 
 // Exit codes shared by every subcommand.
@@ -106,6 +111,7 @@ struct GuiWindowFlags {
   std::string frame_log;                // --frame-log: per-frame times to this file
   double screenshot_every_s = 0.0;      // --screenshot-every: also <screenshot stem>_<n>.png
   bool no_auto_solve = false;           // --no-auto-solve: solve only on F5 / Run
+  std::string camera;                   // --camera: the rig camera to open (default: the first)
 };
 // Shared by `gui` and `demo`: opens the workbench window on a dataset or session.
 int RunGuiWindow(const std::string& dataset, const std::string& session, int width, int height,
@@ -116,14 +122,19 @@ int RunGuiWindow(const std::string& dataset, const std::string& session, int wid
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
                    bool solve, const std::string& view, int width, int height,
                    const std::string& out, const std::string& backend_name,
-                   const std::string& save_session, bool intrinsics = false);
+                   const std::string& save_session, bool intrinsics = false,
+                   const std::string& camera = "");
 // `demo` on a machine without a display: solve and write the workbench and each view as PNG.
 int RenderDemoViews(const std::string& dataset, const std::string& out_dir);
 // The report's pictures, drawn headless by the workbench (cmd_ui.cpp): a 3D overview and, per
 // pair, the camera view with the LiDAR points coloured over it. Empty with *why when there is no
 // headless OpenGL.
+// The report's views of a dataset or session, drawn headless. A rig's camera (`camera` of the rig
+// `dataset`) draws the rig's other cameras from `rig` (its solve, not run again).
 std::vector<ReportFigure> RenderReportFigures(const std::string& dataset,
-                                              const std::string& session, std::string* why);
+                                              const std::string& session, std::string* why,
+                                              const std::string& camera = "",
+                                              const RigOutcome* rig = nullptr);
 int RunReport(int argc, char** argv);
 // What a report is written from, besides the pipeline's outcome.
 struct ReportRequest {
@@ -138,5 +149,9 @@ struct ReportRequest {
 // atomically; kOk (an unreadable asset throws IoError).
 int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
                 const PipelineOptions& options, const ReportRequest& request);
+// The rig's report (core/report/report_html.h RigReportHtml): the rig solve, then every camera
+// as WriteReport has one. Needs outcome.joint.
+int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const PipelineOptions& options,
+                   const ReportRequest& request);
 
 }  // namespace calibench::app

@@ -1,13 +1,19 @@
-// Calibench report plots: Chart.js (Debian's libjs-chart.js, inlined above) over REPORT.
+// Calibench report plots: Chart.js (Debian's libjs-chart.js, inlined above) over REPORT: one
+// camera's data, or a rig's ({cameras: [...]}, each with the prefix of its canvases' ids).
 (function () {
   if (typeof Chart === "undefined") return;
   Chart.defaults.animation = false;  // drawn at once: printing and screenshots see the plots
   Chart.defaults.font.family = "DejaVu Sans, sans-serif";
+  const reports = REPORT.cameras || [Object.assign({ prefix: "" }, REPORT)];
+  reports.forEach(camera => draw(camera, camera.prefix));
+})();
+
+function draw(REPORT, prefix) {
   const solved = REPORT.pairs.filter(p => p.solved);
   const ids = solved.map(p => p.id);
   const colour = p => (p.disagrees ? "#c0392b" : "#3b6ea5");
   function chart(id, config) {
-    const canvas = document.getElementById(id);
+    const canvas = document.getElementById(prefix + id);
     if (!canvas) return;
     config.options = Object.assign({ responsive: true, maintainAspectRatio: false }, config.options);
     new Chart(canvas, config);
@@ -50,4 +56,4 @@
     data: { datasets: [{ label: "board centre seen from the LiDAR", data: solved.filter(p => p.lidar).map(p => ({ x: p.lidar[0], y: p.lidar[1], id: p.id })), backgroundColor: solved.filter(p => p.lidar).map(colour), pointRadius: 5 }] },
     options: { plugins: { title: title("Coverage: the LiDAR's field"), tooltip: { callbacks: { label: c => c.raw.id } } },
                scales: { x: { reverse: true, title: title("azimuth [deg] (left is +)") }, y: { title: title("elevation [deg]") } } } });
-})();
+}

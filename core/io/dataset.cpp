@@ -24,6 +24,14 @@ namespace {
 
 constexpr char kFormat[] = "calibench.dataset.v1";
 
+// What a command that takes one camera says when it is given a rig (folder or manifest).
+[[noreturn]] void FailRig(const fs::path& path, const char* form) {
+  Fail(path, std::string("a rig ") + form +
+                 " (several cameras by name): `calibench calibrate --dataset` calibrates every "
+                 "camera and the rig; `calibench gui` and `render` take `--camera <name>` for one "
+                 "of them");
+}
+
 PairEntry ParsePair(const json_io::Fields& p, std::set<std::string>* seen) {
   const fs::path base = p.file().parent_path();
   PairEntry pair;
@@ -31,15 +39,7 @@ PairEntry ParsePair(const json_io::Fields& p, std::set<std::string>* seen) {
   json_io::CheckUniquePairId(pair.id, seen, p.file());
   pair.cloud = json_io::Resolve(base, p.String("cloud"));
   pair.image = json_io::Resolve(base, p.String("image"));
-  if (p.Has("lidar_seed")) {
-    const json_io::Fields s = p.Object("lidar_seed");
-    const auto point = s.Get<std::vector<double>>("point");
-    if (point.size() != 3) s.Fail("point", "must be [x, y, z]");
-    LidarSeed seed{Vec3(point[0], point[1], point[2]), s.Number("radius")};
-    if (!(seed.radius > 0) || !seed.point.allFinite())
-      p.Fail("lidar_seed", "needs a finite point and a radius > 0");
-    pair.lidar_seed = seed;
-  }
+  pair.lidar_seed = json_io::ParseLidarSeed(p);
   return pair;
 }
 
@@ -67,6 +67,8 @@ Dataset LoadManifest(const fs::path& manifest) {
   Dataset dataset;
   dataset.manifest = manifest;
   json_io::CheckFormat(root, kFormat);
+  if (root.Has("cameras") && !root.Has("camera") && !root.Has("camera_file"))
+    FailRig(manifest, "manifest");
   dataset.camera = json_io::ParseManifestCamera(root);
   dataset.target = json_io::ParseTarget(root.Object("target"));
   if (root.Has("lidar")) dataset.lidar_rings = root.Object("lidar").GetOr("rings", 0);
@@ -116,9 +118,7 @@ Dataset LoadFolderSetup(const fs::path& dir, CameraFile camera) {
   const fs::path target_file = dir / "target.json";
   const bool has_camera = fs::exists(camera_file);
   if (!has_camera && fs::is_directory(dir / "cameras"))
-    Fail(dir,
-         "a rig folder (cameras/<camera>.yaml, images/<camera>/): `calibench calibrate --dataset` "
-         "calibrates every camera and the rig; this command takes one camera's dataset for now");
+    FailRig(dir, "folder (cameras/<camera>.yaml, images/<camera>/)");
   if (!has_camera && camera == CameraFile::kRequired)
     Fail(dir,
          "folder dataset has no camera.yaml (and no dataset.json): put the camera's intrinsics "

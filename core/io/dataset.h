@@ -41,6 +41,9 @@ struct SimulationRecord {
 
 struct Dataset {
   std::filesystem::path manifest;  // the file read (or the folder for the shorthand)
+  // One camera of a rig (core/io/rig_folder.h, LoadRigCamera): its name; `manifest` is then the
+  // rig's folder or manifest. Empty for a single-camera dataset.
+  std::string camera_name;
   CameraModel camera;
   BoardSpec target;
   int lidar_rings = 0;  // 0 = unknown

@@ -198,6 +198,17 @@ json PoseToResultJson(const Pose& pose) {
       {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
 }
 
+std::optional<LidarSeed> ParseLidarSeed(const Fields& p) {
+  if (!p.Has("lidar_seed")) return std::nullopt;
+  const Fields s = p.Object("lidar_seed");
+  const auto point = s.Get<std::vector<double>>("point");
+  if (point.size() != 3) s.Fail("point", "must be [x, y, z]");
+  LidarSeed seed{Vec3(point[0], point[1], point[2]), s.Number("radius")};
+  if (!(seed.radius > 0) || !seed.point.allFinite())
+    p.Fail("lidar_seed", "needs a finite point and a radius > 0");
+  return seed;
+}
+
 CameraModel ParseManifestCamera(const Fields& root) {
   const fs::path base = root.file().parent_path();
   CameraModel camera;

@@ -69,6 +69,9 @@ void CheckUniquePairId(const std::string& id, std::set<std::string>* seen,
 // either is absent.
 std::optional<Pose> OptionalPose(const Fields& root, const char* group, const char* key);
 
+// A manifest pair's optional "lidar_seed": {"point": [x, y, z], "radius" > 0} (metres).
+std::optional<LidarSeed> ParseLidarSeed(const Fields& pair);
+
 // An absolute path, or one relative to base_dir.
 std::filesystem::path Resolve(const std::filesystem::path& base_dir, const std::string& path);
 

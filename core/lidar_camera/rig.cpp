@@ -54,14 +54,17 @@ std::string TranslationText(const Pose& pose) {
 }  // namespace
 
 RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
-                        const ProgressCallback& progress) {
+                        const ProgressCallback& progress, const RigEdits& edits) {
   RigOutcome outcome;
   outcome.camera_names = rig.camera_names;
   std::vector<Pose> initial;
   // Captures by stem: the LiDAR plane (the first camera's pair that has one) and every view.
   std::map<std::string, RigCapture, NaturalOrder> captures;
   for (size_t c = 0; c < rig.cameras.size(); ++c) {
-    outcome.single.push_back(CalibrateDataset(rig.cameras[c], options, progress));
+    const auto camera_edits = edits.find(rig.camera_names[c]);
+    outcome.single.push_back(
+        CalibrateDataset(rig.cameras[c], options, progress,
+                         camera_edits == edits.end() ? PairEdits{} : camera_edits->second));
     const CalibrationOutcome& single = outcome.single.back();
     if (!single.solution) {
       outcome.failure = "camera '" + rig.camera_names[c] + "': " + single.failure;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,10 +25,14 @@ struct RigOutcome {
   int shared_captures = 0;                 // captures two or more cameras saw the board in
 };
 
+// The user's edits per camera (by camera name): each camera's session's brushes and rejections.
+using RigEdits = std::map<std::string, PairEdits>;
+
 // Calibrates every camera of the rig, then the rig. A camera whose own solve fails leaves the
-// rig without a joint solution (failure says which and why).
+// rig without a joint solution (failure says which and why). `edits` apply to their camera's
+// pairs, as `calibrate --session` applies one session's.
 RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
-                        const ProgressCallback& progress = {});
+                        const ProgressCallback& progress = {}, const RigEdits& edits = {});
 
 // The rig's result file (format calibench.rig.v1): "cameras": {"<camera>": {"cam_from_lidar":
 // 4x4, "sigma_translation_mm", "sigma_rotation_deg" (camera axes), "covariance" (6x6, right

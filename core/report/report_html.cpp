@@ -108,8 +108,9 @@ std::string DirectionCard(const std::string& name, const std::string& meaning, c
          " " + Num(q.w(), 6) + "</p></div>";
 }
 
-std::string ResultSection(const CalibrationReport& r) {
-  std::string html = "<section id=\"result\"><h2>Result</h2><div class=\"cards\">";
+std::string ResultSection(const CalibrationReport& r, const std::string& prefix) {
+  std::string html =
+      "<section id=\"" + prefix + "result\"><h2>Result</h2><div class=\"cards\">";
   html += DirectionCard("cam_from_lidar",
                         "maps LiDAR points into the camera frame: p_cam = R p_lidar + t",
                         r.cam_from_lidar);
@@ -139,9 +140,9 @@ std::string ResultSection(const CalibrationReport& r) {
   return html;
 }
 
-std::string PairTable(const CalibrationReport& r) {
+std::string PairTable(const CalibrationReport& r, const std::string& prefix) {
   std::string html =
-      "<section id=\"pairs\"><h2>Pairs</h2><table class=\"pairs\"><thead><tr><th>pair</th>"
+      "<section id=\"" + prefix + "pairs\"><h2>Pairs</h2><table class=\"pairs\"><thead><tr><th>pair</th>"
       "<th>status</th><th>LiDAR board from</th><th>plane angle [deg]</th><th>plane offset "
       "[mm]</th><th>edge crossings / RMS [mm]</th><th>weight</th><th>without it: moves [mm / "
       "deg]</th><th>held out: angle [deg] / offset [mm] / "
@@ -167,8 +168,9 @@ std::string PairTable(const CalibrationReport& r) {
   return html + "</tbody></table></section>";
 }
 
-std::string CrossValidationSection(const CalibrationReport& r) {
-  std::string html = "<section id=\"cross-validation\"><h2>Held-out cross-validation</h2>";
+std::string CrossValidationSection(const CalibrationReport& r, const std::string& prefix) {
+  std::string html = "<section id=\"" + prefix +
+                     "cross-validation\"><h2>Held-out cross-validation</h2>";
   if (!r.cross_validation)
     return html + "<p>Not computed: " + Escape(r.cross_validation_skipped) + ".</p></section>";
   const CrossValidation& cv = *r.cross_validation;
@@ -184,9 +186,10 @@ std::string CrossValidationSection(const CalibrationReport& r) {
          Num(cv.heldout_rms_distance_mm, 2) + "</td></tr></table></section>";
 }
 
-std::string FiguresSection(const std::vector<ReportFigure>& figures) {
+std::string FiguresSection(const std::vector<ReportFigure>& figures, const std::string& prefix) {
   if (figures.empty()) return "";
-  std::string html = "<section id=\"views\"><h2>Views</h2><div class=\"figures\">";
+  std::string html =
+      "<section id=\"" + prefix + "views\"><h2>Views</h2><div class=\"figures\">";
   for (const ReportFigure& f : figures) {
     html += "<figure" +
             (f.pair_id.empty() ? std::string(" class=\"overview\"")
@@ -278,54 +281,146 @@ std::string CoverageGaps(const CalibrationReport& r) {
   return words;
 }
 
-std::string ReportHtml(const CalibrationReport& report, const ReportProvenance& provenance,
-                       const std::vector<ReportFigure>& figures, const ReportAssets& assets) {
+namespace {
+
+// The provenance table, the notes and the report's own warning, as the header opens.
+std::string HeaderFacts(const ReportProvenance& provenance, const std::string& pairs,
+                        const std::string& options) {
+  std::string html = "<table class=\"provenance\">";
+  auto fact = [&](const std::string& name, const std::string& value) {
+    if (!value.empty()) html += "<tr><th>" + name + "</th><td>" + Escape(value) + "</td></tr>";
+  };
+  fact("source", provenance.source);
+  fact("result", provenance.result_file);
+  fact("pairs", pairs);
+  fact("options", options);
+  fact("written", provenance.created_utc);
+  fact("Calibench", provenance.calibench_version);
+  html += "</table>";
+  for (const std::string& note : provenance.notes)
+    html += "<p class=\"verdict bad\">" + Escape(note) + "</p>";
+  return html;
+}
+
+std::string PairsFact(const CalibrationReport& report) {
   int accepted = 0, solved = 0;
   for (const PairReportRow& p : report.pairs) {
     accepted += p.status == PairStatus::kAccepted;
     solved += p.solved;
   }
-  std::string body = "<header><h1>Calibench calibration report</h1><table class=\"provenance\">";
-  auto fact = [&](const std::string& name, const std::string& value) {
-    if (!value.empty()) body += "<tr><th>" + name + "</th><td>" + Escape(value) + "</td></tr>";
-  };
-  fact("source", provenance.source);
-  fact("result", provenance.result_file);
-  fact("pairs", std::to_string(report.pairs.size()) + " (" + std::to_string(accepted) +
-                    " accepted, " + std::to_string(solved) + " in the solve)");
-  fact("options", report.options);
-  fact("written", provenance.created_utc);
-  fact("Calibench", provenance.calibench_version);
-  body += "</table>";
-  for (const std::string& note : provenance.notes)
-    body += "<p class=\"verdict bad\">" + Escape(note) + "</p>";
-  if (!report.distrust.empty())
-    body += "<p class=\"verdict bad\">" + Escape(report.distrust) + "</p>";
-  body += "</header>";
-  body += ResultSection(report) + CrossValidationSection(report);
+  return std::to_string(report.pairs.size()) + " (" + std::to_string(accepted) + " accepted, " +
+         std::to_string(solved) + " in the solve)";
+}
+
+// One camera's result, cross-validation, plots, pairs and views; every id starts with `prefix`
+// (report.js draws the plots of each camera's canvases).
+std::string CameraBody(const CalibrationReport& report, const std::vector<ReportFigure>& figures,
+                       const std::string& prefix) {
+  std::string body = ResultSection(report, prefix) + CrossValidationSection(report, prefix);
   const std::string gaps = CoverageGaps(report);
-  body +=
-      "<section id=\"plots\"><h2>Plots</h2><div class=\"plots\">"
-      "<div class=\"plot\"><canvas id=\"residuals\"></canvas></div>"
-      "<div class=\"plot\"><canvas id=\"weights\"></canvas></div>"
-      "<div class=\"plot\"><canvas id=\"convergence\"></canvas></div>"
-      "<div class=\"plot\"><canvas id=\"sigma\"></canvas></div>"
-      "<div class=\"plot\"><canvas id=\"coverage-image\"></canvas></div>"
-      "<div class=\"plot\"><canvas id=\"coverage-lidar\"></canvas></div></div>"
-      "<p class=\"coverage\">Coverage: " +
-      Escape(gaps.empty() ? "the boards cover the image's 3 x 3 grid and a wide LiDAR field."
-                          : gaps + " More poses there would help.") +
-      "</p></section>";
-  body += PairTable(report) + FiguresSection(figures);
-  std::string data = ChartData(report).dump();
-  for (size_t at = data.find("</"); at != std::string::npos; at = data.find("</", at + 3))
-    data.replace(at, 2, "<\\/");  // never close the <script> early
-  return FillTemplate(assets.html_template, {{"title", "Calibench calibration report"},
+  body += "<section id=\"" + prefix + "plots\"><h2>Plots</h2><div class=\"plots\">";
+  for (const char* plot :
+       {"residuals", "weights", "convergence", "sigma", "coverage-image", "coverage-lidar"})
+    body += "<div class=\"plot\"><canvas id=\"" + prefix + plot + "\"></canvas></div>";
+  body += "</div><p class=\"coverage\">Coverage: " +
+          Escape(gaps.empty() ? "the boards cover the image's 3 x 3 grid and a wide LiDAR field."
+                              : gaps + " More poses there would help.") +
+          "</p></section>";
+  return body + PairTable(report, prefix) + FiguresSection(figures, prefix);
+}
+
+std::string FillReport(const std::string& title, const std::string& body, json data,
+                       const ReportAssets& assets) {
+  std::string text = data.dump();
+  for (size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3))
+    text.replace(at, 2, "<\\/");  // never close the <script> early
+  return FillTemplate(assets.html_template, {{"title", title},
                                              {"style", assets.style},
                                              {"chart_js", assets.chart_js},
-                                             {"data", data},
+                                             {"data", text},
                                              {"script", assets.script},
                                              {"body", body}});
+}
+
+std::string SigmaCells(const Vec3& t_mm, const Vec3& r_deg) {
+  return "<td>" + Num(t_mm.x(), 2) + " " + Num(t_mm.y(), 2) + " " + Num(t_mm.z(), 2) +
+         "</td><td>" + Num(r_deg.x(), 3) + " " + Num(r_deg.y(), 3) + " " + Num(r_deg.z(), 3) +
+         "</td>";
+}
+
+}  // namespace
+
+std::string ReportHtml(const CalibrationReport& report, const ReportProvenance& provenance,
+                       const std::vector<ReportFigure>& figures, const ReportAssets& assets) {
+  std::string body = "<header><h1>Calibench calibration report</h1>" +
+                     HeaderFacts(provenance, PairsFact(report), report.options);
+  if (!report.distrust.empty())
+    body += "<p class=\"verdict bad\">" + Escape(report.distrust) + "</p>";
+  body += "</header>" + CameraBody(report, figures, "");
+  return FillReport("Calibench calibration report", body, ChartData(report), assets);
+}
+
+std::string RigReportHtml(const RigReportSummary& rig, const std::vector<RigCameraReport>& cameras,
+                          const ReportProvenance& provenance, const ReportAssets& assets) {
+  std::string body = "<header><h1>Calibench rig calibration report</h1>";
+  std::string names;
+  for (const RigCameraReport& camera : cameras)
+    names += (names.empty() ? "" : ", ") + camera.name;
+  body += HeaderFacts(provenance, std::to_string(cameras.size()) + " cameras (" + names + "), " +
+                                      std::to_string(rig.shared_captures) +
+                                      " captures seen by two or more",
+                      cameras.empty() ? "" : cameras.front().report.options);
+  body += "<nav class=\"cameras\">";
+  for (const RigCameraReport& camera : cameras)
+    body += "<a href=\"#" + Escape(camera.prefix) + "camera\">" + Escape(camera.name) + "</a> ";
+  body += "</nav></header>";
+  // The rig: each camera's pose from the joint solve next to its own, and the cameras' relative
+  // poses, which only the joint solve ties with boards two cameras saw at once.
+  body +=
+      "<section id=\"rig\"><h2>The rig</h2><p>Every camera with the LiDAR in one problem (the "
+      "rig solve); the camera sections below are each camera alone, as <code>calibrate</code> "
+      "solves one camera.</p><table class=\"sigma\"><tr><th>camera</th><th>pairs</th>"
+      "<th>rig: translation [m]</th><th>rig: sigma t [mm] (x y z)</th><th>rig: sigma r [deg]</th>"
+      "<th>alone: sigma t [mm]</th><th>alone: sigma r [deg]</th><th>rig vs alone [mm / "
+      "deg]</th></tr>";
+  for (const RigReportSummary::Camera& camera : rig.cameras) {
+    const Vec3 t = camera.cam_from_lidar.translation();
+    const double moved_mm = 1e3 * (t - camera.single_cam_from_lidar.translation()).norm();
+    const double turned_deg = Eigen::AngleAxisd(camera.cam_from_lidar.linear().transpose() *
+                                                camera.single_cam_from_lidar.linear())
+                                  .angle() *
+                              kRadToDeg;
+    body += "<tr data-rig-camera=\"" + Escape(camera.name) + "\"><td>" + Escape(camera.name) +
+            "</td><td>" + std::to_string(camera.pairs) + "</td><td>" + Num(t.x(), 4) + " " +
+            Num(t.y(), 4) + " " + Num(t.z(), 4) + "</td>" +
+            SigmaCells(camera.sigma_t_mm, camera.sigma_r_deg) +
+            SigmaCells(camera.single_sigma_t_mm, camera.single_sigma_r_deg) + "<td>" +
+            Num(moved_mm, 2) + " / " + Num(turned_deg, 3) + "</td></tr>";
+  }
+  body += "</table><h3>Cameras relative to each other</h3><table class=\"sigma\"><tr>"
+          "<th>pose</th><th>translation [m]</th><th>sigma t [mm] (x y z)</th>"
+          "<th>sigma r [deg]</th></tr>";
+  for (const RigReportSummary::Relative& relative : rig.relative) {
+    const Vec3 t = relative.to_from_from.translation();
+    body += "<tr data-relative=\"" + Escape(relative.name) + "\"><td><code>" +
+            Escape(relative.name) + "</code></td><td>" + Num(t.x(), 4) + " " + Num(t.y(), 4) +
+            " " + Num(t.z(), 4) + "</td>" + SigmaCells(relative.sigma_t_mm, relative.sigma_r_deg) +
+            "</tr>";
+  }
+  body += "</table></section>";
+  json data = {{"cameras", json::array()}};
+  for (const RigCameraReport& camera : cameras) {
+    body += "<section class=\"camera\" id=\"" + Escape(camera.prefix) + "camera\"><h2>Camera " +
+            Escape(camera.name) + " alone</h2>";
+    if (!camera.report.distrust.empty())
+      body += "<p class=\"verdict bad\">" + Escape(camera.report.distrust) + "</p>";
+    body += "<p>pairs: " + PairsFact(camera.report) + "</p>" +
+            CameraBody(camera.report, camera.figures, camera.prefix) + "</section>";
+    json chart = ChartData(camera.report);
+    chart["prefix"] = camera.prefix;
+    data["cameras"].push_back(chart);
+  }
+  return FillReport("Calibench rig calibration report", body, data, assets);
 }
 
 }  // namespace calibench

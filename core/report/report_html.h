@@ -45,6 +45,35 @@ ReportAssets LoadReportAssets(
 std::string ReportHtml(const CalibrationReport& report, const ReportProvenance& provenance,
                        const std::vector<ReportFigure>& figures, const ReportAssets& assets);
 
+// A rig's report: the rig solve per camera (its pose and σ next to the camera's own) and the
+// cameras' relative poses, then each camera's section as one camera's report has it.
+struct RigReportSummary {
+  struct Camera {
+    std::string name;
+    int pairs = 0;
+    Pose cam_from_lidar = Pose::Identity();  // the rig solve's
+    Vec3 sigma_t_mm = Vec3::Zero(), sigma_r_deg = Vec3::Zero();
+    Pose single_cam_from_lidar = Pose::Identity();  // the camera alone
+    Vec3 single_sigma_t_mm = Vec3::Zero(), single_sigma_r_deg = Vec3::Zero();
+  };
+  struct Relative {
+    std::string name;  // "<to>_from_<from>"
+    Pose to_from_from = Pose::Identity();
+    Vec3 sigma_t_mm = Vec3::Zero(), sigma_r_deg = Vec3::Zero();
+  };
+  std::vector<Camera> cameras;
+  std::vector<Relative> relative;
+  int shared_captures = 0;
+};
+struct RigCameraReport {
+  std::string name;
+  std::string prefix;  // of its section's ids ("cam0-"): unique per camera
+  CalibrationReport report;
+  std::vector<ReportFigure> figures;
+};
+std::string RigReportHtml(const RigReportSummary& rig, const std::vector<RigCameraReport>& cameras,
+                          const ReportProvenance& provenance, const ReportAssets& assets);
+
 // Where more poses would help, in words: the cells of a 3 x 3 image grid ("top left" ... "bottom
 // right") where no board centre lies, and a LiDAR field the boards span narrowly (azimuth or
 // elevation under 20 degrees). "" when the boards cover both.

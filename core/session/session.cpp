@@ -11,6 +11,7 @@
 
 #include "core/base/atomic_file.h"
 #include "core/io/json_io.h"
+#include "core/io/rig_folder.h"
 
 namespace calibench {
 
@@ -91,9 +92,19 @@ std::filesystem::path NormalizeSessionPath(const std::filesystem::path& path) {
   return p;
 }
 
+std::filesystem::path DefaultSessionPath(const std::filesystem::path& dataset,
+                                         const std::string& camera) {
+  std::error_code error;
+  const std::filesystem::path folder =
+      std::filesystem::is_directory(dataset, error) ? dataset : dataset.parent_path();
+  return folder / (camera.empty() ? "calibench.session.json"
+                                  : "calibench.session." + camera + ".json");
+}
+
 Session NewSession(const Dataset& dataset) {
   Session session;
   session.dataset = NormalizeSessionPath(dataset.manifest);
+  session.camera = dataset.camera_name;
   for (const PairEntry& entry : dataset.pairs) {
     PairState pair;
     pair.id = entry.id;
@@ -154,7 +165,8 @@ Session LoadSession(const std::filesystem::path& path) {
 
 SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_path) {
   Session session = LoadSession(session_path);
-  Dataset dataset = LoadDataset(session.dataset);
+  Dataset dataset = session.camera.empty() ? LoadDataset(session.dataset)
+                                           : LoadRigCamera(session.dataset, session.camera);
   if (session.pairs.size() != dataset.pairs.size())
     throw IoError(session_path.string() + ": the session has " +
                   std::to_string(session.pairs.size()) + " pairs but " + dataset.manifest.string() +

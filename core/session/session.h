@@ -85,6 +85,9 @@ struct Session {
   int version = 1;  // of the file format; this build reads and writes 1
   // The manifest (or shorthand folder); absolute and lexically normal in memory.
   std::filesystem::path dataset;
+  // The camera of a rig this session edits (Dataset::camera_name; the file's "camera", written
+  // only for a rig): `dataset` is then the rig's folder or manifest. Empty for one camera.
+  std::string camera;
   std::vector<PairState> pairs;                      // in the dataset's order
   SolverMethod method = SolverOptions{}.method;      // solver (see SolverOptions)
   double huber_delta = SolverOptions{}.huber_delta;  // Huber threshold (see SolverOptions)
@@ -102,6 +105,11 @@ struct Session {
 // The form Session::dataset is kept in: absolute (against the working directory), lexically
 // normal, no trailing separator. Use it when setting Session::dataset from a user's path.
 std::filesystem::path NormalizeSessionPath(const std::filesystem::path& path);
+
+// Where the workbench keeps a dataset's session unless told: calibench.session.json in the
+// dataset's folder (the manifest's folder), calibench.session.<camera>.json for a rig's camera.
+std::filesystem::path DefaultSessionPath(const std::filesystem::path& dataset,
+                                         const std::string& camera = "");
 
 // One pending PairState per dataset pair, default options, an empty view (the workbench then
 // selects the first pair).

@@ -344,6 +344,10 @@ Session ReadSession(const json& root, const std::filesystem::path& source_path) 
   const std::string dataset = f.String("dataset");
   if (dataset.empty()) f.Fail("dataset", "must not be empty");
   s.dataset = NormalizeSessionPath(NormalizeSessionPath(source_path).parent_path() / dataset);
+  if (f.Has("camera")) {
+    s.camera = f.String("camera");
+    if (s.camera.empty()) f.Fail("camera", "must name a camera of the rig");
+  }
   ReadOptions(f.Object("options"), &s);
   const json& pairs = f.Array("pairs");
   for (size_t i = 0; i < pairs.size(); ++i) {
@@ -382,6 +386,7 @@ std::string SessionToJson(const Session& session, const std::filesystem::path& s
                {"pairs", pairs},
                {"view", ViewObject(session.view_json)},
                {"result", session.result ? ResultToJson(*session.result) : Json(nullptr)}};
+  if (!session.camera.empty()) root["camera"] = session.camera;
   std::string text;
   Pretty(root, 0, &text);
   return text + "\n";

@@ -19,6 +19,7 @@ Controller::Controller(PipelineOptions options) : pipeline_(std::move(options)) 
 
 Controller::~Controller() {
   StopWatching();
+  WaitRig();
   StopWorker();
 }
 
@@ -221,6 +222,7 @@ void Controller::EnsureSelectedImage() {
   state_.selected_image_pair = state_.pairs[state_.selected].id;
   state_.selected_undistorted = undistorted;
   ++state_.generation;
+  if (state_.rig) worker_.Enqueue([this] { LoadRigFrames(); });
 }
 
 bool Controller::ValidPair(int index) const {

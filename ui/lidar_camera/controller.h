@@ -7,6 +7,7 @@
 #include <atomic>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -21,9 +22,11 @@
 #include "core/camera/undistort.h"
 #include "core/io/camera_file.h"
 #include "core/io/capture_feed.h"
+#include "core/io/rig_folder.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
 #include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/rig.h"
 #include "core/reproject/reproject.h"
 #include "core/results/export.h"
 #include "core/session/calibration_job.h"  // the job, with the guidance and the session
@@ -84,6 +87,46 @@ struct MeterPoint {
   Vec3 sigma_r_deg = Vec3::Zero();
 };
 
+// One camera of a rig (core/io/rig_folder.h) as the workbench shows it beside the one open.
+struct RigCameraView {
+  std::string name;
+  CameraModel camera;  // its intrinsics: the 3D view's frustum
+  int captures = 0;    // the captures it has a frame of
+  // Its own solve (each camera through the pipeline as `calibrate` runs it, with its session's
+  // edits); the open camera's is the workbench's latest solve.
+  std::shared_ptr<const SolverResult> single;
+  int pairs_used = 0;
+  std::optional<CaptureState> meter;  // the stop rule on `single` against the goal
+  // The rig's joint solve (all cameras in one problem) at its last run; nullopt before one.
+  std::optional<Pose> joint_cam_from_lidar;
+  Vec3 joint_sigma_t_mm = Vec3::Zero();
+  Vec3 joint_sigma_r_deg = Vec3::Zero();
+  std::string failure;  // why it has no solve
+  // Its frame of the selected capture, small (the strip); null when it has none.
+  std::shared_ptr<const ImageU8> frame;
+};
+
+// A rig's cameras around the one open (Controller::OpenDataset of a rig).
+struct RigView {
+  std::filesystem::path path;  // the rig's folder or manifest
+  int active = 0;              // the camera open in the views
+  std::vector<RigCameraView> cameras;
+  std::string frames_pair;  // the capture the strip's frames show
+  bool solving = false;     // the rig solve runs (on its own thread)
+  int shared_captures = 0;  // at the last rig solve: captures two or more cameras saw the board in
+  // Each camera after the first relative to the first (x_in_<to> = to_from_from · x_in_<from>),
+  // from the joint solve, with σ; named "<to>_from_<from>".
+  struct Relative {
+    std::string name;
+    Pose to_from_from = Pose::Identity();
+    Vec3 sigma_t_mm = Vec3::Zero(), sigma_r_deg = Vec3::Zero();
+  };
+  std::vector<Relative> relative;
+  std::string failure;  // the last rig solve's failure
+  // Every camera's stop rule is met.
+  bool AllDone() const;
+};
+
 struct Snapshot : SnapshotHeader {
   std::filesystem::path dataset_path;
   std::filesystem::path session_path;  // empty: the session lives in memory only (render)
@@ -125,6 +168,8 @@ struct Snapshot : SnapshotHeader {
   // A folder being followed (WatchFolder): pairs join the list as they land.
   std::filesystem::path watching;
   bool auto_solve = false;
+  // Opened from a rig: its cameras, the strip of the selected capture's frames, the rig solve.
+  std::optional<RigView> rig;
 };
 
 // What the user asked for. Panels return these; Controller::Apply carries them out.
@@ -196,10 +241,19 @@ struct SaveIntrinsics {
   std::filesystem::path path;
   CameraFileFormat format = CameraFileFormat::kRosCameraInfo;
 };
+// Another camera of the rig into the views (its own session, resumed): the window replaces the
+// controller (WindowShell::SelectCamera); a controller alone says so on its status line.
+struct SelectCamera {
+  std::string camera;
+};
+// The rig's joint solve over every camera, with each camera's session edits (the open one's as
+// they are now), on its own thread; the meter and the frustums follow.
+struct SolveRig {};
 using Intent =
     std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush, DetectBoardAgain,
                  PaintPoints, RunSolver, ResetSolver, SetSolverOptions, SetView, ExportResult,
-                 SaveSessionAs, Undo, Redo, EstimateIntrinsics, SaveIntrinsics, SetGoal>;
+                 SaveSessionAs, Undo, Redo, EstimateIntrinsics, SaveIntrinsics, SetGoal,
+                 SelectCamera, SolveRig>;
 
 class Controller : public ControllerState<Snapshot> {
  public:
@@ -222,9 +276,18 @@ class Controller : public ControllerState<Snapshot> {
   // session file alone and never writes one (render draws; it does not edit).
   // A session file is locked (FileLock) while open: one that another workbench has open throws
   // IoError naming that process.
+  // A rig (a rig folder or manifest) opens one camera: `camera`, else the first; its session is
+  // calibench.session.<camera>.json beside the rig, and the rig's other cameras are solved on a
+  // thread of their own (RigView) for the meter, the frustums and the strip.
   enum class ExistingSession { kReplace, kResume, kStartFresh, kInMemory };
   void OpenDataset(const std::filesystem::path& dataset, std::filesystem::path session_path = {},
-                   ExistingSession existing = ExistingSession::kReplace);
+                   ExistingSession existing = ExistingSession::kReplace,
+                   const std::string& camera = "");
+  // Before opening another camera of the same rig: its cameras' solves as `rig` holds them (the
+  // window's camera switch), so that they are not solved again.
+  void CarryRig(const RigView& rig);
+  // The same from a rig solve already run (the report's views of a rig's cameras).
+  void CarryRig(std::shared_ptr<const RigOutcome> outcome);
   // The same for a dataset already read (a followed capture's, before it has pairs).
   void OpenLoadedDataset(const Dataset& dataset, std::filesystem::path session_path,
                          ExistingSession existing);
@@ -248,6 +311,8 @@ class Controller : public ControllerState<Snapshot> {
   void WatchRecording(const std::filesystem::path& recording, const std::filesystem::path& out,
                       std::optional<BoardSpec> board, BagImportOptions options);
   void StopWatching();
+  // Waits for the rig solve's thread (tests, renders).
+  void WaitRig();
   // One pair more, loaded and detected on the worker (a watched folder; any thread).
   void AddPair(const PairEntry& entry);
 
@@ -311,6 +376,14 @@ class Controller : public ControllerState<Snapshot> {
   // history's last step is amended, so that one stroke is one undo step.
   void CommitEdit();
   void ApplySessionToState(const Session& session);  // call with mutex_ held
+  // Rig (controller_rig.cpp), with mutex_ held unless said: the rig view with camera `active`
+  // open (true: the other cameras' solves carried from CarryRig); the rig solve on rig_thread_;
+  // the open camera's entry from the latest solve and every camera's meter; the strip's frames of
+  // the selected capture (worker, mutex_ not held).
+  bool SetUpRig(const RigFolder& rig, size_t active);
+  void StartRigSolve();
+  void UpdateActiveRigCamera();
+  void LoadRigFrames();
   // `note` (how the session came to be opened) joins the status line once the pairs have loaded.
   void Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
             const std::string& note, std::optional<FileLock> lock);
@@ -350,6 +423,11 @@ class Controller : public ControllerState<Snapshot> {
   bool follow_newest_ = true;         // a followed capture's views move to each new pair (mutex_)
   bool opened_pairs_loaded_ = false;  // every pair Open started with has loaded (mutex_)
   std::thread watch_thread_;
+  std::thread rig_thread_;                    // the rig solve (SolveRig, and at open)
+  std::optional<RigView> carried_rig_;        // CarryRig's, for the next Open
+  std::shared_ptr<const RigOutcome> carried_rig_outcome_;  // the same
+  std::map<std::string, std::shared_ptr<const ImageU8>> rig_frames_;  // "<camera>/<pair>" (worker)
+  std::vector<std::map<std::string, std::filesystem::path>> rig_images_;  // per camera (mutex_)
   std::atomic<bool> stop_watch_{false};
 };
 
@@ -390,5 +468,9 @@ template <>
 void Controller::Handle(const SaveIntrinsics&);
 template <>
 void Controller::Handle(const SetGoal&);  // controller_meter.cpp
+template <>
+void Controller::Handle(const SelectCamera&);  // controller_rig.cpp
+template <>
+void Controller::Handle(const SolveRig&);
 
 }  // namespace calibench::ui

@@ -9,6 +9,7 @@ namespace calibench::ui {
 void Controller::JudgeMeter(bool record) {
   if (!state_.solver.result) {
     state_.meter.reset();
+    UpdateActiveRigCamera();
     return;
   }
   // The pairs the solve used; a reopened session's result: the pairs accepted in it.
@@ -18,6 +19,7 @@ void Controller::JudgeMeter(bool record) {
         std::count_if(state_.pairs.begin(), state_.pairs.end(),
                       [](const PairView& p) { return p.status == PairStatus::kAccepted; }));
   state_.meter = JudgeCapture(*state_.solver.result, pairs, state_.goal, StopRuleOptions{});
+  UpdateActiveRigCamera();
   if (!record) return;
   const MeterPoint point{pairs, state_.meter->sigma_t_mm, state_.meter->sigma_r_deg};
   // One point per number of pairs: a solve again at the same count replaces it.

@@ -9,6 +9,7 @@
 #include "core/base/atomic_file.h"
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
+#include "core/io/rig_folder.h"
 #include "core/lidar_camera/result_io.h"
 #include "ui/lidar_camera/controller.h"
 
@@ -35,7 +36,17 @@ std::filesystem::path BackUpSession(const std::filesystem::path& path) {
 }  // namespace
 
 void Controller::OpenDataset(const std::filesystem::path& dataset_path,
-                             std::filesystem::path session_path, ExistingSession existing) {
+                             std::filesystem::path session_path, ExistingSession existing,
+                             const std::string& camera) {
+  if (IsRig(dataset_path)) {
+    const RigFolder rig = LoadRig(dataset_path);
+    const size_t index = camera.empty() ? 0 : RigCameraIndex(rig, camera);
+    OpenLoadedDataset(rig.cameras[index], std::move(session_path), existing);
+    return;
+  }
+  if (!camera.empty())
+    throw IoError(dataset_path.string() + ": not a rig (a folder with cameras/, or a manifest "
+                  "with \"cameras\"), so it has no camera '" + camera + "'");
   OpenLoadedDataset(LoadDataset(dataset_path), std::move(session_path), existing);
 }
 
@@ -47,12 +58,7 @@ void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path
     Open(dataset, std::move(session), {}, "", std::nullopt);
     return;
   }
-  if (session_path.empty()) {
-    const auto folder = std::filesystem::is_directory(dataset.manifest)
-                            ? dataset.manifest
-                            : dataset.manifest.parent_path();
-    session_path = folder / "calibench.session.json";
-  }
+  if (session_path.empty()) session_path = DefaultSessionPath(dataset.manifest, dataset.camera_name);
   std::string note;
   std::optional<FileLock> lock = LockSession(session_path, &note);
   if (existing != ExistingSession::kReplace && std::filesystem::exists(session_path)) {
@@ -139,6 +145,13 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
   std::vector<std::string> ids;
   for (const PairState& pair : session.pairs) ids.push_back(pair.id);
   ViewFromJson(session.view_json, session_path.empty() ? dataset.manifest : session_path, ids);
+  // A rig's camera: the rig read (and the camera found in it) before anything changes.
+  std::optional<RigFolder> rig;
+  size_t rig_camera = 0;
+  if (!dataset.camera_name.empty()) {
+    rig = LoadRig(dataset.manifest);
+    rig_camera = RigCameraIndex(*rig, dataset.camera_name);
+  }
   WaitIdle();
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -175,6 +188,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
                  }});
     history_.Reset(session_);
     autosaver_ = session_path.empty() ? nullptr : std::make_unique<Autosaver>(session_path);
+    if (rig && !SetUpRig(*rig, rig_camera)) StartRigSolve();
     SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
                   dataset.manifest.string(),
               false);

@@ -77,9 +77,10 @@ std::unique_ptr<Controller> WindowShell::NewController() const {
   return controller;
 }
 
-void WindowShell::OpenDataset(const fs::path& dataset, Controller::ExistingSession existing) {
+void WindowShell::OpenDataset(const fs::path& dataset, Controller::ExistingSession existing,
+                              const std::string& camera) {
   auto opened = NewController();
-  opened->OpenDataset(dataset, {}, existing);
+  opened->OpenDataset(dataset, {}, existing, camera);
   Replace(std::move(opened));
 }
 
@@ -87,6 +88,25 @@ void WindowShell::OpenSession(const fs::path& session) {
   auto opened = NewController();
   opened->OpenSession(session);
   Replace(std::move(opened));
+}
+
+void WindowShell::SelectCamera(const std::string& camera) {
+  const Snapshot s = controller_->GetSnapshot();
+  if (!s.rig || s.rig->cameras[s.rig->active].name == camera) return;
+  try {
+    auto opened = NewController();
+    // While the rig solves, its cameras' solves are not all there: the new controller solves.
+    if (!s.rig->solving) opened->CarryRig(*s.rig);
+    opened->OpenDataset(s.rig->path, {}, Controller::ExistingSession::kResume, camera);
+    const std::string pair = s.selected >= 0 ? s.pairs[s.selected].id : "";
+    const auto pairs = opened->GetSnapshot().pairs;
+    for (size_t i = 0; i < pairs.size(); ++i)
+      if (pairs[i].id == pair) opened->Apply(SelectPair{static_cast<int>(i)});
+    Replace(std::move(opened));
+  } catch (const IoError& e) {
+    error_ = e.what();
+    show_error_ = true;
+  }
 }
 
 void WindowShell::Watch(const fs::path& source) {
@@ -212,6 +232,7 @@ WindowRun WindowShell::Run(const WindowOptions& options) {
 bool WindowShell::Frame(Window& window, int width, int height, double seconds) {
   if (pending_open_) OpenFromUser(*std::exchange(pending_open_, std::nullopt));
   if (pending_watch_) Watch(*std::exchange(pending_watch_, std::nullopt));
+  if (pending_camera_) SelectCamera(*std::exchange(pending_camera_, std::nullopt));
   for (const std::string& dropped : window.TakeDroppedPaths()) pending_open_ = dropped;
   const bool importing = PollImport();  // may open a dataset, replacing the workbench
   if (!workbench_) workbench_ = std::make_unique<Workbench>();
@@ -219,14 +240,20 @@ bool WindowShell::Frame(Window& window, int width, int height, double seconds) {
   const Snapshot snapshot = controller_->GetSnapshot();
   drawn_generation_ = snapshot.generation;
   const auto intents = workbench_->Frame(snapshot, width, height, Layout::kWorkbench, seconds, top);
-  for (const Intent& intent : intents) controller_->Apply(intent);
+  for (const Intent& intent : intents) {
+    // A camera of the rig is another controller's (its own session): the next frame opens it.
+    if (const auto* camera = std::get_if<ui::SelectCamera>(&intent))
+      pending_camera_ = camera->camera;
+    else
+      controller_->Apply(intent);
+  }
   if (const auto chosen = browser_.Draw())
     (std::exchange(choosing_watch_, false) ? pending_watch_ : pending_open_) = *chosen;
   if (!browser_.IsOpen()) choosing_watch_ = false;
   Popups();
   if (quit_) window.RequestClose();
   return importing || report_ != nullptr || !intents.empty() || workbench_->Animating(snapshot) ||
-         pending_open_.has_value();
+         pending_open_.has_value() || pending_camera_.has_value();
 }
 
 float WindowShell::MenuBar() {

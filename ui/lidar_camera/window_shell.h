@@ -49,11 +49,16 @@ class WindowShell {
 
   // What the window opens with; the command line's errors are thrown (IoError) before a window
   // exists. A recording starts importing and opens when done.
-  void OpenDataset(const std::filesystem::path& dataset, Controller::ExistingSession existing);
+  void OpenDataset(const std::filesystem::path& dataset, Controller::ExistingSession existing,
+                   const std::string& camera = "");
   void OpenSession(const std::filesystem::path& session);
   void ImportRecording(const std::filesystem::path& recording);
   // What the File menu, Recent and a drop do: any kind of path; failures go to the popup.
   void OpenFromUser(const std::filesystem::path& path);
+  // Another camera of the open rig (the workbench's camera selector and strip): a controller on
+  // that camera's session (resumed) replaces this one, the rig's other solves carried over and
+  // the same capture selected; failures go to the popup.
+  void SelectCamera(const std::string& camera);
   // Follows a capture folder or a recording being written (Controller::WatchFolder /
   // WatchRecording; File → Watch a capture…).
   void Watch(const std::filesystem::path& source);
@@ -99,6 +104,7 @@ class WindowShell {
   std::optional<BagImportSummary> last_import_;
   std::optional<std::filesystem::path> pending_open_;   // chosen during a frame, opened at the next
   std::optional<std::filesystem::path> pending_watch_;  // the same, to be watched
+  std::optional<std::string> pending_camera_;           // the same, a rig camera to switch to
   std::uint64_t drawn_generation_ = 0;  // the controller's state the last frame showed
   bool choosing_watch_ = false;         // the browser is open for File → Watch folder…
   std::string error_;

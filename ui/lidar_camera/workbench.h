@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ui/gfx/renderers.h"
+#include "ui/gfx/scene_layers.h"
 #include "ui/lidar_camera/controller.h"
 #include "ui/widgets/export_row.h"
 #include "ui/widgets/view_window.h"
@@ -25,6 +26,11 @@ struct CameraShown;  // what the camera view shows in a frame (workbench_gl.h)
 enum class Layout { kWorkbench, kLidarOnly, kCameraOnly, kSceneOnly, kGuide };
 // "workbench", "lidar", "camera", "3d", "guide"; false for others.
 bool ParseLayout(const std::string& name, Layout* layout);
+
+// The camera's viewing frustum as lines: its image border's rays to depth_m (metres, camera z),
+// from the camera's centre, in the frame lidar_from_cam maps into.
+void AddCameraFrustum(const CameraModel& camera, const Pose& lidar_from_cam, double depth_m,
+                      const gfx::Rgba& color, gfx::LineBatch* lines);
 
 class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
  public:
@@ -72,6 +78,12 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   // The meter: σ per axis against the goal, the weakest in words, done (workbench_meter.cpp).
   void MeterRows(const Snapshot& s, std::vector<Intent>* intents);
   void GuideRows(const Snapshot& s);  // the next pose in words, the ghost's match
+  // A rig (workbench_rig.cpp): the camera selector and the strip of the selected capture's frames
+  // (measurements panel); the meter over every camera and the rig solve (solver panel); every
+  // camera's frustum into the 3D view's camera layer.
+  void RigStrip(const Snapshot& s, std::vector<Intent>* intents);
+  void RigMeterRows(const Snapshot& s, std::vector<Intent>* intents);
+  void DrawRigFrustums(const Snapshot& s, const Pose* estimate, gfx::SceneLayers::Layer* layer);
   // The camera-intrinsics window (workbench_intrinsics.cpp): estimate from the loaded pairs, the
   // coverage map, the per-image error, σ and the verdict, save beside the dataset.
   void IntrinsicsWindow(const Snapshot& s, std::vector<Intent>* intents);

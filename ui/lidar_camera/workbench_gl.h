@@ -38,6 +38,12 @@ struct Workbench::Gl {
   float scene_floor_z = -1.5f;    // metres, LiDAR frame; from the shown cloud
   gfx::SceneLayers scene_layers;  // grid, frames, cloud, boards, ghost (DrawScene)
   std::map<std::string, std::unique_ptr<gfx::ImageTexture>> thumbnails;
+  // The rig strip's frames by camera, with the picture each holds (they change with the capture).
+  struct RigFrame {
+    std::unique_ptr<gfx::ImageTexture> texture;
+    const ImageU8* source = nullptr;
+  };
+  std::map<std::string, RigFrame> rig_frames;
 };
 
 // What the camera view shows in a frame: the raw image with the real lens, or the undistorted one

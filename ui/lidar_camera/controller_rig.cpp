@@ -1,0 +1,244 @@
+// The controller's rig: a rig camera opened in the views with the rig's other cameras beside it.
+// Each camera's own solve and the rig's joint solve (core/lidar_camera/rig.h, as `calibrate` runs
+// them) on a thread of their own; the meter over every camera; the strip of the selected capture's
+// frames.
+#include <algorithm>
+
+#include "core/estimation/uncertainty.h"
+#include "core/io/image_io.h"
+#include "core/io/rig_folder.h"
+#include "core/lidar_camera/rig.h"
+#include "ui/lidar_camera/controller.h"
+
+namespace calibench::ui {
+
+namespace {
+
+constexpr int kRigFrameWidth = 160;  // pixels, as the pairs' thumbnails
+
+int AcceptedPairs(const CalibrationOutcome& outcome) {
+  return static_cast<int>(std::count_if(outcome.pairs.begin(), outcome.pairs.end(),
+                                        [](const PairFeatures& p) {
+                                          return p.status == PairStatus::kAccepted;
+                                        }));
+}
+
+// The rig solve's outcome into the rig's view; the open camera keeps its live solve once it has
+// one.
+void ApplyRigOutcome(const RigOutcome& outcome, bool active_solved, RigView* rig) {
+  for (size_t c = 0; c < outcome.camera_names.size() && c < rig->cameras.size(); ++c) {
+    RigCameraView& view = rig->cameras[c];
+    const CalibrationOutcome& single = outcome.single[c];
+    if (static_cast<int>(c) != rig->active || !active_solved) {
+      view.single =
+          single.solution ? std::make_shared<const SolverResult>(*single.solution) : nullptr;
+      view.pairs_used = AcceptedPairs(single);
+      view.failure = single.solution ? "" : single.failure;
+    }
+    view.joint_cam_from_lidar.reset();
+    if (!outcome.joint) continue;
+    const Pose& pose = outcome.joint->cam_from_lidar[c];
+    const Mat6 covariance = outcome.joint->covariance.block<6, 6>(6 * c, 6 * c);
+    view.joint_cam_from_lidar = pose;
+    view.joint_sigma_t_mm = 1e3 * TranslationStd(covariance, pose);
+    view.joint_sigma_r_deg = RotationStdDeg(covariance, pose);
+  }
+  rig->relative.clear();
+  rig->shared_captures = outcome.shared_captures;
+  rig->failure = outcome.joint ? "" : outcome.failure;
+  if (!outcome.joint) return;
+  for (size_t to = 1; to < outcome.camera_names.size(); ++to) {
+    const RelativePose relative = CameraFromCamera(*outcome.joint, static_cast<int>(to), 0);
+    rig->relative.push_back({outcome.camera_names[to] + "_from_" + outcome.camera_names[0],
+                             relative.to_from_from,
+                             1e3 * TranslationStd(relative.covariance, relative.to_from_from),
+                             RotationStdDeg(relative.covariance, relative.to_from_from)});
+  }
+}
+
+}  // namespace
+
+bool RigView::AllDone() const {
+  return !cameras.empty() && std::all_of(cameras.begin(), cameras.end(), [](const auto& camera) {
+    return camera.meter && camera.meter->done;
+  });
+}
+
+void Controller::CarryRig(const RigView& rig) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  carried_rig_ = rig;
+}
+
+void Controller::CarryRig(std::shared_ptr<const RigOutcome> outcome) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  carried_rig_outcome_ = std::move(outcome);
+}
+
+void Controller::WaitRig() {
+  if (rig_thread_.joinable()) rig_thread_.join();
+}
+
+bool Controller::SetUpRig(const RigFolder& rig, size_t active) {
+  RigView view;
+  view.path = rig.folder;
+  view.active = static_cast<int>(active);
+  rig_images_.assign(rig.cameras.size(), {});
+  for (size_t c = 0; c < rig.cameras.size(); ++c) {
+    RigCameraView camera;
+    camera.name = rig.camera_names[c];
+    camera.camera = rig.cameras[c].camera;
+    camera.captures = static_cast<int>(rig.cameras[c].pairs.size());
+    for (const PairEntry& pair : rig.cameras[c].pairs) rig_images_[c][pair.id] = pair.image;
+    view.cameras.push_back(std::move(camera));
+  }
+  // A camera switch carries the other cameras' solves: the same rig, the same cameras.
+  const bool carry = carried_rig_ && carried_rig_->path == view.path &&
+                     carried_rig_->cameras.size() == view.cameras.size();
+  if (carry) {
+    RigView carried = std::move(*carried_rig_);
+    carried.active = view.active;
+    carried.cameras[active].single.reset();  // its live solve takes over, once there is one
+    carried.cameras[active].meter.reset();
+    for (RigCameraView& camera : carried.cameras) camera.frame.reset();
+    carried.frames_pair.clear();
+    carried.solving = false;
+    view = std::move(carried);
+  }
+  carried_rig_.reset();
+  const bool solved = carry || carried_rig_outcome_ != nullptr;
+  if (carried_rig_outcome_) {
+    ApplyRigOutcome(*carried_rig_outcome_, false, &view);
+    carried_rig_outcome_.reset();
+  }
+  state_.rig = std::move(view);
+  return solved;
+}
+
+void Controller::StartRigSolve() {
+  if (!state_.rig || state_.rig->solving) return;
+  // Not solving: the last run has set that under mutex_ and does nothing after it.
+  if (rig_thread_.joinable()) rig_thread_.join();
+  state_.rig->solving = true;
+  ++state_.generation;
+  const std::filesystem::path path = state_.rig->path;
+  const std::string active = state_.rig->cameras[state_.rig->active].name;
+  RigEdits edits;
+  edits[active] = EditsFromSession(session_);
+  const PipelineOptions options = PipelineOptionsFromState();
+  rig_thread_ = std::thread([this, path, active, edits, options]() mutable {
+    std::optional<RigOutcome> outcome;
+    std::string failure, notes;
+    try {
+      const RigFolder rig = LoadRig(path);
+      // The other cameras' edits: their sessions beside the rig, where the workbench left them.
+      for (const std::string& name : rig.camera_names) {
+        const std::filesystem::path session = DefaultSessionPath(path, name);
+        std::error_code error;
+        if (name == active || !std::filesystem::exists(session, error)) continue;
+        try {
+          edits[name] = EditsFromSession(LoadSession(session));
+        } catch (const IoError& e) {
+          notes += std::string(notes.empty() ? "" : "; ") + e.what();
+        }
+      }
+      outcome = CalibrateRig(rig, options, {}, edits);
+    } catch (const std::exception& e) {  // IoError, or a filesystem error reading the rig
+      failure = e.what();
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!state_.rig || state_.rig->path != path) return;
+    state_.rig->solving = false;
+    if (outcome) {
+      ApplyRigOutcome(*outcome, state_.solver.result.has_value(), &*state_.rig);
+      JudgeMeter(/*record=*/false);
+    } else {
+      state_.rig->failure = failure;
+    }
+    if (!notes.empty())
+      SetStatus("rig solve without some cameras' edits (their sessions did not read): " + notes,
+                true);
+    ++state_.generation;
+  });
+}
+
+void Controller::UpdateActiveRigCamera() {
+  if (!state_.rig) return;
+  RigCameraView& active = state_.rig->cameras[state_.rig->active];
+  if (state_.solver.result) {
+    active.single = std::make_shared<const SolverResult>(*state_.solver.result);
+    active.pairs_used = state_.meter ? state_.meter->pairs_used : 0;
+    active.failure.clear();
+  }
+  for (RigCameraView& camera : state_.rig->cameras)
+    if (&camera == &active && state_.solver.result)
+      camera.meter = state_.meter;
+    else if (camera.single)
+      camera.meter = JudgeCapture(*camera.single, camera.pairs_used, state_.goal, StopRuleOptions{});
+    else
+      camera.meter.reset();
+}
+
+void Controller::LoadRigFrames() {
+  std::string pair;
+  std::vector<std::pair<std::string, std::filesystem::path>> wanted;  // key, image
+  std::shared_ptr<const ImageU8> own;
+  int active = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!state_.rig || state_.selected < 0) return;
+    pair = state_.pairs[state_.selected].id;
+    own = state_.pairs[state_.selected].thumbnail;
+    active = state_.rig->active;
+    for (size_t c = 0; c < rig_images_.size(); ++c) {
+      const auto image = rig_images_[c].find(pair);
+      wanted.emplace_back(state_.rig->cameras[c].name + "/" + pair,
+                          image == rig_images_[c].end() ? std::filesystem::path()
+                                                        : image->second);
+    }
+  }
+  std::vector<std::shared_ptr<const ImageU8>> frames;
+  for (size_t c = 0; c < wanted.size(); ++c) {
+    const auto& [key, image] = wanted[c];
+    if (static_cast<int>(c) == active && own) {
+      frames.push_back(own);
+      continue;
+    }
+    if (image.empty()) {
+      frames.push_back(nullptr);
+      continue;
+    }
+    auto& cached = rig_frames_[key];
+    if (!cached) {
+      try {
+        cached = std::make_shared<const ImageU8>(ResizeImage(LoadImage(image), kRigFrameWidth));
+      } catch (const IoError& e) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        SetStatus(e.what(), true);
+      }
+    }
+    frames.push_back(cached);
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!state_.rig || state_.selected < 0 || state_.pairs[state_.selected].id != pair) return;
+  for (size_t c = 0; c < frames.size() && c < state_.rig->cameras.size(); ++c)
+    state_.rig->cameras[c].frame = frames[c];
+  state_.rig->frames_pair = pair;
+  ++state_.generation;
+}
+
+template <>
+void Controller::Handle(const SelectCamera& select) {
+  if (!state_.rig) return SetStatus("not a rig: there is one camera", true);
+  SetStatus("switching to camera '" + select.camera +
+                "' is the window's: open it with `calibench gui --dataset " +
+                state_.rig->path.string() + " --camera " + select.camera + "`",
+            true);
+}
+
+template <>
+void Controller::Handle(const SolveRig&) {
+  if (!state_.rig) return SetStatus("not a rig: there is one camera", true);
+  StartRigSolve();
+}
+
+}  // namespace calibench::ui
