@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -43,8 +44,10 @@ TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
 
   std::string out;
   const auto result_path = dir / "rig.json";
+  const auto report_path = dir / "rig_report.html";
   ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
-                                 (dir / "rig").string() + " --out " + result_path.string(),
+                                 (dir / "rig").string() + " --out " + result_path.string() +
+                                 " --report " + report_path.string(),
                              &out),
             0)
       << out;
@@ -77,6 +80,41 @@ TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
               composed.rotation_rad * 180 / M_PI);
   EXPECT_LT(rig.translation_m, 0.025);
   EXPECT_LT(rig.rotation_rad, 0.6 * M_PI / 180);
+
+  // The report shows the rig (each camera's pose from the rig solve next to its own, the relative
+  // pose as the result has it) and then each camera as one camera's report does.
+  std::ifstream report_file(report_path);
+  const std::string html((std::istreambuf_iterator<char>(report_file)), {});
+  EXPECT_NE(html.find("Calibench rig calibration report"), std::string::npos);
+  for (const char* row : {"data-rig-camera=\"cam0\"", "data-rig-camera=\"cam1\"",
+                          "data-relative=\"cam1_from_cam0\"", "Camera cam0 alone",
+                          "Camera cam1 alone", "id=\"camera0-residuals\"",
+                          "id=\"camera1-coverage-image\"", "id=\"camera1-pairs\""})
+    EXPECT_NE(html.find(row), std::string::npos) << row;
+  char translation[96];
+  std::snprintf(translation, sizeof(translation), "%.4f %.4f %.4f", written.translation().x(),
+                written.translation().y(), written.translation().z());
+  EXPECT_NE(html.find(translation), std::string::npos) << translation;
+  // Every pair of each camera has its row in that camera's table.
+  for (int c = 0; c < 2; ++c) {
+    const size_t section = html.find("id=\"camera" + std::to_string(c) + "-pairs\"");
+    const size_t next = html.find("</section>", section);
+    ASSERT_NE(section, std::string::npos);
+    int rows = 0;
+    for (size_t at = html.find("data-pair=", section); at < next;
+         at = html.find("data-pair=", at + 1))
+      ++rows;
+    int frames = 0;
+    for (const auto& entry :
+         std::filesystem::directory_iterator(dir / "rig" / "images" / ("cam" + std::to_string(c))))
+      frames += entry.is_regular_file();
+    EXPECT_EQ(rows, frames) << "cam" << c;
+  }
+  // The views need a headless OpenGL, which CI requires (CALIBENCH_REQUIRE_GL=1).
+  if (const char* gl = std::getenv("CALIBENCH_REQUIRE_GL"); gl && std::string(gl) == "1") {
+    EXPECT_NE(html.find("rig's cameras (cam0 in orange)"), std::string::npos);
+    EXPECT_NE(html.find("rig's cameras (cam1 in orange)"), std::string::npos);
+  }
 
   // The tree a robot loads: a URDF with a joint per camera, which urdfdom's parser accepts, and
   // whose joints read back as the rig's poses; the ROS 2 launch file with a publisher per camera.
@@ -121,6 +159,82 @@ TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
                              &out),
             0);
   EXPECT_NE(out.find("holds one transform"), std::string::npos) << out;
+}
+
+// The rig's manifest (cameras by name, each pair's frames by camera) calibrates as its folder; one
+// camera of it alone is that camera's own result.
+TEST(Rig, AManifestNamingItsCamerasCalibratesAsItsFolder) {
+  const auto dir = test::TempDir("rig_manifest_cli");
+  RigSimOptions sim;
+  sim.base = SimPreset("default");
+  sim.base.min_distance_m = 1.2;
+  sim.base.max_distance_m = 2.5;
+  sim.base.seed = 5;
+  sim.num_captures = 14;
+  const RigSimTruth truth = SimulateRigFolder(sim, dir / "rig");
+  nlohmann::json manifest = {{"format", "calibench.dataset.v1"},
+                             {"cameras",
+                              {{"front", {{"file", "rig/cameras/cam0.yaml"}}},
+                               {"side", {{"file", "rig/cameras/cam1.yaml"}}}}},
+                             {"target", nlohmann::json::parse(std::ifstream(dir / "rig" / "target.json"))},
+                             {"pairs", nlohmann::json::array()}};
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "rig" / "clouds")) {
+    const std::string stem = entry.path().stem().string();
+    nlohmann::json images = nlohmann::json::object();
+    for (const auto& [camera, name] : {std::pair{"cam0", "front"}, std::pair{"cam1", "side"}})
+      if (std::filesystem::exists(dir / "rig" / "images" / camera / (stem + ".png")))
+        images[name] = "rig/images/" + std::string(camera) + "/" + stem + ".png";
+    manifest["pairs"].push_back(
+        {{"id", stem}, {"cloud", "rig/clouds/" + stem + ".pcd"}, {"images", images}});
+  }
+  manifest["ground_truth"]["cameras"]["front"]["cam_from_lidar"] = {
+      {1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+  std::ofstream(dir / "rig.json") << manifest.dump(2);
+
+  std::string out;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
+                                 (dir / "rig").string() + " --out " +
+                                 (dir / "folder_result.json").string(),
+                             &out),
+            0)
+      << out;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
+                                 (dir / "rig.json").string() + " --out " +
+                                 (dir / "manifest_result.json").string(),
+                             &out),
+            0)
+      << out;
+  const auto folder = nlohmann::json::parse(std::ifstream(dir / "folder_result.json"));
+  const auto named = nlohmann::json::parse(std::ifstream(dir / "manifest_result.json"));
+  ASSERT_TRUE(named["cameras"].contains("front") && named["cameras"].contains("side")) << named;
+  for (const auto& [camera, name] : {std::pair{"cam0", "front"}, std::pair{"cam1", "side"}}) {
+    const Pose a = PoseFromRows(folder["cameras"][camera]["cam_from_lidar"]);
+    const Pose b = PoseFromRows(named["cameras"][name]["cam_from_lidar"]);
+    EXPECT_LT((a.matrix() - b.matrix()).norm(), 1e-12) << name;
+  }
+  EXPECT_TRUE(named["camera_from_camera"].contains("side_from_front")) << named;
+  const PoseError side = ComputePoseError(PoseFromRows(named["cameras"]["side"]["cam_from_lidar"]),
+                                          truth.cam_from_lidar[1]);
+  EXPECT_LT(side.translation_m, 0.025);
+
+  // --camera: that camera alone, a one-camera result equal to the rig result's single_camera.
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
+                                 (dir / "rig.json").string() + " --camera side --out " +
+                                 (dir / "side.json").string(),
+                             &out),
+            0)
+      << out;
+  const auto alone = nlohmann::json::parse(std::ifstream(dir / "side.json"));
+  EXPECT_EQ(alone["format"], "calibench.result.v1");
+  EXPECT_LT((PoseFromRows(alone["cam_from_lidar"]["matrix"]).matrix() -
+             PoseFromRows(named["cameras"]["side"]["single_camera"]["matrix"]).matrix())
+                .norm(),
+            1e-12);
+  EXPECT_NE(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
+                                 (dir / "rig.json").string() + " --camera rear",
+                             &out),
+            0);
+  EXPECT_NE(out.find("no camera 'rear' (its cameras: front, side)"), std::string::npos) << out;
 }
 
 // A recording with two camera topics (an MCAP as `ros2 bag record` writes it: a VLP-16 and two
