@@ -164,6 +164,10 @@ TEST(RigWorkbench, SwitchingCamerasKeepsEachCamerasEditsAndTheRigSolveTakesThem)
   shell.controller().Apply(ui::SetPairStatus{s.selected, PairStatus::kRejected});
   Settled(shell.controller());
   EXPECT_EQ(EditsFromSession(LoadSession(rig_path / "calibench.session.cam1.json")).size(), 1u);
+  // Solved again without that capture, cam1 has moved from where the rig solve had it.
+  EXPECT_FALSE(shell.controller().GetSnapshot().rig->JointStale());
+  shell.controller().Apply(ui::RunSolver{});
+  EXPECT_TRUE(Settled(shell.controller()).rig->JointStale());
 
   // Back to cam0; the rig solve takes cam1's edit from its session: one pair fewer.
   shell.SelectCamera("cam0");
@@ -172,6 +176,7 @@ TEST(RigWorkbench, SwitchingCamerasKeepsEachCamerasEditsAndTheRigSolveTakesThem)
   s = Settled(shell.controller());
   ASSERT_TRUE(s.rig.has_value());
   EXPECT_EQ(s.rig->cameras[1].pairs_used, cam1_pairs - 1);
+  EXPECT_FALSE(s.rig->JointStale());
   // The same as the command line given cam1's session.
   const RigOutcome cli = CalibrateRig(
       rig, PipelineOptions{}, {},

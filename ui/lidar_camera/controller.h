@@ -99,6 +99,7 @@ struct RigCameraView {
   std::optional<CaptureState> meter;  // the stop rule on `single` against the goal
   // The rig's joint solve (all cameras in one problem) at its last run; nullopt before one.
   std::optional<Pose> joint_cam_from_lidar;
+  std::optional<Pose> single_at_joint;  // its own pose when the rig solve ran (from it)
   Vec3 joint_sigma_t_mm = Vec3::Zero();
   Vec3 joint_sigma_r_deg = Vec3::Zero();
   std::string failure;  // why it has no solve
@@ -125,6 +126,8 @@ struct RigView {
   std::string failure;  // the last rig solve's failure
   // Every camera's stop rule is met.
   bool AllDone() const;
+  // A camera's own solve moved since the rig solve ran (an edit, a solve): it is out of date.
+  bool JointStale() const;
 };
 
 struct Snapshot : SnapshotHeader {

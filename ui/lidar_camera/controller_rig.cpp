@@ -36,7 +36,9 @@ void ApplyRigOutcome(const RigOutcome& outcome, bool active_solved, RigView* rig
       view.failure = single.solution ? "" : single.failure;
     }
     view.joint_cam_from_lidar.reset();
+    view.single_at_joint.reset();
     if (!outcome.joint) continue;
+    view.single_at_joint = single.solution->cam_from_lidar;
     const Pose& pose = outcome.joint->cam_from_lidar[c];
     const Mat6 covariance = outcome.joint->covariance.block<6, 6>(6 * c, 6 * c);
     view.joint_cam_from_lidar = pose;
@@ -61,6 +63,14 @@ void ApplyRigOutcome(const RigOutcome& outcome, bool active_solved, RigView* rig
 bool RigView::AllDone() const {
   return !cameras.empty() && std::all_of(cameras.begin(), cameras.end(), [](const auto& camera) {
     return camera.meter && camera.meter->done;
+  });
+}
+
+bool RigView::JointStale() const {
+  return std::any_of(cameras.begin(), cameras.end(), [](const RigCameraView& camera) {
+    return camera.single_at_joint && camera.single &&
+           (camera.single->cam_from_lidar.matrix() - camera.single_at_joint->matrix()).norm() >
+               1e-9;
   });
 }
 

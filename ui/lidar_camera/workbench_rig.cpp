@@ -45,7 +45,7 @@ void Workbench::RigStrip(const Snapshot& s, std::vector<Intent>* intents) {
     ImGui::SetTooltip(rig.solving ? "the rig solves; the cameras can be switched once it is done"
                                   : "the camera in the views; each camera keeps its own session");
   ImGui::SameLine();
-  ImGui::TextDisabled("of %zu (rig %s); capture %s", rig.cameras.size(),
+  ImGui::TextDisabled("one of %zu in %s; capture %s", rig.cameras.size(),
                       rig.path.filename().string().c_str(),
                       rig.frames_pair.empty() ? "-" : rig.frames_pair.c_str());
   // The strip: every camera's frame of the selected capture, the open one framed.
@@ -147,6 +147,9 @@ void Workbench::RigMeterRows(const Snapshot& s, std::vector<Intent>* intents) {
                 relative.sigma_r_deg.maxCoeff(), rig.shared_captures);
   }
   if (!rig.failure.empty()) ImGui::TextColored(kNotDone, "rig: %s", rig.failure.c_str());
+  if (rig.JointStale() && !rig.solving)
+    ImGui::TextColored(kNotDone,
+                       "a camera's own solve moved since the rig solve ran: Solve rig again");
 }
 
 void Workbench::DrawRigFrustums(const Snapshot& s, const Pose* estimate,
@@ -175,9 +178,9 @@ void Workbench::DrawRigFrustums(const Snapshot& s, const Pose* estimate,
 void AddCameraFrustum(const CameraModel& camera, const Pose& lidar_from_cam, double depth_m,
                       const gfx::Rgba& color, gfx::LineBatch* lines) {
   // The image border's rays, a few per edge (a fisheye's border is not straight), each cut where
-  // its depth reaches depth_m. A fisheye sees past 90 degrees: its rays are drawn at most 70
+  // its depth reaches depth_m. A fisheye sees past 90 degrees: its rays are drawn at most 60
   // degrees off the axis, so that the frustum still reads as one.
-  constexpr double kMaxOffAxis = 70.0 * kDegToRad;
+  constexpr double kMaxOffAxis = 60.0 * kDegToRad;
   std::vector<Vec3> border;
   const double w = camera.width, h = camera.height;
   constexpr int kPerEdge = 6;
