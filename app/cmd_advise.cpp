@@ -2,12 +2,14 @@
 // next (core/guidance).
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "core/guidance/advise.h"
 #include "core/guidance/lrf_meter.h"
 #include "core/io/dataset.h"
+#include "core/io/rig_folder.h"
 #include "core/lrf/dataset.h"
 #include "core/session/calibration_job.h"
 
@@ -48,6 +50,40 @@ int AdviseLidarCamera(const std::string& dataset_path, const AdviseOptions& opti
   return kOk;
 }
 
+// A rig: every camera's advice (its own capture against the goal, where to hold the board next
+// for it), and whether every camera is done; text, or one JSON object {"cameras": {"<camera>":
+// advice}, "done"}.
+int AdviseRig(const std::string& rig_path, const AdviseOptions& options, bool json) {
+  const RigFolder rig = LoadRig(rig_path);
+  nlohmann::json cameras = nlohmann::json::object();
+  bool all_done = true, input_error = false;
+  for (size_t c = 0; c < rig.cameras.size(); ++c) {
+    CalibrationJobOptions job_options;
+    job_options.advise = options;
+    CalibrationJob job(rig.cameras[c], job_options, {}, {.detected = StderrProgress("extracted")});
+    job.DetectAll();
+    for (const PairFeatures& p : job.Solve().pairs) input_error |= p.input_error;
+    const CaptureAdvice& advice = job.Advise();
+    all_done = all_done && advice.state && advice.state->done;
+    if (json)
+      cameras[rig.camera_names[c]] = nlohmann::json::parse(CaptureAdviceJson(advice));
+    else
+      std::printf("camera %s:\n%s\n", rig.camera_names[c].c_str(),
+                  FormatCaptureAdvice(advice).c_str());
+  }
+  if (json)
+    std::printf("%s\n", nlohmann::json({{"cameras", cameras}, {"done", all_done}}).dump().c_str());
+  else
+    std::printf("rig: %s\n", all_done ? "DONE: every camera's sigma is under the goal and trusted"
+                                       : "not done: see the cameras above");
+  if (input_error) {
+    std::fprintf(stderr, "calibench advise: some pair files of %s could not be read (see above)\n",
+                 rig_path.c_str());
+    return kInputError;
+  }
+  return kOk;
+}
+
 }  // namespace
 
 int RunAdvise(int argc, char** argv) {
@@ -58,7 +94,9 @@ int RunAdvise(int argc, char** argv) {
   std::string dataset_path;
   AdviseOptions options;
   bool json = false;
-  AddDatasetOption(app, &dataset_path, "a LiDAR-camera or 2D LRF dataset")->required();
+  AddDatasetOption(app, &dataset_path,
+                   "a LiDAR-camera or 2D LRF dataset, or a rig (every camera against the goal)")
+      ->required();
   app.add_option("--goal-mm", options.goal.translation_mm,
                  "goal: 1σ of the translation per axis [mm]")
       ->capture_default_str();
@@ -115,6 +153,15 @@ int RunAdvise(int argc, char** argv) {
   if (!options.Check(&why)) {
     std::fprintf(stderr, "calibench advise: %s\n", why.c_str());
     return kUsage;
+  }
+  if (IsRig(dataset_path)) {
+    if (options.estimate_intrinsics) {
+      std::fprintf(stderr,
+                   "calibench advise: --estimate-intrinsics takes one camera; a rig's cameras "
+                   "bring their files (cameras/<camera>.yaml)\n");
+      return kUsage;
+    }
+    return AdviseRig(dataset_path, options, json);
   }
   return AdviseLidarCamera(dataset_path, options, intrinsics_model, json);
 }

@@ -217,6 +217,26 @@ TEST(Rig, AManifestNamingItsCamerasCalibratesAsItsFolder) {
                                           truth.cam_from_lidar[1]);
   EXPECT_LT(side.translation_m, 0.025);
 
+  // advise: every camera against the goal, and the rig done only when every camera is.
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " advise --json --dataset " +
+                                 (dir / "rig.json").string(),
+                             &out),
+            0)
+      << out;
+  // The one JSON object on stdout (the progress lines go to stderr, captured with it here).
+  const std::string lines = "\n" + out;
+  const size_t object = lines.find("\n{");
+  ASSERT_NE(object, std::string::npos) << out;
+  const auto advice = nlohmann::json::parse(
+      lines.substr(object + 1, lines.find('\n', object + 1) - object - 1));
+  bool all_done = true;
+  for (const char* name : {"front", "side"}) {
+    ASSERT_TRUE(advice["cameras"].contains(name)) << advice;
+    EXPECT_EQ(advice["cameras"][name]["pairs_used"], named["cameras"][name]["pairs"]) << name;
+    all_done = all_done && advice["cameras"][name]["done"].get<bool>();
+  }
+  EXPECT_EQ(advice["done"].get<bool>(), all_done);
+
   // --camera: that camera alone, a one-camera result equal to the rig result's single_camera.
   ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
                                  (dir / "rig.json").string() + " --camera side --out " +
