@@ -57,8 +57,11 @@ RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
                         const ProgressCallback& progress, const RigEdits& edits) {
   RigOutcome outcome;
   outcome.camera_names = rig.camera_names;
-  std::vector<Pose> initial;
-  // Captures by stem: the LiDAR plane (the first camera's pair that has one) and every view.
+  std::vector<RigCameraPrior> cameras;
+  // Captures by stem: every camera's view of the board. Each camera's own calibration (with the
+  // LiDAR's planes, the board's edges, the range offset and its honest σ) is its prior; the
+  // boards two cameras saw at once tie the cameras to each other on top of it
+  // (SolveRigFromCameras).
   std::map<std::string, RigCapture, NaturalOrder> captures;
   for (size_t c = 0; c < rig.cameras.size(); ++c) {
     const auto camera_edits = edits.find(rig.camera_names[c]);
@@ -70,27 +73,21 @@ RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
       outcome.failure = "camera '" + rig.camera_names[c] + "': " + single.failure;
       continue;
     }
-    initial.push_back(single.solution->cam_from_lidar);
+    cameras.push_back({single.solution->cam_from_lidar, single.solution->covariance});
     for (const PairFeatures& pair : single.pairs) {
       if (pair.status != PairStatus::kAccepted || !pair.lidar || !pair.camera) continue;
       RigCapture& capture = captures[pair.id];
       capture.id = pair.id;
-      if (!capture.lidar_plane) {
-        capture.lidar_plane = pair.lidar->plane;
-        capture.lidar_covariance = pair.lidar->covariance;
-      }
       capture.views.push_back(
           {static_cast<int>(c), pair.camera->cam_from_board, pair.camera->pose_covariance});
     }
   }
   if (!outcome.failure.empty()) return outcome;
   std::vector<RigCapture> all;
-  for (auto& [stem, capture] : captures) {
-    outcome.shared_captures += capture.views.size() > 1;
-    all.push_back(std::move(capture));
-  }
+  for (auto& [stem, capture] : captures) all.push_back(std::move(capture));
   std::string why;
-  outcome.joint = SolveRig(all, initial, RigSolverOptions{}, &why);
+  outcome.joint =
+      SolveRigFromCameras(all, cameras, RigSolverOptions{}, &why, &outcome.shared_captures);
   if (!outcome.joint) outcome.failure = "rig solve: " + why;
   return outcome;
 }

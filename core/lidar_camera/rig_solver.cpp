@@ -2,7 +2,9 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <algorithm>
 #include <map>
+#include <vector>
 
 namespace calibench {
 namespace {
@@ -29,12 +31,22 @@ struct RigPlaneTerm {
   double sign = 1.0;  // the board's +z or -z faces the LiDAR
 };
 
+struct RigPriorTerm {
+  int camera;
+  Pose measured_inverse;  // prior⁻¹
+  Mat6 whitening;
+};
+
 struct RigProblem {
   int cameras = 0;
   std::vector<Pose> cam_from_lidar;
   std::vector<Pose> lidar_from_board;
   std::vector<RigViewTerm> views;
   std::vector<RigPlaneTerm> planes;
+  std::vector<RigPriorTerm> priors;
+  int Measurements() const {
+    return 6 * static_cast<int>(views.size() + priors.size()) + 3 * static_cast<int>(planes.size());
+  }
   int Size() const { return 6 * (cameras + static_cast<int>(lidar_from_board.size())); }
   int CameraOffset(int c) const { return 6 * c; }
   int CaptureOffset(int k) const { return 6 * (cameras + k); }
@@ -75,8 +87,14 @@ Vec3 RigPlaneResidual(const RigProblem& p, const RigPlaneTerm& t) {
                         (RigBoardPlane(p.lidar_from_board[t.capture], t.sign) - t.measured));
 }
 
+Vec6 RigPriorError(const RigProblem& p, const RigPriorTerm& t) {
+  return LogSE3(t.measured_inverse * p.cam_from_lidar[t.camera]);
+}
+
 double RigCost(const RigProblem& p, double delta) {
   double cost = 0.0;
+  for (const RigPriorTerm& t : p.priors)
+    cost += RigHuberCost((t.whitening * RigPriorError(p, t)).norm(), delta);
   for (const RigViewTerm& v : p.views) cost += RigHuberCost(RigViewResidual(p, v).norm(), delta);
   for (const RigPlaneTerm& t : p.planes) cost += RigHuberCost(RigPlaneResidual(p, t).norm(), delta);
   return cost;
@@ -86,6 +104,16 @@ double RigCost(const RigProblem& p, double delta) {
 void RigLinearize(const RigProblem& p, double delta, Eigen::MatrixXd* h, Eigen::VectorXd* g) {
   h->setZero(p.Size(), p.Size());
   g->setZero(p.Size());
+  for (const RigPriorTerm& t : p.priors) {
+    // r = Log(P⁻¹ x): x Exp(δ) gives r + Jr⁻¹(r) δ.
+    const Vec6 error = RigPriorError(p, t);
+    const Vec6 e = t.whitening * error;
+    const double w = RigHuberWeight(e.norm(), delta);
+    const Mat6 j = t.whitening * RightJacobianInverse(error);
+    const int block = p.CameraOffset(t.camera);
+    g->segment<6>(block) += w * j.transpose() * e;
+    h->block<6, 6>(block, block) += w * j.transpose() * j;
+  }
   for (const RigViewTerm& v : p.views) {
     const Vec6 error = RigViewError(p, v);
     const Vec6 e = v.whitening * error;
@@ -131,11 +159,24 @@ void RigApplyStep(const Eigen::VectorXd& step, RigProblem* p) {
 }
 
 // The problem's terms from the captures; *why when they do not determine every camera.
-std::optional<RigProblem> BuildRigProblem(const std::vector<RigCapture>& captures,
-                                          const std::vector<Pose>& initial, std::string* why) {
+std::optional<RigProblem> BuildRigProblem(
+    const std::vector<RigCapture>& captures, const std::vector<Pose>& initial,
+    const std::vector<std::optional<RigCameraPrior>>& priors, std::string* why) {
   RigProblem p;
   p.cameras = static_cast<int>(initial.size());
   p.cam_from_lidar = initial;
+  if (!priors.empty() && priors.size() != initial.size())
+    return *why = std::to_string(priors.size()) + " priors for " +
+                  std::to_string(initial.size()) + " cameras",
+           std::nullopt;
+  for (size_t c = 0; c < priors.size(); ++c) {
+    if (!priors[c]) continue;
+    const auto whitening = RigWhitening<6>(priors[c]->covariance);
+    if (!whitening)
+      return *why = "camera " + std::to_string(c) + "'s prior covariance is not positive definite",
+             std::nullopt;
+    p.priors.push_back({static_cast<int>(c), priors[c]->cam_from_lidar.inverse(), *whitening});
+  }
   std::vector<int> planes_per_camera(p.cameras, 0);
   for (const RigCapture& capture : captures) {
     if (capture.views.empty()) continue;
@@ -175,7 +216,7 @@ std::optional<RigProblem> BuildRigProblem(const std::vector<RigCapture>& capture
     p.planes.push_back(term);
   }
   for (int c = 0; c < p.cameras; ++c)
-    if (planes_per_camera[c] < 3)
+    if (planes_per_camera[c] < 3 && !(c < static_cast<int>(priors.size()) && priors[c]))
       return *why = "camera " + std::to_string(c) + " sees the board in " +
                     std::to_string(planes_per_camera[c]) +
                     " capture(s) with a LiDAR plane; at least 3 are needed",
@@ -194,43 +235,70 @@ bool RigSolverOptions::Check(std::string* why) const {
 
 std::optional<RigSolution> SolveRig(const std::vector<RigCapture>& captures,
                                     const std::vector<Pose>& initial,
-                                    const RigSolverOptions& options, std::string* why) {
+                                    const RigSolverOptions& options, std::string* why,
+                                    const std::vector<std::optional<RigCameraPrior>>& priors) {
   if (!options.Check(why)) return std::nullopt;
   if (initial.empty()) return *why = "a rig needs at least one camera", std::nullopt;
-  std::optional<RigProblem> problem = BuildRigProblem(captures, initial, why);
+  std::optional<RigProblem> problem = BuildRigProblem(captures, initial, priors, why);
   if (!problem) return std::nullopt;
   RigProblem& p = *problem;
   RigSolution solution;
   solution.used_captures = static_cast<int>(p.lidar_from_board.size());
-  double cost = RigCost(p, options.huber_delta);
+  double cost = 0.0;
   Eigen::MatrixXd h;
   Eigen::VectorXd g;
-  for (int it = 0; it < options.max_iterations; ++it) {
-    RigLinearize(p, options.huber_delta, &h, &g);
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
-    const Eigen::VectorXd step = ldlt.solve(-g);
-    if (ldlt.info() != Eigen::Success || !step.allFinite())
-      return *why = "the rig's normal equations are singular", std::nullopt;
-    ++solution.iterations;
-    // Backtracking: a step that raises the robust cost is halved (at most 8 times); when none
-    // lowers it, the estimate is the minimum to the cost's precision.
-    double scale = 1.0;
-    bool lowered = false;
-    for (int halving = 0; halving <= 8 && !lowered; ++halving, scale *= 0.5) {
-      RigProblem trial = p;
-      RigApplyStep(scale * step, &trial);
-      const double trial_cost = RigCost(trial, options.huber_delta);
-      if (trial_cost <= cost) {
-        p = std::move(trial);
-        cost = trial_cost;
-        lowered = true;
+  // The cameras' board poses are the terms whose covariances are least to be believed (PnP's
+  // covariance from the corners' spread leaves out the lens model's and the print's errors):
+  // their variance factor is estimated from their own residuals (the boards' poses take 6 of
+  // each capture's view dimensions, the cameras' relative poses 6 per camera after the first)
+  // and their covariances scaled by it, a few times over.
+  double view_factor = 1.0;
+  const int view_redundancy = 6 * static_cast<int>(p.views.size()) -
+                              6 * static_cast<int>(p.lidar_from_board.size()) -
+                              6 * (p.cameras - 1);
+  for (int round = 0; round < 4; ++round) {
+    cost = RigCost(p, options.huber_delta);
+    for (int it = 0; it < options.max_iterations; ++it) {
+      RigLinearize(p, options.huber_delta, &h, &g);
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
+      const Eigen::VectorXd step = ldlt.solve(-g);
+      if (ldlt.info() != Eigen::Success || !step.allFinite())
+        return *why = "the rig's normal equations are singular", std::nullopt;
+      ++solution.iterations;
+      // Backtracking: a step that raises the robust cost is halved (at most 8 times); when none
+      // lowers it, the estimate is the minimum to the cost's precision.
+      double scale = 1.0;
+      bool lowered = false;
+      const double cost_before = cost;
+      for (int halving = 0; halving <= 8 && !lowered; ++halving, scale *= 0.5) {
+        RigProblem trial = p;
+        RigApplyStep(scale * step, &trial);
+        const double trial_cost = RigCost(trial, options.huber_delta);
+        if (trial_cost <= cost) {
+          p = std::move(trial);
+          cost = trial_cost;
+          lowered = true;
+        }
       }
+      // Converged: no step lowers the cost, the step is negligible, or the cost no longer moves.
+      solution.converged = !lowered || step.norm() < options.min_step ||
+                           cost_before - cost <= 1e-12 * cost_before;
+      if (solution.converged) break;
     }
-    if (!lowered || step.norm() < options.min_step) {
-      solution.converged = true;
-      break;
-    }
+    if (view_redundancy <= 0 || p.priors.empty()) break;
+    // The median of the views' squared whitened norms against χ²₆'s (5.35): robust to the few
+    // boards whose PnP is off (those the Huber kernel down-weights).
+    std::vector<double> squared;
+    for (const RigViewTerm& v : p.views) squared.push_back(RigViewResidual(p, v).squaredNorm());
+    std::nth_element(squared.begin(), squared.begin() + squared.size() / 2, squared.end());
+    const double factor = squared[squared.size() / 2] / 5.35;
+    if (factor < 1.2 && factor > 1.0 / 1.2) break;
+    if (factor <= 1.0 && view_factor <= 1.0) break;  // never narrower than PnP says
+    const double applied = std::max(factor, 1.0 / view_factor);
+    view_factor *= applied;
+    for (RigViewTerm& v : p.views) v.whitening /= std::sqrt(applied);
   }
+  solution.view_variance_factor = view_factor;
   // The cameras' joint covariance: their block of H⁻¹ (the boards marginalised).
   RigLinearize(p, options.huber_delta, &h, &g);
   const int camera_size = 6 * p.cameras;
@@ -238,9 +306,51 @@ std::optional<RigSolution> SolveRig(const std::vector<RigCapture>& captures,
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
   solution.covariance = ldlt.solve(selector).topRows(camera_size);
   solution.covariance = 0.5 * (solution.covariance + solution.covariance.transpose()).eval();
+  // Measurements that disagree more than their covariances say widen σ: the median of every
+  // term's squared whitened norm over its χ² median (6-dof 5.35, 3-dof 2.37), when above 1. The
+  // median, because the few boards the Huber kernel down-weights would otherwise set it.
+  if (p.Measurements() > p.Size()) {
+    std::vector<double> ratios;
+    for (const RigViewTerm& v : p.views) ratios.push_back(RigViewResidual(p, v).squaredNorm() / 5.35);
+    for (const RigPlaneTerm& t : p.planes)
+      ratios.push_back(RigPlaneResidual(p, t).squaredNorm() / 2.37);
+    for (const RigPriorTerm& t : p.priors)
+      ratios.push_back((t.whitening * RigPriorError(p, t)).squaredNorm() / 5.35);
+    std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+    solution.variance_factor = ratios[ratios.size() / 2];
+    if (solution.variance_factor > 1.0) solution.covariance *= solution.variance_factor;
+  }
   solution.cam_from_lidar = p.cam_from_lidar;
   solution.cost = cost;
   return solution;
+}
+
+std::optional<RigSolution> SolveRigFromCameras(const std::vector<RigCapture>& captures,
+                                               const std::vector<RigCameraPrior>& cameras,
+                                               const RigSolverOptions& options, std::string* why,
+                                               int* shared_captures) {
+  std::vector<int> seen(cameras.size(), 0), shared(cameras.size(), 0);
+  std::vector<RigCapture> ties;
+  for (const RigCapture& capture : captures) {
+    for (const RigBoardView& view : capture.views)
+      if (view.camera >= 0 && view.camera < static_cast<int>(cameras.size())) ++seen[view.camera];
+    if (capture.views.size() < 2) continue;  // one camera's board adds nothing to its prior
+    for (const RigBoardView& view : capture.views)
+      if (view.camera >= 0 && view.camera < static_cast<int>(cameras.size())) ++shared[view.camera];
+    RigCapture tie = capture;
+    tie.lidar_plane.reset();
+    ties.push_back(std::move(tie));
+  }
+  if (shared_captures) *shared_captures = static_cast<int>(ties.size());
+  std::vector<Pose> initial;
+  std::vector<std::optional<RigCameraPrior>> priors;
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    initial.push_back(cameras[c].cam_from_lidar);
+    RigCameraPrior prior = cameras[c];
+    if (seen[c] > 0) prior.covariance *= 1.0 + static_cast<double>(shared[c]) / seen[c];
+    priors.push_back(prior);
+  }
+  return SolveRig(ties, initial, options, why, priors);
 }
 
 RelativePose CameraFromCamera(const RigSolution& solution, int to, int from) {

@@ -15,6 +15,15 @@
 //     lidar_from_board_k (3-dof, in the plane's tangent coordinates).
 // With one camera this is the plane alignment of Ca²Lib with the camera plane taken from the
 // full PnP pose: the board's in-plane pose is free and absorbs the camera's in-plane error.
+//   - per camera with a prior (its single-camera calibration, which has the LiDAR's planes, the
+//     board's edges and the range offset in it): Log(prior⁻¹ · cam_from_lidar) (6-dof). With
+//     priors the captures' LiDAR planes are left out (they are in the priors already) and only
+//     the boards two cameras saw at once add to it: the cameras' relative pose.
+// With priors, the board views' covariances are scaled by their own variance factor (the median
+// of their squared whitened norms over χ²₆'s), and the covariance by the whole problem's when
+// that exceeds 1: measurements that disagree more than their covariances allow widen σ instead
+// of being believed. Medians, so that the few boards the Huber kernel down-weights do not set
+// them.
 // Gauss-Newton on SE(3) (right perturbations, [rho; phi]) with a Huber kernel on each whitened
 // measurement's norm.
 #pragma once
@@ -43,6 +52,13 @@ struct RigCapture {
   std::vector<RigBoardView> views;
 };
 
+// A camera's pose known from elsewhere (its single-camera calibration), with its covariance
+// (right perturbation [rho; phi]).
+struct RigCameraPrior {
+  Pose cam_from_lidar = Pose::Identity();
+  Mat6 covariance = Mat6::Zero();  // must be > 0
+};
+
 struct RigSolverOptions {
   double huber_delta = 3.0;  // on each measurement's whitened norm, in standard deviations
   int max_iterations = 50;
@@ -58,17 +74,36 @@ struct RigSolution {
   int iterations = 0;
   bool converged = false;
   double cost = 0.0;      // robust cost at the solution (half the sum of squared whitened norms)
+  // The median over the terms of the squared whitened norm over its χ² median; the covariance
+  // is scaled by it when it exceeds 1. 1 when the problem has no redundancy.
+  double variance_factor = 1.0;
+  // With priors: the factor the cameras' board-pose covariances were scaled by, estimated from
+  // their residuals (PnP's covariance leaves out the lens model's and the print's errors).
+  double view_variance_factor = 1.0;
   int used_captures = 0;  // captures with at least one camera view
 };
 
 // Solves the rig from `initial` cam_from_lidar guesses (one per camera; single-camera solutions
-// are good starts). Captures without a camera view are skipped; every camera needs at least three
-// captures with a LiDAR plane (else its pose is not determined). nullopt with *why when the
+// are good starts). Captures without a camera view are skipped; every camera without a prior needs
+// at least three captures with a LiDAR plane (else its pose is not determined). `priors`: empty,
+// or one per camera (nullopt: none for that camera). nullopt with *why when the
 // problem cannot be solved (a camera without enough captures, a covariance that is not positive,
 // a singular system).
 std::optional<RigSolution> SolveRig(const std::vector<RigCapture>& captures,
                                     const std::vector<Pose>& initial,
-                                    const RigSolverOptions& options, std::string* why);
+                                    const RigSolverOptions& options, std::string* why,
+                                    const std::vector<std::optional<RigCameraPrior>>& priors = {});
+
+// The rig solve over the cameras' own calibrations (what CalibrateRig runs): each camera's
+// solution as its prior, widened by the share of its captures that other cameras saw too (their
+// LiDAR planes are in both priors: from independence when nothing is shared to covariance
+// intersection's halves when everything is), and the boards two cameras saw at once (their views;
+// the LiDAR planes are in the priors) tying the cameras to each other. `captures` holds every
+// camera's views of every capture; *shared_captures gets how many two or more cameras saw.
+std::optional<RigSolution> SolveRigFromCameras(const std::vector<RigCapture>& captures,
+                                               const std::vector<RigCameraPrior>& cameras,
+                                               const RigSolverOptions& options, std::string* why,
+                                               int* shared_captures = nullptr);
 
 // cam_<to>_from_cam_<from> = cam_from_lidar[to] · cam_from_lidar[from]⁻¹ (x_in_to =
 // to_from_from · x_in_from), with its covariance (right perturbation) from the joint covariance.

@@ -181,6 +181,62 @@ TEST(RigSolver, TheBoardTiesTheCamerasBetterThanComposingTwoSingleCameraSolves) 
   EXPECT_LT(nees, 8.5);
 }
 
+// What CalibrateRig runs: the cameras' own calibrations as priors (here the single-camera plane
+// solves with their covariances), the shared boards tying them. Each camera no worse than alone,
+// the relative pose better than composed, and no σ narrower than the spread (the priors share
+// the LiDAR planes of the shared captures, which the widening accounts for).
+TEST(RigSolver, TheCamerasOwnCalibrationsTiedByTheSharedBoards) {
+  const RigTruth truth = MakeRig();
+  const Pose true_1_from_0 = truth.cam_from_lidar[1] * truth.cam_from_lidar[0].inverse();
+  std::mt19937 rng(17);
+  Rms single[2], joint[2], composed, relative;
+  double nees_relative = 0.0, nees_camera[2] = {0.0, 0.0};
+  constexpr int kTrials = 40;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const std::vector<RigCapture> captures = SimulateCaptures(truth, 30, rng);
+    std::string why;
+    std::vector<RigCameraPrior> alone;
+    for (int c = 0; c < 2; ++c) {
+      const auto solved =
+          SolveRig(OneCamera(captures, c), {Perturbed(truth.cam_from_lidar[c], rng)}, {}, &why);
+      ASSERT_TRUE(solved && solved->converged) << why;
+      alone.push_back({solved->cam_from_lidar[0], solved->covariance});
+      single[c].Add(alone[c].cam_from_lidar, truth.cam_from_lidar[c]);
+    }
+    composed.Add(alone[1].cam_from_lidar * alone[0].cam_from_lidar.inverse(), true_1_from_0);
+    int shared = 0;
+    const auto both = SolveRigFromCameras(captures, alone, {}, &why, &shared);
+    ASSERT_TRUE(both && both->converged) << why;
+    EXPECT_GT(shared, 0);
+    for (int c = 0; c < 2; ++c) {
+      joint[c].Add(both->cam_from_lidar[c], truth.cam_from_lidar[c]);
+      const Vec6 error = LogSE3(both->cam_from_lidar[c].inverse() * truth.cam_from_lidar[c]);
+      nees_camera[c] += error.dot(both->covariance.block<6, 6>(6 * c, 6 * c).ldlt().solve(error));
+    }
+    const RelativePose one_from_zero = CameraFromCamera(*both, 1, 0);
+    relative.Add(one_from_zero.to_from_from, true_1_from_0);
+    const Vec6 error = LogSE3(one_from_zero.to_from_from.inverse() * true_1_from_0);
+    nees_relative += error.dot(one_from_zero.covariance.ldlt().solve(error));
+  }
+  for (int c = 0; c < 2; ++c) {
+    nees_camera[c] /= kTrials;
+    std::printf("camera %d: alone %.2f mm %.3f deg, joint %.2f mm %.3f deg (RMS); NEES %.2f\n", c,
+                single[c].TranslationMm(), single[c].RotationDeg(), joint[c].TranslationMm(),
+                joint[c].RotationDeg(), nees_camera[c]);
+    EXPECT_LE(joint[c].TranslationMm(), 1.05 * single[c].TranslationMm()) << c;
+    EXPECT_LE(joint[c].RotationDeg(), 1.05 * single[c].RotationDeg()) << c;
+    EXPECT_LT(nees_camera[c], 8.5) << c;  // not narrower than its spread
+  }
+  nees_relative /= kTrials;
+  std::printf("cam1_from_cam0: composed %.2f mm %.3f deg, joint %.2f mm %.3f deg; NEES %.2f (6)\n",
+              composed.TranslationMm(), composed.RotationDeg(), relative.TranslationMm(),
+              relative.RotationDeg(), nees_relative);
+  EXPECT_LT(relative.TranslationMm(), 0.8 * composed.TranslationMm());
+  EXPECT_LT(relative.RotationDeg(), composed.RotationDeg());
+  EXPECT_LT(nees_relative, 8.5);
+  EXPECT_GT(nees_relative, 2.0);  // nor much wider
+}
+
 TEST(RigSolver, ACameraTheCapturesDoNotDetermineIsNamed) {
   const RigTruth truth = MakeRig();
   std::mt19937 rng(3);

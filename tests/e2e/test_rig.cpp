@@ -69,6 +69,8 @@ TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
     // The single-camera bar (tests/e2e/test_simulated.cpp): 25 mm and 0.6 deg.
     EXPECT_LT(e.translation_m, 0.025) << c;
     EXPECT_LT(e.rotation_rad, 0.6 * M_PI / 180) << c;
+    // Each camera's own calibration is the rig's prior: the rig does not make it worse.
+    EXPECT_LT(e.translation_m, 1.1 * s.translation_m + 0.0002) << c;
   }
   const Pose true_relative = truth.cam_from_lidar[1] * truth.cam_from_lidar[0].inverse();
   const Pose written = PoseFromRows(result["camera_from_camera"]["cam1_from_cam0"]["matrix"]);
@@ -80,6 +82,9 @@ TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
               composed.rotation_rad * 180 / M_PI);
   EXPECT_LT(rig.translation_m, 0.025);
   EXPECT_LT(rig.rotation_rad, 0.6 * M_PI / 180);
+  // The boards both cameras saw tie them: better than composing the two single results.
+  EXPECT_LT(rig.translation_m, 0.5 * composed.translation_m);
+  EXPECT_LT(rig.rotation_rad, 0.5 * composed.rotation_rad);
 
   // The report shows the rig (each camera's pose from the rig solve next to its own, the relative
   // pose as the result has it) and then each camera as one camera's report does.
