@@ -27,8 +27,8 @@ enum class Layout { kWorkbench, kLidarOnly, kCameraOnly, kSceneOnly, kGuide };
 // "workbench", "lidar", "camera", "3d", "guide"; false for others.
 bool ParseLayout(const std::string& name, Layout* layout);
 
-// The camera's viewing frustum as lines: its image border's rays to depth_m (metres, camera z),
-// from the camera's centre, in the frame lidar_from_cam maps into.
+// The camera's viewing frustum as lines: its image border's rays, depth_m (metres) long, from the
+// camera's centre, in the frame lidar_from_cam maps into.
 void AddCameraFrustum(const CameraModel& camera, const Pose& lidar_from_cam, double depth_m,
                       const gfx::Rgba& color, gfx::LineBatch* lines);
 

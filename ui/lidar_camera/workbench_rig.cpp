@@ -177,10 +177,8 @@ void Workbench::DrawRigFrustums(const Snapshot& s, const Pose* estimate,
 
 void AddCameraFrustum(const CameraModel& camera, const Pose& lidar_from_cam, double depth_m,
                       const gfx::Rgba& color, gfx::LineBatch* lines) {
-  // The image border's rays, a few per edge (a fisheye's border is not straight), each cut where
-  // its depth reaches depth_m. A fisheye sees past 90 degrees: its rays are drawn at most 60
-  // degrees off the axis, so that the frustum still reads as one.
-  constexpr double kMaxOffAxis = 60.0 * kDegToRad;
+  // The image border's rays, a few per edge (a fisheye's border is not straight), each drawn to
+  // depth_m along itself: a fisheye's rays past 90 degrees still close the rim.
   std::vector<Vec3> border;
   const double w = camera.width, h = camera.height;
   constexpr int kPerEdge = 6;
@@ -191,14 +189,7 @@ void AddCameraFrustum(const CameraModel& camera, const Pose& lidar_from_cam, dou
                          : edge == 1 ? Vec2(w, f * h)
                          : edge == 2 ? Vec2((1 - f) * w, h)
                                      : Vec2(0, (1 - f) * h);
-      const auto ray = camera.Unproject(pixel);
-      if (!ray) continue;
-      const Vec3 direction = ray->normalized();
-      const double off_axis = std::min(std::acos(std::clamp(direction.z(), -1.0, 1.0)), kMaxOffAxis);
-      const Vec2 across = direction.head<2>().norm() > 1e-9 ? Vec2(direction.head<2>().normalized())
-                                                            : Vec2(0, 0);
-      border.push_back(depth_m * Vec3(std::tan(off_axis) * across.x(),
-                                      std::tan(off_axis) * across.y(), 1.0));
+      if (const auto ray = camera.Unproject(pixel)) border.push_back(depth_m * ray->normalized());
     }
   const Vec3 centre = lidar_from_cam.translation();
   for (size_t i = 0; i < border.size(); ++i) {
