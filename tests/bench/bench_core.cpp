@@ -10,7 +10,9 @@
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
 #include "core/lidar/cloud.h"
+#include "core/io/rig_folder.h"
 #include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/rig.h"
 #include "core/lidar_camera/solver.h"
 #include "core/lrf/depth_planes.h"
 #include "core/lrf/scan_lines.h"
@@ -227,6 +229,41 @@ void BM_CalibrateReal40Pairs2Threads(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(CalibrateDataset(dataset, options));
 }
 BENCHMARK(BM_CalibrateReal40Pairs2Threads)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+// The real ACFR capture as a rig of two cameras (cam0: all 40 frames, cam1: every other one;
+// links, not copies): `calibrate --dataset <rig>`, each camera's own calibration and the rig
+// solve. Against BM_CalibrateReal40Pairs2Threads: what the second camera and the rig add.
+void BM_CalibrateRealRigTwoCameras2Threads(benchmark::State& state) {
+  const auto acfr = AcfrDir();
+  if (!acfr) {
+    state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
+    return;
+  }
+  const fs::path folder = test::WriteAcfrFolder(*acfr, BenchDir("rig_source"));
+  const fs::path rig = BenchDir("rig");
+  fs::remove_all(rig);
+  fs::create_directories(rig / "cameras");
+  fs::copy(folder / "target.json", rig / "target.json");
+  fs::create_directory_symlink(fs::absolute(folder / "clouds"), rig / "clouds");
+  const Dataset all = LoadDataset(folder);
+  for (int c = 0; c < 2; ++c) {
+    const std::string name = "cam" + std::to_string(c);
+    fs::copy(folder / "camera.yaml", rig / "cameras" / (name + ".yaml"));
+    fs::create_directories(rig / "images" / name);
+    for (size_t i = c; i < all.pairs.size(); i += c + 1)
+      fs::create_symlink(fs::absolute(all.pairs[i].image),
+                         rig / "images" / name / all.pairs[i].image.filename());
+  }
+  const RigFolder loaded = LoadRig(rig);
+  PipelineOptions options;
+  options.threads = 2;
+  for (auto _ : state) benchmark::DoNotOptimize(CalibrateRig(loaded, options));
+  state.SetLabel("40 + 20 pairs, 20 captures shared");
+}
+BENCHMARK(BM_CalibrateRealRigTwoCameras2Threads)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
 
 // `watch`'s step for one new pair (core/session/calibration_job.h): the real ACFR capture's first
 // state.range(0) - 1 pairs already in the job, then the next pair read, detected, solved with the

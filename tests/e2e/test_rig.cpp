@@ -222,6 +222,26 @@ TEST(Rig, AManifestNamingItsCamerasCalibratesAsItsFolder) {
                                           truth.cam_from_lidar[1]);
   EXPECT_LT(side.translation_m, 0.025);
 
+  // report on a rig result: the rig solved again, each camera against the file's, one page.
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " report --result " +
+                                 (dir / "manifest_result.json").string() + " --dataset " +
+                                 (dir / "rig.json").string() + " --no-views --no-cross-validation" +
+                                 " --out " + (dir / "report.html").string(),
+                             &out),
+            0)
+      << out;
+  EXPECT_EQ(out.find("differs from a re-solve"), std::string::npos) << out;
+  std::ifstream report_file(dir / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(report_file)), {});
+  EXPECT_NE(html.find("data-relative=\"side_from_front\""), std::string::npos);
+  EXPECT_NE(html.find("Camera side alone"), std::string::npos);
+  EXPECT_NE(test::RunCommand(test::CalibenchExe() + " report --result " +
+                                 (dir / "manifest_result.json").string() + " --out " +
+                                 (dir / "r.html").string(),
+                             &out),
+            0);
+  EXPECT_NE(out.find("a rig result: give --dataset"), std::string::npos) << out;
+
   // advise: every camera against the goal, and the rig done only when every camera is.
   ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " advise --json --dataset " +
                                  (dir / "rig.json").string(),
