@@ -75,7 +75,7 @@ int AdviseRig(const std::string& rig_path, const AdviseOptions& options, bool js
     std::printf("%s\n", nlohmann::json({{"cameras", cameras}, {"done", all_done}}).dump().c_str());
   else
     std::printf("rig: %s\n", all_done ? "DONE: every camera's sigma is under the goal and trusted"
-                                       : "not done: see the cameras above");
+                                      : "not done: see the cameras above");
   if (input_error) {
     std::fprintf(stderr, "calibench advise: some pair files of %s could not be read (see above)\n",
                  rig_path.c_str());

@@ -52,8 +52,8 @@ int CalibrateRigDataset(const std::string& path, const std::vector<std::string>&
     const Session session = LoadSession(session_path);
     if (session.camera.empty() ||
         NormalizeSessionPath(session.dataset) != NormalizeSessionPath(rig.folder))
-      throw IoError(session_path + ": not a session of a camera of the rig " +
-                    rig.folder.string() + " (its dataset is " + session.dataset.string() + ")");
+      throw IoError(session_path + ": not a session of a camera of the rig " + rig.folder.string() +
+                    " (its dataset is " + session.dataset.string() + ")");
     RigCameraIndex(rig, session.camera);  // a camera the rig has
     edits[session.camera] = EditsFromSession(session);
   }
@@ -88,10 +88,11 @@ int RunCalibrate(int argc, char** argv) {
                    "a LiDAR-camera dataset, or a rig (a folder with cameras/<camera>.yaml, "
                    "images/<camera>/<stem>, clouds/<stem>; or a manifest naming \"cameras\"): "
                    "every camera, then the rig (calibench.rig.v1)");
-  app.add_option("--session", sessions,
-                 "a workbench session (calibench.session.json): its brushes, rejections and "
-                 "solver choices are used, so the result is the workbench's; its dataset unless "
-                 "--dataset is given. A rig takes one per camera (calibench.session.<camera>.json)");
+  app.add_option(
+      "--session", sessions,
+      "a workbench session (calibench.session.json): its brushes, rejections and "
+      "solver choices are used, so the result is the workbench's; its dataset unless "
+      "--dataset is given. A rig takes one per camera (calibench.session.<camera>.json)");
   app.add_option("--camera", camera,
                  "with a rig: calibrate this camera alone (a calibench.result.v1, as for one "
                  "camera's dataset)");
@@ -128,8 +129,7 @@ int RunCalibrate(int argc, char** argv) {
     return kUsage;
   }
   if (!rig && !camera.empty()) {
-    std::fprintf(stderr, "calibench calibrate: --camera: %s is not a rig\n",
-                 dataset_path.c_str());
+    std::fprintf(stderr, "calibench calibrate: --camera: %s is not a rig\n", dataset_path.c_str());
     return kUsage;
   }
   const std::string session_path = sessions.empty() ? "" : sessions.front();

@@ -11,8 +11,8 @@
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "core/base/atomic_file.h"
-#include "core/io/assets.h"
 #include "core/estimation/uncertainty.h"
+#include "core/io/assets.h"
 #include "core/io/dataset.h"
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
@@ -88,7 +88,8 @@ int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const Pipeli
     const Pose& joint = outcome.joint->cam_from_lidar[c];
     const Mat6 covariance = outcome.joint->covariance.block<6, 6>(6 * c, 6 * c);
     int pairs = 0;
-    for (const PairFeatures& p : outcome.single[c].pairs) pairs += p.status == PairStatus::kAccepted;
+    for (const PairFeatures& p : outcome.single[c].pairs)
+      pairs += p.status == PairStatus::kAccepted;
     summary.cameras.push_back({name, pairs, joint, 1e3 * TranslationStd(covariance, joint),
                                RotationStdDeg(covariance, joint), single.cam_from_lidar,
                                1e3 * TranslationStd(single.covariance, single.cam_from_lidar),
@@ -96,8 +97,7 @@ int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const Pipeli
     RigCameraReport camera;
     camera.name = name;
     camera.prefix = "camera" + std::to_string(c) + "-";  // ids stay valid whatever the name
-    camera.report = AnalyseCalibration(rig.cameras[c], outcome.single[c], options,
-                                       request.options);
+    camera.report = AnalyseCalibration(rig.cameras[c], outcome.single[c], options, request.options);
     if (request.renders && why.empty())
       camera.figures = RenderReportFigures(rig.folder.string(), "", &why, name, &outcome);
     cameras.push_back(std::move(camera));
@@ -124,11 +124,10 @@ int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const Pipeli
   WriteFileAtomically(request.out_path, RigReportHtml(summary, cameras, provenance, assets));
   std::printf("wrote %s (a rig of %zu cameras", request.out_path.c_str(), cameras.size());
   for (const RigCameraReport& camera : cameras)
-    std::printf("; %s: %zu pairs, %zu views%s%s", camera.name.c_str(), camera.report.pairs.size(),
-                camera.figures.size(), camera.report.cross_validation ? ", " : "",
-                camera.report.cross_validation
-                    ? camera.report.cross_validation->verdict.c_str()
-                    : "");
+    std::printf(
+        "; %s: %zu pairs, %zu views%s%s", camera.name.c_str(), camera.report.pairs.size(),
+        camera.figures.size(), camera.report.cross_validation ? ", " : "",
+        camera.report.cross_validation ? camera.report.cross_validation->verdict.c_str() : "");
   std::printf(")\n");
   return kOk;
 }
@@ -149,8 +148,8 @@ int ReportRig(const std::string& result_path, const std::string& dataset_path,
   for (const auto& [name, reported] : LoadRigResult(result_path)) {
     const auto at = std::find(outcome.camera_names.begin(), outcome.camera_names.end(), name);
     if (at == outcome.camera_names.end()) {
-      request.notes.push_back(result_path + " has a camera '" + name + "' that " +
-                              dataset_path + " has not.");
+      request.notes.push_back(result_path + " has a camera '" + name + "' that " + dataset_path +
+                              " has not.");
       continue;
     }
     const Pose& solved = outcome.joint->cam_from_lidar[at - outcome.camera_names.begin()];

@@ -7,10 +7,10 @@
 #include <optional>
 
 #include "app/commands.h"
-#include "core/lidar_camera/rig.h"
 #include "core/base/image.h"
 #include "core/io/bag.h"
 #include "core/io/image_io.h"
+#include "core/lidar_camera/rig.h"
 #include "ui/gfx/context.h"
 #include "ui/lidar_camera/controller.h"
 #include "ui/lidar_camera/window_shell.h"
@@ -47,11 +47,10 @@ std::optional<int> ParseFlags(CLI::App& app, int argc, char** argv, const std::s
 }
 
 // Opens the dataset or session the flags name; false (message printed) when neither is given.
-bool OpenInput(
-    ui::Controller& controller, const std::string& dataset, const std::string& session,
-    const char* command,
-    ui::Controller::ExistingSession existing = ui::Controller::ExistingSession::kReplace,
-    const std::string& camera = "") {
+bool OpenInput(ui::Controller& controller, const std::string& dataset, const std::string& session,
+               const char* command,
+               ui::Controller::ExistingSession existing = ui::Controller::ExistingSession::kReplace,
+               const std::string& camera = "") {
   if (!session.empty()) {
     controller.OpenSession(session, existing != ui::Controller::ExistingSession::kInMemory);
   } else if (!dataset.empty()) {
@@ -275,8 +274,8 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
   if (!context) return kInputError;
   ui::Controller controller;
   // Render draws; it leaves session files alone (a dataset's session may be an hour of work).
-  if (!OpenInput(controller, dataset, session, "render",
-                 ui::Controller::ExistingSession::kInMemory, camera))
+  if (!OpenInput(controller, dataset, session, "render", ui::Controller::ExistingSession::kInMemory,
+                 camera))
     return kUsage;
   controller.WaitRig();  // a rig's other cameras: their frustums and meter rows
   if (intrinsics) {

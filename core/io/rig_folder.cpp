@@ -82,7 +82,8 @@ RigFolder LoadRigManifest(const fs::path& manifest) {
     const json_io::Fields images = pair.Object("images");
     for (const auto& item : pair.At("images").items()) {
       const auto at = std::find(names.begin(), names.end(), item.key());
-      if (at == names.end()) images.Fail(item.key(), "camera '" + item.key() + "' is not in cameras");
+      if (at == names.end())
+        images.Fail(item.key(), "camera '" + item.key() + "' is not in cameras");
       entry.image = json_io::Resolve(base, images.String(item.key()));
       rig.cameras[at - names.begin()].pairs.push_back(entry);
     }

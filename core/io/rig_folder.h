@@ -23,7 +23,7 @@
 namespace calibench {
 
 struct RigFolder {
-  std::filesystem::path folder;  // the folder, or the manifest file
+  std::filesystem::path folder;           // the folder, or the manifest file
   std::vector<std::string> camera_names;  // cameras/<name>.yaml, in natural order
   std::vector<Dataset> cameras;           // per camera: its intrinsics, the board, its pairs
 };

@@ -1,8 +1,8 @@
 #include "core/lidar_camera/rig_solver.h"
 
 #include <Eigen/Cholesky>
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <vector>
 
@@ -159,15 +159,16 @@ void RigApplyStep(const Eigen::VectorXd& step, RigProblem* p) {
 }
 
 // The problem's terms from the captures; *why when they do not determine every camera.
-std::optional<RigProblem> BuildRigProblem(
-    const std::vector<RigCapture>& captures, const std::vector<Pose>& initial,
-    const std::vector<std::optional<RigCameraPrior>>& priors, std::string* why) {
+std::optional<RigProblem> BuildRigProblem(const std::vector<RigCapture>& captures,
+                                          const std::vector<Pose>& initial,
+                                          const std::vector<std::optional<RigCameraPrior>>& priors,
+                                          std::string* why) {
   RigProblem p;
   p.cameras = static_cast<int>(initial.size());
   p.cam_from_lidar = initial;
   if (!priors.empty() && priors.size() != initial.size())
-    return *why = std::to_string(priors.size()) + " priors for " +
-                  std::to_string(initial.size()) + " cameras",
+    return *why = std::to_string(priors.size()) + " priors for " + std::to_string(initial.size()) +
+                  " cameras",
            std::nullopt;
   for (size_t c = 0; c < priors.size(); ++c) {
     if (!priors[c]) continue;
@@ -254,8 +255,7 @@ std::optional<RigSolution> SolveRig(const std::vector<RigCapture>& captures,
   // and their covariances scaled by it, a few times over.
   double view_factor = 1.0;
   const int view_redundancy = 6 * static_cast<int>(p.views.size()) -
-                              6 * static_cast<int>(p.lidar_from_board.size()) -
-                              6 * (p.cameras - 1);
+                              6 * static_cast<int>(p.lidar_from_board.size()) - 6 * (p.cameras - 1);
   for (int round = 0; round < 4; ++round) {
     cost = RigCost(p, options.huber_delta);
     for (int it = 0; it < options.max_iterations; ++it) {
@@ -281,8 +281,8 @@ std::optional<RigSolution> SolveRig(const std::vector<RigCapture>& captures,
         }
       }
       // Converged: no step lowers the cost, the step is negligible, or the cost no longer moves.
-      solution.converged = !lowered || step.norm() < options.min_step ||
-                           cost_before - cost <= 1e-12 * cost_before;
+      solution.converged =
+          !lowered || step.norm() < options.min_step || cost_before - cost <= 1e-12 * cost_before;
       if (solution.converged) break;
     }
     if (view_redundancy <= 0 || p.priors.empty()) break;
@@ -311,7 +311,8 @@ std::optional<RigSolution> SolveRig(const std::vector<RigCapture>& captures,
   // median, because the few boards the Huber kernel down-weights would otherwise set it.
   if (p.Measurements() > p.Size()) {
     std::vector<double> ratios;
-    for (const RigViewTerm& v : p.views) ratios.push_back(RigViewResidual(p, v).squaredNorm() / 5.35);
+    for (const RigViewTerm& v : p.views)
+      ratios.push_back(RigViewResidual(p, v).squaredNorm() / 5.35);
     for (const RigPlaneTerm& t : p.planes)
       ratios.push_back(RigPlaneResidual(p, t).squaredNorm() / 2.37);
     for (const RigPriorTerm& t : p.priors)

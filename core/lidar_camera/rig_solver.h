@@ -73,7 +73,7 @@ struct RigSolution {
   Eigen::MatrixXd covariance;
   int iterations = 0;
   bool converged = false;
-  double cost = 0.0;      // robust cost at the solution (half the sum of squared whitened norms)
+  double cost = 0.0;  // robust cost at the solution (half the sum of squared whitened norms)
   // The median over the terms of the squared whitened norm over its χ² median; the covariance
   // is scaled by it when it exceeds 1. 1 when the problem has no redundancy.
   double variance_factor = 1.0;

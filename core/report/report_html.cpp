@@ -109,8 +109,7 @@ std::string DirectionCard(const std::string& name, const std::string& meaning, c
 }
 
 std::string ResultSection(const CalibrationReport& r, const std::string& prefix) {
-  std::string html =
-      "<section id=\"" + prefix + "result\"><h2>Result</h2><div class=\"cards\">";
+  std::string html = "<section id=\"" + prefix + "result\"><h2>Result</h2><div class=\"cards\">";
   html += DirectionCard("cam_from_lidar",
                         "maps LiDAR points into the camera frame: p_cam = R p_lidar + t",
                         r.cam_from_lidar);
@@ -142,7 +141,8 @@ std::string ResultSection(const CalibrationReport& r, const std::string& prefix)
 
 std::string PairTable(const CalibrationReport& r, const std::string& prefix) {
   std::string html =
-      "<section id=\"" + prefix + "pairs\"><h2>Pairs</h2><table class=\"pairs\"><thead><tr><th>pair</th>"
+      "<section id=\"" + prefix +
+      "pairs\"><h2>Pairs</h2><table class=\"pairs\"><thead><tr><th>pair</th>"
       "<th>status</th><th>LiDAR board from</th><th>plane angle [deg]</th><th>plane offset "
       "[mm]</th><th>edge crossings / RMS [mm]</th><th>weight</th><th>without it: moves [mm / "
       "deg]</th><th>held out: angle [deg] / offset [mm] / "
@@ -169,8 +169,8 @@ std::string PairTable(const CalibrationReport& r, const std::string& prefix) {
 }
 
 std::string CrossValidationSection(const CalibrationReport& r, const std::string& prefix) {
-  std::string html = "<section id=\"" + prefix +
-                     "cross-validation\"><h2>Held-out cross-validation</h2>";
+  std::string html =
+      "<section id=\"" + prefix + "cross-validation\"><h2>Held-out cross-validation</h2>";
   if (!r.cross_validation)
     return html + "<p>Not computed: " + Escape(r.cross_validation_skipped) + ".</p></section>";
   const CrossValidation& cv = *r.cross_validation;
@@ -188,8 +188,7 @@ std::string CrossValidationSection(const CalibrationReport& r, const std::string
 
 std::string FiguresSection(const std::vector<ReportFigure>& figures, const std::string& prefix) {
   if (figures.empty()) return "";
-  std::string html =
-      "<section id=\"" + prefix + "views\"><h2>Views</h2><div class=\"figures\">";
+  std::string html = "<section id=\"" + prefix + "views\"><h2>Views</h2><div class=\"figures\">";
   for (const ReportFigure& f : figures) {
     html += "<figure" +
             (f.pair_id.empty() ? std::string(" class=\"overview\"")
@@ -343,9 +342,8 @@ std::string FillReport(const std::string& title, const std::string& body, json d
 }
 
 std::string SigmaCells(const Vec3& t_mm, const Vec3& r_deg) {
-  return "<td>" + Num(t_mm.x(), 2) + " " + Num(t_mm.y(), 2) + " " + Num(t_mm.z(), 2) +
-         "</td><td>" + Num(r_deg.x(), 3) + " " + Num(r_deg.y(), 3) + " " + Num(r_deg.z(), 3) +
-         "</td>";
+  return "<td>" + Num(t_mm.x(), 2) + " " + Num(t_mm.y(), 2) + " " + Num(t_mm.z(), 2) + "</td><td>" +
+         Num(r_deg.x(), 3) + " " + Num(r_deg.y(), 3) + " " + Num(r_deg.z(), 3) + "</td>";
 }
 
 }  // namespace
@@ -364,11 +362,10 @@ std::string RigReportHtml(const RigReportSummary& rig, const std::vector<RigCame
                           const ReportProvenance& provenance, const ReportAssets& assets) {
   std::string body = "<header><h1>Calibench rig calibration report</h1>";
   std::string names;
-  for (const RigCameraReport& camera : cameras)
-    names += (names.empty() ? "" : ", ") + camera.name;
-  body += HeaderFacts(provenance, std::to_string(cameras.size()) + " cameras (" + names + "), " +
-                                      std::to_string(rig.shared_captures) +
-                                      " captures seen by two or more",
+  for (const RigCameraReport& camera : cameras) names += (names.empty() ? "" : ", ") + camera.name;
+  body += HeaderFacts(provenance,
+                      std::to_string(cameras.size()) + " cameras (" + names + "), " +
+                          std::to_string(rig.shared_captures) + " captures seen by two or more",
                       cameras.empty() ? "" : cameras.front().report.options);
   body += "<nav class=\"cameras\">";
   for (const RigCameraReport& camera : cameras)
@@ -397,14 +394,15 @@ std::string RigReportHtml(const RigReportSummary& rig, const std::vector<RigCame
             SigmaCells(camera.single_sigma_t_mm, camera.single_sigma_r_deg) + "<td>" +
             Num(moved_mm, 2) + " / " + Num(turned_deg, 3) + "</td></tr>";
   }
-  body += "</table><h3>Cameras relative to each other</h3><table class=\"sigma\"><tr>"
-          "<th>pose</th><th>translation [m]</th><th>sigma t [mm] (x y z)</th>"
-          "<th>sigma r [deg]</th></tr>";
+  body +=
+      "</table><h3>Cameras relative to each other</h3><table class=\"sigma\"><tr>"
+      "<th>pose</th><th>translation [m]</th><th>sigma t [mm] (x y z)</th>"
+      "<th>sigma r [deg]</th></tr>";
   for (const RigReportSummary::Relative& relative : rig.relative) {
     const Vec3 t = relative.to_from_from.translation();
     body += "<tr data-relative=\"" + Escape(relative.name) + "\"><td><code>" +
-            Escape(relative.name) + "</code></td><td>" + Num(t.x(), 4) + " " + Num(t.y(), 4) +
-            " " + Num(t.z(), 4) + "</td>" + SigmaCells(relative.sigma_t_mm, relative.sigma_r_deg) +
+            Escape(relative.name) + "</code></td><td>" + Num(t.x(), 4) + " " + Num(t.y(), 4) + " " +
+            Num(t.z(), 4) + "</td>" + SigmaCells(relative.sigma_t_mm, relative.sigma_r_deg) +
             "</tr>";
   }
   body += "</table></section>";

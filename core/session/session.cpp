@@ -97,8 +97,8 @@ std::filesystem::path DefaultSessionPath(const std::filesystem::path& dataset,
   std::error_code error;
   const std::filesystem::path folder =
       std::filesystem::is_directory(dataset, error) ? dataset : dataset.parent_path();
-  return folder / (camera.empty() ? "calibench.session.json"
-                                  : "calibench.session." + camera + ".json");
+  return folder /
+         (camera.empty() ? "calibench.session.json" : "calibench.session." + camera + ".json");
 }
 
 Session NewSession(const Dataset& dataset) {

@@ -88,15 +88,15 @@ TEST(RigFolder, ABrokenRigFolderNamesWhatIsMissing) {
 // camera, a ground truth per camera.
 void WriteRigManifest(const fs::path& dir, const std::string& extra_pair = "") {
   const CameraModel fisheye = DefaultSimCamera(true);
-  std::ofstream(dir / "rig.json")
-      << R"({"format": "calibench.dataset.v1",
+  std::ofstream(dir / "rig.json") << R"({"format": "calibench.dataset.v1",
   "cameras": {"cam0": {"file": "cameras/cam0.yaml"},
               "cam1": {"model": "kannala-brandt", "width": )"
-      << fisheye.width << ", \"height\": " << fisheye.height << ", \"fx\": " << fisheye.fx
-      << ", \"fy\": " << fisheye.fy << ", \"cx\": " << fisheye.cx << ", \"cy\": " << fisheye.cy
-      << R"(, "distortion": [0.01, 0.0, 0.0, 0.0]}},
-  "target": )"
-      << std::ifstream(dir / "target.json").rdbuf() << R"(,
+                                  << fisheye.width << ", \"height\": " << fisheye.height
+                                  << ", \"fx\": " << fisheye.fx << ", \"fy\": " << fisheye.fy
+                                  << ", \"cx\": " << fisheye.cx << ", \"cy\": " << fisheye.cy
+                                  << R"(, "distortion": [0.01, 0.0, 0.0, 0.0]}},
+  "target": )" << std::ifstream(dir / "target.json").rdbuf()
+                                  << R"(,
   "pairs": [
     {"id": "0000", "cloud": "clouds/0000.pcd", "images": {"cam0": "images/cam0/0000.png"}},
     {"id": "0001", "cloud": "clouds/0001.pcd",
@@ -104,7 +104,7 @@ void WriteRigManifest(const fs::path& dir, const std::string& extra_pair = "") {
      "lidar_seed": {"point": [3, 0, 0], "radius": 0.3}},
     {"id": "0002", "cloud": "clouds/0002.pcd",
      "images": {"cam0": "images/cam0/0002.png", "cam1": "images/cam1/0002.png"}})"
-      << extra_pair << R"(],
+                                  << extra_pair << R"(],
   "ground_truth": {"cameras": {"cam1": {"cam_from_lidar": [[1,0,0,0.1],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}}}
 })";
 }

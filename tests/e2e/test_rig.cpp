@@ -45,11 +45,11 @@ TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
   std::string out;
   const auto result_path = dir / "rig.json";
   const auto report_path = dir / "rig_report.html";
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
-                                 (dir / "rig").string() + " --out " + result_path.string() +
-                                 " --report " + report_path.string(),
-                             &out),
-            0)
+  ASSERT_EQ(
+      test::RunCommand(test::CalibenchExe() + " calibrate --dataset " + (dir / "rig").string() +
+                           " --out " + result_path.string() + " --report " + report_path.string(),
+                       &out),
+      0)
       << out;
   std::printf("%s", out.c_str());
   const nlohmann::json result = nlohmann::json::parse(std::ifstream(result_path));
@@ -91,10 +91,10 @@ TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
   std::ifstream report_file(report_path);
   const std::string html((std::istreambuf_iterator<char>(report_file)), {});
   EXPECT_NE(html.find("Calibench rig calibration report"), std::string::npos);
-  for (const char* row : {"data-rig-camera=\"cam0\"", "data-rig-camera=\"cam1\"",
-                          "data-relative=\"cam1_from_cam0\"", "Camera cam0 alone",
-                          "Camera cam1 alone", "id=\"camera0-residuals\"",
-                          "id=\"camera1-coverage-image\"", "id=\"camera1-pairs\""})
+  for (const char* row :
+       {"data-rig-camera=\"cam0\"", "data-rig-camera=\"cam1\"", "data-relative=\"cam1_from_cam0\"",
+        "Camera cam0 alone", "Camera cam1 alone", "id=\"camera0-residuals\"",
+        "id=\"camera1-coverage-image\"", "id=\"camera1-pairs\""})
     EXPECT_NE(html.find(row), std::string::npos) << row;
   char translation[96];
   std::snprintf(translation, sizeof(translation), "%.4f %.4f %.4f", written.translation().x(),
@@ -177,12 +177,13 @@ TEST(Rig, AManifestNamingItsCamerasCalibratesAsItsFolder) {
   sim.base.seed = 5;
   sim.num_captures = 14;
   const RigSimTruth truth = SimulateRigFolder(sim, dir / "rig");
-  nlohmann::json manifest = {{"format", "calibench.dataset.v1"},
-                             {"cameras",
-                              {{"front", {{"file", "rig/cameras/cam0.yaml"}}},
-                               {"side", {{"file", "rig/cameras/cam1.yaml"}}}}},
-                             {"target", nlohmann::json::parse(std::ifstream(dir / "rig" / "target.json"))},
-                             {"pairs", nlohmann::json::array()}};
+  nlohmann::json manifest = {
+      {"format", "calibench.dataset.v1"},
+      {"cameras",
+       {{"front", {{"file", "rig/cameras/cam0.yaml"}}},
+        {"side", {{"file", "rig/cameras/cam1.yaml"}}}}},
+      {"target", nlohmann::json::parse(std::ifstream(dir / "rig" / "target.json"))},
+      {"pairs", nlohmann::json::array()}};
   for (const auto& entry : std::filesystem::directory_iterator(dir / "rig" / "clouds")) {
     const std::string stem = entry.path().stem().string();
     nlohmann::json images = nlohmann::json::object();
@@ -197,11 +198,11 @@ TEST(Rig, AManifestNamingItsCamerasCalibratesAsItsFolder) {
   std::ofstream(dir / "rig.json") << manifest.dump(2);
 
   std::string out;
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
-                                 (dir / "rig").string() + " --out " +
-                                 (dir / "folder_result.json").string(),
-                             &out),
-            0)
+  ASSERT_EQ(
+      test::RunCommand(test::CalibenchExe() + " calibrate --dataset " + (dir / "rig").string() +
+                           " --out " + (dir / "folder_result.json").string(),
+                       &out),
+      0)
       << out;
   ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
                                  (dir / "rig.json").string() + " --out " +
@@ -243,17 +244,17 @@ TEST(Rig, AManifestNamingItsCamerasCalibratesAsItsFolder) {
   EXPECT_NE(out.find("a rig result: give --dataset"), std::string::npos) << out;
 
   // advise: every camera against the goal, and the rig done only when every camera is.
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " advise --json --dataset " +
-                                 (dir / "rig.json").string(),
-                             &out),
-            0)
+  ASSERT_EQ(
+      test::RunCommand(
+          test::CalibenchExe() + " advise --json --dataset " + (dir / "rig.json").string(), &out),
+      0)
       << out;
   // The one JSON object on stdout (the progress lines go to stderr, captured with it here).
   const std::string lines = "\n" + out;
   const size_t object = lines.find("\n{");
   ASSERT_NE(object, std::string::npos) << out;
-  const auto advice = nlohmann::json::parse(
-      lines.substr(object + 1, lines.find('\n', object + 1) - object - 1));
+  const auto advice =
+      nlohmann::json::parse(lines.substr(object + 1, lines.find('\n', object + 1) - object - 1));
   bool all_done = true;
   for (const char* name : {"front", "side"}) {
     ASSERT_TRUE(advice["cameras"].contains(name)) << advice;

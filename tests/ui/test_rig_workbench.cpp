@@ -77,12 +77,12 @@ TEST(RigWorkbench, ACameraOpensWithTheRigsOtherCamerasSolvedBesideIt) {
   for (int c = 0; c < 2; ++c) {
     const ui::RigCameraView& camera = s.rig->cameras[c];
     ASSERT_TRUE(camera.single && camera.joint_cam_from_lidar) << c << " " << camera.failure;
-    EXPECT_LT((camera.joint_cam_from_lidar->matrix() - cli.joint->cam_from_lidar[c].matrix())
-                  .norm(),
-              1e-9)
+    EXPECT_LT(
+        (camera.joint_cam_from_lidar->matrix() - cli.joint->cam_from_lidar[c].matrix()).norm(),
+        1e-9)
         << c;
-    const PoseError error = ComputePoseError(*camera.joint_cam_from_lidar,
-                                             Rig().truth.cam_from_lidar[c]);
+    const PoseError error =
+        ComputePoseError(*camera.joint_cam_from_lidar, Rig().truth.cam_from_lidar[c]);
     std::printf("cam%d in the workbench's rig solve: %.2f mm %.3f deg from the truth\n", c,
                 error.translation_m * 1e3, error.rotation_rad / kDegToRad);
     EXPECT_LT(error.translation_m, 0.025) << c;  // the single-camera bar
@@ -92,10 +92,10 @@ TEST(RigWorkbench, ACameraOpensWithTheRigsOtherCamerasSolvedBesideIt) {
     EXPECT_GT(camera.meter->pairs_used, 3) << c;
   }
   ASSERT_TRUE(s.solver.result.has_value()) << s.status_line;
-  EXPECT_LT((s.rig->cameras[0].single->cam_from_lidar.matrix() -
-             s.solver.result->cam_from_lidar.matrix())
-                .norm(),
-            1e-12)
+  EXPECT_LT(
+      (s.rig->cameras[0].single->cam_from_lidar.matrix() - s.solver.result->cam_from_lidar.matrix())
+          .norm(),
+      1e-12)
       << s.rig->cameras[0].single->cam_from_lidar.matrix() << "\n"
       << s.solver.result->cam_from_lidar.matrix() << "\n"
       << s.status_line;
@@ -117,8 +117,8 @@ TEST(RigWorkbench, ACameraOpensWithTheRigsOtherCamerasSolvedBesideIt) {
     const std::string& id = selected.pairs[index].id;
     ASSERT_EQ(selected.rig->frames_pair, id);
     for (int c = 0; c < 2; ++c) {
-      const bool has_frame = fs::exists(rig_path / "images" / ("cam" + std::to_string(c)) /
-                                        (id + ".png"));
+      const bool has_frame =
+          fs::exists(rig_path / "images" / ("cam" + std::to_string(c)) / (id + ".png"));
       EXPECT_EQ(selected.rig->cameras[c].frame != nullptr, has_frame) << id << " cam" << c;
     }
   }
@@ -182,9 +182,10 @@ TEST(RigWorkbench, SwitchingCamerasKeepsEachCamerasEditsAndTheRigSolveTakesThem)
       rig, PipelineOptions{}, {},
       {{"cam1", EditsFromSession(LoadSession(rig_path / "calibench.session.cam1.json"))}});
   ASSERT_TRUE(cli.joint.has_value());
-  EXPECT_LT((s.rig->cameras[1].joint_cam_from_lidar->matrix() - cli.joint->cam_from_lidar[1].matrix())
-                .norm(),
-            1e-9);
+  EXPECT_LT(
+      (s.rig->cameras[1].joint_cam_from_lidar->matrix() - cli.joint->cam_from_lidar[1].matrix())
+          .norm(),
+      1e-9);
   // A controller alone cannot switch (the window does); it says how.
   shell.controller().Apply(ui::SelectCamera{"cam1"});
   s = shell.controller().GetSnapshot();

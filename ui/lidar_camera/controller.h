@@ -252,11 +252,10 @@ struct SelectCamera {
 // The rig's joint solve over every camera, with each camera's session edits (the open one's as
 // they are now), on its own thread; the meter and the frustums follow.
 struct SolveRig {};
-using Intent =
-    std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush, DetectBoardAgain,
-                 PaintPoints, RunSolver, ResetSolver, SetSolverOptions, SetView, ExportResult,
-                 SaveSessionAs, Undo, Redo, EstimateIntrinsics, SaveIntrinsics, SetGoal,
-                 SelectCamera, SolveRig>;
+using Intent = std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush,
+                            DetectBoardAgain, PaintPoints, RunSolver, ResetSolver, SetSolverOptions,
+                            SetView, ExportResult, SaveSessionAs, Undo, Redo, EstimateIntrinsics,
+                            SaveIntrinsics, SetGoal, SelectCamera, SolveRig>;
 
 class Controller : public ControllerState<Snapshot> {
  public:
@@ -426,8 +425,8 @@ class Controller : public ControllerState<Snapshot> {
   bool follow_newest_ = true;         // a followed capture's views move to each new pair (mutex_)
   bool opened_pairs_loaded_ = false;  // every pair Open started with has loaded (mutex_)
   std::thread watch_thread_;
-  std::thread rig_thread_;                    // the rig solve (SolveRig, and at open)
-  std::optional<RigView> carried_rig_;        // CarryRig's, for the next Open
+  std::thread rig_thread_;                                 // the rig solve (SolveRig, and at open)
+  std::optional<RigView> carried_rig_;                     // CarryRig's, for the next Open
   std::shared_ptr<const RigOutcome> carried_rig_outcome_;  // the same
   std::map<std::string, std::shared_ptr<const ImageU8>> rig_frames_;  // "<camera>/<pair>" (worker)
   std::vector<std::map<std::string, std::filesystem::path>> rig_images_;  // per camera (mutex_)

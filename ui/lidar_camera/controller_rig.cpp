@@ -17,10 +17,9 @@ namespace {
 constexpr int kRigFrameWidth = 160;  // pixels, as the pairs' thumbnails
 
 int AcceptedPairs(const CalibrationOutcome& outcome) {
-  return static_cast<int>(std::count_if(outcome.pairs.begin(), outcome.pairs.end(),
-                                        [](const PairFeatures& p) {
-                                          return p.status == PairStatus::kAccepted;
-                                        }));
+  return static_cast<int>(
+      std::count_if(outcome.pairs.begin(), outcome.pairs.end(),
+                    [](const PairFeatures& p) { return p.status == PairStatus::kAccepted; }));
 }
 
 // The rig solve's outcome into the rig's view; the open camera keeps its live solve once it has
@@ -183,7 +182,8 @@ void Controller::UpdateActiveRigCamera() {
     if (&camera == &active && state_.solver.result)
       camera.meter = state_.meter;
     else if (camera.single)
-      camera.meter = JudgeCapture(*camera.single, camera.pairs_used, state_.goal, StopRuleOptions{});
+      camera.meter =
+          JudgeCapture(*camera.single, camera.pairs_used, state_.goal, StopRuleOptions{});
     else
       camera.meter.reset();
 }
@@ -202,8 +202,7 @@ void Controller::LoadRigFrames() {
     for (size_t c = 0; c < rig_images_.size(); ++c) {
       const auto image = rig_images_[c].find(pair);
       wanted.emplace_back(state_.rig->cameras[c].name + "/" + pair,
-                          image == rig_images_[c].end() ? std::filesystem::path()
-                                                        : image->second);
+                          image == rig_images_[c].end() ? std::filesystem::path() : image->second);
     }
   }
   std::vector<std::shared_ptr<const ImageU8>> frames;

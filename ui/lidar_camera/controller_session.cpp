@@ -45,8 +45,10 @@ void Controller::OpenDataset(const std::filesystem::path& dataset_path,
     return;
   }
   if (!camera.empty())
-    throw IoError(dataset_path.string() + ": not a rig (a folder with cameras/, or a manifest "
-                  "with \"cameras\"), so it has no camera '" + camera + "'");
+    throw IoError(dataset_path.string() +
+                  ": not a rig (a folder with cameras/, or a manifest "
+                  "with \"cameras\"), so it has no camera '" +
+                  camera + "'");
   OpenLoadedDataset(LoadDataset(dataset_path), std::move(session_path), existing);
 }
 
@@ -58,7 +60,8 @@ void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path
     Open(dataset, std::move(session), {}, "", std::nullopt);
     return;
   }
-  if (session_path.empty()) session_path = DefaultSessionPath(dataset.manifest, dataset.camera_name);
+  if (session_path.empty())
+    session_path = DefaultSessionPath(dataset.manifest, dataset.camera_name);
   std::string note;
   std::optional<FileLock> lock = LockSession(session_path, &note);
   if (existing != ExistingSession::kReplace && std::filesystem::exists(session_path)) {

@@ -65,11 +65,10 @@ void Workbench::RigStrip(const Snapshot& s, std::vector<Intent>* intents) {
       }
       const float w = kStripHeight * camera.frame->width / std::max(1, camera.frame->height);
       ImGui::PushID(static_cast<int>(c));
-      const bool clicked = ImGui::ImageButton(TextureId(texture.texture->texture()),
-                                              ImVec2(w, kStripHeight), ImVec2(0, 0), ImVec2(1, 1),
-                                              active ? 3 : 1,
-                                              active ? ToImVec4(RigCameraColor(0, true))
-                                                     : ImVec4(0, 0, 0, 0));
+      const bool clicked =
+          ImGui::ImageButton(TextureId(texture.texture->texture()), ImVec2(w, kStripHeight),
+                             ImVec2(0, 0), ImVec2(1, 1), active ? 3 : 1,
+                             active ? ToImVec4(RigCameraColor(0, true)) : ImVec4(0, 0, 0, 0));
       ImGui::PopID();
       if (clicked && !active && !rig.solving) intents->push_back(SelectCamera{camera.name});
     } else {
@@ -97,11 +96,11 @@ void Workbench::RigMeterRows(const Snapshot& s, std::vector<Intent>* intents) {
     ImGui::SetTooltip(
         "every camera with the LiDAR in one problem (boards two cameras saw at once tie them), "
         "each camera with its session's edits, as `calibench calibrate --dataset <rig>`");
-  if (ImGui::BeginTable("rig cameras", 5,
-                        ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerH |
-                            ImGuiTableFlags_SizingFixedFit)) {
-    for (const char* column : {"camera", "pairs", "own sigma t / r (worst)",
-                               "rig sigma t / r (worst)", "meter"})
+  if (ImGui::BeginTable(
+          "rig cameras", 5,
+          ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerH | ImGuiTableFlags_SizingFixedFit)) {
+    for (const char* column :
+         {"camera", "pairs", "own sigma t / r (worst)", "rig sigma t / r (worst)", "meter"})
       ImGui::TableSetupColumn(column);
     ImGui::TableHeadersRow();
     for (size_t c = 0; c < rig.cameras.size(); ++c) {
@@ -119,8 +118,8 @@ void Workbench::RigMeterRows(const Snapshot& s, std::vector<Intent>* intents) {
                     camera.meter->sigma_r_deg.maxCoeff());
       else
         ImGui::TextDisabled("%s", !camera.failure.empty() ? camera.failure.c_str()
-                                  : rig.solving             ? "solving..."
-                                                            : "not solved");
+                                  : rig.solving           ? "solving..."
+                                                          : "not solved");
       ImGui::TableNextColumn();
       if (camera.joint_cam_from_lidar)
         ImGui::Text("%.2f mm / %.3f deg", camera.joint_sigma_t_mm.maxCoeff(),
@@ -133,18 +132,19 @@ void Workbench::RigMeterRows(const Snapshot& s, std::vector<Intent>* intents) {
       else if (camera.meter->done)
         ImGui::TextColored(kDone, "done");
       else
-        ImGui::TextColored(kNotDone, "not done: %s", camera.meter->goal_met
-                                                         ? camera.meter->trust_note.c_str()
-                                                         : camera.meter->weakest.c_str());
+        ImGui::TextColored(kNotDone, "not done: %s",
+                           camera.meter->goal_met ? camera.meter->trust_note.c_str()
+                                                  : camera.meter->weakest.c_str());
     }
     ImGui::EndTable();
   }
   for (const RigView::Relative& relative : rig.relative) {
     const Vec3 t = 1e3 * relative.to_from_from.translation();
-    ImGui::Text("%s: t = [%.1f %.1f %.1f] mm, sigma t %.2f mm, r %.3f deg (worst axis; %d shared "
-                "captures)",
-                relative.name.c_str(), t.x(), t.y(), t.z(), relative.sigma_t_mm.maxCoeff(),
-                relative.sigma_r_deg.maxCoeff(), rig.shared_captures);
+    ImGui::Text(
+        "%s: t = [%.1f %.1f %.1f] mm, sigma t %.2f mm, r %.3f deg (worst axis; %d shared "
+        "captures)",
+        relative.name.c_str(), t.x(), t.y(), t.z(), relative.sigma_t_mm.maxCoeff(),
+        relative.sigma_r_deg.maxCoeff(), rig.shared_captures);
   }
   if (!rig.failure.empty()) ImGui::TextColored(kNotDone, "rig: %s", rig.failure.c_str());
   if (rig.JointStale() && !rig.solving)

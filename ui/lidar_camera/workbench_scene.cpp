@@ -263,8 +263,8 @@ void Workbench::DrawScene(const Snapshot& s, const PairView& pair,
   if (estimate) {
     const Pose lidar_from_cam = estimate->inverse();
     camera.lines.AddAxes(lidar_from_cam, 0.3);
-    if (!s.rig) AddCameraFrustum(s.dataset->camera, lidar_from_cam, 0.35, {255, 150, 40, 255},
-                                 &camera.lines);
+    if (!s.rig)
+      AddCameraFrustum(s.dataset->camera, lidar_from_cam, 0.35, {255, 150, 40, 255}, &camera.lines);
     if (pair.camera)
       camera.triangles.AddRectangle(lidar_from_cam * pair.camera->cam_from_board,
                                     s.dataset->target.SheetWidth(), s.dataset->target.SheetHeight(),
