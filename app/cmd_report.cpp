@@ -43,6 +43,19 @@ std::string ResultMethod(const fs::path& path) {
   return result["solver"].value("method", "");
 }
 
+// What a report says when its re-solve is not the reported pose ("" when they agree to 0.1 mm
+// and 0.01 deg): "<what> differs from a re-solve of <data> by .. mm and .. deg: <consequence>".
+std::string ResolveNote(const Pose& solved, const Pose& reported, const std::string& what,
+                        const std::string& data, const std::string& consequence) {
+  const double moved_mm = 1000.0 * (solved.translation() - reported.translation()).norm();
+  const double turned_deg =
+      Eigen::AngleAxisd(solved.linear().transpose() * reported.linear()).angle() * kRadToDeg;
+  if (moved_mm <= 0.1 && turned_deg <= 0.01) return "";
+  char amount[96];
+  std::snprintf(amount, sizeof(amount), " by %.1f mm and %.3f deg: ", moved_mm, turned_deg);
+  return what + " differs from a re-solve of " + data + amount + consequence;
+}
+
 }  // namespace
 
 int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
@@ -152,19 +165,13 @@ int ReportRig(const std::string& result_path, const std::string& dataset_path,
                               " has not.");
       continue;
     }
-    const Pose& solved = outcome.joint->cam_from_lidar[at - outcome.camera_names.begin()];
-    const double moved_mm = 1000.0 * (solved.translation() - reported.translation()).norm();
-    const double turned_deg =
-        Eigen::AngleAxisd(solved.linear().transpose() * reported.linear()).angle() * kRadToDeg;
-    if (moved_mm > 0.1 || turned_deg > 0.01) {
-      char note[512];
-      std::snprintf(note, sizeof(note),
-                    "%s: camera %s differs from a re-solve of this rig with these options by "
-                    "%.1f mm and %.3f deg: the figures below are the re-solve's.",
-                    result_path.c_str(), name.c_str(), moved_mm, turned_deg);
-      request.notes.push_back(note);
-      std::fprintf(stderr, "calibench report: %s\n", note);
-    }
+    const std::string note =
+        ResolveNote(outcome.joint->cam_from_lidar[at - outcome.camera_names.begin()], reported,
+                    result_path + ": camera " + name, "this rig with these options",
+                    "the figures below are the re-solve's.");
+    if (note.empty()) continue;
+    request.notes.push_back(note);
+    std::fprintf(stderr, "calibench report: %s\n", note.c_str());
   }
   return WriteRigReport(rig, outcome, options, request);
 }
@@ -235,19 +242,13 @@ int RunReport(int argc, char** argv) {
     return kNoCalibration;
   }
   // The figures are the re-solve's: say so when it is not the result's pose.
-  const Pose& solved = outcome.solution->cam_from_lidar;
-  const double moved_mm = 1000.0 * (solved.translation() - reported.translation()).norm();
-  const double turned_deg =
-      Eigen::AngleAxisd(solved.linear().transpose() * reported.linear()).angle() * kRadToDeg;
-  if (moved_mm > 0.1 || turned_deg > 0.01) {
-    char note[512];
-    std::snprintf(note, sizeof(note),
-                  "%s differs from a re-solve of this data with these options by %.1f mm and "
-                  "%.3f deg: the result, per-pair figures and views below are the re-solve's. "
-                  "Pass the options calibrate was run with (or its session).",
-                  result_path.c_str(), moved_mm, turned_deg);
+  const std::string note = ResolveNote(
+      outcome.solution->cam_from_lidar, reported, result_path, "this data with these options",
+      "the result, per-pair figures and views below are the re-solve's. Pass the options "
+      "calibrate was run with (or its session).");
+  if (!note.empty()) {
     request.notes.push_back(note);
-    std::fprintf(stderr, "calibench report: %s\n", note);
+    std::fprintf(stderr, "calibench report: %s\n", note.c_str());
   }
   return WriteReport(dataset, outcome, flags.options, request);
 }
