@@ -3,9 +3,11 @@
 // frames, the meter over every camera; switching cameras in the window keeps each camera's edits,
 // and the rig solve takes them.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include "core/geometry/geometry.h"
 #include "core/io/rig_folder.h"
@@ -29,7 +31,8 @@ struct SimulatedRig {
 const SimulatedRig& Rig() {
   static const SimulatedRig rig = [] {
     SimulatedRig made;
-    made.folder = test::TempDir("rig_workbench") / "rig";
+    // Per process: ctest runs these tests in processes of their own, side by side.
+    made.folder = test::TempDir("rig_workbench_" + std::to_string(getpid())) / "rig";
     RigSimOptions sim;
     sim.base = SimPreset("default");
     sim.base.min_distance_m = 1.2;
