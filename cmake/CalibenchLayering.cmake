@@ -4,7 +4,7 @@
 # step with the file and the include named.
 
 # The target a project header (or source file) belongs to: core/<x>/ -> calibench_<x>; ui/gfx,
-# ui/widgets, ui/state; ui/<method>/controller.* -> calibench_<method>_controller, the rest of
+# ui/widgets, ui/state; ui/<method>/controller*.* -> calibench_<method>_controller, the rest of
 # ui/<method>/ -> calibench_<method>_workbench.
 function(calibench_owner_target path out)
   set(owner "")
@@ -16,7 +16,7 @@ function(calibench_owner_target path out)
     set(owner calibench_widgets)
   elseif(path MATCHES "^ui/state/")
     set(owner calibench_ui_state)
-  elseif(path MATCHES "^ui/([a-z_]+)/controller\\.")
+  elseif(path MATCHES "^ui/([a-z_]+)/controller[a-z_]*\\.")
     set(owner "calibench_${CMAKE_MATCH_1}_controller")
   elseif(path MATCHES "^ui/([a-z_]+)/")
     set(owner "calibench_${CMAKE_MATCH_1}_workbench")

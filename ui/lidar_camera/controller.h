@@ -18,162 +18,17 @@
 #include <vector>
 
 #include "core/base/file_lock.h"
-#include "core/base/image.h"
-#include "core/camera/undistort.h"
 #include "core/io/camera_file.h"
 #include "core/io/capture_feed.h"
 #include "core/io/rig_folder.h"
-#include "core/lidar/cloud.h"
-#include "core/lidar/lidar_image.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/rig.h"
-#include "core/reproject/reproject.h"
 #include "core/results/export.h"
-#include "core/session/calibration_job.h"  // the job, with the guidance and the session
-#include "core/target/board_camera.h"
-#include "core/target/lidar_plane.h"
-#include "ui/state/controller_state.h"
+#include "core/session/calibration_job.h"         // the job, with the guidance and the session
+#include "ui/lidar_camera/controller_snapshot.h"  // Snapshot and the views it holds
 #include "ui/state/view_state.h"
 
 namespace calibench::ui {
-
-// Everything the panels show about one pair. Heavy members are shared, immutable buffers.
-struct PairView : PairHeader {
-  bool loaded = false;
-  std::shared_ptr<const LidarCloud> cloud;
-  std::shared_ptr<const LidarImage> lidar_image;
-  std::shared_ptr<const ImageU8> thumbnail;  // small BGR picture of the camera image
-  std::vector<int> brush_pixels;             // sorted LiDAR-image pixel indices
-  bool brush_from_seed = false;  // brush_pixels picture the manifest's lidar_seed (not painted)
-  // The user painted or erased: the brush is the region. Neither edited nor seeded: the board is
-  // detected (BoardOrigin says so).
-  bool brush_edited = false;
-  bool brush_detected = false;  // brush_pixels picture the detected board (not painted)
-  std::optional<LidarPlaneFit> lidar;
-  BoardOrigin board_origin;
-  std::string lidar_failure;
-  std::optional<BoardDetection> detection;
-  std::optional<CameraBoardObservation> camera;
-  std::string camera_failure;
-  std::optional<Vec4> residual;  // after a solve
-  double robust_weight = 1.0;
-  bool awaiting_detection = false;  // loaded, its board to be found once the background allows
-  // Pre-flight's findings after the last solve, as `advise` lists them (shown on its row).
-  std::vector<PreflightFinding> findings;
-};
-
-struct SolverView {
-  bool running = false;
-  std::vector<IterationReport> iterations;  // recorded by the solver's callback
-  std::optional<SolverResult> result;
-  std::vector<std::string> solved_pair_ids;  // the pairs behind result->residuals, in order
-  // The CLI summary's words on the solve's inputs: the LiDAR model and why, which residuals the
-  // pairs gave (DescribeLidarModel, CountResiduals); a reopened session's from its file.
-  std::vector<std::string> notes;
-  std::string failure;
-};
-
-// The camera-side reprojection of the selected pair after a solve.
-struct Reprojection {
-  std::string pair_id;
-  std::vector<ProjectedPoint> points;
-  std::vector<bool> visible;
-};
-
-// The meter after each solve: σ per camera axis at that many pairs.
-struct MeterPoint {
-  int pairs = 0;
-  Vec3 sigma_t_mm = Vec3::Zero();
-  Vec3 sigma_r_deg = Vec3::Zero();
-};
-
-// One camera of a rig (core/io/rig_folder.h) as the workbench shows it beside the one open.
-struct RigCameraView {
-  std::string name;
-  CameraModel camera;  // its intrinsics: the 3D view's frustum
-  int captures = 0;    // the captures it has a frame of
-  // Its own solve (each camera through the pipeline as `calibrate` runs it, with its session's
-  // edits); the open camera's is the workbench's latest solve.
-  std::shared_ptr<const SolverResult> single;
-  int pairs_used = 0;
-  std::optional<CaptureState> meter;  // the stop rule on `single` against the goal
-  // The rig's joint solve (all cameras in one problem) at its last run; nullopt before one.
-  std::optional<Pose> joint_cam_from_lidar;
-  std::optional<Pose> single_at_joint;  // its own pose when the rig solve ran (from it)
-  Vec3 joint_sigma_t_mm = Vec3::Zero();
-  Vec3 joint_sigma_r_deg = Vec3::Zero();
-  std::string failure;  // why it has no solve
-  // Its frame of the selected capture, small (the strip); null when it has none.
-  std::shared_ptr<const ImageU8> frame;
-};
-
-// A rig's cameras around the one open (Controller::OpenDataset of a rig).
-struct RigView {
-  std::filesystem::path path;  // the rig's folder or manifest
-  int active = 0;              // the camera open in the views
-  std::vector<RigCameraView> cameras;
-  std::string frames_pair;  // the capture the strip's frames show
-  bool solving = false;     // the rig solve runs (on its own thread)
-  int shared_captures = 0;  // at the last rig solve: captures two or more cameras saw the board in
-  // Each camera after the first relative to the first (x_in_<to> = to_from_from · x_in_<from>),
-  // from the joint solve, with σ; named "<to>_from_<from>".
-  struct Relative {
-    std::string name;
-    Pose to_from_from = Pose::Identity();
-    Vec3 sigma_t_mm = Vec3::Zero(), sigma_r_deg = Vec3::Zero();
-  };
-  std::vector<Relative> relative;
-  std::string failure;  // the last rig solve's failure
-  // Every camera's stop rule is met.
-  bool AllDone() const;
-  // A camera's own solve moved since the rig solve ran (an edit, a solve): it is out of date.
-  bool JointStale() const;
-};
-
-struct Snapshot : SnapshotHeader {
-  std::filesystem::path dataset_path;
-  std::filesystem::path session_path;  // empty: the session lives in memory only (render)
-  std::string save_error;  // the last save's failure (autosave, save as); empty once one succeeds
-  std::optional<Dataset> dataset;
-  std::vector<PairView> pairs;
-  int selected = -1;
-  std::shared_ptr<const ImageU8> selected_image;  // full-resolution camera image of `selected`
-  std::shared_ptr<const UndistortedView> selected_undistorted;  // the same, distortion removed
-  // The pair they show (a followed capture's last one until the newest pair's is decoded).
-  std::string selected_image_pair;
-  SolverView solver;
-  std::shared_ptr<const Reprojection> reprojection;
-  ViewState view;
-  SolverMethod method = SolverOptions{}.method;
-  double huber_delta = SolverOptions{}.huber_delta;
-  int max_iterations = SolverOptions{}.max_iterations;
-  bool estimate_range_offset = false;  // weighted-ml only
-  bool can_undo = false, can_redo = false;
-  int loading_done = 0, loading_total = 0;
-  // The camera's intrinsics estimated from the loaded pairs' corners (EstimateIntrinsics), what
-  // the intrinsics window shows: coverage, per-image error, σ, the verdict; or why not.
-  std::shared_ptr<const IntrinsicsResult> intrinsics;
-  std::string intrinsics_failure;
-  bool intrinsics_running = false;
-  std::filesystem::path intrinsics_saved;  // where SaveIntrinsics last wrote them
-  // The meter (core/guidance's stop rule, as `advise` and `watch` judge): σ per direction against
-  // the user's goal, the weakest in words, done; its history over the solves.
-  CaptureGoal goal;
-  std::optional<CaptureState> meter;
-  std::vector<MeterPoint> meter_history;
-  // Where to hold the board next (`advise` after every solve): the ghost board in the camera and
-  // 3D views, with its words; or why there is none (done, or no feasible pose).
-  std::optional<PoseSuggestion> next_pose;
-  std::string next_pose_failure;
-  // The newest pair against the ghost shown when it was taken (MatchGhost), in words.
-  std::string ghost_match;
-  bool ghost_matched = false;
-  // A folder being followed (WatchFolder): pairs join the list as they land.
-  std::filesystem::path watching;
-  bool auto_solve = false;
-  // Opened from a rig: its cameras, the strip of the selected capture's frames, the rig solve.
-  std::optional<RigView> rig;
-};
 
 // What the user asked for. Panels return these; Controller::Apply carries them out.
 struct SelectPair {
