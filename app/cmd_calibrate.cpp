@@ -75,6 +75,37 @@ int CalibrateRigDataset(const std::string& path, const std::vector<std::string>&
   return WriteRigReport(rig, outcome, options, request);
 }
 
+// One camera's dataset: its intrinsics first when `intrinsics_model` names a model (else its
+// camera file must be there), the calibration written to request.result_file, the report to
+// request.out_path (none when empty).
+int CalibrateOneCamera(Dataset* dataset, const PairEdits& edits,
+                       const std::string& intrinsics_model, const PipelineOptions& options,
+                       const ReportRequest& request) {
+  std::optional<IntrinsicsResult> intrinsics;
+  if (!dataset->missing_camera_file.empty() && intrinsics_model.empty()) {
+    std::fprintf(stderr,
+                 "calibench calibrate: %s is missing: the camera's intrinsics go there (OpenCV "
+                 "YAML, ROS camera_info or a Kalibr camchain); or pass --estimate-intrinsics to "
+                 "estimate them from the pairs' images first\n",
+                 dataset->missing_camera_file.c_str());
+    return kInputError;
+  }
+  if (!intrinsics_model.empty()) {
+    if (const int code =
+            EstimateDatasetIntrinsics("calibrate", intrinsics_model, dataset, &intrinsics);
+        code != kOk)
+      return code;
+  }
+  const std::string& out_path = request.result_file;
+  CalibrationOutcome outcome;
+  const int code = CalibrateAndReport(*dataset, options, out_path, &outcome, edits);
+  if (intrinsics && outcome.solution && !out_path.empty())
+    AddIntrinsicsToResult(out_path, *intrinsics);
+  if (request.out_path.empty() || !outcome.solution) return code;
+  const int written = WriteReport(*dataset, outcome, options, request);
+  return code != kOk ? code : written;
+}
+
 }  // namespace
 
 int RunCalibrate(int argc, char** argv) {
@@ -136,32 +167,9 @@ int RunCalibrate(int argc, char** argv) {
   const PairEdits edits = ApplySessionFlag(session_path, &dataset_path, &flags.options);
   Dataset dataset =
       rig ? LoadRigCamera(dataset_path, camera) : LoadDataset(dataset_path, CameraFile::kOptional);
-  std::optional<IntrinsicsResult> intrinsics;
-  if (!dataset.missing_camera_file.empty() && !estimate_intrinsics) {
-    std::fprintf(stderr,
-                 "calibench calibrate: %s is missing: the camera's intrinsics go there (OpenCV "
-                 "YAML, ROS camera_info or a Kalibr camchain); or pass --estimate-intrinsics to "
-                 "estimate them from the pairs' images first\n",
-                 dataset.missing_camera_file.c_str());
-    return kInputError;
-  }
-  if (estimate_intrinsics) {
-    if (const int code =
-            EstimateDatasetIntrinsics("calibrate", intrinsics_model, &dataset, &intrinsics);
-        code != kOk)
-      return code;
-  }
-  CalibrationOutcome outcome;
-  const int code = CalibrateAndReport(dataset, flags.options, out_path, &outcome, edits);
-  if (intrinsics && outcome.solution && !out_path.empty())
-    AddIntrinsicsToResult(out_path, *intrinsics);
-  if (report_path.empty() || !outcome.solution) return code;
-  ReportRequest request;
-  request.out_path = report_path;
-  request.session_path = session_path;
-  request.result_file = out_path;
-  const int written = WriteReport(dataset, outcome, flags.options, request);
-  return code != kOk ? code : written;
+  const std::string intrinsics = estimate_intrinsics ? intrinsics_model : "";
+  return CalibrateOneCamera(&dataset, edits, intrinsics, flags.options,
+                            {report_path, session_path, out_path});
 }
 
 }  // namespace calibench::app

@@ -98,13 +98,12 @@ int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const Pipeli
   for (size_t c = 0; c < outcome.camera_names.size(); ++c) {
     const std::string& name = outcome.camera_names[c];
     const SolverResult& single = *outcome.single[c].solution;
-    const Pose& joint = outcome.joint->cam_from_lidar[c];
-    const Mat6 covariance = outcome.joint->covariance.block<6, 6>(6 * c, 6 * c);
+    const PoseWithSigmas joint = RigJointPose(outcome, c);
     int pairs = 0;
     for (const PairFeatures& p : outcome.single[c].pairs)
       pairs += p.status == PairStatus::kAccepted;
-    summary.cameras.push_back({name, pairs, joint, 1e3 * TranslationStd(covariance, joint),
-                               RotationStdDeg(covariance, joint), single.cam_from_lidar,
+    summary.cameras.push_back({name, pairs, joint.pose, joint.sigma_t_mm, joint.sigma_r_deg,
+                               single.cam_from_lidar,
                                1e3 * TranslationStd(single.covariance, single.cam_from_lidar),
                                RotationStdDeg(single.covariance, single.cam_from_lidar)});
     RigCameraReport camera;
@@ -115,13 +114,7 @@ int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const Pipeli
       camera.figures = RenderReportFigures(rig.folder.string(), "", &why, name, &outcome);
     cameras.push_back(std::move(camera));
   }
-  for (size_t to = 1; to < outcome.camera_names.size(); ++to) {
-    const RelativePose relative = CameraFromCamera(*outcome.joint, static_cast<int>(to), 0);
-    summary.relative.push_back({outcome.camera_names[to] + "_from_" + outcome.camera_names[0],
-                                relative.to_from_from,
-                                1e3 * TranslationStd(relative.covariance, relative.to_from_from),
-                                RotationStdDeg(relative.covariance, relative.to_from_from)});
-  }
+  summary.relative = RigRelativePoses(outcome);
   ReportProvenance provenance;
   provenance.source = rig.folder.string() + " (a rig of " +
                       std::to_string(outcome.camera_names.size()) + " cameras)";

@@ -92,6 +92,26 @@ RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
   return outcome;
 }
 
+PoseWithSigmas RigJointPose(const RigOutcome& outcome, size_t c) {
+  CALIBENCH_CHECK(outcome.joint.has_value());
+  const Pose& pose = outcome.joint->cam_from_lidar[c];
+  const Mat6 covariance = outcome.joint->covariance.block<6, 6>(6 * c, 6 * c);
+  return {outcome.camera_names[c], pose, 1e3 * TranslationStd(covariance, pose),
+          RotationStdDeg(covariance, pose)};
+}
+
+std::vector<PoseWithSigmas> RigRelativePoses(const RigOutcome& outcome) {
+  CALIBENCH_CHECK(outcome.joint.has_value());
+  std::vector<PoseWithSigmas> relative;
+  for (size_t to = 1; to < outcome.camera_names.size(); ++to) {
+    const RelativePose pose = CameraFromCamera(*outcome.joint, static_cast<int>(to), 0);
+    relative.push_back({outcome.camera_names[to] + "_from_" + outcome.camera_names[0],
+                        pose.to_from_from, 1e3 * TranslationStd(pose.covariance, pose.to_from_from),
+                        RotationStdDeg(pose.covariance, pose.to_from_from)});
+  }
+  return relative;
+}
+
 void WriteRigResult(const std::filesystem::path& path, const RigOutcome& outcome) {
   CALIBENCH_CHECK(outcome.joint.has_value());
   const RigSolution& joint = *outcome.joint;

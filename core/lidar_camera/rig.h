@@ -28,6 +28,18 @@ struct RigOutcome {
 // The user's edits per camera (by camera name): each camera's session's brushes and rejections.
 using RigEdits = std::map<std::string, PairEdits>;
 
+// A pose with its σ in its own axes (mm, deg), named ("cam0", "cam1_from_cam0").
+struct PoseWithSigmas {
+  std::string name;
+  Pose pose = Pose::Identity();
+  Vec3 sigma_t_mm = Vec3::Zero(), sigma_r_deg = Vec3::Zero();
+};
+// The rig solve's cam_from_lidar of camera `c` with its σ (needs outcome.joint).
+PoseWithSigmas RigJointPose(const RigOutcome& outcome, size_t c);
+// Each camera after the first relative to the first, "<to>_from_<first>" (x_in_to = pose ·
+// x_in_first), from the rig solve with σ (needs outcome.joint).
+std::vector<PoseWithSigmas> RigRelativePoses(const RigOutcome& outcome);
+
 // Calibrates every camera of the rig, then the rig. A camera whose own solve fails leaves the
 // rig without a joint solution (failure says which and why). `edits` apply to their camera's
 // pairs, as `calibrate --session` applies one session's.

@@ -234,6 +234,88 @@ bool RigSolverOptions::Check(std::string* why) const {
   return true;
 }
 
+namespace {
+
+// χ² medians: what a term's squared whitened norm is, half of the time, when its covariance is
+// right.
+constexpr double kChiSquare6Median = 5.35, kChiSquare3Median = 2.37;
+
+double RigMedian(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// Gauss-Newton from p's estimate, with backtracking: a step that raises the robust cost is halved
+// (at most 8 times); converged when none lowers it, the step is negligible or the cost no longer
+// moves. False, with *why, when the normal equations are singular.
+bool RigGaussNewton(const RigSolverOptions& options, RigProblem* p, RigSolution* solution,
+                    std::string* why) {
+  double cost = RigCost(*p, options.huber_delta);
+  Eigen::MatrixXd h;
+  Eigen::VectorXd g;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    RigLinearize(*p, options.huber_delta, &h, &g);
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
+    const Eigen::VectorXd step = ldlt.solve(-g);
+    if (ldlt.info() != Eigen::Success || !step.allFinite())
+      return *why = "the rig's normal equations are singular", false;
+    ++solution->iterations;
+    double scale = 1.0;
+    bool lowered = false;
+    const double cost_before = cost;
+    for (int halving = 0; halving <= 8 && !lowered; ++halving, scale *= 0.5) {
+      RigProblem trial = *p;
+      RigApplyStep(scale * step, &trial);
+      const double trial_cost = RigCost(trial, options.huber_delta);
+      if (trial_cost <= cost) {
+        *p = std::move(trial);
+        cost = trial_cost;
+        lowered = true;
+      }
+    }
+    solution->converged =
+        !lowered || step.norm() < options.min_step || cost_before - cost <= 1e-12 * cost_before;
+    if (solution->converged) break;
+  }
+  solution->cost = cost;
+  return true;
+}
+
+// The board views' variance factor: the median of their squared whitened norms against χ²₆'s,
+// robust to the few boards whose PnP is off (those the Huber kernel down-weights).
+double RigViewsFactor(const RigProblem& p) {
+  std::vector<double> ratios;
+  for (const RigViewTerm& v : p.views)
+    ratios.push_back(RigViewResidual(p, v).squaredNorm() / kChiSquare6Median);
+  return RigMedian(std::move(ratios));
+}
+
+// The whole problem's: the same median over every term.
+double RigProblemFactor(const RigProblem& p) {
+  std::vector<double> ratios;
+  for (const RigViewTerm& v : p.views)
+    ratios.push_back(RigViewResidual(p, v).squaredNorm() / kChiSquare6Median);
+  for (const RigPlaneTerm& t : p.planes)
+    ratios.push_back(RigPlaneResidual(p, t).squaredNorm() / kChiSquare3Median);
+  for (const RigPriorTerm& t : p.priors)
+    ratios.push_back((t.whitening * RigPriorError(p, t)).squaredNorm() / kChiSquare6Median);
+  return RigMedian(std::move(ratios));
+}
+
+// The cameras' joint covariance: their block of H⁻¹ (the boards marginalised).
+Eigen::MatrixXd RigCamerasCovariance(const RigProblem& p, double huber_delta) {
+  Eigen::MatrixXd h;
+  Eigen::VectorXd g;
+  RigLinearize(p, huber_delta, &h, &g);
+  const int camera_size = 6 * p.cameras;
+  const Eigen::MatrixXd selector = Eigen::MatrixXd::Identity(p.Size(), camera_size);
+  const Eigen::MatrixXd covariance =
+      Eigen::LDLT<Eigen::MatrixXd>(h).solve(selector).topRows(camera_size);
+  return 0.5 * (covariance + covariance.transpose());
+}
+
+}  // namespace
+
 std::optional<RigSolution> SolveRig(const std::vector<RigCapture>& captures,
                                     const std::vector<Pose>& initial,
                                     const RigSolverOptions& options, std::string* why,
@@ -245,84 +327,33 @@ std::optional<RigSolution> SolveRig(const std::vector<RigCapture>& captures,
   RigProblem& p = *problem;
   RigSolution solution;
   solution.used_captures = static_cast<int>(p.lidar_from_board.size());
-  double cost = 0.0;
-  Eigen::MatrixXd h;
-  Eigen::VectorXd g;
-  // The cameras' board poses are the terms whose covariances are least to be believed (PnP's
-  // covariance from the corners' spread leaves out the lens model's and the print's errors):
-  // their variance factor is estimated from their own residuals (the boards' poses take 6 of
-  // each capture's view dimensions, the cameras' relative poses 6 per camera after the first)
-  // and their covariances scaled by it, a few times over.
-  double view_factor = 1.0;
+  // With priors, the cameras' board poses are the terms whose covariances are least to be
+  // believed (PnP's covariance from the corners' spread leaves out the lens model's and the
+  // print's errors): their covariances are scaled by their own variance factor, re-estimated
+  // after each solve, a few times over. Never narrower than PnP says. Redundancy: the boards'
+  // poses take 6 of each capture's view dimensions, the relative poses 6 per camera after the
+  // first.
   const int view_redundancy = 6 * static_cast<int>(p.views.size()) -
                               6 * static_cast<int>(p.lidar_from_board.size()) - 6 * (p.cameras - 1);
   for (int round = 0; round < 4; ++round) {
-    cost = RigCost(p, options.huber_delta);
-    for (int it = 0; it < options.max_iterations; ++it) {
-      RigLinearize(p, options.huber_delta, &h, &g);
-      const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
-      const Eigen::VectorXd step = ldlt.solve(-g);
-      if (ldlt.info() != Eigen::Success || !step.allFinite())
-        return *why = "the rig's normal equations are singular", std::nullopt;
-      ++solution.iterations;
-      // Backtracking: a step that raises the robust cost is halved (at most 8 times); when none
-      // lowers it, the estimate is the minimum to the cost's precision.
-      double scale = 1.0;
-      bool lowered = false;
-      const double cost_before = cost;
-      for (int halving = 0; halving <= 8 && !lowered; ++halving, scale *= 0.5) {
-        RigProblem trial = p;
-        RigApplyStep(scale * step, &trial);
-        const double trial_cost = RigCost(trial, options.huber_delta);
-        if (trial_cost <= cost) {
-          p = std::move(trial);
-          cost = trial_cost;
-          lowered = true;
-        }
-      }
-      // Converged: no step lowers the cost, the step is negligible, or the cost no longer moves.
-      solution.converged =
-          !lowered || step.norm() < options.min_step || cost_before - cost <= 1e-12 * cost_before;
-      if (solution.converged) break;
-    }
+    if (!RigGaussNewton(options, &p, &solution, why)) return std::nullopt;
     if (view_redundancy <= 0 || p.priors.empty()) break;
-    // The median of the views' squared whitened norms against χ²₆'s (5.35): robust to the few
-    // boards whose PnP is off (those the Huber kernel down-weights).
-    std::vector<double> squared;
-    for (const RigViewTerm& v : p.views) squared.push_back(RigViewResidual(p, v).squaredNorm());
-    std::nth_element(squared.begin(), squared.begin() + squared.size() / 2, squared.end());
-    const double factor = squared[squared.size() / 2] / 5.35;
-    if (factor < 1.2 && factor > 1.0 / 1.2) break;
-    if (factor <= 1.0 && view_factor <= 1.0) break;  // never narrower than PnP says
-    const double applied = std::max(factor, 1.0 / view_factor);
-    view_factor *= applied;
+    const double factor = RigViewsFactor(p);
+    if ((factor < 1.2 && factor > 1.0 / 1.2) ||
+        (factor <= 1.0 && solution.view_variance_factor <= 1.0))
+      break;
+    const double applied = std::max(factor, 1.0 / solution.view_variance_factor);
+    solution.view_variance_factor *= applied;
     for (RigViewTerm& v : p.views) v.whitening /= std::sqrt(applied);
   }
-  solution.view_variance_factor = view_factor;
-  // The cameras' joint covariance: their block of H⁻¹ (the boards marginalised).
-  RigLinearize(p, options.huber_delta, &h, &g);
-  const int camera_size = 6 * p.cameras;
-  const Eigen::MatrixXd selector = Eigen::MatrixXd::Identity(p.Size(), camera_size);
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
-  solution.covariance = ldlt.solve(selector).topRows(camera_size);
-  solution.covariance = 0.5 * (solution.covariance + solution.covariance.transpose()).eval();
-  // Measurements that disagree more than their covariances say widen σ: the median of every
-  // term's squared whitened norm over its χ² median (6-dof 5.35, 3-dof 2.37), when above 1. The
-  // median, because the few boards the Huber kernel down-weights would otherwise set it.
+  solution.covariance = RigCamerasCovariance(p, options.huber_delta);
+  // Measurements that disagree more than their covariances say widen σ (medians, so that the few
+  // boards the Huber kernel down-weights do not set it).
   if (p.Measurements() > p.Size()) {
-    std::vector<double> ratios;
-    for (const RigViewTerm& v : p.views)
-      ratios.push_back(RigViewResidual(p, v).squaredNorm() / 5.35);
-    for (const RigPlaneTerm& t : p.planes)
-      ratios.push_back(RigPlaneResidual(p, t).squaredNorm() / 2.37);
-    for (const RigPriorTerm& t : p.priors)
-      ratios.push_back((t.whitening * RigPriorError(p, t)).squaredNorm() / 5.35);
-    std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
-    solution.variance_factor = ratios[ratios.size() / 2];
+    solution.variance_factor = RigProblemFactor(p);
     if (solution.variance_factor > 1.0) solution.covariance *= solution.variance_factor;
   }
   solution.cam_from_lidar = p.cam_from_lidar;
-  solution.cost = cost;
   return solution;
 }
 

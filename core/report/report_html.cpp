@@ -398,8 +398,8 @@ std::string RigReportHtml(const RigReportSummary& rig, const std::vector<RigCame
       "</table><h3>Cameras relative to each other</h3><table class=\"sigma\"><tr>"
       "<th>pose</th><th>translation [m]</th><th>sigma t [mm] (x y z)</th>"
       "<th>sigma r [deg]</th></tr>";
-  for (const RigReportSummary::Relative& relative : rig.relative) {
-    const Vec3 t = relative.to_from_from.translation();
+  for (const PoseWithSigmas& relative : rig.relative) {
+    const Vec3 t = relative.pose.translation();
     body += "<tr data-relative=\"" + Escape(relative.name) + "\"><td><code>" +
             Escape(relative.name) + "</code></td><td>" + Num(t.x(), 4) + " " + Num(t.y(), 4) + " " +
             Num(t.z(), 4) + "</td>" + SigmaCells(relative.sigma_t_mm, relative.sigma_r_deg) +

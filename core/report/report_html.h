@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/lidar_camera/rig.h"
 #include "core/report/calibration_report.h"
 
 namespace calibench {
@@ -56,13 +57,8 @@ struct RigReportSummary {
     Pose single_cam_from_lidar = Pose::Identity();  // the camera alone
     Vec3 single_sigma_t_mm = Vec3::Zero(), single_sigma_r_deg = Vec3::Zero();
   };
-  struct Relative {
-    std::string name;  // "<to>_from_<from>"
-    Pose to_from_from = Pose::Identity();
-    Vec3 sigma_t_mm = Vec3::Zero(), sigma_r_deg = Vec3::Zero();
-  };
   std::vector<Camera> cameras;
-  std::vector<Relative> relative;
+  std::vector<PoseWithSigmas> relative;  // RigRelativePoses
   int shared_captures = 0;
 };
 struct RigCameraReport {

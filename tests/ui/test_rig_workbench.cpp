@@ -105,7 +105,7 @@ TEST(RigWorkbench, ACameraOpensWithTheRigsOtherCamerasSolvedBesideIt) {
   ASSERT_EQ(s.rig->relative.size(), 1u);
   EXPECT_EQ(s.rig->relative[0].name, "cam1_from_cam0");
   const Pose truth = Rig().truth.cam_from_lidar[1] * Rig().truth.cam_from_lidar[0].inverse();
-  const PoseError relative = ComputePoseError(s.rig->relative[0].to_from_from, truth);
+  const PoseError relative = ComputePoseError(s.rig->relative[0].pose, truth);
   std::printf("cam1_from_cam0: %.2f mm %.3f deg from the truth (sigma %.2f mm)\n",
               relative.translation_m * 1e3, relative.rotation_rad / kDegToRad,
               s.rig->relative[0].sigma_t_mm.maxCoeff());

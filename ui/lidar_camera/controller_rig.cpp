@@ -4,7 +4,6 @@
 // frames.
 #include <algorithm>
 
-#include "core/estimation/uncertainty.h"
 #include "core/io/image_io.h"
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
@@ -38,23 +37,14 @@ void ApplyRigOutcome(const RigOutcome& outcome, bool active_solved, RigView* rig
     view.single_at_joint.reset();
     if (!outcome.joint) continue;
     view.single_at_joint = single.solution->cam_from_lidar;
-    const Pose& pose = outcome.joint->cam_from_lidar[c];
-    const Mat6 covariance = outcome.joint->covariance.block<6, 6>(6 * c, 6 * c);
-    view.joint_cam_from_lidar = pose;
-    view.joint_sigma_t_mm = 1e3 * TranslationStd(covariance, pose);
-    view.joint_sigma_r_deg = RotationStdDeg(covariance, pose);
+    const PoseWithSigmas joint = RigJointPose(outcome, c);
+    view.joint_cam_from_lidar = joint.pose;
+    view.joint_sigma_t_mm = joint.sigma_t_mm;
+    view.joint_sigma_r_deg = joint.sigma_r_deg;
   }
-  rig->relative.clear();
   rig->shared_captures = outcome.shared_captures;
   rig->failure = outcome.joint ? "" : outcome.failure;
-  if (!outcome.joint) return;
-  for (size_t to = 1; to < outcome.camera_names.size(); ++to) {
-    const RelativePose relative = CameraFromCamera(*outcome.joint, static_cast<int>(to), 0);
-    rig->relative.push_back({outcome.camera_names[to] + "_from_" + outcome.camera_names[0],
-                             relative.to_from_from,
-                             1e3 * TranslationStd(relative.covariance, relative.to_from_from),
-                             RotationStdDeg(relative.covariance, relative.to_from_from)});
-  }
+  rig->relative = outcome.joint ? RigRelativePoses(outcome) : std::vector<PoseWithSigmas>{};
 }
 
 }  // namespace

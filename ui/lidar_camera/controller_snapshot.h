@@ -14,6 +14,7 @@
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
 #include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/rig.h"
 #include "core/reproject/reproject.h"
 #include "core/session/calibration_job.h"
 #include "core/target/board_camera.h"
@@ -101,14 +102,8 @@ struct RigView {
   std::string frames_pair;  // the capture the strip's frames show
   bool solving = false;     // the rig solve runs (on its own thread)
   int shared_captures = 0;  // at the last rig solve: captures two or more cameras saw the board in
-  // Each camera after the first relative to the first (x_in_<to> = to_from_from · x_in_<from>),
-  // from the joint solve, with σ; named "<to>_from_<from>".
-  struct Relative {
-    std::string name;
-    Pose to_from_from = Pose::Identity();
-    Vec3 sigma_t_mm = Vec3::Zero(), sigma_r_deg = Vec3::Zero();
-  };
-  std::vector<Relative> relative;
+  // Each camera after the first relative to the first, from the joint solve (RigRelativePoses).
+  std::vector<PoseWithSigmas> relative;
   std::string failure;  // the last rig solve's failure
   // Every camera's stop rule is met.
   bool AllDone() const;

@@ -90,25 +90,6 @@ void WindowShell::OpenSession(const fs::path& session) {
   Replace(std::move(opened));
 }
 
-void WindowShell::SelectCamera(const std::string& camera) {
-  const Snapshot s = controller_->GetSnapshot();
-  if (!s.rig || s.rig->cameras[s.rig->active].name == camera) return;
-  try {
-    auto opened = NewController();
-    // While the rig solves, its cameras' solves are not all there: the new controller solves.
-    if (!s.rig->solving) opened->CarryRig(*s.rig);
-    opened->OpenDataset(s.rig->path, {}, Controller::ExistingSession::kResume, camera);
-    const std::string pair = s.selected >= 0 ? s.pairs[s.selected].id : "";
-    const auto pairs = opened->GetSnapshot().pairs;
-    for (size_t i = 0; i < pairs.size(); ++i)
-      if (pairs[i].id == pair) opened->Apply(SelectPair{static_cast<int>(i)});
-    Replace(std::move(opened));
-  } catch (const IoError& e) {
-    error_ = e.what();
-    show_error_ = true;
-  }
-}
-
 void WindowShell::Watch(const fs::path& source) {
   auto watching = NewController();
   // Each opens its dataset folder once the camera and the target are known.
@@ -152,10 +133,7 @@ namespace {
 
 // The session file opening `path` would edit (the controller's rule: beside the dataset).
 fs::path SessionOpenedBy(const fs::path& path, OpenKind kind) {
-  if (kind == OpenKind::kSession) return path;
-  std::error_code error;
-  const fs::path folder = fs::is_directory(path, error) ? path : path.parent_path();
-  return folder / "calibench.session.json";
+  return kind == OpenKind::kSession ? path : DefaultSessionPath(path);
 }
 
 bool SameFile(const fs::path& a, const fs::path& b) {

@@ -138,8 +138,8 @@ void Workbench::RigMeterRows(const Snapshot& s, std::vector<Intent>* intents) {
     }
     ImGui::EndTable();
   }
-  for (const RigView::Relative& relative : rig.relative) {
-    const Vec3 t = 1e3 * relative.to_from_from.translation();
+  for (const PoseWithSigmas& relative : rig.relative) {
+    const Vec3 t = 1e3 * relative.pose.translation();
     ImGui::Text(
         "%s: t = [%.1f %.1f %.1f] mm, sigma t %.2f mm, r %.3f deg (worst axis; %d shared "
         "captures)",
