@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/machine_stdout.h"
 #include "app/pipeline_flags.h"
 #include "core/guidance/advise.h"
 #include "core/guidance/lrf_meter.h"
@@ -20,7 +21,7 @@ namespace {
 // The LiDAR-camera dataset's advice (with --estimate-intrinsics, its camera from its images
 // first), printed as text or one JSON object.
 int AdviseLidarCamera(const std::string& dataset_path, const AdviseOptions& options,
-                      const std::string& intrinsics_model, bool json) {
+                      const std::string& intrinsics_model, bool json, MachineStdout& out) {
   Dataset dataset = LoadDataset(
       dataset_path, options.estimate_intrinsics ? CameraFile::kOptional : CameraFile::kRequired);
   if (options.estimate_intrinsics) {
@@ -39,7 +40,7 @@ int AdviseLidarCamera(const std::string& dataset_path, const AdviseOptions& opti
   for (const PairFeatures& p : job.Solve().pairs) input_error |= p.input_error;
   const CaptureAdvice& advice = job.Advise();
   if (json)
-    std::printf("%s\n", CaptureAdviceJson(advice).c_str());
+    out.Print(CaptureAdviceJson(advice));
   else
     std::printf("%s", FormatCaptureAdvice(advice).c_str());
   if (input_error) {
@@ -53,7 +54,8 @@ int AdviseLidarCamera(const std::string& dataset_path, const AdviseOptions& opti
 // A rig: every camera's advice (its own capture against the goal, where to hold the board next
 // for it), and whether every camera is done; text, or one JSON object {"cameras": {"<camera>":
 // advice}, "done"}.
-int AdviseRig(const std::string& rig_path, const AdviseOptions& options, bool json) {
+int AdviseRig(const std::string& rig_path, const AdviseOptions& options, bool json,
+              MachineStdout& out) {
   const RigFolder rig = LoadRig(rig_path);
   nlohmann::json cameras = nlohmann::json::object();
   bool all_done = true, input_error = false;
@@ -72,7 +74,7 @@ int AdviseRig(const std::string& rig_path, const AdviseOptions& options, bool js
                   FormatCaptureAdvice(advice).c_str());
   }
   if (json)
-    std::printf("%s\n", nlohmann::json({{"cameras", cameras}, {"done", all_done}}).dump().c_str());
+    out.Print(nlohmann::json({{"cameras", cameras}, {"done", all_done}}).dump());
   else
     std::printf("rig: %s\n", all_done ? "DONE: every camera's sigma is under the goal and trusted"
                                       : "not done: see the cameras above");
@@ -129,6 +131,7 @@ int RunAdvise(int argc, char** argv) {
     return kUsage;
   }
   options.pipeline = flags.options;
+  MachineStdout out(json);  // from here on, only the JSON object reaches stdout
   if (IsLrfManifest(dataset_path)) {
     if (!options.goal.Check(&why) || !options.stop.Check(&why) || !(lrf_threshold_mm > 0)) {
       if (why.empty()) why = "--error-threshold-mm must be > 0";
@@ -146,8 +149,10 @@ int RunAdvise(int argc, char** argv) {
     lrf_stop.min_pairs = 4;
     const LrfCaptureAdvice advice =
         AdviseLrfCapture(outcome, lrf_options.adaptive_error_threshold_m, options.goal, lrf_stop);
-    std::printf("%s", json ? (LrfCaptureAdviceJson(advice) + "\n").c_str()
-                           : FormatLrfCaptureAdvice(advice).c_str());
+    if (json)
+      out.Print(LrfCaptureAdviceJson(advice));
+    else
+      std::printf("%s", FormatLrfCaptureAdvice(advice).c_str());
     return kOk;
   }
   if (!options.Check(&why)) {
@@ -161,9 +166,9 @@ int RunAdvise(int argc, char** argv) {
                    "bring their files (cameras/<camera>.yaml)\n");
       return kUsage;
     }
-    return AdviseRig(dataset_path, options, json);
+    return AdviseRig(dataset_path, options, json, out);
   }
-  return AdviseLidarCamera(dataset_path, options, intrinsics_model, json);
+  return AdviseLidarCamera(dataset_path, options, intrinsics_model, json, out);
 }
 
 }  // namespace calibench::app

@@ -103,6 +103,9 @@ void AddSelectionFlags(CLI::App& app, PairSelectionOptions* options_out) {
 
 void PrintSummary(const BagImportSummary& summary, const BagImportOptions& options) {
   std::printf("%s\n", summary.format.c_str());
+  if (!summary.cut_short.empty())
+    std::printf("note: %s: the pairs below are those held before that point\n",
+                summary.cut_short.c_str());
   std::printf("clouds  %-28s %lld messages\n", summary.cloud_topic.c_str(),
               static_cast<long long>(summary.clouds));
   std::printf("images  %-28s %lld messages; searched %d for the board, found in %d\n",

@@ -53,7 +53,7 @@ void CheckTargetJsonFree(const fs::path& path, const std::string& text) {
   existing << in.rdbuf();
   if (existing.str() != text)
     throw IoError(path.string() +
-                  ": a different target.json is already there (another board?); move it away or "
+                  ": a different target file is already there (another board?); move it away or "
                   "name another file with --target-json");
 }
 
@@ -133,8 +133,9 @@ std::optional<BoardSpec> BoardFromPatternFlags(const PatternFlags& f, std::strin
 int RunTarget(int argc, char** argv) {
   CLI::App app{
       "Write a printable calibration board at exact scale (PDF or SVG through cairo) with a "
-      "100 mm ruler and a caption, and beside it the target.json that `calibrate` reads "
-      "(board_size = the sheet). ChArUco boards are OpenCV's for the same parameters. Lengths "
+      "100 mm ruler and a caption, and beside it the target file that `calibrate` reads "
+      "(board_size = the sheet; board.pdf -> board.target.json). ChArUco boards are OpenCV's for "
+      "the same parameters. Lengths "
       "are metres or carry a unit: 0.04, 40mm, 4cm.",
       "calibench target"};
   PatternFlags pattern;
@@ -159,7 +160,8 @@ int RunTarget(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--out,-o", out, "board.pdf or board.svg")->required();
   app.add_option("--target-json", target_json,
-                 "where the matching target file goes (default: target.json beside --out)");
+                 "where the matching target file goes (default: beside --out, named after it: "
+                 "board.pdf -> board.target.json)");
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
   pattern.type_given = app.count("--type") > 0;
 
@@ -187,8 +189,11 @@ int RunTarget(int argc, char** argv) {
     return usage(e.what());
   }
   const fs::path out_path(out);
+  // Named after the print, so that two targets printed into one folder keep their own files;
+  // import and watch find <recording>.target.json, target.json, or the only *.target.json.
   const fs::path json_path =
-      target_json.empty() ? out_path.parent_path() / "target.json" : fs::path(target_json);
+      target_json.empty() ? out_path.parent_path() / (out_path.stem().string() + ".target.json")
+                          : fs::path(target_json);
   const std::string json_text = json_io::TargetToJson(sheet.board).dump(2) + "\n";
   CheckTargetJsonFree(json_path, json_text);
   try {
@@ -197,6 +202,7 @@ int RunTarget(int argc, char** argv) {
     return usage(e.what());
   }
   WriteFileAtomically(json_path, json_text);
+  if (!sheet.note.empty()) std::fprintf(stderr, "calibench target: note: %s\n", sheet.note.c_str());
   std::printf("%s\n  %s\n  %s (%.0f x %.0f mm)\nwrote %s and %s\n", sheet.title.c_str(),
               sheet.caption.c_str(), PaperName(sheet.paper).c_str(), sheet.sheet_mm.x(),
               sheet.sheet_mm.y(), out_path.string().c_str(), json_path.string().c_str());

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "app/machine_stdout.h"
 #include "app/pipeline_flags.h"
 #include "core/guidance/stop_rule.h"
 #include "core/io/camera_file.h"
@@ -35,17 +36,15 @@ double UnixSeconds() {
 // Where the stream goes: one JSON object per line, or one line for people per event.
 class EventStream {
  public:
-  explicit EventStream(bool json_lines) : json_lines_(json_lines) {}
+  explicit EventStream(bool json_lines) : json_lines_(json_lines), out_(json_lines) {}
 
   void Emit(nlohmann::json event, const std::string& human) {
     if (json_lines_) {
       event["time"] = UnixSeconds();
-      std::printf("%s\n",
-                  event.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+      out_.Print(event.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
     } else {
-      std::printf("%s\n", human.c_str());
+      out_.Print(human);
     }
-    std::fflush(stdout);
   }
   void Note(const std::string& kind, const std::string& name, const std::string& reason) {
     Emit({{"event", kind}, {"name", name}, {"reason", reason}},
@@ -54,6 +53,7 @@ class EventStream {
 
  private:
   bool json_lines_;
+  MachineStdout out_;  // with --json-lines, only the events reach stdout
 };
 
 // The advice's first line (σ against the goal) and the next pose in words.
@@ -201,6 +201,8 @@ class Watch {
       const double now = SteadySeconds();
       bool added = false;
       const FeedUpdate update = feed_->Poll(now);
+      // A recording that grows is alive even while no pair comes out of it (its board unknown).
+      if (update.data_arrived) last_activity = now;
       for (const std::string& note : update.notes) stream_.Note("note", "", note);
       for (const FolderEvent& event : update.events) {
         last_activity = now;

@@ -5,7 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/base/types.h"
@@ -42,6 +45,25 @@ struct SimRecordingTruth {
   std::optional<Pose> second_cam_from_lidar;  // the rig's second camera (same model)
   double seconds = 0.0;                       // the recording's length
   std::int64_t messages = 0;
+};
+
+// Hands messages on to `inner`, calling `pause` once before the first message stamped at or after
+// `at_ns`: a recorder held mid-recording while a test waits for what a follower says.
+class PausingWriter : public RecordingWriter {
+ public:
+  PausingWriter(std::unique_ptr<RecordingWriter> inner, std::function<void()> pause,
+                std::int64_t at_ns)
+      : inner_(std::move(inner)), pause_(std::move(pause)), at_ns_(at_ns) {}
+  void Add(const RecordedMessage& message) override {
+    if (pause_ && message.log_time_ns >= at_ns_) std::exchange(pause_, nullptr)();
+    inner_->Add(message);
+  }
+  void Close() override { inner_->Close(); }
+
+ private:
+  std::unique_ptr<RecordingWriter> inner_;
+  std::function<void()> pause_;
+  std::int64_t at_ns_;
 };
 
 // What the tests record: 4 s of sensors per pose instead of 8, 640 x 360 images with the board

@@ -209,6 +209,8 @@ class FolderBag final : public BagReader {
       }
       topic_maps_.push_back(std::move(map));
       size_bytes_ += part->SizeBytes();
+      if (!part->CutShort().empty())  // the folder's last file, most often: where it stops
+        cut_short_ = part->Path().filename().string() + ": " + part->CutShort();
     }
   }
 

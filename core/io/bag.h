@@ -46,6 +46,10 @@ class BagReader {
   const std::string& Format() const { return format_; }
   const std::vector<BagTopic>& Topics() const { return topics_; }
   std::int64_t SizeBytes() const { return size_bytes_; }
+  // A recording its recorder never closed (a crash, a full disk) may end inside a record: the
+  // messages are read up to the last complete one, and this says where the file stops being
+  // complete ("cut short at byte N of M: ..."). Empty for a whole recording.
+  const std::string& CutShort() const { return cut_short_; }
   // The topic's index by name, -1 when absent.
   int FindTopic(const std::string& name) const;
 
@@ -70,6 +74,7 @@ class BagReader {
   std::string format_;
   std::vector<BagTopic> topics_;
   std::int64_t size_bytes_ = 0;
+  std::string cut_short_;
 };
 
 // Opens a recording by its content (the first bytes), not its extension; a folder is a rosbag2

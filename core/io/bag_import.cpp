@@ -50,6 +50,8 @@ class Importer {
     image_topic_ = bag_->FindTopic(options_.image_topic);
     info_topic_ = options_.camera ? -1 : bag_->FindTopic(options_.camera_info_topic);
     summary_.format = bag_->Format();
+    if (!bag_->CutShort().empty())
+      summary_.cut_short = bag_->Path().string() + ": " + bag_->CutShort();
     summary_.cloud_topic = options_.cloud_topic;
     summary_.image_topic = options_.image_topic;
     summary_.camera_source = options_.camera ? "the --camera file" : options_.camera_info_topic;
@@ -190,6 +192,7 @@ class Importer {
     record["board"] = summary_.board_source;
     record["tries"] = summary_.tries;
     record["images_searched"] = summary_.images_searched;
+    if (!summary_.cut_short.empty()) record["cut_short"] = summary_.cut_short;
     WriteFileAtomically(out_dir_ / "import.json", record.dump(2) + "\n");
   }
 

@@ -37,6 +37,9 @@ struct BagImportOptions : PairSelectionOptions {
 // reason in `dropped`.
 struct BagImportSummary {
   std::string format;  // the reader's description of the file
+  // A recording its recorder never closed, read up to its last complete record: where it stops
+  // (BagReader::CutShort, naming the file); empty for a whole recording.
+  std::string cut_short;
   std::string cloud_topic, image_topic, camera_source;
   std::int64_t clouds = 0;            // messages on the cloud topic
   std::int64_t images = 0;            // messages on the image topic
@@ -75,8 +78,10 @@ std::filesystem::path DefaultImportFolder(const std::filesystem::path& bag);
 using ImportProgress =
     std::function<void(const std::string& phase, std::int64_t done, std::int64_t total)>;
 
-// The target.json a user keeps with a recording: beside the file (or the rosbag2 folder), or
-// inside the rosbag2 folder. nullopt when there is none.
+// The target file a user keeps with a recording: <recording>.target.json beside it (rig.mcap:
+// rig.target.json), else target.json inside the rosbag2 folder or beside the recording, else the
+// only *.target.json beside it (as `calibench target` names them). nullopt when there is none, or
+// several that nothing tells apart.
 std::optional<std::filesystem::path> TargetBesideRecording(const std::filesystem::path& bag);
 
 // What import and watch share: the board as the user gave it, else from the target.json beside

@@ -32,10 +32,25 @@ bool BagImportOptions::Check(std::string* why) const {
 std::optional<fs::path> TargetBesideRecording(const fs::path& bag) {
   fs::path source = fs::absolute(bag).lexically_normal();
   if (source.filename().empty()) source = source.parent_path();  // "folder/"
+  const fs::path beside = source.parent_path();
   std::error_code error;
-  for (const fs::path& candidate : {source / "target.json", source.parent_path() / "target.json"})
+  // Named after the recording (rig.mcap: rig.target.json or rig.mcap.target.json), then the
+  // folder's own target.json (inside a rosbag2 folder, then beside it).
+  for (const fs::path& candidate : {beside / (source.stem().string() + ".target.json"),
+                                    beside / (source.filename().string() + ".target.json"),
+                                    source / "target.json", beside / "target.json"})
     if (fs::is_regular_file(candidate, error)) return candidate;
-  return std::nullopt;
+  // Else the only target file `calibench target` left beside it (board.pdf -> board.target.json).
+  std::optional<fs::path> only;
+  for (const fs::directory_entry& entry : fs::directory_iterator(beside, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() <= 12 || name.compare(name.size() - 12, 12, ".target.json") != 0 ||
+        !entry.is_regular_file(error))
+      continue;
+    if (only) return std::nullopt;  // several: which one is the user's to say (--board)
+    only = entry.path();
+  }
+  return only;
 }
 
 fs::path DefaultImportFolder(const fs::path& bag) {

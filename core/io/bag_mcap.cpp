@@ -47,7 +47,10 @@ class Mcap final : public BagReader {
           "MCAP (" + (profile_.empty() ? std::string("no") : profile_) + " profile), followed";
       return;
     }
-    if (!ReadSummary()) CountByScanning();
+    if (!ReadSummary()) {
+      data_end_ = CompleteEnd();
+      CountByScanning();
+    }
     format_ = "MCAP (" + (profile_.empty() ? std::string("no") : profile_) + " profile), " +
               std::to_string(chunk_count_) + " chunks" +
               (compressions_.empty() ? "" : " (" + JoinWords(compressions_) + ")");
@@ -185,8 +188,37 @@ class Mcap final : public BagReader {
     }
   }
 
+  // Where the data of a recording without a summary ends: the file's end, or the start of a
+  // record the file ends inside (a recorder that crashed mid-chunk), said in cut_short_. Reads
+  // only the records' opcodes and lengths.
+  std::int64_t CompleteEnd() {
+    std::vector<std::uint8_t> head;
+    std::int64_t offset = data_start_;
+    for (;;) {
+      if (offset == size_bytes_) return offset;
+      if (offset + 9 <= size_bytes_) {
+        file_.ReadAt(offset, 9, &head, "a record's opcode and length");
+        std::uint64_t length;
+        std::memcpy(&length, head.data() + 1, 8);
+        if (head[0] == kMcapOpDataEnd || head[0] == kMcapOpFooter) return size_bytes_;
+        if (length > kMaxChunkBytes)
+          Fail(path_, "the record at byte " + std::to_string(offset) + " declares " +
+                          std::to_string(length) + " bytes, over the limit");
+        const std::int64_t next = offset + 9 + static_cast<std::int64_t>(length);
+        if (next <= size_bytes_) {
+          offset = next;
+          continue;
+        }
+      }
+      cut_short_ = "cut short at byte " + std::to_string(offset) + " of " +
+                   std::to_string(size_bytes_) +
+                   " (no summary, the last record incomplete: its recorder did not close it); "
+                   "read up to there";
+      return offset;
+    }
+  }
+
   void CountByScanning() {
-    data_end_ = size_bytes_;
     counting_ = true;
     chunk_count_ = 0;
     compressions_.clear();

@@ -115,7 +115,7 @@ class Ros1Bag final : public BagReader {
     if (index_pos_ >= data_start_ && index_pos_ < size_bytes_) {
       ReadIndex();
     } else {
-      index_pos_ = size_bytes_;  // not closed by its recorder: no index, count by reading
+      index_pos_ = CompleteEnd();  // not closed by its recorder: no index, count by reading
       CountByScanning();
     }
     format_ = "ROS 1 bag v2.0, " + std::to_string(chunk_count_) + " chunks (" + compression_ + ")" +
@@ -236,6 +236,38 @@ class Ros1Bag final : public BagReader {
     if (header.Op() != kRos1OpChunk)
       Fail(path_, "the index points at byte " + std::to_string(offset) + ", which is no chunk");
     compressions->insert(std::string(header.Get("compression")));
+  }
+
+  // Where the records of a bag without an index end: the file's end, or the start of a record the
+  // file ends inside (a recorder that crashed mid-chunk), said in cut_short_. Reads only the
+  // records' lengths.
+  std::int64_t CompleteEnd() {
+    std::vector<std::uint8_t> bytes;
+    std::int64_t offset = data_start_;
+    for (;;) {
+      if (offset == size_bytes_) return offset;
+      if (offset + 8 <= size_bytes_) {
+        file_.ReadAt(offset, 4, &bytes, "a record's header length");
+        std::uint32_t header_length;
+        std::memcpy(&header_length, bytes.data(), 4);
+        if (offset + 8 + static_cast<std::int64_t>(header_length) <= size_bytes_) {
+          file_.ReadAt(offset + 4 + header_length, 4, &bytes, "a record's data length");
+          std::uint32_t data_length;
+          std::memcpy(&data_length, bytes.data(), 4);
+          const std::int64_t next = offset + 8 + static_cast<std::int64_t>(header_length) +
+                                    static_cast<std::int64_t>(data_length);
+          if (next <= size_bytes_) {
+            offset = next;
+            continue;
+          }
+        }
+      }
+      cut_short_ = "cut short at byte " + std::to_string(offset) + " of " +
+                   std::to_string(size_bytes_) +
+                   " (no index, the last record incomplete: its recorder did not close it); read "
+                   "up to there";
+      return offset;
+    }
   }
 
   void CountByScanning() {

@@ -9,6 +9,7 @@
 #include <map>
 
 #include "core/io/bag_internal.h"
+#include "core/io/sqlite_salvage.h"
 
 namespace calibench::bag_internal {
 namespace {
@@ -88,9 +89,13 @@ class SqliteBag final : public BagReader {
     }
     try {
       ReadTopics();
-    } catch (...) {
-      sqlite3_close(db_);
-      throw;
+    } catch (const IoError& refused) {
+      try {
+        Salvage(refused.what());
+      } catch (const IoError&) {
+        sqlite3_close(db_);
+        throw refused;
+      }
     }
     format_ = "rosbag2 sqlite3";
   }
@@ -101,6 +106,7 @@ class SqliteBag final : public BagReader {
     std::int64_t total = 0, done = 0;
     for (std::size_t t = 0; t < topics_.size(); ++t)
       if (wanted.empty() || wanted[t]) total += topics_[t].message_count;
+    if (salvage_) return ForEachSalvaged(wanted, visit, progress);
     Statement rows(db_, "SELECT topic_id, timestamp, data FROM messages ORDER BY timestamp", path_);
     while (rows.Step()) {
       const auto topic = topic_index_.find(rows.Integer(0));
@@ -185,9 +191,58 @@ class SqliteBag final : public BagReader {
     }
   }
 
+  // SQLite refuses a file shorter than its header says (a recorder killed mid-write with
+  // synchronous=OFF, a copy that stopped), and the b-tree pages it lost may hide every row: the
+  // topics are read with the schema made readable, the messages from the pages themselves
+  // (sqlite_salvage.h), in the order written up to the first one lost.
+  void Salvage(const std::string& refused) {
+    sqlite3_exec(db_, "PRAGMA writable_schema=ON", nullptr, nullptr, nullptr);
+    topics_.clear();
+    topic_index_.clear();
+    Statement topics(db_, "SELECT id, name, type, serialization_format FROM topics ORDER BY id",
+                     path_);
+    while (topics.Step())
+      topic_index_[topics.Integer(0)] =
+          AddTopic(&topics_, topics.Text(1), topics.Text(2), topics.Text(3));
+    salvage_ = std::make_unique<SqliteSalvage>(path_);
+    for (const SqliteSalvage::Row& row : salvage_->Rows()) {
+      const auto topic = topic_index_.find(row.topic_id);
+      if (topic != topic_index_.end()) ++topics_[topic->second].message_count;
+    }
+    // SQLite's own words, the innermost parenthesis of the refusal ("database disk image is
+    // malformed").
+    std::string why = refused;
+    if (const auto open = why.rfind('('); open != std::string::npos)
+      why = why.substr(open + 1, why.find(')', open) - open - 1);
+    cut_short_ = "cut short (SQLite: " + why + "): " + std::to_string(salvage_->Rows().size()) +
+                 " messages read from its pages in the order written";
+    if (salvage_->RowsBeyond() > 0)
+      cut_short_ += ", " + std::to_string(salvage_->RowsBeyond()) +
+                    " more beyond the first one lost left out";
+  }
+
+  void ForEachSalvaged(const std::vector<bool>& wanted, const BagVisitor& visit,
+                       const BagProgress& progress) {
+    std::vector<std::uint8_t> data;
+    const std::vector<SqliteSalvage::Row>& rows = salvage_->Rows();
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const auto topic = topic_index_.find(rows[i].topic_id);
+      if (topic == topic_index_.end() || (!wanted.empty() && !wanted[topic->second])) continue;
+      salvage_->ReadData(rows[i], &data);
+      BagMessage message;
+      message.topic = topic->second;
+      message.log_time_ns = rows[i].timestamp;
+      message.data = data;
+      if (!visit(message)) return;
+      if (progress)
+        progress(size_bytes_ * static_cast<std::int64_t>(i + 1) / rows.size(), size_bytes_);
+    }
+  }
+
   sqlite3* db_ = nullptr;
   std::map<std::int64_t, int> topic_index_;
-  std::int64_t last_row_ = 0;  // FollowNewMessages: the last message row read
+  std::int64_t last_row_ = 0;               // FollowNewMessages: the last message row read
+  std::unique_ptr<SqliteSalvage> salvage_;  // a file SQLite refuses: its rows from the pages
 };
 
 }  // namespace

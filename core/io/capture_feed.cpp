@@ -9,7 +9,7 @@ class FolderFeed final : public CaptureFeed {
  public:
   FolderFeed(Dataset setup, const std::filesystem::path& folder, const FolderWatchOptions& options)
       : setup_(std::move(setup)), folder_(std::filesystem::absolute(folder), options) {}
-  FeedUpdate Poll(double now_s) override { return {folder_.Poll(now_s), {}, false}; }
+  FeedUpdate Poll(double now_s) override { return {folder_.Poll(now_s), {}, false, false}; }
   std::optional<Dataset> Setup() const override { return setup_; }
   std::filesystem::path DatasetFolder() const override { return folder_.folder(); }
 
@@ -25,7 +25,7 @@ class RecordingFeed final : public CaptureFeed {
       : recording_(std::filesystem::absolute(recording), out_dir, std::move(board), options) {}
   FeedUpdate Poll(double) override {
     RecordingUpdate update = recording_.Poll();
-    FeedUpdate feed{{}, std::move(update.notes), update.closed};
+    FeedUpdate feed{{}, std::move(update.notes), update.closed, update.data_arrived};
     for (PairEntry& pair : update.pairs) {
       FolderEvent event;
       event.stem = pair.id;
@@ -36,6 +36,11 @@ class RecordingFeed final : public CaptureFeed {
   }
   std::optional<Dataset> Setup() const override { return recording_.Setup(); }
   std::filesystem::path DatasetFolder() const override { return recording_.OutDir(); }
+  bool SetBoard(const BoardSpec& board, const std::string& source) override {
+    recording_.SetBoard(board, source);
+    return true;
+  }
+  std::string BoardProblem() const override { return recording_.BoardProblem(); }
 
  private:
   GrowingRecording recording_;

@@ -21,6 +21,8 @@ struct FeedUpdate {
   std::vector<FolderEvent> events;  // complete pairs in capture order, incomplete stems, removals
   std::vector<std::string> notes;   // what the source chose or is waiting for, in words
   bool closed = false;              // nothing more will come (a recording closed by its recorder)
+  // Data came though no pair did (a recording's messages): the capture is alive, not idle.
+  bool data_arrived = false;
 };
 
 class CaptureFeed {
@@ -34,6 +36,11 @@ class CaptureFeed {
   // The folder that holds the pairs and the session (the watched folder, or where a recording's
   // pairs are written).
   virtual std::filesystem::path DatasetFolder() const = 0;
+  // A recording whose board no preset explains: the board, picked by the user; false when the
+  // source takes none (a folder's target.json says it).
+  virtual bool SetBoard(const BoardSpec& /*board*/, const std::string& /*source*/) { return false; }
+  // Why no pair can come though a board is visibly there; empty otherwise.
+  virtual std::string BoardProblem() const { return ""; }
 };
 
 // A folder in the folder form whose camera and target (`setup`) are known.

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/geometry/geometry.h"
+#include "core/io/ros_messages.h"
 #include "core/target/board_camera.h"
 
 namespace calibench {
@@ -104,6 +105,65 @@ CameraVerdict JudgeCameraSide(const ImageU8& image, std::size_t others,
     }
   verdict.cam_from_board = pose;
   return verdict;
+}
+
+ImageU8 DecodeTryMessageImage(const recording_detail::StampedBytes& image, const PairTopics& topics,
+                              const LoadLimits& limits) {
+  return topics.compressed_image ? DecodeCompressedImage(*image.bytes, topics.image, limits).image
+                                 : DecodeImage(*image.bytes, topics.image, limits).image;
+}
+
+TryOutcome JudgeTry(const recording_detail::Try& attempt, std::optional<ImageU8> decoded,
+                    const PairTopics& topics, const BoardSpec& board, const std::vector<Pose>& kept,
+                    const PairSelectionOptions& options, const std::string& source) {
+  TryOutcome outcome;
+  ImageU8 image;
+  try {
+    image = decoded ? std::move(*decoded)
+                    : DecodeTryMessageImage(attempt.image, topics, options.limits);
+  } catch (const std::invalid_argument&) {
+    outcome.dropped = "image unreadable";
+    return outcome;
+  }
+  if (attempt.camera.width != image.width || attempt.camera.height != image.height)
+    throw IoError(source + ": the images on " + topics.image_topic + " are " +
+                  std::to_string(image.width) + " x " + std::to_string(image.height) +
+                  " but the camera intrinsics are for " + std::to_string(attempt.camera.width) +
+                  " x " + std::to_string(attempt.camera.height));
+  const CameraVerdict verdict = JudgeCameraSide(
+      image, attempt.others.size(),
+      [&](std::size_t i) -> std::optional<ImageU8> {
+        try {
+          return DecodeTryMessageImage(attempt.others[i], topics, options.limits);
+        } catch (const std::invalid_argument&) {
+          return std::nullopt;
+        }
+      },
+      attempt.camera, board, kept, options);
+  outcome.searched = verdict.searched;
+  outcome.found = verdict.found;
+  if (!verdict.cam_from_board) {
+    outcome.dropped = verdict.dropped;
+    return outcome;
+  }
+  FoundPair pair;
+  try {
+    pair.cloud = DecodePointCloud2(*attempt.cloud.bytes, topics.cloud, options.limits).cloud;
+  } catch (const std::invalid_argument&) {
+    outcome.dropped = "cloud message unreadable";
+    return outcome;
+  }
+  if (pair.cloud.size() == 0) {
+    outcome.dropped = "cloud has no finite point";
+    return outcome;
+  }
+  pair.cloud_stamp_ns = attempt.cloud.stamp_ns;
+  pair.image_stamp_ns = attempt.image.stamp_ns;
+  pair.image = std::move(image);
+  pair.cam_from_board = *verdict.cam_from_board;
+  pair.stillness_checked = verdict.stillness_checked;
+  outcome.pair = std::move(pair);
+  return outcome;
 }
 
 }  // namespace calibench

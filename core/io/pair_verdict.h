@@ -12,6 +12,7 @@
 #include "core/base/types.h"
 #include "core/camera/camera.h"
 #include "core/io/recording_pairs.h"
+#include "core/io/recording_try.h"
 #include "core/target/board.h"
 
 namespace calibench {
@@ -33,5 +34,22 @@ CameraVerdict JudgeCameraSide(const ImageU8& image, std::size_t others,
                               const std::function<std::optional<ImageU8>(std::size_t)>& other_image,
                               const CameraModel& camera, const BoardSpec& board,
                               const std::vector<Pose>& kept, const PairSelectionOptions& options);
+
+// The image of a try's message (Image or CompressedImage, as `topics` says); throws
+// std::invalid_argument when it cannot be decoded.
+ImageU8 DecodeTryMessageImage(const recording_detail::StampedBytes& image, const PairTopics& topics,
+                              const LoadLimits& limits);
+
+// One try searched with the board known: the camera's verdict, then the sweep decoded.
+struct TryOutcome {
+  std::optional<FoundPair> pair;  // set when the try gives a pair
+  std::string dropped;            // why not, otherwise
+  bool searched = false, found = false;
+};
+// `decoded`: the try's image when already decoded. Throws IoError naming `source` when the
+// images contradict the intrinsics (another size).
+TryOutcome JudgeTry(const recording_detail::Try& attempt, std::optional<ImageU8> decoded,
+                    const PairTopics& topics, const BoardSpec& board, const std::vector<Pose>& kept,
+                    const PairSelectionOptions& options, const std::string& source);
 
 }  // namespace calibench

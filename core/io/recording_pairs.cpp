@@ -10,18 +10,18 @@
 #include <thread>
 
 #include "core/io/pair_verdict.h"
+#include "core/io/recording_board.h"
 #include "core/io/ros_messages.h"
-#include "core/target/board_choice.h"
 
 namespace calibench {
 
 namespace {
 
-using Bytes = std::shared_ptr<const std::vector<std::uint8_t>>;
-
-Bytes Copy(std::span<const std::uint8_t> data) {
-  return std::make_shared<const std::vector<std::uint8_t>>(data.begin(), data.end());
-}
+using recording_detail::BoardDecision;
+using recording_detail::Copy;
+using recording_detail::HeldTry;
+using recording_detail::StampedBytes;
+using recording_detail::Try;
 
 std::int64_t Ns(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e9)); }
 
@@ -41,23 +41,7 @@ constexpr std::size_t kMaxWaitingForCamera = 8;
 // Tries queued for the second thread (each holds its window's images: ~20 MB at 720p); the
 // reader waits beyond that, so memory stays bounded whatever the recording's length.
 constexpr std::size_t kMaxQueuedTries = 2;
-// Tries kept while the board is chosen; with no preset in any of them they are dropped.
-constexpr std::size_t kMaxBoardSamples = 12;
 constexpr const char* kHoldDone = "not needed: its hold already gave a pair";
-
-struct StampedBytes {
-  std::int64_t stamp_ns = 0;
-  Bytes bytes;
-};
-
-// One sweep tried: what the second thread needs, copied out of the reader's window.
-struct Try {
-  int hold = 0;
-  StampedBytes cloud;
-  StampedBytes image;                // the nearest in time
-  std::vector<StampedBytes> others;  // the other images within the stillness window
-  CameraModel camera;
-};
 
 }  // namespace
 
@@ -328,10 +312,13 @@ struct RecordingPairFinder::Impl {
         worker_idle.notify_all();
         continue;
       }
-      // Finishing and nothing queued: the board is chosen from whatever samples came.
-      if (!board && !samples.empty() && !worker_error) {
+      // Finishing and nothing queued: the board is chosen from whatever tries came (or taken
+      // as given at the last moment).
+      if (!board && !worker_error) {
         lock.unlock();
-        Guard([&] { ChooseBoard(); });
+        Guard([&] {
+          if (!AdoptGivenBoard()) Decide(board_choice.Finish());
+        });
         lock.lock();
       }
       finished = true;
@@ -351,52 +338,49 @@ struct RecordingPairFinder::Impl {
   }
 
   ImageU8 DecodeTryImage(const StampedBytes& image) const {
-    return topics.compressed_image
-               ? DecodeCompressedImage(*image.bytes, topics.image, options.limits).image
-               : DecodeImage(*image.bytes, topics.image, options.limits).image;
+    return DecodeTryMessageImage(image, topics, options.limits);
   }
 
-  struct Sample {
-    Try attempt;
-    std::optional<ImageU8> image;
-  };
-
   void Process(Try attempt) {
+    if (!board) AdoptGivenBoard();
     if (board) {
       ProcessWithBoard(attempt, std::nullopt);
       return;
     }
-    Sample sample{std::move(attempt), std::nullopt};
+    HeldTry sample{std::move(attempt), std::nullopt};
     try {
       sample.image = DecodeTryImage(sample.attempt.image);
-      chooser.Add(*sample.image);
     } catch (const std::invalid_argument&) {
     }
-    samples.push_back(std::move(sample));
-    if (chooser.images_with_a_fit() >= options.board_sample_images ||
-        (samples.size() >= kMaxBoardSamples && chooser.images_with_a_fit() > 0)) {
-      ChooseBoard();
-    } else if (samples.size() >= kMaxBoardSamples && chooser.images_with_a_fit() == 0) {
-      // Nothing like a board yet (the user walking in): these tries cannot give a pair.
-      for (std::size_t i = 0; i < samples.size(); ++i) Drop("board not found in the image");
-      samples.clear();
-    }
+    Decide(board_choice.Offer(std::move(sample)));
+    std::lock_guard lock(mutex);
+    board_problem = board_choice.Problem();
   }
 
-  void ChooseBoard() {
-    const BoardChoice choice = chooser.Choose();
-    if (!choice.board)
-      throw IoError(source + ": no preset board explains the images (" + choice.explanation +
-                    "): give the board with --board NAME|FILE or --target target.json, or put a "
-                    "target.json beside the recording");
+  // A board given while following (SetBoard), taken at the next try; true when taken.
+  bool AdoptGivenBoard() {
+    std::optional<std::pair<BoardSpec, std::string>> given;
     {
       std::lock_guard lock(mutex);
-      board = choice.board;
-      stats.board_choice = choice.explanation;
+      given = std::exchange(given_board, std::nullopt);
     }
-    std::deque<Sample> held = std::move(samples);
-    samples.clear();
-    for (Sample& sample : held) ProcessWithBoard(sample.attempt, std::move(sample.image));
+    if (!given) return false;
+    Decide(board_choice.Give(given->first, given->second));
+    return true;
+  }
+
+  // What the board choice decided: the board once known, the held tries searched with it.
+  void Decide(BoardDecision decision) {
+    for (const std::string& reason : decision.dropped) Drop(reason);
+    if (!decision.board) return;
+    {
+      std::lock_guard lock(mutex);
+      board = decision.board;
+      stats.board_choice = decision.board_choice;
+      board_problem.clear();
+    }
+    for (HeldTry& sample : decision.release)
+      ProcessWithBoard(sample.attempt, std::move(sample.image));
   }
 
   void ProcessWithBoard(const Try& attempt, std::optional<ImageU8> decoded) {
@@ -404,60 +388,19 @@ struct RecordingPairFinder::Impl {
       Drop(kHoldDone);
       return;
     }
-    ImageU8 image;
-    try {
-      image = decoded ? std::move(*decoded) : DecodeTryImage(attempt.image);
-    } catch (const std::invalid_argument&) {
-      Drop("image unreadable");
-      return;
-    }
-    if (attempt.camera.width != image.width || attempt.camera.height != image.height)
-      throw IoError(source + ": the images on " + topics.image_topic + " are " +
-                    std::to_string(image.width) + " x " + std::to_string(image.height) +
-                    " but the camera intrinsics are for " + std::to_string(attempt.camera.width) +
-                    " x " + std::to_string(attempt.camera.height));
-    const CameraVerdict verdict = JudgeCameraSide(
-        image, attempt.others.size(),
-        [&](std::size_t i) -> std::optional<ImageU8> {
-          try {
-            return DecodeTryImage(attempt.others[i]);
-          } catch (const std::invalid_argument&) {
-            return std::nullopt;
-          }
-        },
-        attempt.camera, *board, kept_poses, options);
-    {
-      std::lock_guard lock(mutex);
-      stats.images_searched += verdict.searched;
-      stats.boards_found += verdict.found;
-    }
-    if (!verdict.cam_from_board) {
-      Drop(verdict.dropped);
-      return;
-    }
-    const Pose& pose = *verdict.cam_from_board;
-    const bool judged = verdict.stillness_checked;
-    FoundPair pair;
-    try {
-      pair.cloud = DecodePointCloud2(*attempt.cloud.bytes, topics.cloud, options.limits).cloud;
-    } catch (const std::invalid_argument&) {
-      Drop("cloud message unreadable");
-      return;
-    }
-    if (pair.cloud.size() == 0) {
-      Drop("cloud has no finite point");
-      return;
-    }
-    pair.cloud_stamp_ns = attempt.cloud.stamp_ns;
-    pair.image_stamp_ns = attempt.image.stamp_ns;
-    pair.image = std::move(image);
-    pair.cam_from_board = pose;
-    pair.stillness_checked = judged;
-    kept_poses.push_back(pose);
+    TryOutcome outcome =
+        JudgeTry(attempt, std::move(decoded), topics, *board, kept_poses, options, source);
     std::lock_guard lock(mutex);
+    stats.images_searched += outcome.searched;
+    stats.boards_found += outcome.found;
+    if (!outcome.pair) {
+      ++stats.dropped[outcome.dropped];
+      return;
+    }
+    kept_poses.push_back(outcome.pair->cam_from_board);
     if (attempt.hold > 0) satisfied_holds.insert(attempt.hold);
-    if (!judged) ++stats.kept_without_stillness_check;
-    found.push_back(std::move(pair));
+    if (!outcome.pair->stillness_checked) ++stats.kept_without_stillness_check;
+    found.push_back(std::move(*outcome.pair));
   }
 
   // ---- state ---------------------------------------------------------------------------------
@@ -484,8 +427,8 @@ struct RecordingPairFinder::Impl {
   std::deque<Try> waiting_for_camera;
 
   // Worker.
-  BoardChooser chooser;
-  std::deque<Sample> samples;
+  recording_detail::RecordingBoardChoice board_choice{source, options.board_sample_images,
+                                                      options.stop_on_unknown_board};
   std::vector<Pose> kept_poses;
 
   // Shared, under `mutex`.
@@ -498,6 +441,8 @@ struct RecordingPairFinder::Impl {
   std::set<int> satisfied_holds;  // holds that gave a pair
   std::uint64_t tries_queued = 0, tries_done = 0;
   PairFinderStats stats;
+  std::string board_problem;  // the board choice's Problem(), for the reader
+  std::optional<std::pair<BoardSpec, std::string>> given_board;  // SetBoard's, until taken
   std::thread worker;  // last: started once everything above exists
 };
 
@@ -536,6 +481,16 @@ std::optional<CameraModel> RecordingPairFinder::Camera() const { return impl_->c
 std::optional<BoardSpec> RecordingPairFinder::Board() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->board;
+}
+
+std::string RecordingPairFinder::BoardProblem() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->board ? "" : impl_->board_problem;
+}
+
+void RecordingPairFinder::SetBoard(const BoardSpec& board, const std::string& source) {
+  std::lock_guard lock(impl_->mutex);
+  if (!impl_->board) impl_->given_board = std::make_pair(board, source);
 }
 
 }  // namespace calibench

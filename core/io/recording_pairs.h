@@ -47,6 +47,10 @@ struct PairSelectionOptions {
   double lidar_blind_s = 3.0;
   // Without a board given: the presets are tried on the tries' images until this many show one.
   int board_sample_images = 3;
+  // A board that no preset is (one found only inside a larger print) ends the reading at once
+  // with the reason (import); false: the recording is followed on, the reason in BoardProblem,
+  // until SetBoard gives the board (watch).
+  bool stop_on_unknown_board = true;
   LoadLimits limits;
 
   bool Check(std::string* why) const;
@@ -104,6 +108,12 @@ class RecordingPairFinder {
   PairFinderStats Stats() const;
   std::optional<CameraModel> Camera() const;
   std::optional<BoardSpec> Board() const;
+  // Why no board is known though one is visibly there ("...: no preset board explains the
+  // images (...)"); empty otherwise. Only with stop_on_unknown_board false.
+  std::string BoardProblem() const;
+  // The board, given while following (`source` says by what): the held tries and every later one
+  // are searched with it. Ignored once a board is known.
+  void SetBoard(const BoardSpec& board, const std::string& source);
 
  private:
   struct Impl;

@@ -55,6 +55,7 @@ RecordingUpdate GrowingRecording::Poll() {
     }
   }
   const bool closed = reader_->FollowNewMessages([&](const BagMessage& message) {
+    update.data_arrived = true;
     if (finder_) {
       Route(message.topic, message.log_time_ns, message.data);
     } else {
@@ -65,6 +66,7 @@ RecordingUpdate GrowingRecording::Poll() {
     return true;
   });
   if (!finder_) ChooseTopicsWhenPresent(closed, &update);
+  if (finder_) WatchForTheBoard(&update);
   if (finder_ && closed) {
     finder_->Finish();
     finished_ = true;
@@ -91,14 +93,53 @@ void GrowingRecording::ChooseTopicsWhenPresent(bool closed, RecordingUpdate* upd
   image_topic_ = reader_->FindTopic(options_.image_topic);
   info_topic_ = options_.camera ? -1 : reader_->FindTopic(options_.camera_info_topic);
   board_ = RecordingBoard(recording_, board_, &board_source_);
-  finder_ = std::make_unique<RecordingPairFinder>(
-      recording_.string(), ChosenPairTopics(*reader_, options_), board_, options_.camera, options_);
+  // Followed, a board no preset explains is said and waited for (a target file put beside the
+  // recording, the workbench's pick), not the end of the watch.
+  PairSelectionOptions selection = options_;
+  selection.stop_on_unknown_board = false;
+  finder_ = std::make_unique<RecordingPairFinder>(recording_.string(),
+                                                  ChosenPairTopics(*reader_, options_), board_,
+                                                  options_.camera, selection);
+  if (given_board_) finder_->SetBoard(given_board_->first, given_board_->second);
   update->notes.push_back("topics: clouds " + options_.cloud_topic + ", images " +
                           options_.image_topic + ", camera " +
                           (options_.camera ? "from --camera" : options_.camera_info_topic) +
                           (board_source_.empty() ? "" : "; board from " + board_source_));
   for (const Pending& message : pending_) Route(message.topic, message.log_time_ns, message.data);
   pending_.clear();
+}
+
+void GrowingRecording::SetBoard(const BoardSpec& board, const std::string& source) {
+  if (finder_)
+    finder_->SetBoard(board, source);
+  else
+    given_board_ = std::make_pair(board, source);
+}
+
+std::string GrowingRecording::BoardProblem() const {
+  return finder_ ? finder_->BoardProblem() : "";
+}
+
+// While no board is known though one is visibly there: said once, live, as soon as the presets
+// rule themselves out; a target file put beside the recording meanwhile is taken.
+void GrowingRecording::WatchForTheBoard(RecordingUpdate* update) {
+  const std::string problem = finder_->BoardProblem();
+  if (problem.empty()) return;
+  if (problem != said_board_problem_) {
+    update->notes.push_back("board: " + problem +
+                            "; still following: the pairs come once the board is given");
+    said_board_problem_ = problem;
+  }
+  if (const std::optional<fs::path> file = TargetBesideRecording(recording_)) {
+    try {
+      finder_->SetBoard(LoadTargetFile(*file), file->string() + " (beside the recording)");
+      update->notes.push_back("board: from " + file->string());
+    } catch (const IoError& error) {
+      if (said_target_error_ != error.what())
+        update->notes.push_back(std::string("board: ") + error.what());
+      said_target_error_ = error.what();
+    }
+  }
 }
 
 void GrowingRecording::Route(int topic, std::int64_t log_time_ns,

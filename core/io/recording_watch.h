@@ -25,6 +25,7 @@ struct RecordingUpdate {
   std::vector<PairEntry> pairs;    // new, in the order found
   std::vector<std::string> notes;  // what was chosen or is awaited, in words
   bool closed = false;             // the recorder closed the file and every pair of it is out
+  bool data_arrived = false;       // messages came since the last look: the recording is alive
 };
 
 class GrowingRecording {
@@ -39,6 +40,12 @@ class GrowingRecording {
   // damaged data, ambiguous topics (the flag to pass), a board no preset explains.
   RecordingUpdate Poll();
 
+  // The board, given while following (the workbench's pick; `source` says which): the pairs held
+  // for want of one are searched with it. Ignored once a board is known.
+  void SetBoard(const BoardSpec& board, const std::string& source);
+  // Why no pair can come yet though a board is there (no preset explains it); empty otherwise.
+  std::string BoardProblem() const;
+
   // The camera and the board, once the first pair is out (nullopt before); the dataset folder.
   std::optional<Dataset> Setup() const;
   const std::filesystem::path& OutDir() const { return out_dir_; }
@@ -48,6 +55,7 @@ class GrowingRecording {
   void ChooseTopicsWhenPresent(bool closed, RecordingUpdate* update);
   void Route(int topic, std::int64_t log_time_ns, std::span<const std::uint8_t> data);
   void WritePairs(RecordingUpdate* update);
+  void WatchForTheBoard(RecordingUpdate* update);
 
   std::filesystem::path recording_, out_dir_;
   std::optional<BoardSpec> board_;
@@ -59,6 +67,9 @@ class GrowingRecording {
   std::vector<Pending> pending_;  // messages read before the topics were chosen
   Dataset dataset_;               // the pairs written so far
   bool said_waiting_ = false, finished_ = false;
+  std::string said_board_problem_;  // the board problem last said (said once)
+  std::string said_target_error_;   // a broken target file beside it, said once
+  std::optional<std::pair<BoardSpec, std::string>> given_board_;  // before the finder exists
 };
 
 }  // namespace calibench

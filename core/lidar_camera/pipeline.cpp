@@ -103,9 +103,9 @@ CameraFeatures ExtractCameraFeatures(const Dataset& dataset, const ImageU8& imag
 
 std::vector<int> SelectBoardRegion(const LidarCloud& cloud, const BoardHint& hint,
                                    std::string* why) {
-  if (hint.brush_pixels && !hint.brush_pixels->empty()) {
+  if (!hint.brush_pixels.empty()) {
     CALIBENCH_CHECK(hint.image != nullptr);
-    return SelectBrushRegion(*hint.image, *hint.brush_pixels);
+    return SelectBrushRegion(*hint.image, hint.brush_pixels);
   }
   if (hint.seed) return SelectSeedRegion(cloud, *hint.seed);
   *why = "no board region: brush the board in the workbench or add lidar_seed to the manifest";
@@ -117,7 +117,7 @@ namespace {
 // The region of the hint (brush, else seed) or, without one, of the detected board.
 std::vector<int> RegionFor(const Dataset& dataset, const LidarCloud& cloud, const BoardHint& hint,
                            const PipelineOptions& options, std::string* why, BoardOrigin* origin) {
-  const bool brushed = hint.brush_pixels && !hint.brush_pixels->empty();
+  const bool brushed = !hint.brush_pixels.empty();
   if (brushed || hint.seed || !options.detect_board || !hint.detect) {
     *origin = {brushed                 ? BoardSource::kBrush
                : hint.seed_from_camera ? BoardSource::kCameraGuided
@@ -183,14 +183,18 @@ void SetStatusFromFeatures(PairFeatures* features, const std::string& lidar_fail
 
 std::optional<BoardHint> BoardHintFor(const PairEntry& pair, const PairEdit& edit,
                                       const LidarImage* image, std::string* why) {
-  if (!edit.brush_pixels) return BoardHint{.seed = pair.lidar_seed};
+  if (!edit.brush_pixels) {
+    BoardHint hint;
+    hint.seed = pair.lidar_seed;
+    return hint;
+  }
   if (image->rows != edit.brush_rows || image->columns != edit.brush_columns) {
     *why = "the brush was painted on a " + std::to_string(edit.brush_rows) + "x" +
            std::to_string(edit.brush_columns) + " LiDAR image but " + pair.cloud.string() +
            " gives " + std::to_string(image->rows) + "x" + std::to_string(image->columns);
     return std::nullopt;
   }
-  BoardHint hint{&*edit.brush_pixels, image, std::nullopt};
+  BoardHint hint{*edit.brush_pixels, image, std::nullopt};
   hint.detect = false;  // the user's brush, even an erased one, is the word
   return hint;
 }

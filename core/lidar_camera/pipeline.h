@@ -132,8 +132,10 @@ CameraFeatures ExtractCameraFeatures(const Dataset& dataset, const ImageU8& imag
 // without a brush the seed's cone of rays is used (SelectSeedRegion). The one place that decides
 // which LiDAR points a plane is fitted to, for the CLI and the workbench alike.
 struct BoardHint {
-  const std::vector<int>* brush_pixels = nullptr;  // null or empty: no brush
-  const LidarImage* image = nullptr;               // the image the brush was painted on
+  // Owned, not pointed to: a hint built from a PairEdit returned by value (the job's EditOf)
+  // must not outlive the edit's pixels (issue 51's use-after-free). Empty: no brush.
+  std::vector<int> brush_pixels;
+  const LidarImage* image = nullptr;  // the image the brush was painted on
   std::optional<LidarSeed> seed;
   bool seed_from_camera = false;  // the seed is the camera's prediction
   bool detect = true;  // without brush or seed: detect the board (false: the user erased it)

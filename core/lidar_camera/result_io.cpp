@@ -170,6 +170,7 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
                     {"converged", s.converged},
                     {"termination", TerminationToJson(s.termination)},
                     {"cost_history", s.cost_history},
+                    {"cost_comparable_from", s.cost_comparable_from},
                     {"huber_delta", options.huber_delta},
                     {"board_edge_points", s.num_edge_residuals},
                     // What the data said about the noise models: 1 = they held.
@@ -400,12 +401,21 @@ void PrintModelFigures(const SolverResult& s, std::ostringstream& out) {
                   s.unmodelled_range_offset->sigma_m * 1e3);
     out << line;
   }
-  if (s.covariance_inflation > 1.0) {
+  // Which widening happened, in words whose numbers say it: the jackknife's covariance replaces
+  // the model's when the pairs scatter more than their noise says; the sandwich only scales it.
+  if (s.jackknife_widened) {
+    out << "covariance from the pairs' leave-one-out spread (widened for the few pairs): they "
+           "scatter more than the noise models say";
+    if (s.covariance_inflation >= 1.005) {
+      std::snprintf(line, sizeof(line), ", up to %.2fx their variance", s.covariance_inflation);
+      out << line;
+    }
+    out << "\n";
+  } else if (s.covariance_inflation >= 1.005) {
     std::snprintf(line, sizeof(line),
-                  "covariance widened up to %.1fx (variance) by the spread over the pairs%s: the "
+                  "covariance widened up to %.2fx (variance) by the spread over the pairs: the "
                   "noise models underestimate this data\n",
-                  s.covariance_inflation,
-                  s.jackknife_widened ? " (leave-one-out, widened for the few pairs)" : "");
+                  s.covariance_inflation);
     out << line;
   }
 }
@@ -443,7 +453,7 @@ void PrintIntrinsics(const CalibrationOutcome& outcome, std::ostringstream& out)
   }
   if (!s.intrinsics_covariance.isZero(0.0)) {
     const Vec3 t = s.intrinsics_covariance.diagonal().head<3>().cwiseSqrt() * 1e3;
-    const Vec3 r = s.intrinsics_covariance.diagonal().tail<3>().cwiseSqrt() * 180.0 / M_PI;
+    const Vec3 r = s.intrinsics_covariance.diagonal().tail<3>().cwiseSqrt() * kRadToDeg;
     std::snprintf(line, sizeof(line),
                   "the intrinsics' covariance is in the std above: alone it gives translation "
                   "[mm] %.2f %.2f %.2f, rotation [deg] %.3f %.3f %.3f (more pairs do not shrink "
@@ -456,8 +466,16 @@ void PrintIntrinsics(const CalibrationOutcome& outcome, std::ostringstream& out)
 // Iterations, convergence and the observability verdict.
 void PrintConvergence(const SolverResult& s, std::ostringstream& out) {
   char line[256];
-  std::snprintf(line, sizeof(line), "; cost %.3e -> %.3e\n", s.cost_history.front(),
-                s.cost_history.back());
+  // Costs compare only under the same weights: from the last re-weighting (outliers gated,
+  // variance factors re-estimated) on.
+  const int from = s.cost_comparable_from;
+  if (from == 0)
+    std::snprintf(line, sizeof(line), "; cost %.3e -> %.3e\n", s.cost_history.front(),
+                  s.cost_history.back());
+  else
+    std::snprintf(line, sizeof(line),
+                  "; cost %.3e -> %.3e from iteration %d, when the pairs were last re-weighted\n",
+                  s.cost_history[from], s.cost_history.back(), from);
   out << "solver: " << s.iterations << " iterations, " << s.termination.Describe() << line;
   if (s.observability.well_constrained) {
     out << "observability: well constrained\n";

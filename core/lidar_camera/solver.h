@@ -149,7 +149,10 @@ struct SolverResult {
   bool converged = false;          // termination.Converged()
   Termination termination;         // which test ended the solve
   int iterations = 0;
-  std::vector<double> cost_history;    // one entry per iteration, the initial cost first
+  std::vector<double> cost_history;  // one entry per iteration, the initial cost first
+  // The first entry of cost_history comparable with the last: the iteration the weights last
+  // changed at (IterationReport::reweighted), 0 when they never did.
+  int cost_comparable_from = 0;
   std::vector<Vec4> residuals;         // per pair, Eq. (6) at the solution
   std::vector<double> robust_weights;  // per pair, Huber IRLS weight at the solution (0 = gated)
   double negligible_weight = SolverOptions{}.negligible_weight;  // the options' threshold

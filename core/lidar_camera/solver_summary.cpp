@@ -208,7 +208,10 @@ SolverResult PlaneAlignmentSolver::Summarize() const {
   result.termination = termination_;
   result.converged = termination_.Converged();
   result.iterations = static_cast<int>(history_.size()) - 1;
-  for (const IterationReport& it : history_) result.cost_history.push_back(it.cost);
+  for (const IterationReport& it : history_) {
+    if (it.reweighted) result.cost_comparable_from = static_cast<int>(result.cost_history.size());
+    result.cost_history.push_back(it.cost);
+  }
   for (const PlanePair& pair : pairs_)
     result.residuals.push_back(PlaneAlignmentResidual(
         cam_from_lidar_, CorrectedLidarPlane(pair, range_offset_m_), pair.camera_plane, nullptr));

@@ -30,7 +30,7 @@ RigSimTruth SimulateRigFolder(const RigSimOptions& options, const std::filesyste
   // Camera 1: camera 0's mount turned about the LiDAR's z axis and moved 20 cm to the left.
   Pose lidar_from_cam1 = resolved[0].cam_from_lidar.inverse();
   lidar_from_cam1.linear() =
-      Eigen::AngleAxisd(options.second_camera_yaw_deg * M_PI / 180.0, Vec3::UnitZ())
+      Eigen::AngleAxisd(options.second_camera_yaw_deg * kDegToRad, Vec3::UnitZ())
           .toRotationMatrix() *
       lidar_from_cam1.linear();
   lidar_from_cam1.translation() += Vec3(0.0, 0.20, 0.0);

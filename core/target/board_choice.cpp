@@ -27,14 +27,16 @@ BoardChooser::BoardChooser() {
 
 void BoardChooser::Add(const ImageU8& image) {
   ++images_;
-  bool fit_any = false;
+  bool fit_any = false, board_any = false;
   for (Tally& tally : tallies_) {
     const BoardFit fit = FitBoard(image, tally.board);
     tally.fits += fit == BoardFit::kFits;
     tally.part_of_larger += fit == BoardFit::kPartOfLarger;
     fit_any = fit_any || fit == BoardFit::kFits;
+    board_any = board_any || fit == BoardFit::kFits || fit == BoardFit::kPartOfLarger;
   }
   images_with_a_fit_ += fit_any;
+  images_with_a_board_ += board_any;
 }
 
 BoardChoice BoardChooser::Choose() const {

@@ -32,6 +32,8 @@ class BoardChooser {
   void Add(const ImageU8& image);
   int images() const { return images_; }
   int images_with_a_fit() const { return images_with_a_fit_; }
+  // Images where some preset was found, fitting or as part of a larger print: a board is there.
+  int images_with_a_board() const { return images_with_a_board_; }
   BoardChoice Choose() const;
 
  private:
@@ -43,6 +45,7 @@ class BoardChooser {
   std::vector<Tally> tallies_;
   int images_ = 0;
   int images_with_a_fit_ = 0;
+  int images_with_a_board_ = 0;
 };
 
 }  // namespace calibench

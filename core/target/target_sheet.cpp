@@ -36,12 +36,17 @@ std::string Upper(std::string s) {
   return s;
 }
 
-// The pattern's largest square size (mm) that fits a page of `sheet` mm with these options.
+// The pattern's largest square size (mm) that fits the printable area of a page of `sheet` mm.
 double LargestSquareMm(const BoardSpec& board, const Vec2& sheet, const TargetSheetOptions& o) {
   const double width = sheet.x() - 2.0 * o.margin_mm;
-  const double height = sheet.y() - 2.0 * (o.margin_mm + o.band_mm);
+  const double height = sheet.y() - 2.0 * o.margin_mm;
   return std::min(width / board.SquaresX(), height / board.SquaresY());
 }
+
+// The ruler needs its 100 mm and a few for the "10 cm" label along the strip it lies in.
+constexpr double kRulerRunMm = 112.0;
+// The short caption, where no ruler fits, needs a line of 2.4 mm text.
+constexpr double kCaptionLineMm = 3.5;
 
 std::string PatternWords(const BoardSpec& board) {
   char text[256];
@@ -70,10 +75,23 @@ void DrawText(cairo_t* cr, const std::string& text, double x, double baseline, d
   cairo_show_text(cr, text.c_str());
 }
 
+// Text centred on `anchor`'s baseline, upright or reading up the page.
+void DrawAnchoredText(cairo_t* cr, const std::string& text, const Vec2& anchor, bool vertical,
+                      double size_mm) {
+  cairo_save(cr);
+  cairo_translate(cr, anchor.x(), anchor.y());
+  if (vertical) cairo_rotate(cr, -90.0 * kDegToRad);
+  DrawText(cr, text, 0.0, 0.0, size_mm, true);
+  cairo_restore(cr);
+}
+
 // The 100 mm ruler: a baseline with a tick every millimetre below it (longer every 5 and 10 mm)
-// and the centimetres numbered.
+// and the centimetres numbered; drawn in its own frame (turned up the page when vertical).
 void DrawRuler(cairo_t* cr, const TargetSheet& sheet) {
-  const Vec2 o = sheet.ruler_start_mm;
+  cairo_save(cr);
+  cairo_translate(cr, sheet.ruler_start_mm.x(), sheet.ruler_start_mm.y());
+  if (sheet.ruler_vertical) cairo_rotate(cr, -90.0 * kDegToRad);  // along: up; ticks: to the right
+  const Vec2 o = Vec2::Zero();
   cairo_set_line_width(cr, 0.2);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
   cairo_move_to(cr, o.x(), o.y());
@@ -92,6 +110,7 @@ void DrawRuler(cairo_t* cr, const TargetSheet& sheet) {
              o.x() + cm * 10.0 - (cm * 10 == ticks ? 1.0 : 0.0),
              o.y() + 2.0 * sheet.ruler_tick_mm + 2.6, 2.2, cm * 10 != ticks);
   }
+  cairo_restore(cr);
 }
 
 void DrawSheet(cairo_t* cr, const TargetSheet& sheet) {
@@ -108,9 +127,11 @@ void DrawSheet(cairo_t* cr, const TargetSheet& sheet) {
   cairo_set_fill_rule(cr, CAIRO_FILL_RULE_WINDING);
   cairo_fill(cr);
   cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-  DrawText(cr, sheet.title, centre.x(), sheet.title_baseline_mm, 2.8, true);
-  DrawRuler(cr, sheet);
-  DrawText(cr, sheet.caption, centre.x(), sheet.caption_baseline_mm, 2.4, true);
+  if (sheet.draw_title)
+    DrawAnchoredText(cr, sheet.title, sheet.title_anchor_mm, sheet.title_vertical, 2.8);
+  if (sheet.has_ruler) DrawRuler(cr, sheet);
+  if (sheet.draw_caption)
+    DrawAnchoredText(cr, sheet.caption, sheet.caption_anchor_mm, sheet.caption_vertical, 2.4);
 }
 
 }  // namespace
@@ -161,6 +182,85 @@ bool TargetSheetOptions::Check(std::string* why) const {
   return true;
 }
 
+namespace {
+
+// Where the ruler, the caption and the title go around a pattern centred on the sheet: below and
+// above it when that band has room, else right and left of it (reading up the page), else no
+// ruler (the caption, where a line fits, says to measure a square instead).
+void PlaceAnnotations(const TargetSheetOptions& options, TargetSheet* sheet) {
+  const Vec2 page = sheet->sheet_mm;
+  const BoardSpec& board = sheet->board;
+  const double m = options.margin_mm;
+  const double above_below = 0.5 * (page.y() - 1000.0 * board.PatternHeight()) - m;
+  const double beside = 0.5 * (page.x() - 1000.0 * board.PatternWidth()) - m;
+  const std::string square = Mm(board.square_size);
+  sheet->caption = "square " + square +
+                   " - measure the ruler after printing: it must read 100 mm; print at 100 %, no "
+                   "fit-to-page";
+  if (above_below >= options.band_mm && page.x() - 2.0 * m >= kRulerRunMm) {
+    // The ruler and caption at the bottom of the band, as far from the pattern as the margin
+    // lets them: the detector likes a quiet white border around the squares.
+    sheet->caption_anchor_mm = Vec2(0.5 * page.x(), page.y() - m - 0.8);
+    sheet->title_anchor_mm = Vec2(0.5 * page.x(), m + 3.0);
+    sheet->ruler_start_mm =
+        Vec2(0.5 * (page.x() - sheet->ruler_length_mm), sheet->caption_anchor_mm.y() - 9.6);
+    return;
+  }
+  if (beside >= options.band_mm && page.y() - 2.0 * m >= kRulerRunMm) {
+    // The same band turned a quarter: x' = up the page, y' = to the right; the caption at the
+    // right margin, the ruler inside it, the title in the left margin.
+    sheet->ruler_vertical = sheet->caption_vertical = sheet->title_vertical = true;
+    sheet->caption_anchor_mm = Vec2(page.x() - m - 0.8, 0.5 * page.y());
+    sheet->ruler_start_mm =
+        Vec2(sheet->caption_anchor_mm.x() - 9.6, 0.5 * (page.y() + sheet->ruler_length_mm));
+    sheet->title_anchor_mm = Vec2(m + 3.0, 0.5 * page.y());
+    return;
+  }
+  // No strip beside the pattern holds the ruler: the squares themselves are the scale.
+  sheet->has_ruler = false;
+  sheet->note = "no room for the 100 mm ruler beside this pattern on " +
+                Upper(PaperName(sheet->paper)) + ": check the print by measuring a square, it " +
+                "must be " + square + " (print at 100 %, no fit-to-page)";
+  sheet->caption = "square " + square + " - measure a square after printing; print at 100 %";
+  const double gap = std::max(above_below, beside);
+  if (gap < kCaptionLineMm) {
+    sheet->draw_caption = sheet->draw_title = false;
+    return;
+  }
+  const bool vertical = beside > above_below;
+  sheet->caption_vertical = sheet->title_vertical = vertical;
+  sheet->caption_anchor_mm = vertical ? Vec2(page.x() - m - 0.8, 0.5 * page.y())
+                                      : Vec2(0.5 * page.x(), page.y() - m - 0.8);
+  sheet->title_anchor_mm = vertical ? Vec2(m + 3.0, 0.5 * page.y()) : Vec2(0.5 * page.x(), m + 3.0);
+  sheet->draw_title = gap >= 4.0;  // the title's 2.8 mm letters need a little more
+}
+
+// Whether the pattern, centred on `page`, leaves a strip beside it for the ruler.
+bool RulerFits(const BoardSpec& board, const Vec2& page, const TargetSheetOptions& o) {
+  const double above_below = 0.5 * (page.y() - 1000.0 * board.PatternHeight()) - o.margin_mm;
+  const double beside = 0.5 * (page.x() - 1000.0 * board.PatternWidth()) - o.margin_mm;
+  return (above_below >= o.band_mm && page.x() - 2.0 * o.margin_mm >= kRulerRunMm) ||
+         (beside >= o.band_mm && page.y() - 2.0 * o.margin_mm >= kRulerRunMm);
+}
+
+}  // namespace
+
+double LargestSquareThatFitsMm(const BoardSpec& board, const TargetSheetOptions& options) {
+  const Vec2 portrait = PaperSizeMm(options.paper);
+  const Vec2 landscape(portrait.y(), portrait.x());
+  const double fits_portrait = LargestSquareMm(board, portrait, options);
+  const double fits_landscape = LargestSquareMm(board, landscape, options);
+  switch (options.orientation) {
+    case SheetOrientation::kPortrait:
+      return fits_portrait;
+    case SheetOrientation::kLandscape:
+      return fits_landscape;
+    case SheetOrientation::kAuto:
+      break;
+  }
+  return std::max(fits_portrait, fits_landscape);
+}
+
 TargetSheet LayoutTargetSheet(const BoardSpec& pattern, const TargetSheetOptions& options) {
   std::string why;
   if (!options.Check(&why)) throw std::invalid_argument(why);
@@ -172,9 +272,20 @@ TargetSheet LayoutTargetSheet(const BoardSpec& pattern, const TargetSheetOptions
   const double square_mm = 1000.0 * board.square_size;
   const double fits_portrait = LargestSquareMm(board, portrait, options);
   const double fits_landscape = LargestSquareMm(board, landscape, options);
-  bool use_landscape =
-      options.orientation == SheetOrientation::kLandscape ||
-      (options.orientation == SheetOrientation::kAuto && fits_landscape > fits_portrait);
+  bool use_landscape = options.orientation == SheetOrientation::kLandscape;
+  if (options.orientation == SheetOrientation::kAuto) {
+    // Where the pattern fits both ways, the way that keeps a ruler beside it; else the better fit.
+    const bool in_portrait = square_mm <= fits_portrait + 1e-9;
+    const bool in_landscape = square_mm <= fits_landscape + 1e-9;
+    if (in_portrait && in_landscape) {
+      const bool ruler_portrait = RulerFits(board, portrait, options);
+      const bool ruler_landscape = RulerFits(board, landscape, options);
+      use_landscape =
+          ruler_portrait != ruler_landscape ? ruler_landscape : fits_landscape > fits_portrait;
+    } else {
+      use_landscape = fits_landscape > fits_portrait;
+    }
+  }
   const double fits = use_landscape ? fits_landscape : fits_portrait;
   const std::string paper = Upper(PaperName(options.paper));
   if (square_mm > fits + 1e-9) {
@@ -183,10 +294,10 @@ TargetSheet LayoutTargetSheet(const BoardSpec& pattern, const TargetSheetOptions
                                   : paper + (use_landscape ? " landscape" : " portrait");
     char text[256];
     std::snprintf(text, sizeof(text),
-                  "a %s with %.1f mm squares does not fit %s (%.0f mm margins, %.0f mm above and "
-                  "below for the ruler and caption): the largest square that fits %s is %.1f mm",
+                  "a %s with %.1f mm squares does not fit %s (%.0f mm margins): the largest "
+                  "square that fits %s is %.1f mm",
                   board.type == BoardType::kCheckerboard ? "checkerboard" : "ChArUco board",
-                  square_mm, where.c_str(), options.margin_mm, options.band_mm, where.c_str(),
+                  square_mm, where.c_str(), options.margin_mm, where.c_str(),
                   std::floor(fits * 10.0) / 10.0);
     throw std::invalid_argument(text);
   }
@@ -199,19 +310,9 @@ TargetSheet LayoutTargetSheet(const BoardSpec& pattern, const TargetSheetOptions
   sheet.board = board;
   sheet.pattern_top_left_mm =
       0.5 * sheet.sheet_mm - 500.0 * Vec2(board.PatternWidth(), board.PatternHeight());
-  if (sheet.sheet_mm.x() - 2.0 * options.margin_mm < sheet.ruler_length_mm + 12.0)
-    throw std::invalid_argument("the paper is too narrow for the 100 mm ruler");
-  // The ruler and caption sit at the bottom of the band, as far from the pattern as the margin
-  // lets them: the detector likes a quiet white border around the squares.
-  sheet.caption_baseline_mm = sheet.sheet_mm.y() - options.margin_mm - 0.8;
-  sheet.title_baseline_mm = options.margin_mm + 3.0;
-  sheet.ruler_start_mm =
-      Vec2(0.5 * (sheet.sheet_mm.x() - sheet.ruler_length_mm), sheet.caption_baseline_mm - 9.6);
   sheet.title = "Calibench target: " + PatternWords(board) + ", square " + Mm(board.square_size) +
                 ", " + paper + (use_landscape ? " landscape" : " portrait");
-  sheet.caption = "square " + Mm(board.square_size) +
-                  " - measure the ruler after printing: it must read 100 mm; print at 100 %, no "
-                  "fit-to-page";
+  PlaceAnnotations(options, &sheet);
   return sheet;
 }
 

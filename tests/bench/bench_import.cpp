@@ -4,13 +4,20 @@
 // ROS 2 MCAP (lz4) and a ROS 1 bag (lz4), then imported.
 //   BM_ImportSimRecording/N/format  the import as a whole; counters: the recording's length, the
 //                                   import's wall and CPU time, their ratio, pairs, searches
+//   BM_ImportPeakMemory/N/format    `calibench import` as a user runs it, in a process of its
+//                                   own: its peak resident memory (wait4's ru_maxrss); 9 poses
+//                                   make a 3.6 GB MCAP, the size of the real recording issue 51
+//                                   measured
 // And what import pays per message, to see where the time goes:
 //   BM_ImportSweep      a VLP-16 sweep decoded, gridded and compared with its hold's first
 //   BM_ImportImageStamp an image's stamp read (every image pays only this)
 //   BM_ImportTry        a try: the board searched in one image, followed into 5 others, 6 PnP
 //   BM_ImportSearchEveryImage  what the importer before the LiDAR-first rule paid per image
 #include <benchmark/benchmark.h>
+#include <fcntl.h>
+#include <spawn.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
 
 #include <chrono>
 #include <filesystem>
@@ -91,6 +98,50 @@ void BM_ImportSimRecording(benchmark::State& state) {
 BENCHMARK(BM_ImportSimRecording)
     ->Args({30, 0})
     ->Args({30, 1})
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime()
+    ->Iterations(1);
+
+extern "C" char** environ;
+
+// Runs `argv` and returns its peak resident memory in MiB (-1 when it failed).
+double PeakMiBOf(std::vector<std::string> argv) {
+  std::vector<char*> args;
+  for (std::string& arg : argv) args.push_back(arg.data());
+  args.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) return -1.0;
+  int status = 0;
+  rusage usage{};
+  if (wait4(pid, &status, 0, &usage) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    return -1.0;
+  return usage.ru_maxrss / 1024.0;  // kilobytes on Linux
+}
+
+void BM_ImportPeakMemory(benchmark::State& state) {
+  const int poses = static_cast<int>(state.range(0));
+  const int format = static_cast<int>(state.range(1));
+  const BenchRecording& recording = Recording(poses, format);
+  const fs::path out = recording.path.string() + ".peak.dataset";
+  double peak = 0.0;
+  for (auto _ : state) {
+    fs::remove_all(out);
+    peak = PeakMiBOf({CALIBENCH_EXE_PATH, "import", recording.path.string(), "--board", "a3", "-o",
+                      out.string()});
+    if (peak < 0) state.SkipWithError("calibench import failed");
+  }
+  state.counters["peak_MiB"] = peak;
+  state.counters["GB"] = static_cast<double>(fs::file_size(recording.path)) / 1e9;
+  state.SetLabel(kRecordingFormats[format]);
+}
+BENCHMARK(BM_ImportPeakMemory)
+    ->Args({9, 0})
+    ->Args({9, 1})
     ->Unit(benchmark::kSecond)
     ->UseRealTime()
     ->Iterations(1);

@@ -48,5 +48,48 @@ TEST(DownWeighted, AGatedPairIsNamedInTheSummaryAndTheResult) {
     EXPECT_EQ(result["pairs"][i]["down_weighted"].get<bool>(), i == 3) << i;
 }
 
+// The summary's numbers say what they compare: the cost from the last re-weighting on (the gated
+// pair changes the weights mid-solve, so the first cost is not comparable with the last), and
+// the covariance's widening by what widened it.
+TEST(SummaryWords, TheCostAndTheWideningSayWhatTheirNumbersCompare) {
+  const fs::path dir = test::TempDir("summary_words");
+  SimOptions sim = SimPreset("default");
+  sim.num_pairs = 10;
+  sim.seed = 4;
+  const Dataset dataset = SimulateDataset(sim, dir / "sim");
+  std::vector<PairFeatures> pairs;
+  for (const PairEntry& entry : dataset.pairs)
+    pairs.push_back(ExtractPairFeatures(dataset, entry, PipelineOptions{}));
+  ASSERT_TRUE(pairs[3].camera);
+  pairs[3].camera->plane.distance += 0.3;
+  CalibrationOutcome outcome = SolveFromFeatures(pairs, PipelineOptions{});
+  ASSERT_TRUE(outcome.solution) << outcome.failure;
+  SolverResult& s = *outcome.solution;
+  ASSERT_GT(s.cost_comparable_from, 0) << "the gate re-weighted the pairs";
+  char expected[160];
+  std::snprintf(expected, sizeof(expected),
+                "cost %.3e -> %.3e from iteration %d, when the pairs were last re-weighted",
+                s.cost_history[s.cost_comparable_from], s.cost_history.back(),
+                s.cost_comparable_from);
+  std::string summary = FormatSummary(outcome);
+  EXPECT_NE(summary.find(expected), std::string::npos) << summary;
+  // Under one set of weights Gauss-Newton does not raise the cost.
+  EXPECT_LE(s.cost_history.back(), s.cost_history[s.cost_comparable_from] * (1.0 + 1e-9));
+
+  s.jackknife_widened = true;
+  s.covariance_inflation = 1.0;
+  summary = FormatSummary(outcome);
+  EXPECT_NE(summary.find("covariance from the pairs' leave-one-out spread"), std::string::npos)
+      << summary;
+  EXPECT_EQ(summary.find("1.0x"), std::string::npos) << summary;
+  EXPECT_EQ(summary.find("x1.0"), std::string::npos) << summary;
+  s.jackknife_widened = false;
+  s.covariance_inflation = 2.5;
+  summary = FormatSummary(outcome);
+  EXPECT_NE(summary.find("covariance widened up to 2.50x (variance) by the spread"),
+            std::string::npos)
+      << summary;
+}
+
 }  // namespace
 }  // namespace calibench

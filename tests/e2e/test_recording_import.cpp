@@ -137,27 +137,90 @@ TEST(RecordingImport, ChoosesThePresetThatFitsWithoutBeingTold) {
 TEST(RecordingImport, ABoardNoPresetExplainsIsRefusedUntilItsTargetLiesBeside) {
   const fs::path dir = test::TempDir("recording_import_large_board");
   // 8x6 inner corners of 70 mm: a4's 5x4 and a3's 7x5 grids are found inside it.
-  test::SimRecordingOptions options = test::SmallSimRecording(3);
+  test::SimRecordingOptions options = test::SmallSimRecording(10);
   options.board = Board(8, 6, 0.07, 0.70, 0.56);
   fs::create_directories(dir / "site");
   const fs::path bag = dir / "site" / "large.mcap";
-  Record(bag, options);
+  const test::SimRecordingTruth truth = Record(bag, options);
+  std::int64_t read_when_refused = 0, total = 0;
   try {
-    ImportBag(bag, dir / "refused.dataset", std::nullopt, {});
+    ImportBag(bag, dir / "refused.dataset", std::nullopt, {},
+              [&](const std::string& phase, std::int64_t done, std::int64_t all) {
+                if (phase == "reading") read_when_refused = done, total = all;
+              });
     ADD_FAILURE() << "a board no preset explains was not refused";
   } catch (const IoError& error) {
+    // Said as soon as the presets have ruled themselves out, not after the whole recording.
+    EXPECT_GT(total, 0);
+    EXPECT_LT(read_when_refused, total * 6 / 10) << read_when_refused << " of " << total;
+    std::printf("refused after %.0f %% of the recording\n", 100.0 * read_when_refused / total);
     const std::string what = error.what();
     EXPECT_NE(what.find("no preset board explains the images"), std::string::npos) << what;
     EXPECT_NE(what.find("part of a larger board"), std::string::npos) << what;
     EXPECT_NE(what.find("--board"), std::string::npos) << what;
     EXPECT_NE(what.find("--target"), std::string::npos) << what;
   }
-  std::ofstream(dir / "site" / "target.json") << json_io::TargetToJson(options.board).dump(2);
+  // Named after the recording, as `calibench target` names the file it prints beside a board.
+  std::ofstream(dir / "site" / "large.target.json") << json_io::TargetToJson(options.board).dump(2);
   const BagImportSummary summary = ImportBag(bag, dir / "beside.dataset", std::nullopt, {});
   EXPECT_EQ(summary.board.cols, 8);
   EXPECT_EQ(summary.board.square_size, 0.07);
+  EXPECT_NE(summary.board_source.find("large.target.json"), std::string::npos);
   EXPECT_NE(summary.board_source.find("beside the recording"), std::string::npos);
-  EXPECT_EQ(summary.pair_ids.size(), 3u);
+  EXPECT_EQ(summary.pair_ids.size(), truth.held_cam_from_board.size());
+}
+
+// The last message a reader gets from a recording (its complete part, for one cut short).
+std::int64_t LastLogTime(const fs::path& path) {
+  std::int64_t last = 0;
+  OpenBag(path)->ForEachMessage({}, [&](const BagMessage& message) {
+    last = std::max(last, message.log_time_ns);
+    return true;
+  });
+  return last;
+}
+
+// A recorder killed mid-write: no index or summary, the last chunk (or sqlite pages) torn off.
+// import reads what is complete, says where it stopped, and gives every hold before it.
+TEST(RecordingImport, ARecordingCutShortImportsItsCompletePart) {
+  const fs::path dir = test::TempDir("recording_import_torn");
+  const test::SimRecordingOptions options = test::SmallSimRecording(6);
+  for (const char* name : {"torn.mcap", "torn.bag", "torn.db3"}) {
+    SCOPED_TRACE(name);
+    const fs::path path = dir / name;
+    test::SimRecordingTruth truth;
+    if (path.extension() == ".db3") {
+      auto writer = test::OpenDb3Writer(path, 50);
+      truth = test::WriteSimRecording(writer.get(), MessageEncoding::kCdr, options);
+      writer->Close();
+    } else {
+      truth = Record(path, options);
+    }
+    fs::resize_file(path, fs::file_size(path) * 6 / 10 + 7);
+    const std::int64_t complete_until = LastLogTime(path);
+    int complete_holds = 0;
+    for (const std::int64_t end : truth.hold_end_ns) complete_holds += end <= complete_until;
+    ASSERT_GE(complete_holds, 2);
+    const BagImportSummary summary =
+        ImportBag(path, dir / (std::string(name) + ".dataset"), truth.board, {});
+    EXPECT_NE(summary.cut_short.find("cut short"), std::string::npos) << summary.cut_short;
+    EXPECT_NE(summary.cut_short.find(path.string()), std::string::npos) << summary.cut_short;
+    std::printf("%s: %s; %zu pairs, %d holds complete\n", name, summary.cut_short.c_str(),
+                summary.pair_ids.size(), complete_holds);
+    // Every hold before the tear, and at most the one it cut into.
+    EXPECT_GE(static_cast<int>(summary.pair_ids.size()), complete_holds);
+    EXPECT_LE(static_cast<int>(summary.pair_ids.size()), complete_holds + 1);
+    EXPECT_EQ(ImportRecord(summary).value("cut_short", ""), summary.cut_short);
+    // The command says it too, and succeeds.
+    std::string output;
+    EXPECT_EQ(
+        test::RunCommand(test::CalibenchExe() + " import " + path.string() + " --board a3 -o " +
+                             (dir / (std::string(name) + ".cli")).string(),
+                         &output),
+        0)
+        << output;
+    EXPECT_NE(output.find("cut short"), std::string::npos) << output;
+  }
 }
 
 }  // namespace

@@ -139,24 +139,29 @@ double CharucoSquareMm(const Raster& r, const BoardSpec& board) {
   return MeanNeighbourMm(cols, rows, at, r.px_per_mm);
 }
 
-// The ruler's millimetre ticks along a row 1 mm below its baseline: 101 dark runs whose first and
-// last centres lie 100 mm apart.
+// The ruler's millimetre ticks along a line 1 mm below its baseline (a row for a ruler below the
+// pattern, a column for one beside it): 101 dark runs whose first and last centres lie 100 mm
+// apart.
 void ExpectRulerReads100Mm(const Raster& r, const TargetSheet& sheet) {
-  const int row = static_cast<int>(std::lround((sheet.ruler_start_mm.y() + 1.0) * r.px_per_mm));
-  const int x0 = static_cast<int>((sheet.ruler_start_mm.x() - 3.0) * r.px_per_mm);
-  const int x1 = static_cast<int>((sheet.ruler_start_mm.x() + 103.0) * r.px_per_mm);
-  ASSERT_TRUE(row > 0 && row < r.gray.rows && x0 > 0 && x1 < r.gray.cols);
+  ASSERT_TRUE(sheet.has_ruler);
+  const Vec2 along = sheet.ruler_vertical ? Vec2(0.0, -1.0) : Vec2(1.0, 0.0);
+  const Vec2 below = sheet.ruler_vertical ? Vec2(1.0, 0.0) : Vec2(0.0, 1.0);  // the ticks' side
+  const Vec2 start_px = (sheet.ruler_start_mm + 1.0 * below) * r.px_per_mm;
+  const int samples = static_cast<int>(std::lround(106.0 * r.px_per_mm));
   std::vector<double> centres;
   int start = -1;
-  for (int x = x0; x <= x1; ++x) {
-    const bool dark = r.gray.at<std::uint8_t>(row, x) < 128;
-    if (dark && start < 0) start = x;
-    if (!dark && start >= 0) centres.push_back(0.5 * (start + x - 1)), start = -1;
+  for (int i = 0; i <= samples; ++i) {
+    const Vec2 at = start_px + (i - 3.0 * r.px_per_mm) * along;
+    const int x = static_cast<int>(std::lround(at.x())), y = static_cast<int>(std::lround(at.y()));
+    ASSERT_TRUE(x > 0 && x < r.gray.cols && y > 0 && y < r.gray.rows) << x << ", " << y;
+    const bool dark = r.gray.at<std::uint8_t>(y, x) < 128;
+    if (dark && start < 0) start = i;
+    if (!dark && start >= 0) centres.push_back(0.5 * (start + i - 1)), start = -1;
   }
   ASSERT_EQ(centres.size(), 101u) << "the ruler's millimetre ticks";
   const double length_mm = (centres.back() - centres.front()) / r.px_per_mm;
   EXPECT_NEAR(length_mm, 100.0, 0.2) << "the ruler";
-  std::printf("ruler %.3f mm\n", length_mm);
+  std::printf("ruler %.3f mm (%s)\n", length_mm, sheet.ruler_vertical ? "beside" : "below");
 }
 
 struct PrintCase {
@@ -181,8 +186,8 @@ TEST_P(TargetPrint, OpenCvFindsThePatternAtTheRequestedScale) {
   std::string output;
   ASSERT_EQ(RunCommand(command, &output), 0) << output;
 
-  // target.json beside the print: the pattern, and the sheet as board_size.
-  const BoardSpec board = LoadTargetFile(dir / "target.json");
+  // The target file beside the print, named after it: the pattern, and the sheet as board_size.
+  const BoardSpec board = LoadTargetFile(dir / ("board" + std::string(".target.json")));
   const TargetSheet sheet = LayoutTargetSheet(board, TargetSheetOptions{c.paper});
   EXPECT_NEAR(board.board_width * 1000.0, sheet.sheet_mm.x(), 1e-9);
   EXPECT_NEAR(board.board_height * 1000.0, sheet.sheet_mm.y(), 1e-9);
@@ -224,7 +229,15 @@ TEST_P(TargetPrint, OpenCvFindsThePatternAtTheRequestedScale) {
 
 INSTANTIATE_TEST_SUITE_P(
     Boards, TargetPrint,
-    ::testing::Values(PrintCase{"a4_checker_pdf",
+    ::testing::Values(PrintCase{"a4_side_ruler_pdf",  // 240 x 180 mm: the ruler goes beside it
+                                {"--inner-corners 7 5", "--square-size 30mm", "--paper a4"},
+                                Paper::kA4,
+                                ".pdf"},
+                      PrintCase{"a4_side_ruler_svg",
+                                {"--inner-corners 7 5", "--square-size 30mm", "--paper a4"},
+                                Paper::kA4,
+                                ".svg"},
+                      PrintCase{"a4_checker_pdf",
                                 {"--inner-corners 7 5", "--square-size 25mm", "--paper a4"},
                                 Paper::kA4,
                                 ".pdf"},
@@ -252,10 +265,10 @@ TEST(TargetCli, ABoardTooLargeNamesTheLargestSquareThatFits) {
                        &output),
             1)
       << output;
-  // 10 x 7 squares on 297 x 210 mm: (210 - 2 x (6 + 11)) / 7 = 25.1 mm.
-  EXPECT_NE(output.find("the largest square that fits A4 is 25.1 mm"), std::string::npos) << output;
+  // 10 x 7 squares on the printable 285 x 198 mm of A4 landscape: min(28.5, 28.28) mm.
+  EXPECT_NE(output.find("the largest square that fits A4 is 28.2 mm"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(dir / "b.pdf"));
-  EXPECT_FALSE(fs::exists(dir / "target.json"));
+  EXPECT_FALSE(fs::exists(dir / "b.target.json"));
   EXPECT_EQ(RunCommand(CalibenchExe() + " target --inner-corners 9 6 --square-size 40 --out " +
                            (dir / "b.pdf").string(),
                        &output),
@@ -265,18 +278,101 @@ TEST(TargetCli, ABoardTooLargeNamesTheLargestSquareThatFits) {
       RunCommand(CalibenchExe() + " target --preset a4 --out " + (dir / "b.png").string(), &output),
       1);
   EXPECT_NE(output.find(".pdf or .svg"), std::string::npos) << output;
-  // A different target.json already there is kept, and named.
+  // Two targets into one folder: each its own target file, named after its print.
   ASSERT_EQ(RunCommand(CalibenchExe() + " target --preset a4 --out " + (dir / "a4.pdf").string(),
                        &output),
             0)
       << output;
-  const std::string before = test::ReadFileBytes(dir / "target.json");
-  EXPECT_EQ(
+  ASSERT_EQ(
       RunCommand(CalibenchExe() + " target --preset charuco-a4 --out " + (dir / "c.pdf").string(),
                  &output),
+      0)
+      << output;
+  EXPECT_EQ(LoadTargetFile(dir / "a4.target.json").type, BoardType::kCheckerboard);
+  EXPECT_EQ(LoadTargetFile(dir / "c.target.json").type, BoardType::kCharuco);
+  // A different target file already there under the same name is kept, and named.
+  const std::string before = test::ReadFileBytes(dir / "a4.target.json");
+  EXPECT_EQ(
+      RunCommand(CalibenchExe() + " target --preset charuco-a4 --out " + (dir / "a4.pdf").string(),
+                 &output),
       2);
-  EXPECT_NE(output.find("a different target.json is already there"), std::string::npos) << output;
-  EXPECT_EQ(test::ReadFileBytes(dir / "target.json"), before);
+  EXPECT_NE(output.find("a different target file is already there"), std::string::npos) << output;
+  EXPECT_EQ(test::ReadFileBytes(dir / "a4.target.json"), before);
+}
+
+// The board: 7 x 5 inner corners of 30 mm (240 x 180 mm) on A4 (297 x 210 mm) leaves 9 mm
+// above and below, 22.5 mm beside: the ruler goes beside it, nothing is refused.
+TEST(TargetLayout, ABoardThatFitsThePaperIsNeverRefused) {
+  BoardSpec board;
+  board.type = BoardType::kCheckerboard;
+  board.cols = 7;
+  board.rows = 5;
+  board.square_size = 0.030;
+  const TargetSheet sheet = LayoutTargetSheet(board, TargetSheetOptions{Paper::kA4});
+  EXPECT_TRUE(sheet.landscape);
+  ASSERT_TRUE(sheet.has_ruler);
+  EXPECT_TRUE(sheet.ruler_vertical);
+  EXPECT_TRUE(sheet.note.empty()) << sheet.note;
+  // The ruler lies in the right margin strip: right of the pattern, inside the printable area,
+  // and its 100 mm within the page's height.
+  const double pattern_right = sheet.pattern_top_left_mm.x() + 240.0;
+  EXPECT_GT(sheet.ruler_start_mm.x(), pattern_right + 1.0);
+  EXPECT_LT(sheet.ruler_start_mm.x() + 2.0 * sheet.ruler_tick_mm + 2.6, 297.0 - 6.0);
+  EXPECT_LT(sheet.ruler_start_mm.y(), 210.0 - 6.0);
+  EXPECT_GT(sheet.ruler_start_mm.y() - 100.0, 6.0);
+  EXPECT_GT(sheet.caption_anchor_mm.x(), sheet.ruler_start_mm.x());
+  EXPECT_LT(sheet.title_anchor_mm.x(), sheet.pattern_top_left_mm.x());
+}
+
+// Every preset paper: the largest square is what the printable area (the paper less 6 mm margins)
+// holds, in the better orientation; a pattern of that size is laid out (with its ruler where a
+// strip beside it holds one, else a note saying to measure a square), and one 0.2 mm larger is
+// refused naming it.
+TEST(TargetLayout, TheLargestSquareOfEveryPaperComesFromItsPrintableArea) {
+  BoardSpec checker;
+  checker.type = BoardType::kCheckerboard;
+  checker.cols = 7;
+  checker.rows = 5;
+  BoardSpec charuco;
+  charuco.type = BoardType::kCharuco;
+  charuco.cols = 7;
+  charuco.rows = 5;
+  charuco.dictionary = "DICT_4X4_50";
+  for (const Paper paper :
+       {Paper::kA4, Paper::kA3, Paper::kA2, Paper::kA1, Paper::kA0, Paper::kLetter}) {
+    for (BoardSpec board : {checker, charuco}) {
+      SCOPED_TRACE(PaperName(paper) +
+                   (board.type == BoardType::kCharuco ? " charuco" : " checker"));
+      const Vec2 page = PaperSizeMm(paper);
+      const double portrait =
+          std::min((page.x() - 12.0) / board.SquaresX(), (page.y() - 12.0) / board.SquaresY());
+      const double landscape =
+          std::min((page.y() - 12.0) / board.SquaresX(), (page.x() - 12.0) / board.SquaresY());
+      const double largest = std::max(portrait, landscape);
+      EXPECT_NEAR(LargestSquareThatFitsMm(board, TargetSheetOptions{paper}), largest, 1e-9);
+      board.square_size = std::floor(largest * 10.0) / 10.0 / 1000.0;
+      board.marker_size = 0.75 * board.square_size;
+      TargetSheet sheet;
+      ASSERT_NO_THROW(sheet = LayoutTargetSheet(board, TargetSheetOptions{paper}));
+      EXPECT_EQ(sheet.has_ruler, sheet.note.empty()) << sheet.note;
+      if (!sheet.has_ruler) EXPECT_NE(sheet.note.find("measuring a square"), std::string::npos);
+      std::printf("%-6s %-8s largest square %.1f mm, ruler %s\n", PaperName(paper).c_str(),
+                  board.type == BoardType::kCharuco ? "charuco" : "checker", largest,
+                  !sheet.has_ruler       ? "none (measure a square)"
+                  : sheet.ruler_vertical ? "beside"
+                                         : "below");
+      board.square_size += 0.0002;
+      board.marker_size = 0.75 * board.square_size;
+      try {
+        LayoutTargetSheet(board, TargetSheetOptions{paper});
+        ADD_FAILURE() << "a pattern larger than the printable area was laid out";
+      } catch (const std::invalid_argument& error) {
+        char expected[64];
+        std::snprintf(expected, sizeof(expected), "is %.1f mm", std::floor(largest * 10.0) / 10.0);
+        EXPECT_NE(std::string(error.what()).find(expected), std::string::npos) << error.what();
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -7,10 +7,12 @@
 
 #include <chrono>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <thread>
 
 #include "core/geometry/geometry.h"
+#include "core/io/json_io.h"
 #include "core/results/result_file.h"
 #include "tests/sim_recording.h"
 #include "tests/test_support.h"
@@ -161,6 +163,64 @@ TEST(WatchRecording, FollowsRecordingsWhileWrittenAndEndsWithImportsPairs) {
               0)
         << output;
   }
+}
+
+// A board no preset explains, on a recording still being written: the true reason said as soon as
+// the presets rule themselves out (not "no new data" while data still comes), the watch follows
+// on, and the pairs come once the board's target file is put beside the recording.
+TEST(WatchRecording, ABoardNoPresetExplainsIsSaidLiveAndTheWatchWaitsForIt) {
+  test::SimRecordingOptions options = test::SmallSimRecording(10);
+  options.board.type = BoardType::kCheckerboard;
+  options.board.cols = 8;
+  options.board.rows = 6;
+  options.board.square_size = 0.07;
+  options.board.board_width = 0.70;
+  options.board.board_height = 0.56;
+  const fs::path dir = test::TempDir("watch_recording_unknown_board");
+  const fs::path source = dir / "large.mcap", stream = dir / "stream.jsonl";
+  // --idle-exit 10: shorter than the recording; only data that keeps coming keeps the watch on.
+  std::thread watch([&] {
+    test::RunCommand(test::CalibenchExe() + " watch " + source.string() +
+                     " --json-lines --idle-exit 10 --out " + (dir / "watched").string() + " > " +
+                     stream.string() + " 2>/dev/null");
+  });
+  // The recorder pauses after the sixth pose until the watch says why no pair comes (at most a
+  // minute), then the user puts the board's file beside the recording and the recording goes on.
+  const test::SimRecordingTruth plan = test::PlanSimRecording(options);
+  bool said_while_written = false;
+  auto pause = [&] {
+    for (int i = 0; i < 600; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      if (test::ReadFileBytes(stream).find("no preset board explains the images") ==
+          std::string::npos)
+        continue;
+      said_while_written = true;
+      break;
+    }
+    std::ofstream(dir / "large.target.json.tmp") << json_io::TargetToJson(options.board).dump(2);
+    fs::rename(dir / "large.target.json.tmp", dir / "large.target.json");
+  };
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  test::PausingWriter writer(
+      std::make_unique<PacedWriter>(test::OpenMcapWriter(source, "ros2", "lz4", true, 256 * 1024),
+                                    2.0),
+      pause, plan.hold_end_ns[5]);
+  test::WriteSimRecording(&writer, MessageEncoding::kCdr, options);
+  writer.Close();
+  watch.join();
+  EXPECT_TRUE(said_while_written) << test::ReadFileBytes(stream);
+  const std::vector<json> lines = ReadJsonLines(stream);
+  ASSERT_FALSE(lines.empty());
+  int pairs = 0;
+  bool board_from_file = false;
+  for (const json& line : lines) {
+    pairs += line["event"] == "pair";
+    board_from_file |= line["event"] == "note" &&
+                       line["reason"].get<std::string>().find("board: from") != std::string::npos;
+  }
+  EXPECT_TRUE(board_from_file) << test::ReadFileBytes(stream);
+  EXPECT_GE(pairs, 6) << test::ReadFileBytes(stream);
+  EXPECT_EQ(lines.back()["reason"], "the recording was closed by its recorder");
 }
 
 }  // namespace

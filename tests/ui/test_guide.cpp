@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -13,6 +14,7 @@
 #include "core/base/names.h"
 #include "core/geometry/geometry.h"
 #include "core/io/dataset.h"
+#include "core/io/json_io.h"
 #include "core/results/result_file.h"
 #include "core/session/session.h"
 #include "tests/acfr_manifest.h"
@@ -273,6 +275,61 @@ TEST(Guide, ARecordingFollowedInTheWorkbenchGivesItsHoldsAndTheTruth) {
   EXPECT_EQ(resumed.pairs[1].reason, kRejectedByUser);
   for (const auto& entry : fs::directory_iterator(dir / "capture.dataset"))
     EXPECT_NE(entry.path().extension(), ".bak") << entry.path() << ": the session was not resumed";
+}
+
+// A recording still being written whose board no preset explains: the workbench says why (the
+// "Which board?" window reads Snapshot::board_problem) and keeps following; the board picked
+// there (a target file) brings the held pairs, and the rest as the recording goes on.
+TEST(Guide, ABoardNoPresetExplainsIsPickedInTheWorkbench) {
+  const fs::path dir = test::TempDir("guide_pick_board");
+  test::SimRecordingOptions options = test::SmallSimRecording(8);
+  options.board.type = BoardType::kCheckerboard;
+  options.board.cols = 8;  // 8x6 inner corners of 70 mm: a3's and a4's grids are found inside it
+  options.board.rows = 6;
+  options.board.square_size = 0.07;
+  options.board.board_width = 0.70;
+  options.board.board_height = 0.56;
+  Controller controller;
+  controller.SetAutoSolve(true);
+  controller.WatchRecording(dir / "large.mcap", dir / "large.dataset", std::nullopt, {});
+  // The recorder pauses after the fifth pose until the workbench says why no pair comes; the user
+  // picks the board there, and three more poses are recorded.
+  Snapshot s;
+  auto pick = [&] {
+    for (int wait = 0; wait < 600 && s.board_problem.empty(); ++wait) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      s = controller.GetSnapshot();
+    }
+    EXPECT_NE(s.board_problem.find("no preset board explains the images"), std::string::npos)
+        << s.status_line;
+    EXPECT_TRUE(s.pairs.empty());
+    // A wrong pick is refused in words, nothing taken.
+    controller.Apply(PickBoard{"a5"});
+    EXPECT_TRUE(controller.GetSnapshot().status_is_error);
+    const fs::path target = dir / "my_board.json";
+    std::ofstream(target) << json_io::TargetToJson(options.board).dump(2);
+    controller.Apply(PickBoard{target.string()});
+  };
+  test::PausingWriter writer(test::OpenMcapWriter(dir / "large.mcap", "ros2", "lz4", true), pick,
+                             test::PlanSimRecording(options).hold_end_ns[4]);
+  test::WriteSimRecording(&writer, MessageEncoding::kCdr, options);
+  writer.Close();
+  // Until the recording's end is read and every pair is in and solved.
+  std::uint64_t seen = 0;
+  int still = 0;  // polls in a row with nothing new
+  for (int wait = 0; wait < 600 && still < 5; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    s = controller.GetSnapshot();
+    const bool settled = s.pairs.size() >= 6 && s.loading_done == s.loading_total && !s.busy &&
+                         s.solver.result && s.generation == seen;
+    still = settled ? still + 1 : 0;
+    seen = s.generation;
+  }
+  controller.StopWatching();
+  EXPECT_GE(s.pairs.size(), 6u) << s.status_line;
+  EXPECT_TRUE(s.board_problem.empty()) << s.board_problem;
+  ASSERT_TRUE(s.solver.result) << s.solver.failure;
+  EXPECT_EQ(LoadDataset(dir / "large.dataset").target.square_size, 0.07);
 }
 
 }  // namespace

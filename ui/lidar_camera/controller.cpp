@@ -356,7 +356,8 @@ void Controller::Handle(const ExportResult& export_result) {
 
 void Controller::Apply(const Intent& intent) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!state_.dataset) return;
+  // A followed recording's board is picked before anything opens: its first pair needs it.
+  if (!state_.dataset && !std::holds_alternative<PickBoard>(intent)) return;
   // A stroke is its dabs; anything else in between ends it.
   if (!std::holds_alternative<BrushStroke>(intent) && !std::holds_alternative<PaintPoints>(intent))
     stroke_open_ = false;

@@ -107,10 +107,16 @@ struct SelectCamera {
 // The rig's joint solve over every camera, with each camera's session edits (the open one's as
 // they are now), on its own thread; the meter and the frustums follow.
 struct SolveRig {};
+// A followed recording whose board no preset explains (Snapshot::board_problem): the board the
+// user picks, a preset's name (core/target/board.h) or a target file; the pairs held for want of
+// it are searched with it.
+struct PickBoard {
+  std::string board;
+};
 using Intent = std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush,
                             DetectBoardAgain, PaintPoints, RunSolver, ResetSolver, SetSolverOptions,
                             SetView, ExportResult, SaveSessionAs, Undo, Redo, EstimateIntrinsics,
-                            SaveIntrinsics, SetGoal, SelectCamera, SolveRig>;
+                            SaveIntrinsics, SetGoal, SelectCamera, SolveRig, PickBoard>;
 
 class Controller : public ControllerState<Snapshot> {
  public:
@@ -286,6 +292,8 @@ class Controller : public ControllerState<Snapshot> {
   std::map<std::string, std::shared_ptr<const ImageU8>> rig_frames_;  // "<camera>/<pair>" (worker)
   std::vector<std::map<std::string, std::filesystem::path>> rig_images_;  // per camera (mutex_)
   std::atomic<bool> stop_watch_{false};
+  // PickBoard's board and its words, for the follow thread to give its feed (mutex_).
+  std::optional<std::pair<BoardSpec, std::string>> picked_board_;
 };
 
 // The handlers (controller.cpp, controller_pairs.cpp, controller_session.cpp).
@@ -329,5 +337,7 @@ template <>
 void Controller::Handle(const SelectCamera&);  // controller_rig.cpp
 template <>
 void Controller::Handle(const SolveRig&);
+template <>
+void Controller::Handle(const PickBoard&);  // controller_watch.cpp
 
 }  // namespace calibench::ui

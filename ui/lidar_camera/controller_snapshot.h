@@ -151,6 +151,9 @@ struct Snapshot : SnapshotHeader {
   bool ghost_matched = false;
   // A folder being followed (WatchFolder): pairs join the list as they land.
   std::filesystem::path watching;
+  // A followed recording shows a board no preset explains: why, in words (the board is then
+  // picked from a list: PickBoard); empty otherwise.
+  std::string board_problem;
   bool auto_solve = false;
   // Opened from a rig: its cameras, the strip of the selected capture's frames, the rig solve.
   std::optional<RigView> rig;

@@ -102,6 +102,16 @@ void Controller::FollowLoop(CaptureFeed* feed) {
   std::vector<PairEntry> read_before_open;  // the pairs read until the reader caught up
   const double first_look_s = SteadySeconds();
   while (!stop_watch_) {
+    {
+      // The board the user picked goes to the feed before it reads on: only this thread touches
+      // the feed, and a recording closed meanwhile is finished with it.
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (picked_board_) {
+        if (!feed->SetBoard(picked_board_->first, picked_board_->second))
+          SetStatus("this capture's board comes from its target.json", true);
+        picked_board_.reset();
+      }
+    }
     FeedUpdate update;
     try {
       update = feed->Poll(SteadySeconds());
@@ -113,6 +123,11 @@ void Controller::FollowLoop(CaptureFeed* feed) {
     std::vector<PairEntry> pairs;
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      const std::string problem = feed->BoardProblem();
+      if (problem != state_.board_problem) {
+        state_.board_problem = problem;
+        ++state_.generation;
+      }
       if (!update.notes.empty()) SetStatus(update.notes.back(), false);
       for (const FolderEvent& event : update.events)
         if (event.kind == FolderEvent::Kind::kPairComplete)
@@ -154,6 +169,20 @@ void Controller::FollowLoop(CaptureFeed* feed) {
       return;
     }
     std::this_thread::sleep_for(kPollPeriod);
+  }
+}
+
+template <>
+void Controller::Handle(const PickBoard& intent) {
+  try {
+    std::error_code error;
+    const BoardSpec board = std::filesystem::is_regular_file(intent.board, error)
+                                ? LoadTargetFile(intent.board)
+                                : BoardPreset(intent.board);
+    picked_board_ = std::make_pair(board, "picked in the workbench: " + intent.board);
+    SetStatus("board " + intent.board + ": the held pairs are searched with it", false);
+  } catch (const std::exception& e) {
+    SetStatus(std::string("board not taken: ") + e.what(), true);
   }
 }
 

@@ -78,6 +78,9 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   // The meter: σ per axis against the goal, the weakest in words, done (workbench_meter.cpp).
   void MeterRows(const Snapshot& s, std::vector<Intent>* intents);
   void GuideRows(const Snapshot& s);  // the next pose in words, the ghost's match
+  // A followed recording whose board no preset explains: why, and the board picked from a list
+  // (the presets, or a target file's path) (workbench_meter.cpp).
+  void BoardPicker(const Snapshot& s, std::vector<Intent>* intents);
   // A rig (workbench_rig.cpp): the camera selector and the strip of the selected capture's frames
   // (measurements panel); the meter over every camera and the rig solve (solver panel); every
   // camera's frustum into the 3D view's camera layer.
@@ -98,6 +101,8 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   struct Gl;
   std::unique_ptr<Gl> gl_;
   // View-local state.
+  int picked_preset_ = 0;           // BoardPicker's list
+  std::string picked_target_file_;  // BoardPicker's path field
   // Horizontal zoom of the LiDAR image (1 = all 360 degrees); 0 = fit the rows, drawn at the
   // sensor's angular aspect, to the view's height.
   float lidar_zoom_ = 0.0f;

@@ -6,7 +6,9 @@
 #include <cstdio>
 #include <vector>
 
+#include "core/target/board_choice.h"
 #include "ui/lidar_camera/workbench.h"
+#include "ui/widgets/path_field.h"
 
 namespace calibench::ui {
 namespace {
@@ -88,6 +90,26 @@ void Workbench::GuideRows(const Snapshot& s) {
   if (!s.ghost_match.empty())
     ImGui::TextColored(s.ghost_matched ? kUnder : kOver, "%s", s.ghost_match.c_str());
   ImGui::PopTextWrapPos();
+}
+
+void Workbench::BoardPicker(const Snapshot& s, std::vector<Intent>* intents) {
+  ImGui::SetNextWindowSize(ImVec2(560, 0), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Which board?")) return ImGui::End();
+  ImGui::PushTextWrapPos(0);
+  ImGui::TextColored(kOver, "%s", s.board_problem.c_str());
+  ImGui::TextDisabled("The capture goes on; its pairs are held until the board is known.");
+  ImGui::PopTextWrapPos();
+  const std::vector<std::string> presets = ChoosablePresets();
+  std::vector<const char*> names;
+  for (const std::string& name : presets) names.push_back(name.c_str());
+  picked_preset_ = std::clamp(picked_preset_, 0, static_cast<int>(names.size()) - 1);
+  ImGui::SetNextItemWidth(160);
+  ImGui::Combo("##preset", &picked_preset_, names.data(), static_cast<int>(names.size()));
+  ImGui::SameLine();
+  if (ImGui::Button("Use this preset")) intents->push_back(PickBoard{presets[picked_preset_]});
+  if (PathField("##target_file", &picked_target_file_, "Use this target file"))
+    intents->push_back(PickBoard{picked_target_file_});
+  ImGui::End();
 }
 
 }  // namespace calibench::ui

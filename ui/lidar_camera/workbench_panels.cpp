@@ -243,6 +243,7 @@ void Workbench::SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent
     intents->push_back(SaveSessionAs{session_path_});
   ImGui::End();
   if (intrinsics_open_) IntrinsicsWindow(s, intents);
+  if (!s.board_problem.empty()) BoardPicker(s, intents);
 }
 
 void Workbench::SolutionReadouts(const SolverView& solver, std::vector<Intent>* intents) {
