@@ -8,8 +8,11 @@ function(calibench_target_options target)
   endif()
 endfunction()
 
-# ccache shortens rebuilds a lot on 2 cores; use it when the machine has it.
+# ccache shortens rebuilds a lot on 2 cores; use it when the machine has it. Paths under the
+# source tree are hashed relative to it (and the build folder not at all), so that another clone
+# of the same sources on the machine (a fresh clone's check, CI) reuses what this one compiled.
 find_program(CALIBENCH_CCACHE ccache)
 if(CALIBENCH_CCACHE)
-  set(CMAKE_CXX_COMPILER_LAUNCHER ${CALIBENCH_CCACHE} CACHE STRING "" FORCE)
+  set(CMAKE_CXX_COMPILER_LAUNCHER ${CMAKE_COMMAND} -E env CCACHE_BASEDIR=${PROJECT_SOURCE_DIR}
+      CCACHE_NOHASHDIR=1 ${CALIBENCH_CCACHE} CACHE STRING "" FORCE)
 endif()

@@ -24,4 +24,7 @@ demo_flags=()
 
 if [ $run_tests -eq 1 ]; then
   ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" --timeout 900
+  # The sanitizers, routinely: the core and workbench tests again under ASan + UBSan
+  # (scripts/sanitize.sh --ci, in build-asan/; the whole suite and valgrind: scripts/sanitize.sh).
+  bash scripts/sanitize.sh --ci
 fi

@@ -5,9 +5,9 @@
 //   BM_ImportSimRecording/N/format  the import as a whole; counters: the recording's length, the
 //                                   import's wall and CPU time, their ratio, pairs, searches
 //   BM_ImportPeakMemory/N/format    `calibench import` as a user runs it, in a process of its
-//                                   own: its peak resident memory (wait4's ru_maxrss); 9 poses
-//                                   make a 3.6 GB MCAP, the size of the real recording issue 51
-//                                   measured
+//                                   own: its peak resident memory (wait4's ru_maxrss); 19 poses
+//                                   make a 3.5 GB MCAP (lz4), the size of the real recording issue
+//                                   51 measured
 // And what import pays per message, to see where the time goes:
 //   BM_ImportSweep      a VLP-16 sweep decoded, gridded and compared with its hold's first
 //   BM_ImportImageStamp an image's stamp read (every image pays only this)
@@ -140,8 +140,8 @@ void BM_ImportPeakMemory(benchmark::State& state) {
   state.SetLabel(kRecordingFormats[format]);
 }
 BENCHMARK(BM_ImportPeakMemory)
-    ->Args({9, 0})
-    ->Args({9, 1})
+    ->Args({19, 0})
+    ->Args({19, 1})
     ->Unit(benchmark::kSecond)
     ->UseRealTime()
     ->Iterations(1);

@@ -176,11 +176,17 @@ TEST(Guide, AFolderFollowedWhileTheRealCaptureFillsItEndsWhereCalibrateEnds) {
       << controller.GetSnapshot().status_line;
   CopySetup(capture);
   const std::vector<std::string> stems = CaptureStems(source);
-  for (const std::string& stem : stems) {
-    CopyCapturedPair(source, watched, stem);
-    // Slower than a pair's processing (a user takes seconds per pose), so that every pair
-    // is solved with as it lands.
+  for (size_t i = 0; i < stems.size(); ++i) {
+    CopyCapturedPair(source, watched, stems[i]);
+    // Slower than a pair's processing (a user takes seconds per pose), so that every pair is
+    // solved with as it lands: 400 ms, and longer while the workbench is still busy with it (a
+    // loaded machine, a sanitizer build), up to 10 s.
     std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    for (int wait = 0; wait < 48; ++wait) {
+      const Snapshot now = controller.GetSnapshot();
+      if (now.pairs.size() > i && now.loading_done == now.loading_total && !now.busy) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
   }
   WaitUntilSettled(controller, stems.size());
   controller.StopWatching();
