@@ -231,7 +231,8 @@ bool WindowShell::Frame(Window& window, int width, int height, double seconds) {
   Popups();
   if (quit_) window.RequestClose();
   return importing || report_ != nullptr || !intents.empty() || workbench_->Animating(snapshot) ||
-         pending_open_.has_value() || pending_camera_.has_value();
+         workbench_->NeedsAnotherFrame() || pending_open_.has_value() ||
+         pending_camera_.has_value();
 }
 
 float WindowShell::MenuBar() {

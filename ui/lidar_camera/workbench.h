@@ -81,6 +81,13 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   // A followed recording whose board no preset explains: why, and the board picked from a list
   // (the presets, or a target file's path) (workbench_meter.cpp).
   void BoardPicker(const Snapshot& s, std::vector<Intent>* intents);
+
+ public:
+  // A window that appeared without input (the board picker, opened by the follow thread) is
+  // sized in its first frame and shown in the next: the window must draw that next one too.
+  bool NeedsAnotherFrame() const { return picker_frames_ == 1; }
+
+ private:
   // A rig (workbench_rig.cpp): the camera selector and the strip of the selected capture's frames
   // (measurements panel); the meter over every camera and the rig solve (solver panel); every
   // camera's frustum into the 3D view's camera layer.
@@ -102,6 +109,7 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   std::unique_ptr<Gl> gl_;
   // View-local state.
   int picked_preset_ = 0;           // BoardPicker's list
+  int picker_frames_ = 0;           // frames BoardPicker has been drawn in a row
   std::string picked_target_file_;  // BoardPicker's path field
   // Horizontal zoom of the LiDAR image (1 = all 360 degrees); 0 = fit the rows, drawn at the
   // sensor's angular aspect, to the view's height.

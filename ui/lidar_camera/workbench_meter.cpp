@@ -93,6 +93,7 @@ void Workbench::GuideRows(const Snapshot& s) {
 }
 
 void Workbench::BoardPicker(const Snapshot& s, std::vector<Intent>* intents) {
+  ++picker_frames_;
   ImGui::SetNextWindowSize(ImVec2(560, 0), ImGuiCond_FirstUseEver);
   if (!ImGui::Begin("Which board?")) return ImGui::End();
   ImGui::PushTextWrapPos(0);

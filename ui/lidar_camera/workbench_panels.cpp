@@ -243,7 +243,10 @@ void Workbench::SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent
     intents->push_back(SaveSessionAs{session_path_});
   ImGui::End();
   if (intrinsics_open_) IntrinsicsWindow(s, intents);
-  if (!s.board_problem.empty()) BoardPicker(s, intents);
+  if (!s.board_problem.empty())
+    BoardPicker(s, intents);
+  else
+    picker_frames_ = 0;
 }
 
 void Workbench::SolutionReadouts(const SolverView& solver, std::vector<Intent>* intents) {
