@@ -480,8 +480,11 @@ TEST(Controller, TheMeterJudgesTheSolveAgainstTheGoal) {
   s = Loaded(controller);
   EXPECT_TRUE(s.status_is_error);
   EXPECT_EQ(s.goal.translation_mm, 100.0);
-  // Solving again at the same number of pairs replaces the point; one fewer pair adds one.
+  // Solving again at the same number of pairs replaces the point; one fewer pair adds one. (A
+  // solve reads the pairs when the worker runs it: the first is waited for before the rejection,
+  // or on a loaded machine both would see three pairs.)
   controller.Apply(RunSolver{});
+  s = Loaded(controller);
   controller.Apply(SetPairStatus{0, PairStatus::kRejected});
   controller.Apply(RunSolver{});
   s = Loaded(controller);
