@@ -86,6 +86,33 @@ int AdviseRig(const std::string& rig_path, const AdviseOptions& options, bool js
   return kOk;
 }
 
+// An LRF dataset's advice: Algorithm 1's meter (core/guidance/lrf_meter.h).
+int AdviseLrf(const std::string& dataset_path, AdviseOptions options, double lrf_threshold_mm,
+              int threads, bool json, MachineStdout& out) {
+  std::string why;
+  if (!options.goal.Check(&why) || !options.stop.Check(&why) || !(lrf_threshold_mm > 0)) {
+    if (why.empty()) why = "--error-threshold-mm must be > 0";
+    std::fprintf(stderr, "calibench advise: %s\n", why.c_str());
+    return kUsage;
+  }
+  const LrfDataset lrf = LoadLrfDataset(dataset_path);
+  LrfPipelineOptions lrf_options;
+  lrf_options.threads = threads;
+  lrf_options.adaptive_error_threshold_m = lrf_threshold_mm * 1e-3;
+  const LrfCalibrationOutcome outcome =
+      CalibrateLrfDataset(lrf, lrf_options, StderrProgress("extracted"));
+  // Algorithm 1's check stands in for the jackknife's, which is what asks for 8 pairs.
+  StopRuleOptions lrf_stop = options.stop;
+  lrf_stop.min_pairs = 4;
+  const LrfCaptureAdvice advice =
+      AdviseLrfCapture(outcome, lrf_options.adaptive_error_threshold_m, options.goal, lrf_stop);
+  if (json)
+    out.Print(LrfCaptureAdviceJson(advice));
+  else
+    std::printf("%s", FormatLrfCaptureAdvice(advice).c_str());
+  return kOk;
+}
+
 }  // namespace
 
 int RunAdvise(int argc, char** argv) {
@@ -132,29 +159,8 @@ int RunAdvise(int argc, char** argv) {
   }
   options.pipeline = flags.options;
   MachineStdout out(json);  // from here on, only the JSON object reaches stdout
-  if (IsLrfManifest(dataset_path)) {
-    if (!options.goal.Check(&why) || !options.stop.Check(&why) || !(lrf_threshold_mm > 0)) {
-      if (why.empty()) why = "--error-threshold-mm must be > 0";
-      std::fprintf(stderr, "calibench advise: %s\n", why.c_str());
-      return kUsage;
-    }
-    const LrfDataset lrf = LoadLrfDataset(dataset_path);
-    LrfPipelineOptions lrf_options;
-    lrf_options.threads = flags.options.threads;
-    lrf_options.adaptive_error_threshold_m = lrf_threshold_mm * 1e-3;
-    const LrfCalibrationOutcome outcome =
-        CalibrateLrfDataset(lrf, lrf_options, StderrProgress("extracted"));
-    // Algorithm 1's check stands in for the jackknife's, which is what asks for 8 pairs.
-    StopRuleOptions lrf_stop = options.stop;
-    lrf_stop.min_pairs = 4;
-    const LrfCaptureAdvice advice =
-        AdviseLrfCapture(outcome, lrf_options.adaptive_error_threshold_m, options.goal, lrf_stop);
-    if (json)
-      out.Print(LrfCaptureAdviceJson(advice));
-    else
-      std::printf("%s", FormatLrfCaptureAdvice(advice).c_str());
-    return kOk;
-  }
+  if (IsLrfManifest(dataset_path))
+    return AdviseLrf(dataset_path, options, lrf_threshold_mm, flags.options.threads, json, out);
   if (!options.Check(&why)) {
     std::fprintf(stderr, "calibench advise: %s\n", why.c_str());
     return kUsage;

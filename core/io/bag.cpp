@@ -137,6 +137,11 @@ void Decompress(const std::string& method, std::span<const std::uint8_t> compres
   }
 }
 
+std::string CutShortAt(std::int64_t offset, std::int64_t size, const char* missing) {
+  return "cut short at byte " + std::to_string(offset) + " of " + std::to_string(size) + " (no " +
+         missing + ", the last record incomplete: its recorder did not close it); read up to there";
+}
+
 std::string JoinWords(const std::set<std::string>& words) {
   std::string text;
   for (const std::string& word : words) text += (text.empty() ? "" : ", ") + word;

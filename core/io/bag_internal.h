@@ -109,6 +109,10 @@ std::unique_ptr<BagReader> OpenRos1Bag(const std::filesystem::path& path, bool f
 std::unique_ptr<BagReader> OpenMcap(const std::filesystem::path& path, bool follow = false);
 std::unique_ptr<BagReader> OpenSqliteBag(const std::filesystem::path& path, bool follow = false);
 
+// BagReader::CutShort's words for a recording without `missing` ("index", "summary") whose record
+// at `offset` runs past the file's `size`.
+std::string CutShortAt(std::int64_t offset, std::int64_t size, const char* missing);
+
 // "bz2, lz4" for a listing's compressions; "none" when there are none.
 std::string JoinWords(const std::set<std::string>& words);
 

@@ -210,10 +210,7 @@ class Mcap final : public BagReader {
           continue;
         }
       }
-      cut_short_ = "cut short at byte " + std::to_string(offset) + " of " +
-                   std::to_string(size_bytes_) +
-                   " (no summary, the last record incomplete: its recorder did not close it); "
-                   "read up to there";
+      cut_short_ = CutShortAt(offset, size_bytes_, "summary");
       return offset;
     }
   }

@@ -262,10 +262,7 @@ class Ros1Bag final : public BagReader {
           }
         }
       }
-      cut_short_ = "cut short at byte " + std::to_string(offset) + " of " +
-                   std::to_string(size_bytes_) +
-                   " (no index, the last record incomplete: its recorder did not close it); read "
-                   "up to there";
+      cut_short_ = CutShortAt(offset, size_bytes_, "index");
       return offset;
     }
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 
 #include "core/io/bag_internal.h"
 
@@ -62,6 +63,53 @@ std::uint64_t ColumnBytes(std::uint64_t type) {
   return type >= 12 ? (type - 12) / 2 : 0;
 }
 
+// The record at `cell` of a table leaf page when it has the messages table's shape: the rowid,
+// then (NULL: the rowid alias), topic_id, timestamp, data (a blob); nullopt otherwise.
+std::optional<SqliteSalvage::Row> MessageRecordAt(const std::vector<std::uint8_t>& page,
+                                                  std::uint32_t cell, std::uint32_t usable,
+                                                  std::uint32_t number) {
+  const std::uint8_t* end = page.data() + usable;
+  // A table leaf's local share of a payload (the file format's X, M and K).
+  const std::uint64_t max_local = usable - 35;
+  const std::uint64_t min_local = (usable - 12) * 32 / 255 - 23;
+  const std::uint8_t* p = page.data() + cell;
+  std::uint64_t payload = 0, rowid = 0;
+  if (!Varint(p, end, &payload) || !Varint(p, end, &rowid) || payload > kMaxPayloadBytes)
+    return std::nullopt;
+  std::uint64_t local = payload;
+  if (payload > max_local) {
+    const std::uint64_t k = min_local + (payload - min_local) % (usable - 4);
+    local = k <= max_local ? k : min_local;
+  }
+  const std::uint8_t* record = p;
+  if (record + local + (local < payload ? 4 : 0) > end) return std::nullopt;
+  // The messages table's shape: (NULL: the rowid alias), topic_id, timestamp, data (a blob).
+  const std::uint8_t* h = record;
+  std::uint64_t header_bytes = 0;
+  if (!Varint(h, record + local, &header_bytes) || header_bytes > local) return std::nullopt;
+  std::uint64_t types[5] = {};
+  int columns = 0;
+  while (h < record + header_bytes && columns < 5)
+    if (!Varint(h, record + header_bytes, &types[columns++])) break;
+  if (columns != 4 || types[0] != 0 || types[3] < 12 || types[3] % 2 != 0) return std::nullopt;
+  const std::uint8_t* value = record + header_bytes;
+  SqliteSalvage::Row row;
+  if (!IntegerOf(types[1], value, record + local, &row.topic_id)) return std::nullopt;
+  value += ColumnBytes(types[1]);
+  if (!IntegerOf(types[2], value, record + local, &row.timestamp)) return std::nullopt;
+  value += ColumnBytes(types[2]);
+  if (header_bytes + ColumnBytes(types[1]) + ColumnBytes(types[2]) + ColumnBytes(types[3]) !=
+      payload)
+    return std::nullopt;
+  row.id = static_cast<std::int64_t>(rowid);
+  row.page = number;
+  row.cell = static_cast<std::uint32_t>(record - page.data());
+  row.payload = payload;
+  row.local = static_cast<std::uint32_t>(local);
+  row.data_at = static_cast<std::uint32_t>(value - record);
+  return row;
+}
+
 }  // namespace
 
 SqliteSalvage::SqliteSalvage(const std::filesystem::path& path)
@@ -77,9 +125,6 @@ SqliteSalvage::SqliteSalvage(const std::filesystem::path& path)
   usable_ = page_size_ - header[20];
   pages_ = static_cast<std::uint32_t>(file.Size() / page_size_);
   next_page_.assign(pages_ + 1, 0);
-  // A table leaf's local share of a payload (the file format's X, M and K).
-  const std::uint64_t max_local = usable_ - 35;
-  const std::uint64_t min_local = (usable_ - 12) * 32 / 255 - 23;
   std::vector<Row> found;
   std::vector<std::uint8_t> page;
   for (std::uint32_t number = 1; number <= pages_; ++number) {
@@ -88,48 +133,13 @@ SqliteSalvage::SqliteSalvage(const std::filesystem::path& path)
     const std::uint32_t at = number == 1 ? kFileHeaderBytes : 0;
     if (page[at] != kTableLeafPage) continue;
     const std::uint32_t cells = Big16(page.data() + at + 3);
-    const std::uint8_t* end = page.data() + usable_;
     for (std::uint32_t c = 0; c < cells; ++c) {
       const std::uint32_t pointer_at = at + kLeafHeaderBytes + 2 * c;
       if (pointer_at + 2 > usable_) break;
       const std::uint32_t cell = Big16(page.data() + pointer_at);
       if (cell < at + kLeafHeaderBytes || cell >= usable_) continue;
-      const std::uint8_t* p = page.data() + cell;
-      std::uint64_t payload = 0, rowid = 0;
-      if (!Varint(p, end, &payload) || !Varint(p, end, &rowid) || payload > kMaxPayloadBytes)
-        continue;
-      std::uint64_t local = payload;
-      if (payload > max_local) {
-        const std::uint64_t k = min_local + (payload - min_local) % (usable_ - 4);
-        local = k <= max_local ? k : min_local;
-      }
-      const std::uint8_t* record = p;
-      if (record + local + (local < payload ? 4 : 0) > end) continue;
-      // The messages table's shape: (NULL: the rowid alias), topic_id, timestamp, data (a blob).
-      const std::uint8_t* h = record;
-      std::uint64_t header_bytes = 0;
-      if (!Varint(h, record + local, &header_bytes) || header_bytes > local) continue;
-      std::uint64_t types[5] = {};
-      int columns = 0;
-      while (h < record + header_bytes && columns < 5)
-        if (!Varint(h, record + header_bytes, &types[columns++])) break;
-      if (columns != 4 || types[0] != 0 || types[3] < 12 || types[3] % 2 != 0) continue;
-      const std::uint8_t* value = record + header_bytes;
-      Row row;
-      if (!IntegerOf(types[1], value, record + local, &row.topic_id)) continue;
-      value += ColumnBytes(types[1]);
-      if (!IntegerOf(types[2], value, record + local, &row.timestamp)) continue;
-      value += ColumnBytes(types[2]);
-      if (header_bytes + ColumnBytes(types[1]) + ColumnBytes(types[2]) + ColumnBytes(types[3]) !=
-          payload)
-        continue;
-      row.id = static_cast<std::int64_t>(rowid);
-      row.page = number;
-      row.cell = static_cast<std::uint32_t>(record - page.data());
-      row.payload = payload;
-      row.local = static_cast<std::uint32_t>(local);
-      row.data_at = static_cast<std::uint32_t>(value - record);
-      found.push_back(row);
+      if (const std::optional<Row> row = MessageRecordAt(page, cell, usable_, number))
+        found.push_back(*row);
     }
   }
   std::sort(found.begin(), found.end(), [](const Row& a, const Row& b) { return a.id < b.id; });
