@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "app/commands.h"
+#include "app/progress_listener.h"
 #include "app/pipeline_flags.h"
 #include "core/io/bag.h"
 #include "core/io/bag_import.h"
@@ -74,6 +75,7 @@ ImportProgress ProgressBar() {
     if (phase != last) last_tenth = -1;
     last = phase;
     last_tenth = percent / 10;
+    NotifyProgress(phase, done, total, "");
   };
 }
 

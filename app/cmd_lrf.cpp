@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/pipeline_flags.h"
 #include "core/io/dataset_source.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/lrf/pipeline.h"
@@ -85,11 +86,16 @@ int RunLrfCalibrate(int argc, char** argv) {
     return kUsage;
   }
   const LrfDataset dataset = LoadLrfDataset(dataset_path);
-  const LrfCalibrationOutcome outcome = CalibrateLrfDataset(dataset, options);
+  const LrfCalibrationOutcome outcome =
+      CalibrateLrfDataset(dataset, options, StderrProgress("extracted"));
   std::printf("%s", FormatLrfSummary(outcome).c_str());
   bool input_error = false;
   for (const LrfPairFeatures& p : outcome.pairs) input_error |= p.input_error;
-  if (!outcome.solution) return input_error ? kInputError : kNoCalibration;
+  if (!outcome.solution) {
+    std::fprintf(stderr, "calibench lrf-calibrate: no calibration for %s: %s\n",
+                 dataset_path.c_str(), outcome.failure.c_str());
+    return input_error ? kInputError : kNoCalibration;
+  }
   if (!out_path.empty()) {
     WriteLrfResult(out_path, outcome, options);
     std::printf("wrote %s\n", out_path.c_str());

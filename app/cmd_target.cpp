@@ -158,11 +158,29 @@ int RunTarget(int argc, char** argv) {
   app.add_option("--orientation", orientation_name,
                  "auto (the one the pattern fits best) | portrait | landscape")
       ->capture_default_str();
-  app.add_option("--out,-o", out, "board.pdf or board.svg")->required();
+  bool list_presets = false;
+  app.add_flag("--list-presets", list_presets,
+               "print the named boards (name, pattern, sheet) and exit");
+  app.add_option("--out,-o", out, "board.pdf or board.svg (required unless --list-presets)");
   app.add_option("--target-json", target_json,
                  "where the matching target file goes (default: beside --out, named after it: "
                  "board.pdf -> board.target.json)");
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
+  if (list_presets) {
+    for (const std::string& name : BoardPresetNames()) {
+      const BoardSpec preset = BoardPreset(name);
+      const bool charuco = preset.type == BoardType::kCharuco;
+      std::printf("%-11s %s %d x %d %s of %.0f mm, sheet %.0f x %.0f mm\n", name.c_str(),
+                  charuco ? "charuco" : "checkerboard", preset.cols, preset.rows,
+                  charuco ? "squares" : "inner corners", preset.square_size * 1e3,
+                  preset.board_width * 1e3, preset.board_height * 1e3);
+    }
+    return kOk;
+  }
+  if (out.empty()) {
+    std::fprintf(stderr, "calibench target: --out is required (board.pdf or board.svg)\n");
+    return kUsage;
+  }
   pattern.type_given = app.count("--type") > 0;
 
   auto usage = [](const std::string& why) {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/progress_listener.h"
 #include "core/lidar_camera/joint_intrinsics.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/session/calibration_job.h"
@@ -150,6 +151,7 @@ ProgressCallback StderrProgress(const std::string& verb) {
                  verb.c_str(), id.c_str());
     if (tty && done == total) std::fprintf(stderr, "\n");
     std::fflush(stderr);
+    NotifyProgress(verb, done, total, id);
   };
 }
 
@@ -173,11 +175,16 @@ int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
   CalibrationOutcome outcome = job.Solve();
   std::printf("%s", FormatSummary(outcome).c_str());
   bool input_error = false;
-  for (const PairFeatures& p : outcome.pairs) input_error |= p.input_error;
+  std::string unreadable;  // "pair 0003: cannot read image '...': ..." per line
+  for (const PairFeatures& p : outcome.pairs) {
+    input_error |= p.input_error;
+    if (p.input_error) unreadable += "\n  pair " + p.id + ": " + p.reason;
+  }
   int code = kOk;
   if (!outcome.solution) {
-    std::fprintf(stderr, "calibench: no calibration for %s: %s\n",
-                 dataset.manifest.string().c_str(), outcome.failure.c_str());
+    std::fprintf(stderr, "calibench: no calibration for %s: %s%s%s\n",
+                 dataset.manifest.string().c_str(), outcome.failure.c_str(),
+                 input_error ? "; unreadable:" : "", unreadable.c_str());
     code = input_error ? kInputError : kNoCalibration;
   } else {
     if (!out_path.empty()) {
@@ -186,8 +193,9 @@ int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
     }
     if (input_error) {
       std::fprintf(stderr,
-                   "calibench: some pair files could not be read (see above); the result "
-                   "uses the remaining pairs\n");
+                   "calibench: some pair files could not be read; the result uses the remaining "
+                   "pairs:%s\n",
+                   unreadable.c_str());
       code = kInputError;
     } else if (!outcome.solution->observability.well_constrained) {
       std::fprintf(stderr,

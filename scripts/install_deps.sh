@@ -11,11 +11,14 @@ PACKAGES=(
   libglfw3-dev libimgui-dev libegl-dev libgl-dev libgles-dev libosmesa6-dev
   xvfb xauth fonts-dejavu-core
   libcairo2-dev libjs-chart.js chromium poppler-utils liburdfdom-tools
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib help2man
 )
-# Only for the robustness scripts: scripts/fuzz.sh (libFuzzer) and scripts/sanitize.sh (valgrind).
+# Only for the robustness scripts: scripts/fuzz.sh (libFuzzer) and scripts/sanitize.sh (valgrind);
+# and for scripts/package.sh (the .deb checked by lintian).
 case "${1:-}" in
   --fuzz) PACKAGES+=(clang-14 libclang-rt-14-dev) ;;
   --sanitize) PACKAGES+=(valgrind) ;;
+  --package) PACKAGES+=(dpkg-dev lintian fakeroot) ;;
 esac
 
 missing=()

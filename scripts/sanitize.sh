@@ -34,7 +34,7 @@ fi
 
 if [ $mode = thread ]; then
   cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCALIBENCH_SANITIZE=thread -DCALIBENCH_BUILD_BENCHMARKS=OFF >/dev/null
+    -DCALIBENCH_SANITIZE=thread -DCALIBENCH_BUILD_BENCHMARKS=OFF -DCALIBENCH_BUILD_PYTHON=OFF >/dev/null
   cmake --build build-tsan -j "$JOBS" --target calibench test_core test_ui
   export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/tsan.supp"
   ctest --test-dir build-tsan --output-on-failure -j "$JOBS" --timeout 1800 -L 'core|ui' "$@"
@@ -58,7 +58,8 @@ if [ $mode = ci ]; then
 fi
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=$build_type \
   -DCMAKE_CXX_FLAGS_CALIBENCHSANITIZECI="-O1" -DCALIBENCH_SANITIZE_DEBUG=$debug \
-  -DCALIBENCH_SANITIZE=address,undefined -DCALIBENCH_BUILD_BENCHMARKS=OFF >/dev/null
+  -DCALIBENCH_SANITIZE=address,undefined -DCALIBENCH_BUILD_BENCHMARKS=OFF \
+  -DCALIBENCH_BUILD_PYTHON=OFF >/dev/null  # an instrumented module would need ASan preloaded into python3
 cmake --build build-asan -j "$JOBS" "${targets[@]}"
 
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0"

@@ -136,8 +136,15 @@ BoardSpec BoardPreset(const std::string& name) {
     board.board_height = named.height;
     return board;
   }
-  throw std::invalid_argument("unknown board '" + name +
-                              "' (known: a3, a4, charuco-a3, charuco-a4, paper)");
+  std::string known;
+  for (const std::string& n : BoardPresetNames()) known += (known.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("unknown board '" + name + "' (known: " + known + ")");
+}
+
+std::vector<std::string> BoardPresetNames() {
+  std::vector<std::string> names;
+  for (const NamedBoard& named : kNamedBoards) names.emplace_back(named.name);
+  return names;
 }
 
 }  // namespace calibench

@@ -55,5 +55,7 @@ std::pair<int, int> PatternSquareAt(const BoardSpec& board, const Vec2& xy);
 // squares so that 4x4 markers decode at 3-4 m) and "paper" (Ca²Lib's 8x6 squares of 0.2 m).
 // Throws std::invalid_argument naming the known boards for any other name.
 BoardSpec BoardPreset(const std::string& name);
+// The names BoardPreset knows, in its order.
+std::vector<std::string> BoardPresetNames();
 
 }  // namespace calibench
