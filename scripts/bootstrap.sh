@@ -21,6 +21,9 @@ cmake --build "$BUILD_DIR" -j "$JOBS"
 demo_flags=()
 [ $run_tests -eq 1 ] && demo_flags+=(--no-gui)
 "$BUILD_DIR/calibench" demo --out "$BUILD_DIR/demo" "${demo_flags[@]}"
+# The same result from the Python module built beside it (python/, README "Python").
+PYTHONPATH="$BUILD_DIR/python" /usr/bin/python3 -c \
+  "import calibench; print('from Python:', calibench.load_result('$BUILD_DIR/demo/result.json'))"
 
 if [ $run_tests -eq 1 ]; then
   ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" --timeout 900

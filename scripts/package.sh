@@ -20,7 +20,7 @@ deb=$(ls "$BUILD_DIR"/calibench_*_amd64.deb)
 echo "package: $deb ($(du -h "$deb" | cut -f1))"
 dpkg-deb --field "$deb" Package Version Depends | sed 's/^/  /'
 echo "lintian:"
-lintian --no-tag-display-limit "$deb" | sed 's/^/  /' || true
+lintian --tag-display-limit 0 "$deb" | sed 's/^/  /' || true
 
 [ $verify -eq 1 ] || exit 0
 # A fresh Debian 12 (minbase: no compiler, no -dev package), the package installed by apt with
