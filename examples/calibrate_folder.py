@@ -35,8 +35,10 @@ def main() -> int:
     print(f"sigma translation [mm]: {np.round(result.std_t_m * 1e3, 2).tolist()}")
     print(f"sigma rotation [deg]:   {np.round(result.std_r_deg, 3).tolist()}")
     for pair in result.pairs:
-        if pair.status != "accepted" or pair.weight == 0.0:
-            print(f"  {pair.id}: {pair.status} {pair.reason}".rstrip())
+        if pair.status != "accepted":
+            print(f"  {pair.id}: {pair.status}: {pair.reason}")
+        elif pair.weight == 0.0:
+            print(f"  {pair.id}: accepted, but down-weighted to nothing by the robust kernel")
 
     if args.plot:
         import matplotlib.pyplot as plt

@@ -206,7 +206,8 @@ class Pair:
     status: str  # "accepted", or why not ("rejected", "failed", ...)
     reason: str  # why it is not used, or what was down-weighted ("" when nothing)
     weight: float  # the robust kernel's weight in the final iteration (0 = down-weighted to nothing)
-    residuals: np.ndarray  # the plane residual at the solution (normal rotation [3], distance [m])
+    residuals: np.ndarray  # Ca2Lib Eq. (6) at the solution: the planes' normal difference [3]
+    #                        (unitless, ~radians) and distance difference [m]; empty if not used
     document: Mapping[str, Any] = field(repr=False, compare=False)
 
 
