@@ -10,8 +10,8 @@
 #include <tuple>
 
 #include "app/commands.h"
-#include "app/progress_listener.h"
 #include "app/pipeline_flags.h"
+#include "app/progress_listener.h"
 #include "core/io/bag.h"
 #include "core/io/bag_import.h"
 #include "core/io/camera_file.h"

@@ -128,18 +128,8 @@ std::optional<BoardSpec> BoardFromPatternFlags(const PatternFlags& f, std::strin
   return board;
 }
 
-}  // namespace
-
-int RunTarget(int argc, char** argv) {
-  CLI::App app{
-      "Write a printable calibration board at exact scale (PDF or SVG through cairo) with a "
-      "100 mm ruler and a caption, and beside it the target file that `calibrate` reads "
-      "(board_size = the sheet; board.pdf -> board.target.json). ChArUco boards are OpenCV's for "
-      "the same parameters. Lengths "
-      "are metres or carry a unit: 0.04, 40mm, 4cm.",
-      "calibench target"};
-  PatternFlags pattern;
-  std::string paper_name = "a4", orientation_name = "auto", out, target_json;
+// The pattern's flags (BoardFromPatternFlags reads them).
+void AddPatternFlags(CLI::App& app, PatternFlags& pattern) {
   app.add_option("--type", pattern.type, "checkerboard | charuco")->capture_default_str();
   app.add_option("--preset", pattern.preset,
                  "start from a named board (a3, a4, charuco-a3, charuco-a4); other flags override "
@@ -154,6 +144,34 @@ int RunTarget(int argc, char** argv) {
                  "charuco: side of one marker (default 0.75 of the square)");
   app.add_option("--dictionary", pattern.dictionary, "charuco: OpenCV's ArUco dictionary")
       ->capture_default_str();
+}
+
+// `target --list-presets`: one line per named board (bash completion reads the first column).
+int PrintBoardPresets() {
+  for (const std::string& name : BoardPresetNames()) {
+    const BoardSpec preset = BoardPreset(name);
+    const bool charuco = preset.type == BoardType::kCharuco;
+    std::printf("%-11s %s %d x %d %s of %.0f mm, sheet %.0f x %.0f mm\n", name.c_str(),
+                charuco ? "charuco" : "checkerboard", preset.cols, preset.rows,
+                charuco ? "squares" : "inner corners", preset.square_size * 1e3,
+                preset.board_width * 1e3, preset.board_height * 1e3);
+  }
+  return kOk;
+}
+
+}  // namespace
+
+int RunTarget(int argc, char** argv) {
+  CLI::App app{
+      "Write a printable calibration board at exact scale (PDF or SVG through cairo) with a "
+      "100 mm ruler and a caption, and beside it the target file that `calibrate` reads "
+      "(board_size = the sheet; board.pdf -> board.target.json). ChArUco boards are OpenCV's for "
+      "the same parameters. Lengths "
+      "are metres or carry a unit: 0.04, 40mm, 4cm.",
+      "calibench target"};
+  PatternFlags pattern;
+  std::string paper_name = "a4", orientation_name = "auto", out, target_json;
+  AddPatternFlags(app, pattern);
   app.add_option("--paper", paper_name, PaperNames())->capture_default_str();
   app.add_option("--orientation", orientation_name,
                  "auto (the one the pattern fits best) | portrait | landscape")
@@ -166,17 +184,7 @@ int RunTarget(int argc, char** argv) {
                  "where the matching target file goes (default: beside --out, named after it: "
                  "board.pdf -> board.target.json)");
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
-  if (list_presets) {
-    for (const std::string& name : BoardPresetNames()) {
-      const BoardSpec preset = BoardPreset(name);
-      const bool charuco = preset.type == BoardType::kCharuco;
-      std::printf("%-11s %s %d x %d %s of %.0f mm, sheet %.0f x %.0f mm\n", name.c_str(),
-                  charuco ? "charuco" : "checkerboard", preset.cols, preset.rows,
-                  charuco ? "squares" : "inner corners", preset.square_size * 1e3,
-                  preset.board_width * 1e3, preset.board_height * 1e3);
-    }
-    return kOk;
-  }
+  if (list_presets) return PrintBoardPresets();
   if (out.empty()) {
     std::fprintf(stderr, "calibench target: --out is required (board.pdf or board.svg)\n");
     return kUsage;

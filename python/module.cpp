@@ -28,7 +28,8 @@ class CapturedDescriptor {
  public:
   explicit CapturedDescriptor(int fd) : fd_(fd), file_(std::tmpfile()), saved_(dup(fd)) {
     if (file_ == nullptr || saved_ < 0)
-      throw std::runtime_error("calibench: cannot capture the command's output (no temporary file)");
+      throw std::runtime_error(
+          "calibench: cannot capture the command's output (no temporary file)");
     Resume();
   }
   CapturedDescriptor(const CapturedDescriptor&) = delete;

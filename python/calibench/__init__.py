@@ -232,7 +232,7 @@ class Result:
         """What the solve printed on stderr (progress, warnings)."""
 
     def _matrix(self, key: str) -> np.ndarray:
-        for name in (key, key.replace("lidar", "lrf"), key.replace("lidar", "source")):
+        for name in (key, key.replace("lidar", "lrf")):  # an LRF result: cam_from_lrf
             if name in self.document:
                 m = np.array(self.document[name]["matrix"], dtype=float)
                 m.setflags(write=False)
