@@ -29,6 +29,9 @@ constexpr Command kCommands[] = {
     {"advise", RunAdvise,
      "is the capture enough for the goal (σ per axis, stop rule), and where to hold the board "
      "next"},
+    {"check", RunCheck,
+     "is a calibration still right? judged from the scene without a target: consistent, "
+     "miscalibrated (with an estimate and its sigma) or cannot tell (and along which axis)"},
     {"watch", RunWatch,
      "follow a capture while it is written (a growing folder): per pair, accept/reject, σ against "
      "the goal, the next pose"},

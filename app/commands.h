@@ -55,6 +55,8 @@ CLI::Option* AddBoardOption(CLI::App& app, std::string* board, const std::string
 int RunCalibrate(int argc, char** argv);
 int RunAdvise(int argc, char** argv);
 int RunWatch(int argc, char** argv);
+// `check`: a calibration judged without a target (core/targetless).
+int RunCheck(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
 // `evaluate --subsets`: the σ-honesty protocol (core/sim/subset_coverage.h).
 int RunEvaluateSubsets(int argc, char** argv);

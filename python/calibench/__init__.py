@@ -33,7 +33,7 @@ from . import _calibench
 
 __all__ = [
     "AccuracyError", "Error", "InputError", "NoCalibrationError", "NotConstrainedError", "Pair",
-    "Progress", "Result", "UsageError", "__version__", "advise", "calibrate", "commands",
+    "Progress", "Result", "UsageError", "__version__", "advise", "calibrate", "check", "commands",
     "import_recording", "load_result", "lrf_calibrate", "report", "run",
 ]
 
@@ -381,6 +381,31 @@ def advise(dataset: PathLike, *, progress: Optional[Progress] = None,
     run_ = _check(_run("advise", ["--dataset", os.fspath(dataset), "--json"] +
                        _flag_args(options), progress))
     return json.loads(run_.out)
+
+
+def check(dataset: PathLike, result: Union[Result, PathLike], *,
+          write_result: Optional[PathLike] = None, progress: Optional[Progress] = None,
+          **options: Any) -> dict[str, Any]:
+    """`calibench check --json`: is a calibration still right, judged from the scene without a
+    target. ``dataset`` is a folder, manifest or recording; ``result`` a Result or its file.
+    Options as the command's (``search_deg``, ``search_m``, ``tolerance_deg``, ``tolerance_m``,
+    ``max_frames``, ...). Returns the documented object: ``verdict`` ("consistent",
+    "miscalibrated" or "cannot tell"), ``why``, ``frames_used``, ``cam_from_lidar`` (4x4 numpy,
+    None without an estimate), ``sigma_t_mm``, ``sigma_r_deg``, ``change_t_mm``,
+    ``change_r_deg``, ``unconstrained_axes``. ``write_result`` saves the estimate as a result file
+    (its provenance says targetless); load it with load_result."""
+    with tempfile.TemporaryDirectory(prefix="calibench-") as tmp:
+        if isinstance(result, Result):
+            result = result.save(Path(tmp) / "result.json")
+        args = ["--dataset", os.fspath(dataset), "--result", os.fspath(result), "--json"]
+        if write_result is not None:
+            args += ["--write-result", os.fspath(write_result)]
+        run_ = _check(_run("check", args + _flag_args(options), progress))
+    out = json.loads(run_.out)
+    for key in ("cam_from_lidar", "reference_cam_from_lidar"):
+        if out.get(key) is not None:
+            out[key] = np.array(out[key], dtype=float)
+    return out
 
 
 def report(out: PathLike, result: Union[Result, PathLike], *, dataset: Optional[PathLike] = None,

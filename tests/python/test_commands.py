@@ -1,4 +1,5 @@
-"""calibench.import_recording, advise, report, lrf_calibrate, run: each the command's own work."""
+"""calibench.import_recording, advise, check, report, lrf_calibrate, run: each the command's own
+work."""
 import json
 import os
 import subprocess
@@ -169,3 +170,32 @@ def test_the_installed_package_works_from_its_files_alone(tmp_path):
                              env=env, cwd=elsewhere, check=True).stdout
     assert f"assets: {prefix / 'share/calibench/assets'}" in printed, printed
     assert str(site / "calibench/__init__.py") in printed
+
+
+def test_check_judges_a_calibration_as_the_command_line_does(exe, acfr, tmp_path):
+    result = calibench.calibrate(acfr, out=tmp_path / "result.json")
+    printed = cli(exe, "check", "--dataset", acfr, "--result", tmp_path / "result.json", "--json")
+    assert printed.returncode == 0, printed.stderr
+    expected = json.loads(printed.stdout)
+    verdict = calibench.check(acfr, result, write_result=tmp_path / "targetless.json")
+    assert verdict["verdict"] == expected["verdict"] == "consistent", verdict["why"]
+    assert verdict["frames_used"] == 40
+    np.testing.assert_array_equal(verdict["cam_from_lidar"], np.array(expected["cam_from_lidar"]))
+    # The estimate saved as a result, its provenance targetless, readable as any result.
+    saved = calibench.load_result(tmp_path / "targetless.json")
+    np.testing.assert_allclose(saved.cam_from_lidar, verdict["cam_from_lidar"], atol=1e-12)
+    assert saved.document["provenance"]["kind"] == "targetless"
+    # A calibration moved by 1 degree about the camera's y axis: miscalibrated, and corrected.
+    moved = result.document.copy()
+    turn = np.eye(4)
+    c, s = np.cos(np.radians(1.0)), np.sin(np.radians(1.0))
+    turn[0, 0], turn[0, 2], turn[2, 0], turn[2, 2] = c, s, -s, c
+    moved_matrix = turn @ result.cam_from_lidar
+    moved["cam_from_lidar"] = {"matrix": moved_matrix.tolist()}
+    moved["lidar_from_cam"] = {"matrix": np.linalg.inv(moved_matrix).tolist()}
+    (tmp_path / "moved.json").write_text(json.dumps(moved))
+    off = calibench.check(acfr, tmp_path / "moved.json")
+    assert off["verdict"] == "miscalibrated", off["why"]
+    assert abs(off["change_r_deg"][1] + 1.0) < 0.5
+    with pytest.raises(calibench.InputError):
+        calibench.check(tmp_path / "nowhere", result)

@@ -1,0 +1,113 @@
+// The check's report as text, as the `check --json` object (docs/targetless.md "Output"), and as
+// a calibench.result.v1 file whose provenance says targetless.
+#include "core/targetless/check_output.h"
+
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "core/estimation/uncertainty.h"
+#include "core/results/result_json.h"
+
+namespace calibench {
+namespace {
+
+nlohmann::json Matrix(const Mat4& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+  return rows;
+}
+
+nlohmann::json Triple(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+std::string Line(const char* format, const Vec3& v) {
+  char buffer[160];
+  std::snprintf(buffer, sizeof buffer, format, v.x(), v.y(), v.z());
+  return buffer;
+}
+
+}  // namespace
+
+std::string FormatCheckReport(const CheckReport& report) {
+  std::string out = "verdict: " + CheckVerdictName(report.verdict) + "\n";
+  out += "why: " + report.why + "\n";
+  char buffer[160];
+  std::snprintf(buffer, sizeof buffer, "frames used: %d of %d\n", report.frames_used,
+                report.frames_given);
+  out += buffer;
+  if (!report.has_estimate) return out;
+  std::snprintf(buffer, sizeof buffer,
+                "alignment: %s, rms %.2f sigma; independent parts disagree %.1fx beyond their "
+                "sigma (sigma scaled by it)\n",
+                report.alignment.converged ? "converged" : "NOT converged",
+                report.alignment.rms_sigma, std::sqrt(report.model_dispersion));
+  out += buffer;
+  out += Line("change from the calibration: t [%+.1f %+.1f %+.1f] mm", report.change_t_m * 1e3);
+  out += Line(", r [%+.3f %+.3f %+.3f] deg (camera axes)\n", report.change_r_deg);
+  out += Line("targetless estimate sigma:   t [%.1f %.1f %.1f] mm", report.sigma_t_m * 1e3);
+  out += Line(", r [%.3f %.3f %.3f] deg\n", report.sigma_r_deg);
+  const Mat4 m = report.estimate.matrix();
+  out += "targetless cam_from_lidar:\n";
+  for (int r = 0; r < 3; ++r) {
+    std::snprintf(buffer, sizeof buffer, "  [% .6f % .6f % .6f % .5f]\n", m(r, 0), m(r, 1), m(r, 2),
+                  m(r, 3));
+    out += buffer;
+  }
+  return out;
+}
+
+std::string CheckReportJson(const CheckReport& report) {
+  nlohmann::json j;
+  j["verdict"] = CheckVerdictName(report.verdict);
+  j["frames_used"] = report.frames_used;
+  j["frames_given"] = report.frames_given;
+  j["why"] = report.why;
+  std::vector<std::string> axes;
+  for (int a : report.unconstrained_axes) axes.push_back(CameraAxisName(a));
+  j["unconstrained_axes"] = axes;
+  j["reference_cam_from_lidar"] = Matrix(report.reference.matrix());
+  if (report.has_estimate) {
+    j["cam_from_lidar"] = Matrix(report.estimate.matrix());
+    j["sigma_t_mm"] = Triple(report.sigma_t_m * 1e3);
+    j["sigma_r_deg"] = Triple(report.sigma_r_deg);
+    j["change_t_mm"] = Triple(report.change_t_m * 1e3);
+    j["change_r_deg"] = Triple(report.change_r_deg);
+    j["change_sigmas"] = report.change_sigmas;
+    j["model_dispersion"] = report.model_dispersion;
+    j["matched_edges"] = report.alignment.points_matched;
+    j["image_cells"] = report.alignment.clusters;
+  } else {
+    for (const char* key : {"cam_from_lidar", "sigma_t_mm", "sigma_r_deg", "change_t_mm",
+                            "change_r_deg", "change_sigmas"})
+      j[key] = nullptr;
+    j["matched_edges"] = report.alignment.points_matched;
+    j["image_cells"] = report.alignment.clusters;
+  }
+  j["axes"] = "camera axes: x right, y down, z forward; change = estimate minus the calibration";
+  return j.dump();
+}
+
+void WriteCheckResult(const std::filesystem::path& path, const CheckReport& report,
+                      const std::filesystem::path& checked_result) {
+  CALIBENCH_CHECK(report.has_estimate);
+  const Mat6 right = RightPerturbationCovariance(report.covariance, report.estimate);
+  ObservabilityReport observability;
+  observability.well_constrained = report.unconstrained_axes.empty();
+  for (int a : report.unconstrained_axes)
+    observability.weak_directions.push_back(CameraAxisName(a));
+  nlohmann::json root = ResultHeaderJson(ResultNames{}, report.estimate, right, observability);
+  root["method"] = "targetless";
+  root["provenance"] = {
+      {"kind", "targetless"},
+      {"text", "estimated without a target by `calibench check` from the scene's edges, around " +
+                   checked_result.string()},
+      {"checked_result", checked_result.string()},
+      {"verdict", CheckVerdictName(report.verdict)},
+      {"why", report.why},
+      {"frames_used", report.frames_used},
+      {"frames", report.frame_ids}};
+  root["pairs"] = nlohmann::json::array();
+  WriteResultJson(path, root);
+}
+
+}  // namespace calibench
