@@ -140,9 +140,14 @@ int RunCheck(int argc, char** argv) {
   Mat6 reference_covariance;
   const Pose reference = ReferenceOf(f.result, &reference_covariance);
   const ProgressCallback progress = StderrProgress("read");
-  const CheckInput input = LoadCheckInput(
-      f.dataset, f.check, f.input,
-      [&](int done, int total, const std::string& id) { progress(done, total, id); });
+  const CheckInput input =
+      LoadCheckInput(f.dataset, f.check, f.input, [&](int done, int total, const std::string& id) {
+        // A recording's frame count is known only at its end.
+        if (total > 0)
+          progress(done, total, id);
+        else
+          std::fprintf(stderr, "[%d] read frame %s\n", done, id.c_str());
+      });
   for (const std::string& problem : input.unreadable)
     std::fprintf(stderr, "calibench check: skipped %s\n", problem.c_str());
   const CheckReport report =

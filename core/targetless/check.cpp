@@ -167,8 +167,12 @@ void Decide(const CheckOptions& options, const Mat6& reference_covariance, Check
                   " to the tolerance (" +
                   Fmt("%.2f deg / %.0f mm", options.tolerance_deg, 1e3 * options.tolerance_m) +
                   "): its edges do not constrain " +
-                  (report->unconstrained_axes.size() > 1 ? "them" : "it") + "; the other axes " +
-                  (significant ? "moved by " + change : "agree") + " (" + evidence +
+                  (report->unconstrained_axes.size() > 1 ? "them" : "it") +
+                  (report->unconstrained_axes.size() == 6
+                       ? std::string()
+                       : std::string("; the other axes ") +
+                             (significant ? "moved by " + change : "agree with it")) +
+                  " (" + evidence +
                   "). A scene with edges at several depths and in several directions "
                   "(near objects, vertical and horizontal structure) can tell";
   }
