@@ -390,8 +390,9 @@ int RunRender(int argc, char** argv) {
   app.add_flag("--solve", solve, "run the solver before drawing");
   app.add_option("--view", view,
                  "lidar | camera | 3d | workbench | guide (the camera and 3D views with the ghost "
-                 "board where to hold the board next, and the meter; with --solve) (LRF "
-                 "datasets: scan | depth | 3d | workbench)")
+                 "board where to hold the board next, and the meter; with --solve) | check (the "
+                 "targetless check of --result: the LiDAR's edges on the image under it and "
+                 "under the estimate) (LRF datasets: scan | depth | 3d | workbench)")
       ->capture_default_str();
   app.add_option("--size", size, "WxH")->capture_default_str();
   app.add_option("--out,-o", out, "PNG file")->required();
@@ -409,8 +410,11 @@ int RunRender(int argc, char** argv) {
   app.add_flag("--intrinsics", intrinsics,
                "LiDAR-camera: open the camera-intrinsics window, estimated from the loaded pairs "
                "(coverage map, per-image error, sigma)");
+  std::string result;
+  app.add_option("--result,-r", result, "with --view check: the calibration to check");
   int width = 0, height = 0;
   if (const auto code = ParseFlags(app, argc, argv, size, "render", &width, &height)) return *code;
+  if (view == "check") return RenderCheckView(dataset, result, pair, out);
   return RenderHeadless(dataset, session, pair, solve, view, width, height, out, gl, save_session,
                         intrinsics, camera);
 }

@@ -3,6 +3,7 @@
 // estimate (green), for `render --view check`, the report and the workbench's check panel.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "core/base/image.h"
@@ -18,8 +19,10 @@ struct OverlayPose {
 };
 
 // The image (grey, darkened so that coloured points stand out) with every LiDAR edge of the frame
-// drawn at each pose, the first pose underneath.
+// drawn at each pose, the first pose underneath; `caption` lines, when given, on a dark band at
+// the top.
 ImageU8 DrawEdgeOverlay(const ImageU8& image, const std::vector<SceneEdgePoint>& lidar_edges,
-                        const CameraModel& camera, const std::vector<OverlayPose>& poses);
+                        const CameraModel& camera, const std::vector<OverlayPose>& poses,
+                        const std::vector<std::string>& caption = {});
 
 }  // namespace calibench

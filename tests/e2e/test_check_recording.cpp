@@ -1,11 +1,12 @@
 // `calibench check` on a recording read directly (an MCAP written by the test-side writer from the
 // simulator: a VLP-16 and a camera streaming while a board is held at 4 poses), against the
 // calibration of the same capture imported as a folder: the same frames either way, one JSON
-// object on stdout, exit 0 whatever the verdict.
+// object on stdout, exit 0 whatever the verdict; and `render --view check` of one of its pairs.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
+#include "core/io/image_io.h"
 #include "tests/bag_writers.h"
 #include "tests/sim_recording.h"
 #include "tests/test_support.h"
@@ -49,6 +50,25 @@ TEST(CheckRecording, AnMcapIsCheckedDirectlyWithOneJsonObjectOnStdout) {
   // A small room with a board and blank walls: this scene fixes little, and says so.
   EXPECT_EQ(verdict, "cannot tell") << j["why"];
   EXPECT_FALSE(j["unconstrained_axes"].empty());
+
+  // `render --view check`: one pair's image with the edges under R and the estimate, headless
+  // without OpenGL.
+  const auto png = dir / "check.png";
+  ASSERT_EQ(
+      test::RunCommand(exe + " render --view check --dataset " + (dir / "folder").string() +
+                           " --result " + (dir / "result.json").string() + " --out " + png.string(),
+                       &out),
+      0)
+      << out;
+  const ImageU8 drawn = LoadImage(png);
+  EXPECT_EQ(drawn.channels, 3);
+  EXPECT_GT(drawn.width, 0);
+  EXPECT_NE(out.find("check, pair"), std::string::npos) << out;
+  EXPECT_NE(test::RunCommand(exe + " render --view check --dataset " + (dir / "folder").string() +
+                                 " --out " + png.string(),
+                             &out),
+            0);
+  EXPECT_NE(out.find("needs --dataset and --result"), std::string::npos) << out;
 }
 
 }  // namespace
