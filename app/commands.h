@@ -58,8 +58,8 @@ int RunWatch(int argc, char** argv);
 // `check`: a calibration judged without a target (core/targetless).
 int RunCheck(int argc, char** argv);
 // `render --view check`: one pair's image with the LiDAR's edges under R and under the estimate.
-int RenderCheckView(const std::string& dataset, const std::string& result,
-                    const std::string& pair, const std::string& out);
+int RenderCheckView(const std::string& dataset, const std::string& result, const std::string& pair,
+                    const std::string& out);
 int RunEvaluate(int argc, char** argv);
 // `evaluate --subsets`: the σ-honesty protocol (core/sim/subset_coverage.h).
 int RunEvaluateSubsets(int argc, char** argv);

@@ -24,7 +24,7 @@ struct Match {
 // does not project into the image or has no image edge near.
 bool MatchEdge(const SceneEdgePoint& edge, const ImageEdgeMap& image_edges,
                const CameraModel& camera, const Pose& cam_from_lidar, double radius_px,
-               const EdgeAlignmentOptions& options, bool* projected, Match* match) {
+               const EdgeAlignmentOptions& options, int cells_x, bool* projected, Match* match) {
   const Vec3 rotated = cam_from_lidar.linear() * edge.point;
   const Vec3 in_cam = rotated + cam_from_lidar.translation();
   Eigen::Matrix<double, 2, 3> d_pixel;
@@ -47,6 +47,8 @@ bool MatchEdge(const SceneEdgePoint& edge, const ImageEdgeMap& image_edges,
   match->j = nearest->normal.transpose() * d_pixel * d_point / sigma;
   const double a = std::abs(match->z);
   match->weight = a <= options.huber_k ? 1.0 : options.huber_k / a;
+  match->cluster = static_cast<long>(pixel->y() / options.cluster_px) * cells_x +
+                   static_cast<long>(pixel->x() / options.cluster_px);
   return true;
 }
 
@@ -70,15 +72,10 @@ std::vector<FrameMatches> MatchAll(const std::vector<EdgeFrame>& frames, const C
                   ++out[f].considered;
                   bool projected = false;
                   Match m;
-                  const bool ok = MatchEdge(edge, frames[f].image_edges, camera, pose, radius_px,
-                                            options, &projected, &m);
+                  if (MatchEdge(edge, frames[f].image_edges, camera, pose, radius_px, options,
+                                cells_x, &projected, &m))
+                    out[f].matches.push_back(m);
                   out[f].projected += projected;
-                  if (!ok) continue;
-                  const Vec3 in_cam = pose * edge.point;
-                  const Vec2 pixel = *camera.Project(in_cam);
-                  m.cluster = static_cast<long>(pixel.y() / options.cluster_px) * cells_x +
-                              static_cast<long>(pixel.x() / options.cluster_px);
-                  out[f].matches.push_back(m);
                 }
               });
   return out;
@@ -141,126 +138,148 @@ double AlignmentCost(const std::vector<EdgeFrame>& frames, const CameraModel& ca
                 options.final_radius_px, options);
 }
 
+namespace {
+
+// What every level of one alignment shares.
+struct AlignmentProblem {
+  const std::vector<EdgeFrame>& frames;
+  const CameraModel& camera;
+  const EdgeAlignmentOptions& options;
+  Pose prior_centre;
+  Mat6 prior;  // the search window as information 1/σ² per axis
+  double fx = 0.0;
+
+  double Cost(const Pose& pose, double radius, std::vector<FrameMatches>* matches) const {
+    *matches = MatchAll(frames, camera, pose, radius, options);
+    const Vec6 d = DeltaOnCameraAxes(prior_centre, pose);
+    return CostOf(*matches, radius, options) + 0.5 * d.dot(prior * d);
+  }
+};
+
+// One level of the coarse-to-fine schedule: iterates from *pose at this matching radius; leaves
+// the pose reached and its matches (always the matches of that pose). True when it converged.
+//
+// Levenberg–Marquardt on the coarse levels: a step is kept only when the robust cost at this
+// radius (an edge without a match, or out of view, at the cap) with the prior falls. Without that
+// test a direction the edges barely fix drifts with the correspondences' noise, iteration after
+// iteration, until the edges slide off each other. The final radius takes Gauss–Newton's steps as
+// they come: correspondences within a few pixels change from step to step, and a cost test there
+// stops short of the minimum.
+bool SolveLevel(const AlignmentProblem& problem, double radius, bool final_level, Pose* pose,
+                std::vector<FrameMatches>* matches) {
+  const EdgeAlignmentOptions& options = problem.options;
+  // Coarse levels only bring the edges near: fewer iterations, a looser stop. The final stop
+  // (0.1 mm, 0.0006 deg) lies far below any σ the edges give.
+  const int iterations = final_level ? options.max_iterations_per_level
+                                     : std::min(15, options.max_iterations_per_level);
+  const double stop_m = final_level ? 1e-4 : 1e-3, stop_rad = final_level ? 1e-5 : 1e-4;
+  double cost = problem.Cost(*pose, radius, matches);
+  double lambda = 1e-4;
+  for (int it = 0; it < iterations; ++it) {
+    Mat6 h = problem.prior;
+    Vec6 g = problem.prior * DeltaOnCameraAxes(problem.prior_centre, *pose);
+    int n = 0;
+    for (const FrameMatches& f : *matches) {
+      for (const Match& m : f.matches) {
+        h += m.weight * m.j.transpose() * m.j;
+        g += m.weight * m.j.transpose() * m.z;
+        ++n;
+      }
+    }
+    if (n < 12) return false;
+    Mat6 damped = h;
+    damped.diagonal() *= 1.0 + lambda;
+    Vec6 delta = -damped.ldlt().solve(g);
+    if (!delta.allFinite()) return false;
+    // A step never moves the edges farther than the matching radius: beyond it the matches it
+    // was computed from say nothing.
+    const double reach = radius / problem.fx;
+    delta /= std::max({1.0, delta.tail<3>().norm() / reach,
+                       delta.head<3>().norm() / (reach * options.typical_depth_m)});
+    const bool small = delta.head<3>().norm() < stop_m && delta.tail<3>().norm() < stop_rad;
+    const Pose candidate = PerturbOnCameraAxes(*pose, delta);
+    std::vector<FrameMatches> candidate_matches;
+    const double candidate_cost = problem.Cost(candidate, radius, &candidate_matches);
+    if (candidate_cost <= cost || final_level) {
+      *pose = candidate, *matches = std::move(candidate_matches), cost = candidate_cost;
+      lambda = std::max(1e-7, lambda / 3);
+      if (small) return true;
+    } else {
+      lambda *= 10;
+      // No smaller step lowers the cost: this is the minimum at this radius.
+      if (small || lambda > 1e4) return true;
+    }
+  }
+  return false;
+}
+
+// The figures of an alignment from the final radius' matches: counts, the information and the
+// cluster-robust sandwich covariance, the prior counted as one more observation.
+void Summarise(const std::vector<FrameMatches>& matches, const Mat6& prior, EdgeAlignment* out) {
+  std::unordered_map<long, Vec6> per_cluster;
+  double sum_sq = 0.0;
+  for (const FrameMatches& f : matches) {
+    out->points_projected += f.projected;
+    out->matched_per_frame.push_back(static_cast<int>(f.matches.size()));
+    for (const Match& m : f.matches) {
+      out->information += m.weight * m.j.transpose() * m.j;
+      auto [it, inserted] = per_cluster.try_emplace(m.cluster, Vec6::Zero());
+      it->second += m.weight * m.j.transpose() * m.z;
+      sum_sq += m.z * m.z;
+      ++out->points_matched;
+    }
+  }
+  out->clusters = static_cast<int>(per_cluster.size());
+  out->rms_sigma = out->points_matched > 0 ? std::sqrt(sum_sq / out->points_matched) : 0.0;
+  if (out->clusters <= 6) return;
+  Mat6 meat = Mat6::Zero();
+  for (const auto& [cluster, g] : per_cluster) meat += g * g.transpose();
+  meat *= static_cast<double>(out->clusters) / (out->clusters - 6);
+  meat += prior;
+  out->information += prior;
+  const Mat6 h_inv = out->information.inverse();
+  out->covariance = h_inv * meat * h_inv.transpose();
+  out->covariance = 0.5 * (out->covariance + out->covariance.transpose());
+}
+
+}  // namespace
+
 EdgeAlignment AlignEdges(const std::vector<EdgeFrame>& frames, const CameraModel& camera,
                          const Pose& start, const EdgeAlignmentOptions& options,
                          double first_radius_px, const Pose* prior_centre) {
-  const Pose centre = prior_centre ? *prior_centre : start;
-  // Coarse to fine: the first radius covers the search window's reach in the image.
-  const double fx = std::max(camera.fx, camera.fy);
-  double radius = std::max(options.final_radius_px,
-                           first_radius_px > 0 ? first_radius_px
-                                               : fx * (options.search_deg * kDegToRad +
-                                                       options.search_m / options.typical_depth_m));
-  EdgeAlignment out;
-  Pose pose = start;
-  // The search window as a prior about the start (information 1/σ² per axis): a direction the
-  // edges do not constrain stays where the calibration put it, with the window as its σ, instead
-  // of running off.
+  // The search window as a prior about R (information 1/σ² per axis): a direction the edges do
+  // not constrain stays where the calibration put it, with the window as its σ, instead of
+  // running off.
   Vec6 prior_information;
   prior_information << Vec3::Constant(1.0 / std::pow(std::max(options.search_m, 1e-4), 2)),
       Vec3::Constant(1.0 / std::pow(std::max(options.search_deg, 1e-3) * kDegToRad, 2));
-  const Mat6 prior = prior_information.asDiagonal();
+  const AlignmentProblem problem{frames,
+                                 camera,
+                                 options,
+                                 prior_centre ? *prior_centre : start,
+                                 prior_information.asDiagonal(),
+                                 std::max(camera.fx, camera.fy)};
+  // Coarse to fine: the first radius covers the search window's reach in the image.
+  double radius =
+      std::max(options.final_radius_px,
+               first_radius_px > 0 ? first_radius_px
+                                   : problem.fx * (options.search_deg * kDegToRad +
+                                                   options.search_m / options.typical_depth_m));
+  EdgeAlignment out;
+  Pose pose = start;
   std::vector<FrameMatches> matches;
   while (true) {
     const bool final_level = radius <= options.final_radius_px * 1.0001;
-    bool level_converged = false;
-    // Coarse levels only bring the edges near: fewer iterations, a looser stop. The final stop
-    // (0.1 mm, 0.0006 deg) lies far below any σ the edges give.
-    const int iterations = final_level ? options.max_iterations_per_level
-                                       : std::min(15, options.max_iterations_per_level);
-    const double stop_m = final_level ? 1e-4 : 1e-3, stop_rad = final_level ? 1e-5 : 1e-4;
-    // Levenberg–Marquardt on the coarse levels: a step is kept only when the robust cost at this
-    // radius (an edge without a match, or out of view, at the cap) with the prior falls. Without
-    // that test a direction the edges barely fix drifts with the correspondences' noise, iteration
-    // after iteration, until the edges slide off each other.
-    auto cost_of = [&](const Pose& p, std::vector<FrameMatches>* m) {
-      *m = MatchAll(frames, camera, p, radius, options);
-      const Vec6 d = DeltaOnCameraAxes(centre, p);
-      return CostOf(*m, radius, options) + 0.5 * d.dot(prior * d);
-    };
-    double cost = cost_of(pose, &matches);
-    double lambda = 1e-4;
-    for (int it = 0; it < iterations; ++it) {
-      Mat6 h = Mat6::Zero();
-      Vec6 g = Vec6::Zero();
-      int n = 0;
-      for (const FrameMatches& f : matches) {
-        for (const Match& m : f.matches) {
-          h += m.weight * m.j.transpose() * m.j;
-          g += m.weight * m.j.transpose() * m.z;
-          ++n;
-        }
-      }
-      if (n < 12) break;
-      h += prior;
-      g += prior * DeltaOnCameraAxes(centre, pose);
-      Mat6 damped = h;
-      damped.diagonal() *= 1.0 + lambda;
-      Vec6 delta = -damped.ldlt().solve(g);
-      if (!delta.allFinite()) break;
-      // A step never moves the edges farther than the matching radius: beyond it the matches it
-      // was computed from say nothing.
-      const double reach = radius / fx;
-      const double scale = std::max({1.0, delta.tail<3>().norm() / reach,
-                                     delta.head<3>().norm() / (reach * options.typical_depth_m)});
-      delta /= scale;
-      const bool small = delta.head<3>().norm() < stop_m && delta.tail<3>().norm() < stop_rad;
-      const Pose candidate = PerturbOnCameraAxes(pose, delta);
-      std::vector<FrameMatches> candidate_matches;
-      const double candidate_cost = cost_of(candidate, &candidate_matches);
-      // The final radius takes Gauss–Newton's steps as they come: correspondences within a few
-      // pixels change from step to step, and a cost test there stops short of the minimum.
-      if (candidate_cost <= cost || final_level) {
-        pose = candidate, matches = std::move(candidate_matches), cost = candidate_cost;
-        lambda = std::max(1e-7, lambda / 3);
-        if (small) {
-          level_converged = true;
-          break;
-        }
-      } else {
-        lambda *= 10;
-        // No smaller step lowers the cost: this is the minimum at this radius.
-        if (small || lambda > 1e4) {
-          level_converged = true;
-          break;
-        }
-      }
-    }
+    const bool converged = SolveLevel(problem, radius, final_level, &pose, &matches);
     if (final_level) {
-      out.converged = level_converged;
+      out.converged = converged;
       break;
     }
     radius = std::max(options.final_radius_px, 0.5 * radius);
   }
-  // The figures at the estimate, with the correspondences of the final radius.
-  matches = MatchAll(frames, camera, pose, options.final_radius_px, options);
+  // `matches` are the final radius' at `pose`.
   out.cam_from_lidar = pose;
-  std::unordered_map<long, Vec6> per_cluster;
-  double sum_sq = 0.0;
-  for (const FrameMatches& f : matches) {
-    out.points_projected += f.projected;
-    out.matched_per_frame.push_back(static_cast<int>(f.matches.size()));
-    for (const Match& m : f.matches) {
-      out.information += m.weight * m.j.transpose() * m.j;
-      auto [it, inserted] = per_cluster.try_emplace(m.cluster, Vec6::Zero());
-      it->second += m.weight * m.j.transpose() * m.z;
-      sum_sq += m.z * m.z;
-      ++out.points_matched;
-    }
-  }
-  out.clusters = static_cast<int>(per_cluster.size());
-  out.rms_sigma = out.points_matched > 0 ? std::sqrt(sum_sq / out.points_matched) : 0.0;
-  if (out.clusters > 6) {
-    Mat6 meat = Mat6::Zero();
-    for (const auto& [cluster, g] : per_cluster) meat += g * g.transpose();
-    meat *= static_cast<double>(out.clusters) / (out.clusters - 6);
-    // The prior counts as one more observation of the extrinsic.
-    meat += prior;
-    out.information += prior;
-    const Mat6 h_inv = out.information.inverse();
-    out.covariance = h_inv * meat * h_inv.transpose();
-    out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
-  }
+  Summarise(matches, problem.prior, &out);
   return out;
 }
 
