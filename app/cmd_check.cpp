@@ -98,7 +98,7 @@ void DrawViews(const CheckFlags& f, const CheckInput& input, const CheckReport& 
     std::fprintf(stderr, "calibench check: --views draws dataset frames only (not a recording)\n");
     return;
   }
-  const Dataset dataset = LoadDataset(f.dataset, CameraFile::kOptional);
+  const Dataset dataset = LoadDataset(f.dataset, CameraFile::kOptional, TargetFile::kOptional);
   std::filesystem::create_directories(f.views);
   int drawn = 0;
   for (const EdgeFrame& frame : input.frames) {
@@ -131,7 +131,7 @@ int RenderCheckView(const std::string& dataset_path, const std::string& result_p
   const CheckInput input = LoadCheckInput(dataset_path, options, CheckInputOptions{});
   const CheckReport report =
       CheckCalibration(input.frames, input.camera, reference, reference_covariance, options);
-  const Dataset dataset = LoadDataset(dataset_path, CameraFile::kOptional);
+  const Dataset dataset = LoadDataset(dataset_path, CameraFile::kOptional, TargetFile::kOptional);
   const PairEntry* pair = nullptr;
   for (const PairEntry& p : dataset.pairs)
     if (pair_id.empty() ? !pair : p.id == pair_id) pair = &p;

@@ -32,6 +32,9 @@ constexpr Command kCommands[] = {
     {"check", RunCheck,
      "is a calibration still right? judged from the scene without a target: consistent, "
      "miscalibrated (with an estimate and its sigma) or cannot tell (and along which axis)"},
+    {"check-sweep", RunCheckSweep,
+     "the targetless check measured on simulated textured rooms: catch rates, false alarms, "
+     "chi2 of its sigma"},
     {"watch", RunWatch,
      "follow a capture while it is written (a growing folder): per pair, accept/reject, σ against "
      "the goal, the next pose"},

@@ -57,6 +57,7 @@ int RunAdvise(int argc, char** argv);
 int RunWatch(int argc, char** argv);
 // `check`: a calibration judged without a target (core/targetless).
 int RunCheck(int argc, char** argv);
+int RunCheckSweep(int argc, char** argv);
 // `render --view check`: one pair's image with the LiDAR's edges under R and under the estimate.
 int RenderCheckView(const std::string& dataset, const std::string& result, const std::string& pair,
                     const std::string& out);

@@ -84,8 +84,8 @@ Dataset LoadManifest(const fs::path& manifest) {
 }
 
 // Folder shorthand: clouds/ and images/ paired by file stem, camera.yaml, target.json.
-Dataset LoadFolder(const fs::path& dir, CameraFile camera) {
-  Dataset dataset = LoadFolderSetup(dir, camera);
+Dataset LoadFolder(const fs::path& dir, CameraFile camera, TargetFile target) {
+  Dataset dataset = LoadFolderSetup(dir, camera, target);
   auto list = [&](const char* sub) {
     std::map<std::string, fs::path, NaturalOrder> by_stem;  // pose2 before pose10
     if (!fs::is_directory(dir / sub)) Fail(dir, std::string("folder dataset has no ") + sub + "/");
@@ -111,7 +111,7 @@ Dataset LoadFolder(const fs::path& dir, CameraFile camera) {
 
 }  // namespace
 
-Dataset LoadFolderSetup(const fs::path& dir, CameraFile camera) {
+Dataset LoadFolderSetup(const fs::path& dir, CameraFile camera, TargetFile target) {
   Dataset dataset;
   dataset.manifest = dir;
   const fs::path camera_file = dir / "camera.yaml";
@@ -124,14 +124,15 @@ Dataset LoadFolderSetup(const fs::path& dir, CameraFile camera) {
          "folder dataset has no camera.yaml (and no dataset.json): put the camera's intrinsics "
          "there (OpenCV YAML, ROS camera_info or a Kalibr camchain), or estimate them from the "
          "images (`calibench intrinsics`, `calibrate --estimate-intrinsics`)");
-  if (!fs::exists(target_file))
+  const bool has_target = fs::exists(target_file);
+  if (!has_target && target == TargetFile::kRequired)
     Fail(dir, "folder dataset has no target.json (and no dataset.json)");
   if (has_camera) {
     dataset.camera = LoadCameraFile(camera_file);
   } else {
     dataset.missing_camera_file = camera_file;
   }
-  dataset.target = LoadTargetFile(target_file);
+  if (has_target) dataset.target = LoadTargetFile(target_file);
   return dataset;
 }
 
@@ -145,9 +146,9 @@ void SaveTargetFile(const fs::path& path, const BoardSpec& board) {
   WriteFileAtomically(path, json_io::TargetToJson(board).dump(2) + "\n");
 }
 
-Dataset LoadDataset(const fs::path& path, CameraFile camera) {
+Dataset LoadDataset(const fs::path& path, CameraFile camera, TargetFile target) {
   const DatasetSource source = ResolveDataset(path, DatasetKind::kLidarCamera);
-  return source.folder_form ? LoadFolder(fs::absolute(source.path), camera)
+  return source.folder_form ? LoadFolder(fs::absolute(source.path), camera, target)
                             : LoadManifest(fs::absolute(source.path));
 }
 

@@ -58,16 +58,21 @@ struct Dataset {
 // Whether a folder dataset must bring its camera.yaml (`calibrate --estimate-intrinsics` and
 // `intrinsics` read folders without one).
 enum class CameraFile { kRequired, kOptional };
+// Whether a folder dataset must bring its target.json: the targetless check (core/targetless)
+// reads folders of scenes without a board; without one, Dataset::target keeps its default.
+enum class TargetFile { kRequired, kOptional };
 
 // Loads a manifest file, or a folder with clouds/ + images/ (paired by stem), camera.yaml and
 // target.json. Relative paths resolve against the manifest's folder. Throws IoError naming the
 // file and the problem; validates the camera and the target.
-Dataset LoadDataset(const std::filesystem::path& path, CameraFile camera = CameraFile::kRequired);
+Dataset LoadDataset(const std::filesystem::path& path, CameraFile camera = CameraFile::kRequired,
+                    TargetFile target = TargetFile::kRequired);
 
 // The folder form's camera (camera.yaml) and target (target.json) without its pairs: a capture
 // that has not written any yet (`calibench watch`). Throws IoError like LoadDataset.
 Dataset LoadFolderSetup(const std::filesystem::path& dir,
-                        CameraFile camera = CameraFile::kRequired);
+                        CameraFile camera = CameraFile::kRequired,
+                        TargetFile target = TargetFile::kRequired);
 
 // The board presets shipped as assets/targets/*.json, by name in name order; the built-in
 // presets when that folder is missing (what the workbench's Board menu lists).

@@ -22,7 +22,9 @@ int Threads(int threads) { return threads > 0 ? threads : DefaultThreads(); }
 
 CheckInput LoadDatasetFrames(const fs::path& path, const CheckOptions& check,
                              const CheckInputOptions& options, const CheckInputProgress& progress) {
-  const Dataset dataset = LoadDataset(path, CameraFile::kRequired);
+  const Dataset dataset =
+      LoadDataset(path, options.camera ? CameraFile::kOptional : CameraFile::kRequired,
+                  TargetFile::kOptional);
   CheckInput input;
   input.camera = options.camera ? *options.camera : dataset.camera;
   input.source = "dataset";
