@@ -183,7 +183,8 @@ void Decide(const CheckOptions& options, const Mat6& reference_covariance, Check
 // frames; the start whose alignment costs least is then aligned on every frame, from a radius of
 // 4x the final one.
 EdgeAlignment BestAlignment(const std::vector<EdgeFrame>& frames, const CameraModel& camera,
-                            const Pose& reference, const CheckOptions& options) {
+                            const Pose& reference, const CheckOptions& options,
+                            std::vector<Pose>* minima) {
   std::vector<Pose> starts = {reference};
   const double turn = 0.5 * options.alignment.search_deg * kDegToRad;
   for (int axis = 3; axis < 6 && turn > 0; ++axis) {
@@ -203,9 +204,61 @@ EdgeAlignment BestAlignment(const std::vector<EdgeFrame>& frames, const CameraMo
     const EdgeAlignment a = AlignEdges(sample, camera, start, options.alignment, 0.0, &reference);
     const double cost = AlignmentCost(sample, camera, a.cam_from_lidar, options.alignment);
     if (cost < best_cost) best_cost = cost, best = a.cam_from_lidar;
+    minima->push_back(a.cam_from_lidar);
   }
   return AlignEdges(frames, camera, best, options.alignment,
                     4.0 * options.alignment.final_radius_px, &reference);
+}
+
+// Student's t, one-sided 99 %, by degrees of freedom (1..30; beyond, the normal's 2.33).
+double StudentT99(int dof) {
+  static constexpr double kTable[] = {31.82, 6.965, 4.541, 3.747, 3.365, 3.143, 2.998, 2.896,
+                                      2.821, 2.764, 2.718, 2.681, 2.650, 2.624, 2.602, 2.583,
+                                      2.567, 2.552, 2.539, 2.528, 2.518, 2.508, 2.500, 2.492,
+                                      2.485, 2.479, 2.473, 2.467, 2.462, 2.457};
+  return dof >= 1 && dof <= 30 ? kTable[dof - 1] : 2.326;
+}
+
+// Edges can fit more than one alignment about equally well (a box's silhouette beside the shading
+// edge of its own corner, rows of posters, a 16-beam LiDAR's 2° between rings): the local
+// curvature then says nothing of the other fit, and the sandwich σ is far too small. Every other
+// minimum the starts found, farther than 3σ from the estimate, is put to a paired test over the
+// frames (each frame an independent look at the scene, whatever σ says): the estimate's cost must
+// be lower by more than the frames' own spread of the difference allows by chance (Student's t,
+// one-sided, 1 %). A rival that survives widens the covariance by its offset, so the axes it moves
+// along are not called constrained. One frame cannot be tested against itself: no rival then.
+void AddRivalMinima(const std::vector<EdgeFrame>& frames, const CameraModel& camera,
+                    const std::vector<Pose>& minima, const CheckOptions& options,
+                    CheckReport* report) {
+  const std::vector<double> best =
+      AlignmentCostPerFrame(frames, camera, report->estimate, options.alignment);
+  std::vector<Vec6> rivals;
+  for (const Pose& m : minima) {
+    const Vec6 d = DeltaOnCameraAxes(report->estimate, m);
+    if (d.dot(report->covariance.ldlt().solve(d)) < 9.0) continue;  // the same minimum
+    bool known = false;
+    for (const Vec6& r : rivals) known = known || (r - d).tail<3>().norm() < 0.05 * kDegToRad;
+    if (known) continue;
+    const std::vector<double> other = AlignmentCostPerFrame(frames, camera, m, options.alignment);
+    const int n = static_cast<int>(best.size());
+    if (n < 2) continue;
+    double sum = 0.0, sum_sq = 0.0;
+    int wins = 0, decided = 0;
+    for (int f = 0; f < n; ++f) {
+      const double gain = other[f] - best[f];
+      sum += gain;
+      sum_sq += gain * gain;
+      decided += gain != 0.0;
+      wins += gain > 0.0;
+    }
+    const double mean = sum / n, var = std::max(0.0, (sum_sq - n * mean * mean) / (n - 1));
+    if (mean > 0.0 && (var == 0.0 || mean / std::sqrt(var / n) > StudentT99(n - 1))) continue;
+    rivals.push_back(d);
+    report->rival_offsets.push_back(d);
+    report->rival_frames_preferring.push_back(decided - wins);
+    report->rival_frames_decided.push_back(decided);
+  }
+  for (const Vec6& d : rivals) report->covariance += d * d.transpose();
 }
 
 }  // namespace
@@ -276,7 +329,8 @@ CheckReport CheckCalibration(const std::vector<EdgeFrame>& frames, const CameraM
     report.frame_ids.push_back(f.id);
     report.lidar_edges_per_frame.push_back(static_cast<int>(f.lidar_edges.size()));
   }
-  report.alignment = BestAlignment(frames, camera, reference, options);
+  std::vector<Pose> minima;
+  report.alignment = BestAlignment(frames, camera, reference, options, &minima);
   const EdgeAlignment& a = report.alignment;
   for (int m : a.matched_per_frame) report.frames_used += m >= options.min_frame_matches;
   if (a.points_matched < options.min_matched_edges || a.clusters < options.min_clusters ||
@@ -295,12 +349,21 @@ CheckReport CheckCalibration(const std::vector<EdgeFrame>& frames, const CameraM
   report.estimate = a.cam_from_lidar;
   report.model_dispersion = ModelDispersion(frames, camera, report.estimate, options);
   report.covariance = report.model_dispersion * a.covariance;
+  AddRivalMinima(frames, camera, minima, options, &report);
   report.sigma_t_m = report.covariance.diagonal().head<3>().cwiseSqrt();
   report.sigma_r_deg = report.covariance.diagonal().tail<3>().cwiseSqrt() * kRadToDeg;
   const Vec6 delta = DeltaOnCameraAxes(reference, report.estimate);
   report.change_t_m = delta.head<3>();
   report.change_r_deg = delta.tail<3>() * kRadToDeg;
   Decide(options, reference_covariance, &report);
+  for (size_t r = 0; r < report.rival_offsets.size(); ++r) {
+    const Vec6& d = report.rival_offsets[r];
+    report.why += Fmt(". The edges also fit an alignment %.2f deg / %.1f mm from the estimate "
+                      "about as well",
+                      d.tail<3>().norm() * kRadToDeg, 1e3 * d.head<3>().norm()) +
+                  Fmt(" (better in %.0f of %.0f frames); its offset is counted in the sigma",
+                      report.rival_frames_preferring[r], report.rival_frames_decided[r]);
+  }
   WeakestProfile(frames, camera, options, &report);
   return report;
 }

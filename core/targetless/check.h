@@ -59,6 +59,11 @@ struct CheckReport {
   Vec3 change_r_deg = Vec3::Zero();     // rotation from R to the estimate, camera axes
   double change_sigmas = 0.0;           // the change's significance over the constrained axes
   std::vector<int> unconstrained_axes;  // 0..5 as CameraAxisName
+  // Other alignments the frames do not reject (check.cpp AddRivalMinima): each one's offset from
+  // the estimate (δ), and in how many of the frames that tell them apart it fits better. Their
+  // offsets are in the covariance.
+  std::vector<Vec6> rival_offsets;
+  std::vector<int> rival_frames_preferring, rival_frames_decided;
   // The cost along the estimate's least constrained direction (in units of tolerance), for the
   // plot of the workbench and the report: offsets in [-2, 2] tolerances and costs.
   Vec6 weakest_direction = Vec6::Zero();  // unit in tolerance units

@@ -12,6 +12,7 @@
 #include "core/io/dataset_source.h"
 #include "core/io/image_io.h"
 #include "core/io/ros_messages.h"
+#include "core/targetless/frame_pairer.h"
 
 namespace calibench {
 namespace {
@@ -58,107 +59,48 @@ CheckInput LoadDatasetFrames(const fs::path& path, const CheckOptions& check,
   return input;
 }
 
-// Clouds of a recording, each with the image nearest in time, thinned to one per interval.
-class RecordingFrames {
- public:
-  RecordingFrames(const fs::path& path, const CheckOptions& check, const CheckInputOptions& options,
-                  const CheckInputProgress& progress)
-      : path_(path), check_(check), options_(options), progress_(progress) {}
-
-  CheckInput Read() {
-    const std::unique_ptr<BagReader> bag = OpenBag(path_);
-    BagImportOptions topics_wanted;
-    topics_wanted.cloud_topic = options_.cloud_topic;
-    topics_wanted.image_topic = options_.image_topic;
-    topics_wanted.camera_info_topic = options_.camera_info_topic;
-    topics_wanted.camera = options_.camera;
-    ChooseTopics(*bag, &topics_wanted);
-    topics_ = ChosenPairTopics(*bag, topics_wanted);
-    cloud_topic_ = bag->FindTopic(topics_wanted.cloud_topic);
-    image_topic_ = bag->FindTopic(topics_wanted.image_topic);
-    const int info_topic = options_.camera ? -1 : bag->FindTopic(topics_wanted.camera_info_topic);
-    if (options_.camera) camera_ = options_.camera;
-    std::vector<bool> wanted(bag->Topics().size(), false);
-    wanted[cloud_topic_] = wanted[image_topic_] = true;
-    if (info_topic >= 0) wanted[info_topic] = true;
-    bag->ForEachMessage(wanted, [&](const BagMessage& message) {
-      if (message.topic == cloud_topic_)
-        OnCloud(message);
-      else if (message.topic == image_topic_)
-        OnImage(message);
-      else if (!camera_)
-        camera_ = DecodeCameraInfo(message.data, topics_.camera_info).camera;
-      return true;
-    });
-    if (!camera_)
-      throw IoError(path_.string() + ": no camera intrinsics: the recording has no CameraInfo on " +
-                    topics_wanted.camera_info_topic + "; give them with --camera FILE");
-    CheckInput input;
-    input.camera = *camera_;
-    input.source = bag->Format();
-    input.unreadable = unreadable_;
-    // At most max_frames, spread evenly over the recording.
-    const size_t n = frames_.size(), keep = std::min<size_t>(n, options_.max_frames);
-    for (size_t k = 0; k < keep; ++k) input.frames.push_back(std::move(frames_[k * n / keep]));
-    return input;
-  }
-
- private:
-  struct Held {
-    std::vector<std::uint8_t> data;
-    std::int64_t time_ns = 0;
-  };
-
-  void OnCloud(const BagMessage& message) {
-    const std::int64_t interval_ns = static_cast<std::int64_t>(options_.frame_interval_s * 1e9);
-    if (pending_cloud_ || (last_frame_ns_ && message.log_time_ns - *last_frame_ns_ < interval_ns))
-      return;
-    pending_cloud_ = Held{std::vector<std::uint8_t>(message.data.begin(), message.data.end()),
-                          message.log_time_ns};
-  }
-
-  void OnImage(const BagMessage& message) {
-    Held image{std::vector<std::uint8_t>(message.data.begin(), message.data.end()),
-               message.log_time_ns};
-    const std::int64_t max_offset_ns = static_cast<std::int64_t>(options_.max_pair_offset_s * 1e9);
-    if (pending_cloud_ && image.time_ns >= pending_cloud_->time_ns) {
-      const Held* best = &image;
-      if (last_image_ && std::llabs(last_image_->time_ns - pending_cloud_->time_ns) <
-                             std::llabs(image.time_ns - pending_cloud_->time_ns))
-        best = &*last_image_;
-      if (std::llabs(best->time_ns - pending_cloud_->time_ns) <= max_offset_ns) MakeFrame(*best);
-      pending_cloud_.reset();
-    }
-    last_image_ = std::move(image);
-  }
-
-  void MakeFrame(const Held& image_message) {
-    const std::string id = "t" + std::to_string(pending_cloud_->time_ns);
-    try {
-      const LidarCloud cloud = DecodePointCloud2(pending_cloud_->data, topics_.cloud).cloud;
-      const ImageU8 image = topics_.compressed_image
-                                ? DecodeCompressedImage(image_message.data, topics_.image).image
-                                : DecodeImage(image_message.data, topics_.image).image;
-      frames_.push_back(MakeEdgeFrame(id, cloud, image, check_));
-      last_frame_ns_ = pending_cloud_->time_ns;
-      if (progress_) progress_(static_cast<int>(frames_.size()), 0, id);
-    } catch (const std::invalid_argument& e) {
-      unreadable_.push_back(path_.string() + " at " + id + ": " + e.what());
-    }
-  }
-
-  fs::path path_;
-  const CheckOptions& check_;
-  const CheckInputOptions& options_;
-  const CheckInputProgress& progress_;
-  PairTopics topics_;
-  int cloud_topic_ = -1, image_topic_ = -1;
-  std::optional<CameraModel> camera_;
-  std::optional<Held> pending_cloud_, last_image_;
-  std::optional<std::int64_t> last_frame_ns_;
-  std::vector<EdgeFrame> frames_;
-  std::vector<std::string> unreadable_;
-};
+// A whole recording read in file order through the pairer.
+CheckInput LoadRecordingFrames(const fs::path& path, const CheckOptions& check,
+                               const CheckInputOptions& options,
+                               const CheckInputProgress& progress) {
+  const std::unique_ptr<BagReader> bag = OpenBag(path);
+  BagImportOptions topics_wanted;
+  topics_wanted.cloud_topic = options.cloud_topic;
+  topics_wanted.image_topic = options.image_topic;
+  topics_wanted.camera_info_topic = options.camera_info_topic;
+  topics_wanted.camera = options.camera;
+  ChooseTopics(*bag, &topics_wanted);
+  const PairTopics topics = ChosenPairTopics(*bag, topics_wanted);
+  const int cloud_topic = bag->FindTopic(topics_wanted.cloud_topic);
+  const int image_topic = bag->FindTopic(topics_wanted.image_topic);
+  const int info_topic = options.camera ? -1 : bag->FindTopic(topics_wanted.camera_info_topic);
+  std::optional<CameraModel> camera = options.camera;
+  std::vector<bool> wanted(bag->Topics().size(), false);
+  wanted[cloud_topic] = wanted[image_topic] = true;
+  if (info_topic >= 0) wanted[info_topic] = true;
+  CheckFramePairer pairer(path.string(), topics, check, options, progress);
+  bag->ForEachMessage(wanted, [&](const BagMessage& message) {
+    if (message.topic == cloud_topic)
+      pairer.AddCloud(message.data, message.log_time_ns);
+    else if (message.topic == image_topic)
+      pairer.AddImage(message.data, message.log_time_ns);
+    else if (!camera)
+      camera = DecodeCameraInfo(message.data, topics.camera_info).camera;
+    return true;
+  });
+  if (!camera)
+    throw IoError(path.string() + ": no camera intrinsics: the recording has no CameraInfo on " +
+                  topics_wanted.camera_info_topic + "; give them with --camera FILE");
+  CheckInput input;
+  input.camera = *camera;
+  input.source = bag->Format();
+  input.unreadable = pairer.TakeProblems();
+  std::vector<EdgeFrame> frames = pairer.TakeFrames();
+  // At most max_frames, spread evenly over the recording.
+  const size_t n = frames.size(), keep = std::min<size_t>(n, options.max_frames);
+  for (size_t k = 0; k < keep; ++k) input.frames.push_back(std::move(frames[k * n / keep]));
+  return input;
+}
 
 }  // namespace
 
@@ -180,7 +122,7 @@ CheckInput LoadCheckInput(const fs::path& path, const CheckOptions& check,
   const std::optional<DatasetSource> source = RecogniseDataset(path, &why);
   CheckInput input;
   if (source && source->kind == DatasetKind::kRecording)
-    input = RecordingFrames(path, check, options, progress).Read();
+    input = LoadRecordingFrames(path, check, options, progress);
   else
     input = LoadDatasetFrames(path, check, options, progress);
   if (input.frames.empty()) {

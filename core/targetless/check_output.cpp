@@ -76,6 +76,13 @@ std::string CheckReportJson(const CheckReport& report) {
     j["model_dispersion"] = report.model_dispersion;
     j["matched_edges"] = report.alignment.points_matched;
     j["image_cells"] = report.alignment.clusters;
+    nlohmann::json rivals = nlohmann::json::array();
+    for (size_t r = 0; r < report.rival_offsets.size(); ++r)
+      rivals.push_back({{"offset_t_mm", Triple(report.rival_offsets[r].head<3>() * 1e3)},
+                        {"offset_r_deg", Triple(report.rival_offsets[r].tail<3>() * kRadToDeg)},
+                        {"frames_preferring", report.rival_frames_preferring[r]},
+                        {"frames_deciding", report.rival_frames_decided[r]}});
+    j["rival_alignments"] = rivals;
   } else {
     for (const char* key : {"cam_from_lidar", "sigma_t_mm", "sigma_r_deg", "change_t_mm",
                             "change_r_deg", "change_sigmas"})

@@ -138,6 +138,16 @@ double AlignmentCost(const std::vector<EdgeFrame>& frames, const CameraModel& ca
                 options.final_radius_px, options);
 }
 
+std::vector<double> AlignmentCostPerFrame(const std::vector<EdgeFrame>& frames,
+                                          const CameraModel& camera, const Pose& cam_from_lidar,
+                                          const EdgeAlignmentOptions& options) {
+  const std::vector<FrameMatches> all =
+      MatchAll(frames, camera, cam_from_lidar, options.final_radius_px, options);
+  std::vector<double> costs;
+  for (const FrameMatches& f : all) costs.push_back(CostOf({f}, options.final_radius_px, options));
+  return costs;
+}
+
 namespace {
 
 // What every level of one alignment shares.

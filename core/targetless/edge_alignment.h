@@ -68,6 +68,11 @@ EdgeAlignment AlignEdges(const std::vector<EdgeFrame>& frames, const CameraModel
 double AlignmentCost(const std::vector<EdgeFrame>& frames, const CameraModel& camera,
                      const Pose& cam_from_lidar, const EdgeAlignmentOptions& options);
 
+// The same, frame by frame (in the frames' order): the check's test of rival alignments.
+std::vector<double> AlignmentCostPerFrame(const std::vector<EdgeFrame>& frames,
+                                          const CameraModel& camera, const Pose& cam_from_lidar,
+                                          const EdgeAlignmentOptions& options);
+
 // t' = t + δ.head(3), R' = Exp(δ.tail(3)) R.
 Pose PerturbOnCameraAxes(const Pose& cam_from_lidar, const Vec6& delta);
 // The δ that takes `from` to `to` (inverse of PerturbOnCameraAxes).
