@@ -81,15 +81,6 @@ void AddCheckFlags(CLI::App& app, CheckFlags& f) {
       ->capture_default_str();
 }
 
-// R and its own covariance on camera axes (zero when the file has none: a session's result).
-Pose ReferenceOf(const std::string& path, Mat6* covariance) {
-  *covariance = Mat6::Zero();
-  if (IsSessionFile(path)) return CalibrationOf(path);
-  const LoadedResult loaded = LoadResult(path);
-  *covariance = CameraAxesCovariance(loaded.covariance, loaded.cam_from_source);
-  return loaded.cam_from_source;
-}
-
 // --views: each drawn frame's image read again (the check keeps only edges).
 void DrawViews(const CheckFlags& f, const CheckInput& input, const CheckReport& report) {
   std::string why;
@@ -119,6 +110,14 @@ void DrawViews(const CheckFlags& f, const CheckInput& input, const CheckReport& 
 
 }  // namespace
 
+Pose CheckedCalibration(const std::string& path, Mat6* covariance) {
+  *covariance = Mat6::Zero();
+  if (IsSessionFile(path)) return CalibrationOf(path);
+  const LoadedResult loaded = LoadResult(path);
+  *covariance = CameraAxesCovariance(loaded.covariance, loaded.cam_from_source);
+  return loaded.cam_from_source;
+}
+
 int RenderCheckView(const std::string& dataset_path, const std::string& result_path,
                     const std::string& pair_id, const std::string& out) {
   if (result_path.empty() || dataset_path.empty()) {
@@ -126,7 +125,7 @@ int RenderCheckView(const std::string& dataset_path, const std::string& result_p
     return kUsage;
   }
   Mat6 reference_covariance;
-  const Pose reference = ReferenceOf(result_path, &reference_covariance);
+  const Pose reference = CheckedCalibration(result_path, &reference_covariance);
   const CheckOptions options;
   const CheckInput input = LoadCheckInput(dataset_path, options, CheckInputOptions{});
   const CheckReport report =
@@ -178,7 +177,7 @@ int RunCheck(int argc, char** argv) {
   }
   MachineStdout out(f.json);  // from here on, only the JSON object reaches stdout
   Mat6 reference_covariance;
-  const Pose reference = ReferenceOf(f.result, &reference_covariance);
+  const Pose reference = CheckedCalibration(f.result, &reference_covariance);
   const ProgressCallback progress = StderrProgress("read");
   const CheckInput input =
       LoadCheckInput(f.dataset, f.check, f.input, [&](int done, int total, const std::string& id) {

@@ -11,6 +11,7 @@
 #include "core/intrinsics/intrinsics.h"
 #include "core/report/report_html.h"
 #include "core/target/board.h"
+#include "core/targetless/check_follow.h"
 
 namespace CLI {
 class App;
@@ -58,6 +59,20 @@ int RunWatch(int argc, char** argv);
 // `check`: a calibration judged without a target (core/targetless).
 int RunCheck(int argc, char** argv);
 int RunCheckSweep(int argc, char** argv);
+// The calibration a check judges: a result file's cam_from_lidar and its covariance on camera
+// axes, or a session's result (covariance zero).
+Pose CheckedCalibration(const std::string& path, Mat6* covariance);
+// `watch --check R RECORDING`: the drift meter (app/cmd_watch_check.cpp).
+struct WatchCheckRequest {
+  std::string source, result;
+  CheckOptions check;
+  CheckInputOptions input;
+  DriftMeterOptions drift;
+  bool json_lines = false;
+  bool exit_when_sure = false;
+  double idle_exit_s = 0.0;
+};
+int WatchCheck(const WatchCheckRequest& request);
 // `render --view check`: one pair's image with the LiDAR's edges under R and under the estimate.
 int RenderCheckView(const std::string& dataset, const std::string& result, const std::string& pair,
                     const std::string& out);

@@ -133,9 +133,10 @@ Vec6 DeltaOnCameraAxes(const Pose& from, const Pose& to) {
 }
 
 double AlignmentCost(const std::vector<EdgeFrame>& frames, const CameraModel& camera,
-                     const Pose& cam_from_lidar, const EdgeAlignmentOptions& options) {
-  return CostOf(MatchAll(frames, camera, cam_from_lidar, options.final_radius_px, options),
-                options.final_radius_px, options);
+                     const Pose& cam_from_lidar, const EdgeAlignmentOptions& options,
+                     double radius_px) {
+  const double radius = radius_px > 0 ? radius_px : options.final_radius_px;
+  return CostOf(MatchAll(frames, camera, cam_from_lidar, radius, options), radius, options);
 }
 
 std::vector<double> AlignmentCostPerFrame(const std::vector<EdgeFrame>& frames,

@@ -65,8 +65,10 @@ EdgeAlignment AlignEdges(const std::vector<EdgeFrame>& frames, const CameraModel
 
 // The robust cost (sum of Huber costs in σ units, unmatched edges at the cap) of an extrinsic at
 // a fixed matching radius: what the check plots along its weakest direction.
+// radius_px > 0: at that matching radius instead of the final one.
 double AlignmentCost(const std::vector<EdgeFrame>& frames, const CameraModel& camera,
-                     const Pose& cam_from_lidar, const EdgeAlignmentOptions& options);
+                     const Pose& cam_from_lidar, const EdgeAlignmentOptions& options,
+                     double radius_px = 0.0);
 
 // The same, frame by frame (in the frames' order): the check's test of rival alignments.
 std::vector<double> AlignmentCostPerFrame(const std::vector<EdgeFrame>& frames,
