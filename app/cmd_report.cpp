@@ -16,6 +16,7 @@
 #include "core/io/dataset.h"
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
+#include "core/report/targetless_section.h"
 #include "core/results/result_file.h"
 #include "core/session/session.h"
 
@@ -80,7 +81,10 @@ int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
     }
   }
   const ReportAssets assets = LoadReportAssets(FindAsset("report"));
-  WriteFileAtomically(request.out_path, ReportHtml(report, provenance, figures, assets));
+  const std::string sections =
+      request.check_json.empty() ? ""
+                                 : TargetlessCheckHtml(LoadTargetlessCheck(request.check_json));
+  WriteFileAtomically(request.out_path, ReportHtml(report, provenance, figures, assets, sections));
   std::printf("wrote %s (%zu pairs, %zu views)%s%s\n", request.out_path.c_str(),
               report.pairs.size(), figures.size(), report.cross_validation ? ": " : "",
               report.cross_validation ? report.cross_validation->verdict.c_str() : "");
@@ -189,6 +193,9 @@ int RunReport(int argc, char** argv) {
                  "the workbench session it came from (its brushes, rejections and options)");
   app.add_option("--out,-o", request.out_path, "report.html")->required();
   app.add_flag("--no-views", no_renders, "leave out the rendered views (no OpenGL needed)");
+  app.add_option("--check", request.check_json,
+                 "a targetless check of this calibration, as `calibench check --json` printed "
+                 "it: the report gains its section");
   app.add_flag("--no-cross-validation", no_cross_validation,
                "skip the leave-one-out re-solves (influence, held-out errors)");
   PipelineFlags flags;
@@ -205,10 +212,16 @@ int RunReport(int argc, char** argv) {
   }
   request.renders = !no_renders;
   request.options.cross_validate = !no_cross_validation;
+  // Read before the solve: a wrong file is said at once, not after a minute of work.
+  if (!request.check_json.empty()) LoadTargetlessCheck(request.check_json);
   request.result_file = result_path;
   if (IsRigResultFile(result_path) || (!dataset_path.empty() && IsRig(dataset_path))) {
     if (dataset_path.empty()) {
       std::fprintf(stderr, "calibench report: a rig result: give --dataset <the rig>\n");
+      return kUsage;
+    }
+    if (!request.check_json.empty()) {
+      std::fprintf(stderr, "calibench report: --check goes with one camera's report, not a rig's\n");
       return kUsage;
     }
     RigEdits edits;

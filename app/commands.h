@@ -165,6 +165,7 @@ struct ReportRequest {
   bool renders = true;       // draw the views headless
   ReportOptions options;
   std::vector<std::string> notes;  // shown at the top
+  std::string check_json;  // `check --json`'s output: the targetless-check section ("" = none)
 };
 // `report` and `calibrate --report`: analyses the outcome, draws the views, writes the HTML
 // atomically; kOk (an unreadable asset throws IoError).

@@ -349,12 +349,13 @@ std::string SigmaCells(const Vec3& t_mm, const Vec3& r_deg) {
 }  // namespace
 
 std::string ReportHtml(const CalibrationReport& report, const ReportProvenance& provenance,
-                       const std::vector<ReportFigure>& figures, const ReportAssets& assets) {
+                       const std::vector<ReportFigure>& figures, const ReportAssets& assets,
+                       const std::string& extra_sections) {
   std::string body = "<header><h1>Calibench calibration report</h1>" +
                      HeaderFacts(provenance, PairsFact(report), report.options);
   if (!report.distrust.empty())
     body += "<p class=\"verdict bad\">" + Escape(report.distrust) + "</p>";
-  body += "</header>" + CameraBody(report, figures, "");
+  body += "</header>" + CameraBody(report, figures, "") + extra_sections;
   return FillReport("Calibench calibration report", body, ChartData(report), assets);
 }
 

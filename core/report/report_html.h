@@ -43,8 +43,11 @@ ReportAssets LoadReportAssets(
     const std::filesystem::path& report_dir,
     const std::filesystem::path& chart_js = "/usr/share/javascript/chart.js/chart.min.js");
 
+// `extra_sections`: HTML sections appended after the camera's (the targetless check's,
+// core/report/targetless_section.h).
 std::string ReportHtml(const CalibrationReport& report, const ReportProvenance& provenance,
-                       const std::vector<ReportFigure>& figures, const ReportAssets& assets);
+                       const std::vector<ReportFigure>& figures, const ReportAssets& assets,
+                       const std::string& extra_sections = "");
 
 // A rig's report: the rig solve per camera (its pose and σ next to the camera's own) and the
 // cameras' relative poses, then each camera's section as one camera's report has it.

@@ -51,6 +51,19 @@ TEST(CheckRecording, AnMcapIsCheckedDirectlyWithOneJsonObjectOnStdout) {
   EXPECT_EQ(verdict, "cannot tell") << j["why"];
   EXPECT_FALSE(j["unconstrained_axes"].empty());
 
+  // The report of that calibration with the check as a section.
+  const auto html = dir / "report.html";
+  ASSERT_EQ(test::RunCommand(exe + " report --result " + (dir / "result.json").string() +
+                                 " --dataset " + (dir / "folder").string() + " --check " +
+                                 json_path.string() + " --no-views --no-cross-validation --out " +
+                                 html.string(),
+                             &out),
+            0)
+      << out;
+  const std::string page = test::ReadFileBytes(html);
+  EXPECT_NE(page.find("id=\"targetless-check\""), std::string::npos);
+  EXPECT_NE(page.find(verdict), std::string::npos);
+
   // `render --view check`: one pair's image with the edges under R and the estimate, headless
   // without OpenGL.
   const auto png = dir / "check.png";
