@@ -96,6 +96,19 @@ std::optional<SceneEdgePoint> DepthEdgeBetween(const LineReturn& a, const LineRe
   const double side = std::max(before ? std::abs(1.0 / a.range - 1.0 / before->range) : 0.0,
                                after ? std::abs(1.0 / after->range - 1.0 / b.range) : 0.0);
   if (jump < options.min_abruptness * side) return std::nullopt;
+  // An occluding edge, not a fold: the near surface, continued past its last return to the far
+  // ray (linearly in inverse range, as a plane is), must pass well in front of the far return. At
+  // a concave corner (a wall meeting the ceiling between two rings) the far return lies on or in
+  // front of that continuation: the surfaces meet between the rays, and the midpoint of the rays
+  // at the near range is not where the image's edge is. Without a return beyond the near one
+  // (the outermost ring) the two cannot be told apart, and the edge is left out.
+  const LineReturn* near_beyond = near == &a ? before : after;
+  const LineReturn& far = near == &a ? b : a;
+  if (!near_beyond) return std::nullopt;
+  const double continued_inverse = 2.0 / near->range - 1.0 / near_beyond->range;
+  if (continued_inverse <= 0.0 ||
+      far.range - 1.0 / continued_inverse < options.min_depth_jump_m)
+    return std::nullopt;
   // The silhouette lies somewhere between the two rays, at the near surface's range.
   const Vec3 direction = (a.direction + b.direction).normalized();
   return SceneEdgePoint{near->range * direction, gap_rad / kSqrt12, spread_direction,
