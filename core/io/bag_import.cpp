@@ -231,6 +231,17 @@ std::optional<BoardSpec> RecordingBoard(const fs::path& bag, const std::optional
   return std::nullopt;
 }
 
+bool PairTopicsPresent(const BagReader& bag, bool camera_given) {
+  auto has = [&](auto is) {
+    for (const BagTopic& topic : bag.Topics())
+      if (is(topic.type) && topic.message_count > 0) return true;
+    return false;
+  };
+  return has([](const std::string& t) { return t == kPointCloud2Type; }) &&
+         has([](const std::string& t) { return t == kImageType || t == kCompressedImageType; }) &&
+         (camera_given || has([](const std::string& t) { return t == kCameraInfoType; }));
+}
+
 PairTopics ChosenPairTopics(const BagReader& bag, const BagImportOptions& options) {
   const BagTopic& image = bag.Topics()[bag.FindTopic(options.image_topic)];
   PairTopics topics;

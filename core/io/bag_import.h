@@ -91,6 +91,11 @@ std::optional<std::filesystem::path> TargetBesideRecording(const std::filesystem
 std::optional<BoardSpec> RecordingBoard(const std::filesystem::path& bag,
                                         const std::optional<BoardSpec>& given, std::string* source);
 PairTopics ChosenPairTopics(const BagReader& bag, const BagImportOptions& options);
+// A recording being written (followed): whether a PointCloud2, an image and (unless the camera is
+// given) a CameraInfo topic have each brought a message yet — a recorder may announce a topic
+// before its first message; only then can the topics be chosen. What watch and the drift meter
+// wait for.
+bool PairTopicsPresent(const BagReader& bag, bool camera_given);
 PairEntry WriteFoundPair(const FoundPair& pair, const std::filesystem::path& dir,
                          const std::string& id);
 

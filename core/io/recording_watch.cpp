@@ -12,13 +12,6 @@ namespace {
 // first message); beyond this many the oldest go.
 constexpr std::size_t kMaxPending = 2000;
 
-// A topic of the type with a message read already (a recorder may announce a topic first).
-bool HasTopicOfType(const BagReader& bag, bool (*is)(const std::string&)) {
-  for (const BagTopic& topic : bag.Topics())
-    if (is(topic.type) && topic.message_count > 0) return true;
-  return false;
-}
-
 }  // namespace
 
 struct GrowingRecording::Pending {
@@ -80,14 +73,7 @@ RecordingUpdate GrowingRecording::Poll() {
 }
 
 void GrowingRecording::ChooseTopicsWhenPresent(bool closed, RecordingUpdate* update) {
-  const bool present =
-      HasTopicOfType(*reader_, [](const std::string& t) { return t == kPointCloud2Type; }) &&
-      HasTopicOfType(
-          *reader_,
-          [](const std::string& t) { return t == kImageType || t == kCompressedImageType; }) &&
-      (options_.camera ||
-       HasTopicOfType(*reader_, [](const std::string& t) { return t == kCameraInfoType; }));
-  if (!present && !closed) return;
+  if (!PairTopicsPresent(*reader_, options_.camera.has_value()) && !closed) return;
   ChooseTopics(*reader_, &options_);
   cloud_topic_ = reader_->FindTopic(options_.cloud_topic);
   image_topic_ = reader_->FindTopic(options_.image_topic);

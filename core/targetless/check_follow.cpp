@@ -10,12 +10,6 @@ namespace {
 
 constexpr size_t kMaxPending = 4000;  // messages held before the topics are known
 
-bool HasTopicOfType(const BagReader& bag, bool (*is)(const std::string&)) {
-  for (const BagTopic& topic : bag.Topics())
-    if (is(topic.type) && topic.message_count > 0) return true;
-  return false;
-}
-
 }  // namespace
 
 struct DriftMeter::Pending {
@@ -102,14 +96,7 @@ DriftUpdate DriftMeter::Poll() {
 }
 
 void DriftMeter::ChooseTopicsWhenPresent(bool closed, DriftUpdate* update) {
-  const bool present =
-      HasTopicOfType(*reader_, [](const std::string& t) { return t == kPointCloud2Type; }) &&
-      HasTopicOfType(
-          *reader_,
-          [](const std::string& t) { return t == kImageType || t == kCompressedImageType; }) &&
-      (input_.camera ||
-       HasTopicOfType(*reader_, [](const std::string& t) { return t == kCameraInfoType; }));
-  if (!present && !closed) return;
+  if (!PairTopicsPresent(*reader_, input_.camera.has_value()) && !closed) return;
   BagImportOptions wanted;
   wanted.cloud_topic = input_.cloud_topic;
   wanted.image_topic = input_.image_topic;
