@@ -21,9 +21,11 @@ int RunCheckSweep(int argc, char** argv) {
   std::string write_scene;
   app.add_option("--lidar", options.lidar, "vlp16 | os0-128 | hdl64 | mid40 | avia | mid360")
       ->capture_default_str();
-  app.add_flag("--moving", options.moving, "the rig drives through the room (else it stands still)");
+  app.add_flag("--moving", options.moving,
+               "the rig drives through the room (else it stands still)");
   app.add_option("--seeds", options.seeds, "rooms")->capture_default_str();
-  app.add_option("--first-seed", options.first_seed, "the first room's seed")->capture_default_str();
+  app.add_option("--first-seed", options.first_seed, "the first room's seed")
+      ->capture_default_str();
   app.add_option("--frames", options.frames, "frames per room")->capture_default_str();
   app.add_option("--range-noise", options.range_noise_m, "LiDAR range noise sigma [m]")
       ->capture_default_str();
@@ -57,10 +59,11 @@ int RunCheckSweep(int argc, char** argv) {
   }
   if (!write_scene.empty()) {
     WriteCheckScene(SimulateCheckScene(options, options.first_seed), write_scene);
-    std::printf("wrote %d frames of room %llu (%s, %s rig) into %s, the truth in "
-                "truth.result.json\n",
-                options.frames, static_cast<unsigned long long>(options.first_seed),
-                options.lidar.c_str(), options.moving ? "moving" : "still", write_scene.c_str());
+    std::printf(
+        "wrote %d frames of room %llu (%s, %s rig) into %s, the truth in "
+        "truth.result.json\n",
+        options.frames, static_cast<unsigned long long>(options.first_seed), options.lidar.c_str(),
+        options.moving ? "moving" : "still", write_scene.c_str());
     return kOk;
   }
   MachineStdout out(json);

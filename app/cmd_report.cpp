@@ -16,7 +16,6 @@
 #include "core/io/dataset.h"
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
-#include "core/report/targetless_section.h"
 #include "core/results/result_file.h"
 #include "core/session/session.h"
 
@@ -81,9 +80,7 @@ int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
     }
   }
   const ReportAssets assets = LoadReportAssets(FindAsset("report"));
-  const std::string sections =
-      request.check_json.empty() ? ""
-                                 : TargetlessCheckHtml(LoadTargetlessCheck(request.check_json));
+  const std::string sections = request.check ? TargetlessCheckHtml(*request.check) : "";
   WriteFileAtomically(request.out_path, ReportHtml(report, provenance, figures, assets, sections));
   std::printf("wrote %s (%zu pairs, %zu views)%s%s\n", request.out_path.c_str(),
               report.pairs.size(), figures.size(), report.cross_validation ? ": " : "",
@@ -148,6 +145,10 @@ namespace {
 // the result file's, the report written.
 int ReportRig(const std::string& result_path, const std::string& dataset_path,
               const RigEdits& edits, const PipelineOptions& options, ReportRequest request) {
+  if (request.check) {
+    std::fprintf(stderr, "calibench report: --check goes with one camera's report, not a rig's\n");
+    return kUsage;
+  }
   const RigFolder rig = LoadRig(dataset_path);
   const RigOutcome outcome = CalibrateRig(rig, options, StderrProgress("extracted"), edits);
   if (!outcome.joint) {
@@ -193,7 +194,8 @@ int RunReport(int argc, char** argv) {
                  "the workbench session it came from (its brushes, rejections and options)");
   app.add_option("--out,-o", request.out_path, "report.html")->required();
   app.add_flag("--no-views", no_renders, "leave out the rendered views (no OpenGL needed)");
-  app.add_option("--check", request.check_json,
+  std::string check_path;
+  app.add_option("--check", check_path,
                  "a targetless check of this calibration, as `calibench check --json` printed "
                  "it: the report gains its section");
   app.add_flag("--no-cross-validation", no_cross_validation,
@@ -212,16 +214,11 @@ int RunReport(int argc, char** argv) {
   }
   request.renders = !no_renders;
   request.options.cross_validate = !no_cross_validation;
-  // Read before the solve: a wrong file is said at once, not after a minute of work.
-  if (!request.check_json.empty()) LoadTargetlessCheck(request.check_json);
+  if (!check_path.empty()) request.check = LoadTargetlessCheck(check_path);
   request.result_file = result_path;
   if (IsRigResultFile(result_path) || (!dataset_path.empty() && IsRig(dataset_path))) {
     if (dataset_path.empty()) {
       std::fprintf(stderr, "calibench report: a rig result: give --dataset <the rig>\n");
-      return kUsage;
-    }
-    if (!request.check_json.empty()) {
-      std::fprintf(stderr, "calibench report: --check goes with one camera's report, not a rig's\n");
       return kUsage;
     }
     RigEdits edits;

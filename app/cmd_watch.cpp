@@ -343,6 +343,20 @@ int WatchFolder(WatchFlags* flags_in, const CalibrationJobOptions& options, Even
   return watch.Run();
 }
 
+// `watch --check`: the drift meter instead of the board capture, with the recording's flags.
+int WatchWithDriftMeter(WatchCheckRequest drift, const WatchFlags& flags,
+                        const std::string& camera_file) {
+  drift.source = flags.source;
+  drift.camera_file = camera_file;
+  drift.json_lines = flags.json_lines;
+  drift.exit_when_sure = flags.exit_when_done;
+  drift.idle_exit_s = flags.idle_exit_s;
+  drift.input.cloud_topic = flags.import.cloud_topic;
+  drift.input.image_topic = flags.import.image_topic;
+  drift.input.camera_info_topic = flags.import.camera_info_topic;
+  return WatchCheck(drift);
+}
+
 }  // namespace
 
 int RunWatch(int argc, char** argv) {
@@ -383,8 +397,7 @@ int RunWatch(int argc, char** argv) {
   app.add_flag("--json-lines", flags.json_lines,
                "one JSON object per line: {\"event\": \"pair\", ...} per pair, {\"event\": "
                "\"solve\", ...advise --json's fields} per solve");
-  app.add_flag("--exit-when-done", flags.exit_when_done,
-               "end when the stop rule says done (with --check: when the verdict is sure)");
+  app.add_flag("--exit-when-done", flags.exit_when_done, "end when the stop rule says done");
   app.add_flag("--estimate-intrinsics", options.advise.estimate_intrinsics,
                "the camera's intrinsics are being calibrated from these pairs too: the meter "
                "includes them (done only once they are good: sigma, RMS, corners near every "
@@ -403,33 +416,11 @@ int RunWatch(int argc, char** argv) {
                  "report a cloud without its image (or the reverse) after this long [s]")
       ->capture_default_str();
   WatchCheckRequest drift;
-  app.add_option("--check", drift.result,
-                 "recordings: no board capture; the drift meter instead: this calibration "
-                 "(result file or session) judged without a target over the frames so far (as "
-                 "`calibench check`), the verdict once it is sure");
-  app.add_option("--check-every", drift.drift.recheck_every,
-                 "with --check: check again after this many new frames")
-      ->capture_default_str();
+  AddDriftMeterFlags(app, &drift);
   PipelineFlags pipeline;
   AddPipelineFlags(app, pipeline, /*with_selection=*/false);
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
-  if (!drift.result.empty()) {
-    drift.source = flags.source;
-    drift.json_lines = flags.json_lines;
-    drift.exit_when_sure = flags.exit_when_done;
-    drift.idle_exit_s = flags.idle_exit_s;
-    drift.input.cloud_topic = flags.import.cloud_topic;
-    drift.input.image_topic = flags.import.image_topic;
-    drift.input.camera_info_topic = flags.import.camera_info_topic;
-    if (!camera_file.empty()) drift.input.camera = LoadCameraFile(camera_file);
-    std::string why;
-    if (!drift.drift.Check(&why) || !drift.input.Check(&why) || !(flags.idle_exit_s >= 0)) {
-      std::fprintf(stderr, "calibench watch: %s\n",
-                   why.empty() ? "--idle-exit must be >= 0 (seconds)" : why.c_str());
-      return kUsage;
-    }
-    return WatchCheck(drift);
-  }
+  if (!drift.result.empty()) return WatchWithDriftMeter(drift, flags, camera_file);
   std::string why;
   if (!FinalizePipelineFlags(pipeline, &why) || !flags.folder.Check(&why) ||
       !(flags.idle_exit_s >= 0)) {

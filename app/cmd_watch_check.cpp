@@ -1,14 +1,15 @@
 // `calibench watch --check R RECORDING`: the drift meter (core/targetless/check_follow.h) on a
 // recording being written — a drive after calibration: the targetless estimate and its σ over the
 // frames so far, the verdict once it is sure.
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
-#include <thread>
-
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "app/commands.h"
 #include "app/machine_stdout.h"
+#include "core/io/camera_file.h"
 #include "core/io/recording_watch.h"
 #include "core/targetless/check_follow.h"
 #include "core/targetless/check_output.h"
@@ -47,7 +48,24 @@ std::string DriftJson(const DriftUpdate& update, const char* event) {
 
 }  // namespace
 
-int WatchCheck(const WatchCheckRequest& request) {
+void AddDriftMeterFlags(CLI::App& app, WatchCheckRequest* request) {
+  app.add_option("--check", request->result,
+                 "recordings: no board capture; the drift meter instead: this calibration "
+                 "(result file or session) judged without a target over the frames so far (as "
+                 "`calibench check`), the verdict once it is sure (--exit-when-done: end then)");
+  app.add_option("--check-every", request->drift.recheck_every,
+                 "with --check: check again after this many new frames")
+      ->capture_default_str();
+}
+
+int WatchCheck(WatchCheckRequest request) {
+  if (!request.camera_file.empty()) request.input.camera = LoadCameraFile(request.camera_file);
+  std::string why;
+  if (!request.drift.Check(&why) || !request.input.Check(&why) || !(request.idle_exit_s >= 0)) {
+    std::fprintf(stderr, "calibench watch: %s\n",
+                 why.empty() ? "--idle-exit must be >= 0 (seconds)" : why.c_str());
+    return kUsage;
+  }
   Mat6 reference_covariance;
   const Pose reference = CheckedCalibration(request.result, &reference_covariance);
   if (!IsRecordingSource(request.source)) {
@@ -83,9 +101,10 @@ int WatchCheck(const WatchCheckRequest& request) {
       said_sure = said_sure || update.sure;
       last_report = update;
     }
-    const bool idle = request.idle_exit_s > 0 &&
-                      std::chrono::duration<double>(std::chrono::steady_clock::now() - last_data)
-                              .count() > request.idle_exit_s;
+    const bool idle =
+        request.idle_exit_s > 0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_data).count() >
+            request.idle_exit_s;
     if (update.closed || idle || (request.exit_when_sure && update.sure)) {
       const char* why = update.closed ? "the recorder closed the file"
                         : idle        ? "no new data within --idle-exit"

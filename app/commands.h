@@ -10,6 +10,7 @@
 
 #include "core/intrinsics/intrinsics.h"
 #include "core/report/report_html.h"
+#include "core/report/targetless_section.h"
 #include "core/target/board.h"
 #include "core/targetless/check_follow.h"
 
@@ -65,6 +66,7 @@ Pose CheckedCalibration(const std::string& path, Mat6* covariance);
 // `watch --check R RECORDING`: the drift meter (app/cmd_watch_check.cpp).
 struct WatchCheckRequest {
   std::string source, result;
+  std::string camera_file;  // intrinsics instead of the recording's CameraInfo ("" = those)
   CheckOptions check;
   CheckInputOptions input;
   DriftMeterOptions drift;
@@ -72,7 +74,10 @@ struct WatchCheckRequest {
   bool exit_when_sure = false;
   double idle_exit_s = 0.0;
 };
-int WatchCheck(const WatchCheckRequest& request);
+// --check and --check-every of `watch`.
+void AddDriftMeterFlags(CLI::App& app, WatchCheckRequest* request);
+// Checks the request's options (kUsage with the reason on stderr), then follows the recording.
+int WatchCheck(WatchCheckRequest request);
 // `render --view check`: one pair's image with the LiDAR's edges under R and under the estimate.
 int RenderCheckView(const std::string& dataset, const std::string& result, const std::string& pair,
                     const std::string& out);
@@ -165,7 +170,9 @@ struct ReportRequest {
   bool renders = true;       // draw the views headless
   ReportOptions options;
   std::vector<std::string> notes;  // shown at the top
-  std::string check_json;  // `check --json`'s output: the targetless-check section ("" = none)
+  // `check --json`'s output, read when the flags are (a wrong file fails before the solve): the
+  // targetless-check section (none when absent).
+  std::optional<TargetlessCheckSection> check;
 };
 // `report` and `calibrate --report`: analyses the outcome, draws the views, writes the HTML
 // atomically; kOk (an unreadable asset throws IoError).

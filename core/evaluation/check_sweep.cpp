@@ -4,9 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <random>
-
 #include <nlohmann/json.hpp>
+#include <random>
 
 #include "core/base/parallel.h"
 #include "core/io/camera_file.h"
@@ -145,8 +144,7 @@ SimulatedCheckScene SimulateCheckScene(const CheckSweepOptions& options, std::ui
   const std::vector<Pose> rig = RigPoses(options, rng);
   const std::optional<LidarModel> spinning = SpinningModel(options.lidar);
   const BeamTable beams = spinning ? MakeBeamTable(*spinning) : BeamTable{};
-  const RisleyPattern pattern =
-      spinning ? RisleyPattern{} : MakeRisleyPattern(options.lidar);
+  const RisleyPattern pattern = spinning ? RisleyPattern{} : MakeRisleyPattern(options.lidar);
   std::uniform_real_distribution<double> phase(0.0, 2.0 * M_PI);
   for (int k = 0; k < options.frames; ++k) {
     SimulatedCheckFrame frame;
@@ -182,8 +180,8 @@ void WriteCheckScene(const SimulatedCheckScene& scene, const fs::path& dir) {
     SaveImage(dir / "images" / (frame.id + ".png"), frame.image);
   }
   SaveCameraFile(dir / "camera.yaml", scene.camera, CameraFileFormat::kRosCameraInfo);
-  nlohmann::json truth = ResultHeaderJson(ResultNames{}, scene.cam_from_lidar, Mat6::Zero(),
-                                          ObservabilityReport{});
+  nlohmann::json truth =
+      ResultHeaderJson(ResultNames{}, scene.cam_from_lidar, Mat6::Zero(), ObservabilityReport{});
   truth["method"] = "simulation";
   truth["provenance"] = {{"kind", "simulation"},
                          {"text", "the simulator's ground truth (calibench check-sweep)"}};
@@ -265,12 +263,13 @@ std::string FormatCheckSweep(const CheckSweepResult& result) {
                 o.lidar.c_str(), o.moving ? "moving" : "still", o.seeds, o.frames,
                 o.check.tolerance_deg, o.check.tolerance_m * 1e3, o.check.significance_sigma);
   text += line;
-  text += "error      trials  miscal.  consist.  cannot  signif.  chi2/6  covered  err deg  err mm\n";
+  text +=
+      "error      trials  miscal.  consist.  cannot  signif.  chi2/6  covered  err deg  err mm\n";
   for (const CheckSweepRow& r : result.rows) {
-    std::snprintf(line, sizeof line, "%-9s  %6d  %7d  %8d  %6d  %7d  %6.2f  %4d/%-3d  %7.3f  %6.1f\n",
-                  r.error.c_str(), r.trials, r.miscalibrated, r.consistent, r.cannot_tell,
-                  r.significant, r.mean_chi2 / 6.0, r.covered, r.with_estimate,
-                  r.median_error_deg, r.median_error_mm);
+    std::snprintf(
+        line, sizeof line, "%-9s  %6d  %7d  %8d  %6d  %7d  %6.2f  %4d/%-3d  %7.3f  %6.1f\n",
+        r.error.c_str(), r.trials, r.miscalibrated, r.consistent, r.cannot_tell, r.significant,
+        r.mean_chi2 / 6.0, r.covered, r.with_estimate, r.median_error_deg, r.median_error_mm);
     text += line;
   }
   std::snprintf(line, sizeof line, "%.1f s per check\n", result.seconds_per_check);

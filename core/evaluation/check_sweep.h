@@ -24,10 +24,10 @@ struct CheckSweepOptions {
   bool moving = false;  // the rig drives through the room (one pose per frame) or stands still
   int seeds = 6;
   std::uint64_t first_seed = 1;
-  int frames = 8;                  // per seed
-  double range_noise_m = 0.01;     // along each ray
-  double image_noise = 0.01;       // [0,1] intensity units
-  double livox_hold_s = 1.0;       // a Livox-class frame: returns of this long at one pose
+  int frames = 8;               // per seed
+  double range_noise_m = 0.01;  // along each ray
+  double image_noise = 0.01;    // [0,1] intensity units
+  double livox_hold_s = 1.0;    // a Livox-class frame: returns of this long at one pose
   std::vector<double> rotation_errors_deg = {0.25, 0.5, 1.0};
   std::vector<double> translation_errors_m = {0.01, 0.02, 0.05};
   CheckOptions check;
@@ -55,15 +55,15 @@ void WriteCheckScene(const SimulatedCheckScene& scene, const std::filesystem::pa
 
 // One error size (or none) over all seeds.
 struct CheckSweepRow {
-  std::string error;        // "none", "0.5 deg", "2 cm"
+  std::string error;  // "none", "0.5 deg", "2 cm"
   int trials = 0;
-  int miscalibrated = 0;    // the verdict (caught; a false alarm on "none")
+  int miscalibrated = 0;  // the verdict (caught; a false alarm on "none")
   int consistent = 0;
   int cannot_tell = 0;
-  int significant = 0;      // the change from R beyond 3σ, whether or not above the tolerance
+  int significant = 0;  // the change from R beyond 3σ, whether or not above the tolerance
   int with_estimate = 0;
-  int covered = 0;          // the estimate's error χ² (6 axes) below the 95 % level (12.59)
-  double mean_chi2 = 0.0;   // over trials with an estimate; 6 when σ is honest
+  int covered = 0;         // the estimate's error χ² (6 axes) below the 95 % level (12.59)
+  double mean_chi2 = 0.0;  // over trials with an estimate; 6 when σ is honest
   double median_error_deg = 0.0, median_error_mm = 0.0;  // the estimate from the truth
 };
 struct CheckSweepResult {

@@ -70,8 +70,7 @@ Dataset LoadDataset(const std::filesystem::path& path, CameraFile camera = Camer
 
 // The folder form's camera (camera.yaml) and target (target.json) without its pairs: a capture
 // that has not written any yet (`calibench watch`). Throws IoError like LoadDataset.
-Dataset LoadFolderSetup(const std::filesystem::path& dir,
-                        CameraFile camera = CameraFile::kRequired,
+Dataset LoadFolderSetup(const std::filesystem::path& dir, CameraFile camera = CameraFile::kRequired,
                         TargetFile target = TargetFile::kRequired);
 
 // The board presets shipped as assets/targets/*.json, by name in name order; the built-in

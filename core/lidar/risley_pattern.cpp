@@ -6,7 +6,6 @@
 namespace calibench {
 namespace {
 
-
 Vec3 FromAzimuthElevation(double azimuth_rad, double elevation_rad) {
   return Vec3(std::cos(elevation_rad) * std::cos(azimuth_rad),
               std::cos(elevation_rad) * std::sin(azimuth_rad), std::sin(elevation_rad));
@@ -36,8 +35,8 @@ RisleyPattern MakeRisleyPattern(const std::string& name) {
     p.min_range_m = 0.1;
     return p;
   }
-  throw std::invalid_argument("unknown Livox-class pattern \"" + name + "\" (known: " +
-                              RisleyPatternNames() + ")");
+  throw std::invalid_argument("unknown Livox-class pattern \"" + name +
+                              "\" (known: " + RisleyPatternNames() + ")");
 }
 
 std::string RisleyPatternNames() { return "mid40, avia, mid360"; }

@@ -14,10 +14,10 @@ namespace calibench {
 
 // Field of view and timing of one scanner. Angles in degrees, rates in Hz.
 struct RisleyPattern {
-  std::string name;              // "mid40", "avia", "mid360"
-  bool spinning = false;         // 360° about z (Mid-360-like) rather than a cone about +x
-  double half_fov_h_deg = 19.2;  // cone: half width across azimuth (spinning: unused)
-  double half_fov_v_deg = 19.2;  // cone: half height; spinning: half of the elevation band
+  std::string name;                   // "mid40", "avia", "mid360"
+  bool spinning = false;              // 360° about z (Mid-360-like) rather than a cone about +x
+  double half_fov_h_deg = 19.2;       // cone: half width across azimuth (spinning: unused)
+  double half_fov_v_deg = 19.2;       // cone: half height; spinning: half of the elevation band
   double centre_elevation_deg = 0.0;  // spinning: the elevation band's centre
   double points_per_s = 100000.0;
   double prism1_hz = 121.7;  // the two prisms' turning rates (opposite signs: a rosette)

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstdio>
-
 #include <nlohmann/json.hpp>
 
 #include "core/io/json_io.h"
@@ -42,8 +41,7 @@ Vec3 JsonTriple(const nlohmann::json& j, const std::filesystem::path& path, cons
 
 // The cost along the weakest direction: a polyline in a 360x140 box, the calibration at 0.
 std::string ProfileSvg(const TargetlessCheckSection& c) {
-  if (c.weakest_offsets.size() < 2 || c.weakest_offsets.size() != c.weakest_costs.size())
-    return "";
+  if (c.weakest_offsets.size() < 2 || c.weakest_offsets.size() != c.weakest_costs.size()) return "";
   const auto [lo, hi] = std::minmax_element(c.weakest_costs.begin(), c.weakest_costs.end());
   const double x0 = c.weakest_offsets.front(), x1 = c.weakest_offsets.back();
   const double span = std::max(*hi - *lo, 1e-9);
@@ -56,10 +54,11 @@ std::string ProfileSvg(const TargetlessCheckSection& c) {
   const double zero_x = 20 + 320 * (0 - x0) / (x1 - x0);
   return "<figure><svg class=\"profile\" viewBox=\"0 0 360 140\" width=\"360\" height=\"140\" "
          "role=\"img\" aria-label=\"cost along the weakest direction\">"
-         "<line x1=\"" + FixedDigits(zero_x, 1) + "\" y1=\"10\" x2=\"" + FixedDigits(zero_x, 1) +
+         "<line x1=\"" +
+         FixedDigits(zero_x, 1) + "\" y1=\"10\" x2=\"" + FixedDigits(zero_x, 1) +
          "\" y2=\"125\" stroke=\"#999\" stroke-dasharray=\"3 3\"/>"
-         "<polyline fill=\"none\" stroke=\"#2a6\" stroke-width=\"2\" points=\"" + points +
-         "\"/><text x=\"20\" y=\"138\" font-size=\"10\">" + FixedDigits(x0, 1) +
+         "<polyline fill=\"none\" stroke=\"#2a6\" stroke-width=\"2\" points=\"" +
+         points + "\"/><text x=\"20\" y=\"138\" font-size=\"10\">" + FixedDigits(x0, 1) +
          " tol.</text><text x=\"300\" y=\"138\" font-size=\"10\">+" + FixedDigits(x1, 1) +
          " tol.</text></svg><figcaption>The scene's robust cost along its least constrained "
          "direction about the estimate, in units of the tolerance (dashed: the estimate). A flat "
@@ -73,7 +72,8 @@ TargetlessCheckSection LoadTargetlessCheck(const std::filesystem::path& path) {
   if (!j.is_object() || !j.contains("verdict") || !j["verdict"].is_string())
     throw IoError(path.string() +
                   ": not what `calibench check --json` prints (no \"verdict\"); write it with "
-                  "calibench check --dataset D --result R --json > " + path.string());
+                  "calibench check --dataset D --result R --json > " +
+                  path.string());
   TargetlessCheckSection c;
   c.source = path.string();
   try {
@@ -108,14 +108,16 @@ std::string TargetlessCheckHtml(const TargetlessCheckSection& c) {
   std::string html =
       "<section id=\"targetless-check\"><h2>Targetless check</h2><p>The calibration judged "
       "without a target, from the edges the LiDAR and the camera both see (<code>calibench "
-      "check</code>; " + EscapeHtml(c.source) + "; " + std::to_string(c.frames_used) + " of " +
+      "check</code>; " +
+      EscapeHtml(c.source) + "; " + std::to_string(c.frames_used) + " of " +
       std::to_string(c.frames_given) + " frames used).</p><p class=\"verdict " + kind + "\">" +
       EscapeHtml(c.verdict) + ": " + EscapeHtml(c.why) + "</p>";
   if (c.has_estimate) {
     html += "<table><tr><th></th><th>x (right)</th><th>y (down)</th><th>z (forward)</th></tr>";
     auto row = [&](const char* name, const Vec3& v, int digits) {
-      html += std::string("<tr><td>") + name + "</td><td>" + FixedDigits(v.x(), digits) + "</td><td>" +
-              FixedDigits(v.y(), digits) + "</td><td>" + FixedDigits(v.z(), digits) + "</td></tr>";
+      html += std::string("<tr><td>") + name + "</td><td>" + FixedDigits(v.x(), digits) +
+              "</td><td>" + FixedDigits(v.y(), digits) + "</td><td>" + FixedDigits(v.z(), digits) +
+              "</td></tr>";
     };
     row("change, translation [mm]", c.change_t_mm, 1);
     row("σ, translation [mm]", c.sigma_t_mm, 1);

@@ -10,11 +10,11 @@
 namespace calibench {
 namespace {
 
-constexpr double kAmbientLight = 0.35;        // of the light a face gets whatever its orientation
-constexpr double kNoSurfaceGrey = 0.4;   // where a pixel's ray leaves the room (never, closed)
+constexpr double kAmbientLight = 0.35;  // of the light a face gets whatever its orientation
+constexpr double kNoSurfaceGrey = 0.4;  // where a pixel's ray leaves the room (never, closed)
 constexpr double kReflectivityScale = 230.0;
 constexpr double kReflectivityNoise = 2.0;  // 0..255
-constexpr double kPaintStepM = 0.002;    // each painted layer this much off what it is painted on
+constexpr double kPaintStepM = 0.002;  // each painted layer this much off what it is painted on
 
 // A quad ready for ray tests.
 struct QuadGeometry {
@@ -28,8 +28,8 @@ std::vector<QuadGeometry> Geometry(const TexturedScene& scene) {
   quads.reserve(scene.quads.size());
   for (const TexturedQuad& q : scene.quads) {
     const Mat3 r = q.world_from_quad.linear();
-    quads.push_back({q.world_from_quad.translation(), r.col(2), r.col(0), r.col(1), q.half_size_m,
-                     q.albedo});
+    quads.push_back(
+        {q.world_from_quad.translation(), r.col(2), r.col(0), r.col(1), q.half_size_m, q.albedo});
   }
   return quads;
 }
@@ -91,8 +91,8 @@ void AddBox(const Vec3& foot_centre, double yaw, const Vec3& size, double albedo
     const Vec3 along = side < 2 ? ay : ax;
     const double half_out = side < 2 ? size.x() / 2 : size.y() / 2;
     const double half_along = side < 2 ? size.y() / 2 : size.x() / 2;
-    scene->quads.push_back({QuadPose(mid + half_out * out, along, out),
-                            Vec2(half_along, size.z() / 2), albedo});
+    scene->quads.push_back(
+        {QuadPose(mid + half_out * out, along, out), Vec2(half_along, size.z() / 2), albedo});
   }
   if (top)
     scene->quads.push_back(
@@ -129,8 +129,8 @@ TexturedScene MakeTexturedRoom(const TexturedRoomOptions& options) {
       {Vec3(0, W, H / 2), Vec3::UnitX(), -Vec3::UnitY(), Vec2(L, H / 2)},
       {Vec3(0, -W, H / 2), Vec3::UnitX(), Vec3::UnitY(), Vec2(L, H / 2)}};
   for (const Wall& wall : walls)
-    scene.quads.push_back({QuadPose(wall.centre, wall.axis_u, wall.inward), wall.half_size,
-                           uniform(0.5, 0.72)});
+    scene.quads.push_back(
+        {QuadPose(wall.centre, wall.axis_u, wall.inward), wall.half_size, uniform(0.5, 0.72)});
   // Posters: a wall in proportion to its length, a place on it, each layer a step off the last.
   for (int i = 0; i < options.posters; ++i) {
     const Wall& wall = walls[unit(rng) < L / (L + W) ? 2 + (unit(rng) < 0.5) : (unit(rng) < 0.5)];
@@ -138,8 +138,10 @@ TexturedScene MakeTexturedRoom(const TexturedRoomOptions& options) {
     const double u = uniform(-wall.half_size.x() + half.x(), wall.half_size.x() - half.x());
     const double v = uniform(-wall.half_size.y() + half.y(), wall.half_size.y() - half.y());
     const Vec3 up = Vec3::UnitZ();
-    const Vec3 centre = wall.centre + u * wall.axis_u + v * up + (i + 1) * kPaintStepM * wall.inward;
-    scene.quads.push_back({QuadPose(centre, wall.axis_u, wall.inward), half, ContrastingAlbedo(rng)});
+    const Vec3 centre =
+        wall.centre + u * wall.axis_u + v * up + (i + 1) * kPaintStepM * wall.inward;
+    scene.quads.push_back(
+        {QuadPose(centre, wall.axis_u, wall.inward), half, ContrastingAlbedo(rng)});
   }
   for (int i = 0; i < options.floor_marks; ++i) {
     const double yaw = uniform(0, M_PI);
@@ -185,9 +187,9 @@ ImageU8 RenderSceneImage(const CameraModel& camera, const Pose& world_from_cam,
                       std::optional<Hit> hit;
                       if (bearing) hit = CastRay(quads, origin, rotation * *bearing, 0.0, 1e3);
                       sum += hit ? hit->quad->albedo *
-                                       (kAmbientLight + (1.0 - kAmbientLight) *
-                                                       std::abs(hit->quad->normal.dot(
-                                                           scene.light_direction)))
+                                       (kAmbientLight +
+                                        (1.0 - kAmbientLight) *
+                                            std::abs(hit->quad->normal.dot(scene.light_direction)))
                                  : kNoSurfaceGrey;
                     }
                   grey[row * camera.width + x] = sum / (ss * ss);
@@ -220,13 +222,13 @@ class SceneScanner {
         rng_(options.seed) {}
 
   void Fire(const Vec3& origin, const Vec3& dir, double min_range, double max_range, int ring) {
-    const std::optional<Hit> hit =
-        CastRay(quads_, world_from_lidar_ * origin, world_from_lidar_.linear() * dir, min_range,
-                max_range);
+    const std::optional<Hit> hit = CastRay(quads_, world_from_lidar_ * origin,
+                                           world_from_lidar_.linear() * dir, min_range, max_range);
     if (!hit) return;
     double range = hit->range;
     if (options_.range_noise_m > 0) range += options_.range_noise_m * normal_(rng_);
-    const double intensity = hit->quad->albedo * kReflectivityScale + kReflectivityNoise * normal_(rng_);
+    const double intensity =
+        hit->quad->albedo * kReflectivityScale + kReflectivityNoise * normal_(rng_);
     cloud_.points.push_back((origin + range * dir).cast<float>());
     cloud_.intensity.push_back(static_cast<float>(std::clamp(intensity, 0.0, 255.0)));
     if (ring >= 0) cloud_.ring.push_back(ring);

@@ -35,9 +35,9 @@ struct TexturedRoomOptions {
   double half_length_m = 7.0;  // walls at x = ±half_length
   double half_width_m = 5.0;   // walls at y = ±half_width
   double height_m = 3.0;       // ceiling
-  int boxes = 10;              // boxes and pillars standing on the floor, 1.5 m or more from z's axis
-  int posters = 36;            // painted rectangles on the walls
-  int floor_marks = 8;         // tape and mats on the floor
+  int boxes = 10;       // boxes and pillars standing on the floor, 1.5 m or more from z's axis
+  int posters = 36;     // painted rectangles on the walls
+  int floor_marks = 8;  // tape and mats on the floor
   std::uint64_t seed = 1;
   bool Check(std::string* why) const;
 };

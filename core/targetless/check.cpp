@@ -183,8 +183,9 @@ void Decide(const CheckOptions& options, const Mat6& reference_covariance, Check
 // quarter of the search window (±half of it per axis, 125 points) are scored by the robust cost
 // at a matching radius of 3x the final one; around each of the best few, a grid of half that step
 // picks the start. The scene's own answer is then found wherever in the window it lies.
-std::vector<Pose> RotationGridStarts(const std::vector<EdgeFrame>& sample, const CameraModel& camera,
-                                     const Pose& reference, const CheckOptions& options) {
+std::vector<Pose> RotationGridStarts(const std::vector<EdgeFrame>& sample,
+                                     const CameraModel& camera, const Pose& reference,
+                                     const CheckOptions& options) {
   constexpr int kKeep = 4;
   const double step = 0.25 * options.alignment.search_deg * kDegToRad;
   const double radius = 3.0 * options.alignment.final_radius_px;
@@ -280,23 +281,25 @@ double StudentT99(int dof) {
 // minimum the starts found, farther than 3σ from the estimate, is put to a paired test over the
 // frames (each frame an independent look at the scene, whatever σ says): the estimate's cost must
 // be lower by more than the frames' own spread of the difference allows by chance (Student's t,
-// one-sided, 1 %), or lower in significantly more frames than not (sign test, one-sided, 5 %). A rival that survives widens the covariance by its offset, so the axes it moves
-// along are not called constrained. One frame cannot be tested against itself: no rival then.
+// one-sided, 1 %), or lower in significantly more frames than not (sign test, one-sided, 5 %). A
+// rival that survives widens the covariance by its offset, so the axes it moves along are not
+// called constrained. One frame cannot be tested against itself: no rival then.
 void AddRivalMinima(const std::vector<EdgeFrame>& frames, const CameraModel& camera,
                     const std::vector<Pose>& minima, const CheckOptions& options,
                     CheckReport* report) {
+  const int n = static_cast<int>(frames.size());
+  if (n < 2) return;
   const std::vector<double> best =
       AlignmentCostPerFrame(frames, camera, report->estimate, options.alignment);
-  std::vector<Vec6> rivals;
+  const Eigen::LDLT<Mat6> covariance = report->covariance.ldlt();
   for (const Pose& m : minima) {
     const Vec6 d = DeltaOnCameraAxes(report->estimate, m);
-    if (d.dot(report->covariance.ldlt().solve(d)) < 9.0) continue;  // the same minimum
+    if (d.dot(covariance.solve(d)) < 9.0) continue;  // the same minimum
     bool known = false;
-    for (const Vec6& r : rivals) known = known || (r - d).tail<3>().norm() < 0.05 * kDegToRad;
+    for (const Vec6& r : report->rival_offsets)
+      known = known || (r - d).tail<3>().norm() < 0.05 * kDegToRad;
     if (known) continue;
     const std::vector<double> other = AlignmentCostPerFrame(frames, camera, m, options.alignment);
-    const int n = static_cast<int>(best.size());
-    if (n < 2) continue;
     double sum = 0.0, sum_sq = 0.0;
     int wins = 0, decided = 0;
     for (int f = 0; f < n; ++f) {
@@ -311,12 +314,11 @@ void AddRivalMinima(const std::vector<EdgeFrame>& frames, const CameraModel& cam
     // A few frames with large differences can hide a consistent preference from the t test.
     const bool sign_test = BinomialUpperTail(wins, decided) < 0.05;
     if (t_test || sign_test) continue;
-    rivals.push_back(d);
     report->rival_offsets.push_back(d);
     report->rival_frames_preferring.push_back(decided - wins);
     report->rival_frames_decided.push_back(decided);
   }
-  for (const Vec6& d : rivals) report->covariance += d * d.transpose();
+  for (const Vec6& d : report->rival_offsets) report->covariance += d * d.transpose();
 }
 
 }  // namespace

@@ -78,8 +78,7 @@ DriftUpdate DriftMeter::Poll() {
                       (frames_at_last_check_ == 0 || new_since_check >= options_.recheck_every);
   const bool last_look = closed && new_since_check > 0;
   if (camera_ && !frames_.empty() && (enough || last_look)) {
-    update.report =
-        CheckCalibration(frames_, *camera_, reference_, reference_covariance_, check_);
+    update.report = CheckCalibration(frames_, *camera_, reference_, reference_covariance_, check_);
     frames_at_last_check_ = frames_seen_;
     const CheckVerdict verdict = update.report->verdict;
     update.sure = verdict != CheckVerdict::kCannotTell && last_verdict_ == verdict;
@@ -89,7 +88,8 @@ DriftUpdate DriftMeter::Poll() {
     finished_ = true;
     update.closed = true;
     if (!camera_)
-      throw IoError(recording_.string() + ": no camera intrinsics: the recording has no "
+      throw IoError(recording_.string() +
+                    ": no camera intrinsics: the recording has no "
                     "CameraInfo; give them with --camera FILE");
   }
   return update;
@@ -97,20 +97,15 @@ DriftUpdate DriftMeter::Poll() {
 
 void DriftMeter::ChooseTopicsWhenPresent(bool closed, DriftUpdate* update) {
   if (!PairTopicsPresent(*reader_, input_.camera.has_value()) && !closed) return;
-  BagImportOptions wanted;
-  wanted.cloud_topic = input_.cloud_topic;
-  wanted.image_topic = input_.image_topic;
-  wanted.camera_info_topic = input_.camera_info_topic;
-  wanted.camera = input_.camera;
-  ChooseTopics(*reader_, &wanted);
-  topics_ = ChosenPairTopics(*reader_, wanted);
-  cloud_topic_ = reader_->FindTopic(wanted.cloud_topic);
-  image_topic_ = reader_->FindTopic(wanted.image_topic);
-  info_topic_ = input_.camera ? -1 : reader_->FindTopic(wanted.camera_info_topic);
+  const CheckTopics chosen = ChooseCheckTopics(*reader_, input_);
+  topics_ = chosen.encodings;
+  cloud_topic_ = chosen.cloud;
+  image_topic_ = chosen.image;
+  info_topic_ = chosen.camera_info;
   pairer_ = std::make_unique<CheckFramePairer>(recording_.string(), topics_, check_, input_);
-  update->notes.push_back("topics: clouds " + wanted.cloud_topic + ", images " +
-                          wanted.image_topic + ", camera " +
-                          (input_.camera ? "from --camera" : wanted.camera_info_topic));
+  update->notes.push_back("topics: clouds " + chosen.cloud_name + ", images " + chosen.image_name +
+                          ", camera " +
+                          (input_.camera ? "from --camera" : chosen.camera_info_name));
   for (const Pending& message : pending_) Route(message.topic, message.log_time_ns, message.data);
   pending_.clear();
 }

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "core/targetless/check.h"
 #include "core/io/recording_pairs.h"
+#include "core/targetless/check.h"
 #include "core/targetless/check_input.h"
 
 namespace calibench {
@@ -28,11 +28,11 @@ struct DriftMeterOptions {
 struct DriftUpdate {
   std::vector<std::string> notes;  // topics chosen, frames skipped, waiting, in words
   int new_frames = 0;
-  int frames = 0;                  // held now (at most CheckInputOptions::max_frames)
-  int frames_seen = 0;             // made since the start
+  int frames = 0;                     // held now (at most CheckInputOptions::max_frames)
+  int frames_seen = 0;                // made since the start
   std::optional<CheckReport> report;  // when a check ran at this poll
-  bool sure = false;               // the verdict has held at two checks in a row
-  bool closed = false;             // the recorder closed the file; a last check ran if needed
+  bool sure = false;                  // the verdict has held at two checks in a row
+  bool closed = false;                // the recorder closed the file; a last check ran if needed
   bool data_arrived = false;
 };
 

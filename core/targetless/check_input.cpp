@@ -23,9 +23,8 @@ int Threads(int threads) { return threads > 0 ? threads : DefaultThreads(); }
 
 CheckInput LoadDatasetFrames(const fs::path& path, const CheckOptions& check,
                              const CheckInputOptions& options, const CheckInputProgress& progress) {
-  const Dataset dataset =
-      LoadDataset(path, options.camera ? CameraFile::kOptional : CameraFile::kRequired,
-                  TargetFile::kOptional);
+  const Dataset dataset = LoadDataset(
+      path, options.camera ? CameraFile::kOptional : CameraFile::kRequired, TargetFile::kOptional);
   CheckInput input;
   input.camera = options.camera ? *options.camera : dataset.camera;
   input.source = "dataset";
@@ -64,16 +63,10 @@ CheckInput LoadRecordingFrames(const fs::path& path, const CheckOptions& check,
                                const CheckInputOptions& options,
                                const CheckInputProgress& progress) {
   const std::unique_ptr<BagReader> bag = OpenBag(path);
-  BagImportOptions topics_wanted;
-  topics_wanted.cloud_topic = options.cloud_topic;
-  topics_wanted.image_topic = options.image_topic;
-  topics_wanted.camera_info_topic = options.camera_info_topic;
-  topics_wanted.camera = options.camera;
-  ChooseTopics(*bag, &topics_wanted);
-  const PairTopics topics = ChosenPairTopics(*bag, topics_wanted);
-  const int cloud_topic = bag->FindTopic(topics_wanted.cloud_topic);
-  const int image_topic = bag->FindTopic(topics_wanted.image_topic);
-  const int info_topic = options.camera ? -1 : bag->FindTopic(topics_wanted.camera_info_topic);
+  const CheckTopics chosen = ChooseCheckTopics(*bag, options);
+  const PairTopics& topics = chosen.encodings;
+  const int cloud_topic = chosen.cloud, image_topic = chosen.image;
+  const int info_topic = chosen.camera_info;
   std::optional<CameraModel> camera = options.camera;
   std::vector<bool> wanted(bag->Topics().size(), false);
   wanted[cloud_topic] = wanted[image_topic] = true;
@@ -90,7 +83,7 @@ CheckInput LoadRecordingFrames(const fs::path& path, const CheckOptions& check,
   });
   if (!camera)
     throw IoError(path.string() + ": no camera intrinsics: the recording has no CameraInfo on " +
-                  topics_wanted.camera_info_topic + "; give them with --camera FILE");
+                  chosen.camera_info_name + "; give them with --camera FILE");
   CheckInput input;
   input.camera = *camera;
   input.source = bag->Format();

@@ -83,11 +83,10 @@ std::string CheckReportJson(const CheckReport& report) {
                         {"frames_preferring", report.rival_frames_preferring[r]},
                         {"frames_deciding", report.rival_frames_decided[r]}});
     j["rival_alignments"] = rivals;
-    j["weakest_profile"] = {
-        {"direction", std::vector<double>(report.weakest_direction.data(),
-                                          report.weakest_direction.data() + 6)},
-        {"offsets_tolerance", report.weakest_offsets},
-        {"costs", report.weakest_costs}};
+    j["weakest_profile"] = {{"direction", std::vector<double>(report.weakest_direction.data(),
+                                                              report.weakest_direction.data() + 6)},
+                            {"offsets_tolerance", report.weakest_offsets},
+                            {"costs", report.weakest_costs}};
   } else {
     for (const char* key : {"cam_from_lidar", "sigma_t_mm", "sigma_r_deg", "change_t_mm",
                             "change_r_deg", "change_sigmas"})

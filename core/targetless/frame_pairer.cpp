@@ -2,13 +2,32 @@
 
 #include <cstdlib>
 
+#include "core/io/bag.h"
+#include "core/io/bag_import.h"
 #include "core/io/ros_messages.h"
 
 namespace calibench {
 
-CheckFramePairer::CheckFramePairer(std::string source, PairTopics topics,
-                                   const CheckOptions& check, const CheckInputOptions& options,
-                                   CheckInputProgress progress)
+CheckTopics ChooseCheckTopics(const BagReader& bag, const CheckInputOptions& options) {
+  BagImportOptions wanted;
+  wanted.cloud_topic = options.cloud_topic;
+  wanted.image_topic = options.image_topic;
+  wanted.camera_info_topic = options.camera_info_topic;
+  wanted.camera = options.camera;
+  ChooseTopics(bag, &wanted);
+  CheckTopics topics;
+  topics.encodings = ChosenPairTopics(bag, wanted);
+  topics.cloud = bag.FindTopic(wanted.cloud_topic);
+  topics.image = bag.FindTopic(wanted.image_topic);
+  topics.camera_info = options.camera ? -1 : bag.FindTopic(wanted.camera_info_topic);
+  topics.cloud_name = wanted.cloud_topic;
+  topics.image_name = wanted.image_topic;
+  topics.camera_info_name = wanted.camera_info_topic;
+  return topics;
+}
+
+CheckFramePairer::CheckFramePairer(std::string source, PairTopics topics, const CheckOptions& check,
+                                   const CheckInputOptions& options, CheckInputProgress progress)
     : source_(std::move(source)),
       topics_(std::move(topics)),
       check_(check),

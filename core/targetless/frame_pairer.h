@@ -14,6 +14,18 @@
 
 namespace calibench {
 
+class BagReader;
+
+// The topics a check reads from a recording, chosen as `import` chooses them unless the options
+// name them: each one's index in the reader (camera_info -1 when the camera is given), its name,
+// and how they are serialized. Throws IoError as ChooseTopics.
+struct CheckTopics {
+  PairTopics encodings;
+  int cloud = -1, image = -1, camera_info = -1;
+  std::string cloud_name, image_name, camera_info_name;
+};
+CheckTopics ChooseCheckTopics(const BagReader& bag, const CheckInputOptions& options);
+
 class CheckFramePairer {
  public:
   // `source` names the recording in messages.

@@ -106,8 +106,7 @@ std::optional<SceneEdgePoint> DepthEdgeBetween(const LineReturn& a, const LineRe
   const LineReturn& far = near == &a ? b : a;
   if (!near_beyond) return std::nullopt;
   const double continued_inverse = 2.0 / near->range - 1.0 / near_beyond->range;
-  if (continued_inverse <= 0.0 ||
-      far.range - 1.0 / continued_inverse < options.min_depth_jump_m)
+  if (continued_inverse <= 0.0 || far.range - 1.0 / continued_inverse < options.min_depth_jump_m)
     return std::nullopt;
   // The silhouette lies somewhere between the two rays, at the near surface's range.
   const Vec3 direction = (a.direction + b.direction).normalized();

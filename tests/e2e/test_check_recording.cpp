@@ -53,12 +53,12 @@ TEST(CheckRecording, AnMcapIsCheckedDirectlyWithOneJsonObjectOnStdout) {
 
   // The report of that calibration with the check as a section.
   const auto html = dir / "report.html";
-  ASSERT_EQ(test::RunCommand(exe + " report --result " + (dir / "result.json").string() +
-                                 " --dataset " + (dir / "folder").string() + " --check " +
-                                 json_path.string() + " --no-views --no-cross-validation --out " +
-                                 html.string(),
-                             &out),
-            0)
+  ASSERT_EQ(
+      test::RunCommand(exe + " report --result " + (dir / "result.json").string() + " --dataset " +
+                           (dir / "folder").string() + " --check " + json_path.string() +
+                           " --no-views --no-cross-validation --out " + html.string(),
+                       &out),
+      0)
       << out;
   const std::string page = test::ReadFileBytes(html);
   EXPECT_NE(page.find("id=\"targetless-check\""), std::string::npos);

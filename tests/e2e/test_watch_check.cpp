@@ -37,9 +37,9 @@ void RecordDrive(const SimulatedCheckScene& scene, test::RecordingWriter* writer
                  test::SerializeCameraInfo(scene.camera, t, "camera", cdr)});
     writer->Add({"/lidar/points", "sensor_msgs/PointCloud2", t,
                  test::SerializePointCloud2(scene.frames[k].cloud, t, "lidar", cdr)});
-    writer->Add({"/camera/image_raw", "sensor_msgs/Image", t + 5'000'000,
-                 test::SerializeImage(scene.frames[k].image, "mono8", t + 5'000'000, "camera",
-                                      cdr)});
+    writer->Add(
+        {"/camera/image_raw", "sensor_msgs/Image", t + 5'000'000,
+         test::SerializeImage(scene.frames[k].image, "mono8", t + 5'000'000, "camera", cdr)});
     std::this_thread::sleep_for(std::chrono::milliseconds(pace_ms));
   }
 }
