@@ -15,6 +15,7 @@
 #include "core/targetless/check_input.h"
 #include "core/targetless/check_output.h"
 #include "core/targetless/check_overlay.h"
+#include "core/targetless/checked_calibration.h"
 
 namespace calibench::app {
 
@@ -110,54 +111,6 @@ void DrawViews(const CheckFlags& f, const CheckInput& input, const CheckReport& 
 
 }  // namespace
 
-Pose CheckedCalibration(const std::string& path, Mat6* covariance) {
-  *covariance = Mat6::Zero();
-  if (IsSessionFile(path)) return CalibrationOf(path);
-  const LoadedResult loaded = LoadResult(path);
-  *covariance = CameraAxesCovariance(loaded.covariance, loaded.cam_from_source);
-  return loaded.cam_from_source;
-}
-
-int RenderCheckView(const std::string& dataset_path, const std::string& result_path,
-                    const std::string& pair_id, const std::string& out) {
-  if (result_path.empty() || dataset_path.empty()) {
-    std::fprintf(stderr, "calibench render: --view check needs --dataset and --result\n");
-    return kUsage;
-  }
-  Mat6 reference_covariance;
-  const Pose reference = CheckedCalibration(result_path, &reference_covariance);
-  const CheckOptions options;
-  const CheckInput input = LoadCheckInput(dataset_path, options, CheckInputOptions{});
-  const CheckReport report =
-      CheckCalibration(input.frames, input.camera, reference, reference_covariance, options);
-  const Dataset dataset = LoadDataset(dataset_path, CameraFile::kOptional, TargetFile::kOptional);
-  const PairEntry* pair = nullptr;
-  for (const PairEntry& p : dataset.pairs)
-    if (pair_id.empty() ? !pair : p.id == pair_id) pair = &p;
-  const EdgeFrame* frame = nullptr;
-  for (const EdgeFrame& f : input.frames)
-    if (pair && f.id == pair->id) frame = &f;
-  if (!pair || !frame) {
-    std::fprintf(stderr, "calibench render: no readable pair %s in %s\n", pair_id.c_str(),
-                 dataset_path.c_str());
-    return kInputError;
-  }
-  std::vector<OverlayPose> poses = {{report.reference, 40, 40, 255}};
-  if (report.has_estimate) poses.push_back({report.estimate, 60, 255, 60});
-  char change[200] = "";
-  if (report.has_estimate)
-    std::snprintf(change, sizeof change, "change %.2f deg / %.1f mm (%.1f sigma)",
-                  report.change_r_deg.norm(), 1e3 * report.change_t_m.norm(), report.change_sigmas);
-  const std::vector<std::string> caption = {
-      "targetless check: " + CheckVerdictName(report.verdict) + "   " + change,
-      "red: LiDAR edges under the calibration; green: under the targetless estimate; pair " +
-          pair->id};
-  SaveImage(out, DrawEdgeOverlay(LoadImage(pair->image), frame->lidar_edges, input.camera, poses,
-                                 caption));
-  std::printf("wrote %s (check, pair %s): %s\n", out.c_str(), pair->id.c_str(), report.why.c_str());
-  return kOk;
-}
-
 int RunCheck(int argc, char** argv) {
   CLI::App app{
       "Judge a calibration without a target: the scene's edges (depth jumps and paint the LiDAR "
@@ -176,8 +129,9 @@ int RunCheck(int argc, char** argv) {
     return kUsage;
   }
   MachineStdout out(f.json);  // from here on, only the JSON object reaches stdout
-  Mat6 reference_covariance;
-  const Pose reference = CheckedCalibration(f.result, &reference_covariance);
+  const CheckedCalibration checked = LoadCheckedCalibration(f.result);
+  const Pose& reference = checked.cam_from_lidar;
+  const Mat6& reference_covariance = checked.camera_axes_covariance;
   const ProgressCallback progress = StderrProgress("read");
   const CheckInput input =
       LoadCheckInput(f.dataset, f.check, f.input, [&](int done, int total, const std::string& id) {

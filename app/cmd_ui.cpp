@@ -252,6 +252,53 @@ int RunGui(int argc, char** argv) {
   return RunGuiWindow(dataset, session, width, height, screenshot, quit);
 }
 
+namespace {
+
+// `render --view check`: the workbench with its targetless check window open, after the check of
+// `result` (empty: the workbench's own solve, with --solve or a session's) over the dataset's
+// scenes.
+int RenderCheckHeadless(const std::string& dataset, const std::string& session,
+                        const std::string& result, const ui::HeadlessShot& shot,
+                        const std::string& out, gfx::HeadlessBackend backend) {
+  const auto context = OpenHeadless(backend, "calibench render: no headless OpenGL");
+  if (!context) return kInputError;
+  ui::Controller controller;
+  // In memory: render leaves the session beside the dataset alone.
+  if (!OpenInput(controller, dataset, session, "render",
+                 ui::Controller::ExistingSession::kInMemory))
+    return kUsage;
+  controller.WaitIdle();
+  if (!shot.pair_id.empty()) {
+    const int index = ui::FindPair(controller.GetSnapshot(), shot.pair_id);
+    if (index < 0) {
+      std::fprintf(stderr, "calibench render: no pair %s\n", shot.pair_id.c_str());
+      return kUsage;
+    }
+    controller.Apply(ui::SelectPair{index});
+  }
+  if (shot.solve) controller.Apply(ui::RunSolver{});
+  controller.WaitIdle();
+  controller.Apply(
+      ui::RunCheck{result.empty() ? std::filesystem::path() : std::filesystem::absolute(result)});
+  controller.WaitIdle();
+  const ui::Snapshot checked = controller.GetSnapshot();
+  if (!checked.check.report) {
+    std::fprintf(stderr, "calibench render: %s\n", checked.check.failure.c_str());
+    return kInputError;
+  }
+  const ui::HeadlessShot as_is{"", false, shot.width, shot.height};
+  const auto picture = ui::RenderShot<ui::Workbench, ui::SelectPair, ui::RunSolver>(
+      controller, ui::Layout::kWorkbench, as_is,
+      [](ui::Workbench& workbench) { workbench.set_check_open(true); });
+  const int code = SaveShot(picture, as_is, "check", out, checked.dataset_path.string(), *context);
+  if (code == kOk)
+    std::printf("targetless check of %s: %s\n", checked.check.checked.c_str(),
+                checked.check.report->why.c_str());
+  return code;
+}
+
+}  // namespace
+
 int RenderHeadless(const std::string& dataset, const std::string& session, const std::string& pair,
                    bool solve, const std::string& view, int width, int height,
                    const std::string& out, const std::string& backend_name,
@@ -391,7 +438,8 @@ int RunRender(int argc, char** argv) {
   app.add_option("--view", view,
                  "lidar | camera | 3d | workbench | guide (the camera and 3D views with the ghost "
                  "board where to hold the board next, and the meter; with --solve) | check (the "
-                 "targetless check of --result: the LiDAR's edges on the image under it and "
+                 "workbench with its targetless check window: --result, or the workbench's solve, "
+                 "checked against the scene's edges; the LiDAR's edges on the image under it and "
                  "under the estimate) (LRF datasets: scan | depth | 3d | workbench)")
       ->capture_default_str();
   app.add_option("--size", size, "WxH")->capture_default_str();
@@ -411,10 +459,20 @@ int RunRender(int argc, char** argv) {
                "LiDAR-camera: open the camera-intrinsics window, estimated from the loaded pairs "
                "(coverage map, per-image error, sigma)");
   std::string result;
-  app.add_option("--result,-r", result, "with --view check: the calibration to check");
+  app.add_option("--result,-r", result,
+                 "with --view check: the calibration to check (a result file or a session; "
+                 "default: the workbench's solve)");
   int width = 0, height = 0;
   if (const auto code = ParseFlags(app, argc, argv, size, "render", &width, &height)) return *code;
-  if (view == "check") return RenderCheckView(dataset, result, pair, out);
+  if (view == "check") {
+    gfx::HeadlessBackend backend;
+    if (!gfx::ParseHeadlessBackend(gl, &backend)) {
+      std::fprintf(stderr, "calibench render: --gl must be auto, egl or osmesa\n");
+      return kUsage;
+    }
+    return RenderCheckHeadless(dataset, session, result, {pair, solve, width, height}, out,
+                               backend);
+  }
   return RenderHeadless(dataset, session, pair, solve, view, width, height, out, gl, save_session,
                         intrinsics, camera);
 }

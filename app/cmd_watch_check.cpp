@@ -13,6 +13,7 @@
 #include "core/io/recording_watch.h"
 #include "core/targetless/check_follow.h"
 #include "core/targetless/check_output.h"
+#include "core/targetless/checked_calibration.h"
 
 namespace calibench::app {
 
@@ -66,8 +67,9 @@ int WatchCheck(WatchCheckRequest request) {
                  why.empty() ? "--idle-exit must be >= 0 (seconds)" : why.c_str());
     return kUsage;
   }
-  Mat6 reference_covariance;
-  const Pose reference = CheckedCalibration(request.result, &reference_covariance);
+  const CheckedCalibration checked = LoadCheckedCalibration(request.result);
+  const Pose& reference = checked.cam_from_lidar;
+  const Mat6& reference_covariance = checked.camera_axes_covariance;
   if (!IsRecordingSource(request.source)) {
     std::fprintf(stderr,
                  "calibench watch: --check follows a recording being written (.bag, .mcap, "

@@ -60,9 +60,6 @@ int RunWatch(int argc, char** argv);
 // `check`: a calibration judged without a target (core/targetless).
 int RunCheck(int argc, char** argv);
 int RunCheckSweep(int argc, char** argv);
-// The calibration a check judges: a result file's cam_from_lidar and its covariance on camera
-// axes, or a session's result (covariance zero).
-Pose CheckedCalibration(const std::string& path, Mat6* covariance);
 // `watch --check R RECORDING`: the drift meter (app/cmd_watch_check.cpp).
 struct WatchCheckRequest {
   std::string source, result;
@@ -78,9 +75,6 @@ struct WatchCheckRequest {
 void AddDriftMeterFlags(CLI::App& app, WatchCheckRequest* request);
 // Checks the request's options (kUsage with the reason on stderr), then follows the recording.
 int WatchCheck(WatchCheckRequest request);
-// `render --view check`: one pair's image with the LiDAR's edges under R and under the estimate.
-int RenderCheckView(const std::string& dataset, const std::string& result, const std::string& pair,
-                    const std::string& out);
 int RunEvaluate(int argc, char** argv);
 // `evaluate --subsets`: the σ-honesty protocol (core/sim/subset_coverage.h).
 int RunEvaluateSubsets(int argc, char** argv);

@@ -6,8 +6,10 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 
 #include "core/geometry/geometry.h"
+#include "core/results/result_json.h"
 #include "tests/acfr_manifest.h"
 
 namespace calibench::test {
@@ -82,6 +84,13 @@ SimOptions A3Hdl64Options(int pairs, double range_noise_m, std::uint64_t seed) {
   options.lidar_range_noise_m = range_noise_m;
   options.seed = seed;
   return options;
+}
+
+void WriteBareResult(const std::filesystem::path& path, const Pose& cam_from_lidar) {
+  nlohmann::json root =
+      ResultHeaderJson(ResultNames{}, cam_from_lidar, Mat6::Zero(), ObservabilityReport{});
+  root["pairs"] = nlohmann::json::array();
+  WriteResultJson(path, root);
 }
 
 }  // namespace calibench::test

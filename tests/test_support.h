@@ -50,6 +50,9 @@ template <typename A, typename B>
 // in x / y / z and 0.40–0.66 deg per angle. Prints the differences, prefixed by `what`.
 void ExpectNearAcfrReference(const Pose& cam_from_lidar, const char* what);
 
+// A result file holding only cam_from_lidar (zero covariance, no pairs): a calibration to check.
+void WriteBareResult(const std::filesystem::path& path, const Pose& cam_from_lidar);
+
 // The issue-5 protocol's simulation: an A3 checkerboard, an HDL-64, boards at 1.5–6 m.
 SimOptions A3Hdl64Options(int pairs, double range_noise_m, std::uint64_t seed);
 

@@ -132,7 +132,10 @@ Dataset LoadFolderSetup(const fs::path& dir, CameraFile camera, TargetFile targe
   } else {
     dataset.missing_camera_file = camera_file;
   }
-  if (has_target) dataset.target = LoadTargetFile(target_file);
+  if (has_target)
+    dataset.target = LoadTargetFile(target_file);
+  else
+    dataset.missing_target_file = target_file;
   return dataset;
 }
 

@@ -53,6 +53,9 @@ struct Dataset {
   // LoadDataset(path, CameraFile::kOptional) of a folder without camera.yaml: the file that is
   // missing (`camera` is then empty); empty when the camera was read.
   std::filesystem::path missing_camera_file;
+  // LoadDataset(path, ..., TargetFile::kOptional) of a folder without target.json (a drive for
+  // the targetless check: no board): the file that is missing; empty when the target was read.
+  std::filesystem::path missing_target_file;
 };
 
 // Whether a folder dataset must bring its camera.yaml (`calibrate --estimate-intrinsics` and

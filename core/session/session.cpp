@@ -37,7 +37,7 @@ bool SessionResult::operator==(const SessionResult& other) const {
          covariance_inflation == other.covariance_inflation &&
          plane_variance_factor == other.plane_variance_factor &&
          edge_variance_factor == other.edge_variance_factor && termination == other.termination &&
-         notes == other.notes &&
+         notes == other.notes && targetless_provenance == other.targetless_provenance &&
          std::equal(estimate_history.begin(), estimate_history.end(),
                     other.estimate_history.begin(), other.estimate_history.end(),
                     [](const Pose& a, const Pose& b) { return a.matrix() == b.matrix(); });
@@ -165,8 +165,10 @@ Session LoadSession(const std::filesystem::path& path) {
 
 SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_path) {
   Session session = LoadSession(session_path);
-  Dataset dataset = session.camera.empty() ? LoadDataset(session.dataset)
-                                           : LoadRigCamera(session.dataset, session.camera);
+  // A folder without a board (a drive kept for the targetless check) reopens too.
+  Dataset dataset = session.camera.empty()
+                        ? LoadDataset(session.dataset, CameraFile::kRequired, TargetFile::kOptional)
+                        : LoadRigCamera(session.dataset, session.camera);
   if (session.pairs.size() != dataset.pairs.size())
     throw IoError(session_path.string() + ": the session has " +
                   std::to_string(session.pairs.size()) + " pairs but " + dataset.manifest.string() +

@@ -72,6 +72,10 @@ struct SessionResult {
   // The summary's words on the solve's inputs (the LiDAR model, the residuals available), as the
   // workbench showed them (optional in the file).
   std::vector<std::string> notes;
+  // Not a board solve: a targetless check's estimate the user adopted (the workbench's check
+  // window), and the words of where it came from; empty for a solve. An export writes it as a
+  // targetless result (core/targetless/check_output.h).
+  std::string targetless_provenance;
 
   // Exact value comparison (no tolerance), so a file round trip can be checked with ==.
   bool operator==(const SessionResult& other) const;

@@ -112,6 +112,7 @@ Json ResultToJson(const SessionResult& r) {
   if (r.termination.test != TerminationTest::kNone)
     json["termination"] = TerminationToJson(r.termination);
   if (!r.notes.empty()) json["notes"] = r.notes;
+  if (!r.targetless_provenance.empty()) json["targetless_provenance"] = r.targetless_provenance;
   if (r.edge_dilation)
     json["board_edge_dilation"] = {{"value_m", r.edge_dilation->value_m},
                                    {"sigma_m", r.edge_dilation->sigma_m},
@@ -257,6 +258,8 @@ void ReadResultExtras(const Fields& f, SessionResult* r) {
       if (!note.is_string()) f.Fail("notes", "must hold strings");
       r->notes.push_back(note.get<std::string>());
     }
+  // Written since the workbench adopts a targetless check's estimate.
+  if (f.Has("targetless_provenance")) r->targetless_provenance = f.String("targetless_provenance");
   if (f.Has("termination")) {  // written since the solver says which test ended it
     const Fields t = f.Object("termination");
     const std::string name = t.String("test");

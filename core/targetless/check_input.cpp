@@ -21,10 +21,21 @@ namespace fs = std::filesystem;
 
 int Threads(int threads) { return threads > 0 ? threads : DefaultThreads(); }
 
-CheckInput LoadDatasetFrames(const fs::path& path, const CheckOptions& check,
-                             const CheckInputOptions& options, const CheckInputProgress& progress) {
-  const Dataset dataset = LoadDataset(
-      path, options.camera ? CameraFile::kOptional : CameraFile::kRequired, TargetFile::kOptional);
+// A check needs one frame at least: none read is an error naming the source and why.
+CheckInput RequireFrames(CheckInput input, const fs::path& path) {
+  if (input.frames.empty()) {
+    std::string reasons;
+    for (const std::string& r : input.unreadable) reasons += "; " + r;
+    throw IoError(path.string() + ": no frame to check (no cloud with an image)" + reasons);
+  }
+  return input;
+}
+
+}  // namespace
+
+CheckInput LoadDatasetCheckInput(const Dataset& dataset, const CheckOptions& check,
+                                 const CheckInputOptions& options,
+                                 const CheckInputProgress& progress) {
   CheckInput input;
   input.camera = options.camera ? *options.camera : dataset.camera;
   input.source = "dataset";
@@ -55,8 +66,10 @@ CheckInput LoadDatasetFrames(const fs::path& path, const CheckOptions& check,
     if (frames[i]) input.frames.push_back(std::move(*frames[i]));
     if (!problems[i].empty()) input.unreadable.push_back(problems[i]);
   }
-  return input;
+  return RequireFrames(std::move(input), dataset.manifest);
 }
+
+namespace {
 
 // A whole recording read in file order through the pairer.
 CheckInput LoadRecordingFrames(const fs::path& path, const CheckOptions& check,
@@ -113,17 +126,12 @@ CheckInput LoadCheckInput(const fs::path& path, const CheckOptions& check,
                           const CheckInputOptions& options, const CheckInputProgress& progress) {
   std::string why;
   const std::optional<DatasetSource> source = RecogniseDataset(path, &why);
-  CheckInput input;
   if (source && source->kind == DatasetKind::kRecording)
-    input = LoadRecordingFrames(path, check, options, progress);
-  else
-    input = LoadDatasetFrames(path, check, options, progress);
-  if (input.frames.empty()) {
-    std::string reasons;
-    for (const std::string& r : input.unreadable) reasons += "; " + r;
-    throw IoError(path.string() + ": no frame to check (no cloud with an image)" + reasons);
-  }
-  return input;
+    return RequireFrames(LoadRecordingFrames(path, check, options, progress), path);
+  return LoadDatasetCheckInput(
+      LoadDataset(path, options.camera ? CameraFile::kOptional : CameraFile::kRequired,
+                  TargetFile::kOptional),
+      check, options, progress);
 }
 
 }  // namespace calibench

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/camera/camera.h"
+#include "core/io/dataset.h"
 #include "core/targetless/check.h"
 
 namespace calibench {
@@ -45,5 +46,11 @@ using CheckInputProgress = std::function<void(int done, int total, const std::st
 CheckInput LoadCheckInput(const std::filesystem::path& path, const CheckOptions& check,
                           const CheckInputOptions& options,
                           const CheckInputProgress& progress = {});
+
+// The same for a dataset already read (the workbench's): every pair's cloud and image read again
+// from its files, as `check` reads them. Throws IoError naming the manifest when no frame reads.
+CheckInput LoadDatasetCheckInput(const Dataset& dataset, const CheckOptions& check,
+                                 const CheckInputOptions& options,
+                                 const CheckInputProgress& progress = {});
 
 }  // namespace calibench

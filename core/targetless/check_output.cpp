@@ -98,27 +98,56 @@ std::string CheckReportJson(const CheckReport& report) {
   return j.dump();
 }
 
+namespace {
+
+// The result file's header for a targetless estimate, provenance {kind: targetless, text}.
+nlohmann::json TargetlessResultJson(const Pose& cam_from_lidar, const Mat6& right_covariance,
+                                    const std::vector<std::string>& weak_directions,
+                                    const std::string& provenance_text) {
+  ObservabilityReport observability;
+  observability.well_constrained = weak_directions.empty();
+  observability.weak_directions = weak_directions;
+  nlohmann::json root =
+      ResultHeaderJson(ResultNames{}, cam_from_lidar, right_covariance, observability);
+  root["method"] = "targetless";
+  root["provenance"] = {{"kind", "targetless"}, {"text", provenance_text}};
+  root["pairs"] = nlohmann::json::array();
+  return root;
+}
+
+std::vector<std::string> UnconstrainedAxisNames(const CheckReport& report) {
+  std::vector<std::string> names;
+  for (int a : report.unconstrained_axes) names.push_back(CameraAxisName(a));
+  return names;
+}
+
+}  // namespace
+
+std::string TargetlessProvenanceText(const std::string& checked, const std::string& by) {
+  return "estimated without a target by " + by + " from the scene's edges, around " + checked;
+}
+
 void WriteCheckResult(const std::filesystem::path& path, const CheckReport& report,
                       const std::filesystem::path& checked_result) {
   CALIBENCH_CHECK(report.has_estimate);
-  const Mat6 right = RightPerturbationCovariance(report.covariance, report.estimate);
-  ObservabilityReport observability;
-  observability.well_constrained = report.unconstrained_axes.empty();
-  for (int a : report.unconstrained_axes)
-    observability.weak_directions.push_back(CameraAxisName(a));
-  nlohmann::json root = ResultHeaderJson(ResultNames{}, report.estimate, right, observability);
-  root["method"] = "targetless";
-  root["provenance"] = {
-      {"kind", "targetless"},
-      {"text", "estimated without a target by `calibench check` from the scene's edges, around " +
-                   checked_result.string()},
-      {"checked_result", checked_result.string()},
-      {"verdict", CheckVerdictName(report.verdict)},
-      {"why", report.why},
-      {"frames_used", report.frames_used},
-      {"frames", report.frame_ids}};
-  root["pairs"] = nlohmann::json::array();
+  nlohmann::json root = TargetlessResultJson(
+      report.estimate, RightPerturbationCovariance(report.covariance, report.estimate),
+      UnconstrainedAxisNames(report),
+      TargetlessProvenanceText(checked_result.string(), "`calibench check`"));
+  root["provenance"]["checked_result"] = checked_result.string();
+  root["provenance"]["verdict"] = CheckVerdictName(report.verdict);
+  root["provenance"]["why"] = report.why;
+  root["provenance"]["frames_used"] = report.frames_used;
+  root["provenance"]["frames"] = report.frame_ids;
   WriteResultJson(path, root);
+}
+
+void WriteTargetlessResult(const std::filesystem::path& path, const Pose& cam_from_lidar,
+                           const Mat6& right_covariance,
+                           const std::vector<std::string>& weak_directions,
+                           const std::string& provenance_text) {
+  WriteResultJson(path, TargetlessResultJson(cam_from_lidar, right_covariance, weak_directions,
+                                             provenance_text));
 }
 
 }  // namespace calibench

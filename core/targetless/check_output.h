@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "core/targetless/check.h"
 
@@ -20,5 +21,16 @@ std::string CheckReportJson(const CheckReport& report);
 // targetless and names the result checked. Requires report.has_estimate.
 void WriteCheckResult(const std::filesystem::path& path, const CheckReport& report,
                       const std::filesystem::path& checked_result);
+
+// The words of a targetless estimate's provenance: made `by` (a command, the workbench) around
+// the calibration `checked`.
+std::string TargetlessProvenanceText(const std::string& checked, const std::string& by);
+
+// A targetless estimate kept elsewhere (the workbench's adopted one) as a result file: method and
+// provenance kind "targetless", `provenance_text`, no pairs. Written atomically.
+void WriteTargetlessResult(const std::filesystem::path& path, const Pose& cam_from_lidar,
+                           const Mat6& right_covariance,
+                           const std::vector<std::string>& weak_directions,
+                           const std::string& provenance_text);
 
 }  // namespace calibench

@@ -21,13 +21,6 @@ namespace calibench {
 namespace {
 namespace fs = std::filesystem;
 
-void WriteResult(const fs::path& path, const Pose& cam_from_lidar) {
-  nlohmann::json root =
-      ResultHeaderJson(ResultNames{}, cam_from_lidar, Mat6::Zero(), ObservabilityReport{});
-  root["pairs"] = nlohmann::json::array();
-  WriteResultJson(path, root);
-}
-
 // The scene's frames as a drive recorded at 0.6 s per frame, handed to the writer `pace_ms` apart.
 void RecordDrive(const SimulatedCheckScene& scene, test::RecordingWriter* writer, int pace_ms) {
   const MessageEncoding cdr = MessageEncoding::kCdr;
@@ -53,8 +46,8 @@ TEST(WatchCheck, TheDriftMeterFollowsADriveAndCatchesATurnedCalibration) {
   const SimulatedCheckScene scene = SimulateCheckScene(options, 3);
   Vec6 turn = Vec6::Zero();
   turn.tail<3>() = Vec3(0.6, -0.5, 0.62).normalized() * kDegToRad;
-  WriteResult(dir / "truth.json", scene.cam_from_lidar);
-  WriteResult(dir / "turned.json", PerturbOnCameraAxes(scene.cam_from_lidar, turn));
+  test::WriteBareResult(dir / "truth.json", scene.cam_from_lidar);
+  test::WriteBareResult(dir / "turned.json", PerturbOnCameraAxes(scene.cam_from_lidar, turn));
 
   const fs::path mcap = dir / "drive.mcap";
   const fs::path lines = dir / "drift.jsonl";

@@ -12,6 +12,7 @@
 #include "core/io/image_io.h"
 #include "core/lidar_camera/joint_intrinsics.h"
 #include "core/lidar_camera/result_io.h"
+#include "core/targetless/check_output.h"
 
 namespace calibench::ui {
 
@@ -345,6 +346,14 @@ void Controller::Handle(const ExportResult& export_result) {
                     "): the pose of '" + frames.child() + "' in '" + frames.parent() +
                     "', camera frame " + CameraFrameName(frames.camera_frame),
                 false);
+      return;
+    }
+    if (!state_.solver.targetless_provenance.empty()) {
+      // An adopted targetless estimate: no board solve stands behind it, and the file says so.
+      WriteTargetlessResult(path, outcome.solution->cam_from_lidar, outcome.solution->covariance,
+                            outcome.solution->observability.weak_directions,
+                            state_.solver.targetless_provenance);
+      SetStatus("exported " + path.string() + " (the adopted targetless estimate)", false);
       return;
     }
     WriteResult(path, outcome, SolverOptionsFromState());

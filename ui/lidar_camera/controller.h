@@ -113,10 +113,20 @@ struct SolveRig {};
 struct PickBoard {
   std::string board;
 };
-using Intent = std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush,
-                            DetectBoardAgain, PaintPoints, RunSolver, ResetSolver, SetSolverOptions,
-                            SetView, ExportResult, SaveSessionAs, Undo, Redo, EstimateIntrinsics,
-                            SaveIntrinsics, SetGoal, SelectCamera, SolveRig, PickBoard>;
+// The targetless check (core/targetless, the step `calibench check` runs) of a calibration over
+// the scenes of the dataset's pairs, on the worker, using no board: `result` a result file or a
+// session (relative: beside the session); empty: the workbench's own calibration.
+struct RunCheck {
+  std::filesystem::path result;
+};
+// The check's estimate becomes the workbench's calibration, its provenance targetless (an export
+// writes a targetless result); one undo step.
+struct AdoptCheckEstimate {};
+using Intent =
+    std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush, DetectBoardAgain,
+                 PaintPoints, RunSolver, ResetSolver, SetSolverOptions, SetView, ExportResult,
+                 SaveSessionAs, Undo, Redo, EstimateIntrinsics, SaveIntrinsics, SetGoal,
+                 SelectCamera, SolveRig, PickBoard, RunCheck, AdoptCheckEstimate>;
 
 class Controller : public ControllerState<Snapshot> {
  public:
@@ -339,5 +349,9 @@ template <>
 void Controller::Handle(const SolveRig&);
 template <>
 void Controller::Handle(const PickBoard&);  // controller_watch.cpp
+template <>
+void Controller::Handle(const RunCheck&);  // controller_check.cpp
+template <>
+void Controller::Handle(const AdoptCheckEstimate&);
 
 }  // namespace calibench::ui

@@ -65,10 +65,22 @@ std::string StartBrush(const PairEntry& entry, const LidarCloud& cloud, const Li
          ": " + dropped;
 }
 
+constexpr const char* kNoTarget = "no board to find: the dataset has no target.json";
+
 }  // namespace
 
 void Controller::OnAllPairsLoaded() {
-  worker_.Enqueue([this] { DetectWithBackground(); });
+  if (state_.dataset->missing_target_file.empty()) {
+    worker_.Enqueue([this] { DetectWithBackground(); });
+  } else {
+    // No board to find (a drive opened for the targetless check): no detection, said per pair.
+    for (PairView& pair : state_.pairs) {
+      if (!pair.awaiting_detection) continue;
+      pair.awaiting_detection = false;
+      pair.status = PairStatus::kFailed;
+      pair.reason = pair.lidar_failure = kNoTarget;
+    }
+  }
   // What went wrong while loading stays on the status line (in the warning colour).
   std::string loaded_line = "loaded " + std::to_string(state_.loading_total) + " pairs";
   if (!open_note_.empty()) loaded_line += "; " + open_note_;
@@ -131,6 +143,12 @@ void Controller::LoadPair(int index) {
     loaded.detection = std::move(camera.detection);
     loaded.camera = std::move(camera.observation);
     loaded.camera_failure = camera.failure;
+    // No target (a drive for the targetless check): no board to see, whatever the default says.
+    if (!dataset.missing_target_file.empty()) {
+      loaded.detection.reset();
+      loaded.camera.reset();
+      loaded.camera_failure = kNoTarget;
+    }
     brush_dropped = StartBrush(entry, *cloud, *lidar_image, painted ? &*saved_mask : nullptr,
                                saved_brush, &loaded);
     painted = painted && brush_dropped.empty();

@@ -49,7 +49,9 @@ void Controller::OpenDataset(const std::filesystem::path& dataset_path,
                   ": not a rig (a folder with cameras/, or a manifest "
                   "with \"cameras\"), so it has no camera '" +
                   camera + "'");
-  OpenLoadedDataset(LoadDataset(dataset_path), std::move(session_path), existing);
+  // A folder without target.json opens too (a drive to check without a board); Open says so.
+  OpenLoadedDataset(LoadDataset(dataset_path, CameraFile::kRequired, TargetFile::kOptional),
+                    std::move(session_path), existing);
 }
 
 void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path session_path,
@@ -174,6 +176,11 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     load_warnings_.clear();
     opened_pairs_loaded_ = dataset.pairs.empty();
     open_note_ = note;
+    if (!dataset.missing_target_file.empty())
+      open_note_ += (note.empty() ? "" : "; ") + std::string("no ") +
+                    dataset.missing_target_file.string() +
+                    ": no board to find in these pairs (the targetless check needs none: "
+                    "Targetless check... in the solver panel)";
     session_ = std::move(session);
     ApplySessionToState(session_);
     // The pipeline job over the dataset's pairs as they load (LoadPair appends them), with the
@@ -239,6 +246,7 @@ void Controller::ApplySessionToState(const Session& session) {
   if (session.result) {
     state_.solver.result = SolverResultFromSession(*session.result, session.method);
     state_.solver.notes = session.result->notes;
+    state_.solver.targetless_provenance = session.result->targetless_provenance;
     // The recorded convergence, so that the solver panel and the replay look as they did.
     const auto& costs = session.result->cost_history;
     const auto& steps = session.result->step_history;
@@ -284,6 +292,7 @@ void Controller::CommitEdit() {
   if (state_.solver.result) {
     session_.result = SessionResultFromSolver(*state_.solver.result);
     session_.result->notes = state_.solver.notes;
+    session_.result->targetless_provenance = state_.solver.targetless_provenance;
     for (const IterationReport& it : state_.solver.iterations) {
       session_.result->step_history.push_back(it.step_norm);
       session_.result->estimate_history.push_back(it.cam_from_lidar);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -19,6 +20,7 @@
 #include "core/session/calibration_job.h"
 #include "core/target/board_camera.h"
 #include "core/target/lidar_plane.h"
+#include "core/targetless/check.h"
 #include "ui/state/controller_state.h"
 #include "ui/state/view_state.h"
 
@@ -57,6 +59,21 @@ struct SolverView {
   // The CLI summary's words on the solve's inputs: the LiDAR model and why, which residuals the
   // pairs gave (DescribeLidarModel, CountResiduals); a reopened session's from its file.
   std::vector<std::string> notes;
+  std::string failure;
+  // Not a board solve: the targetless check's estimate the user adopted (AdoptCheckEstimate),
+  // where it came from in words (SessionResult::targetless_provenance); empty for a solve.
+  std::string targetless_provenance;
+};
+
+// The targetless check (RunCheck) of a calibration over the scenes of the loaded pairs, as
+// `calibench check` runs it (core/targetless): what the check window shows, or why not.
+struct CheckView {
+  bool running = false;
+  std::string checked;  // the calibration checked, in words: a file, or "the workbench's ..."
+  std::shared_ptr<const CheckReport> report;
+  // Every frame's LiDAR edges by pair id: drawn on that pair's image under R and the estimate.
+  std::shared_ptr<const std::map<std::string, std::vector<SceneEdgePoint>>> lidar_edges;
+  std::vector<std::string> unreadable;  // frames the check could not read, "file: reason"
   std::string failure;
 };
 
@@ -137,6 +154,7 @@ struct Snapshot : SnapshotHeader {
   std::string intrinsics_failure;
   bool intrinsics_running = false;
   std::filesystem::path intrinsics_saved;  // where SaveIntrinsics last wrote them
+  CheckView check;                         // the targetless check window's
   // The meter (core/guidance's stop rule, as `advise` and `watch` judge): σ per direction against
   // the user's goal, the weakest in words, done; its history over the solves.
   CaptureGoal goal;

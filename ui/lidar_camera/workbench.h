@@ -50,6 +50,8 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   void set_scene_brush(bool on) { scene_brush_ = on; }
   // The camera-intrinsics window (its button in the solver panel; `render --intrinsics`).
   void set_intrinsics_open(bool on) { intrinsics_open_ = on; }
+  // The targetless check window (its button in the solver panel; `render --view check`).
+  void set_check_open(bool on) { check_open_ = on; }
 
  private:
   // LiDAR view (workbench_lidar.cpp).
@@ -97,6 +99,11 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   // The camera-intrinsics window (workbench_intrinsics.cpp): estimate from the loaded pairs, the
   // coverage map, the per-image error, σ and the verdict, save beside the dataset.
   void IntrinsicsWindow(const Snapshot& s, std::vector<Intent>* intents);
+  // The targetless check window (workbench_check.cpp): check the workbench's calibration or a
+  // result file, the verdict, change and σ per axis, the weakest direction's cost, the selected
+  // pair's LiDAR edges under both calibrations, adopt the estimate.
+  void CheckWindow(const Snapshot& s, std::vector<Intent>* intents);
+  void CheckOverlay(const Snapshot& s, const CheckReport& r);
   // workbench.cpp
   void View(int index, const Snapshot& s, const Rect& r, std::vector<Intent>* intents) override;
   std::string Opened(const Snapshot& s) const override;
@@ -129,6 +136,10 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   int intrinsics_model_ = -1;  // 0 pinhole, 1 fisheye; -1 = the dataset camera's
   int intrinsics_format_ = 0;  // ros, opencv, kalibr
   std::string intrinsics_path_ = "camera.estimated.yaml";
+  bool check_open_ = false;
+  std::string check_result_path_;
+  bool check_show_reference_ = true, check_show_estimate_ = true;
+  std::string check_overlay_key_;      // what gl_->check_overlay shows
   std::uint64_t scene_frame_key_ = 0;  // what the 3D framebuffer last showed
   std::uint64_t lidar_key_ = ~0ull, camera_key_ = ~0ull, scene_key_ = ~0ull;
 };

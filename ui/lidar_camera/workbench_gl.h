@@ -44,6 +44,7 @@ struct Workbench::Gl {
     const ImageU8* source = nullptr;
   };
   std::map<std::string, RigFrame> rig_frames;
+  gfx::ImageTexture check_overlay;  // the check window's picture (Workbench::CheckOverlay)
 };
 
 // What the camera view shows in a frame: the raw image with the real lens, or the undistorted one

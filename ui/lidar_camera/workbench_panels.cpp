@@ -226,6 +226,11 @@ void Workbench::SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent
     ImGui::SetTooltip(
         "estimate the camera's intrinsics from the loaded pairs: coverage, per-image "
         "error, sigma");
+  ImGui::SameLine();
+  if (ImGui::Button("Targetless check...")) check_open_ = !check_open_;
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "is the calibration still right? check it against the scene's edges, without a board");
   MeterRows(s, intents);
   if (s.rig) RigMeterRows(s, intents);
   if (!s.solver.iterations.empty()) {
@@ -243,6 +248,7 @@ void Workbench::SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent
     intents->push_back(SaveSessionAs{session_path_});
   ImGui::End();
   if (intrinsics_open_) IntrinsicsWindow(s, intents);
+  if (check_open_) CheckWindow(s, intents);
   if (!s.board_problem.empty())
     BoardPicker(s, intents);
   else
@@ -267,6 +273,8 @@ void Workbench::SolutionReadouts(const SolverView& solver, std::vector<Intent>* 
   ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.7f, 0.75f, 0.8f, 1));
   for (const std::string& note : solver.notes) ImGui::TextWrapped("%s", note.c_str());
   ImGui::PopStyleColor();
+  if (!solver.targetless_provenance.empty())
+    ImGui::TextColored({1.0f, 0.72f, 0.3f, 1}, "targetless estimate, not a board solve");
   ObservabilityReadout(
       res.observability,
       std::to_string(res.iterations) + " iterations, " + res.termination.Describe(),
