@@ -1,12 +1,12 @@
 // `calibench sweep --guided`: guided against random board placement on simulated data
-// (core/guidance/guided_sweep.h).
+// (core/evaluation/guided_sweep.h).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "app/sim_flags.h"
-#include "core/guidance/guided_sweep.h"
+#include "core/evaluation/guided_sweep.h"
 
 namespace calibench::app {
 

@@ -81,7 +81,7 @@ int RunEvaluateSubsets(int argc, char** argv);
 int RunSimulate(int argc, char** argv);
 int RunDemo(int argc, char** argv);
 int RunSweep(int argc, char** argv);
-// `sweep --guided`: guided against random placement (core/guidance/guided_sweep.h).
+// `sweep --guided`: guided against random placement (core/evaluation/guided_sweep.h).
 int RunSweepGuided(int argc, char** argv);
 int RunLrfCalibrate(int argc, char** argv);
 // `simulate --kind lrf` and the LRF side of `evaluate` (dispatched from RunSimulate/RunEvaluate).

@@ -7,8 +7,9 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/estimation/fisher_information.h"
 #include "core/estimation/uncertainty.h"
-#include "core/sim/crlb.h"
+#include "core/lidar_camera/solver.h"
 
 namespace calibench {
 

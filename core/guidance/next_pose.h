@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "core/camera/camera.h"
+#include "core/lidar/beam_table.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar_camera/pipeline.h"
-#include "core/sim/sim.h"
 #include "core/target/board.h"
 
 namespace calibench {

@@ -1,4 +1,5 @@
-// The Cramér–Rao bound of the extrinsic for board observations of known geometry.
+// The Cramér–Rao bound of the extrinsic for a simulated dataset's board observations (the
+// information of each plane: core/estimation/fisher_information.h).
 //
 // Each pair contributes its two plane features; their bound covariances follow from the noise
 // models: LiDAR range noise along the rays of the noise-free board returns (the Fisher
@@ -11,38 +12,11 @@
 
 #include <vector>
 
-#include "core/camera/camera.h"
-#include "core/geometry/geometry.h"
+#include "core/estimation/fisher_information.h"
 #include "core/lidar_camera/solver.h"
 #include "core/sim/sim.h"
 
 namespace calibench {
-
-// Inverse Fisher information of (n, d) (4x4, rank 3) for a plane measured by range noise
-// `range_sigma_m` (1σ) along the rays from the origin to `points` (noise-free, on `plane`).
-Mat4 LidarPlaneBoundCovariance(const std::vector<Vec3>& points, const Plane& plane,
-                               double range_sigma_m);
-
-// Inverse Fisher information of the board pose (right perturbation, [rho; phi]) for corners
-// `board_corners` (board frame) seen at `cam_from_board` with pixel noise `corner_sigma_px`.
-Mat6 CameraPoseBoundCovariance(const CameraModel& camera, const std::vector<Vec3>& board_corners,
-                               const Pose& cam_from_board, double corner_sigma_px);
-
-// Inverse Fisher information of the board plane (n, d) in the camera frame (4x4, rank 3) for
-// corners `board_corners` (board frame) seen at `cam_from_board` with pixel noise
-// `corner_sigma_px` (1σ per coordinate).
-Mat4 CameraPlaneBoundCovariance(const CameraModel& camera, const std::vector<Vec3>& board_corners,
-                                const Pose& cam_from_board, double corner_sigma_px);
-
-struct CramerRaoBound {
-  Mat6 covariance = Mat6::Zero();  // right perturbation of cam_from_lidar, [rho; phi]
-  // Expected RMS of |t_est − t_true| (metres) and of the rotation angle (degrees) of an
-  // efficient unbiased estimator: sqrt of the traces of the two blocks.
-  double translation_rms_m = 0.0;
-  double rotation_rms_deg = 0.0;
-};
-
-CramerRaoBound BoundFromInformation(const Mat6& information);
 
 // The bound for a simulated dataset's pairs (all, or the indices in `subset`), with the
 // simulator's range noise and `corner_sigma_px`. Both noises must be > 0.

@@ -1,4 +1,4 @@
-// Spinning-LiDAR beam tables and the ray caster of the simulator (core/sim.h).
+// The ray caster of the simulator (core/sim/sim.h; the beam tables: core/lidar/beam_table.h).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -19,15 +19,6 @@ constexpr double kInkIntensity = 20.0;
 constexpr double kWallIntensity = 90.0;
 constexpr double kFloorIntensity = 60.0;
 constexpr double kIntensityNoise = 3.0;
-
-// n angles from first_deg to last_deg inclusive, in radians.
-std::vector<double> LinspaceDeg(double first_deg, double last_deg, int n) {
-  std::vector<double> out(n);
-  for (int i = 0; i < n; ++i) {
-    out[i] = (first_deg + (last_deg - first_deg) * i / (n - 1)) * kDegToRad;
-  }
-  return out;
-}
 
 // The nearest hit of one ray from the LiDAR origin.
 struct RayHit {
@@ -121,58 +112,6 @@ double SurfaceIntensity(const RayHit& hit, const BoardPrint& print) {
 }
 
 }  // namespace
-
-namespace {
-constexpr EnumName<LidarModel> kLidarModelNames[] = {{LidarModel::kHdl64, "hdl64"},
-                                                     {LidarModel::kVlp16, "vlp16"},
-                                                     {LidarModel::kOs0_128, "os0-128"},
-                                                     {LidarModel::kSwept2d, "swept-2d"}};
-}  // namespace
-
-std::string LidarModelName(LidarModel model) { return NameIn(kLidarModelNames, model); }
-
-std::optional<LidarModel> ParseLidarModelName(const std::string& name) {
-  return ValueIn(kLidarModelNames, name);
-}
-
-std::string LidarModelNames() { return NamesIn(kLidarModelNames); }
-
-BeamTable MakeBeamTable(LidarModel model) {
-  BeamTable table;
-  switch (model) {
-    case LidarModel::kHdl64: {
-      // HDL-64E S2: lower block of 32 lasers at 1/2 deg, upper block of 32 at ~1/3 deg;
-      // 0.1728 deg azimuth resolution at 10 Hz.
-      table.elevations_rad = LinspaceDeg(-24.33, -8.83, 32);
-      const std::vector<double> upper = LinspaceDeg(-8.33, 2.0, 32);
-      table.elevations_rad.insert(table.elevations_rad.end(), upper.begin(), upper.end());
-      table.azimuth_steps = 2083;
-      table.max_range_m = 120.0;
-      break;
-    }
-    case LidarModel::kVlp16:
-      table.elevations_rad = LinspaceDeg(-15.0, 15.0, 16);
-      table.azimuth_steps = 1800;  // 0.2 deg at 10 Hz
-      table.max_range_m = 100.0;
-      break;
-    case LidarModel::kOs0_128:
-      table.elevations_rad = LinspaceDeg(-45.0, 45.0, 128);
-      table.azimuth_steps = 1024;
-      table.max_range_m = 50.0;
-      break;
-    case LidarModel::kSwept2d:
-      // A SICK LMS400-like scanner (70° fan, 0.2° resolution) turned by a stage in 0.4° steps,
-      // its mirror 10 cm in front of and 5 cm above the stage's axis (the scanner's box sits on
-      // it).
-      table.elevations_rad = LinspaceDeg(-35.0, 35.0, 351);
-      table.azimuth_steps = 900;
-      table.max_range_m = 10.0;
-      table.swept = true;
-      table.mirror_offset_m = Vec3(0.10, 0.0, 0.05);
-      break;
-  }
-  return table;
-}
 
 LidarCloud LidarScan::ToCloud(bool board_only) const {
   LidarCloud cloud;

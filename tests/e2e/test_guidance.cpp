@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/estimation/uncertainty.h"
-#include "core/guidance/guided_sweep.h"
+#include "core/evaluation/guided_sweep.h"
 #include "core/guidance/next_pose.h"
 #include "core/io/dataset.h"
 #include "core/sim/subset_coverage.h"

@@ -2,8 +2,8 @@
 // (perturbed as a hand holds it) or where the simulator's random placement puts it, the pairs go
 // through the real pipeline (image detection, LiDAR plane, solve) one at a time, and the stop
 // rule decides when to stop. Compared: the pairs each placement needs to reach the goal, and the
-// true error when the tool said "done". (It lives here, not in core/sim, because it drives the
-// guidance library, which itself builds on the simulator's beam tables and ray caster.)
+// true error when the tool said "done". An evaluation protocol: it drives both the simulator and
+// guidance, neither of which depends on the other.
 #pragma once
 
 #include <cstdint>

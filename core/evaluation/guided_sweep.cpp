@@ -1,4 +1,4 @@
-#include "core/guidance/guided_sweep.h"
+#include "core/evaluation/guided_sweep.h"
 
 #include <algorithm>
 #include <cmath>
