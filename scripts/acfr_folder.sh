@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Lays the real VLP-16 + fisheye set (../shared/datasets/acfr-vlp16-chessboard) out as a user's
 # folder of recordings (clouds/, images/, camera.yaml, target.json; symlinks, no copies), the
-# input of the real-data figures in README:
+# input of the real-data figures in docs/results.md:
 #
 #   scripts/acfr_folder.sh /tmp/acfr_folder
 #   /usr/bin/time -v build/calibench calibrate --dataset /tmp/acfr_folder --out /tmp/acfr.json

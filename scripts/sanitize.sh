@@ -46,7 +46,7 @@ build_type=RelWithDebInfo
 debug=-g
 targets=()
 labels=()
-# The --ci subset, by gtest suite (README "Fuzzing and sanitizers" names it).
+# The --ci subset, by gtest suite (docs/manual.md "Fuzzing and sanitizers" names it).
 CI_SUBSET='^(Controller|CalibrationJob|OnePipeline|SessionTest|RealBags|BagFormats|LidarPlane|FeatureCache)\.'
 if [ $mode = ci ]; then
   # -O1 and line tables only: faster to compile than RelWithDebInfo's -O2 -g, and a report still

@@ -221,7 +221,7 @@ TEST(AccuracyBound, FeatureCovariancesMatchTheirErrors) {
       return v[v.size() / 2];
     };
     // The median of χ²(3) is 2.37. Means are dominated by a few pairs (a planar-PnP flip, far
-    // boards hit by two rings) that the solver's outlier gate handles; see the README.
+    // boards hit by two rings) that the solver's outlier gate handles; see docs/results.md.
     std::printf("  medians: LiDAR %.2f, camera %.2f (χ²(3) median 2.37)\n", median(lidar_chi2),
                 median(camera_chi2));
     EXPECT_GT(median(lidar_chi2), 1.0);
