@@ -1,4 +1,5 @@
-// Speed of the pipeline's stages (Google Benchmark). Figures go to the closing note / docs/results.md.
+// Speed of the pipeline's stages (Google Benchmark). Figures go to the closing note /
+// docs/results.md.
 #include <benchmark/benchmark.h>
 
 #include <filesystem>

@@ -156,7 +156,8 @@ TEST(RealVlp16, AllPairsLandNearTheAuthorsReference) {
   // moves each board along its rays, sideways for the boards off to one side, and which boards a
   // subset holds decides how much of that shows. Estimated, the offset halves the x spread;
   // per-ring angle offsets of the LiDAR, which we suspected first, explain almost nothing of the
-  // edge residuals (docs/results.md, "Real data"). z pays for the offset it shares its information with.
+  // edge residuals (docs/results.md, "Real data"). z pays for the offset it shares its information
+  // with.
   const double kDegree = M_PI / 180;
   for (const Spread* sp : {&weighted, &weighted_offset}) {
     EXPECT_LT(sp->translation_std.maxCoeff(), 0.02);

@@ -61,7 +61,9 @@ TEST(CheckWindow, ATurnedCalibrationIsCaughtItsEstimateAdoptedExportedReopenedAn
   controller.Apply(RunCheck{dir / "turned.json"});
   s = Loaded(controller);
   ASSERT_TRUE(s.check.report) << s.check.failure;
-  const CheckReport& report = *s.check.report;
+  // Held here: the snapshots below replace `s`, and with it their pointer to this report.
+  const std::shared_ptr<const CheckReport> checked = s.check.report;
+  const CheckReport& report = *checked;
   EXPECT_EQ(report.verdict, CheckVerdict::kMiscalibrated) << report.why;
   ASSERT_TRUE(report.has_estimate);
   EXPECT_EQ(report.frames_given, 12);
