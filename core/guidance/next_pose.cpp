@@ -35,7 +35,7 @@ bool GuidanceOptions::Check(std::string* why) const {
   if (!(image_margin_fraction >= 0 && image_margin_fraction < 0.25))
     return *why = "image_margin_fraction must be in [0, 0.25)", false;
   if (!(min_square_px >= 0)) return *why = "min_square_px must be >= 0", false;
-  if (min_rings < 1 || min_points < 3) return *why = "min_rings >= 1 and min_points >= 3", false;
+  if (!lidar_returns.Check(why)) return false;
   if (!(max_incidence_deg > 0 && max_incidence_deg < 90))
     return *why = "max_incidence_deg must be in (0, 90)", false;
   if (distance_steps < 1 || image_columns < 1 || image_rows < 1)
@@ -85,75 +85,16 @@ std::pair<double, double> GoalScore(const Mat6& covariance, const Pose& cam_from
 
 }  // namespace
 
-PredictedReturns PredictBoardReturns(const SensorGeometry& sensors, const Pose& lidar_from_board) {
-  PredictedReturns out;
-  const BeamTable& beams = sensors.lidar;
-  if (beams.azimuth_steps < 1) return out;
-  const Vec3 normal = lidar_from_board.linear().col(2);
-  const Vec3 origin = lidar_from_board.translation();
-  const double offset = normal.dot(origin);
-  const Vec2 half(0.5 * sensors.board.SheetWidth(), 0.5 * sensors.board.SheetHeight());
-  // Only the azimuths the sheet spans (around its centre's), plus one step each side.
-  const double step = 2 * M_PI / beams.azimuth_steps;
-  const double centre_azimuth = std::atan2(origin.y(), origin.x());
-  double half_span = 0.0;
-  for (const Vec3& c : SheetCorners(sensors.board)) {
-    const Vec3 p = lidar_from_board * c;
-    double d = std::atan2(p.y(), p.x()) - centre_azimuth;
-    d = std::remainder(d, 2 * M_PI);
-    half_span = std::max(half_span, std::abs(d));
-  }
-  const int first = static_cast<int>(std::floor((centre_azimuth - half_span) / step)) - 1;
-  const int last = static_cast<int>(std::ceil((centre_azimuth + half_span) / step)) + 1;
-  auto hit = [&](double elevation, double azimuth, Vec3* point, bool* on_sheet) {
-    const Vec3 ray(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
-                   std::sin(elevation));
-    const double denominator = normal.dot(ray);
-    if (std::abs(denominator) < 1e-9) return false;
-    const double range = offset / denominator;
-    if (!(range > 0.3) || range > beams.max_range_m) return false;
-    *point = range * ray;
-    const Vec3 local = lidar_from_board.linear().transpose() * (*point - origin);
-    *on_sheet = std::abs(local.x()) <= half.x() && std::abs(local.y()) <= half.y();
-    return true;
-  };
-  for (int ring = 0; ring < static_cast<int>(beams.elevations_rad.size()); ++ring) {
-    const double elevation = beams.elevations_rad[ring];
-    int count = 0;
-    Vec3 previous = Vec3::Zero();
-    bool previous_on = false, previous_valid = false;
-    for (int a = first; a <= last; ++a) {
-      Vec3 point = Vec3::Zero();
-      bool on = false;
-      const bool valid = hit(elevation, a * step, &point, &on);
-      if (valid && on) {
-        out.points.push_back(point);
-        out.ring.push_back(ring);
-        ++count;
-      }
-      // A crossing of the sheet's edge: midway between the last return on the sheet and the
-      // first beyond it, on the plane (as ExtractBoardEdgePoints measures it).
-      if (valid && previous_valid && on != previous_on) {
-        LidarEdgePoint edge;
-        const Vec3& inside = on ? point : previous;
-        const Vec3& outside = on ? previous : point;
-        edge.point = 0.5 * (inside + outside);
-        edge.along_ring = (outside - inside).normalized();
-        edge.sigma_along_m = (outside - inside).norm() / std::sqrt(12.0);
-        out.edges.push_back(edge);
-      }
-      previous = point;
-      previous_on = on;
-      previous_valid = valid;
-    }
-    out.rings += count >= 3;
-  }
-  return out;
+BoardReturns PredictBoardReturns(const SensorGeometry& sensors, const Pose& lidar_from_board) {
+  LidarRectangle sheet;
+  sheet.lidar_from_rectangle = lidar_from_board;
+  sheet.half_size_m = 0.5 * Vec2(sensors.board.SheetWidth(), sensors.board.SheetHeight());
+  return CastBoardReturns(sensors.lidar, sheet);
 }
 
 Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pose>& cam_from_lidar,
                           const Pose& cam_from_board, const GuidanceOptions& options,
-                          PredictedReturns* returns) {
+                          BoardReturns* returns) {
   Feasibility f;
   char text[200];
   f.distance_m = cam_from_board.translation().norm();
@@ -205,14 +146,12 @@ Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pos
       f.why = TooOblique("LiDAR", f.lidar_incidence_deg, options.max_incidence_deg);
       return f;
     }
-    PredictedReturns predicted = PredictBoardReturns(sensors, lidar_from_board);
-    f.rings = predicted.rings;
+    BoardReturns predicted = PredictBoardReturns(sensors, lidar_from_board);
+    f.rings = options.lidar_returns.RingsCovered(predicted);
     f.points = static_cast<int>(predicted.points.size());
-    if (f.rings < options.min_rings || f.points < options.min_points) {
-      std::snprintf(text, sizeof(text),
-                    "too few LiDAR returns on the sheet (%d rings, %d points; at least %d and %d)",
-                    f.rings, f.points, options.min_rings, options.min_points);
-      f.why = text;
+    std::string short_by;
+    if (!options.lidar_returns.Met(predicted, &short_by)) {
+      f.why = "too few LiDAR returns on the sheet (" + short_by + ")";
       return f;
     }
     if (returns) *returns = std::move(predicted);
@@ -222,7 +161,7 @@ Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pos
 }
 
 PlanePair PlannedPair(const SensorGeometry& sensors, const Pose& cam_from_lidar,
-                      const Pose& cam_from_board, const PredictedReturns& returns) {
+                      const Pose& cam_from_board, const BoardReturns& returns) {
   PlanePair pair;
   pair.id = "planned";
   // Camera plane: normal towards the camera (BoardSpec's z points away from it).
@@ -404,7 +343,7 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
     // No solution yet: the LiDAR cannot be checked, so stay where a spinning LiDAR beside the
     // camera sees most (the image's middle band, moderate turns).
     if (!cam_from_lidar && !(c.middle_row && c.moderate)) continue;
-    PredictedReturns returns;
+    BoardReturns returns;
     const Feasibility f =
         CheckFeasible(sensors, cam_from_lidar, c.cam_from_board, options, &returns);
     if (!f.feasible) {

@@ -9,6 +9,7 @@
 
 #include "core/camera/camera.h"
 #include "core/lidar/beam_table.h"
+#include "core/lidar/board_returns.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/target/board.h"
@@ -51,8 +52,7 @@ std::optional<SensorGeometry> LearnSensorGeometry(const CameraModel& camera, con
 struct GuidanceOptions {
   double image_margin_fraction = 0.03;  // the whole sheet this far inside the image (of width)
   double min_square_px = 12.0;          // a pattern square at least this wide in the image
-  int min_rings = 4;                    // rings with >= 3 returns on the sheet
-  int min_points = 40;                  // returns on the sheet
+  BoardReturnsRule lidar_returns;       // predicted returns on the sheet enough to find it
   double max_incidence_deg = 60.0;      // board normal against the ray, for both sensors
   // The candidate grid (camera frame): distances across the usable range, image cells, and
   // tilts of the board about its vertical and horizontal axes and in its own plane.
@@ -74,14 +74,9 @@ struct GuidanceOptions {
   bool Check(std::string* why) const;
 };
 
-// The board's noise-free returns for a pose: the points and, per ring, where it leaves the sheet.
-struct PredictedReturns {
-  std::vector<Vec3> points;  // LiDAR frame
-  std::vector<int> ring;
-  std::vector<LidarEdgePoint> edges;
-  int rings = 0;  // rings with >= 3 returns
-};
-PredictedReturns PredictBoardReturns(const SensorGeometry& sensors, const Pose& lidar_from_board);
+// The board's noise-free returns for a pose: the points and, per ring, where it leaves the sheet
+// (the ray caster the simulator scans with, core/lidar/board_returns.h).
+BoardReturns PredictBoardReturns(const SensorGeometry& sensors, const Pose& lidar_from_board);
 
 struct Feasibility {
   bool feasible = false;
@@ -96,12 +91,12 @@ struct Feasibility {
 // estimate. The LiDAR checks are skipped when cam_from_lidar is absent (no solution yet).
 Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pose>& cam_from_lidar,
                           const Pose& cam_from_board, const GuidanceOptions& options,
-                          PredictedReturns* returns = nullptr);
+                          BoardReturns* returns = nullptr);
 
 // One planned pair as the solver would see it: true planes with their Cramér–Rao covariances at
 // the sensors' noise, and the board edges the rings would cross.
 PlanePair PlannedPair(const SensorGeometry& sensors, const Pose& cam_from_lidar,
-                      const Pose& cam_from_board, const PredictedReturns& returns);
+                      const Pose& cam_from_board, const BoardReturns& returns);
 
 struct PoseSuggestion {
   Pose cam_from_board = Pose::Identity();    // BoardSpec frame

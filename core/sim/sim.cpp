@@ -9,14 +9,16 @@
 
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
+#include "core/lidar/board_returns.h"
 #include "core/lidar/cloud.h"
 
 namespace calibench {
 namespace {
 
 constexpr double kImageMarginFraction = 0.05;  // of the image width, around the whole sheet
-constexpr int kMinBoardRings = 4;
-constexpr int kMinBoardPoints = 60;
+// Simulated boards are placed where the LiDAR's returns leave a margin over what finding the
+// board needs (guidance's BoardReturnsRule asks for 40 returns): 4 rings of 3+ returns, 60 in all.
+constexpr BoardReturnsRule kSimulatedBoardReturns{4, 3, 60};
 constexpr double kMaxIncidenceDeg = 80.0;  // LiDAR ray vs. board normal at the board centre
 constexpr int kMaxTriesPerPair = 5000;
 
@@ -134,36 +136,29 @@ bool SheetInLidarFov(const SimOptions& r, const BeamTable& beams, const Pose& li
 }
 
 // The noise-free returns of the board alone (no room).
-LidarScan ScanBoardOnly(const BeamTable& beams, const BoardPrint& print,
-                        const Pose& lidar_from_board, double azimuth_offset_rad) {
-  LidarScene board_only;
-  board_only.lidar_from_board = lidar_from_board;
-  board_only.clutter = false;
-  LidarScanOptions scan_options;
-  scan_options.azimuth_offset_rad = azimuth_offset_rad;
-  return SimulateLidarScan(beams, print, board_only, scan_options);
+// The sheet's noise-free returns with nothing in front of it: the ray caster guidance predicts
+// with.
+BoardReturns ScanBoardOnly(const BeamTable& beams, const BoardPrint& print,
+                           const Pose& lidar_from_board, double azimuth_offset_rad) {
+  LidarRectangle sheet;
+  sheet.lidar_from_rectangle = lidar_from_board;
+  sheet.half_size_m = 0.5 * Vec2(print.board().SheetWidth(), print.board().SheetHeight());
+  return CastBoardReturns(beams, sheet, azimuth_offset_rad);
 }
 
 // Where a user would brush: the centroid of the noise-free board returns.
 Vec3 BoardHitCentroid(const BeamTable& beams, const BoardPrint& print, const Pose& lidar_from_board,
                       double azimuth_offset_rad) {
-  const LidarCloud hits =
-      ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad).ToCloud();
+  const BoardReturns hits = ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad);
   Vec3 centroid = Vec3::Zero();
-  for (const auto& p : hits.points) centroid += p.cast<double>() / static_cast<double>(hits.size());
-  return hits.size() > 0 ? centroid : lidar_from_board.translation();
+  for (const Vec3& p : hits.points) centroid += p / static_cast<double>(hits.points.size());
+  return hits.points.empty() ? lidar_from_board.translation() : centroid;
 }
 
 bool EnoughLidarHits(const BeamTable& beams, const BoardPrint& print, const Pose& lidar_from_board,
                      double azimuth_offset_rad) {
-  const LidarScan scan = ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad);
-  // A ring that only grazes a corner (one or two returns) does not help a plane fit.
-  constexpr int kMinPointsPerRing = 3;
-  std::vector<int> hits_per_ring(beams.elevations_rad.size(), 0);
-  for (int ring : scan.ring) ++hits_per_ring[ring];
-  const int rings = static_cast<int>(std::count_if(hits_per_ring.begin(), hits_per_ring.end(),
-                                                   [](int n) { return n >= kMinPointsPerRing; }));
-  return rings >= kMinBoardRings && static_cast<int>(scan.size()) >= kMinBoardPoints;
+  return kSimulatedBoardReturns.Met(
+      ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad));
 }
 
 PairPlan PlanPair(const SimOptions& r, const BeamTable& beams, const BoardPrint& print,
@@ -339,10 +334,11 @@ std::vector<SimPairTruth> SimulatePairTruth(const SimOptions& options) {
   for (const PairPlan& plan : PlanPairs(r, beams, print, RoomScene(r))) {
     SimPairTruth pair;
     pair.cam_from_board = plan.cam_from_board;
-    const LidarScan scan =
+    const BoardReturns hits =
         ScanBoardOnly(beams, print, lidar_from_cam * plan.cam_from_board, plan.azimuth_offset_rad);
-    for (const Eigen::Vector3f& p : scan.ToCloud().points)
-      pair.lidar_board_points.push_back(p.cast<double>());
+    // As the PCD file stores them: floats.
+    for (const Vec3& p : hits.points)
+      pair.lidar_board_points.push_back(p.cast<float>().cast<double>());
     truth.push_back(std::move(pair));
   }
   return truth;

@@ -9,19 +9,10 @@
 #include <vector>
 
 #include "core/geometry/geometry.h"
+#include "core/lidar/board_returns.h"  // LidarEdgePoint
 #include "core/lidar/cloud.h"
 
 namespace calibench {
-
-// One crossing of a ring over the sheet's edge, on the fitted board plane (LiDAR frame).
-struct LidarEdgePoint {
-  Vec3 point = Vec3::Zero();        // the crossing: midway between the last board return and
-                                    // the first return beyond the board, on the plane
-  Vec3 along_ring = Vec3::UnitX();  // unit, LiDAR frame: the ring's direction there, outwards
-  // The crossing lies somewhere in the gap between those two returns: its standard deviation
-  // along the ring is the gap's length / √12 (uniform).
-  double sigma_along_m = 0.0;
-};
 
 struct BoardEdgeOptions {
   // The return beyond the board must lie at least this far behind the board plane along its ray

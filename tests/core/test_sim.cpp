@@ -21,8 +21,6 @@
 namespace calibench {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 CameraModel Pinhole() {
   CameraModel c;
   c.width = 1440, c.height = 1080, c.fx = c.fy = 1000.0, c.cx = 719.5, c.cy = 539.5;
@@ -68,7 +66,7 @@ Pose MakePose(const Vec3& centre, const Mat3& base, double rx, double ry, double
 Pose LidarFromBoard() {
   Mat3 facing;
   facing << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // board x = -LiDAR y, y = -LiDAR z, z = LiDAR x
-  return MakePose(Vec3(4.0, 0.3, -0.2), facing, 20 * kDeg, -15 * kDeg, 10 * kDeg);
+  return MakePose(Vec3(4.0, 0.3, -0.2), facing, 20 * kDegToRad, -15 * kDegToRad, 10 * kDegToRad);
 }
 
 BoardSpec PaperBoard() {
@@ -139,18 +137,18 @@ TEST(SimBeams, TablesMatchTheSensors) {
     ASSERT_EQ(table.elevations_rad.size(), e.rings);
     EXPECT_EQ(table.azimuth_steps, e.steps);
     EXPECT_DOUBLE_EQ(table.max_range_m, e.range);
-    EXPECT_NEAR(table.elevations_rad.front(), e.lowest_deg * kDeg, 1e-12);
-    EXPECT_NEAR(table.elevations_rad.back(), e.highest_deg * kDeg, 1e-12);
+    EXPECT_NEAR(table.elevations_rad.front(), e.lowest_deg * kDegToRad, 1e-12);
+    EXPECT_NEAR(table.elevations_rad.back(), e.highest_deg * kDegToRad, 1e-12);
     for (size_t r = 1; r < table.elevations_rad.size(); ++r) {
       EXPECT_GT(table.elevations_rad[r], table.elevations_rad[r - 1]);  // ring 0 = lowest
     }
     EXPECT_EQ(ParseLidarModelName(LidarModelName(e.model)), e.model);
   }
   const BeamTable hdl = MakeBeamTable(LidarModel::kHdl64);
-  EXPECT_NEAR(hdl.elevations_rad[1] - hdl.elevations_rad[0], 0.5 * kDeg, 1e-4);  // lower block
-  EXPECT_NEAR(hdl.elevations_rad[63] - hdl.elevations_rad[62], kDeg / 3, 1e-3);  // upper block
-  EXPECT_NEAR(hdl.elevations_rad[32], -8.33 * kDeg, 1e-12);
-  EXPECT_EQ(MakeBeamTable(LidarModel::kVlp16).elevations_rad[1], -13.0 * kDeg);
+  EXPECT_NEAR(hdl.elevations_rad[1] - hdl.elevations_rad[0], 0.5 * kDegToRad, 1e-4);  // lower block
+  EXPECT_NEAR(hdl.elevations_rad[63] - hdl.elevations_rad[62], kDegToRad / 3, 1e-3);  // upper block
+  EXPECT_NEAR(hdl.elevations_rad[32], -8.33 * kDegToRad, 1e-12);
+  EXPECT_EQ(MakeBeamTable(LidarModel::kVlp16).elevations_rad[1], -13.0 * kDegToRad);
   EXPECT_FALSE(ParseLidarModelName("VLP16"));
 }
 
@@ -405,7 +403,8 @@ TEST(SimPoses, SampledBoardsSatisfyTheConstraints) {
     EXPECT_GE(centre.norm(), 1.5);
     EXPECT_LE(centre.norm(), 4.0);
     const Vec3 normal = pose.linear().col(2);
-    EXPECT_LE(std::acos(normal.dot(centre.normalized())), 40.0 * kDeg + 1e-9);  // print faces us
+    EXPECT_LE(std::acos(normal.dot(centre.normalized())),
+              40.0 * kDegToRad + 1e-9);  // print faces us
     for (const Vec3& c : {Vec3(-hw, -hh, 0), Vec3(hw, -hh, 0), Vec3(hw, hh, 0), Vec3(-hw, hh, 0)}) {
       EXPECT_TRUE(camera.InImage(*camera.Project(pose * c), 0.05 * 1440));
     }

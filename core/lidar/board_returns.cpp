@@ -1,0 +1,151 @@
+#include "core/lidar/board_returns.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace calibench {
+
+BeamRays::BeamRays(const BeamTable& beams, double azimuth_offset_rad)
+    : steps_(beams.azimuth_steps),
+      azimuth_offset_rad_(azimuth_offset_rad),
+      mirror_offset_m_(beams.swept ? beams.mirror_offset_m : Vec3::Zero()) {
+  for (const double elevation : beams.elevations_rad) {
+    cos_elevation_.push_back(std::cos(elevation));
+    sin_elevation_.push_back(std::sin(elevation));
+  }
+}
+
+double BeamRays::StepRad() const { return steps_ > 0 ? 2.0 * M_PI / steps_ : 0.0; }
+
+BeamRay BeamRays::Ray(int ring, int step) const {
+  const int wrapped = ((step % steps_) + steps_) % steps_;
+  const double azimuth = azimuth_offset_rad_ + 2.0 * M_PI * wrapped / steps_;
+  const double cos_az = std::cos(azimuth), sin_az = std::sin(azimuth);
+  // A swept scanner's rays start on its mirror, which the stage turns with the scan plane.
+  const Vec3& m = mirror_offset_m_;
+  return {Vec3(cos_az * m.x() - sin_az * m.y(), sin_az * m.x() + cos_az * m.y(), m.z()),
+          Vec3(cos_elevation_[ring] * cos_az, cos_elevation_[ring] * sin_az, sin_elevation_[ring])};
+}
+
+std::optional<RectangleHit> HitRectangle(const BeamRay& ray, const LidarRectangle& rectangle) {
+  const Mat3& axes = rectangle.lidar_from_rectangle.linear();
+  const Vec3& centre = rectangle.lidar_from_rectangle.translation();
+  const Vec3 normal = axes.col(2);
+  const double denominator = normal.dot(ray.direction);
+  if (std::abs(denominator) < 1e-12) return std::nullopt;
+  const double range = normal.dot(centre - ray.origin) / denominator;
+  if (!(range > 0.0)) return std::nullopt;
+  const Vec3 local = ray.origin + range * ray.direction - centre;
+  RectangleHit hit;
+  hit.range_m = range;
+  hit.xy = Vec2(axes.col(0).dot(local), axes.col(1).dot(local));
+  hit.inside = std::abs(hit.xy.x()) <= rectangle.half_size_m.x() &&
+               std::abs(hit.xy.y()) <= rectangle.half_size_m.y();
+  return hit;
+}
+
+namespace {
+
+// The steps [first, last] whose rays can reach the sheet: its corners' azimuths about the
+// centre's, widened by what a swept scanner's mirror offset can add, plus one step each side.
+// Every step when the sheet spans more than half the sweep (or hangs over the LiDAR).
+std::pair<int, int> StepsOverSheet(const BeamRays& rays, const BeamTable& beams,
+                                   const LidarRectangle& sheet, double azimuth_offset_rad) {
+  const Pose& pose = sheet.lidar_from_rectangle;
+  const Vec3& centre = pose.translation();
+  const double centre_azimuth = std::atan2(centre.y(), centre.x());
+  double half_span = 0.0, nearest_m = centre.head<2>().norm();
+  for (const double sx : {-1.0, 1.0}) {
+    for (const double sy : {-1.0, 1.0}) {
+      const Vec3 corner = pose * Vec3(sx * sheet.half_size_m.x(), sy * sheet.half_size_m.y(), 0.0);
+      half_span = std::max(
+          half_span, std::abs(std::remainder(std::atan2(corner.y(), corner.x()) - centre_azimuth,
+                                             2.0 * M_PI)));
+      nearest_m = std::min(nearest_m, corner.head<2>().norm());
+    }
+  }
+  const double mirror_m = beams.swept ? beams.mirror_offset_m.head<2>().norm() : 0.0;
+  if (nearest_m <= mirror_m + 1e-6) return {0, rays.steps() - 1};
+  half_span += std::asin(std::min(1.0, mirror_m / nearest_m));
+  if (half_span >= 0.5 * M_PI) return {0, rays.steps() - 1};
+  const double step = rays.StepRad();
+  const int first =
+      static_cast<int>(std::floor((centre_azimuth - half_span - azimuth_offset_rad) / step)) - 1;
+  const int last =
+      static_cast<int>(std::ceil((centre_azimuth + half_span - azimuth_offset_rad) / step)) + 1;
+  return {first, last};
+}
+
+}  // namespace
+
+BoardReturns CastBoardReturns(const BeamTable& beams, const LidarRectangle& sheet,
+                              double azimuth_offset_rad) {
+  BoardReturns out;
+  out.points_per_ring.assign(beams.elevations_rad.size(), 0);
+  if (beams.azimuth_steps < 1) return out;
+  const BeamRays rays(beams, azimuth_offset_rad);
+  const auto [first, last] = StepsOverSheet(rays, beams, sheet, azimuth_offset_rad);
+  for (int ring = 0; ring < rays.rings(); ++ring) {
+    Vec3 previous = Vec3::Zero();
+    bool previous_on = false, previous_valid = false;
+    for (int step = first; step <= last; ++step) {
+      const BeamRay ray = rays.Ray(ring, step);
+      const auto hit = HitRectangle(ray, sheet);
+      const bool valid = hit && hit->range_m >= kLidarMinRangeM && hit->range_m < beams.max_range_m;
+      const Vec3 point = valid ? Vec3(ray.origin + hit->range_m * ray.direction) : Vec3::Zero();
+      const bool on = valid && hit->inside;
+      if (on) {
+        out.points.push_back(point);
+        out.ring.push_back(ring);
+        ++out.points_per_ring[ring];
+      }
+      // A crossing of the sheet's edge: midway between the last return on the sheet and the
+      // first beyond it, on the plane (as ExtractBoardEdgePoints measures it).
+      if (valid && previous_valid && on != previous_on) {
+        const Vec3& inside = on ? point : previous;
+        const Vec3& outside = on ? previous : point;
+        LidarEdgePoint edge;
+        edge.point = 0.5 * (inside + outside);
+        edge.along_ring = (outside - inside).normalized();
+        edge.sigma_along_m = (outside - inside).norm() / std::sqrt(12.0);
+        out.edges.push_back(edge);
+      }
+      previous = point;
+      previous_on = on;
+      previous_valid = valid;
+    }
+  }
+  return out;
+}
+
+bool BoardReturnsRule::Check(std::string* why) const {
+  if (min_rings < 1 || min_points_per_ring < 1 || min_points < 3) {
+    *why = "board returns: min_rings >= 1, min_points_per_ring >= 1 and min_points >= 3";
+    return false;
+  }
+  return true;
+}
+
+int BoardReturnsRule::RingsCovered(const BoardReturns& returns) const {
+  return static_cast<int>(std::count_if(returns.points_per_ring.begin(),
+                                        returns.points_per_ring.end(),
+                                        [this](int n) { return n >= min_points_per_ring; }));
+}
+
+bool BoardReturnsRule::Met(const BoardReturns& returns, std::string* why) const {
+  const int rings = RingsCovered(returns);
+  const int points = static_cast<int>(returns.points.size());
+  if (rings >= min_rings && points >= min_points) return true;
+  if (why != nullptr) {
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  "%d rings and %d returns on the board, under the %d rings (of %d+ returns each) "
+                  "and %d returns it needs",
+                  rings, points, min_rings, min_points_per_ring, min_points);
+    *why = text;
+  }
+  return false;
+}
+
+}  // namespace calibench
