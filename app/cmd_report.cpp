@@ -18,6 +18,7 @@
 #include "core/lidar_camera/rig.h"
 #include "core/results/result_file.h"
 #include "core/session/session.h"
+#include "ui/lidar_camera/report_figures.h"
 
 namespace calibench::app {
 
@@ -72,11 +73,15 @@ int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
   std::vector<ReportFigure> figures;
   if (request.renders) {
     std::string why;
-    figures = RenderReportFigures(request.session_path.empty() ? dataset.manifest.string() : "",
-                                  request.session_path, &why);
-    if (!why.empty()) {
+    ui::ReportFigureOptions figure_options;
+    figure_options.threads = options.threads;
+    figures = ui::DrawReportFigures(dataset, outcome, figure_options, &why);
+    if (figures.empty() && !why.empty()) {
       std::fprintf(stderr, "calibench report: %s; the report has no views\n", why.c_str());
       provenance.notes.push_back("No views: " + why + ".");
+    } else if (!why.empty()) {
+      std::fprintf(stderr, "calibench report: %s\n", why.c_str());
+      provenance.notes.push_back(why + ".");
     }
   }
   const ReportAssets assets = LoadReportAssets(FindAsset("report"));

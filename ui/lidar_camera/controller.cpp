@@ -13,6 +13,7 @@
 #include "core/lidar_camera/joint_intrinsics.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/targetless/check_output.h"
+#include "ui/lidar_camera/controller_outcome.h"
 
 namespace calibench::ui {
 
@@ -186,22 +187,7 @@ void Controller::ComputeReprojection(int index) {
     id = state_.pairs[index].id;
   }
   if (!cloud) return;
-  auto reprojection = std::make_shared<Reprojection>();
-  reprojection->pair_id = id;
-  reprojection->points = ProjectCloud(camera, *cam_from_lidar, *cloud);
-  if (view.visibility == VisibilityMode::kHpr) {
-    std::vector<Vec3> in_cam;
-    in_cam.reserve(reprojection->points.size());
-    for (const ProjectedPoint& p : reprojection->points)
-      in_cam.push_back(*cam_from_lidar * cloud->points[p.index].cast<double>());
-    HprOptions options;
-    options.radius_exponent = view.hpr_radius_exponent;
-    reprojection->visible = HiddenPointRemoval(in_cam, options);
-  } else if (view.visibility == VisibilityMode::kZBuffer) {
-    reprojection->visible = ZBufferVisibility(camera, reprojection->points, ZBufferOptions{});
-  } else {
-    reprojection->visible.assign(reprojection->points.size(), true);
-  }
+  auto reprojection = ReprojectPair(camera, *cam_from_lidar, *cloud, view, id);
   std::lock_guard<std::mutex> lock(mutex_);
   state_.reprojection = reprojection;
   ++state_.generation;
