@@ -75,7 +75,8 @@ int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
     std::string why;
     ui::ReportFigureOptions figure_options;
     figure_options.threads = options.threads;
-    figures = ui::DrawReportFigures(dataset, outcome, figure_options, &why);
+    figures =
+        ui::DrawReportFigures(dataset, outcome, figure_options, request.kept_inputs.get(), &why);
     if (figures.empty() && !why.empty()) {
       std::fprintf(stderr, "calibench report: %s; the report has no views\n", why.c_str());
       provenance.notes.push_back("No views: " + why + ".");
@@ -242,8 +243,15 @@ int RunReport(int argc, char** argv) {
   }
   request.session_path = session_path;
   const Dataset dataset = LoadDataset(dataset_path);
+  // The figures keep the pairs' files as the extraction reads them.
+  if (request.renders) {
+    request.kept_inputs =
+        std::make_shared<ui::KeptPairInputs>(dataset.camera, ui::ReportFigureOptions{});
+    flags.options.on_pair_inputs = request.kept_inputs->Keeper();
+  }
   const CalibrationOutcome outcome =
       CalibrateDataset(dataset, flags.options, StderrProgress("extracted"), edits);
+  flags.options.on_pair_inputs = nullptr;
   if (!outcome.solution) {
     std::fprintf(stderr, "calibench report: the data gives no calibration: %s\n",
                  outcome.failure.c_str());

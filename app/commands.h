@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,6 +24,10 @@ namespace calibench {
 struct RigFolder;   // core/io/rig_folder.h
 struct RigOutcome;  // core/lidar_camera/rig.h
 }  // namespace calibench
+
+namespace calibench::ui {
+class KeptPairInputs;  // ui/lidar_camera/report_figures.h
+}  // namespace calibench::ui
 
 namespace calibench::app {
 
@@ -167,6 +172,9 @@ struct ReportRequest {
   // `check --json`'s output, read when the flags are (a wrong file fails before the solve): the
   // targetless-check section (none when absent).
   std::optional<TargetlessCheckSection> check;
+  // The pairs' files as the extraction read them (PipelineOptions::on_pair_inputs), for the views;
+  // null: the views read them again.
+  std::shared_ptr<ui::KeptPairInputs> kept_inputs;
 };
 // `report` and `calibrate --report`: analyses the outcome, draws the views, writes the HTML
 // atomically; kOk (an unreadable asset throws IoError).

@@ -211,6 +211,7 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
     SetStatusFromFeatures(&features, why, why);
     return features;
   }
+  if (options.on_pair_inputs) options.on_pair_inputs(pair, *inputs);
   // The brush's pixels index the image the workbench shows (ProjectById, default options).
   std::optional<LidarImage> image;
   if (edit.brush_pixels) image = ProjectById(inputs->cloud, LidarImageOptions{});

@@ -28,6 +28,8 @@ enum class IntrinsicsToRefine {
   kAll,      // fx fy cx cy and the distortion (k3 only where the camera uses it)
 };
 
+struct PairInputs;  // below
+
 struct PipelineOptions {
   LidarPlaneOptions lidar_plane;
   // The LiDAR's noise model (LidarPlaneOptions::geometry): judged from each cloud
@@ -68,6 +70,10 @@ struct PipelineOptions {
   // The extrinsic's covariance includes the intrinsics' (the camera file's, or the refined
   // camera's), propagated through the solve (AddIntrinsicsUncertainty).
   bool propagate_intrinsics = true;
+  // Sees each pair's files once the extraction has read them, on the extraction's workers (so it
+  // must be safe to call from several threads): whoever needs them later (the report's figures)
+  // keeps what it needs instead of reading them again. Optional.
+  std::function<void(const PairEntry&, const PairInputs&)> on_pair_inputs;
   bool Check(std::string* why) const;
 };
 

@@ -77,7 +77,7 @@ TEST(ReportFigures, DrawnFromTheOutcomeAsTheWorkbenchShowsIt) {
 
   // Every pair's figure, and the overview; the points drawn over the image.
   const std::vector<ReportFigure> figures =
-      DrawReportFigures(dataset, outcome, ReportFigureOptions{}, &why);
+      DrawReportFigures(dataset, outcome, ReportFigureOptions{}, nullptr, &why);
   EXPECT_EQ(why, "");
   ASSERT_EQ(figures.size(), dataset.pairs.size() + 1);
   EXPECT_EQ(figures[0].pair_id, "");
@@ -100,11 +100,29 @@ TEST(ReportFigures, DrawnFromTheOutcomeAsTheWorkbenchShowsIt) {
   unsolved.solution.reset();
   unsolved.failure = "test: no solution";
   const std::vector<ReportFigure> bare =
-      DrawReportFigures(dataset, unsolved, ReportFigureOptions{}, &why);
+      DrawReportFigures(dataset, unsolved, ReportFigureOptions{}, nullptr, &why);
   ASSERT_EQ(bare.size(), figures.size());
   for (size_t i = 1; i < bare.size(); ++i) {
     const int without = ColouredPixels(Decoded(bare[i], dir));
     EXPECT_GT(coloured[i - 1], without + 10000) << bare[i].pair_id << ": " << without;
+  }
+
+  // The pairs' files kept as the extraction read them give the same pictures, byte for byte; so
+  // do two kept and the rest read again (the memory bound).
+  for (const int max_pairs : {64, 2}) {
+    KeptPairInputs kept(dataset.camera, ReportFigureOptions{}, max_pairs);
+    PipelineOptions keeping;
+    keeping.on_pair_inputs = kept.Keeper();
+    ASSERT_TRUE(CalibrateDataset(dataset, keeping).solution);
+    int held = 0;
+    for (const PairEntry& entry : dataset.pairs) held += kept.Find(entry.id).has_value();
+    EXPECT_EQ(held, std::min<int>(max_pairs, dataset.pairs.size()));
+    const std::vector<ReportFigure> from_kept =
+        DrawReportFigures(dataset, outcome, ReportFigureOptions{}, &kept, &why);
+    ASSERT_EQ(from_kept.size(), figures.size());
+    for (size_t i = 0; i < figures.size(); ++i)
+      EXPECT_TRUE(from_kept[i].bytes == figures[i].bytes)
+          << figures[i].pair_id << ", " << max_pairs;
   }
 
   // A pair whose image went missing after the solve: its view is left out and named.
@@ -112,7 +130,7 @@ TEST(ReportFigures, DrawnFromTheOutcomeAsTheWorkbenchShowsIt) {
   fs::remove(missing);
   why.clear();
   const std::vector<ReportFigure> fewer =
-      DrawReportFigures(dataset, outcome, ReportFigureOptions{}, &why);
+      DrawReportFigures(dataset, outcome, ReportFigureOptions{}, nullptr, &why);
   EXPECT_EQ(fewer.size(), figures.size() - 1);
   EXPECT_NE(why.find("1 pair(s) without a view"), std::string::npos) << why;
   EXPECT_NE(why.find(missing.filename().string()), std::string::npos) << why;

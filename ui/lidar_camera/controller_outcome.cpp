@@ -86,10 +86,15 @@ std::optional<OutcomePair> LoadOutcomePair(const Snapshot& snapshot, int index,
   pair.image = std::make_shared<const ImageU8>(std::move(inputs->image));
   if (snapshot.view.camera_image == CameraImageMode::kUndistorted && undistorter != nullptr)
     pair.undistorted = std::make_shared<const UndistortedView>(undistorter->Apply(*pair.image));
-  if (snapshot.solver.result)
-    pair.reprojection = ReprojectPair(dataset.camera, snapshot.solver.result->cam_from_lidar,
-                                      *pair.cloud, snapshot.view, id);
+  ReprojectOutcomePair(snapshot, index, &pair);
   return pair;
+}
+
+void ReprojectOutcomePair(const Snapshot& snapshot, int index, OutcomePair* pair) {
+  if (!snapshot.solver.result || !pair->cloud) return;
+  pair->reprojection =
+      ReprojectPair(snapshot.dataset->camera, snapshot.solver.result->cam_from_lidar, *pair->cloud,
+                    snapshot.view, snapshot.pairs.at(index).id);
 }
 
 void ShowOutcomePair(Snapshot* snapshot, int index, const OutcomePair& pair) {

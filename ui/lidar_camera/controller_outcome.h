@@ -39,6 +39,8 @@ struct OutcomePair {
 // undistorted.
 std::optional<OutcomePair> LoadOutcomePair(const Snapshot& snapshot, int index,
                                            const Undistorter* undistorter, std::string* why);
+// The pair's reprojection at the snapshot's solution (none without one), its files already held.
+void ReprojectOutcomePair(const Snapshot& snapshot, int index, OutcomePair* pair);
 // Selects pair `index` in the snapshot with its members (as SelectPair then the worker would).
 void ShowOutcomePair(Snapshot* snapshot, int index, const OutcomePair& pair);
 

@@ -29,9 +29,39 @@ struct LoadedPair {
 
 }  // namespace
 
+double FigureViewScale(const CameraModel& camera, const ReportFigureOptions& options) {
+  return std::min(1.0, 1.25 * options.pair_width / std::max(1, camera.width));
+}
+
+KeptPairInputs::KeptPairInputs(const CameraModel& camera, const ReportFigureOptions& options,
+                               int max_pairs)
+    : undistorter_(camera, 0, 0, FigureViewScale(camera, options)), max_pairs_(max_pairs) {}
+
+std::function<void(const PairEntry&, const PairInputs&)> KeptPairInputs::Keeper() {
+  return [this](const PairEntry& entry, const PairInputs& inputs) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (static_cast<int>(kept_.size()) >= max_pairs_) return;
+    }
+    OutcomePair pair;
+    pair.cloud = std::make_shared<const LidarCloud>(inputs.cloud);
+    pair.undistorted = std::make_shared<const UndistortedView>(undistorter_.Apply(inputs.image));
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (static_cast<int>(kept_.size()) < max_pairs_) kept_[entry.id] = std::move(pair);
+  };
+}
+
+std::optional<OutcomePair> KeptPairInputs::Find(const std::string& pair_id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = kept_.find(pair_id);
+  if (it == kept_.end()) return std::nullopt;
+  return it->second;
+}
+
 std::vector<ReportFigure> DrawReportFigures(const Dataset& dataset,
                                             const CalibrationOutcome& outcome,
-                                            const ReportFigureOptions& options, std::string* why) {
+                                            const ReportFigureOptions& options,
+                                            const KeptPairInputs* kept, std::string* why) {
   std::string no_context;
   const auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &no_context);
   if (!context) {
@@ -39,20 +69,27 @@ std::vector<ReportFigure> DrawReportFigures(const Dataset& dataset,
     return {};
   }
   const Snapshot solved = SnapshotOfOutcome(dataset, outcome);
-  // The undistorted image at about the size the picture shows it (a little over, for bilinear
-  // sampling): the remapping and the texture a fraction of the full image's.
-  const double view_scale =
-      std::min(1.0, 1.25 * options.pair_width / std::max(1, dataset.camera.width));
-  const Undistorter undistorter(dataset.camera, 0, 0, view_scale);
+  // The undistorted image at about the size the picture shows it: the remapping and the texture a
+  // fraction of the full image's.
+  const Undistorter undistorter(dataset.camera, 0, 0, FigureViewScale(dataset.camera, options));
   const int count = static_cast<int>(solved.pairs.size());
   // Pairs are read and reprojected on `threads` workers, ahead of the drawing (GL: this thread).
   std::deque<std::future<LoadedPair>> ahead;
   int next = 0;
   auto launch = [&] {
     if (next >= count) return;
-    ahead.push_back(std::async(std::launch::async, [&solved, &undistorter, index = next] {
+    // Kept pairs are only reprojected. The first is read again in full: the overview colours its
+    // cloud from the raw image.
+    ahead.push_back(std::async(std::launch::async, [&solved, &undistorter, kept, index = next] {
       LoadedPair loaded;
-      loaded.pair = LoadOutcomePair(solved, index, &undistorter, &loaded.why);
+      std::optional<OutcomePair> held;
+      if (kept != nullptr && index > 0) held = kept->Find(solved.pairs[index].id);
+      if (held) {
+        ReprojectOutcomePair(solved, index, &*held);
+        loaded.pair = std::move(held);
+      } else {
+        loaded.pair = LoadOutcomePair(solved, index, &undistorter, &loaded.why);
+      }
       return loaded;
     }));
     ++next;

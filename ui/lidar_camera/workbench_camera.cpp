@@ -126,14 +126,16 @@ void DrawCameraOverlays(const Snapshot& s, const PairView& pair, const CameraSho
 void Workbench::CameraView(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) {
   if (!BeginView("Camera", r)) return ImGui::End();
   const PairView* pair = s.selected >= 0 ? &s.pairs[s.selected] : nullptr;
-  if (!pair || !s.selected_image || !s.dataset) {
+  // The undistorted view alone is enough to show it (a report's figure holds only that).
+  const bool undistorted =
+      s.view.camera_image == CameraImageMode::kUndistorted && s.selected_undistorted;
+  if (!pair || (!s.selected_image && !undistorted) || !s.dataset) {
     ImGui::TextDisabled(s.dataset ? "loading image ..." : "no dataset open");
     return ImGui::End();
   }
   const ViewState view = CameraToolbar(s, *pair, intents);
   CameraShown shown;
-  shown.undistorted =
-      s.view.camera_image == CameraImageMode::kUndistorted && s.selected_undistorted;
+  shown.undistorted = undistorted;
   shown.image = shown.undistorted ? &s.selected_undistorted->image : s.selected_image.get();
   shown.lens = &s.dataset->camera;
   shown.model = shown.undistorted ? &s.selected_undistorted->pinhole : shown.lens;
