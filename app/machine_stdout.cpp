@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
 namespace calibench::app {
 
@@ -42,6 +44,14 @@ void MachineStdout::Print(const std::string& line) {
   std::fputs(line.c_str(), out_);
   std::fputc('\n', out_);
   std::fflush(out_);
+}
+
+void EventLines::Emit(const std::string& event_json, const std::string& human) {
+  if (!json_lines_) return out_.Print(human);
+  nlohmann::json event = nlohmann::json::parse(event_json);
+  event["time"] =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  out_.Print(event.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 }  // namespace calibench::app

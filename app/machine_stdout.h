@@ -25,4 +25,17 @@ class MachineStdout {
   std::FILE* out_ = stdout;  // where Print writes
 };
 
+// An event stream on stdout (`--json-lines`): one JSON object per event with its "time" (Unix
+// seconds), only those on stdout; or, for people, one line of words per event.
+class EventLines {
+ public:
+  explicit EventLines(bool json_lines) : json_lines_(json_lines), out_(json_lines) {}
+  // `event_json`: the event's JSON object (serialized); `human`: its line of words.
+  void Emit(const std::string& event_json, const std::string& human);
+
+ private:
+  bool json_lines_;
+  MachineStdout out_;
+};
+
 }  // namespace calibench::app

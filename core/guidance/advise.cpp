@@ -183,6 +183,14 @@ CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& ou
   return advice;
 }
 
+std::string DescribeCaptureProgress(const CaptureAdvice& advice) {
+  std::string line =
+      advice.state ? DescribeCaptureState(*advice.state, advice.goal)
+                   : std::to_string(advice.pairs_used) + " pairs accepted: no calibration yet";
+  if (advice.next) line += "; next: " + advice.next->words;
+  return line;
+}
+
 std::string CaptureAdviceJson(const CaptureAdvice& advice) {
   nlohmann::json out = MeterJson(
       advice.pairs_used, advice.goal, "cam_from_lidar",

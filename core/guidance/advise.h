@@ -69,5 +69,8 @@ std::string CaptureAdviceJson(const CaptureAdvice& advice);
 
 // The same for people: the state line, the pairs with findings, the next pose in words.
 std::string FormatCaptureAdvice(const CaptureAdvice& advice);
+// One line of it, as a followed capture says it after each solve: σ against the goal (or the
+// pairs accepted so far, without a calibration) and the next pose in words.
+std::string DescribeCaptureProgress(const CaptureAdvice& advice);
 
 }  // namespace calibench

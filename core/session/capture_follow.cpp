@@ -1,0 +1,285 @@
+#include "core/session/capture_follow.h"
+
+#include <chrono>
+#include <map>
+#include <thread>
+
+#include "core/io/capture_feed.h"
+#include "core/io/dataset_source.h"
+#include "core/io/recording_watch.h"
+#include "core/session/feature_cache.h"
+#include "core/session/session.h"
+
+namespace calibench {
+namespace {
+namespace fs = std::filesystem;
+
+double SteadySeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void Say(const FollowSink& sink, const std::string& event, const std::string& name,
+         const std::string& reason) {
+  FollowEvent e;
+  e.event = event;
+  e.name = name;
+  e.reason = reason;
+  sink(e);
+}
+
+// The capture's camera and target: the folder form's camera.yaml and target.json, or a
+// LiDAR-camera manifest of any name in the folder (core/io/dataset_source.h; its pairs are the
+// files clouds/ and images/ hold as they come). A capture script may write them after starting:
+// waits, and when idle_exit_s passes first, returns nullopt with the resolver's *why (what was
+// looked for). Another kind of dataset is refused at once (IoError naming the command for it).
+std::optional<Dataset> WaitForSetup(const fs::path& folder, const fs::path& manifest,
+                                    const CaptureFollowRequest& request, const FollowSink& sink,
+                                    std::string* why) {
+  const double start = SteadySeconds();
+  bool said = false;
+  for (;;) {
+    std::error_code error;
+    if (manifest.empty() && fs::exists(folder / "camera.yaml", error) &&
+        fs::exists(folder / "target.json", error))
+      return LoadFolderSetup(folder);
+    const std::optional<DatasetSource> source =
+        manifest.empty() ? RecogniseDataset(folder, why) : std::nullopt;
+    if (!manifest.empty() || (source && !source->folder_form)) {
+      const DatasetSource lidar_camera =
+          ResolveDataset(manifest.empty() ? folder : manifest, DatasetKind::kLidarCamera);
+      Dataset setup = LoadDataset(lidar_camera.path);
+      setup.pairs.clear();
+      setup.manifest = folder;
+      return setup;
+    }
+    if (!said) {
+      Say(sink, "waiting", "",
+          "waiting for camera.yaml and target.json (or a dataset manifest) in " + folder.string());
+      said = true;
+    }
+    if (request.idle_exit_s > 0 && SteadySeconds() - start >= request.idle_exit_s)
+      return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::duration<double>(request.poll_s));
+  }
+}
+
+// The features a watch detected, kept beside its session (core/session/feature_cache.h): what an
+// earlier watch of the capture left is reused, and each pair is appended when it is new or the
+// solve changed it.
+class FeatureCacheKeeper {
+ public:
+  explicit FeatureCacheKeeper(const fs::path& session_path)
+      : path_(FeatureCachePath(session_path)),
+        earlier_(LoadFeatureCache(path_, &skipped_)),
+        writer_(path_) {}
+
+  // The earlier features of `pair`, when its files are the same; counted for ResumedNote.
+  const PairFeatures* Earlier(const PairEntry& pair) {
+    const auto hit = earlier_.find(pair.id);
+    if (hit == earlier_.end() || hit->second.entry.cloud != pair.cloud ||
+        hit->second.entry.image != pair.image)
+      return nullptr;
+    written_[pair.id] = StateOf(hit->second.features);
+    ++resumed_;
+    return &hit->second.features;
+  }
+  // "N pairs taken from ..." once per batch that reused any; "" otherwise.
+  std::string ResumedNote() {
+    if (resumed_ == 0) return "";
+    std::string note =
+        std::to_string(resumed_) + " pairs taken from " + path_.string() + ", not detected again";
+    if (skipped_ > 0)
+      note += " (" + std::to_string(skipped_) + " stale or cut-short lines ignored)";
+    resumed_ = 0;
+    return note;
+  }
+  // Appends the job's pairs that are new or changed since written; the failures, in words.
+  std::vector<std::string> Record(const CalibrationJob& job) {
+    std::vector<std::string> failures;
+    const std::vector<PairFeatures> detected = job.DetectedPairs();
+    for (size_t i = 0; i < detected.size(); ++i) {
+      const PairFeatures& features = detected[i];
+      std::string& written = written_[features.id];
+      if (written == StateOf(features)) continue;
+      try {
+        writer_.Append(job.dataset().pairs[i], features);
+        written = StateOf(features);
+      } catch (const IoError& e) {
+        failures.push_back(features.id + ": feature cache: " + e.what());
+      }
+    }
+    return failures;
+  }
+
+ private:
+  // What distinguishes two versions of a pair's features in the cache.
+  static std::string StateOf(const PairFeatures& f) {
+    return PairStatusName(f.status) + (f.lidar ? "+lidar" : "") + (f.camera ? "+camera" : "") +
+           ":" + f.reason;
+  }
+
+  fs::path path_;
+  int skipped_ = 0;
+  std::map<std::string, CachedPair> earlier_;
+  FeatureCacheWriter writer_;
+  std::map<std::string, std::string> written_;  // StateOf what the file last says, by pair
+  int resumed_ = 0;
+};
+
+// The loop: look, add the completed pairs, solve, say what changed, save; until idle or done.
+class Follower {
+ public:
+  Follower(std::unique_ptr<CaptureFeed> feed, const CalibrationJobOptions& options,
+           const CaptureFollowRequest& request, const fs::path& session_path,
+           const FollowSink& sink)
+      : request_(request),
+        options_(options),
+        sink_(sink),
+        autosaver_(session_path),
+        cache_(session_path),
+        feed_(std::move(feed)) {}
+
+  void Run() {
+    double last_activity = SteadySeconds();
+    for (;;) {
+      const double now = SteadySeconds();
+      bool added = false;
+      const FeedUpdate update = feed_->Poll(now);
+      // A recording that grows is alive even while no pair comes out of it (its board unknown).
+      if (update.data_arrived) last_activity = now;
+      for (const std::string& note : update.notes) Say(sink_, "note", "", note);
+      for (const FolderEvent& event : update.events) {
+        last_activity = now;
+        if (event.kind == FolderEvent::Kind::kPairComplete) {
+          // The job starts with the first pair: a recording's camera and board are known then.
+          if (!job_) StartJob();
+          job_->AddPair(event.pair, cache_.Earlier(event.pair));
+          added = true;
+        } else {
+          Say(sink_, event.kind == FolderEvent::Kind::kIncomplete ? "incomplete" : "removed",
+              event.stem, event.reason);
+        }
+      }
+      if (added && SolveAndReport(now))
+        return Say(sink_, "end", "", "done: the goal is met with a σ that can be trusted");
+      if (update.closed) return Say(sink_, "end", "", "the recording was closed by its recorder");
+      if (request_.idle_exit_s > 0 && SteadySeconds() - last_activity >= request_.idle_exit_s)
+        return Say(
+            sink_, "end", "",
+            "no new data for " + std::to_string(static_cast<int>(request_.idle_exit_s)) + " s");
+      std::this_thread::sleep_for(std::chrono::duration<double>(request_.poll_s));
+    }
+  }
+
+ private:
+  // The job over the feed's camera and board; the pairs it already holds join as new ones.
+  void StartJob() {
+    Dataset setup = *feed_->Setup();
+    std::vector<PairEntry> known = std::move(setup.pairs);
+    setup.pairs.clear();
+    job_.emplace(std::move(setup), options_);
+    for (const PairEntry& pair : known) job_->AddPair(pair, cache_.Earlier(pair));
+  }
+
+  // Solves, then says the verdicts that changed and the solve, and saves; true when the watch
+  // should end (exit_when_done and done). `looked_s`: when the new pairs were seen complete.
+  bool SolveAndReport(double looked_s) {
+    if (const std::string note = cache_.ResumedNote(); !note.empty())
+      Say(sink_, "resumed", "", note);
+    job_->Solve();
+    const CaptureAdvice& advice = job_->Advise();
+    for (const std::string& failure : cache_.Record(*job_)) Say(sink_, "error", "", failure);
+    ReportVerdicts(advice);
+    FollowEvent solve;
+    solve.event = "solve";
+    solve.advice = &advice;
+    solve.latency_s = SteadySeconds() - looked_s;
+    sink_(solve);
+    try {
+      autosaver_.Save(job_->ToSession(feed_->DatasetFolder()));
+    } catch (const IoError& e) {
+      Say(sink_, "error", "", std::string("session not saved: ") + e.what());
+    }
+    return request_.exit_when_done && advice.state && advice.state->done;
+  }
+
+  // The new pairs, and every earlier pair whose verdict this solve changed (a board found later
+  // at the camera's prediction, a pair a better solution disagrees with).
+  void ReportVerdicts(const CaptureAdvice& advice) {
+    for (const PairAdvice& pair : advice.pairs) {
+      const bool accepted = pair.status == PairStatus::kAccepted;
+      const std::string reason = accepted ? "" : pair.reason;
+      const auto verdict = std::make_pair(accepted, reason);
+      const auto before = reported_.find(pair.id);
+      if (before != reported_.end() && before->second == verdict) continue;
+      reported_[pair.id] = verdict;
+      FollowEvent e;
+      e.event = "pair";
+      e.name = pair.id;
+      e.accepted = accepted;
+      e.status = pair.status;
+      e.reason = reason;
+      sink_(e);
+    }
+  }
+
+  const CaptureFollowRequest& request_;
+  CalibrationJobOptions options_;
+  const FollowSink& sink_;
+  Autosaver autosaver_;
+  FeatureCacheKeeper cache_;
+  std::unique_ptr<CaptureFeed> feed_;
+  std::optional<CalibrationJob> job_;
+  std::map<std::string, std::pair<bool, std::string>> reported_;  // verdicts said, by pair
+};
+
+}  // namespace
+
+bool CaptureFollowRequest::Check(std::string* why) const {
+  if (!folder.Check(why)) return false;
+  if (!(idle_exit_s >= 0)) return *why = "--idle-exit must be >= 0 (seconds)", false;
+  if (!(poll_s > 0)) return *why = "the poll period must be > 0 (seconds)", false;
+  return true;
+}
+
+bool FollowCapture(CaptureFollowRequest request, const CalibrationJobOptions& options,
+                   const FollowSink& sink, std::string* why) {
+  if (!request.Check(why)) return false;
+  if (IsRecordingSource(request.source)) {
+    // A recording: import's pairs, written to the dataset folder; a capture has no cap.
+    request.import.max_pairs = 0;
+    if (request.out.empty()) request.out = DefaultImportFolder(request.source);
+    fs::create_directories(request.out);
+    const fs::path session =
+        request.session.empty() ? request.out / "calibench.session.json" : request.session;
+    Follower(FollowRecording(request.source, request.out, request.board, request.import), options,
+             request, session, sink)
+        .Run();
+    return true;
+  }
+  fs::path manifest;
+  fs::path folder = request.source;
+  std::error_code error;
+  if (fs::is_regular_file(folder, error)) {  // a manifest, named: its folder is watched
+    manifest = ResolveDataset(folder, DatasetKind::kLidarCamera).path;
+    folder = fs::absolute(manifest).parent_path();
+  }
+  if (!fs::is_directory(folder, error)) {
+    *why = folder.string() +
+           " is not a folder (watch follows a folder in the folder form: clouds/, images/, "
+           "camera.yaml, target.json)";
+    return false;
+  }
+  std::optional<Dataset> setup = WaitForSetup(fs::absolute(folder), manifest, request, sink, why);
+  if (!setup) {
+    Say(sink, "end", "", *why);
+    return false;
+  }
+  const fs::path session =
+      request.session.empty() ? folder / "calibench.session.json" : request.session;
+  Follower(FollowFolder(std::move(*setup), folder, request.folder), options, request, session, sink)
+      .Run();
+  return true;
+}
+
+}  // namespace calibench

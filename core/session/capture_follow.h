@@ -1,0 +1,57 @@
+// Following a capture while it is written (`calibench watch`): a folder in the folder form that a
+// capture script fills, or a recording being written, pair by pair into the calibration job —
+// detect, pre-flight, accept or reject, solve again, σ against the goal, the next pose — with the
+// session and the feature cache saved after every solve. What happens is told to a sink as events
+// (the command line prints them as words or JSON lines; docs/architecture.md, "The capture
+// job").
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "core/io/bag_import.h"
+#include "core/io/folder_watch.h"
+#include "core/session/calibration_job.h"
+#include "core/target/board.h"
+
+namespace calibench {
+
+// One thing the follower says. `event` names it: "waiting" (for the folder's camera and
+// target), "note", "incomplete" / "removed" (a pair's files), "resumed" (pairs from an earlier
+// watch's feature cache), "error" (a cache or session not written), "pair" (a verdict, new or
+// changed: `accepted`, `reason`), "solve" (`advice`, `latency_s` from seeing the pairs to the
+// advice), "end" (why the watch ended).
+struct FollowEvent {
+  std::string event;
+  std::string name;       // the pair or file it is about ("" when none)
+  std::string reason;     // in words
+  bool accepted = false;  // "pair": its verdict and status
+  PairStatus status = PairStatus::kPending;
+  const CaptureAdvice* advice = nullptr;  // "solve" only; valid during the call
+  double latency_s = 0.0;
+};
+using FollowSink = std::function<void(const FollowEvent&)>;
+
+struct CaptureFollowRequest {
+  std::string source;              // a folder, a manifest in one, or a recording being written
+  std::filesystem::path out;       // recordings: the dataset folder (default: as `import`'s)
+  std::filesystem::path session;   // default: calibench.session.json in the dataset folder
+  std::optional<BoardSpec> board;  // recordings: the board the camera sees
+  BagImportOptions import;         // recordings: topics, camera, pair selection
+  FolderWatchOptions folder;       // folders: when a file is complete, partners
+  bool exit_when_done = false;     // end when the stop rule says done
+  double idle_exit_s = 0.0;        // end after this long without new data [s] (0 = never)
+  double poll_s = 0.1;             // between looks [s]
+  bool Check(std::string* why) const;
+};
+
+// Follows until done (with exit_when_done), the recording is closed, or idle; the "end" event
+// says which. False with *why when it cannot start: the source is not a folder or a recording,
+// or the folder's camera and target never came (idle_exit_s passed first). Unreadable files
+// throw IoError naming them.
+bool FollowCapture(CaptureFollowRequest request, const CalibrationJobOptions& options,
+                   const FollowSink& sink, std::string* why);
+
+}  // namespace calibench
