@@ -160,8 +160,13 @@ class Follower {
               event.stem, event.reason);
         }
       }
-      if (added && SolveAndReport(now))
-        return Say(sink_, "end", "", "done: the goal is met with a σ that can be trusted");
+      if (added) {
+        if (SolveAndReport(now))
+          return Say(sink_, "end", "", "done: the goal is met with a σ that can be trusted");
+        // Idle means no new data: the time the solve took is not the capture's silence (a slow
+        // solve once ended a watch before the next poll could see the pair already there).
+        last_activity = SteadySeconds();
+      }
       if (update.closed) return Say(sink_, "end", "", "the recording was closed by its recorder");
       if (request_.idle_exit_s > 0 && SteadySeconds() - last_activity >= request_.idle_exit_s)
         return Say(
