@@ -10,7 +10,6 @@
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
 #include "core/session/session.h"
-#include "ui/lidar_camera/report_figures.h"
 
 namespace calibench::app {
 
@@ -100,14 +99,10 @@ int CalibrateOneCamera(Dataset* dataset, const PairEdits& edits,
   const std::string& out_path = request.result_file;
   // With a report: its figures keep the pairs' files as the extraction reads them.
   ReportRequest report = request;
-  PipelineOptions pipeline = options;
-  if (!report.out_path.empty() && report.renders) {
-    report.kept_inputs =
-        std::make_shared<ui::KeptPairInputs>(dataset->camera, ui::ReportFigureOptions{});
-    pipeline.on_pair_inputs = report.kept_inputs->Keeper();
-  }
   CalibrationOutcome outcome;
-  const int code = CalibrateAndReport(*dataset, pipeline, out_path, &outcome, edits);
+  const int code =
+      CalibrateAndReport(*dataset, KeepingInputsForViews(options, dataset->camera, &report),
+                         out_path, &outcome, edits);
   if (intrinsics && outcome.solution && !out_path.empty())
     AddIntrinsicsToResult(out_path, *intrinsics);
   if (report.out_path.empty() || !outcome.solution) return code;

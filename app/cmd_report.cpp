@@ -59,6 +59,15 @@ std::string ResolveNote(const Pose& solved, const Pose& reported, const std::str
 
 }  // namespace
 
+PipelineOptions KeepingInputsForViews(const PipelineOptions& options, const CameraModel& camera,
+                                      ReportRequest* request) {
+  PipelineOptions keeping = options;
+  if (request->out_path.empty() || !request->renders) return keeping;
+  request->kept_inputs = std::make_shared<ui::KeptPairInputs>(camera, ui::ReportFigureOptions{});
+  keeping.on_pair_inputs = request->kept_inputs->Keeper();
+  return keeping;
+}
+
 int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
                 const PipelineOptions& options, const ReportRequest& request) {
   const CalibrationReport report = AnalyseCalibration(dataset, outcome, options, request.options);
@@ -180,6 +189,39 @@ int ReportRig(const std::string& result_path, const std::string& dataset_path,
   return WriteRigReport(rig, outcome, options, request);
 }
 
+// The report of one camera's dataset: the pairs extracted and solved again (with the session's
+// edits, when there is one) and reported.
+int ReportDataset(const std::string& result_path, std::string session_path,
+                  std::string dataset_path, PipelineOptions options, ReportRequest request) {
+  if (session_path.empty() && IsSessionFile(result_path)) session_path = result_path;
+  const Pose reported = CalibrationOf(result_path);
+  const PairEdits edits = ApplySessionFlag(session_path, &dataset_path, &options);
+  if (dataset_path.empty()) {
+    std::fprintf(stderr, "calibench report: give --dataset or --session (the result's data)\n");
+    return kUsage;
+  }
+  request.session_path = session_path;
+  const Dataset dataset = LoadDataset(dataset_path);
+  const CalibrationOutcome outcome =
+      CalibrateDataset(dataset, KeepingInputsForViews(options, dataset.camera, &request),
+                       StderrProgress("extracted"), edits);
+  if (!outcome.solution) {
+    std::fprintf(stderr, "calibench report: the data gives no calibration: %s\n",
+                 outcome.failure.c_str());
+    return kNoCalibration;
+  }
+  // The figures are the re-solve's: say so when it is not the result's pose.
+  const std::string note = ResolveNote(
+      outcome.solution->cam_from_lidar, reported, result_path, "this data with these options",
+      "the result, per-pair figures and views below are the re-solve's. Pass the options "
+      "calibrate was run with (or its session).");
+  if (!note.empty()) {
+    request.notes.push_back(note);
+    std::fprintf(stderr, "calibench report: %s\n", note.c_str());
+  }
+  return WriteReport(dataset, outcome, options, request);
+}
+
 }  // namespace
 
 int RunReport(int argc, char** argv) {
@@ -234,39 +276,7 @@ int RunReport(int argc, char** argv) {
     }
     return ReportRig(result_path, dataset_path, edits, flags.options, request);
   }
-  if (session_path.empty() && IsSessionFile(result_path)) session_path = result_path;
-  const Pose reported = CalibrationOf(result_path);
-  const PairEdits edits = ApplySessionFlag(session_path, &dataset_path, &flags.options);
-  if (dataset_path.empty()) {
-    std::fprintf(stderr, "calibench report: give --dataset or --session (the result's data)\n");
-    return kUsage;
-  }
-  request.session_path = session_path;
-  const Dataset dataset = LoadDataset(dataset_path);
-  // The figures keep the pairs' files as the extraction reads them.
-  if (request.renders) {
-    request.kept_inputs =
-        std::make_shared<ui::KeptPairInputs>(dataset.camera, ui::ReportFigureOptions{});
-    flags.options.on_pair_inputs = request.kept_inputs->Keeper();
-  }
-  const CalibrationOutcome outcome =
-      CalibrateDataset(dataset, flags.options, StderrProgress("extracted"), edits);
-  flags.options.on_pair_inputs = nullptr;
-  if (!outcome.solution) {
-    std::fprintf(stderr, "calibench report: the data gives no calibration: %s\n",
-                 outcome.failure.c_str());
-    return kNoCalibration;
-  }
-  // The figures are the re-solve's: say so when it is not the result's pose.
-  const std::string note = ResolveNote(
-      outcome.solution->cam_from_lidar, reported, result_path, "this data with these options",
-      "the result, per-pair figures and views below are the re-solve's. Pass the options "
-      "calibrate was run with (or its session).");
-  if (!note.empty()) {
-    request.notes.push_back(note);
-    std::fprintf(stderr, "calibench report: %s\n", note.c_str());
-  }
-  return WriteReport(dataset, outcome, flags.options, request);
+  return ReportDataset(result_path, session_path, dataset_path, flags.options, request);
 }
 
 }  // namespace calibench::app

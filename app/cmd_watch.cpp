@@ -1,7 +1,6 @@
-// `calibench watch`: follows a capture while it is written (a folder in the folder form that a
-// capture script fills, or a recording that rosbag / ros2 bag / an MCAP logger is writing), pair
-// by pair: detect, pre-flight, accept or reject, solve again, σ against the goal, the next pose
-// (core/session/capture_follow.h; this file parses the flags and prints the events).
+// `calibench watch`: follows a capture while it is written, a folder being filled or a recording
+// being written, pair by pair (core/session/capture_follow.h); this file parses the flags and
+// prints the events.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -9,7 +8,7 @@
 #include "app/commands.h"
 #include "app/machine_stdout.h"
 #include "app/pipeline_flags.h"
-#include "core/guidance/stop_rule.h"
+#include "core/guidance/advise.h"
 #include "core/io/camera_file.h"
 #include "core/io/recording_watch.h"
 #include "core/session/capture_follow.h"
@@ -34,18 +33,77 @@ void Print(EventLines& stream, const FollowEvent& e) {
               e.event + (e.name.empty() ? "" : " " + e.name) + ": " + e.reason);
 }
 
+// What `watch` is told on its command line.
+struct WatchFlags {
+  CaptureFollowRequest follow;
+  CalibrationJobOptions options;
+  bool json_lines = false;
+  std::string board, camera_file;  // recordings
+  WatchCheckRequest drift;         // --check: the drift meter instead
+  PipelineFlags pipeline;
+};
+
 // `watch --check`: the drift meter instead of the board capture, with the recording's flags.
-int WatchWithDriftMeter(WatchCheckRequest drift, const CaptureFollowRequest& request,
-                        bool json_lines, const std::string& camera_file) {
-  drift.source = request.source;
-  drift.camera_file = camera_file;
-  drift.json_lines = json_lines;
-  drift.exit_when_sure = request.exit_when_done;
-  drift.idle_exit_s = request.idle_exit_s;
-  drift.input.cloud_topic = request.import.cloud_topic;
-  drift.input.image_topic = request.import.image_topic;
-  drift.input.camera_info_topic = request.import.camera_info_topic;
+int WatchWithDriftMeter(const WatchFlags& w) {
+  WatchCheckRequest drift = w.drift;
+  drift.source = w.follow.source;
+  drift.camera_file = w.camera_file;
+  drift.json_lines = w.json_lines;
+  drift.exit_when_sure = w.follow.exit_when_done;
+  drift.idle_exit_s = w.follow.idle_exit_s;
+  drift.input.cloud_topic = w.follow.import.cloud_topic;
+  drift.input.image_topic = w.follow.import.image_topic;
+  drift.input.camera_info_topic = w.follow.import.camera_info_topic;
   return WatchCheck(drift);
+}
+
+void AddWatchFlags(CLI::App& app, WatchFlags* w) {
+  app.add_option("source", w->follow.source,
+                 "the folder the capture writes (the folder form, or a folder holding a "
+                 "LiDAR-camera manifest of any name; or that manifest itself), or the recording "
+                 "being written (.bag, .mcap, .db3, a rosbag2 folder)")
+      ->required();
+  AddBoardOption(app, &w->board, "recordings: the board the camera sees");
+  app.add_option("--out,-o", w->follow.out,
+                 "recordings: the dataset folder the pairs are written to (default: <recording "
+                 "name>.dataset beside it, as import)");
+  app.add_option("--cloud-topic", w->follow.import.cloud_topic,
+                 "recordings: PointCloud2 topic (default: the only one)");
+  app.add_option("--image-topic", w->follow.import.image_topic,
+                 "recordings: Image or CompressedImage topic (default: the only one)");
+  app.add_option("--camera-info-topic", w->follow.import.camera_info_topic,
+                 "recordings: CameraInfo topic (default: the one beside the image topic)");
+  app.add_option("--camera", w->camera_file,
+                 "recordings: intrinsics file instead of the recording's CameraInfo");
+  app.add_option("--goal-mm", w->options.advise.goal.translation_mm,
+                 "goal: 1σ of the translation per axis [mm]")
+      ->capture_default_str();
+  app.add_option("--goal-deg", w->options.advise.goal.rotation_deg,
+                 "goal: 1σ of the rotation per axis [deg]")
+      ->capture_default_str();
+  app.add_flag("--json-lines", w->json_lines,
+               "one JSON object per line: {\"event\": \"pair\", ...} per pair, {\"event\": "
+               "\"solve\", ...advise --json's fields} per solve");
+  app.add_flag("--exit-when-done", w->follow.exit_when_done, "end when the stop rule says done");
+  app.add_flag("--estimate-intrinsics", w->options.advise.estimate_intrinsics,
+               "the camera's intrinsics are being calibrated from these pairs too: the meter "
+               "includes them (done only once they are good: sigma, RMS, corners near every "
+               "border) and the next pose also puts corners where the image has none (the "
+               "camera file is the starting guess)");
+  app.add_option("--idle-exit", w->follow.idle_exit_s,
+                 "end after this many seconds without new data [s] (0 = never)")
+      ->capture_default_str();
+  app.add_option("--session", w->follow.session,
+                 "the session file kept up to date (default: SOURCE/calibench.session.json; for a "
+                 "recording, calibench.session.json in its dataset folder)");
+  app.add_option("--settle", w->follow.folder.settle_s,
+                 "a file is written when its size and time have not changed for this long [s]")
+      ->capture_default_str();
+  app.add_option("--partner-timeout", w->follow.folder.partner_timeout_s,
+                 "report a cloud without its image (or the reverse) after this long [s]")
+      ->capture_default_str();
+  AddDriftMeterFlags(app, &w->drift);
+  AddPipelineFlags(app, w->pipeline, /*with_selection=*/false);
 }
 
 }  // namespace
@@ -59,84 +117,30 @@ int RunWatch(int argc, char** argv) {
       "rejected with the reason, and everything so far is solved again: σ against the goal and "
       "where to hold the board next, per pair.",
       "calibench watch"};
-  CaptureFollowRequest flags;
-  bool json_lines = false;
-  CalibrationJobOptions options;
-  app.add_option("source", flags.source,
-                 "the folder the capture writes (the folder form, or a folder holding a "
-                 "LiDAR-camera manifest of any name; or that manifest itself), or the recording "
-                 "being written (.bag, .mcap, .db3, a rosbag2 folder)")
-      ->required();
-  std::string board, out, camera_file;
-  AddBoardOption(app, &board, "recordings: the board the camera sees");
-  app.add_option("--out,-o", out,
-                 "recordings: the dataset folder the pairs are written to (default: <recording "
-                 "name>.dataset beside it, as import)");
-  app.add_option("--cloud-topic", flags.import.cloud_topic,
-                 "recordings: PointCloud2 topic (default: the only one)");
-  app.add_option("--image-topic", flags.import.image_topic,
-                 "recordings: Image or CompressedImage topic (default: the only one)");
-  app.add_option("--camera-info-topic", flags.import.camera_info_topic,
-                 "recordings: CameraInfo topic (default: the one beside the image topic)");
-  app.add_option("--camera", camera_file,
-                 "recordings: intrinsics file instead of the recording's CameraInfo");
-  app.add_option("--goal-mm", options.advise.goal.translation_mm,
-                 "goal: 1σ of the translation per axis [mm]")
-      ->capture_default_str();
-  app.add_option("--goal-deg", options.advise.goal.rotation_deg,
-                 "goal: 1σ of the rotation per axis [deg]")
-      ->capture_default_str();
-  app.add_flag("--json-lines", json_lines,
-               "one JSON object per line: {\"event\": \"pair\", ...} per pair, {\"event\": "
-               "\"solve\", ...advise --json's fields} per solve");
-  app.add_flag("--exit-when-done", flags.exit_when_done, "end when the stop rule says done");
-  app.add_flag("--estimate-intrinsics", options.advise.estimate_intrinsics,
-               "the camera's intrinsics are being calibrated from these pairs too: the meter "
-               "includes them (done only once they are good: sigma, RMS, corners near every "
-               "border) and the next pose also puts corners where the image has none (the "
-               "camera file is the starting guess)");
-  app.add_option("--idle-exit", flags.idle_exit_s,
-                 "end after this many seconds without new data [s] (0 = never)")
-      ->capture_default_str();
-  app.add_option("--session", flags.session,
-                 "the session file kept up to date (default: SOURCE/calibench.session.json; for a "
-                 "recording, calibench.session.json in its dataset folder)");
-  app.add_option("--settle", flags.folder.settle_s,
-                 "a file is written when its size and time have not changed for this long [s]")
-      ->capture_default_str();
-  app.add_option("--partner-timeout", flags.folder.partner_timeout_s,
-                 "report a cloud without its image (or the reverse) after this long [s]")
-      ->capture_default_str();
-  WatchCheckRequest drift;
-  AddDriftMeterFlags(app, &drift);
-  PipelineFlags pipeline;
-  AddPipelineFlags(app, pipeline, /*with_selection=*/false);
+  WatchFlags w;
+  AddWatchFlags(app, &w);
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
-  if (!drift.result.empty()) return WatchWithDriftMeter(drift, flags, json_lines, camera_file);
+  if (!w.drift.result.empty()) return WatchWithDriftMeter(w);
   std::string why;
-  if (!FinalizePipelineFlags(pipeline, &why) || !flags.Check(&why)) {
+  const bool pipeline_ok = FinalizePipelineFlags(w.pipeline, &why);
+  w.options.advise.pipeline = w.pipeline.options;
+  w.options.warm_start = true;  // each solve from the last: the capture grows by one pair
+  if (!pipeline_ok || !w.follow.Check(&why) || !w.options.Check(&why)) {
     std::fprintf(stderr, "calibench watch: %s\n", why.c_str());
     return kUsage;
   }
-  options.advise.pipeline = pipeline.options;
-  options.warm_start = true;  // each solve from the last: the capture grows by one pair
-  if (!options.Check(&why)) {
-    std::fprintf(stderr, "calibench watch: %s\n", why.c_str());
-    return kUsage;
-  }
-  if (IsRecordingSource(flags.source)) {
+  if (IsRecordingSource(w.follow.source)) {
     try {
-      flags.board = BoardFromFlag(board);
+      w.follow.board = BoardFromFlag(w.board);
     } catch (const std::invalid_argument& e) {
       std::fprintf(stderr, "calibench watch: --board: %s\n", e.what());
       return kUsage;
     }
-    if (!camera_file.empty()) flags.import.camera = LoadCameraFile(camera_file);
-    flags.out = out;
+    if (!w.camera_file.empty()) w.follow.import.camera = LoadCameraFile(w.camera_file);
   }
-  EventLines stream(json_lines);
+  EventLines stream(w.json_lines);
   if (!FollowCapture(
-          flags, options, [&](const FollowEvent& e) { Print(stream, e); }, &why)) {
+          w.follow, w.options, [&](const FollowEvent& e) { Print(stream, e); }, &why)) {
     std::fprintf(stderr, "calibench watch: error: %s\n", why.c_str());
     return kInputError;
   }

@@ -180,6 +180,11 @@ struct ReportRequest {
 // atomically; kOk (an unreadable asset throws IoError).
 int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
                 const PipelineOptions& options, const ReportRequest& request);
+// `options` set to keep each pair's files for the report's views as the extraction reads them
+// (request->kept_inputs; PipelineOptions::on_pair_inputs), when the report is written with views;
+// unchanged otherwise. The returned options refer to request->kept_inputs.
+PipelineOptions KeepingInputsForViews(const PipelineOptions& options, const CameraModel& camera,
+                                      ReportRequest* request);
 // The rig's report (core/report/report_html.h RigReportHtml): the rig solve, then every camera
 // as WriteReport has one. Needs outcome.joint.
 int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const PipelineOptions& options,

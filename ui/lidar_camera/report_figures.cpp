@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <deque>
+#include <functional>
 #include <future>
 
 #include "core/io/image_io.h"
@@ -26,6 +27,19 @@ struct LoadedPair {
   std::optional<OutcomePair> pair;
   std::string why;
 };
+
+// Pair `index` ready to draw: a kept pair only reprojected, any other read from its files. The
+// first is read again in full whatever is kept: the overview colours its cloud from the raw image.
+LoadedPair ReadAhead(const Snapshot& solved, int index, const Undistorter& undistorter,
+                     const KeptPairInputs* kept) {
+  LoadedPair loaded;
+  if (kept != nullptr && index > 0) loaded.pair = kept->Find(solved.pairs[index].id);
+  if (loaded.pair)
+    ReprojectOutcomePair(solved, index, &*loaded.pair);
+  else
+    loaded.pair = LoadOutcomePair(solved, index, &undistorter, &loaded.why);
+  return loaded;
+}
 
 }  // namespace
 
@@ -70,28 +84,18 @@ std::vector<ReportFigure> DrawReportFigures(const Dataset& dataset,
   }
   const Snapshot solved = SnapshotOfOutcome(dataset, outcome);
   // The undistorted image at about the size the picture shows it: the remapping and the texture a
-  // fraction of the full image's.
-  const Undistorter undistorter(dataset.camera, 0, 0, FigureViewScale(dataset.camera, options));
+  // fraction of the full image's. The kept pairs' undistorter when there is one.
+  std::optional<Undistorter> own;
+  if (kept == nullptr) own.emplace(dataset.camera, 0, 0, FigureViewScale(dataset.camera, options));
+  const Undistorter& undistorter = kept != nullptr ? kept->undistorter() : *own;
   const int count = static_cast<int>(solved.pairs.size());
   // Pairs are read and reprojected on `threads` workers, ahead of the drawing (GL: this thread).
   std::deque<std::future<LoadedPair>> ahead;
   int next = 0;
   auto launch = [&] {
     if (next >= count) return;
-    // Kept pairs are only reprojected. The first is read again in full: the overview colours its
-    // cloud from the raw image.
-    ahead.push_back(std::async(std::launch::async, [&solved, &undistorter, kept, index = next] {
-      LoadedPair loaded;
-      std::optional<OutcomePair> held;
-      if (kept != nullptr && index > 0) held = kept->Find(solved.pairs[index].id);
-      if (held) {
-        ReprojectOutcomePair(solved, index, &*held);
-        loaded.pair = std::move(held);
-      } else {
-        loaded.pair = LoadOutcomePair(solved, index, &undistorter, &loaded.why);
-      }
-      return loaded;
-    }));
+    ahead.push_back(std::async(std::launch::async, ReadAhead, std::cref(solved), next,
+                               std::cref(undistorter), kept));
     ++next;
   };
   for (int k = 0; k < std::max(1, options.threads); ++k) launch();
