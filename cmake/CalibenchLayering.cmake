@@ -1,7 +1,8 @@
 # Who may include whom, enforced at configure time from the target graph: a source file in a
 # library may include headers of that library and of the libraries it links (transitively), no
 # others; core/ includes nothing from ui/, OpenGL, GLFW or ImGui. A violation stops the configure
-# step with the file and the include named.
+# step with the file and the include named. Every source file under core/ and ui/ must also be
+# listed in the target that owns it.
 
 # The target a project header (or source file) belongs to: core/<x>/ -> calibench_<x>; ui/gfx,
 # ui/widgets, ui/state; ui/<method>/controller*.* -> calibench_<method>_controller, the rest of
@@ -42,6 +43,18 @@ function(calibench_link_closure target out)
   set(${out} "${closure}" PARENT_SCOPE)
 endfunction()
 
+# The source files `target` compiles, as absolute paths.
+function(calibench_target_sources_absolute target out)
+  get_target_property(sources ${target} SOURCES)
+  get_target_property(dir ${target} SOURCE_DIR)
+  set(absolute "")
+  foreach(source IN LISTS sources)
+    get_filename_component(path "${source}" ABSOLUTE BASE_DIR "${dir}")
+    list(APPEND absolute "${path}")
+  endforeach()
+  set(${out} "${absolute}" PARENT_SCOPE)
+endfunction()
+
 function(calibench_check_layering)
   file(GLOB_RECURSE files RELATIVE ${PROJECT_SOURCE_DIR} CONFIGURE_DEPENDS
        ${PROJECT_SOURCE_DIR}/core/*.h ${PROJECT_SOURCE_DIR}/core/*.cpp
@@ -51,6 +64,13 @@ function(calibench_check_layering)
     calibench_owner_target(${file} owner)
     if(NOT owner OR NOT TARGET ${owner})
       continue()
+    endif()
+    if(file MATCHES "\\.cpp$")
+      calibench_target_sources_absolute(${owner} listed)
+      if(NOT "${PROJECT_SOURCE_DIR}/${file}" IN_LIST listed)
+        list(APPEND problems "${file}: not listed in ${owner}'s sources (a source file is listed \
+by name in its folder's CMakeLists.txt, so an unlisted one would silently not be compiled)")
+      endif()
     endif()
     calibench_link_closure(${owner} allowed)
     list(APPEND allowed ${owner})
@@ -68,6 +88,6 @@ function(calibench_check_layering)
   endforeach()
   if(problems)
     list(JOIN problems "\n  " text)
-    message(FATAL_ERROR "Layering: includes that point past the target graph:\n  ${text}")
+    message(FATAL_ERROR "Layering: includes that point past the target graph, or sources unlisted:\n  ${text}")
   endif()
 endfunction()

@@ -10,8 +10,8 @@
 #            controller and its brush path, the pipeline job, the session, the bag readers, the
 #            LiDAR plane), without valgrind. -O1 with line tables (-O0 compiles only a fifth faster
 #            and runs the job's tests six times slower).
-# --thread   ThreadSanitizer over the threaded tests (the workbench's controller, watch, import):
-#            ctest labels core and ui in build-tsan/.
+# --thread   ThreadSanitizer over the threaded tests: ctest labels core and ui, and the e2e tests
+#            of watch and import, in build-tsan/.
 #
 # Leaks inside the GL drivers and X libraries the workbench tests load are not ours; they are
 # listed in tests/sanitizers/lsan.supp.
@@ -33,12 +33,17 @@ else
 fi
 
 if [ $mode = thread ]; then
-  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  # Unity builds here: this build looks for races, not for missing includes.
+  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCALIBENCH_UNITY_BUILD=ON \
     -DCALIBENCH_SANITIZE=thread -DCALIBENCH_BUILD_BENCHMARKS=OFF -DCALIBENCH_BUILD_PYTHON=OFF >/dev/null
-  cmake --build build-tsan -j "$JOBS" --target calibench test_core test_ui
+  cmake --build build-tsan -j "$JOBS" --target calibench test_core test_ui test_e2e
   export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/tsan.supp"
+  # The core and workbench tests, and the end-to-end ones that follow or import a capture (the
+  # executable they run is instrumented too).
   ctest --test-dir build-tsan --output-on-failure -j "$JOBS" --timeout 1800 -L 'core|ui' "$@"
-  echo "sanitize --thread: the core and workbench tests passed under ThreadSanitizer"
+  ctest --test-dir build-tsan --output-on-failure -j "$JOBS" --timeout 1800 -L e2e \
+    -R '^(Watch|WatchCheck|WatchRecording|ImportCli|RecordingImport|BagImport)\.' "$@"
+  echo "sanitize --thread: the core, workbench, watch and import tests passed under ThreadSanitizer"
   exit 0
 fi
 
@@ -59,7 +64,9 @@ if [ $mode = ci ]; then
 fi
 subset=OFF
 [ $mode = ci ] && subset=ON
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=$build_type -DCALIBENCH_SANITIZE_CI_SUBSET=$subset \
+# Unity builds, as bootstrap.sh's: CI's time budget (the default, file-by-file build is where a
+# missing include shows).
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=$build_type -DCALIBENCH_UNITY_BUILD=ON -DCALIBENCH_SANITIZE_CI_SUBSET=$subset \
   -DCMAKE_CXX_FLAGS_CALIBENCHSANITIZECI="-O1" -DCALIBENCH_SANITIZE_DEBUG=$debug \
   -DCALIBENCH_SANITIZE=address,undefined -DCALIBENCH_BUILD_BENCHMARKS=OFF \
   -DCALIBENCH_BUILD_PYTHON=OFF >/dev/null  # an instrumented module would need ASan preloaded into python3

@@ -44,11 +44,12 @@ struct Plane {
 };
 
 // Plane expressed in frame b, given b_from_a and the plane in frame a:
-// n_b = R n_a, d_b = d_a - n_b·t (DESIGN.md convention).
+// n_b = R n_a, d_b = d_a - n_b·t (docs/architecture.md, "Conventions and file contracts").
 Plane TransformPlane(const Pose& b_from_a, const Plane& plane_in_a);
 
-// Flips (n, d) so that the normal points towards the origin of its frame (d > 0): the DESIGN.md
-// orientation of board planes in both sensor frames.
+// Flips (n, d) so that the normal points towards the origin of its frame (d > 0): the convention of
+// orientation of board planes in both sensor frames (docs/architecture.md, "Conventions and file
+// contracts").
 Plane OrientTowardsOrigin(const Plane& plane);
 
 // The range at which the ray from the frame's origin through `point` meets the plane, r̂ =

@@ -122,8 +122,9 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
                                            const GuidanceOptions& options,
                                            const SolverOptions& solver_options, std::string* why);
 
-// The board frame shown to people (DESIGN.md): origin at the sheet centre, x along its width,
-// y up on the print, z out of the printed face: BoardSpec's frame turned 180° about x.
+// The board frame shown to people (docs/architecture.md, "Conventions and file contracts"): origin
+// at the sheet centre, x along its width, y up on the print, z out of the printed face: BoardSpec's
+// frame turned 180° about x.
 Pose ShownFromBoardSpec();
 
 // "too oblique to the <sensor> (<angle> deg, at most <max>)": the one wording of that refusal.

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "core/io/bag_import.h"
+#include "core/io/ros_messages.h"
 
 namespace calibench {
 namespace fs = std::filesystem;

@@ -1,4 +1,5 @@
-// The calibench.dataset.v1 manifest (DESIGN.md "File contracts") and its folder shorthand.
+// The calibench.dataset.v1 manifest (docs/architecture.md, "Conventions and file contracts") and
+// its folder shorthand.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,6 @@
 // What a `--dataset` path is, recognised by its content rather than its name: the one resolver
-// every command and the workbench open datasets through (DESIGN.md "Dataset manifest").
+// every command and the workbench open datasets through (docs/architecture.md, "Conventions and
+// file contracts").
 #pragma once
 
 #include <filesystem>

@@ -1,6 +1,8 @@
 #include "core/lidar_camera/pipeline.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <set>
 
 #include "core/base/image.h"
@@ -323,7 +325,63 @@ CalibrationOutcome SolveExtractedPairs(const Dataset& dataset,
     RefineIntrinsics(dataset.camera, options, &outcome);
   else if (outcome.solution && options.propagate_intrinsics)
     AddIntrinsicsUncertainty(outcome.pairs, dataset.camera, options, &*outcome.solution);
+  RefuseUnsupportedSolution(dataset.target, options, &outcome);
   return outcome;
+}
+
+void RefuseUnsupportedSolution(const BoardSpec& board, const PipelineOptions& options,
+                               CalibrationOutcome* outcome) {
+  if (!outcome->solution) return;
+  const SolverResult& solution = *outcome->solution;
+  int accepted = 0, supporting = 0;
+  double distance_sum = 0.0;
+  for (const PairFeatures& p : outcome->pairs) {
+    if (p.status != PairStatus::kAccepted || !p.lidar || !p.camera) continue;
+    if (!solution.DownWeighted(accepted)) {
+      ++supporting;
+      distance_sum += std::abs(p.camera->plane.distance);
+    }
+    ++accepted;
+  }
+  char text[400];
+  if (supporting < options.min_pairs && supporting == accepted) {
+    std::snprintf(text, sizeof(text),
+                  "only %d pair(s) were left accepted; at least %d with different "
+                  "board orientations are needed",
+                  accepted, options.min_pairs);
+    outcome->failure = text;
+    outcome->solution.reset();
+    return;
+  }
+  if (supporting < options.min_pairs) {
+    std::snprintf(text, sizeof(text),
+                  "%d of the %d accepted pairs were down-weighted to nothing (their "
+                  "planes disagree with any one pose beyond the noise model), so only %d support "
+                  "the result and at least %d must; check the LiDAR model (--lidar-model) and the "
+                  "pairs' LiDAR planes",
+                  accepted - supporting, accepted, supporting, options.min_pairs);
+    outcome->failure = text;
+    outcome->solution.reset();
+    return;
+  }
+  // What the boards themselves can tell: an offset known no better than the sheet's diagonal, or a
+  // rotation no better than the angle the sheet spans at the boards' mean distance, says nothing
+  // about where the sensors are.
+  const double diagonal_m = std::hypot(board.SheetWidth(), board.SheetHeight());
+  if (diagonal_m <= 0.0) return;
+  const Vec6 sigma = solution.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  const double sigma_translation_m = sigma.head<3>().maxCoeff();
+  const double sigma_rotation_rad = sigma.tail<3>().maxCoeff();
+  const double span_rad = std::atan2(diagonal_m, distance_sum / supporting);
+  if (sigma_translation_m <= diagonal_m && sigma_rotation_rad <= span_rad) return;
+  std::snprintf(text, sizeof(text),
+                "the result's standard deviation (%.3f m, %.2f deg) exceeds what the boards "
+                "can tell (the sheet's diagonal %.3f m, the %.2f deg it spans at %.2f m); more "
+                "pairs, at more orientations, would constrain it",
+                sigma_translation_m, sigma_rotation_rad * 180.0 / M_PI, diagonal_m,
+                span_rad * 180.0 / M_PI, distance_sum / supporting);
+  outcome->failure = text;
+  outcome->solution.reset();
 }
 
 CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,

@@ -225,6 +225,15 @@ std::optional<SceneBackground> BuildSceneBackground(
     const std::vector<const PairEntry*>& pairs, int threads, std::string* why,
     std::vector<std::optional<LidarCloud>>* clouds = nullptr);
 
+// A result nothing supports is refused (`solution` reset, `failure` saying why): when fewer than
+// options.min_pairs accepted pairs keep a robust weight above the negligible one (the rest were
+// down-weighted to nothing), or when its standard deviation exceeds what the boards can tell (the
+// sheet's diagonal in translation, the angle the sheet spans at the pairs' mean distance in
+// rotation). The last step of SolveExtractedPairs, so `calibrate`, `watch` and the workbench
+// refuse alike.
+void RefuseUnsupportedSolution(const BoardSpec& board, const PipelineOptions& options,
+                               CalibrationOutcome* outcome);
+
 // Camera-guided completion (options.camera_guided): with a first solution, predicts every pair's
 // board in the LiDAR frame from its camera pose, drops LiDAR boards that disagree with it (the
 // pair fails, saying by how much) and looks again for the board at the prediction where the LiDAR

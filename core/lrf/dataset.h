@@ -1,8 +1,8 @@
-// The calibench.lrf-dataset.v1 manifest (DESIGN.md "Dataset manifest (2D LRF ↔ depth camera)")
+// The calibench.lrf-dataset.v1 manifest (docs/architecture.md, "Conventions and file contracts")
 // and its files: LaserScan-like JSON scans, plain 2D PCD scans (z = 0), 16-bit depth PNGs and
 // depth-frame PCDs.
 //
-// Beyond DESIGN.md, the same manifest carries the LRF ↔ RGB camera checkerboard case (Zhang &
+// Beyond the agreed contract, the same manifest carries the LRF ↔ RGB camera checkerboard case (Zhang &
 // Pless): "target": {"type": "checkerboard", ...} as in calibench.dataset.v1, "camera" (or
 // "camera_file") for the RGB intrinsics, and "image" per pair instead of "depth"/"cloud".
 // Optional fields: per pair "scan_region" {"angle_min_deg", "angle_max_deg", "range_min",

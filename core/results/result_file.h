@@ -1,7 +1,7 @@
-// The calibench.result.v1 file (DESIGN.md "Result") of both methods: what every result holds in
-// the same form (both directions of the transform, covariance, standard deviations,
-// observability, one entry per pair), and its reader. Each method adds its own solver figures
-// (core/lidar_camera/result_io.h, core/lrf/result_io.h).
+// The calibench.result.v1 file (docs/architecture.md, "Conventions and file contracts") of both
+// methods: what every result holds in the same form (both directions of the transform, covariance,
+// standard deviations, observability, one entry per pair), and its reader. Each method adds its own
+// solver figures (core/lidar_camera/result_io.h, core/lrf/result_io.h).
 #pragma once
 
 #include <filesystem>

@@ -21,7 +21,7 @@ namespace {
 // OpenCV 4.6's interpolateCornersCharuco shifts its own cornerSubPix result by +0.5 px in x and
 // y (OpenCV issue 25539). Measured on rendered boards with 18-70 px squares: +0.48 px in x and
 // +0.50 px in y over 15 boards, +0.46..+0.51 per board where OpenCV's refinement converges
-// (tests/core/test_board_detect.cpp, which fails if OpenCV's behaviour changes).
+// (tests/core/target/test_board_detect.cpp, which fails if OpenCV's behaviour changes).
 constexpr double kCharucoOffsetPx = 0.5;
 
 // cornerSubPix half window for checkerboards, as a fraction of the smallest corner spacing: half
@@ -117,7 +117,7 @@ BoardDetection MakeDetection(const BoardSpec& board, const std::vector<cv::Point
 // the coarsest whose shorter side keeps at least this many pixels. On the real 1920 x 1208 fisheye
 // set the board (47-59 px squares) is found on every image at level 2 (480 x 302) in 32 ms, against
 // 721 ms at full resolution; cornerSubPix at full resolution then lands within 0.0002 px of where
-// it lands from the full-resolution search (tests/core/test_board_detect.cpp).
+// it lands from the full-resolution search (tests/core/target/test_board_detect.cpp).
 constexpr int kMinSearchSidePx = 240;
 constexpr int kMaxPyramidLevel = 3;
 

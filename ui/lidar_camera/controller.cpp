@@ -30,6 +30,7 @@ bool Controller::SolvesWith(const PairView& pair) {
 }
 
 SolverResult Controller::ResultForCurrentPairs() const {
+  mutex_.AssertHeld(__func__);
   SolverResult result = *state_.solver.result;
   std::vector<std::string> accepted;
   for (const PairView& pair : state_.pairs)
@@ -46,6 +47,7 @@ SolverResult Controller::ResultForCurrentPairs() const {
 }
 
 void Controller::RecomputeResiduals() {
+  mutex_.AssertHeld(__func__);
   for (PairView& pair : state_.pairs) pair.residual.reset();
   if (!state_.solver.result) return;
   const SolverResult at_estimate = ResultForCurrentPairs();
@@ -90,6 +92,7 @@ SolverOptions Controller::SolverOptionsFromState() const {
 }
 
 void Controller::ApplyCompletion(const std::vector<PairFeatures>& solved) {
+  mutex_.AssertHeld(__func__);
   for (size_t i = 0; i < solved.size() && i < state_.pairs.size(); ++i) {
     PairView& pair = state_.pairs[i];
     const PairFeatures& after = solved[i];
@@ -119,7 +122,7 @@ void Controller::ApplyCompletion(const std::vector<PairFeatures>& solved) {
 
 void Controller::Solve() {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     if (!state_.dataset || !job_) return;
     state_.solver = SolverView{};
     state_.solver.running = true;
@@ -130,7 +133,7 @@ void Controller::Solve() {
   // camera-guided completion, the intrinsics' σ), watched iteration by iteration (its events).
   CalibrationOutcome outcome = job_->Solve();
   const PipelineOptions& options = job_->options().advise.pipeline;
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   state_.solver.running = false;
   // Pairs added meanwhile (a watched folder) are not in this solve; the next one has them.
   if (outcome.pairs.size() <= state_.pairs.size()) ApplyCompletion(outcome.pairs);
@@ -177,7 +180,7 @@ void Controller::ComputeReprojection(int index) {
   ViewState view;
   std::string id;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     if (index < 0 || index >= static_cast<int>(state_.pairs.size()) || !state_.solver.result)
       return;
     cloud = state_.pairs[index].cloud;
@@ -188,7 +191,7 @@ void Controller::ComputeReprojection(int index) {
   }
   if (!cloud) return;
   auto reprojection = ReprojectPair(camera, *cam_from_lidar, *cloud, view, id);
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   state_.reprojection = reprojection;
   ++state_.generation;
 }
@@ -199,11 +202,11 @@ void Controller::EnsureSelectedImage() {
   if (!image) return;
   CameraModel camera;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     camera = state_.dataset->camera;
   }
   auto undistorted = std::make_shared<const UndistortedView>(Undistort(camera, *image));
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   if (!StillSelected(path)) return;
   state_.selected_image = image;
   state_.selected_image_pair = state_.pairs[state_.selected].id;
@@ -299,6 +302,7 @@ void Controller::Handle(const SetView& view) {
 }
 
 std::filesystem::path Controller::NextToSession(const std::filesystem::path& path) const {
+  mutex_.AssertHeld(__func__);
   if (path.is_absolute() || state_.session_path.empty()) return path;
   return state_.session_path.parent_path() / path;
 }
@@ -350,7 +354,7 @@ void Controller::Handle(const ExportResult& export_result) {
 }
 
 void Controller::Apply(const Intent& intent) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   // A followed recording's board is picked before anything opens: its first pair needs it.
   if (!state_.dataset && !std::holds_alternative<PickBoard>(intent)) return;
   // A stroke is its dabs; anything else in between ends it.

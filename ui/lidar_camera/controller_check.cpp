@@ -72,7 +72,7 @@ void Controller::Handle(const RunCheck& request) {
     } catch (const IoError& e) {
       done.failure = e.what();
     }
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     state_.check = std::move(done);
     if (!state_.check.report) {
       SetStatus("check: " + state_.check.failure, true);

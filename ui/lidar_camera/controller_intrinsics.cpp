@@ -32,7 +32,7 @@ void Controller::Handle(const EstimateIntrinsics& request) {
     } catch (const std::invalid_argument& e) {
       failure = e.what();
     }
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     state_.intrinsics_running = false;
     state_.intrinsics = result;
     state_.intrinsics_failure = failure;

@@ -7,6 +7,7 @@
 namespace calibench::ui {
 
 void Controller::JudgeMeter(bool record) {
+  mutex_.AssertHeld(__func__);
   if (!state_.solver.result) {
     state_.meter.reset();
     UpdateActiveRigCamera();

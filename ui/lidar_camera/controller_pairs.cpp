@@ -70,6 +70,7 @@ constexpr const char* kNoTarget = "no board to find: the dataset has no target.j
 }  // namespace
 
 void Controller::OnAllPairsLoaded() {
+  mutex_.AssertHeld(__func__);
   if (state_.dataset->missing_target_file.empty()) {
     worker_.Enqueue([this] { DetectWithBackground(); });
   } else {
@@ -98,11 +99,13 @@ void Controller::OnAllPairsLoaded() {
 }
 
 bool Controller::FollowsTo(int index) const {
+  mutex_.AssertHeld(__func__);
   return !watching_.empty() && follow_newest_ && index > state_.selected &&
          index + 1 == static_cast<int>(state_.pairs.size());
 }
 
 bool Controller::PairsSettled() const {
+  mutex_.AssertHeld(__func__);
   // A followed capture is never all loaded (the next pair may land while this one is read):
   // once the pairs it opened with are in, each new pair counts as soon as it is.
   return state_.loading_done == state_.loading_total ||
@@ -115,7 +118,7 @@ void Controller::LoadPair(int index) {
   std::optional<BrushMask> saved_mask;
   bool painted = false;  // the session holds a brush the user painted (or erased)
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     dataset = *state_.dataset;
     saved_brush = state_.pairs[index].brush_pixels;
     const PairState& saved = session_.pairs[index];
@@ -133,7 +136,7 @@ void Controller::LoadPair(int index) {
   auto inputs = job_->ReadPair(index, &camera, &why);
   bool selected = false;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     selected = index == state_.selected || FollowsTo(index);
   }
   if (inputs) {
@@ -162,7 +165,7 @@ void Controller::LoadPair(int index) {
   }
   bool refit_now = false;  // the selected pair's plane comes before the other pairs load
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     PairView& pair = state_.pairs[index];
     // Loading is the pair's first job after Open: besides its header nothing was derived yet.
     static_cast<PairHeader&>(loaded) = pair;
@@ -185,6 +188,7 @@ void Controller::LoadPair(int index) {
 }
 
 bool Controller::ScheduleBoard(int index, bool painted) {
+  mutex_.AssertHeld(__func__);
   PairView& pair = state_.pairs[index];
   if (!pair.cloud) {
     pair.status = PairStatus::kFailed;
@@ -209,7 +213,7 @@ void Controller::DetectWithBackground() {
   std::vector<std::pair<int, std::shared_ptr<const LidarCloud>>> clouds;  // by pair index
   std::vector<int> awaiting, detected_before;                             // pairs left to detection
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     for (size_t i = 0; i < state_.pairs.size(); ++i) {
       const PairView& pair = state_.pairs[i];
       if (!pair.cloud) continue;
@@ -226,7 +230,7 @@ void Controller::DetectWithBackground() {
   for (const auto& [index, cloud] : clouds) became_usable |= job_->AddToBackground(index, *cloud);
   if (job_->background_clouds() > before && !job_->background_usable() &&
       job_->background_clouds() >= 3) {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     SetStatus("board detection without a background model: " + job_->background_note(), false);
   }
   std::vector<int> detect = awaiting;
@@ -248,7 +252,7 @@ void Controller::RefitLidar(int index) {
   bool brush_edited = false;
   std::string id;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     cloud = state_.pairs[index].cloud;
     image = state_.pairs[index].lidar_image;
     brush = state_.pairs[index].brush_pixels;
@@ -263,7 +267,7 @@ void Controller::RefitLidar(int index) {
   job_->SetBrush(id, brush_edited ? std::optional(PairEdit{brush, image->rows, image->columns})
                                   : std::nullopt);
   const PairFeatures features = job_->DetectLidar(index, *cloud, image.get(), brush_from_seed);
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   PairView& pair = state_.pairs[index];
   if (pair.brush_pixels != brush) return;  // a newer stroke queued its own refit
   pair.lidar = features.lidar;
@@ -343,6 +347,7 @@ void Controller::Handle(const PaintPoints& paint) {
 }
 
 void Controller::Paint(int index, const std::vector<int>& pixels, bool erase) {
+  mutex_.AssertHeld(__func__);
   PairView& pair = state_.pairs[index];
   std::vector<int> merged;
   if (erase)

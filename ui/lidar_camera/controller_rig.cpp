@@ -64,12 +64,12 @@ bool RigView::JointStale() const {
 }
 
 void Controller::CarryRig(const RigView& rig) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   carried_rig_ = rig;
 }
 
 void Controller::CarryRig(std::shared_ptr<const RigOutcome> outcome) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   carried_rig_outcome_ = std::move(outcome);
 }
 
@@ -78,6 +78,7 @@ void Controller::WaitRig() {
 }
 
 bool Controller::SetUpRig(const RigFolder& rig, size_t active) {
+  mutex_.AssertHeld(__func__);
   RigView view;
   view.path = rig.folder;
   view.active = static_cast<int>(active);
@@ -114,6 +115,7 @@ bool Controller::SetUpRig(const RigFolder& rig, size_t active) {
 }
 
 void Controller::StartRigSolve() {
+  mutex_.AssertHeld(__func__);
   if (!state_.rig || state_.rig->solving) return;
   // Not solving: the last run has set that under mutex_ and does nothing after it.
   if (rig_thread_.joinable()) rig_thread_.join();
@@ -144,7 +146,7 @@ void Controller::StartRigSolve() {
     } catch (const std::exception& e) {  // IoError, or a filesystem error reading the rig
       failure = e.what();
     }
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     if (!state_.rig || state_.rig->path != path) return;
     state_.rig->solving = false;
     if (outcome) {
@@ -161,6 +163,7 @@ void Controller::StartRigSolve() {
 }
 
 void Controller::UpdateActiveRigCamera() {
+  mutex_.AssertHeld(__func__);
   if (!state_.rig) return;
   RigCameraView& active = state_.rig->cameras[state_.rig->active];
   if (state_.solver.result) {
@@ -184,7 +187,7 @@ void Controller::LoadRigFrames() {
   std::shared_ptr<const ImageU8> own;
   int active = 0;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     if (!state_.rig || state_.selected < 0) return;
     pair = state_.pairs[state_.selected].id;
     own = state_.pairs[state_.selected].thumbnail;
@@ -211,13 +214,13 @@ void Controller::LoadRigFrames() {
       try {
         cached = std::make_shared<const ImageU8>(ResizeImage(LoadImage(image), kRigFrameWidth));
       } catch (const IoError& e) {
-        std::lock_guard<std::mutex> lock(mutex_);
+        std::lock_guard lock(mutex_);
         SetStatus(e.what(), true);
       }
     }
     frames.push_back(cached);
   }
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   if (!state_.rig || state_.selected < 0 || state_.pairs[state_.selected].id != pair) return;
   for (size_t c = 0; c < frames.size() && c < state_.rig->cameras.size(); ++c)
     state_.rig->cameras[c].frame = frames[c];

@@ -159,7 +159,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
   }
   WaitIdle();
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     if (session_lock)
       session_lock_ = std::move(session_lock);
     else if (session_path.empty() || !session_lock_ || session_lock_->locked() != session_path)
@@ -192,7 +192,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     setup.pairs.clear();
     job_.emplace(std::move(setup), job_options, PairEdits{},
                  JobEvents{.iteration = [this](const IterationReport& it) {
-                   std::lock_guard<std::mutex> lock(mutex_);
+                   std::lock_guard lock(mutex_);
                    state_.solver.iterations.push_back(it);
                    ++state_.generation;
                  }});
@@ -206,7 +206,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
   // The selected pair and its image first, so that it is on screen while the others load.
   int first = 0;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     first = std::max(0, state_.selected);
   }
   if (!dataset.pairs.empty()) {
@@ -218,6 +218,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
 }
 
 void Controller::ApplySessionToState(const Session& session) {
+  mutex_.AssertHeld(__func__);
   ApplySessionOptions(session, &pipeline_);
   std::vector<std::string> ids;
   for (const PairState& pair : session.pairs) ids.push_back(pair.id);
@@ -264,6 +265,7 @@ void Controller::ApplySessionToState(const Session& session) {
 }
 
 void Controller::CommitEdit() {
+  mutex_.AssertHeld(__func__);
   const bool had_selected =
       state_.selected >= 0 && state_.selected < static_cast<int>(state_.pairs.size());
   state_.view.selected_pair = had_selected ? state_.pairs[state_.selected].id : "";
@@ -310,6 +312,7 @@ void Controller::CommitEdit() {
 }
 
 void Controller::Autosave() {
+  mutex_.AssertHeld(__func__);
   try {
     if (autosaver_) autosaver_->Save(session_);
     state_.save_error.clear();

@@ -23,18 +23,19 @@ constexpr double kFirstLookSeconds = 1.0;
 }  // namespace
 
 void Controller::SetAutoSolve(bool on) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   auto_solve_ = on;
   state_.auto_solve = on;
   ++state_.generation;
 }
 
 void Controller::RequestSolve() {
+  mutex_.AssertHeld(__func__);
   if (!auto_solve_ || solve_queued_ || !state_.dataset) return;
   solve_queued_ = true;
   worker_.Enqueue([this] {
     {
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::lock_guard lock(mutex_);
       solve_queued_ = false;
     }
     Solve();
@@ -48,7 +49,7 @@ void Controller::Follow(const std::filesystem::path& source,
   // Pairs land while the user looks: the window's frames before the pairs' processing.
   worker_.LowerPriority();
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     watching_ = std::filesystem::absolute(source);
     state_.watching = watching_;
   }
@@ -69,7 +70,7 @@ void Controller::WatchFolder(const std::filesystem::path& folder, FolderWatchOpt
           std::filesystem::exists(folder / "target.json", error))
         break;
       if (!said) {
-        std::lock_guard<std::mutex> lock(mutex_);
+        std::lock_guard lock(mutex_);
         SetStatus("watching " + folder.string() + ": waiting for camera.yaml and target.json",
                   false);
         said = true;
@@ -79,7 +80,7 @@ void Controller::WatchFolder(const std::filesystem::path& folder, FolderWatchOpt
     try {
       return FollowFolder(LoadFolderSetup(folder), folder, options);
     } catch (const IoError& e) {
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::lock_guard lock(mutex_);
       SetStatus(std::string("cannot watch: ") + e.what(), true);
       return std::unique_ptr<CaptureFeed>();
     }
@@ -105,7 +106,7 @@ void Controller::FollowLoop(CaptureFeed* feed) {
     {
       // The board the user picked goes to the feed before it reads on: only this thread touches
       // the feed, and a recording closed meanwhile is finished with it.
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::lock_guard lock(mutex_);
       if (picked_board_) {
         if (!feed->SetBoard(picked_board_->first, picked_board_->second))
           SetStatus("this capture's board comes from its target.json", true);
@@ -116,13 +117,13 @@ void Controller::FollowLoop(CaptureFeed* feed) {
     try {
       update = feed->Poll(SteadySeconds());
     } catch (const IoError& e) {
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::lock_guard lock(mutex_);
       SetStatus(std::string("cannot watch: ") + e.what(), true);
       return;
     }
     std::vector<PairEntry> pairs;
     {
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::lock_guard lock(mutex_);
       const std::string problem = feed->BoardProblem();
       if (problem != state_.board_problem) {
         state_.board_problem = problem;
@@ -152,7 +153,7 @@ void Controller::FollowLoop(CaptureFeed* feed) {
         read.pairs = read_before_open;
         if (!ResumeGrownCapture(read)) OpenLoadedDataset(read, {}, ExistingSession::kResume);
       } catch (const IoError& e) {
-        std::lock_guard<std::mutex> lock(mutex_);
+        std::lock_guard lock(mutex_);
         SetStatus(std::string("cannot watch: ") + e.what(), true);
         return;
       }
@@ -161,7 +162,7 @@ void Controller::FollowLoop(CaptureFeed* feed) {
     }
     for (const PairEntry& pair : pairs) AddPair(pair);
     if (update.closed) {
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::lock_guard lock(mutex_);
       SetStatus("the recording was closed by its recorder; its " +
                     std::to_string(state_.pairs.size()) + " pairs are in " +
                     feed->DatasetFolder().string(),
@@ -218,6 +219,7 @@ bool Controller::ResumeGrownCapture(Dataset dataset) {
 }
 
 void Controller::OnLivePairLoaded(int index) {
+  mutex_.AssertHeld(__func__);
   const PairView& pair = state_.pairs[index];
   // The views move to the newest pair once it is loaded (not before: they would show nothing
   // meanwhile), unless the user looks at an older one.
@@ -237,7 +239,7 @@ void Controller::OnLivePairLoaded(int index) {
 }
 
 void Controller::AddPair(const PairEntry& entry) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   if (!state_.dataset) return;
   for (const PairView& pair : state_.pairs)
     if (pair.id == entry.id) return;
@@ -263,7 +265,7 @@ void Controller::SyncJobDecisions() {
   };
   std::vector<Decision> decisions;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     for (size_t i = 0; i < state_.pairs.size() && static_cast<int>(i) < job_->size(); ++i) {
       const PairView& pair = state_.pairs[i];
       Decision decision{pair.id, pair.status == PairStatus::kRejected, pair.reason, std::nullopt};
@@ -286,7 +288,7 @@ void Controller::SyncJobDecisions() {
 void Controller::AdviseFromState() {
   std::optional<SolverResult> at;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     if (!job_ || !state_.solver.result || state_.next_pose) return;
     at = ResultForCurrentPairs();
   }
@@ -297,12 +299,12 @@ void Controller::AdviseFromState() {
 void Controller::Advise(const std::optional<SolverResult>& at) {
   if (!job_) return;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     job_->SetGoal(state_.goal);
   }
   // The job's solve (pairs that joined since are judged after the next solve).
   const CaptureAdvice& advice = job_->Advise(at);
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   state_.next_pose = advice.next;
   state_.next_pose_failure = advice.state && advice.state->done
                                  ? "the goal is met: no more poses needed"

@@ -66,7 +66,7 @@ bool LrfController::Open(const std::filesystem::path& manifest) {
     if (!options_.Check(&why)) throw IoError("LRF pipeline options: " + why);
     dataset = std::make_shared<const LrfDataset>(LoadLrfDataset(manifest));
   } catch (const IoError& e) {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     SetStatus(std::string("cannot open: ") + e.what(), true);
     return false;
   }
@@ -74,7 +74,7 @@ bool LrfController::Open(const std::filesystem::path& manifest) {
   worker_.DropQueued();
   std::uint64_t open_count;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     open_count = ++open_count_;
     const std::uint64_t generation = state_.generation;
     state_ = LrfSnapshot{};
@@ -100,13 +100,13 @@ bool LrfController::Open(const std::filesystem::path& manifest) {
 void LrfController::Extract(std::uint64_t open_count, int index) {
   std::shared_ptr<const LrfDataset> dataset;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     if (open_count != open_count_) return;
     dataset = state_.dataset;
   }
   auto features = std::make_shared<const LrfPairFeatures>(
       ExtractLrfPairFeatures(*dataset, dataset->pairs[index], options_));
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   if (open_count != open_count_) return;
   LrfPairView& pair = state_.pairs[index];
   pair.features = features;
@@ -135,7 +135,7 @@ void LrfController::Solve() {
   std::shared_ptr<const LrfDataset> dataset;
   LrfPipelineOptions options = options_;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     if (!state_.dataset) return;
     dataset = state_.dataset;
     options.solver.method = state_.solver.method;
@@ -154,7 +154,7 @@ void LrfController::Solve() {
   }
   auto outcome = std::make_shared<LrfCalibrationOutcome>(
       SolveLrfFromFeatures(std::move(pairs), *dataset, options));
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   LrfSolverView& solver = state_.solver;
   solver.running = false;
   if (!outcome->solution || !outcome->solution->ok) {
@@ -186,6 +186,7 @@ void LrfController::Solve() {
 }
 
 void LrfController::UpdatePairFigures() {
+  mutex_.AssertHeld(__func__);
   const LrfSolution* solution = state_.solver.solution ? &*state_.solver.solution : nullptr;
   for (LrfPairView& pair : state_.pairs) {
     pair.point_to_line_m.reset();
@@ -202,71 +203,84 @@ void LrfController::LoadSelectedImage() {
   std::filesystem::path path;
   const std::shared_ptr<const ImageU8> image = LoadSelectedImageFile(&path);
   if (!image) return;
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   if (!StillSelected(path)) return;
   state_.selected_image = image;
   ++state_.generation;
 }
 
 void LrfController::Apply(const LrfIntent& intent) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard lock(mutex_);
   if (!state_.dataset) return;
-  const int num_pairs = static_cast<int>(state_.pairs.size());
-  auto valid = [&](int index) { return index >= 0 && index < num_pairs; };
-  if (const auto* select = std::get_if<LrfSelectPair>(&intent)) {
-    if (!valid(select->index) || select->index == state_.selected) return;
-    state_.selected = select->index;
-    state_.selected_image.reset();
-    ++state_.generation;
-    if (state_.dataset->target_type == LrfTargetType::kCheckerboard)
-      worker_.Enqueue([this] { LoadSelectedImage(); });
-  } else if (const auto* status = std::get_if<LrfSetPairStatus>(&intent)) {
-    if (!valid(status->index)) return;
-    LrfPairView& pair = state_.pairs[status->index];
-    if (status->status == PairStatus::kAccepted &&
-        !(pair.features && HasFeatures(*pair.features))) {
-      SetStatus("pair " + pair.id + " cannot be accepted: " +
-                    (pair.features ? FeatureFailure(*pair.features) : "features not extracted yet"),
-                true);
-      return;
-    }
-    pair.status = status->status;
-    pair.reason = status->status == PairStatus::kRejected ? kRejectedByUser : "";
-    SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
-                  (state_.solver.solution ? "; press Run to re-solve" : ""),
-              false);
-  } else if (std::holds_alternative<LrfRunSolver>(intent)) {
-    if (state_.solver.running) return;
-    state_.solver.running = true;  // until the queued solve starts and reports
-    ++state_.generation;
-    worker_.Enqueue([this] { Solve(); });
-  } else if (std::holds_alternative<LrfResetSolver>(intent)) {
-    const LrfMethod method = state_.solver.method;
-    state_.solver = LrfSolverView{};
-    state_.solver.method = method;
-    outcome_.reset();
-    UpdatePairFigures();
-  } else if (const auto* method = std::get_if<LrfSetMethod>(&intent)) {
-    if (method->method == state_.solver.method) return;
-    state_.solver.method = method->method;
-    SetStatus("method " + LrfMethodName(method->method) + "; press Run to solve with it", false);
-  } else if (const auto* export_result = std::get_if<LrfExportResult>(&intent)) {
-    if (!outcome_ || !outcome_->solution) {
-      SetStatus("nothing to export: run the solver first", true);
-      return;
-    }
-    LrfPipelineOptions options = options_;
-    options.solver.method = outcome_->solution->method;
-    // A relative path goes beside the manifest, as the lidar-camera exports go beside the
-    // session: not into wherever the program happened to be started.
-    std::filesystem::path path = export_result->path;
-    if (path.is_relative() && !state_.manifest.empty()) path = state_.manifest.parent_path() / path;
-    try {
-      WriteLrfResult(path, *outcome_, options);
-      SetStatus("exported " + path.string(), false);
-    } catch (const IoError& e) {
-      SetStatus(e.what(), true);
-    }
+  std::visit([this](const auto& what) { Handle(what); }, intent);
+}
+
+bool LrfController::ValidPair(int index) const {
+  return index >= 0 && index < static_cast<int>(state_.pairs.size());
+}
+
+void LrfController::Handle(const LrfSelectPair& select) {
+  if (!ValidPair(select.index) || select.index == state_.selected) return;
+  state_.selected = select.index;
+  state_.selected_image.reset();
+  ++state_.generation;
+  if (state_.dataset->target_type == LrfTargetType::kCheckerboard)
+    worker_.Enqueue([this] { LoadSelectedImage(); });
+}
+
+void LrfController::Handle(const LrfSetPairStatus& status) {
+  if (!ValidPair(status.index)) return;
+  LrfPairView& pair = state_.pairs[status.index];
+  if (status.status == PairStatus::kAccepted && !(pair.features && HasFeatures(*pair.features))) {
+    SetStatus("pair " + pair.id + " cannot be accepted: " +
+                  (pair.features ? FeatureFailure(*pair.features) : "features not extracted yet"),
+              true);
+    return;
+  }
+  pair.status = status.status;
+  pair.reason = status.status == PairStatus::kRejected ? kRejectedByUser : "";
+  SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
+                (state_.solver.solution ? "; press Run to re-solve" : ""),
+            false);
+}
+
+void LrfController::Handle(const LrfRunSolver&) {
+  if (state_.solver.running) return;
+  state_.solver.running = true;  // until the queued solve starts and reports
+  ++state_.generation;
+  worker_.Enqueue([this] { Solve(); });
+}
+
+void LrfController::Handle(const LrfResetSolver&) {
+  const LrfMethod method = state_.solver.method;
+  state_.solver = LrfSolverView{};
+  state_.solver.method = method;
+  outcome_.reset();
+  UpdatePairFigures();
+}
+
+void LrfController::Handle(const LrfSetMethod& method) {
+  if (method.method == state_.solver.method) return;
+  state_.solver.method = method.method;
+  SetStatus("method " + LrfMethodName(method.method) + "; press Run to solve with it", false);
+}
+
+void LrfController::Handle(const LrfExportResult& export_result) {
+  if (!outcome_ || !outcome_->solution) {
+    SetStatus("nothing to export: run the solver first", true);
+    return;
+  }
+  LrfPipelineOptions options = options_;
+  options.solver.method = outcome_->solution->method;
+  // A relative path goes beside the manifest, as the lidar-camera exports go beside the session:
+  // not into wherever the program happened to be started.
+  std::filesystem::path path = export_result.path;
+  if (path.is_relative() && !state_.manifest.empty()) path = state_.manifest.parent_path() / path;
+  try {
+    WriteLrfResult(path, *outcome_, options);
+    SetStatus("exported " + path.string(), false);
+  } catch (const IoError& e) {
+    SetStatus(e.what(), true);
   }
 }
 

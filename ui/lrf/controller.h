@@ -96,6 +96,15 @@ class LrfController : public ControllerState<LrfSnapshot> {
   void Solve();
   void LoadSelectedImage();
   void UpdatePairFigures();  // call with mutex_ held
+  bool ValidPair(int index) const;
+  // One handler per intent type, as the lidar-camera controller has (Apply visits them with
+  // mutex_ held and a dataset open).
+  void Handle(const LrfSelectPair& intent);
+  void Handle(const LrfSetPairStatus& intent);
+  void Handle(const LrfRunSolver& intent);
+  void Handle(const LrfResetSolver& intent);
+  void Handle(const LrfSetMethod& intent);
+  void Handle(const LrfExportResult& intent);
 
   LrfPipelineOptions options_;
   std::shared_ptr<const LrfCalibrationOutcome> outcome_;  // of the shown solution, for export

@@ -12,6 +12,7 @@
 #include "core/base/image.h"
 #include "core/io/image_io.h"
 #include "core/results/pair_status.h"
+#include "ui/state/checked_mutex.h"
 #include "ui/state/work_queue.h"
 
 namespace calibench::ui {
@@ -40,7 +41,7 @@ class ControllerState {
   Snapshot GetSnapshot() const {
     Snapshot copy;
     {
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::lock_guard lock(mutex_);
       copy = state_;
     }
     copy.busy = worker_.Busy();
@@ -48,7 +49,7 @@ class ControllerState {
   }
   // The change counter alone (cheap: a window polls it to redraw when a thread changed the state).
   std::uint64_t Generation() const {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard lock(mutex_);
     return state_.generation;
   }
   // Blocks until the worker has no queued or running job (tests, headless renders).
@@ -57,7 +58,7 @@ class ControllerState {
  protected:
   ControllerState()
       : worker_([this](const std::string& message) {
-          std::lock_guard<std::mutex> lock(mutex_);
+          std::lock_guard lock(mutex_);
           OnJobError();
           SetStatus("error: " + message, true);
         }) {}
@@ -66,6 +67,7 @@ class ControllerState {
   void StopWorker() { worker_.Stop(); }
   // The user's message; call with mutex_ held.
   void SetStatus(const std::string& message, bool error) {
+    mutex_.AssertHeld(__func__);
     state_.status_line = message;
     state_.status_is_error = error;
     ++state_.generation;
@@ -74,7 +76,7 @@ class ControllerState {
   // an image is selected); nullptr with the status line set when the file cannot be read.
   std::shared_ptr<const ImageU8> LoadSelectedImageFile(std::filesystem::path* path) {
     {
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::lock_guard lock(mutex_);
       if (state_.selected < 0 || !state_.dataset) return nullptr;
       *path = state_.dataset->pairs[state_.selected].image;
     }
@@ -83,7 +85,7 @@ class ControllerState {
     try {
       return std::make_shared<const ImageU8>(LoadImage(*path));
     } catch (const IoError& e) {
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::lock_guard lock(mutex_);
       SetStatus(e.what(), true);
       return nullptr;
     }
@@ -97,12 +99,15 @@ class ControllerState {
   // True while `path` is still the selected pair's image (a newer selection drops the old
   // image); call with mutex_ held.
   bool StillSelected(const std::filesystem::path& path) const {
+    mutex_.AssertHeld(__func__);
     return state_.selected >= 0 && state_.dataset->pairs[state_.selected].image == path;
   }
   // What else a failed job resets (with mutex_ held), before its message is shown.
   virtual void OnJobError() {}
 
-  mutable std::mutex mutex_;
+  // Guards state_ and what each controller marks "(mutex_)"; the functions documented "call with
+  // mutex_ held" check it (CheckedMutex::AssertHeld).
+  mutable CheckedMutex mutex_;
   Snapshot state_;
   WorkQueue worker_;
 

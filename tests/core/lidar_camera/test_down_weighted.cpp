@@ -1,7 +1,9 @@
 // A pair the solve weights as if left out (the outlier gate's weight 0) is said to be so: in the
-// summary, in the result file and (tests/ui) in the workbench's pair list.
+// summary, in the result file and (tests/ui) in the workbench's pair list; a result too few pairs
+// support is refused.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -85,6 +87,63 @@ TEST(SummaryWords, TheCostAndTheWideningSayWhatTheirNumbersCompare) {
   EXPECT_NE(summary.find("covariance widened up to 2.50x (variance) by the spread"),
             std::string::npos)
       << summary;
+}
+
+// A result nothing supports is refused, never reported: when fewer than min_pairs accepted pairs
+// keep a weight (the rest down-weighted to nothing), or when its σ exceeds what the boards can tell.
+TEST(Refusal, AResultTooFewPairsSupportOrTooUncertainIsRefused) {
+  SimOptions sim = SimPreset("default");
+  sim.num_pairs = 10;
+  sim.seed = 4;
+  const Dataset dataset = SimulateDataset(sim, test::TempDir("refusal") / "sim");
+  std::vector<PairFeatures> pairs;
+  for (const PairEntry& entry : dataset.pairs)
+    pairs.push_back(ExtractPairFeatures(dataset, entry, PipelineOptions{}));
+  const PipelineOptions options;
+  const CalibrationOutcome solved = SolveFromFeatures(pairs, options);
+  ASSERT_TRUE(solved.solution) << solved.failure;
+  ASSERT_EQ(solved.solution->robust_weights.size(), 10u);
+
+  CalibrationOutcome kept = solved;
+  RefuseUnsupportedSolution(dataset.target, options, &kept);
+  EXPECT_TRUE(kept.solution) << kept.failure;
+  EXPECT_EQ(kept.failure, "");
+
+  CalibrationOutcome two_left = solved;
+  for (size_t i = 2; i < 10; ++i) two_left.solution->robust_weights[i] = 0.0;
+  RefuseUnsupportedSolution(dataset.target, options, &two_left);
+  EXPECT_FALSE(two_left.solution);
+  EXPECT_NE(two_left.failure.find("8 of the 10 accepted pairs were down-weighted to nothing"),
+            std::string::npos)
+      << two_left.failure;
+  EXPECT_NE(two_left.failure.find("only 2 support the result and at least 3 must"),
+            std::string::npos)
+      << two_left.failure;
+
+  CalibrationOutcome three_left = solved;
+  for (size_t i = 3; i < 10; ++i) three_left.solution->robust_weights[i] = 0.0;
+  RefuseUnsupportedSolution(dataset.target, options, &three_left);
+  EXPECT_TRUE(three_left.solution) << "three pairs fix all six degrees of freedom";
+
+  // σ: the sheet's diagonal in translation; the angle it spans at the pairs' distance in rotation.
+  const double diagonal_m =
+      std::hypot(dataset.target.SheetWidth(), dataset.target.SheetHeight());
+  CalibrationOutcome wide = solved;
+  wide.solution->covariance.setZero();
+  wide.solution->covariance.diagonal().head<3>().setConstant(std::pow(0.9 * diagonal_m, 2));
+  RefuseUnsupportedSolution(dataset.target, options, &wide);
+  EXPECT_TRUE(wide.solution) << "0.9 of the diagonal is still less than it: " << wide.failure;
+  wide = solved;
+  wide.solution->covariance(1, 1) = std::pow(1.1 * diagonal_m, 2);
+  RefuseUnsupportedSolution(dataset.target, options, &wide);
+  EXPECT_FALSE(wide.solution);
+  EXPECT_NE(wide.failure.find("exceeds what the boards can tell"), std::string::npos)
+      << wide.failure;
+  wide = solved;
+  wide.solution->covariance(5, 5) = std::pow(0.5, 2);  // 29°: beyond any A3 sheet's span at 2 m+
+  RefuseUnsupportedSolution(dataset.target, options, &wide);
+  EXPECT_FALSE(wide.solution);
+  EXPECT_NE(wide.failure.find("28.65 deg"), std::string::npos) << wide.failure;
 }
 
 }  // namespace

@@ -15,7 +15,7 @@
 #include "core/io/image_io.h"
 #include "core/sim/sim.h"
 #include "core/target/board_camera.h"
-#include "tests/core/board_test_scenes.h"
+#include "tests/core/target/board_test_scenes.h"
 #include "tests/test_support.h"
 
 namespace calibench {

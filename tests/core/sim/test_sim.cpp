@@ -82,7 +82,7 @@ cv::Mat GreyOf(const ImageU8& image) {
   return grey;
 }
 
-std::vector<Vec2> ProjectCorners(const CameraModel& camera, const BoardSpec& board,
+std::vector<Vec2> ProjectSimCorners(const CameraModel& camera, const BoardSpec& board,
                                  const Pose& cam_from_board) {
   std::vector<Vec2> pixels;
   for (const Vec3& p : BoardCornerPoints(board))
@@ -108,7 +108,7 @@ double CheckerboardCornerError(const CameraModel& camera, const Pose& cam_from_b
   const BoardSpec board = A3();
   const cv::Mat grey = GreyOf(RenderBoardImage(camera, board, cam_from_board, RenderOptions{}));
   // findChessboardCornersSB costs ~0.5 s on the full frame: search the board's region only.
-  const std::vector<Vec2> truth = ProjectCorners(camera, board, cam_from_board);
+  const std::vector<Vec2> truth = ProjectSimCorners(camera, board, cam_from_board);
   std::vector<cv::Point> truth_points;
   for (const Vec2& t : truth) truth_points.emplace_back(cvRound(t.x()), cvRound(t.y()));
   constexpr int kPad = 120;  // pixels around the inner corners: the outer squares and a margin
@@ -302,7 +302,7 @@ TEST(SimRender, CharucoDetectionMatchesCornerPoints) {
   std::vector<int> ids;
   cv::aruco::interpolateCornersCharuco(marker_corners, marker_ids, grey, cv_board, corners, ids);
   ASSERT_EQ(ids.size(), 24u);
-  const std::vector<Vec2> truth = ProjectCorners(camera, board, pose);
+  const std::vector<Vec2> truth = ProjectSimCorners(camera, board, pose);
   Vec2 mean_offset = Vec2::Zero();
   for (size_t k = 0; k < ids.size(); ++k)
     mean_offset += Vec2(corners[k].x, corners[k].y) - truth[ids[k]];
