@@ -325,11 +325,11 @@ CalibrationOutcome SolveExtractedPairs(const Dataset& dataset,
     RefineIntrinsics(dataset.camera, options, &outcome);
   else if (outcome.solution && options.propagate_intrinsics)
     AddIntrinsicsUncertainty(outcome.pairs, dataset.camera, options, &*outcome.solution);
-  RefuseUnsupportedSolution(dataset.target, options, &outcome);
+  JudgeSolutionSupport(dataset.target, options, &outcome);
   return outcome;
 }
 
-void RefuseUnsupportedSolution(const BoardSpec& board, const PipelineOptions& options,
+void JudgeSolutionSupport(const BoardSpec& board, const PipelineOptions& options,
                                CalibrationOutcome* outcome) {
   if (!outcome->solution) return;
   const SolverResult& solution = *outcome->solution;
@@ -375,13 +375,13 @@ void RefuseUnsupportedSolution(const BoardSpec& board, const PipelineOptions& op
   const double span_rad = std::atan2(diagonal_m, distance_sum / supporting);
   if (sigma_translation_m <= diagonal_m && sigma_rotation_rad <= span_rad) return;
   std::snprintf(text, sizeof(text),
-                "the result's standard deviation (%.3f m, %.2f deg) exceeds what the boards "
-                "can tell (the sheet's diagonal %.3f m, the %.2f deg it spans at %.2f m); more "
-                "pairs, at more orientations, would constrain it",
+                "the result's standard deviation (%.3f m, %.2f deg) exceeds what the boards can "
+                "tell (the sheet's diagonal %.3f m, the %.2f deg it spans at %.2f m): more pairs, "
+                "at more orientations, would constrain it",
                 sigma_translation_m, sigma_rotation_rad * 180.0 / M_PI, diagonal_m,
                 span_rad * 180.0 / M_PI, distance_sum / supporting);
-  outcome->failure = text;
-  outcome->solution.reset();
+  outcome->solution->observability.well_constrained = false;
+  outcome->solution->observability.weak_directions.push_back(text);
 }
 
 CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,

@@ -225,13 +225,13 @@ std::optional<SceneBackground> BuildSceneBackground(
     const std::vector<const PairEntry*>& pairs, int threads, std::string* why,
     std::vector<std::optional<LidarCloud>>* clouds = nullptr);
 
-// A result nothing supports is refused (`solution` reset, `failure` saying why): when fewer than
+// A result nothing supports is refused (`solution` reset, `failure` saying why) when fewer than
 // options.min_pairs accepted pairs keep a robust weight above the negligible one (the rest were
-// down-weighted to nothing), or when its standard deviation exceeds what the boards can tell (the
+// down-weighted to nothing). One whose standard deviation exceeds what the boards can tell (the
 // sheet's diagonal in translation, the angle the sheet spans at the pairs' mean distance in
-// rotation). The last step of SolveExtractedPairs, so `calibrate`, `watch` and the workbench
-// refuse alike.
-void RefuseUnsupportedSolution(const BoardSpec& board, const PipelineOptions& options,
+// rotation) is kept but never "well constrained": the observability says why. The last step of
+// SolveExtractedPairs, so `calibrate`, `watch` and the workbench judge alike.
+void JudgeSolutionSupport(const BoardSpec& board, const PipelineOptions& options,
                                CalibrationOutcome* outcome);
 
 // Camera-guided completion (options.camera_guided): with a first solution, predicts every pair's

@@ -90,8 +90,9 @@ TEST(SummaryWords, TheCostAndTheWideningSayWhatTheirNumbersCompare) {
 }
 
 // A result nothing supports is refused, never reported: when fewer than min_pairs accepted pairs
-// keep a weight (the rest down-weighted to nothing), or when its σ exceeds what the boards can tell.
-TEST(Refusal, AResultTooFewPairsSupportOrTooUncertainIsRefused) {
+// keep a weight (the rest down-weighted to nothing). One whose σ exceeds what the boards can tell
+// is never called well constrained.
+TEST(Refusal, AResultTooFewPairsSupportIsRefusedATooUncertainOneNotWellConstrained) {
   SimOptions sim = SimPreset("default");
   sim.num_pairs = 10;
   sim.seed = 4;
@@ -105,13 +106,14 @@ TEST(Refusal, AResultTooFewPairsSupportOrTooUncertainIsRefused) {
   ASSERT_EQ(solved.solution->robust_weights.size(), 10u);
 
   CalibrationOutcome kept = solved;
-  RefuseUnsupportedSolution(dataset.target, options, &kept);
-  EXPECT_TRUE(kept.solution) << kept.failure;
+  JudgeSolutionSupport(dataset.target, options, &kept);
+  ASSERT_TRUE(kept.solution) << kept.failure;
   EXPECT_EQ(kept.failure, "");
+  EXPECT_TRUE(kept.solution->observability.well_constrained);
 
   CalibrationOutcome two_left = solved;
   for (size_t i = 2; i < 10; ++i) two_left.solution->robust_weights[i] = 0.0;
-  RefuseUnsupportedSolution(dataset.target, options, &two_left);
+  JudgeSolutionSupport(dataset.target, options, &two_left);
   EXPECT_FALSE(two_left.solution);
   EXPECT_NE(two_left.failure.find("8 of the 10 accepted pairs were down-weighted to nothing"),
             std::string::npos)
@@ -122,7 +124,7 @@ TEST(Refusal, AResultTooFewPairsSupportOrTooUncertainIsRefused) {
 
   CalibrationOutcome three_left = solved;
   for (size_t i = 3; i < 10; ++i) three_left.solution->robust_weights[i] = 0.0;
-  RefuseUnsupportedSolution(dataset.target, options, &three_left);
+  JudgeSolutionSupport(dataset.target, options, &three_left);
   EXPECT_TRUE(three_left.solution) << "three pairs fix all six degrees of freedom";
 
   // σ: the sheet's diagonal in translation; the angle it spans at the pairs' distance in rotation.
@@ -131,19 +133,28 @@ TEST(Refusal, AResultTooFewPairsSupportOrTooUncertainIsRefused) {
   CalibrationOutcome wide = solved;
   wide.solution->covariance.setZero();
   wide.solution->covariance.diagonal().head<3>().setConstant(std::pow(0.9 * diagonal_m, 2));
-  RefuseUnsupportedSolution(dataset.target, options, &wide);
-  EXPECT_TRUE(wide.solution) << "0.9 of the diagonal is still less than it: " << wide.failure;
+  JudgeSolutionSupport(dataset.target, options, &wide);
+  ASSERT_TRUE(wide.solution);
+  EXPECT_TRUE(wide.solution->observability.well_constrained)
+      << "0.9 of the diagonal is still less than it";
+  auto said = [](const CalibrationOutcome& outcome, const std::string& words) {
+    for (const std::string& weak : outcome.solution->observability.weak_directions)
+      if (weak.find(words) != std::string::npos) return true;
+    return false;
+  };
   wide = solved;
   wide.solution->covariance(1, 1) = std::pow(1.1 * diagonal_m, 2);
-  RefuseUnsupportedSolution(dataset.target, options, &wide);
-  EXPECT_FALSE(wide.solution);
-  EXPECT_NE(wide.failure.find("exceeds what the boards can tell"), std::string::npos)
-      << wide.failure;
+  JudgeSolutionSupport(dataset.target, options, &wide);
+  ASSERT_TRUE(wide.solution) << "kept, with what it cannot tell";
+  EXPECT_FALSE(wide.solution->observability.well_constrained);
+  EXPECT_TRUE(said(wide, "exceeds what the boards can tell")) << FormatSummary(wide);
+  EXPECT_NE(FormatSummary(wide).find("NOT well constrained"), std::string::npos);
   wide = solved;
   wide.solution->covariance(5, 5) = std::pow(0.5, 2);  // 29°: beyond any A3 sheet's span at 2 m+
-  RefuseUnsupportedSolution(dataset.target, options, &wide);
-  EXPECT_FALSE(wide.solution);
-  EXPECT_NE(wide.failure.find("28.65 deg"), std::string::npos) << wide.failure;
+  JudgeSolutionSupport(dataset.target, options, &wide);
+  ASSERT_TRUE(wide.solution);
+  EXPECT_FALSE(wide.solution->observability.well_constrained);
+  EXPECT_TRUE(said(wide, "28.65 deg")) << FormatSummary(wide);
 }
 
 }  // namespace
