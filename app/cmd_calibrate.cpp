@@ -1,11 +1,8 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <fstream>
-#include <nlohmann/json.hpp>
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
-#include "core/base/atomic_file.h"
 #include "core/io/dataset.h"
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
@@ -14,31 +11,6 @@
 namespace calibench::app {
 
 namespace {
-
-// The result says that its camera was estimated, and how well.
-void AddIntrinsicsToResult(const std::string& path, const IntrinsicsResult& r) {
-  std::ifstream in(path);
-  nlohmann::json result = nlohmann::json::parse(in);
-  const CameraModel& c = r.camera;
-  int used = 0;
-  for (const IntrinsicsImage& image : r.images) used += image.used;
-  result["intrinsics"] = {
-      {"estimated", true},
-      {"model", c.type == CameraModelType::kKannalaBrandt ? "kannala-brandt" : "pinhole-radtan"},
-      {"image_size", {c.width, c.height}},
-      {"fx", c.fx},
-      {"fy", c.fy},
-      {"cx", c.cx},
-      {"cy", c.cy},
-      {"distortion", c.distortion},
-      {"parameter_names", r.parameter_names},
-      {"sigmas", r.sigmas},
-      {"rms_px", r.rms_px},
-      {"images_used", used},
-      {"images", static_cast<int>(r.images.size())},
-      {"verdict", r.verdict}};
-  WriteFileAtomically(path, result.dump(2) + "\n");
-}
 
 // A rig (its folder or manifest): every camera, then the rig solve (core/lidar_camera/rig.h),
 // each camera with the edits of its session among `sessions`; the summary printed, the rig's
@@ -102,9 +74,7 @@ int CalibrateOneCamera(Dataset* dataset, const PairEdits& edits,
   CalibrationOutcome outcome;
   const int code =
       CalibrateAndReport(*dataset, KeepingInputsForViews(options, dataset->camera, &report),
-                         out_path, &outcome, edits);
-  if (intrinsics && outcome.solution && !out_path.empty())
-    AddIntrinsicsToResult(out_path, *intrinsics);
+                         out_path, &outcome, edits, intrinsics);
   if (report.out_path.empty() || !outcome.solution) return code;
   const int written = WriteReport(*dataset, outcome, options, report);
   return code != kOk ? code : written;

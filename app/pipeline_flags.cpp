@@ -166,13 +166,14 @@ PairEdits ApplySessionFlag(const std::string& session_path, std::string* dataset
 
 int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
                        const std::string& out_path, CalibrationOutcome* outcome_out,
-                       const PairEdits& edits) {
+                       const PairEdits& edits, const std::optional<IntrinsicsResult>& estimated) {
   // The job every front end runs (core/session/calibration_job.h), all pairs at once.
   CalibrationJobOptions job_options;
   job_options.advise.pipeline = options;
   CalibrationJob job(dataset, job_options, edits, {.detected = StderrProgress("extracted")});
   job.DetectAll();
   CalibrationOutcome outcome = job.Solve();
+  outcome.estimated_intrinsics = estimated;
   std::printf("%s", FormatSummary(outcome).c_str());
   bool input_error = false;
   std::string unreadable;  // "pair 0003: cannot read image '...': ..." per line

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 
 #include "core/lidar_camera/pipeline.h"
@@ -33,11 +34,12 @@ PairEdits ApplySessionFlag(const std::string& session_path, std::string* dataset
 // Prints "[k/n] pair ID" progress to stderr (one line per pair when stderr is not a terminal).
 ProgressCallback StderrProgress(const std::string& verb);
 
-// Calibrates and prints the summary; writes the result when out_path is not empty. Returns the
-// exit code (kOk, kInputError when any pair file was unreadable, kNoCalibration,
-// kNotConstrained).
+// Calibrates and prints the summary; writes the result when out_path is not empty (with the
+// intrinsics `estimated` from the images before, when given). Returns the exit code (kOk,
+// kInputError when any pair file was unreadable, kNoCalibration, kNotConstrained).
 int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
                        const std::string& out_path, CalibrationOutcome* outcome_out = nullptr,
-                       const PairEdits& edits = {});
+                       const PairEdits& edits = {},
+                       const std::optional<IntrinsicsResult>& estimated = std::nullopt);
 
 }  // namespace calibench::app

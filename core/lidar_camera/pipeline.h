@@ -10,6 +10,7 @@
 #include "core/base/image.h"
 #include "core/base/parallel.h"
 #include "core/io/dataset.h"
+#include "core/intrinsics/intrinsics.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
 #include "core/lidar_camera/solver.h"
@@ -207,6 +208,10 @@ struct CalibrationOutcome {
   Pose initial_cam_from_lidar = Pose::Identity();
   std::string background_note;  // why no background model was used, when one was wanted
   std::optional<IntrinsicsRefinement> intrinsics_refinement;  // PipelineOptions::refine_intrinsics
+  // The camera's intrinsics as estimated from the pairs' images before the calibration
+  // (`calibrate --estimate-intrinsics`), for the result file to say so; absent when a camera
+  // file gave them.
+  std::optional<IntrinsicsResult> estimated_intrinsics;
 };
 
 // Loads the pair's files and extracts both planes (the steps above; the hint is the pair's edited

@@ -126,6 +126,27 @@ json CameraParametersJson(const CameraModel& camera) {
   return parameters;
 }
 
+// --estimate-intrinsics: the camera the images gave, how well, and whether they were enough.
+json EstimatedJson(const IntrinsicsResult& r) {
+  const CameraModel& c = r.camera;
+  int used = 0;
+  for (const IntrinsicsImage& image : r.images) used += image.used;
+  return {{"estimated", true},
+          {"model", CameraModelName(c.type)},
+          {"image_size", {c.width, c.height}},
+          {"fx", c.fx},
+          {"fy", c.fy},
+          {"cx", c.cx},
+          {"cy", c.cy},
+          {"distortion", c.distortion},
+          {"parameter_names", r.parameter_names},
+          {"sigmas", r.sigmas},
+          {"rms_px", r.rms_px},
+          {"images_used", used},
+          {"images", static_cast<int>(r.images.size())},
+          {"verdict", r.verdict}};
+}
+
 // --refine-intrinsics: both cameras, the refined parameters' σ and covariance, how it went.
 json RefinementJson(const IntrinsicsRefinement& r) {
   json out = {{"refined", r.failure.empty()},
@@ -218,8 +239,15 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
          "the part of covariance_6x6 that the camera's intrinsics' covariance contributes "
          "(propagated through the solve; same convention); more pairs do not shrink it"}};
   }
-  if (outcome.intrinsics_refinement)
+  // "intrinsics": estimated from the images first (--estimate-intrinsics), refined with the
+  // extrinsic (--refine-intrinsics), or both (the estimate, with the refinement inside it).
+  if (outcome.estimated_intrinsics) {
+    root["intrinsics"] = EstimatedJson(*outcome.estimated_intrinsics);
+    if (outcome.intrinsics_refinement)
+      root["intrinsics"]["refinement"] = RefinementJson(*outcome.intrinsics_refinement);
+  } else if (outcome.intrinsics_refinement) {
     root["intrinsics"] = RefinementJson(*outcome.intrinsics_refinement);
+  }
   root["pairs"] = PairsJson(outcome);
   root["solver"]["residuals_available"] = ResidualsAvailable(outcome);
   if (const json model = LidarModelJson(outcome); !model.is_null()) root["lidar_model"] = model;

@@ -277,6 +277,18 @@ TEST(IntrinsicsCli, CalibrateWithoutACameraFile) {
   EXPECT_LT(dt, 0.01);
   EXPECT_LT(dr, 0.3);
 
+  // Estimated from the images, then refined with the extrinsic: the result says both (the
+  // refinement inside the estimate; it once overwrote the refinement with the estimate).
+  ASSERT_EQ(RunCommand(calibrate + " --estimate-intrinsics --refine-intrinsics", &output), 0)
+      << output;
+  const auto both = nlohmann::json::parse(std::ifstream(folder / "result.json"));
+  EXPECT_TRUE(both["intrinsics"]["estimated"].get<bool>()) << both["intrinsics"].dump(1);
+  ASSERT_TRUE(both["intrinsics"].contains("refinement")) << both["intrinsics"].dump(1);
+  EXPECT_TRUE(both["intrinsics"]["refinement"].contains("refined"));
+  EXPECT_NEAR(both["intrinsics"]["refinement"]["before"]["fx"].get<double>(),
+              both["intrinsics"]["fx"].get<double>(), 1e-9)
+      << "the refinement starts from the estimate";
+
   // `advise` while the intrinsics are being estimated: the meter includes them (not done while
   // they are not good), and the next pose also puts corners where the image has none.
   const std::string advise = CalibenchExe() + " advise --dataset " + folder.string();

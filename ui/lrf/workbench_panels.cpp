@@ -5,8 +5,10 @@
 #include <cstdio>
 #include <optional>
 
+#include "core/lrf/result_io.h"
 #include "ui/lrf/workbench.h"
 #include "ui/widgets/pair_review.h"
+#include "ui/widgets/path_field.h"
 #include "ui/widgets/solution_readouts.h"
 
 namespace calibench::ui {
