@@ -126,8 +126,11 @@ int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const Pipeli
     camera.name = name;
     camera.prefix = "camera" + std::to_string(c) + "-";  // ids stay valid whatever the name
     camera.report = AnalyseCalibration(rig.cameras[c], outcome.single[c], options, request.options);
-    if (request.renders && why.empty())
-      camera.figures = RenderReportFigures(rig.folder.string(), "", &why, name, &outcome);
+    if (request.renders && why.empty()) {
+      ui::ReportFigureOptions figure_options;
+      figure_options.threads = options.threads;
+      camera.figures = ui::DrawRigReportFigures(rig, outcome, c, figure_options, &why);
+    }
     cameras.push_back(std::move(camera));
   }
   summary.relative = RigRelativePoses(outcome);

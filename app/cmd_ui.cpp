@@ -374,56 +374,6 @@ int RenderDemoViews(const std::string& dataset, const std::string& out_dir) {
   return kOk;
 }
 
-std::vector<ReportFigure> RenderReportFigures(const std::string& dataset,
-                                              const std::string& session, std::string* why,
-                                              const std::string& camera, const RigOutcome* rig) {
-  std::string no_context;
-  const auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &no_context);
-  if (!context) {
-    *why = "no headless OpenGL to draw the views (" + no_context + ")";
-    return {};
-  }
-  ui::Controller controller;
-  if (rig) controller.CarryRig(std::make_shared<const RigOutcome>(*rig));
-  // In memory: a report leaves the session beside the dataset as it is.
-  if (!session.empty()) {
-    controller.OpenSession(session, false);
-  } else {
-    controller.OpenDataset(dataset, {}, ui::Controller::ExistingSession::kInMemory, camera);
-  }
-  controller.WaitRig();
-  controller.WaitIdle();
-  controller.Apply(ui::RunSolver{});
-  controller.WaitIdle();
-  ui::ImGuiHost host(nullptr);
-  std::vector<ReportFigure> figures;
-  {
-    ui::Workbench workbench;
-    figures.push_back(
-        {camera.empty() ? "3D overview: the LiDAR cloud, the boards and the camera"
-                        : "3D overview: the LiDAR cloud, the boards and the rig's cameras (" +
-                              camera + " in orange)",
-         "",
-         EncodeImage(ui::RenderWorkbenchHeadless(controller, workbench, host,
-                                                 ui::Layout::kSceneOnly, 1200, 560, 4),
-                     ".png"),
-         "image/png"});
-  }
-  const auto pairs = controller.GetSnapshot().pairs;
-  for (size_t i = 0; i < pairs.size(); ++i) {
-    controller.Apply(ui::SelectPair{static_cast<int>(i)});
-    controller.WaitIdle();
-    ui::Workbench workbench;
-    figures.push_back(
-        {"pair " + pairs[i].id + ": the LiDAR points coloured over the image", pairs[i].id,
-         EncodeImage(ui::RenderWorkbenchHeadless(controller, workbench, host,
-                                                 ui::Layout::kCameraOnly, 640, 480, 3),
-                     ".jpg"),
-         "image/jpeg"});
-  }
-  return figures;
-}
-
 int RunRender(int argc, char** argv) {
   CLI::App app{
       "Draw the workbench views to PNG without a window (EGL surfaceless or OSMesa): "

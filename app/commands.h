@@ -151,15 +151,6 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
                    const std::string& camera = "");
 // `demo` on a machine without a display: solve and write the workbench and each view as PNG.
 int RenderDemoViews(const std::string& dataset, const std::string& out_dir);
-// The report's pictures, drawn headless by the workbench (cmd_ui.cpp): a 3D overview and, per
-// pair, the camera view with the LiDAR points coloured over it. Empty with *why when there is no
-// headless OpenGL.
-// The report's views of a dataset or session, drawn headless. A rig's camera (`camera` of the rig
-// `dataset`) draws the rig's other cameras from `rig` (its solve, not run again).
-std::vector<ReportFigure> RenderReportFigures(const std::string& dataset,
-                                              const std::string& session, std::string* why,
-                                              const std::string& camera = "",
-                                              const RigOutcome* rig = nullptr);
 int RunReport(int argc, char** argv);
 // What a report is written from, besides the pipeline's outcome.
 struct ReportRequest {

@@ -159,8 +159,6 @@ class Controller : public ControllerState<Snapshot> {
   // Before opening another camera of the same rig: its cameras' solves as `rig` holds them (the
   // window's camera switch), so that they are not solved again.
   void CarryRig(const RigView& rig);
-  // The same from a rig solve already run (the report's views of a rig's cameras).
-  void CarryRig(std::shared_ptr<const RigOutcome> outcome);
   // The same for a dataset already read (a followed capture's, before it has pairs).
   void OpenLoadedDataset(const Dataset& dataset, std::filesystem::path session_path,
                          ExistingSession existing);
@@ -298,7 +296,6 @@ class Controller : public ControllerState<Snapshot> {
   std::thread watch_thread_;
   std::thread rig_thread_;                                 // the rig solve (SolveRig, and at open)
   std::optional<RigView> carried_rig_;                     // CarryRig's, for the next Open
-  std::shared_ptr<const RigOutcome> carried_rig_outcome_;  // the same
   std::map<std::string, std::shared_ptr<const ImageU8>> rig_frames_;  // "<camera>/<pair>" (worker)
   std::vector<std::map<std::string, std::filesystem::path>> rig_images_;  // per camera (mutex_)
   std::atomic<bool> stop_watch_{false};

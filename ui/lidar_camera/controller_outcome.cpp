@@ -1,10 +1,22 @@
 #include "ui/lidar_camera/controller_outcome.h"
 
+#include <algorithm>
+
 #include "core/camera/undistort.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/reproject/reproject.h"
 
 namespace calibench::ui {
+
+namespace {
+
+int AcceptedPairs(const CalibrationOutcome& outcome) {
+  return static_cast<int>(
+      std::count_if(outcome.pairs.begin(), outcome.pairs.end(),
+                    [](const PairFeatures& p) { return p.status == PairStatus::kAccepted; }));
+}
+
+}  // namespace
 
 std::shared_ptr<const Reprojection> ReprojectPair(const CameraModel& camera,
                                                   const Pose& cam_from_lidar,
@@ -107,6 +119,44 @@ void ShowOutcomePair(Snapshot* snapshot, int index, const OutcomePair& pair) {
   snapshot->selected_image_pair = view.id;
   snapshot->reprojection = pair.reprojection;
   ++snapshot->generation;
+}
+
+RigView RigViewOf(const RigFolder& rig, size_t active) {
+  RigView view;
+  view.path = rig.folder;
+  view.active = static_cast<int>(active);
+  for (size_t c = 0; c < rig.cameras.size(); ++c) {
+    RigCameraView camera;
+    camera.name = rig.camera_names[c];
+    camera.camera = rig.cameras[c].camera;
+    camera.captures = static_cast<int>(rig.cameras[c].pairs.size());
+    view.cameras.push_back(std::move(camera));
+  }
+  return view;
+}
+
+void ApplyRigOutcome(const RigOutcome& outcome, bool active_solved, RigView* rig) {
+  for (size_t c = 0; c < outcome.camera_names.size() && c < rig->cameras.size(); ++c) {
+    RigCameraView& view = rig->cameras[c];
+    const CalibrationOutcome& single = outcome.single[c];
+    if (static_cast<int>(c) != rig->active || !active_solved) {
+      view.single =
+          single.solution ? std::make_shared<const SolverResult>(*single.solution) : nullptr;
+      view.pairs_used = AcceptedPairs(single);
+      view.failure = single.solution ? "" : single.failure;
+    }
+    view.joint_cam_from_lidar.reset();
+    view.single_at_joint.reset();
+    if (!outcome.joint) continue;
+    view.single_at_joint = single.solution->cam_from_lidar;
+    const PoseWithSigmas joint = RigJointPose(outcome, c);
+    view.joint_cam_from_lidar = joint.pose;
+    view.joint_sigma_t_mm = joint.sigma_t_mm;
+    view.joint_sigma_r_deg = joint.sigma_r_deg;
+  }
+  rig->shared_captures = outcome.shared_captures;
+  rig->failure = outcome.joint ? "" : outcome.failure;
+  rig->relative = outcome.joint ? RigRelativePoses(outcome) : std::vector<PoseWithSigmas>{};
 }
 
 }  // namespace calibench::ui

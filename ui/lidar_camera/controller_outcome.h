@@ -8,7 +8,9 @@
 #include <memory>
 #include <string>
 
+#include "core/io/rig_folder.h"
 #include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/rig.h"
 #include "ui/lidar_camera/controller_snapshot.h"
 #include "ui/state/view_state.h"
 
@@ -25,6 +27,12 @@ std::shared_ptr<const Reprojection> ReprojectPair(const CameraModel& camera,
 // status, residual and robust weight, the solution with the summary's notes. No pair is selected
 // or loaded (OutcomePair below).
 Snapshot SnapshotOfOutcome(const Dataset& dataset, const CalibrationOutcome& outcome);
+
+// A rig's cameras around camera `active` (names, intrinsics, captures), before any solve.
+RigView RigViewOf(const RigFolder& rig, size_t active);
+// The rig solve's outcome into the rig's view: every camera's own solve (the open camera's only
+// when `active_solved` is false: once it has a live solve, that one is shown) and the joint one.
+void ApplyRigOutcome(const RigOutcome& outcome, bool active_solved, RigView* rig);
 
 // One pair's heavy members as the controller holds them for its selection.
 struct OutcomePair {

@@ -8,44 +8,13 @@
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
 #include "ui/lidar_camera/controller.h"
+#include "ui/lidar_camera/controller_outcome.h"
 
 namespace calibench::ui {
 
 namespace {
 
 constexpr int kRigFrameWidth = 160;  // pixels, as the pairs' thumbnails
-
-int AcceptedPairs(const CalibrationOutcome& outcome) {
-  return static_cast<int>(
-      std::count_if(outcome.pairs.begin(), outcome.pairs.end(),
-                    [](const PairFeatures& p) { return p.status == PairStatus::kAccepted; }));
-}
-
-// The rig solve's outcome into the rig's view; the open camera keeps its live solve once it has
-// one.
-void ApplyRigOutcome(const RigOutcome& outcome, bool active_solved, RigView* rig) {
-  for (size_t c = 0; c < outcome.camera_names.size() && c < rig->cameras.size(); ++c) {
-    RigCameraView& view = rig->cameras[c];
-    const CalibrationOutcome& single = outcome.single[c];
-    if (static_cast<int>(c) != rig->active || !active_solved) {
-      view.single =
-          single.solution ? std::make_shared<const SolverResult>(*single.solution) : nullptr;
-      view.pairs_used = AcceptedPairs(single);
-      view.failure = single.solution ? "" : single.failure;
-    }
-    view.joint_cam_from_lidar.reset();
-    view.single_at_joint.reset();
-    if (!outcome.joint) continue;
-    view.single_at_joint = single.solution->cam_from_lidar;
-    const PoseWithSigmas joint = RigJointPose(outcome, c);
-    view.joint_cam_from_lidar = joint.pose;
-    view.joint_sigma_t_mm = joint.sigma_t_mm;
-    view.joint_sigma_r_deg = joint.sigma_r_deg;
-  }
-  rig->shared_captures = outcome.shared_captures;
-  rig->failure = outcome.joint ? "" : outcome.failure;
-  rig->relative = outcome.joint ? RigRelativePoses(outcome) : std::vector<PoseWithSigmas>{};
-}
 
 }  // namespace
 
@@ -68,29 +37,16 @@ void Controller::CarryRig(const RigView& rig) {
   carried_rig_ = rig;
 }
 
-void Controller::CarryRig(std::shared_ptr<const RigOutcome> outcome) {
-  std::lock_guard lock(mutex_);
-  carried_rig_outcome_ = std::move(outcome);
-}
-
 void Controller::WaitRig() {
   if (rig_thread_.joinable()) rig_thread_.join();
 }
 
 bool Controller::SetUpRig(const RigFolder& rig, size_t active) {
   mutex_.AssertHeld(__func__);
-  RigView view;
-  view.path = rig.folder;
-  view.active = static_cast<int>(active);
+  RigView view = RigViewOf(rig, active);
   rig_images_.assign(rig.cameras.size(), {});
-  for (size_t c = 0; c < rig.cameras.size(); ++c) {
-    RigCameraView camera;
-    camera.name = rig.camera_names[c];
-    camera.camera = rig.cameras[c].camera;
-    camera.captures = static_cast<int>(rig.cameras[c].pairs.size());
+  for (size_t c = 0; c < rig.cameras.size(); ++c)
     for (const PairEntry& pair : rig.cameras[c].pairs) rig_images_[c][pair.id] = pair.image;
-    view.cameras.push_back(std::move(camera));
-  }
   // A camera switch carries the other cameras' solves: the same rig, the same cameras.
   const bool carry = carried_rig_ && carried_rig_->path == view.path &&
                      carried_rig_->cameras.size() == view.cameras.size();
@@ -105,13 +61,8 @@ bool Controller::SetUpRig(const RigFolder& rig, size_t active) {
     view = std::move(carried);
   }
   carried_rig_.reset();
-  const bool solved = carry || carried_rig_outcome_ != nullptr;
-  if (carried_rig_outcome_) {
-    ApplyRigOutcome(*carried_rig_outcome_, false, &view);
-    carried_rig_outcome_.reset();
-  }
   state_.rig = std::move(view);
-  return solved;
+  return carry;
 }
 
 void Controller::StartRigSolve() {

@@ -72,17 +72,19 @@ std::optional<OutcomePair> KeptPairInputs::Find(const std::string& pair_id) cons
   return it->second;
 }
 
-std::vector<ReportFigure> DrawReportFigures(const Dataset& dataset,
-                                            const CalibrationOutcome& outcome,
-                                            const ReportFigureOptions& options,
-                                            const KeptPairInputs* kept, std::string* why) {
+namespace {
+
+// The overview and every pair's camera view of `solved` (a snapshot of an outcome).
+std::vector<ReportFigure> DrawFigures(const Dataset& dataset, const Snapshot& solved,
+                                      const std::string& overview_caption,
+                                      const ReportFigureOptions& options,
+                                      const KeptPairInputs* kept, std::string* why) {
   std::string no_context;
   const auto context = gfx::CreateHeadlessContext(gfx::HeadlessBackend::kAuto, &no_context);
   if (!context) {
     *why = "no headless OpenGL to draw the views (" + no_context + ")";
     return {};
   }
-  const Snapshot solved = SnapshotOfOutcome(dataset, outcome);
   // The undistorted image at about the size the picture shows it: the remapping and the texture a
   // fraction of the full image's. The kept pairs' undistorter when there is one.
   std::optional<Undistorter> own;
@@ -123,7 +125,7 @@ std::vector<ReportFigure> DrawReportFigures(const Dataset& dataset,
     if (figures.empty()) {
       Workbench overview;
       figures.push_back(
-          {"3D overview: the LiDAR cloud, the boards and the camera", "",
+          {overview_caption, "",
            EncodeImage(DrawView(host, overview, shown, Layout::kSceneOnly, options.overview_width,
                                 options.overview_height, options.frames + 1),
                        ".png"),
@@ -142,6 +144,30 @@ std::vector<ReportFigure> DrawReportFigures(const Dataset& dataset,
     *why = std::to_string(unreadable.size()) + " pair(s) without a view: " + unreadable.front();
   }
   return figures;
+}
+
+}  // namespace
+
+std::vector<ReportFigure> DrawReportFigures(const Dataset& dataset,
+                                            const CalibrationOutcome& outcome,
+                                            const ReportFigureOptions& options,
+                                            const KeptPairInputs* kept, std::string* why) {
+  return DrawFigures(dataset, SnapshotOfOutcome(dataset, outcome),
+                     "3D overview: the LiDAR cloud, the boards and the camera", options, kept, why);
+}
+
+std::vector<ReportFigure> DrawRigReportFigures(const RigFolder& rig, const RigOutcome& outcome,
+                                               size_t camera, const ReportFigureOptions& options,
+                                               std::string* why) {
+  CALIBENCH_CHECK(camera < rig.cameras.size() && camera < outcome.single.size());
+  const Dataset& dataset = rig.cameras[camera];
+  Snapshot solved = SnapshotOfOutcome(dataset, outcome.single[camera]);
+  solved.rig = RigViewOf(rig, camera);
+  ApplyRigOutcome(outcome, false, &*solved.rig);
+  return DrawFigures(dataset, solved,
+                     "3D overview: the LiDAR cloud, the boards and the rig's cameras (" +
+                         rig.camera_names[camera] + " in orange)",
+                     options, nullptr, why);
 }
 
 }  // namespace calibench::ui

@@ -58,4 +58,11 @@ std::vector<ReportFigure> DrawReportFigures(const Dataset& dataset,
                                             const ReportFigureOptions& options,
                                             const KeptPairInputs* kept, std::string* why);
 
+// A rig camera's figures: its own outcome (outcome.single[camera]) drawn as one camera's are, the
+// overview with the rig's other cameras around it (this one in orange), as the workbench shows a
+// rig camera.
+std::vector<ReportFigure> DrawRigReportFigures(const RigFolder& rig, const RigOutcome& outcome,
+                                               size_t camera, const ReportFigureOptions& options,
+                                               std::string* why);
+
 }  // namespace calibench::ui
