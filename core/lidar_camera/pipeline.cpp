@@ -330,7 +330,7 @@ CalibrationOutcome SolveExtractedPairs(const Dataset& dataset,
 }
 
 void JudgeSolutionSupport(const BoardSpec& board, const PipelineOptions& options,
-                               CalibrationOutcome* outcome) {
+                          CalibrationOutcome* outcome) {
   if (!outcome->solution) return;
   const SolverResult& solution = *outcome->solution;
   int accepted = 0, supporting = 0;

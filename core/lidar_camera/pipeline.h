@@ -9,8 +9,8 @@
 
 #include "core/base/image.h"
 #include "core/base/parallel.h"
-#include "core/io/dataset.h"
 #include "core/intrinsics/intrinsics.h"
+#include "core/io/dataset.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
 #include "core/lidar_camera/solver.h"
@@ -237,7 +237,7 @@ std::optional<SceneBackground> BuildSceneBackground(
 // rotation) is kept but never "well constrained": the observability says why. The last step of
 // SolveExtractedPairs, so `calibrate`, `watch` and the workbench judge alike.
 void JudgeSolutionSupport(const BoardSpec& board, const PipelineOptions& options,
-                               CalibrationOutcome* outcome);
+                          CalibrationOutcome* outcome);
 
 // Camera-guided completion (options.camera_guided): with a first solution, predicts every pair's
 // board in the LiDAR frame from its camera pose, drops LiDAR boards that disagree with it (the

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/lidar_camera/result_intrinsics_json.h"
 #include "core/results/result_json.h"
 
 namespace calibench {
@@ -118,69 +119,6 @@ json LidarModelJson(const CalibrationOutcome& outcome) {
           {"pairs", counts}};
 }
 
-json CameraParametersJson(const CameraModel& camera) {
-  json parameters = json::object();
-  const std::vector<std::string> names = IntrinsicParameterNames(camera);
-  const std::vector<double> values = IntrinsicParameters(camera);
-  for (size_t i = 0; i < names.size(); ++i) parameters[names[i]] = values[i];
-  return parameters;
-}
-
-// --estimate-intrinsics: the camera the images gave, how well, and whether they were enough.
-json EstimatedJson(const IntrinsicsResult& r) {
-  const CameraModel& c = r.camera;
-  int used = 0;
-  for (const IntrinsicsImage& image : r.images) used += image.used;
-  return {{"estimated", true},
-          {"model", CameraModelName(c.type)},
-          {"image_size", {c.width, c.height}},
-          {"fx", c.fx},
-          {"fy", c.fy},
-          {"cx", c.cx},
-          {"cy", c.cy},
-          {"distortion", c.distortion},
-          {"parameter_names", r.parameter_names},
-          {"sigmas", r.sigmas},
-          {"rms_px", r.rms_px},
-          {"images_used", used},
-          {"images", static_cast<int>(r.images.size())},
-          {"verdict", r.verdict}};
-}
-
-// --refine-intrinsics: both cameras, the refined parameters' σ and covariance, how it went.
-json RefinementJson(const IntrinsicsRefinement& r) {
-  json out = {{"refined", r.failure.empty()},
-              {"model", CameraModelName(r.before.type)},
-              {"image_size", {r.before.width, r.before.height}},
-              {"before", CameraParametersJson(r.before)}};
-  if (!r.failure.empty()) {
-    out["failure"] = r.failure;
-    return out;
-  }
-  const std::vector<std::string> names = IntrinsicParameterNames(r.after);
-  const size_t n = names.size();
-  json sigmas = json::object(), held = json::array();
-  for (size_t i = 0; i < n; ++i) {
-    if (i < r.refined.size() && r.refined[i])
-      sigmas[names[i]] = std::sqrt(std::max(0.0, r.after.covariance[i * n + i]));
-    else
-      held.push_back(names[i]);
-  }
-  out["after"] = CameraParametersJson(r.after);
-  out["sigmas"] = sigmas;
-  out["held"] = held;
-  out["parameter_names"] = names;
-  out["covariance"] = r.after.covariance;
-  out["corner_rms_px"] = r.corner_rms_px;
-  out["corner_sigma_px"] = r.corner_sigma_px;
-  out["pairs"] = r.pairs;
-  out["corners"] = r.corners;
-  out["edge_points"] = r.edge_points;
-  out["iterations"] = r.iterations;
-  out["converged"] = r.converged;
-  return out;
-}
-
 json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& options,
                   const ResultNames& names) {
   CALIBENCH_CHECK(outcome.solution.has_value());
@@ -239,15 +177,8 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
          "the part of covariance_6x6 that the camera's intrinsics' covariance contributes "
          "(propagated through the solve; same convention); more pairs do not shrink it"}};
   }
-  // "intrinsics": estimated from the images first (--estimate-intrinsics), refined with the
-  // extrinsic (--refine-intrinsics), or both (the estimate, with the refinement inside it).
-  if (outcome.estimated_intrinsics) {
-    root["intrinsics"] = EstimatedJson(*outcome.estimated_intrinsics);
-    if (outcome.intrinsics_refinement)
-      root["intrinsics"]["refinement"] = RefinementJson(*outcome.intrinsics_refinement);
-  } else if (outcome.intrinsics_refinement) {
-    root["intrinsics"] = RefinementJson(*outcome.intrinsics_refinement);
-  }
+  if (outcome.estimated_intrinsics || outcome.intrinsics_refinement)
+    root["intrinsics"] = IntrinsicsJson(outcome);
   root["pairs"] = PairsJson(outcome);
   root["solver"]["residuals_available"] = ResidualsAvailable(outcome);
   if (const json model = LidarModelJson(outcome); !model.is_null()) root["lidar_model"] = model;

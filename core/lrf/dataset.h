@@ -2,8 +2,8 @@
 // and its files: LaserScan-like JSON scans, plain 2D PCD scans (z = 0), 16-bit depth PNGs and
 // depth-frame PCDs.
 //
-// Beyond the agreed contract, the same manifest carries the LRF ↔ RGB camera checkerboard case (Zhang &
-// Pless): "target": {"type": "checkerboard", ...} as in calibench.dataset.v1, "camera" (or
+// Beyond the agreed contract, the same manifest carries the LRF ↔ RGB camera checkerboard case
+// (Zhang & Pless): "target": {"type": "checkerboard", ...} as in calibench.dataset.v1, "camera" (or
 // "camera_file") for the RGB intrinsics, and "image" per pair instead of "depth"/"cloud".
 // Optional fields: per pair "scan_region" {"angle_min_deg", "angle_max_deg", "range_min",
 // "range_max"} (the file form of the user's selection on the scan plot); top level

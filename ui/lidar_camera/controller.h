@@ -294,8 +294,8 @@ class Controller : public ControllerState<Snapshot> {
   bool follow_newest_ = true;         // a followed capture's views move to each new pair (mutex_)
   bool opened_pairs_loaded_ = false;  // every pair Open started with has loaded (mutex_)
   std::thread watch_thread_;
-  std::thread rig_thread_;                                 // the rig solve (SolveRig, and at open)
-  std::optional<RigView> carried_rig_;                     // CarryRig's, for the next Open
+  std::thread rig_thread_;              // the rig solve (SolveRig, and at open)
+  std::optional<RigView> carried_rig_;  // CarryRig's, for the next Open
   std::map<std::string, std::shared_ptr<const ImageU8>> rig_frames_;  // "<camera>/<pair>" (worker)
   std::vector<std::map<std::string, std::filesystem::path>> rig_images_;  // per camera (mutex_)
   std::atomic<bool> stop_watch_{false};

@@ -128,8 +128,7 @@ TEST(Refusal, AResultTooFewPairsSupportIsRefusedATooUncertainOneNotWellConstrain
   EXPECT_TRUE(three_left.solution) << "three pairs fix all six degrees of freedom";
 
   // σ: the sheet's diagonal in translation; the angle it spans at the pairs' distance in rotation.
-  const double diagonal_m =
-      std::hypot(dataset.target.SheetWidth(), dataset.target.SheetHeight());
+  const double diagonal_m = std::hypot(dataset.target.SheetWidth(), dataset.target.SheetHeight());
   CalibrationOutcome wide = solved;
   wide.solution->covariance.setZero();
   wide.solution->covariance.diagonal().head<3>().setConstant(std::pow(0.9 * diagonal_m, 2));

@@ -83,7 +83,7 @@ cv::Mat GreyOf(const ImageU8& image) {
 }
 
 std::vector<Vec2> ProjectSimCorners(const CameraModel& camera, const BoardSpec& board,
-                                 const Pose& cam_from_board) {
+                                    const Pose& cam_from_board) {
   std::vector<Vec2> pixels;
   for (const Vec3& p : BoardCornerPoints(board))
     pixels.push_back(*camera.Project(cam_from_board * p));
