@@ -14,7 +14,11 @@ void AddSimFlags(CLI::App& app, SimFlags& flags) {
   app.add_option(
       "--lidar", flags.lidar,
       "hdl64 | vlp16 | os0-128 | swept-2d (a 2D scanner on a rotary stage, its mirror off "
-      "the axis; no rings) (default: the preset's)");
+      "the axis; no rings) | nodding-2d (a line scanner tilted through ±20°: a 28° window) | mid40 | avia | mid360 (Livox-class non-repetitive scanners; no "
+      "rings) (default: the preset's)");
+  app.add_option("--lidar-frame", flags.lidar_frame,
+                 "seconds of returns in each cloud of a Livox-class LiDAR: one frame (0.1) or a "
+                 "still hold integrated (0.5-2) [s] (default: 0.1)");
   app.add_option("--camera", flags.camera, "pinhole | fisheye (default: the preset's)");
   app.add_option("--board", flags.board,
                  "a3 | a4 | paper | charuco-a3 | charuco-a4 (default: the preset's)");
@@ -90,6 +94,7 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
   if (flags.pairs > 0) options->num_pairs = flags.pairs;
   if (flags.lidar_noise >= 0) options->lidar_range_noise_m = flags.lidar_noise;
   options->lidar_range_offset_m = flags.lidar_range_offset;
+  if (flags.lidar_frame > 0) options->lidar_frame_s = flags.lidar_frame;
   if (flags.image_noise >= 0) options->image_noise = flags.image_noise;
   if (flags.min_distance > 0) options->min_distance_m = flags.min_distance;
   if (flags.max_distance > 0) options->max_distance_m = flags.max_distance;

@@ -71,9 +71,10 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
   app.add_option("--lidar-model", flags.lidar_model,
                  "the LiDAR's noise model: spinning (ranges along rays from one centre, rings: "
                  "ring biases and board edges) | swept (a line scanner turned by a stage, rays "
-                 "from a moving mirror) | segment (board-only clouds); swept and segment fit "
+                 "from a moving mirror) | non-repetitive (Livox-class: ranges along rays from one "
+                 "centre, no rings) | segment (board-only clouds); swept and segment fit "
                  "planes point-to-plane with their own covariance. Default: judged from each "
-                 "cloud (rings, cones of elevation, azimuth covered), said in the summary");
+                 "cloud (rings, cones of elevation, the returns' extent), said in the summary");
   app.add_flag_callback(
       "--no-board-growing", [&o] { o.grow_to_board = false; },
       "fit the LiDAR plane on the brushed / seeded returns only, instead of growing the "

@@ -51,6 +51,7 @@ SimulationRecord ParseSimulation(const json_io::Fields& sim) {
   record.max_distance_m = sim.Number("max_distance_m");
   record.max_tilt_deg = sim.Number("max_tilt_deg");
   record.lidar_range_noise_m = sim.Number("lidar_range_noise_m");
+  record.lidar_frame_s = sim.GetOr("lidar_frame_s", 0.0);  // Livox-class models only
   // Manifests written before the offset existed have none.
   record.lidar_range_offset_m = sim.GetOr("lidar_range_offset_m", 0.0);
   record.image_noise = sim.Number("image_noise");
@@ -190,6 +191,7 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
                           {"seed_radius_m", r.seed_radius_m},
                           {"seed", r.seed},
                           {"lidar_range_offset_m", r.lidar_range_offset_m}};
+    if (r.lidar_frame_s > 0) root["simulation"]["lidar_frame_s"] = r.lidar_frame_s;
   }
   WriteFileAtomically(manifest_path, root.dump(2) + "\n");
 }

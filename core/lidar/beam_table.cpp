@@ -1,5 +1,8 @@
 #include "core/lidar/beam_table.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/base/names.h"
 
 namespace calibench {
@@ -17,7 +20,11 @@ std::vector<double> LinspaceDeg(double first_deg, double last_deg, int n) {
 constexpr EnumName<LidarModel> kLidarModelNames[] = {{LidarModel::kHdl64, "hdl64"},
                                                      {LidarModel::kVlp16, "vlp16"},
                                                      {LidarModel::kOs0_128, "os0-128"},
-                                                     {LidarModel::kSwept2d, "swept-2d"}};
+                                                     {LidarModel::kSwept2d, "swept-2d"},
+                                                     {LidarModel::kMid40, "mid40"},
+                                                     {LidarModel::kAvia, "avia"},
+                                                     {LidarModel::kMid360, "mid360"},
+                                                     {LidarModel::kNodding2d, "nodding-2d"}};
 
 }  // namespace
 
@@ -62,8 +69,50 @@ BeamTable MakeBeamTable(LidarModel model) {
       table.swept = true;
       table.mirror_offset_m = Vec3(0.10, 0.0, 0.05);
       break;
+    case LidarModel::kNodding2d:
+      // A 28° fan at 0.1° (a line scanner's window on the room) tilted through ±20° in 0.1°
+      // steps, its mirror 3 cm in front of and 4 cm above the tilt axis.
+      table.elevations_rad = LinspaceDeg(-14.0, 14.0, 281);
+      table.azimuth_steps = 401;
+      table.max_range_m = 20.0;
+      table.swept = true;
+      table.nodding = true;
+      table.tilt_first_rad = -20.0 * kDegToRad;
+      table.tilt_last_rad = 20.0 * kDegToRad;
+      table.mirror_offset_m = Vec3(0.03, 0.0, 0.04);
+      break;
+    case LidarModel::kMid40:
+    case LidarModel::kAvia:
+    case LidarModel::kMid360:
+      table.risley = MakeRisleyPattern(LidarModelName(model));
+      table.max_range_m = table.risley->max_range_m;
+      break;
   }
   return table;
+}
+
+bool BeamTable::InField(const Vec3& direction) const {
+  const Vec3 d = direction.normalized();
+  if (risley) return InRisleyField(*risley, d);
+  if (elevations_rad.empty()) return false;
+  const auto [lowest, highest] = std::minmax_element(elevations_rad.begin(), elevations_rad.end());
+  if (nodding) {
+    // d = Ry(tilt) (cos a, sin a, 0) = (cos t cos a, sin a, -sin t cos a).
+    const double fan = std::asin(std::clamp(d.y(), -1.0, 1.0));
+    const double tilt = std::atan2(-d.z(), d.x());
+    return d.x() > 0 && fan >= *lowest && fan <= *highest &&
+           tilt >= std::min(tilt_first_rad, tilt_last_rad) &&
+           tilt <= std::max(tilt_first_rad, tilt_last_rad);
+  }
+  const double elevation = std::atan2(d.z(), std::hypot(d.x(), d.y()));
+  return elevation >= *lowest && elevation <= *highest;
+}
+
+double BeamTable::PhaseSpanRad() const {
+  if (risley) return 2.0 * M_PI;
+  if (nodding)
+    return azimuth_steps > 1 ? std::abs(tilt_last_rad - tilt_first_rad) / (azimuth_steps - 1) : 0.0;
+  return azimuth_steps > 0 ? 2.0 * M_PI / azimuth_steps : 0.0;
 }
 
 }  // namespace calibench

@@ -8,17 +8,24 @@
 #include <vector>
 
 #include "core/base/types.h"
+#include "core/lidar/risley_pattern.h"
 
 namespace calibench {
 
 // Spinning LiDARs (one centre, rings) and a swept single-line laser: a 2D scanner on a rotary
 // stage whose scan plane turns about the stage's vertical axis, its mirror off that axis (the
 // rays start on the moving mirror, not at the frame's origin; no rings), as the SICK LMS400 on a
-// rotary stage of public swept sets.
-enum class LidarModel { kHdl64, kVlp16, kOs0_128, kSwept2d };
-std::string LidarModelName(LidarModel model);  // "hdl64", "vlp16", "os0-128", "swept-2d"
+// rotary stage of public swept sets; and Livox-class non-repetitive scanners (one beam steered by
+// a Risley prism pair, or the 360° kind: core/lidar/risley_pattern.h), whose rays all start at the
+// origin but follow no rings.
+// A nodding line scanner (kNodding2d): a 2D scanner's horizontal fan tilted up and down by a
+// stage, its mirror a few centimetres off the tilt axis — a narrow whole scan of a room (28° of
+// azimuth, 40° of tilt), not a board crop.
+enum class LidarModel { kHdl64, kVlp16, kOs0_128, kSwept2d, kMid40, kAvia, kMid360, kNodding2d };
+// "hdl64", "vlp16", "os0-128", "swept-2d", "mid40", "avia", "mid360", "nodding-2d"
+std::string LidarModelName(LidarModel model);
 std::optional<LidarModel> ParseLidarModelName(const std::string& name);
-std::string LidarModelNames();  // "hdl64, vlp16, os0-128, swept-2d", for messages
+std::string LidarModelNames();  // "hdl64, vlp16, ...", for messages
 
 // A spinning LiDAR's beam table: elevation per ring (radians, ring 0 = lowest) and azimuth bins.
 struct BeamTable {
@@ -30,6 +37,24 @@ struct BeamTable {
   // (stage frame at azimuth 0) turned with the stage. Its clouds carry no rings.
   bool swept = false;
   Vec3 mirror_offset_m = Vec3::Zero();
+  // A Livox-class scanner: no elevation table and no azimuth steps; its rays are the pattern's
+  // over `frame_s` seconds (one 0.1 s frame, or a still hold integrated into one cloud), from the
+  // origin, in firing order. Its clouds carry no rings.
+  std::optional<RisleyPattern> risley;
+  double frame_s = 0.1;
+  // A nodding scanner (kNodding2d, with `swept`): elevations are the fan's beam angles (azimuths
+  // in the scan plane) and azimuth steps the stage's tilt steps from tilt_first_rad to
+  // tilt_last_rad (rotation about y; positive tilts the fan down); the mirror offset turns with
+  // the tilt.
+  bool nodding = false;
+  double tilt_first_rad = 0.0, tilt_last_rad = 0.0;
+
+  bool HasRings() const { return !swept && !risley; }
+  // Whether a direction (LiDAR frame, any length) lies inside the rays' field.
+  bool InField(const Vec3& direction) const;
+  // The firing phases one sweep may start at: [0, PhaseSpanRad()) (a table's: one azimuth step;
+  // a Risley pattern's: 2π, read as a start time within the pattern's first second).
+  double PhaseSpanRad() const;
 };
 BeamTable MakeBeamTable(LidarModel model);
 

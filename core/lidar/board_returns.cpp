@@ -10,6 +10,22 @@ BeamRays::BeamRays(const BeamTable& beams, double azimuth_offset_rad)
     : steps_(beams.azimuth_steps),
       azimuth_offset_rad_(azimuth_offset_rad),
       mirror_offset_m_(beams.swept ? beams.mirror_offset_m : Vec3::Zero()) {
+  if (beams.risley) {
+    fired_ = FireRisleyPattern(*beams.risley, azimuth_offset_rad / (2.0 * M_PI), beams.frame_s)
+                 .directions;
+    steps_ = static_cast<int>(fired_.size());
+    cos_elevation_ = {1.0};  // one "ring"
+    sin_elevation_ = {0.0};
+    return;
+  }
+  if (beams.nodding) {
+    nodding_ = true;
+    fan_rad_ = beams.elevations_rad;
+    tilt_step_rad_ = beams.azimuth_steps > 1 ? (beams.tilt_last_rad - beams.tilt_first_rad) /
+                                                   (beams.azimuth_steps - 1)
+                                             : 0.0;
+    tilt_first_rad_ = beams.tilt_first_rad + azimuth_offset_rad;
+  }
   for (const double elevation : beams.elevations_rad) {
     cos_elevation_.push_back(std::cos(elevation));
     sin_elevation_.push_back(std::sin(elevation));
@@ -20,6 +36,17 @@ double BeamRays::StepRad() const { return steps_ > 0 ? 2.0 * M_PI / steps_ : 0.0
 
 BeamRay BeamRays::Ray(int ring, int step) const {
   const int wrapped = ((step % steps_) + steps_) % steps_;
+  if (fired()) return {Vec3::Zero(), fired_[wrapped]};
+  if (nodding_) {
+    // The fan's beam `ring` at tilt step `wrapped`: Ry(tilt) applied to the scan plane's ray and
+    // to the mirror's offset.
+    const double tilt = tilt_first_rad_ + tilt_step_rad_ * wrapped;
+    const double ct = std::cos(tilt), st = std::sin(tilt);
+    const double ca = std::cos(fan_rad_[ring]), sa = std::sin(fan_rad_[ring]);
+    const Vec3& m = mirror_offset_m_;
+    return {Vec3(ct * m.x() + st * m.z(), m.y(), -st * m.x() + ct * m.z()),
+            Vec3(ct * ca, sa, -st * ca)};
+  }
   const double azimuth = azimuth_offset_rad_ + 2.0 * M_PI * wrapped / steps_;
   const double cos_az = std::cos(azimuth), sin_az = std::sin(azimuth);
   // A swept scanner's rays start on its mirror, which the stage turns with the scan plane.
@@ -52,6 +79,8 @@ namespace {
 // Every step when the sheet spans more than half the sweep (or hangs over the LiDAR).
 std::pair<int, int> StepsOverSheet(const BeamRays& rays, const BeamTable& beams,
                                    const LidarRectangle& sheet, double azimuth_offset_rad) {
+  // A rosette comes back anywhere; a nodding fan's steps are tilts, not azimuths.
+  if (rays.fired() || rays.nodding()) return {0, rays.steps() - 1};
   const Pose& pose = sheet.lidar_from_rectangle;
   const Vec3& centre = pose.translation();
   const double centre_azimuth = std::atan2(centre.y(), centre.x());
@@ -82,9 +111,9 @@ std::pair<int, int> StepsOverSheet(const BeamRays& rays, const BeamTable& beams,
 BoardReturns CastBoardReturns(const BeamTable& beams, const LidarRectangle& sheet,
                               double azimuth_offset_rad) {
   BoardReturns out;
-  out.points_per_ring.assign(beams.elevations_rad.size(), 0);
-  if (beams.azimuth_steps < 1) return out;
+  if (beams.azimuth_steps < 1 && !beams.risley) return out;
   const BeamRays rays(beams, azimuth_offset_rad);
+  out.points_per_ring.assign(rays.rings(), 0);
   const auto [first, last] = StepsOverSheet(rays, beams, sheet, azimuth_offset_rad);
   for (int ring = 0; ring < rays.rings(); ++ring) {
     Vec3 previous = Vec3::Zero();

@@ -31,17 +31,26 @@ struct BeamRay {
 };
 
 // The rays of a beam table, ring by ring and azimuth step by step, with the firing phase of one
-// sweep (the azimuth of step 0). Elevation sines and cosines are computed once.
+// sweep (the azimuth of step 0). Elevation sines and cosines are computed once. A Livox-class
+// table's rays are one "ring" whose steps are the pattern's rays in firing order over the
+// table's frame, starting phase / 2π seconds into the pattern: consecutive rays are neighbours on
+// the rosette, so the crossings of a sheet's border are found as a ring's are.
 class BeamRays {
  public:
   BeamRays(const BeamTable& beams, double azimuth_offset_rad);
   int rings() const { return static_cast<int>(cos_elevation_.size()); }
   int steps() const { return steps_; }
+  bool fired() const { return !fired_.empty(); }  // a Risley pattern's rays, not a table's
+  bool nodding() const { return nodding_; }
   double StepRad() const;
   // Step may be any integer: it wraps around the sweep.
   BeamRay Ray(int ring, int step) const;
 
  private:
+  std::vector<Vec3> fired_;  // a Risley pattern's directions
+  bool nodding_ = false;     // steps tilt a fan (BeamTable::nodding) rather than turn it
+  double tilt_first_rad_ = 0.0, tilt_step_rad_ = 0.0;
+  std::vector<double> fan_rad_;
   std::vector<double> cos_elevation_, sin_elevation_;
   int steps_ = 0;
   double azimuth_offset_rad_ = 0.0;

@@ -13,6 +13,8 @@ namespace {
 
 constexpr EnumName<LidarGeometry> kLidarGeometryNames[] = {{LidarGeometry::kSpinning, "spinning"},
                                                            {LidarGeometry::kSwept, "swept"},
+                                                           {LidarGeometry::kNonRepetitive,
+                                                            "non-repetitive"},
                                                            {LidarGeometry::kSegment, "segment"}};
 
 // Elevation clusters of the returns: each one's width and the spacing of their centres, and how
@@ -96,13 +98,16 @@ std::optional<LidarGeometry> ParseLidarGeometry(const std::string& name) {
 
 std::string LidarGeometryNames() { return NamesIn(kLidarGeometryNames); }
 
+bool RaysFromOrigin(LidarGeometry geometry) {
+  return geometry == LidarGeometry::kSpinning || geometry == LidarGeometry::kNonRepetitive;
+}
+
 bool LidarGeometryOptions::Check(std::string* why) const {
   auto fail = [&](const char* message) {
     if (why) *why = message;
     return false;
   };
-  if (!(min_scan_azimuth_deg > 0 && min_scan_azimuth_deg <= 360))
-    return fail("min_scan_azimuth_deg must be in (0, 360] degrees");
+  if (!(max_segment_extent_m > 0)) return fail("max_segment_extent_m must be > 0 (metres)");
   if (!(ring_gap_deg > 0)) return fail("ring_gap_deg must be > 0 (degrees)");
   if (!(max_ring_width_fraction > 0 && max_ring_width_fraction < 1))
     return fail("max_ring_width_fraction must be in (0, 1)");
@@ -122,21 +127,44 @@ double AzimuthCoverageDeg(const LidarCloud& cloud) {
   return std::min(360.0, static_cast<double>(cells.size()) * kCellDeg);
 }
 
+double CloudExtentM(const LidarCloud& cloud) {
+  std::vector<float> axis[3];
+  for (const Eigen::Vector3f& p : cloud.points) {
+    if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
+    for (int k = 0; k < 3; ++k) axis[k].push_back(p[k]);
+  }
+  if (axis[0].empty()) return 0.0;
+  Eigen::Vector3f centre;
+  for (int k = 0; k < 3; ++k) {
+    std::nth_element(axis[k].begin(), axis[k].begin() + axis[k].size() / 2, axis[k].end());
+    centre[k] = axis[k][axis[k].size() / 2];
+  }
+  std::vector<float> distances;
+  distances.reserve(axis[0].size());
+  for (const Eigen::Vector3f& p : cloud.points)
+    if (p.allFinite() && p.squaredNorm() >= 1e-12f) distances.push_back((p - centre).norm());
+  const size_t k = distances.size() * 9 / 10;
+  std::nth_element(distances.begin(), distances.begin() + k, distances.end());
+  return distances[k];
+}
+
 LidarGeometryVerdict ClassifyLidarGeometry(const LidarCloud& cloud,
                                            const LidarGeometryOptions& options) {
   LidarGeometryVerdict verdict;
-  char text[256];
+  char text[400];
   if (cloud.HasRing()) {
     verdict.geometry = LidarGeometry::kSpinning;
     verdict.why = "the cloud carries rings: rays from one centre";
     return verdict;
   }
   const double coverage = AzimuthCoverageDeg(cloud);
-  if (coverage < options.min_scan_azimuth_deg) {
+  const double extent_m = CloudExtentM(cloud);
+  if (extent_m <= options.max_segment_extent_m) {
     std::snprintf(text, sizeof(text),
-                  "no rings, and the returns cover only %.0f deg of azimuth: a segment (the board "
-                  "cropped out of a scan), too little to tell how its rays run",
-                  coverage);
+                  "no rings, and the returns lie within %.2f m of their centre (90%%; %.0f deg of "
+                  "azimuth): a segment (the board cropped out of a scan), too little to tell how "
+                  "its rays run",
+                  extent_m, coverage);
     verdict.geometry = LidarGeometry::kSegment;
     verdict.why = text;
     return verdict;
@@ -167,12 +195,16 @@ LidarGeometryVerdict ClassifyLidarGeometry(const LidarCloud& cloud,
     verdict.why = text;
     return verdict;
   }
+  // A whole scan (returns metres apart) whose elevations run on no cones: one beam steered over
+  // the field without rings (Livox-class prisms), or a line scanner's fan nodded through a tilt.
+  // Its ranges are measured along rays from the sensor, as every time-of-flight sensor's are.
   std::snprintf(text, sizeof(text),
-                "no rings, and the returns' elevations do not form cones about one centre "
-                "(%d clusters, %.2f deg wide, median, %.0f deg of azimuth): a swept pattern whose "
-                "rays do not meet at the origin",
-                clusters.count, clusters.median_width_deg, coverage);
-  verdict.geometry = LidarGeometry::kSwept;
+                "no rings, and the returns' elevations form no cones (%d clusters, %.2f deg wide, "
+                "median) over a scan of %.0f deg of azimuth, %.1f m about its centre: a scan "
+                "that follows no rings (a non-repetitive rosette, a nodding line scanner), "
+                "ranges along rays from the origin",
+                clusters.count, clusters.median_width_deg, coverage, extent_m);
+  verdict.geometry = LidarGeometry::kNonRepetitive;
   verdict.why = text;
   return verdict;
 }

@@ -1,8 +1,11 @@
 // What kind of range sensor a cloud comes from, judged from the cloud alone, and so which noise
 // model its planes get: a spinning LiDAR's returns lie on cones about one centre (its rings), so
-// their noise lies along rays from the origin; a swept single-line laser's rays start on a mirror
-// that moves with the stage, and a board-only segment holds too little to tell. Those two get an
-// isotropic point-to-plane model (the plane's own covariance), and no board edges (no rings).
+// their noise lies along rays from the origin; a non-repetitive scanner (Livox-class: one beam
+// steered by prisms) fires from one centre too but follows no rings; a swept single-line laser's
+// rays start on a mirror that moves with the stage; a board-only segment holds too little to
+// tell. Spinning and non-repetitive clouds are fitted on the ranges along their rays (only rings
+// add ring biases and board edges); swept and segment clouds get an isotropic point-to-plane
+// model (the plane's own covariance).
 #pragma once
 
 #include <optional>
@@ -12,17 +15,24 @@
 
 namespace calibench {
 
-enum class LidarGeometry { kSpinning, kSwept, kSegment };
-std::string LidarGeometryName(LidarGeometry geometry);  // "spinning", "swept", "segment"
+enum class LidarGeometry { kSpinning, kSwept, kNonRepetitive, kSegment };
+// "spinning", "swept", "non-repetitive", "segment"
+std::string LidarGeometryName(LidarGeometry geometry);
 std::optional<LidarGeometry> ParseLidarGeometry(const std::string& name);
-std::string LidarGeometryNames();  // "spinning, swept, segment", for messages
+std::string LidarGeometryNames();  // "spinning, swept, non-repetitive, segment", for messages
 
-// Clouds whose returns cover less azimuth than this are segments, not scans: a board cropped out
-// of a spinning LiDAR's 360° or a scanner's 100°+ field.
-inline constexpr double kSegmentSpanDeg = 60.0;
+// Whether the geometry's rays start at the cloud's origin (their ranges measured along them):
+// spinning and non-repetitive scanners.
+bool RaysFromOrigin(LidarGeometry geometry);
+
+// A cloud whose returns lie within this distance of their centre (metres, 90th percentile) is a
+// segment: the board cropped out of a scan, with no scene around it. Whatever its field of view,
+// a whole scan holds a room's walls and floor metres apart (a Livox Mid-40's 38° or a swept
+// scan's 28° as much as a spinning LiDAR's 360°).
+inline constexpr double kSegmentExtentM = 1.5;
 
 struct LidarGeometryOptions {
-  double min_scan_azimuth_deg = kSegmentSpanDeg;  // below it a ring-less cloud is a segment
+  double max_segment_extent_m = kSegmentExtentM;  // within it a ring-less cloud is a segment
   // Rings from elevations: sorted returns split where consecutive elevations differ by more than
   // this; the clusters are cones about one centre when each is narrower than
   // max_ring_width_fraction of the median spacing between them (a spinning LiDAR without a ring
@@ -52,5 +62,9 @@ LidarGeometryVerdict ClassifyLidarGeometry(const LidarCloud& cloud,
 
 // The azimuth the cloud's returns cover (degrees, 0.5° cells occupied), up to 360.
 double AzimuthCoverageDeg(const LidarCloud& cloud);
+
+// How far the returns spread about their centre (the per-axis median): the 90th percentile of
+// their distances to it, metres. 0 for an empty cloud.
+double CloudExtentM(const LidarCloud& cloud);
 
 }  // namespace calibench

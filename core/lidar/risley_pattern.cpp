@@ -41,6 +41,17 @@ RisleyPattern MakeRisleyPattern(const std::string& name) {
 
 std::string RisleyPatternNames() { return "mid40, avia, mid360"; }
 
+bool InRisleyField(const RisleyPattern& pattern, const Vec3& direction) {
+  const double horizontal = std::hypot(direction.x(), direction.y());
+  const double elevation_deg = std::atan2(direction.z(), horizontal) * kRadToDeg;
+  if (pattern.spinning)
+    return std::abs(elevation_deg - pattern.centre_elevation_deg) <= pattern.half_fov_v_deg;
+  if (!(direction.x() > 0.0)) return false;
+  const double azimuth_deg = std::atan2(direction.y(), direction.x()) * kRadToDeg;
+  const double u = azimuth_deg / pattern.half_fov_h_deg, v = elevation_deg / pattern.half_fov_v_deg;
+  return u * u + v * v <= 1.0;
+}
+
 RisleyRays FireRisleyPattern(const RisleyPattern& pattern, double start_s, double duration_s) {
   RisleyRays rays;
   const long n = std::lround(duration_s * pattern.points_per_s);

@@ -39,6 +39,10 @@ struct RisleyRays {
   std::vector<Vec3> directions;
   std::vector<double> time_offsets_s;
 };
+// Whether a direction (LiDAR frame, any length) lies inside the pattern's field of view: the
+// rosette's ellipse of azimuth × elevation about +x, or the 360° kind's band of elevation.
+bool InRisleyField(const RisleyPattern& pattern, const Vec3& direction);
+
 RisleyRays FireRisleyPattern(const RisleyPattern& pattern, double start_s, double duration_s);
 
 }  // namespace calibench

@@ -111,10 +111,14 @@ Review ReviewPair(const Dataset& dataset, const PairEntry& entry, const PairFeat
   } catch (const IoError&) {
     return review;  // the pair already failed on its input
   }
+  // The sheet's inscribed disc about the predicted centre, and only the returns near the
+  // predicted plane: the whole board's returns where a sparse scanner leaves a few strokes of
+  // them (a Livox frame), without the wall behind.
   BoardHint hint;
   hint.seed = LidarSeed{predicted.centre,
-                        0.4 * std::min(dataset.target.SheetWidth(), dataset.target.SheetHeight())};
+                        0.5 * std::min(dataset.target.SheetWidth(), dataset.target.SheetHeight())};
   hint.seed_from_camera = true;
+  hint.predicted_plane = predicted.plane;
   std::string why;
   BoardOrigin origin;
   auto fit = ExtractLidarFeatures(dataset, cloud, hint, options, &why, &origin);

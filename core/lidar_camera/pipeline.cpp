@@ -109,6 +109,14 @@ std::vector<int> SelectBoardRegion(const LidarCloud& cloud, const BoardHint& hin
     CALIBENCH_CHECK(hint.image != nullptr);
     return SelectBrushRegion(*hint.image, hint.brush_pixels);
   }
+  if (hint.seed && hint.predicted_plane) {
+    std::vector<int> near_plane;
+    for (int i : SelectSeedRegion(cloud, *hint.seed))
+      if (std::abs(hint.predicted_plane->SignedDistance(cloud.points[i].cast<double>())) <=
+          hint.predicted_band_m)
+        near_plane.push_back(i);
+    return near_plane;
+  }
   if (hint.seed) return SelectSeedRegion(cloud, *hint.seed);
   *why = "no board region: brush the board in the workbench or add lidar_seed to the manifest";
   return {};

@@ -145,6 +145,11 @@ struct BoardHint {
   const LidarImage* image = nullptr;  // the image the brush was painted on
   std::optional<LidarSeed> seed;
   bool seed_from_camera = false;  // the seed is the camera's prediction
+  // The camera's prediction of the board's plane (LiDAR frame): only the seed's returns within
+  // this band of it are candidates, so that a sparse cloud's few board returns are not outvoted
+  // by what lies behind the sheet. nullopt: the seed's cone alone.
+  std::optional<Plane> predicted_plane;
+  double predicted_band_m = 0.10;
   bool detect = true;  // without brush or seed: detect the board (false: the user erased it)
   const SceneBackground* background = nullptr;  // for detection; may be null
 };

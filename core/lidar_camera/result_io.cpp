@@ -40,10 +40,12 @@ std::vector<ModelGroup> GroupByLidarModel(const CalibrationOutcome& outcome) {
 }
 
 std::string ModelMeaning(LidarGeometry geometry) {
-  return geometry == LidarGeometry::kSpinning
-             ? "planes fitted on the ranges along the rays, with ring biases and board edges"
-             : "planes fitted point-to-plane (isotropic, their own covariance), no ring biases "
-               "or board edges";
+  if (geometry == LidarGeometry::kSpinning)
+    return "planes fitted on the ranges along the rays, with ring biases and board edges";
+  if (geometry == LidarGeometry::kNonRepetitive)
+    return "planes fitted on the ranges along the rays, no rings: no ring biases or board edges";
+  return "planes fitted point-to-plane (isotropic, their own covariance), no ring biases or board "
+         "edges";
 }
 
 json ResidualsAvailable(const CalibrationOutcome& outcome) {

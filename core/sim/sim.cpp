@@ -19,8 +19,18 @@ constexpr double kImageMarginFraction = 0.05;  // of the image width, around the
 // Simulated boards are placed where the LiDAR's returns leave a margin over what finding the
 // board needs (guidance's BoardReturnsRule asks for 40 returns): 4 rings of 3+ returns, 60 in all.
 constexpr BoardReturnsRule kSimulatedBoardReturns{4, 3, 60};
+// A Livox-class scanner has no rings: 60 returns on the sheet, however its rosette lays them.
+constexpr BoardReturnsRule kSimulatedRinglessReturns{1, 3, 60};
 constexpr double kMaxIncidenceDeg = 80.0;  // LiDAR ray vs. board normal at the board centre
 constexpr int kMaxTriesPerPair = 5000;
+
+// The simulated LiDAR's rays: its model's table, a Livox-class pattern fired for the options'
+// frame (one cloud's worth of returns).
+BeamTable SimBeamTable(const SimOptions& options) {
+  BeamTable beams = MakeBeamTable(options.lidar);
+  beams.frame_s = options.lidar_frame_s;
+  return beams;
+}
 
 // Independent, well-mixed seeds per pair and purpose (SplitMix64 finaliser).
 std::uint64_t MixSeed(std::uint64_t seed, std::uint64_t pair, std::uint64_t stream) {
@@ -124,14 +134,9 @@ bool SheetFitsRoom(const SimOptions& r, const LidarScene& scene, const Pose& lid
 // The whole sheet within the LiDAR's vertical field of view: a "valid measurement" in the sense
 // of Ca²Lib Section 4.1, where both sensors see the complete target.
 bool SheetInLidarFov(const SimOptions& r, const BeamTable& beams, const Pose& lidar_from_board) {
-  const auto [lowest, highest] =
-      std::minmax_element(beams.elevations_rad.begin(), beams.elevations_rad.end());
   const double hw = 0.5 * r.board.SheetWidth(), hh = 0.5 * r.board.SheetHeight();
-  for (const Vec3& c : {Vec3(-hw, -hh, 0), Vec3(hw, -hh, 0), Vec3(hw, hh, 0), Vec3(-hw, hh, 0)}) {
-    const Vec3 p = lidar_from_board * c;
-    const double elevation = std::atan2(p.z(), std::hypot(p.x(), p.y()));
-    if (elevation < *lowest || elevation > *highest) return false;
-  }
+  for (const Vec3& c : {Vec3(-hw, -hh, 0), Vec3(hw, -hh, 0), Vec3(hw, hh, 0), Vec3(-hw, hh, 0)})
+    if (!beams.InField(lidar_from_board * c)) return false;
   return true;
 }
 
@@ -157,7 +162,9 @@ Vec3 BoardHitCentroid(const BeamTable& beams, const BoardPrint& print, const Pos
 
 bool EnoughLidarHits(const BeamTable& beams, const BoardPrint& print, const Pose& lidar_from_board,
                      double azimuth_offset_rad) {
-  return kSimulatedBoardReturns.Met(
+  const BoardReturnsRule& rule =
+      beams.risley ? kSimulatedRinglessReturns : kSimulatedBoardReturns;
+  return rule.Met(
       ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad));
 }
 
@@ -166,7 +173,7 @@ PairPlan PlanPair(const SimOptions& r, const BeamTable& beams, const BoardPrint&
   std::mt19937_64 rng(MixSeed(r.seed, pair, 0));
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   PairPlan plan;
-  plan.azimuth_offset_rad = 2.0 * M_PI / beams.azimuth_steps * unit(rng);
+  plan.azimuth_offset_rad = beams.PhaseSpanRad() * unit(rng);
   const double margin = kImageMarginFraction * r.camera.width;
   const Pose lidar_from_cam = r.cam_from_lidar.inverse();
   for (int attempt = 0; attempt < kMaxTriesPerPair; ++attempt) {
@@ -187,7 +194,7 @@ PairPlan PlanPair(const SimOptions& r, const BeamTable& beams, const BoardPrint&
       std::to_string(kMaxTriesPerPair) +
       " tries: the whole sheet must be in the image with a 5% margin, in front of the LiDAR and "
       "inside its vertical field of view, " +
-      "above the floor and hit by >= 4 rings and >= 60 points of the " + LidarModelName(r.lidar) +
+      "above the floor and hit by >= 4 rings (a Livox-class scanner: any) and >= 60 points of the " + LidarModelName(r.lidar) +
       "; try a larger board, a smaller max_distance_m or max_tilt_deg, or a LiDAR with more rings");
 }
 
@@ -246,6 +253,8 @@ bool SimOptions::Check(std::string* why) const {
   }
   if (max_distance_m <= min_distance_m) return fail("max_distance_m must exceed min_distance_m");
   if (!(max_tilt_deg >= 0.0 && max_tilt_deg < 80.0)) return fail("max_tilt_deg must be in [0, 80)");
+  if (!(lidar_frame_s >= 0.01 && lidar_frame_s <= 5.0))
+    return fail("lidar_frame_s must be in [0.01, 5] s");
   if (!(lidar_range_noise_m >= 0.0) || !std::isfinite(lidar_range_noise_m)) {
     return fail("lidar_range_noise_m must be >= 0");
   }
@@ -313,7 +322,7 @@ SimOptions SimPreset(const std::string& name) {
 std::vector<Pose> SampleBoardPoses(const SimOptions& options) {
   CheckOrThrow(options);
   const SimOptions r = Resolve(options);
-  const BeamTable beams = MakeBeamTable(r.lidar);
+  const BeamTable beams = SimBeamTable(r);
   const BoardPrint print(r.board);
   std::vector<Pose> poses;
   for (const PairPlan& plan : PlanPairs(r, beams, print, RoomScene(r))) {
@@ -327,7 +336,7 @@ SimOptions ResolveSimOptions(const SimOptions& options) { return Resolve(options
 std::vector<SimPairTruth> SimulatePairTruth(const SimOptions& options) {
   CheckOrThrow(options);
   const SimOptions r = Resolve(options);
-  const BeamTable beams = MakeBeamTable(r.lidar);
+  const BeamTable beams = SimBeamTable(r);
   const BoardPrint print(r.board);
   const Pose lidar_from_cam = r.cam_from_lidar.inverse();
   std::vector<SimPairTruth> truth;
@@ -362,6 +371,7 @@ SimOptions SimOptionsFromDataset(const Dataset& dataset) {
   options.min_distance_m = record.min_distance_m;
   options.max_distance_m = record.max_distance_m;
   options.max_tilt_deg = record.max_tilt_deg;
+  if (record.lidar_frame_s > 0) options.lidar_frame_s = record.lidar_frame_s;
   options.lidar_range_noise_m = record.lidar_range_noise_m;
   options.lidar_range_offset_m = record.lidar_range_offset_m;
   options.image_noise = record.image_noise;
@@ -380,7 +390,7 @@ SimOptions SimOptionsFromDataset(const Dataset& dataset) {
 Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& out_dir) {
   CheckOrThrow(options);
   const SimOptions r = Resolve(options);
-  const BeamTable beams = MakeBeamTable(r.lidar);
+  const BeamTable beams = SimBeamTable(r);
   const BoardPrint print(r.board);
   LidarScene scene = RoomScene(r);
   const std::filesystem::path root = std::filesystem::absolute(out_dir);
@@ -391,7 +401,7 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
   dataset.manifest = root / "dataset.json";
   dataset.camera = r.camera;
   dataset.target = r.board;
-  dataset.lidar_rings = beams.swept ? 0 : static_cast<int>(beams.elevations_rad.size());
+  dataset.lidar_rings = beams.HasRings() ? static_cast<int>(beams.elevations_rad.size()) : 0;
   dataset.cam_from_lidar_ground_truth = r.cam_from_lidar;
   SimulationRecord record;
   record.lidar_model = LidarModelName(r.lidar);
@@ -399,6 +409,7 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
   record.min_distance_m = r.min_distance_m;
   record.max_distance_m = r.max_distance_m;
   record.max_tilt_deg = r.max_tilt_deg;
+  if (beams.risley) record.lidar_frame_s = r.lidar_frame_s;
   record.lidar_range_noise_m = r.lidar_range_noise_m;
   record.lidar_range_offset_m = r.lidar_range_offset_m;
   record.image_noise = r.image_noise;
@@ -442,12 +453,12 @@ SimulatedPair SimulatePairAt(const SimOptions& resolved, const Pose& cam_from_bo
                              int pair_index) {
   CheckOrThrow(resolved);
   const SimOptions& r = resolved;
-  const BeamTable beams = MakeBeamTable(r.lidar);
+  const BeamTable beams = SimBeamTable(r);
   const BoardPrint print(r.board);
   LidarScene scene = RoomScene(r);
   std::mt19937_64 rng(MixSeed(r.seed, pair_index, 0));
   const double azimuth_offset =
-      2.0 * M_PI / beams.azimuth_steps * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+      beams.PhaseSpanRad() * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
   scene.lidar_from_board = r.cam_from_lidar.inverse() * cam_from_board;
   SimulatedPair pair;
   pair.seed = LidarSeed{BoardHitCentroid(beams, print, scene.lidar_from_board, azimuth_offset),
@@ -468,7 +479,7 @@ SimulatedPair SimulatePairAt(const SimOptions& resolved, const Pose& cam_from_bo
 bool PlaceableInSimulation(const SimOptions& resolved, const Pose& cam_from_board,
                            std::string* why) {
   const SimOptions& r = resolved;
-  const BeamTable beams = MakeBeamTable(r.lidar);
+  const BeamTable beams = SimBeamTable(r);
   const BoardPrint print(r.board);
   const LidarScene scene = RoomScene(r);
   const Pose lidar_from_board = r.cam_from_lidar.inverse() * cam_from_board;
@@ -486,7 +497,7 @@ bool PlaceableInSimulation(const SimOptions& resolved, const Pose& cam_from_boar
 }
 
 Pose RandomPlacement(const SimOptions& resolved, int pair_index) {
-  const BeamTable beams = MakeBeamTable(resolved.lidar);
+  const BeamTable beams = SimBeamTable(resolved);
   const BoardPrint print(resolved.board);
   return PlanPair(resolved, beams, print, RoomScene(resolved), pair_index).cam_from_board;
 }

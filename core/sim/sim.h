@@ -29,6 +29,9 @@ struct SimOptions {
   double max_distance_m = 4.0;
   double max_tilt_deg = 40.0;        // board normal vs. the camera viewing ray
   double lidar_range_noise_m = 0.0;  // Gaussian, along each ray
+  // A Livox-class LiDAR (mid40, avia, mid360): the seconds of returns each pair's cloud holds —
+  // one 0.1 s frame, or a still hold integrated (1 s: ten times the points).
+  double lidar_frame_s = 0.1;
   // Constant error of the LiDAR's range calibration: measured range = true range + offset (m).
   double lidar_range_offset_m = 0.0;
   double image_noise = 0.0;  // Gaussian pixel noise, in [0,1] intensity units (Gazebo)

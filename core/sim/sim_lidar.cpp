@@ -64,6 +64,11 @@ double SurfaceIntensity(const RayHit& hit, const BoardPrint& print) {
   return kWallIntensity;
 }
 
+// The nearest return the sensor reports (metres).
+double MinRangeM(const BeamTable& beams) {
+  return beams.risley ? std::max(kLidarMinRangeM, beams.risley->min_range_m) : kLidarMinRangeM;
+}
+
 }  // namespace
 
 LidarCloud LidarScan::ToCloud(bool board_only) const {
@@ -81,7 +86,7 @@ LidarCloud LidarScan::ToCloud(bool board_only) const {
 
 LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
                             const LidarScene& scene, const LidarScanOptions& options) {
-  CALIBENCH_CHECK(beams.azimuth_steps > 0 && !beams.elevations_rad.empty());
+  CALIBENCH_CHECK(beams.risley || (beams.azimuth_steps > 0 && !beams.elevations_rad.empty()));
   CALIBENCH_CHECK(options.range_noise_m >= 0.0);
   // The sheet as the print has it (centred on the pattern), the panels as they stand.
   const LidarRectangle sheet{scene.lidar_from_board,
@@ -93,7 +98,7 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
   std::mt19937_64 rng(options.seed);
   std::normal_distribution<double> unit_normal(0.0, 1.0);
   LidarScan scan;
-  scan.has_rings = !beams.swept;
+  scan.has_rings = beams.HasRings();
   for (int step = 0; step < rays.steps(); ++step) {
     for (int r = 0; r < rays.rings(); ++r) {
       const BeamRay ray = rays.Ray(r, step);
@@ -103,7 +108,7 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
       for (const LidarRectangle& panel : panels)
         IntersectRectangle(ray, panel, SimSurface::kWall, &hit);
       if (scene.clutter) IntersectRoom(ray, scene, &hit);
-      if (hit.range >= beams.max_range_m || hit.range < kLidarMinRangeM) continue;
+      if (hit.range >= beams.max_range_m || hit.range < MinRangeM(beams)) continue;
       double range = hit.range + options.range_offset_m;
       if (options.range_noise_m > 0.0) range += options.range_noise_m * unit_normal(rng);
       const double intensity = SurfaceIntensity(hit, print) + kIntensityNoise * unit_normal(rng);

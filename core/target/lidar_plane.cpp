@@ -103,9 +103,10 @@ std::optional<LidarPlaneFit> RefineLeastSquares(const LidarCloud& cloud,
   return fit;
 }
 
-// Whether the options fit ranges along rays from the origin (a spinning LiDAR's model).
+// Whether the options fit ranges along rays from the origin (a spinning or non-repetitive
+// LiDAR's model).
 bool AlongRays(const LidarPlaneOptions& options) {
-  return options.fit_ranges_ml && options.geometry == LidarGeometry::kSpinning;
+  return options.fit_ranges_ml && RaysFromOrigin(options.geometry);
 }
 
 // A return's residual against the plane in the options' model: along its ray, or (isotropic)
@@ -410,8 +411,8 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
   if (n < options.min_inlier_fraction * candidates.size())
     return fail("plane explains only " + std::to_string(n) + " of " +
                 std::to_string(candidates.size()) + " selected points");
-  const bool spinning = options.geometry == LidarGeometry::kSpinning;
-  if (options.grow_radius_m > 0 && (options.fit_ranges_ml || !spinning))
+  const bool along_rays_model = RaysFromOrigin(options.geometry);
+  if (options.grow_radius_m > 0 && (options.fit_ranges_ml || !along_rays_model))
     fit = GrowToBoard(cloud, *fit, options);
   AddBoardExtent(cloud, options, &*fit);
   return fit;

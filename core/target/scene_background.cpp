@@ -45,6 +45,7 @@ void SceneBackground::Add(const LidarCloud& cloud) {
     azimuths.insert(key % 1000000);
   }
   azimuth_span_deg_.push_back(static_cast<double>(azimuths.size()) * cell_rad_ * kRadToDeg);
+  extent_m_.push_back(CloudExtentM(cloud));
   ++clouds_;
   usable_ = false;
 }
@@ -68,18 +69,21 @@ bool SceneBackground::Finish(std::string* why) {
   }
   // A static sensor sees the same room in every cloud; most returns then sit on their medians.
   if (total == 0 || agree < total / 2) {
-    // Say what was seen. Clouds that each cover a narrow azimuth are segments (the board cropped
-    // out of the scan): there is no scene in them to learn. Full scans that do not repeat come
-    // from a sensor that moved, or a scene that changed: which of the two is not known here.
-    std::vector<double> spans = azimuth_span_deg_;
-    std::nth_element(spans.begin(), spans.begin() + spans.size() / 2, spans.end());
-    const double median_span = spans[spans.size() / 2];
+    // Say what was seen. Clouds that each hold little more than a board are segments (the board
+    // cropped out of the scan): there is no scene in them to learn. Full scans that do not repeat
+    // come from a sensor that moved, or a scene that changed: which of the two is not known here.
+    auto median = [](std::vector<double> values) {
+      std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+      return values[values.size() / 2];
+    };
+    const double median_span = median(azimuth_span_deg_);
+    const double median_extent_m = median(extent_m_);
     const double repeat = total ? 100.0 * agree / total : 0.0;
-    if (median_span < kSegmentSpanDeg) {
+    if (median_extent_m <= kSegmentExtentM) {
       *why = Printf(
-          "the clouds hold segments, not scans (each covers about %.0f deg of azimuth, median): "
-          "no static scene to learn, so no background model",
-          median_span);
+          "the clouds hold segments, not scans (each lies within %.2f m of its centre and covers "
+          "about %.0f deg of azimuth, median): no static scene to learn, so no background model",
+          median_extent_m, median_span);
     } else {
       *why = Printf(
           "the clouds do not share a static scene (%.0f%% of returns repeat from cloud to "

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/lidar/cloud.h"
-#include "core/lidar/lidar_geometry.h"  // kSegmentSpanDeg
+#include "core/lidar/lidar_geometry.h"  // CloudExtentM, kSegmentExtentM
 
 namespace calibench {
 
@@ -38,6 +38,7 @@ class SceneBackground {
   std::unordered_map<std::int64_t, std::vector<float>> ranges_;  // per cell, nearest per cloud
   std::unordered_map<std::int64_t, float> median_;
   std::vector<double> azimuth_span_deg_;  // per cloud: the azimuth its returns cover
+  std::vector<double> extent_m_;          // per cloud: CloudExtentM
 };
 
 }  // namespace calibench

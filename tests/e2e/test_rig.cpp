@@ -17,16 +17,12 @@
 #include "tests/bag_writers.h"
 #include "tests/sim_recording.h"
 #include "tests/test_support.h"
+#include "tests/watch_stream.h"
 
 namespace calibench {
 namespace {
 
-Pose PoseFromRows(const nlohmann::json& rows) {
-  Pose pose = Pose::Identity();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) pose.matrix()(r, c) = rows[r][c].get<double>();
-  return pose;
-}
+using test::PoseFromRows;
 
 TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
   const auto dir = test::TempDir("rig_two_cameras");
