@@ -34,7 +34,7 @@ const char* EncodingLabel(const BagTopic& topic) {
 }
 
 bool Importable(const std::string& type) {
-  return type == kPointCloud2Type || type == kImageType || type == kCompressedImageType ||
+  return IsCloudType(type) || type == kImageType || type == kCompressedImageType ||
          type == kCameraInfoType;
 }
 

@@ -29,6 +29,14 @@ struct RecordedMessage {
 std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int64_t stamp_ns,
                                                const std::string& frame, MessageEncoding encoding,
                                                bool big_endian = false);
+// livox_ros_driver(2)/CustomMsg from its definition: the cloud's points in order, offset_time
+// from `offsets_ns` (or 10 µs apart), reflectivity from the intensity, tag 0, line 0; `tags`
+// (optional) per point.
+std::vector<std::uint8_t> SerializeLivoxCustomMsg(const LidarCloud& cloud, std::int64_t stamp_ns,
+                                                  const std::string& frame,
+                                                  MessageEncoding encoding,
+                                                  const std::vector<std::uint32_t>& offsets_ns = {},
+                                                  const std::vector<std::uint8_t>& tags = {});
 // `encoding` names the pixel layout of `image` ("bgr8" for 3 channels, "mono8" for 1, or any
 // raw layout the caller has already arranged, e.g. "bayer_rggb8").
 std::vector<std::uint8_t> SerializeImage(const ImageU8& image, const std::string& encoding,

@@ -71,6 +71,8 @@ SimOptions RecordingSim(const SimRecordingOptions& options) {
   sim.lidar_range_noise_m = options.lidar_range_noise_m;
   sim.min_distance_m = options.min_distance_m;
   sim.max_distance_m = options.max_distance_m;
+  sim.lidar = options.lidar;
+  sim.lidar_frame_s = 1.0 / options.cloud_hz;
   return ResolveSimOptions(sim);
 }
 
@@ -119,10 +121,11 @@ SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding enc
   SimRecordingTruth truth = PlanSimRecording(options);
   const std::int64_t end = truth.hold_end_ns.back();
 
-  const BeamTable beams = MakeBeamTable(resolved.lidar);
+  BeamTable beams = MakeBeamTable(resolved.lidar);
+  beams.frame_s = resolved.lidar_frame_s;
   const BoardPrint print(resolved.board);
   std::mt19937_64 rng(options.seed);
-  std::uniform_real_distribution<double> phase(0.0, 2.0 * M_PI / beams.azimuth_steps);
+  std::uniform_real_distribution<double> phase(0.0, beams.PhaseSpanRad());
   RenderOptions still_render;  // once per hold, then noise per frame
   RenderOptions moving_render;
   moving_render.supersampling = 1;
@@ -141,12 +144,21 @@ SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding enc
       scene.lidar_from_board = truth.cam_from_lidar.inverse() * BoardAt(truth, t);
       LidarScanOptions scan;
       scan.range_noise_m = options.lidar_range_noise_m;
-      scan.azimuth_offset_rad = phase(rng);
+      // A rosette's frame is the pattern from its start time on (BeamRays: phase / 2π seconds).
+      scan.azimuth_offset_rad =
+          beams.risley ? 2.0 * M_PI * static_cast<double>(t - kStart) / kSecond : phase(rng);
       scan.seed = options.seed * 7919 + ++sweep;
       const LidarCloud cloud = SimulateLidarScan(beams, print, scene, scan).ToCloud();
       // The driver stamps a sweep at its start and publishes it when complete.
-      writer->Add({"/velodyne_points", "sensor_msgs/PointCloud2", t + cloud_period,
-                   SerializePointCloud2(cloud, t, "velodyne", encoding)});
+      if (beams.risley) {
+        const char* type = encoding == MessageEncoding::kRos1 ? "livox_ros_driver/CustomMsg"
+                                                              : "livox_ros_driver2/CustomMsg";
+        writer->Add({"/livox/lidar", type, t + cloud_period,
+                     SerializeLivoxCustomMsg(cloud, t, "livox_frame", encoding)});
+      } else {
+        writer->Add({"/velodyne_points", "sensor_msgs/PointCloud2", t + cloud_period,
+                     SerializePointCloud2(cloud, t, "velodyne", encoding)});
+      }
       ++truth.messages;
     } else {
       const std::int64_t t = next_image;

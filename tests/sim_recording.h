@@ -34,6 +34,11 @@ struct SimRecordingOptions {
   // (degrees) and 20 cm to the left; the topics are then /cam0/... and /cam1/... (0 = one
   // camera on /camera/...).
   double second_camera_yaw_deg = 0.0;
+  // The LiDAR: a spinning one (PointCloud2 on /velodyne_points), or a Livox-class scanner
+  // (mid40, avia, mid360), whose 0.1 s frames go out as livox_ros_driver/CustomMsg (ROS 1) or
+  // livox_ros_driver2/CustomMsg (ROS 2) on /livox/lidar, each frame a new stretch of its
+  // rosette.
+  LidarModel lidar = LidarModel::kVlp16;
 };
 
 struct SimRecordingTruth {

@@ -237,7 +237,7 @@ bool PairTopicsPresent(const BagReader& bag, bool camera_given) {
       if (is(topic.type) && topic.message_count > 0) return true;
     return false;
   };
-  return has([](const std::string& t) { return t == kPointCloud2Type; }) &&
+  return has(IsCloudType) &&
          has([](const std::string& t) { return t == kImageType || t == kCompressedImageType; }) &&
          (camera_given || has([](const std::string& t) { return t == kCameraInfoType; }));
 }
@@ -245,7 +245,9 @@ bool PairTopicsPresent(const BagReader& bag, bool camera_given) {
 PairTopics ChosenPairTopics(const BagReader& bag, const BagImportOptions& options) {
   const BagTopic& image = bag.Topics()[bag.FindTopic(options.image_topic)];
   PairTopics topics;
-  topics.cloud = bag.Topics()[bag.FindTopic(options.cloud_topic)].encoding;
+  const BagTopic& cloud = bag.Topics()[bag.FindTopic(options.cloud_topic)];
+  topics.cloud = cloud.encoding;
+  topics.livox_cloud = cloud.type != kPointCloud2Type;
   topics.image = image.encoding;
   topics.compressed_image = image.type == kCompressedImageType;
   topics.image_topic = options.image_topic;

@@ -116,8 +116,8 @@ void ChooseOne(const BagReader& bag, const std::vector<std::string>& candidates,
 }  // namespace
 
 void ChooseTopics(const BagReader& bag, BagImportOptions* options) {
-  ChooseOne(bag, TopicsOfType(bag, [](const std::string& t) { return t == kPointCloud2Type; }),
-            "PointCloud2", "--cloud-topic", &options->cloud_topic);
+  ChooseOne(bag, TopicsOfType(bag, IsCloudType), "cloud (PointCloud2, Livox CustomMsg)",
+            "--cloud-topic", &options->cloud_topic);
   std::vector<std::string> images = TopicsOfType(bag, IsImageType);
   // image_transport republishes a raw topic as <topic>/compressed: the same camera, once.
   std::erase_if(images, [&](const std::string& name) {

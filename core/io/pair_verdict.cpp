@@ -46,6 +46,36 @@ bool StillIn(const ImageU8& image, const BoardDetection& detection, const ImageU
 std::string MillisecondsText(double seconds) {
   return std::to_string(static_cast<int>(std::lround(seconds * 1000))) + " ms";
 }
+namespace {
+
+// A still hold's other sweeps appended to the tried one (returns and intensities; a ring-less
+// cloud has no rings to keep), as long as the cloud stays within the load limit. An unreadable
+// sweep among them is left out.
+void IntegrateSweeps(const std::vector<recording_detail::StampedBytes>& sweeps,
+                     const PairTopics& topics, const LoadLimits& limits, LidarCloud* cloud) {
+  for (const recording_detail::StampedBytes& sweep : sweeps) {
+    LidarCloud more;
+    try {
+      more = DecodeCloudMessage(*sweep.bytes, topics.livox_cloud, topics.cloud, limits).cloud;
+    } catch (const std::invalid_argument&) {
+      continue;
+    }
+    if (more.HasRing() || cloud->HasRing() ||
+        static_cast<std::int64_t>(cloud->size() + more.size()) > limits.max_cloud_points)
+      continue;
+    const bool intensity = cloud->HasIntensity() && more.HasIntensity();
+    if (!intensity) cloud->intensity.clear();
+    cloud->points.insert(cloud->points.end(), more.points.begin(), more.points.end());
+    if (intensity)
+      cloud->intensity.insert(cloud->intensity.end(), more.intensity.begin(), more.intensity.end());
+    cloud->range.clear();
+  }
+  cloud->width = static_cast<int>(cloud->size());
+  cloud->height = 1;
+}
+
+}  // namespace
+
 bool PairSelectionOptions::Check(std::string* why) const {
   if (!(max_pair_offset_s > 0.0) || !(still_window_s >= 0.0)) {
     *why = "max_pair_offset_s must be > 0 and still_window_s >= 0";
@@ -54,6 +84,10 @@ bool PairSelectionOptions::Check(std::string* why) const {
   if (!(still_translation_m >= 0.0) || !(still_rotation_deg >= 0.0) ||
       !(duplicate_translation_m >= 0.0) || !(duplicate_rotation_deg >= 0.0)) {
     *why = "stillness and duplicate thresholds must be >= 0";
+    return false;
+  }
+  if (!(ringless_integration_s >= 0.0 && ringless_integration_s <= 5.0)) {
+    *why = "ringless_integration_s must be in [0, 5] s";
     return false;
   }
   if (!(retry_s > 0.0) || !(lidar_blind_s > 0.0)) {
@@ -148,7 +182,10 @@ TryOutcome JudgeTry(const recording_detail::Try& attempt, std::optional<ImageU8>
   }
   FoundPair pair;
   try {
-    pair.cloud = DecodePointCloud2(*attempt.cloud.bytes, topics.cloud, options.limits).cloud;
+    pair.cloud =
+        DecodeCloudMessage(*attempt.cloud.bytes, topics.livox_cloud, topics.cloud, options.limits)
+            .cloud;
+    IntegrateSweeps(attempt.integrated, topics, options.limits, &pair.cloud);
   } catch (const std::invalid_argument&) {
     outcome.dropped = "cloud message unreadable";
     return outcome;

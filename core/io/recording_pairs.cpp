@@ -55,7 +55,8 @@ struct RecordingPairFinder::Impl {
         options(std::move(options_in)) {
     std::string why;
     if (!options.Check(&why)) throw IoError(source + ": pair selection options: " + why);
-    keep_ns = Ns(options.still_window_s + options.max_pair_offset_s + kKeepBeyondWindowS);
+    keep_ns = Ns(std::max(options.still_window_s, options.ringless_integration_s) +
+                 options.max_pair_offset_s + kKeepBeyondWindowS);
     worker = std::thread([this] { Work(); });
   }
 
@@ -98,12 +99,17 @@ struct RecordingPairFinder::Impl {
       std::lock_guard lock(mutex);
       ++stats.clouds;
     }
-    PointCloud2Message message;
+    CloudMessage message;
     try {
-      message = DecodePointCloud2(data, topics.cloud, options.limits);
+      message = DecodeCloudMessage(data, topics.livox_cloud, topics.cloud, options.limits);
     } catch (const std::invalid_argument&) {
       Drop("cloud message unreadable");
       return;
+    }
+    if (!message.cloud.HasRing() && !ringless && options.ringless_integration_s > 0) {
+      // Decided on the first sweep that lacks rings (a recording's LiDAR does not change).
+      ringless = true;
+      window_s = std::max(options.still_window_s, options.ringless_integration_s);
     }
     const std::int64_t stamp = StampOr(message.header, log_time_ns);
     SweepGrid grid = MakeSweepGrid(message.cloud, options.lidar_motion);
@@ -156,7 +162,7 @@ struct RecordingPairFinder::Impl {
   void Advance(std::int64_t stamp) {
     horizon_ns = std::max(horizon_ns, stamp);
     const std::int64_t ready =
-        horizon_ns - Ns(options.still_window_s / 2 + options.max_pair_offset_s + kJudgeLagS);
+        horizon_ns - Ns(window_s / 2 + options.max_pair_offset_s + kJudgeLagS);
     for (RecentCloud& cloud : recent_clouds)
       if (!cloud.judged && cloud.cloud.stamp_ns <= ready) Judge(&cloud);
     const std::int64_t oldest = horizon_ns - keep_ns;
@@ -249,10 +255,16 @@ struct RecordingPairFinder::Impl {
     attempt.hold = hold;
     attempt.cloud = cloud.cloud;
     attempt.image = *nearest;
-    const std::int64_t half = Ns(options.still_window_s / 2);
+    const std::int64_t half = Ns(window_s / 2);
     for (const StampedBytes& image : recent_images)
       if (&image != nearest && std::abs(image.stamp_ns - stamp) <= half)
         attempt.others.push_back(image);
+    // A ring-less LiDAR's sweeps of the span, for the pair's cloud: the camera checks that the
+    // board held still over the same span.
+    if (ringless)
+      for (const RecentCloud& other : recent_clouds)
+        if (&other != &cloud && std::abs(other.cloud.stamp_ns - stamp) <= half)
+          attempt.integrated.push_back(other.cloud);
     if (!camera) {
       if (waiting_for_camera.size() == kMaxWaitingForCamera) {
         waiting_for_camera.pop_front();
@@ -412,6 +424,8 @@ struct RecordingPairFinder::Impl {
   std::string camera_problem;
   const PairSelectionOptions options;
   std::int64_t keep_ns = 0;
+  bool ringless = false;  // the sweeps carry no rings: holds are integrated
+  double window_s = options.still_window_s;  // the stillness (and integration) window [s]
 
   // Reader.
   std::deque<RecentCloud> recent_clouds;

@@ -45,6 +45,10 @@ struct PairSelectionOptions {
   // A LiDAR that never sees the scene still (a non-repeating scan, a busy street) must not hide
   // the board: after this long without a still sweep, a sweep is tried every `retry_s` anyway.
   double lidar_blind_s = 3.0;
+  // A LiDAR whose sweeps carry no rings (Livox-class: a 0.1 s frame leaves a far board a few
+  // strokes of its rosette): the sweeps within this span centred on the tried one are integrated
+  // into the pair's cloud, and the camera's stillness check spans it too [s]. 0: one sweep.
+  double ringless_integration_s = 1.0;
   // Without a board given: the presets are tried on the tries' images until this many show one.
   int board_sample_images = 3;
   // A board that no preset is (one found only inside a larger print) ends the reading at once
@@ -62,6 +66,7 @@ struct PairTopics {
   MessageEncoding image = MessageEncoding::kRos1;
   MessageEncoding camera_info = MessageEncoding::kRos1;
   bool compressed_image = false;               // sensor_msgs/CompressedImage rather than Image
+  bool livox_cloud = false;                    // livox_ros_driver(2)/CustomMsg, not PointCloud2
   std::string image_topic, camera_info_topic;  // for messages
 };
 

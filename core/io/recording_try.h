@@ -30,6 +30,9 @@ struct Try {
   StampedBytes cloud;
   StampedBytes image;                // the nearest in time
   std::vector<StampedBytes> others;  // the other images within the stillness window
+  // A ring-less LiDAR's other sweeps within the integration span (PairSelectionOptions::
+  // ringless_integration_s), integrated with `cloud` into the pair's cloud.
+  std::vector<StampedBytes> integrated;
   CameraModel camera;
 };
 

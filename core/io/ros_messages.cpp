@@ -432,4 +432,65 @@ CameraInfoMessage DecodeCameraInfo(std::span<const std::uint8_t> data, MessageEn
   return message;
 }
 
+LivoxCustomMessage DecodeLivoxCustomMsg(std::span<const std::uint8_t> data,
+                                        MessageEncoding encoding, const LoadLimits& limits) {
+  const char* type = "Livox CustomMsg";
+  MessageCursor cursor(data, encoding, type);
+  LivoxCustomMessage message;
+  message.header = ReadHeader(cursor, encoding);
+  message.timebase_ns = cursor.Read<std::uint64_t>();
+  const std::uint32_t point_num = cursor.Read<std::uint32_t>();
+  message.lidar_id = cursor.Read<std::uint8_t>();
+  for (int k = 0; k < 3; ++k) cursor.Read<std::uint8_t>();  // rsvd
+  const std::uint32_t count = cursor.Read<std::uint32_t>();
+  if (count != point_num)
+    Bad(std::string(type) + ": point_num " + std::to_string(point_num) + " but " +
+        std::to_string(count) + " points");
+  if (count > limits.max_cloud_points)
+    Bad(std::string(type) + ": " + std::to_string(count) + " points, more than the " +
+        std::to_string(limits.max_cloud_points) + " a cloud may hold");
+  // A point is 19 bytes in ROS 1, 20 in CDR (its uint32 aligned): checked before reserving.
+  if (static_cast<std::uint64_t>(count) * 19 > data.size())
+    Bad(std::string(type) + ": " + std::to_string(count) + " points cannot fit in " +
+        std::to_string(data.size()) + " bytes");
+  message.declared_points = static_cast<int>(count);
+  LidarCloud& cloud = message.cloud;
+  cloud.points.reserve(count);
+  cloud.intensity.reserve(count);
+  message.offset_time_ns.reserve(count);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const std::uint32_t offset_time = cursor.Read<std::uint32_t>();
+    const float x = cursor.Read<float>(), y = cursor.Read<float>(), z = cursor.Read<float>();
+    const std::uint8_t reflectivity = cursor.Read<std::uint8_t>();
+    const std::uint8_t tag = cursor.Read<std::uint8_t>();
+    cursor.Read<std::uint8_t>();  // line
+    const Eigen::Vector3f point(x, y, z);
+    if (!point.allFinite() || point.squaredNorm() < 1e-12f) continue;  // no return
+    if ((tag & 0x03) == 0x01) {
+      ++message.noise_dropped;
+      continue;
+    }
+    cloud.points.push_back(point);
+    cloud.intensity.push_back(reflectivity);
+    message.offset_time_ns.push_back(offset_time);
+  }
+  cloud.width = static_cast<int>(cloud.size());
+  cloud.height = 1;
+  return message;
+}
+
+bool IsCloudType(const std::string& type) {
+  return type == kPointCloud2Type || type == kLivoxCustomMsgType || type == kLivox2CustomMsgType;
+}
+
+CloudMessage DecodeCloudMessage(std::span<const std::uint8_t> data, bool livox,
+                                MessageEncoding encoding, const LoadLimits& limits) {
+  if (livox) {
+    LivoxCustomMessage message = DecodeLivoxCustomMsg(data, encoding, limits);
+    return {std::move(message.header), std::move(message.cloud)};
+  }
+  PointCloud2Message message = DecodePointCloud2(data, encoding, limits);
+  return {std::move(message.header), std::move(message.cloud)};
+}
+
 }  // namespace calibench

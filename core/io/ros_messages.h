@@ -64,10 +64,44 @@ struct CameraInfoMessage {
 // std::invalid_argument for an unknown model, a wrong coefficient count or invalid intrinsics.
 CameraInfoMessage DecodeCameraInfo(std::span<const std::uint8_t> data, MessageEncoding encoding);
 
+// livox_ros_driver/CustomMsg and livox_ros_driver2/CustomMsg, the same layout in both drivers:
+//   std_msgs/Header header; uint64 timebase; uint32 point_num; uint8 lidar_id; uint8[3] rsvd;
+//   CustomPoint[] points  (uint32 offset_time; float32 x, y, z; uint8 reflectivity, tag, line)
+// A Livox scanner's returns of one frame in firing order, each with its time after `timebase`.
+struct LivoxCustomMessage {
+  RosHeader header;
+  std::uint64_t timebase_ns = 0;  // the frame's first point
+  int lidar_id = 0;
+  int declared_points = 0;  // point_num
+  // Finite, non-zero returns whose tag does not mark them high-confidence noise (tag bits 0-1 =
+  // 01); intensity = reflectivity. No ring: a Livox "line" is a laser of the prism head, whose
+  // returns follow the rosette, not a cone.
+  LidarCloud cloud;
+  std::vector<std::uint32_t> offset_time_ns;  // per kept return
+  int noise_dropped = 0;                      // returns tagged as noise
+};
+// Throws std::invalid_argument naming what is wrong (a truncated message, point_num that
+// disagrees with the points, more points than limits.max_cloud_points).
+LivoxCustomMessage DecodeLivoxCustomMsg(std::span<const std::uint8_t> data,
+                                        MessageEncoding encoding, const LoadLimits& limits = {});
+
 // The sensor_msgs types above, by normalized name ("sensor_msgs/Image").
 inline constexpr const char* kPointCloud2Type = "sensor_msgs/PointCloud2";
 inline constexpr const char* kImageType = "sensor_msgs/Image";
 inline constexpr const char* kCompressedImageType = "sensor_msgs/CompressedImage";
 inline constexpr const char* kCameraInfoType = "sensor_msgs/CameraInfo";
+inline constexpr const char* kLivoxCustomMsgType = "livox_ros_driver/CustomMsg";
+inline constexpr const char* kLivox2CustomMsgType = "livox_ros_driver2/CustomMsg";
+
+// The message types a LiDAR's clouds come in: PointCloud2 and the two Livox CustomMsgs.
+bool IsCloudType(const std::string& type);
+
+// One LiDAR frame of either type, as a cloud. Throws std::invalid_argument as the decoders do.
+struct CloudMessage {
+  RosHeader header;
+  LidarCloud cloud;
+};
+CloudMessage DecodeCloudMessage(std::span<const std::uint8_t> data, bool livox,
+                                MessageEncoding encoding, const LoadLimits& limits = {});
 
 }  // namespace calibench

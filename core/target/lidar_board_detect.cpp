@@ -16,6 +16,7 @@ using board_grid::AngularGrid;
 
 struct LocalPlane {
   Vec3 normal = Vec3::Zero();
+  double rms_m = -1.0;  // about its own plane; < 0 where the neighbourhood is too thin to say
   bool planar = false;
 };
 
@@ -81,9 +82,36 @@ std::vector<LocalPlane> LocalPlanes(const AngularGrid& grid, const std::vector<V
       Eigen::SelfAdjointEigenSolver<Mat3> eigen;
       eigen.computeDirect(scatter);
       planes[cell].normal = eigen.eigenvectors().col(0);
-      planes[cell].planar = std::sqrt(std::max(0.0, eigen.eigenvalues()(0))) < options.planar_rms_m;
+      planes[cell].rms_m = std::sqrt(std::max(0.0, eigen.eigenvalues()(0)));
+      planes[cell].planar = planes[cell].rms_m < options.planar_rms_m;
     }
   }
+  return planes;
+}
+
+// The cloud's range noise as its flat neighbourhoods show it: the median of their RMS about
+// their own planes (metres; 0 when none says). It reads about half the sensor's σ: a cell keeps
+// its nearest return (the spread of a minimum is narrower) and a small neighbourhood's plane
+// absorbs part of its noise.
+double MedianLocalRms(const std::vector<LocalPlane>& planes) {
+  std::vector<double> rms;
+  for (const LocalPlane& plane : planes)
+    if (plane.rms_m >= 0) rms.push_back(plane.rms_m);
+  if (rms.empty()) return 0.0;
+  std::nth_element(rms.begin(), rms.begin() + rms.size() / 2, rms.end());
+  return rms[rms.size() / 2];
+}
+
+// The thresholds assume a spinning LiDAR's few millimetres of range noise (its local RMS reads
+// ~3 mm); a noisier sensor (a Livox-class scanner's 2 cm reads ~1 cm) would split its board
+// into strips that each look too small. Planarity widens to 3 and growing to 5 times the local
+// RMS where that exceeds the options'. Returns the planes re-judged.
+std::vector<LocalPlane> ScaleToNoise(std::vector<LocalPlane> planes, double local_rms_m,
+                                     LidarBoardDetectionOptions* options) {
+  options->planar_rms_m = std::max(options->planar_rms_m, 3.0 * local_rms_m);
+  options->plane_tolerance_m = std::max(options->plane_tolerance_m, 5.0 * local_rms_m);
+  for (LocalPlane& plane : planes)
+    plane.planar = plane.rms_m >= 0 && plane.rms_m < options->planar_rms_m;
   return planes;
 }
 
@@ -418,15 +446,18 @@ std::string LidarBoardCandidate::Describe(const BoardSpec& board) const {
 }
 
 LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& board,
-                                     const LidarBoardDetectionOptions& options,
+                                     const LidarBoardDetectionOptions& given_options,
                                      const SceneBackground* background) {
   std::string why;
-  CALIBENCH_CHECK(options.Check(&why));
+  CALIBENCH_CHECK(given_options.Check(&why));
   LidarBoardDetection result;
+  LidarBoardDetectionOptions options = given_options;
   const AngularGrid grid = board_grid::BuildAngularGrid(cloud, options.angular_cell_deg);
   const SheetBounds sheet = BoundsFor(board, options);
   const std::vector<Vec3> cell_points = CellPoints(cloud, grid);
-  const std::vector<LocalPlane> planes = LocalPlanes(grid, cell_points, options);
+  std::vector<LocalPlane> local = LocalPlanes(grid, cell_points, options);
+  result.local_rms_m = MedianLocalRms(local);
+  const std::vector<LocalPlane> planes = ScaleToNoise(std::move(local), result.local_rms_m, &options);
   std::vector<char> in_segment(grid.point.size(), 0);
   for (const std::vector<int>& cells : GrowSegments(grid, cell_points, planes, options)) {
     if (static_cast<int>(cells.size()) < options.min_points) continue;

@@ -79,6 +79,10 @@ struct LidarBoardDetection {
   std::vector<LidarBoardCandidate> candidates;   // that passed every test, best first
   std::vector<LidarBoardCandidate> near_misses;  // the best few that failed a test, best first
   std::string reason;  // why `board` is absent, naming the best near-miss or both rivals
+  // The cloud's flat neighbourhoods' median RMS about their planes (metres, about half the range
+  // noise): the planarity and growing thresholds widen to 3 and 5 times it where it exceeds
+  // what the options assume.
+  double local_rms_m = 0.0;
 };
 
 // Finds the board in one cloud (BoardSpec::SheetWidth/Height, or the pattern's extent plus a

@@ -58,7 +58,8 @@ void CheckFramePairer::AddImage(std::span<const std::uint8_t> data, std::int64_t
 void CheckFramePairer::MakeFrame(const Held& image_message) {
   const std::string id = "t" + std::to_string(pending_cloud_->time_ns);
   try {
-    const LidarCloud cloud = DecodePointCloud2(pending_cloud_->data, topics_.cloud).cloud;
+    const LidarCloud cloud =
+        DecodeCloudMessage(pending_cloud_->data, topics_.livox_cloud, topics_.cloud).cloud;
     const ImageU8 image = topics_.compressed_image
                               ? DecodeCompressedImage(image_message.data, topics_.image).image
                               : DecodeImage(image_message.data, topics_.image).image;

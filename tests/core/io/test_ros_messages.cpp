@@ -95,6 +95,62 @@ TEST(RosMessages, MalformedCloudsAreRefusedWithTheReason) {
   }
 }
 
+// Issue 46 item 3: livox_ros_driver(2)/CustomMsg in both serializations. The sizes follow from
+// the definition alone: ROS 1 packs a point in 19 bytes, CDR aligns each to 20.
+TEST(RosMessages, LivoxCustomMsgInBothSerializations) {
+  LidarCloud cloud = MessageTestCloud(5, 1);
+  cloud.ring.clear();
+  cloud.points.emplace_back(0.f, 0.f, 0.f);  // no return
+  cloud.intensity.push_back(0.f);
+  cloud.points.emplace_back(2.f, 0.5f, 0.25f);  // tagged high-confidence noise
+  cloud.intensity.push_back(40.f);
+  cloud.width = static_cast<int>(cloud.size());
+  const std::vector<std::uint32_t> offsets = {0, 10, 20, 30, 40, 50, 60};
+  const std::vector<std::uint8_t> tags = {0, 0x10, 0x02, 0, 0, 0, 0x01};
+  for (MessageEncoding encoding : {MessageEncoding::kRos1, MessageEncoding::kCdr}) {
+    SCOPED_TRACE(encoding == MessageEncoding::kRos1 ? "ROS 1" : "CDR");
+    const auto data =
+        test::SerializeLivoxCustomMsg(cloud, 1'700'000'000'250'000'000, "livox_frame", encoding,
+                                      offsets, tags);
+    const bool cdr = encoding == MessageEncoding::kCdr;
+    // Header (ROS 1: seq + stamp + "livox_frame"; CDR: encapsulation + stamp + terminated
+    // string, which ends 8-aligned for timebase), timebase 8, point_num 4, lidar_id + rsvd 4,
+    // the sequence's length 4.
+    const std::size_t header = cdr ? 4 + 8 + 4 + 12 : 4 + 8 + 4 + 11;
+    EXPECT_EQ(data.size(), header + 8 + 4 + 4 + 4 + (cdr ? 20 * 6 + 19 : 19 * 7));
+    const LivoxCustomMessage message = DecodeLivoxCustomMsg(data, encoding);
+    EXPECT_EQ(message.header.stamp_ns, 1'700'000'000'250'000'000);
+    EXPECT_EQ(message.header.frame_id, "livox_frame");
+    EXPECT_EQ(message.timebase_ns, 1'700'000'000'250'000'000u);
+    EXPECT_EQ(message.lidar_id, 3);
+    EXPECT_EQ(message.declared_points, 7);
+    EXPECT_EQ(message.noise_dropped, 1);
+    ASSERT_EQ(message.cloud.size(), 5u);  // the zero return and the noise dropped
+    EXPECT_FALSE(message.cloud.HasRing());
+    for (int i = 0; i < 5; ++i) {
+      EXPECT_EQ(message.cloud.points[i], cloud.points[i]);
+      EXPECT_EQ(message.cloud.intensity[i], cloud.intensity[i]);
+      EXPECT_EQ(message.offset_time_ns[i], offsets[i]);
+    }
+    EXPECT_EQ(DecodeCloudMessage(data, true, encoding).cloud.size(), 5u);
+    // Refusals: cut short, and more points than the limit allows.
+    const std::vector<std::uint8_t> cut(data.begin(), data.end() - 10);
+    EXPECT_THROW(DecodeLivoxCustomMsg(cut, encoding), std::invalid_argument);
+    LoadLimits small;
+    small.max_cloud_points = 4;
+    try {
+      DecodeLivoxCustomMsg(data, encoding, small);
+      ADD_FAILURE() << "no refusal";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("7 points, more than the 4"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_TRUE(IsCloudType("livox_ros_driver2/CustomMsg"));
+  EXPECT_TRUE(IsCloudType("livox_ros_driver/CustomMsg"));
+  EXPECT_FALSE(IsCloudType("livox_ros_driver2/CustomPoint"));
+}
+
 TEST(RosMessages, ImageEncodingsGiveTheSamePixels) {
   const ImageU8 bgr = GradientImage(16, 10, 3);
   const ImageMessage direct = DecodeImage(
