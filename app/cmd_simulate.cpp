@@ -14,7 +14,8 @@ void AddSimFlags(CLI::App& app, SimFlags& flags) {
   app.add_option(
       "--lidar", flags.lidar,
       "hdl64 | vlp16 | os0-128 | swept-2d (a 2D scanner on a rotary stage, its mirror off "
-      "the axis; no rings) | nodding-2d (a line scanner tilted through ±20°: a 28° window) | mid40 | avia | mid360 (Livox-class non-repetitive scanners; no "
+      "the axis; no rings) | nodding-2d (a line scanner tilted through ±20°: a 28° window) | mid40 "
+      "| avia | mid360 (Livox-class non-repetitive scanners; no "
       "rings) (default: the preset's)");
   app.add_option("--lidar-frame", flags.lidar_frame,
                  "seconds of returns in each cloud of a Livox-class LiDAR: one frame (0.1) or a "

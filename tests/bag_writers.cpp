@@ -75,18 +75,18 @@ std::vector<std::uint8_t> SerializeLivoxCustomMsg(const LidarCloud& cloud, std::
                                                   const std::vector<std::uint8_t>& tags) {
   MessageWriter out(encoding, false);
   out.Header(stamp_ns, frame);
-  out.Put<std::uint64_t>(static_cast<std::uint64_t>(stamp_ns));  // timebase
+  out.Put<std::uint64_t>(static_cast<std::uint64_t>(stamp_ns));      // timebase
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(cloud.size()));  // point_num
   out.Put<std::uint8_t>(3);                                          // lidar_id
-  for (int k = 0; k < 3; ++k) out.Put<std::uint8_t>(0);             // rsvd
+  for (int k = 0; k < 3; ++k) out.Put<std::uint8_t>(0);              // rsvd
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(cloud.size()));  // the sequence's length
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     out.Put<std::uint32_t>(offsets_ns.empty() ? static_cast<std::uint32_t>(i * 10'000)
                                               : offsets_ns[i]);
     for (int axis = 0; axis < 3; ++axis) out.Put<float>(cloud.points[i][axis]);
-    out.Put<std::uint8_t>(cloud.HasIntensity()
-                              ? static_cast<std::uint8_t>(std::clamp(cloud.intensity[i], 0.f, 255.f))
-                              : 0);
+    out.Put<std::uint8_t>(
+        cloud.HasIntensity() ? static_cast<std::uint8_t>(std::clamp(cloud.intensity[i], 0.f, 255.f))
+                             : 0);
     out.Put<std::uint8_t>(tags.empty() ? 0 : tags[i]);  // tag
     out.Put<std::uint8_t>(0);                           // line
   }

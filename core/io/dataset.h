@@ -26,7 +26,7 @@ struct PairEntry {
 // re-created (SimOptionsFromDataset in sim.h) for the Cramér–Rao bound. Camera, board and ground
 // truth are the dataset's own.
 struct SimulationRecord {
-  std::string lidar_model;  // "hdl64", "vlp16", "os0-128", "swept-2d", "mid40", "avia", "mid360"
+  std::string lidar_model;     // "hdl64", "vlp16", "os0-128", "swept-2d", "mid40", "avia", "mid360"
   double lidar_frame_s = 0.0;  // Livox-class: seconds of returns per cloud (0 = not recorded)
   int num_pairs = 0;
   double min_distance_m = 0.0;

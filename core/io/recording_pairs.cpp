@@ -424,7 +424,7 @@ struct RecordingPairFinder::Impl {
   std::string camera_problem;
   const PairSelectionOptions options;
   std::int64_t keep_ns = 0;
-  bool ringless = false;  // the sweeps carry no rings: holds are integrated
+  bool ringless = false;                     // the sweeps carry no rings: holds are integrated
   double window_s = options.still_window_s;  // the stillness (and integration) window [s]
 
   // Reader.

@@ -17,14 +17,11 @@ std::vector<double> LinspaceDeg(double first_deg, double last_deg, int n) {
   return out;
 }
 
-constexpr EnumName<LidarModel> kLidarModelNames[] = {{LidarModel::kHdl64, "hdl64"},
-                                                     {LidarModel::kVlp16, "vlp16"},
-                                                     {LidarModel::kOs0_128, "os0-128"},
-                                                     {LidarModel::kSwept2d, "swept-2d"},
-                                                     {LidarModel::kMid40, "mid40"},
-                                                     {LidarModel::kAvia, "avia"},
-                                                     {LidarModel::kMid360, "mid360"},
-                                                     {LidarModel::kNodding2d, "nodding-2d"}};
+constexpr EnumName<LidarModel> kLidarModelNames[] = {
+    {LidarModel::kHdl64, "hdl64"},     {LidarModel::kVlp16, "vlp16"},
+    {LidarModel::kOs0_128, "os0-128"}, {LidarModel::kSwept2d, "swept-2d"},
+    {LidarModel::kMid40, "mid40"},     {LidarModel::kAvia, "avia"},
+    {LidarModel::kMid360, "mid360"},   {LidarModel::kNodding2d, "nodding-2d"}};
 
 }  // namespace
 

@@ -21,9 +21,9 @@ BeamRays::BeamRays(const BeamTable& beams, double azimuth_offset_rad)
   if (beams.nodding) {
     nodding_ = true;
     fan_rad_ = beams.elevations_rad;
-    tilt_step_rad_ = beams.azimuth_steps > 1 ? (beams.tilt_last_rad - beams.tilt_first_rad) /
-                                                   (beams.azimuth_steps - 1)
-                                             : 0.0;
+    tilt_step_rad_ = beams.azimuth_steps > 1
+                         ? (beams.tilt_last_rad - beams.tilt_first_rad) / (beams.azimuth_steps - 1)
+                         : 0.0;
     tilt_first_rad_ = beams.tilt_first_rad + azimuth_offset_rad;
   }
   for (const double elevation : beams.elevations_rad) {

@@ -11,11 +11,11 @@
 namespace calibench {
 namespace {
 
-constexpr EnumName<LidarGeometry> kLidarGeometryNames[] = {{LidarGeometry::kSpinning, "spinning"},
-                                                           {LidarGeometry::kSwept, "swept"},
-                                                           {LidarGeometry::kNonRepetitive,
-                                                            "non-repetitive"},
-                                                           {LidarGeometry::kSegment, "segment"}};
+constexpr EnumName<LidarGeometry> kLidarGeometryNames[] = {
+    {LidarGeometry::kSpinning, "spinning"},
+    {LidarGeometry::kSwept, "swept"},
+    {LidarGeometry::kNonRepetitive, "non-repetitive"},
+    {LidarGeometry::kSegment, "segment"}};
 
 // Elevation clusters of the returns: each one's width and the spacing of their centres, and how
 // far from the origin their rays start: a beam whose rays start a distance s off the origin

@@ -162,10 +162,8 @@ Vec3 BoardHitCentroid(const BeamTable& beams, const BoardPrint& print, const Pos
 
 bool EnoughLidarHits(const BeamTable& beams, const BoardPrint& print, const Pose& lidar_from_board,
                      double azimuth_offset_rad) {
-  const BoardReturnsRule& rule =
-      beams.risley ? kSimulatedRinglessReturns : kSimulatedBoardReturns;
-  return rule.Met(
-      ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad));
+  const BoardReturnsRule& rule = beams.risley ? kSimulatedRinglessReturns : kSimulatedBoardReturns;
+  return rule.Met(ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad));
 }
 
 PairPlan PlanPair(const SimOptions& r, const BeamTable& beams, const BoardPrint& print,
@@ -194,7 +192,9 @@ PairPlan PlanPair(const SimOptions& r, const BeamTable& beams, const BoardPrint&
       std::to_string(kMaxTriesPerPair) +
       " tries: the whole sheet must be in the image with a 5% margin, in front of the LiDAR and "
       "inside its vertical field of view, " +
-      "above the floor and hit by >= 4 rings (a Livox-class scanner: any) and >= 60 points of the " + LidarModelName(r.lidar) +
+      "above the floor and hit by >= 4 rings (a Livox-class scanner: any) and >= 60 points of "
+      "the " +
+      LidarModelName(r.lidar) +
       "; try a larger board, a smaller max_distance_m or max_tilt_deg, or a LiDAR with more rings");
 }
 

@@ -457,7 +457,8 @@ LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& b
   const std::vector<Vec3> cell_points = CellPoints(cloud, grid);
   std::vector<LocalPlane> local = LocalPlanes(grid, cell_points, options);
   result.local_rms_m = MedianLocalRms(local);
-  const std::vector<LocalPlane> planes = ScaleToNoise(std::move(local), result.local_rms_m, &options);
+  const std::vector<LocalPlane> planes =
+      ScaleToNoise(std::move(local), result.local_rms_m, &options);
   std::vector<char> in_segment(grid.point.size(), 0);
   for (const std::vector<int>& cells : GrowSegments(grid, cell_points, planes, options)) {
     if (static_cast<int>(cells.size()) < options.min_points) continue;

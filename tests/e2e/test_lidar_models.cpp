@@ -157,10 +157,11 @@ TEST(LidarModels, ANarrowScanIsAScanNotASegment) {
     const Pose truth = *dataset.cam_from_lidar_ground_truth;
     const Errors d = ErrorsOf(*judged.solution, truth);
     const Errors f = ErrorsOf(*spinning.solution, truth);
-    std::printf("nodding seed %d: default %.2f mm %.3f deg (NEES %.1f) | forced spinning %.2f mm "
-                "%.3f deg\n",
-                int(seed), d.translation_m * 1e3, d.rotation_rad * kRadToDeg, d.nees,
-                f.translation_m * 1e3, f.rotation_rad * kRadToDeg);
+    std::printf(
+        "nodding seed %d: default %.2f mm %.3f deg (NEES %.1f) | forced spinning %.2f mm "
+        "%.3f deg\n",
+        int(seed), d.translation_m * 1e3, d.rotation_rad * kRadToDeg, d.nees, f.translation_m * 1e3,
+        f.rotation_rad * kRadToDeg);
     default_t.push_back(d.translation_m);
     forced_t.push_back(f.translation_m);
     default_r.push_back(d.rotation_rad);

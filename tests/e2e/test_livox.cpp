@@ -20,8 +20,8 @@ namespace fs = std::filesystem;
 struct LivoxCase {
   LidarModel lidar;
   double frame_s;
-  int min_accepted;         // of 20
-  double max_bound_ratio;   // error / CRLB, translation and rotation
+  int min_accepted;        // of 20
+  double max_bound_ratio;  // error / CRLB, translation and rotation
 };
 
 SimOptions LivoxSet(const LivoxCase& c) {
@@ -46,11 +46,11 @@ void CheckLivoxSet(const LivoxCase& c, const fs::path& dir) {
   double corner_sigma_px = 0;
   for (const PairFeatures& p : outcome.pairs) {
     accepted += p.status == PairStatus::kAccepted;
-    if (p.status != PairStatus::kAccepted) std::printf("  %s: %s\n", p.id.c_str(), p.reason.c_str());
+    if (p.status != PairStatus::kAccepted)
+      std::printf("  %s: %s\n", p.id.c_str(), p.reason.c_str());
     if (p.camera) corner_sigma_px += p.camera->corner_sigma_px / outcome.pairs.size();
   }
-  const CramerRaoBound bound =
-      SimulationBound(MakeSimulationBoundInput(sim, corner_sigma_px));
+  const CramerRaoBound bound = SimulationBound(MakeSimulationBoundInput(sim, corner_sigma_px));
   const Pose truth = *dataset.cam_from_lidar_ground_truth;
   const PoseError error = ComputePoseError(outcome.solution->cam_from_lidar, truth);
   const double sigma_t =

@@ -124,15 +124,17 @@ TEST(RecordingImport, ALivoxCustomMsgRecordingIntegratesEachHold) {
     pipeline.threads = 2;
     const CalibrationOutcome outcome = CalibrateDataset(dataset, pipeline);
     for (const PairFeatures& p : outcome.pairs)
-      if (p.status != PairStatus::kAccepted) std::printf("  %s: %s\n", p.id.c_str(), p.reason.c_str());
+      if (p.status != PairStatus::kAccepted)
+        std::printf("  %s: %s\n", p.id.c_str(), p.reason.c_str());
     ASSERT_TRUE(outcome.solution) << outcome.failure;
     int accepted = 0;
     for (const PairFeatures& p : outcome.pairs) accepted += p.status == PairStatus::kAccepted;
     EXPECT_EQ(accepted, 6);
     EXPECT_NE(DescribeLidarModel(outcome).find("non-repetitive"), std::string::npos);
-    const PoseError error = ComputePoseError(outcome.solution->cam_from_lidar, truth.cam_from_lidar);
-    std::printf("%s: %d pairs, error %.2f mm %.3f deg\n", name, accepted,
-                error.translation_m * 1e3, error.rotation_rad * kRadToDeg);
+    const PoseError error =
+        ComputePoseError(outcome.solution->cam_from_lidar, truth.cam_from_lidar);
+    std::printf("%s: %d pairs, error %.2f mm %.3f deg\n", name, accepted, error.translation_m * 1e3,
+                error.rotation_rad * kRadToDeg);
     EXPECT_LT(error.translation_m, 0.02);
     EXPECT_LT(error.rotation_rad * kRadToDeg, 0.5);
     records.push_back(record["pairs"]);

@@ -109,9 +109,8 @@ TEST(RosMessages, LivoxCustomMsgInBothSerializations) {
   const std::vector<std::uint8_t> tags = {0, 0x10, 0x02, 0, 0, 0, 0x01};
   for (MessageEncoding encoding : {MessageEncoding::kRos1, MessageEncoding::kCdr}) {
     SCOPED_TRACE(encoding == MessageEncoding::kRos1 ? "ROS 1" : "CDR");
-    const auto data =
-        test::SerializeLivoxCustomMsg(cloud, 1'700'000'000'250'000'000, "livox_frame", encoding,
-                                      offsets, tags);
+    const auto data = test::SerializeLivoxCustomMsg(cloud, 1'700'000'000'250'000'000, "livox_frame",
+                                                    encoding, offsets, tags);
     const bool cdr = encoding == MessageEncoding::kCdr;
     // Header (ROS 1: seq + stamp + "livox_frame"; CDR: encapsulation + stamp + terminated
     // string, which ends 8-aligned for timebase), timebase 8, point_num 4, lidar_id + rsvd 4,

@@ -57,7 +57,7 @@ TEST(LivoxSim, BoardReturnsGrowWithTheHoldAndCrossTheBorder) {
   LidarRectangle sheet;
   sheet.lidar_from_rectangle.translation() = Vec3(2.5, 0.1, 0.0);
   sheet.lidar_from_rectangle.linear() << 0, 0, -1, 1, 0, 0, 0, 1, 0;  // facing the sensor
-  sheet.half_size_m = Vec2(0.21, 0.1485);                            // A3
+  sheet.half_size_m = Vec2(0.21, 0.1485);                             // A3
   BeamTable frame = MakeBeamTable(LidarModel::kMid40);
   ASSERT_TRUE(frame.risley.has_value());
   EXPECT_FALSE(frame.HasRings());
@@ -68,17 +68,18 @@ TEST(LivoxSim, BoardReturnsGrowWithTheHoldAndCrossTheBorder) {
   // The sheet covers (0.42 × 0.297) / 2.5² sr ≈ 0.0200 sr ≈ 65.5 deg² of the 1158 deg² circle:
   // about 5.7 % of the field, 560 of 10 k rays if the rosette were uniform (it is denser at
   // the centre and the rim).
-  std::printf("Mid-40 board at 2.5 m: %zu returns in 0.1 s, %zu in 1 s, %zu and %zu border "
-              "crossings\n",
-              one.points.size(), many.points.size(), one.edges.size(), many.edges.size());
+  std::printf(
+      "Mid-40 board at 2.5 m: %zu returns in 0.1 s, %zu in 1 s, %zu and %zu border "
+      "crossings\n",
+      one.points.size(), many.points.size(), one.edges.size(), many.edges.size());
   EXPECT_GT(one.points.size(), 200u);
   EXPECT_NEAR(double(many.points.size()) / one.points.size(), 10.0, 3.0);
   EXPECT_GT(one.edges.size(), 10u);
   for (const LidarEdgePoint& edge : one.edges) {
     // On the border: |x| = half width or |y| = half height in the sheet's axes, within the gap.
     const Vec3 local = sheet.lidar_from_rectangle.inverse() * edge.point;
-    const double to_border = std::min(std::abs(std::abs(local.x()) - 0.21),
-                                      std::abs(std::abs(local.y()) - 0.1485));
+    const double to_border =
+        std::min(std::abs(std::abs(local.x()) - 0.21), std::abs(std::abs(local.y()) - 0.1485));
     EXPECT_LT(to_border, 2.0 * std::sqrt(12.0) * edge.sigma_along_m + 1e-6);
   }
 }
