@@ -7,6 +7,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <unordered_set>
 
 namespace calibench {
 namespace {
@@ -192,6 +193,38 @@ std::vector<int> RingsFromElevation(const LidarCloud& cloud, double gap) {
   return rings;
 }
 
+// Occupied cells of `cell_rad` (azimuth x elevation).
+std::size_t OccupiedCells(const LidarCloud& cloud, double cell_rad) {
+  std::unordered_set<std::int64_t> occupied;
+  for (const Eigen::Vector3f& p : cloud.points) {
+    if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
+    const auto az = static_cast<std::int64_t>(std::floor(std::atan2(p.y(), p.x()) / cell_rad));
+    const auto el = static_cast<std::int64_t>(std::floor(Elevation(p) / cell_rad));
+    occupied.insert(el * 100000 + az);
+  }
+  return occupied.size();
+}
+
+// Whether inferred rings are rings: each cluster a thin cone (median elevation extent within
+// 0.5°), not a band tens of degrees tall (a rosette's returns make one or two such "clusters").
+bool RingLike(const LidarCloud& cloud, const std::vector<int>& rings) {
+  if (rings.empty()) return true;
+  const int count = *std::max_element(rings.begin(), rings.end()) + 1;
+  std::vector<double> low(count, M_PI), high(count, -M_PI);
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    if (!HasDirection(cloud.points[i])) continue;
+    const double e = Elevation(cloud.points[i]);
+    low[rings[i]] = std::min(low[rings[i]], e);
+    high[rings[i]] = std::max(high[rings[i]], e);
+  }
+  std::vector<double> extents;
+  for (int r = 0; r < count; ++r)
+    if (high[r] >= low[r]) extents.push_back(high[r] - low[r]);
+  if (extents.empty()) return true;
+  std::nth_element(extents.begin(), extents.begin() + extents.size() / 2, extents.end());
+  return extents[extents.size() / 2] <= 0.5 * kDegToRad;
+}
+
 // About one column per point of a ring: the median ring size, within sane image widths.
 int AutoColumns(const std::vector<int>& rings, const std::vector<int>& ring_ids) {
   if (ring_ids.empty()) return 360;
@@ -204,6 +237,22 @@ int AutoColumns(const std::vector<int>& rings, const std::vector<int>& ring_ids)
 }
 
 }  // namespace
+
+// About one return per cell, and cells that are mostly filled: neighbourhoods need returns on
+// every side. A uniform scan fills cells of its solid angle (counted on a 1 degree grid) over its
+// returns; a non-repetitive pattern lays its returns along curves (a Livox rosette's petals, a
+// tenth of a second leaving gaps of a degree), so the cell grows until at least
+// kMinCellFill of the covered area's cells hold a return.
+double RasterCellDeg(const LidarCloud& cloud) {
+  constexpr double kMinCellFill = 0.6;
+  const double covered_deg2 = double(OccupiedCells(cloud, kDegToRad));
+  if (covered_deg2 == 0 || cloud.size() == 0) return 1.0;
+  double cell_deg = std::clamp(std::sqrt(covered_deg2 / double(cloud.size())), 0.05, 2.0);
+  while (cell_deg < 1.0 && double(OccupiedCells(cloud, cell_deg * kDegToRad)) <
+                               kMinCellFill * covered_deg2 / (cell_deg * cell_deg))
+    cell_deg = std::min(1.0, cell_deg * 1.2);
+  return cell_deg;
+}
 
 bool LidarImageOptions::Check(std::string* why) const {
   if (columns < 0 || columns > 65536) {
@@ -254,7 +303,20 @@ int AzimuthColumn(const Eigen::Vector3f& point, int columns) {
 }
 
 LidarImage ProjectById(const LidarCloud& cloud, const LidarImageOptions& options) {
-  const std::vector<int> rings = InferRings(cloud, options);
+  std::vector<int> rings = InferRings(cloud, options);
+  // A cloud without rings (a Livox rosette, a nodding scanner): rows are elevation bins of the
+  // raster cell, so the image is an azimuth x elevation raster at the sensor's aspect.
+  double raster_cell_rad = 0.0;
+  if (!cloud.HasRing() && !cloud.IsOrganized() && !RingLike(cloud, rings)) {
+    raster_cell_rad = RasterCellDeg(cloud) * kDegToRad;
+    double lowest = M_PI;
+    for (const Eigen::Vector3f& p : cloud.points)
+      if (HasDirection(p)) lowest = std::min(lowest, Elevation(p));
+    for (size_t i = 0; i < cloud.size(); ++i)
+      rings[i] = HasDirection(cloud.points[i])
+                     ? static_cast<int>((Elevation(cloud.points[i]) - lowest) / raster_cell_rad)
+                     : 0;
+  }
   std::vector<int> ring_ids = rings;
   std::sort(ring_ids.begin(), ring_ids.end());
   ring_ids.erase(std::unique(ring_ids.begin(), ring_ids.end()), ring_ids.end());
@@ -262,7 +324,11 @@ LidarImage ProjectById(const LidarCloud& cloud, const LidarImageOptions& options
 
   LidarImage image;
   image.rows = static_cast<int>(ring_ids.size());
-  image.columns = options.columns > 0 ? options.columns : AutoColumns(rings, ring_ids);
+  image.columns =
+      options.columns > 0 ? options.columns
+      : raster_cell_rad > 0
+          ? std::clamp(static_cast<int>(std::lround(2.0 * M_PI / raster_cell_rad)), 360, 8192)
+          : AutoColumns(rings, ring_ids);
   image.ring_of_row.assign(ring_ids.rbegin(), ring_ids.rend());  // row 0 = highest ring
   std::vector<int> row_of_ring(ring_ids.empty() ? 0 : ring_ids.back() + 1, -1);
   for (int row = 0; row < image.rows; ++row) row_of_ring[image.ring_of_row[row]] = row;

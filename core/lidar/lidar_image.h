@@ -41,7 +41,13 @@ struct LidarImage {
   double VerticalSpanRad() const;
 };
 
-// Builds the image; within a pixel the nearest point wins.
+// The cell side (degrees) of an azimuth x elevation raster of a ring-less cloud: about one return
+// per cell over the solid angle the returns cover (counted on a 1° grid), grown until at least
+// 60 % of the covered cells hold a return (a rosette lays its returns along curves), at most 1°.
+double RasterCellDeg(const LidarCloud& cloud);
+
+// Builds the image; within a pixel the nearest point wins. A cloud without rings (no ring field,
+// not organized, no thin cones of elevation) gets rows of RasterCellDeg's elevation bins.
 LidarImage ProjectById(const LidarCloud& cloud, const LidarImageOptions& options);
 
 // Azimuth column of a point, Eq. (10)–(11): u = fx·atan2(y, x) + cx with fx = -columns/(2 pi)

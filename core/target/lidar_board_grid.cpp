@@ -74,37 +74,9 @@ AngularGrid FromRings(const LidarCloud& cloud) {
   return grid;
 }
 
-// Occupied cells of `cell_rad` (azimuth x elevation).
-std::size_t OccupiedCells(const LidarCloud& cloud, double cell_rad) {
-  std::unordered_set<std::int64_t> occupied;
-  for (const Eigen::Vector3f& p : cloud.points) {
-    if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;
-    const auto az = static_cast<std::int64_t>(std::floor(std::atan2(p.y(), p.x()) / cell_rad));
-    const auto el = static_cast<std::int64_t>(std::floor(Elevation(p) / cell_rad));
-    occupied.insert(el * 100000 + az);
-  }
-  return occupied.size();
-}
-
-// About one return per cell, and cells that are mostly filled: neighbourhoods need returns on
-// every side. A uniform scan fills cells of its solid angle (counted on a 1 degree grid) over its
-// returns; a non-repetitive pattern lays its returns along curves (a Livox rosette's petals, a
-// tenth of a second leaving gaps of a degree), so the cell grows until at least
-// kMinCellFill of the covered area's cells hold a return.
-double AutoCellDeg(const LidarCloud& cloud) {
-  constexpr double kMinCellFill = 0.6;
-  const double covered_deg2 = double(OccupiedCells(cloud, kDegToRad));
-  if (covered_deg2 == 0 || cloud.size() == 0) return 1.0;
-  double cell_deg = std::clamp(std::sqrt(covered_deg2 / double(cloud.size())), 0.05, 2.0);
-  while (cell_deg < 1.0 && double(OccupiedCells(cloud, cell_deg * kDegToRad)) <
-                               kMinCellFill * covered_deg2 / (cell_deg * cell_deg))
-    cell_deg = std::min(1.0, cell_deg * 1.2);
-  return cell_deg;
-}
-
 AngularGrid FromAngles(const LidarCloud& cloud, double cell_deg) {
   AngularGrid grid;
-  const double cell = (cell_deg > 0 ? cell_deg : AutoCellDeg(cloud)) * kDegToRad;
+  const double cell = (cell_deg > 0 ? cell_deg : RasterCellDeg(cloud)) * kDegToRad;
   double top = -M_PI, bottom = M_PI;
   for (const Eigen::Vector3f& p : cloud.points) {
     if (!p.allFinite() || p.squaredNorm() < 1e-12f) continue;

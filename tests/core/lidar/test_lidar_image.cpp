@@ -10,6 +10,7 @@
 #include "core/io/cloud_io.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
+#include "core/lidar/risley_pattern.h"
 #include "tests/test_support.h"
 
 namespace calibench {
@@ -269,6 +270,37 @@ TEST(LidarImage, RealVlp16RingsRecoveredByClustering) {
   const auto shown =
       image.point_index.size() - std::count(image.point_index.begin(), image.point_index.end(), -1);
   EXPECT_GT(shown, cloud.size() * 8 / 10);  // most points get their own pixel
+}
+
+}  // namespace
+}  // namespace calibench
+
+namespace calibench {
+namespace {
+
+// Issue 46 item 3: a cloud without rings (a Livox Mid-40's 0.1 s rosette) is drawn as an
+// azimuth x elevation raster at the sensor's aspect, not as the one or two "rings" elevation
+// clustering makes of it. A tenth of a second of rosette passes over ~60 % of the circle's square
+// degrees; the raster's cells are sized to fill 60 % of those: over a third of the circle's cells.
+TEST(LidarImage, ARinglessRosetteIsARasterOfItsField) {
+  const RisleyRays rays = FireRisleyPattern(MakeRisleyPattern("mid40"), 0.0, 0.1);
+  LidarCloud cloud;
+  for (const Vec3& d : rays.directions) cloud.points.push_back((5.0 * d).cast<float>());
+  cloud.width = static_cast<int>(cloud.size());
+  const LidarImage image = ProjectById(cloud, LidarImageOptions{});
+  const double cell_deg = RasterCellDeg(cloud);
+  EXPECT_GT(cell_deg, 0.3);
+  EXPECT_LE(cell_deg, 1.0);
+  // 38.4° tall in rows of one cell, 360° wide in columns of one cell.
+  EXPECT_NEAR(image.rows * cell_deg, 38.4, 2.0 * cell_deg);
+  EXPECT_NEAR(image.columns * cell_deg, 360.0, cell_deg);
+  EXPECT_NEAR(image.VerticalSpanRad() * kRadToDeg, 38.4, 2.0 * cell_deg);
+  // Each row's returns lie in its elevation bin, top row highest.
+  EXPECT_GT(image.row_elevation_rad.front(), image.row_elevation_rad.back());
+  int filled = 0;
+  for (int index : image.point_index) filled += index >= 0;
+  const double field_cells = M_PI * 19.2 * 19.2 / (cell_deg * cell_deg);
+  EXPECT_GT(filled, 0.34 * field_cells) << filled << " of ~" << field_cells;
 }
 
 }  // namespace
