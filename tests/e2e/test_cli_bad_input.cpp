@@ -196,8 +196,9 @@ TEST_F(CliBadInput, BadFlags) {
   EXPECT_EQ(Calibrate(*dir_ / "good/dataset.json", &out, "--huber-delta -1"), 1);
   EXPECT_NE(out.find("huber_delta"), std::string::npos) << out;
   EXPECT_EQ(Calibrate(*dir_ / "good/dataset.json", &out, "--lidar-model cone"), 1);
-  EXPECT_NE(out.find("--lidar-model must be one of spinning, swept, segment, not 'cone'"),
-            std::string::npos)
+  EXPECT_NE(
+      out.find("--lidar-model must be one of spinning, swept, non-repetitive, segment, not 'cone'"),
+      std::string::npos)
       << out;
   EXPECT_EQ(test::RunCommand(test::CalibenchExe() + " frobnicate", &out), 1);
 }
