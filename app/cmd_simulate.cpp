@@ -35,6 +35,9 @@ void AddSimFlags(CLI::App& app, SimFlags& flags) {
   app.add_option("--max-distance", flags.max_distance, "farthest board distance [m]");
   app.add_option("--seed", flags.seed, "random seed")->capture_default_str();
   app.add_flag("--no-clutter", flags.no_clutter, "no floor and walls");
+  app.add_flag("--no-lidar-seeds", flags.no_lidar_seeds,
+               "write no lidar_seed per pair: the board is found in each cloud by itself, as in a "
+               "user's dataset");
   app.add_flag("--board-only-clouds", flags.board_only_clouds,
                "clouds cropped to the board's returns, without rings (as some public sets ship "
                "them)");
@@ -102,6 +105,7 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
   options->seed = flags.seed;
   if (flags.no_clutter) options->clutter = false;
   if (flags.board_only_clouds) options->board_only_clouds = true;
+  if (flags.no_lidar_seeds) options->lidar_seeds = false;
   return options->Check(why);
 }
 

@@ -13,8 +13,9 @@ namespace calibench::app {
 int RunEvaluateSubsets(int argc, char** argv) {
   CLI::App app{
       "Calibrate the dataset's first k pairs and random subsets of k pairs, and count how "
-      "often each result lies within its own 3σ (every axis) of the all-pairs result: whether "
-      "the reported σ can be trusted on these sensors.",
+      "often each result lies within its own 3σ (every axis) of the all-pairs result and, on a "
+      "simulated set, of its ground truth: whether the reported σ can be trusted on these "
+      "sensors.",
       "calibench evaluate --subsets"};
   std::string dataset_path, table_path;
   SubsetCoverageOptions coverage;
@@ -49,7 +50,10 @@ int RunEvaluateSubsets(int argc, char** argv) {
                  dataset.manifest.string().c_str(), all.failure.c_str());
     return kNoCalibration;
   }
-  const SubsetCoverage result = RunSubsetCoverage(all.pairs, flags.options, coverage);
+  const SubsetCoverage result = RunSubsetCoverage(
+      all.pairs, flags.options, coverage,
+      // A simulated set's ground truth is the truth; a real set's is someone's estimate.
+      dataset.simulation ? dataset.cam_from_lidar_ground_truth : std::nullopt);
   const std::string table = FormatSubsetCoverage(result, coverage.coverage_sigmas);
   return PrintAndWriteTable(table, table_path, "calibench evaluate --subsets");
 }

@@ -426,9 +426,10 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
     entry.cloud = root / "clouds" / (entry.id + ".pcd");
     entry.image = root / "images" / (entry.id + ".png");
     scene.lidar_from_board = lidar_from_cam * plan.cam_from_board;
-    entry.lidar_seed =
-        LidarSeed{BoardHitCentroid(beams, print, scene.lidar_from_board, plan.azimuth_offset_rad),
-                  r.seed_radius_m};
+    if (r.lidar_seeds)
+      entry.lidar_seed =
+          LidarSeed{BoardHitCentroid(beams, print, scene.lidar_from_board, plan.azimuth_offset_rad),
+                    r.seed_radius_m};
 
     LidarScanOptions scan_options;
     scan_options.range_noise_m = r.lidar_range_noise_m;

@@ -41,6 +41,9 @@ struct SimOptions {
   bool board_only_clouds = false;
   Pose cam_from_lidar = Pose::Identity();  // ground truth; Identity() = the default mount below
   double seed_radius_m = 0.0;              // lidar_seed radius; 0 = 0.4 * the smaller board side
+  // Whether each pair carries a lidar_seed (where its board is, as a seeding tool would say). Off:
+  // a user's dataset, the board to be found in the cloud by itself.
+  bool lidar_seeds = true;
   std::uint64_t seed = 1;
 
   bool Check(std::string* why) const;

@@ -23,9 +23,25 @@ bool SubsetCoverageOptions::Check(std::string* why) const {
 
 namespace {
 
+// The largest |error| / σ over the six axes of `solved` against `reference`, with the errors.
+double WorstRatio(const SolverResult& solved, const Pose& reference, const Vec3& sigma_t_m,
+                  const Vec3& sigma_r_deg, Vec3* translation_error_m, Vec3* rotation_error_deg) {
+  *translation_error_m = solved.cam_from_lidar.translation() - reference.translation();
+  *rotation_error_deg =
+      LogSO3(solved.cam_from_lidar.linear() * reference.linear().transpose()) * kRadToDeg;
+  double worst = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    worst =
+        std::max(worst, std::abs((*translation_error_m)[axis]) / std::max(sigma_t_m[axis], 1e-12));
+    worst =
+        std::max(worst, std::abs((*rotation_error_deg)[axis]) / std::max(sigma_r_deg[axis], 1e-12));
+  }
+  return worst;
+}
+
 SubsetCase SolveCase(const std::string& kind, int k, std::vector<PairFeatures> subset,
                      const PipelineOptions& options, const Pose& reference,
-                     double coverage_sigmas) {
+                     const std::optional<Pose>& truth, double coverage_sigmas) {
   SubsetCase c;
   c.kind = kind;
   c.k = k;
@@ -37,18 +53,16 @@ SubsetCase SolveCase(const std::string& kind, int k, std::vector<PairFeatures> s
   }
   const SolverResult& s = *outcome.solution;
   c.solved = true;
-  c.translation_error_m = s.cam_from_lidar.translation() - reference.translation();
-  c.rotation_error_deg =
-      LogSO3(s.cam_from_lidar.linear() * reference.linear().transpose()) * kRadToDeg;
   c.sigma_t_m = TranslationStd(s.covariance, s.cam_from_lidar);
   c.sigma_r_deg = RotationStdDeg(s.covariance, s.cam_from_lidar);
-  for (int axis = 0; axis < 3; ++axis) {
-    c.worst_ratio = std::max(
-        c.worst_ratio, std::abs(c.translation_error_m[axis]) / std::max(c.sigma_t_m[axis], 1e-12));
-    c.worst_ratio = std::max(
-        c.worst_ratio, std::abs(c.rotation_error_deg[axis]) / std::max(c.sigma_r_deg[axis], 1e-12));
-  }
+  c.worst_ratio = WorstRatio(s, reference, c.sigma_t_m, c.sigma_r_deg, &c.translation_error_m,
+                             &c.rotation_error_deg);
   c.covered = c.worst_ratio <= coverage_sigmas;
+  if (truth) {
+    c.truth_worst_ratio = WorstRatio(s, *truth, c.sigma_t_m, c.sigma_r_deg,
+                                     &c.truth_translation_error_m, &c.truth_rotation_error_deg);
+    c.truth_covered = c.truth_worst_ratio <= coverage_sigmas;
+  }
   return c;
 }
 
@@ -56,7 +70,8 @@ SubsetCase SolveCase(const std::string& kind, int k, std::vector<PairFeatures> s
 
 SubsetCoverage RunSubsetCoverage(const std::vector<PairFeatures>& features,
                                  const PipelineOptions& options,
-                                 const SubsetCoverageOptions& coverage_options) {
+                                 const SubsetCoverageOptions& coverage_options,
+                                 const std::optional<Pose>& cam_from_lidar_truth) {
   std::string why;
   if (!coverage_options.Check(&why)) throw std::invalid_argument(why);
   SubsetCoverage coverage;
@@ -71,7 +86,7 @@ SubsetCoverage RunSubsetCoverage(const std::vector<PairFeatures>& features,
     if (k >= n) continue;
     coverage.cases.push_back(
         SolveCase("first", k, std::vector<PairFeatures>(features.begin(), features.begin() + k),
-                  options, reference, coverage_options.coverage_sigmas));
+                  options, reference, cam_from_lidar_truth, coverage_options.coverage_sigmas));
   }
   std::vector<int> accepted;
   for (int i = 0; i < n; ++i)
@@ -87,41 +102,61 @@ SubsetCoverage RunSubsetCoverage(const std::vector<PairFeatures>& features,
       std::vector<PairFeatures> subset;
       for (int i : order) subset.push_back(features[i]);
       coverage.cases.push_back(SolveCase("random", k, std::move(subset), options, reference,
-                                         coverage_options.coverage_sigmas));
+                                         cam_from_lidar_truth, coverage_options.coverage_sigmas));
     }
   }
+  coverage.has_truth = cam_from_lidar_truth.has_value();
   for (const SubsetCase& c : coverage.cases) {
     coverage.solved += c.solved;
     coverage.covered += c.covered;
+    coverage.truth_covered += c.truth_covered;
   }
   return coverage;
 }
 
 std::string FormatSubsetCoverage(const SubsetCoverage& coverage, double coverage_sigmas) {
+  const bool truth = coverage.has_truth;
   std::string out =
       "| subset | k | used | largest σ_t (mm) | largest σ_r (deg) | distance to all pairs "
-      "(mm / deg) | worst axis (σ) | covered |\n|---|---|---|---|---|---|---|---|\n";
-  char line[320];
+      "(mm / deg) | worst axis (σ) | covered |";
+  out += truth ? " to the truth (mm / deg) | worst axis (σ) | covered |\n" : "\n";
+  out += truth ? "|---|---|---|---|---|---|---|---|---|---|---|\n"
+               : "|---|---|---|---|---|---|---|---|\n";
+  char line[400];
   for (const SubsetCase& c : coverage.cases) {
     if (!c.solved) {
-      std::snprintf(line, sizeof(line), "| %s | %d | %d | — | — | no solution: %s | — | no |\n",
-                    c.kind.c_str(), c.k, c.used, c.failure.c_str());
-    } else {
-      std::snprintf(line, sizeof(line),
-                    "| %s | %d | %d | %.1f | %.3f | %.1f / %.3f | %.2f | %s |\n", c.kind.c_str(),
-                    c.k, c.used, c.sigma_t_m.maxCoeff() * 1e3, c.sigma_r_deg.maxCoeff(),
-                    c.translation_error_m.norm() * 1e3, c.rotation_error_deg.norm(), c.worst_ratio,
-                    c.covered ? "yes" : "NO");
+      std::snprintf(line, sizeof(line), "| %s | %d | %d | — | — | no solution: %s | — | no |%s\n",
+                    c.kind.c_str(), c.k, c.used, c.failure.c_str(), truth ? " — | — | no |" : "");
+      out += line;
+      continue;
     }
+    std::snprintf(line, sizeof(line), "| %s | %d | %d | %.1f | %.3f | %.1f / %.3f | %.2f | %s |",
+                  c.kind.c_str(), c.k, c.used, c.sigma_t_m.maxCoeff() * 1e3,
+                  c.sigma_r_deg.maxCoeff(), c.translation_error_m.norm() * 1e3,
+                  c.rotation_error_deg.norm(), c.worst_ratio, c.covered ? "yes" : "NO");
     out += line;
+    if (truth) {
+      std::snprintf(line, sizeof(line), " %.1f / %.3f | %.2f | %s |",
+                    c.truth_translation_error_m.norm() * 1e3, c.truth_rotation_error_deg.norm(),
+                    c.truth_worst_ratio, c.truth_covered ? "yes" : "NO");
+      out += line;
+    }
+    out += "\n";
   }
   const int cases = static_cast<int>(coverage.cases.size());
+  const auto percent = [cases](int n) { return cases ? 100.0 * n / cases : 0.0; };
   std::snprintf(line, sizeof(line),
-                "\nwithin %.0fσ on every axis: %d of %d cases (%.0f %%); all-pairs result from "
-                "%d pairs\n",
-                coverage_sigmas, coverage.covered, cases,
-                cases ? 100.0 * coverage.covered / cases : 0.0, coverage.reference_pairs);
+                "\nwithin %.0fσ on every axis of the all-pairs result: %d of %d cases (%.0f %%); "
+                "all-pairs result from %d pairs\n",
+                coverage_sigmas, coverage.covered, cases, percent(coverage.covered),
+                coverage.reference_pairs);
   out += line;
+  if (truth) {
+    std::snprintf(line, sizeof(line),
+                  "within %.0fσ on every axis of the ground truth: %d of %d cases (%.0f %%)\n",
+                  coverage_sigmas, coverage.truth_covered, cases, percent(coverage.truth_covered));
+    out += line;
+  }
   return out;
 }
 

@@ -6,12 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "core/io/cloud_io.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/sim/sim.h"
+#include "core/sim/subset_coverage.h"
 #include "tests/acfr_manifest.h"
 #include "tests/test_support.h"
 
@@ -274,6 +276,16 @@ TEST(LidarModels, RealBoardOnlySegmentsWithoutRings) {
       apart.translation_m * 1e3, apart.rotation_rad * kRadToDeg, sigma_t * 1e3,
       to_reference.translation_m * 1e3, to_reference.rotation_rad * kRadToDeg);
   EXPECT_LT(apart.translation_m, 0.5 * sigma_t);
+  // σ at every pair count on the segments (issue 46): first k and 5 random subsets of 4-30 pairs,
+  // each against the 40-pair result. The goal is 90 % within 3σ on every axis; the segment model
+  // (isotropic point-to-plane, rings unknown) reaches 32 of 42 (76 %): at 6-10 pairs the
+  // real segments scatter about 1.3x more than σ says. This floor keeps it from getting worse.
+  const SubsetCoverageOptions coverage;
+  const SubsetCoverage subsets = RunSubsetCoverage(detected.pairs, PipelineOptions{}, coverage);
+  std::printf("%s", FormatSubsetCoverage(subsets, coverage.coverage_sigmas).c_str());
+  const int cases = static_cast<int>(subsets.cases.size());
+  ASSERT_EQ(cases, 7 + 7 * 5);
+  EXPECT_GE(subsets.covered, static_cast<int>(std::ceil(0.75 * cases)));
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "core/geometry/geometry.h"
+#include "core/io/cloud_io.h"
 #include "core/io/json_io.h"
 #include "core/results/result_file.h"
 #include "tests/sim_recording.h"
@@ -162,6 +163,54 @@ TEST(WatchRecording, FollowsRecordingsWhileWrittenAndEndsWithImportsPairs) {
                                &output),
               0)
         << output;
+  }
+}
+
+// A Livox Mid-40 recording (`livox_ros_driver/CustomMsg` in a ROS 1 bag, 10 Hz) while it is
+// written: the watch integrates each still hold's ring-less sweeps into one cloud as import does,
+// and its pairs are import's, byte for byte.
+TEST(WatchRecording, ALivoxCustomMsgRecordingGivesImportsIntegratedPairs) {
+  test::SimRecordingOptions options = test::SmallSimRecording(5);
+  options.lidar = LidarModel::kMid40;
+  options.lidar_range_noise_m = 0.02;
+  const fs::path dir = test::TempDir("watch_recording_livox");
+  const fs::path source = dir / "livox.bag", stream = dir / "stream.jsonl";
+  std::thread watch([&] {
+    test::RunCommand(test::CalibenchExe() + " watch " + source.string() +
+                     " --board a3 --json-lines --idle-exit 20 --out " + (dir / "watched").string() +
+                     " > " + stream.string() + " 2>/dev/null");
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  PacedWriter writer(test::OpenRos1BagWriter(source, "lz4", 256 * 1024), 4.0);
+  test::WriteSimRecording(&writer, MessageEncoding::kRos1, options);
+  writer.Close();
+  watch.join();
+  const std::vector<json> lines = ReadJsonLines(stream);
+  ASSERT_FALSE(lines.empty());
+  int pairs = 0, accepted = 0;
+  for (const json& line : lines) {
+    if (line["event"] != "pair") continue;
+    ++pairs;
+    accepted += line["accepted"].get<bool>();
+  }
+  EXPECT_EQ(pairs, 5) << test::ReadFileBytes(stream);
+  EXPECT_EQ(accepted, 5) << test::ReadFileBytes(stream);
+  EXPECT_EQ(lines.back()["reason"], "the recording was closed by its recorder");
+  std::string output;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " import " + source.string() +
+                                 " --board a3 -o " + (dir / "imported").string(),
+                             &output),
+            0)
+      << output;
+  const std::vector<std::string> watched = Pngs(dir / "watched/images");
+  ASSERT_EQ(watched, Pngs(dir / "imported/images"));
+  ASSERT_EQ(watched.size(), 5u);
+  for (const std::string& png : watched) {
+    const std::string pcd = fs::path(png).replace_extension(".pcd");
+    const std::string cloud = test::ReadFileBytes(dir / "watched/clouds" / pcd);
+    EXPECT_EQ(cloud, test::ReadFileBytes(dir / "imported/clouds" / pcd)) << pcd;
+    // Integrated: a 0.1 s Mid-40 frame holds ~10 k returns, the hold's second several times that.
+    EXPECT_GE(LoadCloud(dir / "watched/clouds" / pcd).size(), 40'000u) << pcd;
   }
 }
 
