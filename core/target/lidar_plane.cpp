@@ -343,6 +343,29 @@ void AddBoardExtent(const LidarCloud& cloud, const LidarPlaneOptions& options, L
 
 }  // namespace
 
+namespace {
+
+// The plane through the returns' centroid that holds their principal direction and faces the
+// origin as squarely as that allows: a board seen along one stroke of the scan.
+std::optional<Plane> FacingPlane(const LidarCloud& cloud, const std::vector<int>& indices) {
+  if (indices.size() < 4) return std::nullopt;
+  const Vec3 centroid = Centroid(cloud, indices);
+  Mat3 scatter = Mat3::Zero();
+  for (int i : indices) {
+    const Vec3 d = cloud.points[i].cast<double>() - centroid;
+    scatter += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Mat3> eigen(scatter);
+  const Vec3 along = eigen.eigenvectors().col(2);
+  const Vec3 towards = -centroid.normalized();
+  Vec3 normal = towards - towards.dot(along) * along;
+  if (!(normal.norm() > 1e-6)) return std::nullopt;
+  normal.normalize();
+  return Plane{normal, -normal.dot(centroid)};
+}
+
+}  // namespace
+
 std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
                                            const std::vector<int>& candidates,
                                            const LidarPlaneOptions& options, std::string* why) {
@@ -401,7 +424,22 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
     // around the maximum-likelihood plane in range units (|r − r̂| ≤ max(threshold, 3σ̂_r)): a
     // band around the biased least-squares plane would truncate the range noise on one side and
     // carry the bias into the ML fit.
-    if (auto ml = RefineRangeMl(cloud, candidates, *fit, options)) fit = ml;
+    std::optional<LidarPlaneFit> ml = RefineRangeMl(cloud, candidates, *fit, options);
+    // The point-to-plane start takes the returns' thinnest direction for the normal. On a few
+    // strokes of a non-repetitive scan (returns along a curve, range noise wider than the curve)
+    // that lies across the strokes: a plane holding the rays, whose ML fit stays in its own basin.
+    // Started again from the plane that faces the sensor through the strokes, the ML fit that
+    // keeps more returns within the band (then the smaller RMS) is the board.
+    if (const std::optional<Plane> facing = FacingPlane(cloud, fit->inliers)) {
+      LidarPlaneFit start = *fit;
+      start.plane = *facing;
+      std::optional<LidarPlaneFit> again = RefineRangeMl(cloud, candidates, start, options);
+      if (again &&
+          (!ml || again->inliers.size() > ml->inliers.size() ||
+           (again->inliers.size() == ml->inliers.size() && again->rms_m < 0.99 * ml->rms_m)))
+        ml = again;
+    }
+    if (ml) fit = ml;
   }
   fit->num_candidates = static_cast<int>(candidates.size());
   const int n = static_cast<int>(fit->inliers.size());
