@@ -45,7 +45,10 @@ void CalibrationJob::Restatus(JobPair* pair) const {
 void CalibrationJob::DetectAll() {
   std::vector<const PairEntry*> entries;
   for (const PairEntry& entry : dataset_.pairs) entries.push_back(&entry);
-  // Rejections apply at the solve (DetectedPairs); detection sees the brushes only.
+  // Rejections apply at the solve (DetectedPairs); detection sees the brushes only. The note says
+  // why there is no background model once all clouds are read: none when it was built, or when no
+  // pair needed detection (seeds, brushes).
+  background_note_.clear();
   std::vector<PairFeatures> features = ExtractDatasetPairs(
       dataset_, entries, options_.advise.pipeline, events_.detected, brushes_, &background_note_);
   for (size_t i = 0; i < features.size(); ++i) {

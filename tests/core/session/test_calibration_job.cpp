@@ -59,6 +59,8 @@ TEST(CalibrationJob, FedAllAtOncePairByPairOrStepByStepItEndsWhereCalibrateEnds)
   ExpectSamePose(all.solution->cam_from_lidar, cli.solution->cam_from_lidar, 0.0, "all at once");
   EXPECT_EQ(all.solution->covariance, cli.solution->covariance);
   EXPECT_EQ(all.pairs[3].board_origin.source, BoardSource::kCameraGuided);
+  // And the same words on the background model (none when it was built).
+  EXPECT_EQ(all.background_note, cli.background_note);
   // Every solve starts from detection: a second one is the first again.
   ExpectSamePose(batch.Solve().solution->cam_from_lidar, cli.solution->cam_from_lidar, 0.0,
                  "solved again");
