@@ -60,7 +60,9 @@ PlanePair MakePlanePair(const std::string& id, const LidarPlaneFit& lidar,
   return {id,
           lidar.plane,
           camera.plane,
-          lidar.covariance,
+          lidar.lidar_model.geometry == LidarGeometry::kSegment
+              ? Mat4(lidar.covariance + lidar.ring_bias_covariance)
+              : lidar.covariance,
           camera.plane_covariance,
           lidar.range_offset_jacobian,
           lidar.edge_points,

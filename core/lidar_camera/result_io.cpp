@@ -44,6 +44,9 @@ std::string ModelMeaning(LidarGeometry geometry) {
     return "planes fitted on the ranges along the rays, with ring biases and board edges";
   if (geometry == LidarGeometry::kNonRepetitive)
     return "planes fitted on the ranges along the rays, no rings: no ring biases or board edges";
+  if (geometry == LidarGeometry::kSegment)
+    return "planes fitted point-to-plane (isotropic, their own covariance, widened by a range bias "
+           "per ring where the returns' elevations fall into rings), no board edges";
   return "planes fitted point-to-plane (isotropic, their own covariance), no ring biases or board "
          "edges";
 }

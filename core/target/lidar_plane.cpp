@@ -309,6 +309,35 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
 
 namespace {
 
+// The group of each of `indices` when the returns' elevations are split at gaps over 0.15°: the
+// rings of a cloud that lost its ring field.
+std::vector<int> ElevationGroups(const LidarCloud& cloud, const std::vector<int>& indices) {
+  std::vector<std::pair<double, size_t>> elevations;
+  for (size_t k = 0; k < indices.size(); ++k) {
+    const Vec3 x = cloud.points[indices[k]].cast<double>();
+    elevations.push_back({std::atan2(x.z(), x.head<2>().norm()), k});
+  }
+  std::sort(elevations.begin(), elevations.end());
+  std::vector<int> group(indices.size(), 0);
+  int current = 0;
+  for (size_t j = 0; j < elevations.size(); ++j) {
+    if (j > 0 && elevations[j].first - elevations[j - 1].first > 0.15 * kDegToRad) ++current;
+    group[elevations[j].second] = current;
+  }
+  return group;
+}
+
+// How many rings the returns' elevations show: groups of at least 3 returns, counted only when
+// such groups hold 90 % of the returns (a scan without rings leaves scattered stragglers).
+int ElevationRings(const LidarCloud& cloud, const std::vector<int>& indices) {
+  std::map<int, int> sizes;
+  for (int g : ElevationGroups(cloud, indices)) ++sizes[g];
+  int rings = 0, in_rings = 0;
+  for (const auto& [g, size] : sizes)
+    if (size >= 3) ++rings, in_rings += size;
+  return in_rings >= 0.9 * static_cast<double>(indices.size()) ? rings : 0;
+}
+
 // Rings among the points (0 when the cloud has none).
 int DistinctRings(const LidarCloud& cloud, const std::vector<int>& indices) {
   if (!cloud.HasRing()) return 0;
@@ -336,7 +365,13 @@ void AddBoardExtent(const LidarCloud& cloud, const LidarPlaneOptions& options, L
                               : "the target gives no sheet size";
   }
   fit->num_rings = DistinctRings(cloud, fit->inliers);
-  if (options.ring_bias_sigma_m > 0 && spinning)
+  // A board-only segment cut from a spinning LiDAR's scan still carries its rings' range biases,
+  // though its ring field is gone: where the returns' elevations fall into rings, they widen the
+  // plane as on the whole scan (the real ACFR segments scatter about twice their point-to-plane
+  // σ without it; docs/results.md).
+  const bool segment_with_rings =
+      options.geometry == LidarGeometry::kSegment && ElevationRings(cloud, fit->inliers) >= 3;
+  if (options.ring_bias_sigma_m > 0 && (spinning || segment_with_rings))
     fit->ring_bias_covariance =
         RingBiasCovariance(cloud, fit->inliers, fit->plane, options.ring_bias_sigma_m);
 }
@@ -464,17 +499,7 @@ Mat4 RingBiasCovariance(const LidarCloud& cloud, const std::vector<int>& indices
   if (cloud.HasRing()) {
     for (size_t k = 0; k < indices.size(); ++k) ring[k] = cloud.ring[indices[k]];
   } else {
-    std::vector<std::pair<double, size_t>> elevations;
-    for (size_t k = 0; k < indices.size(); ++k) {
-      const Vec3 x = cloud.points[indices[k]].cast<double>();
-      elevations.push_back({std::atan2(x.z(), x.head<2>().norm()), k});
-    }
-    std::sort(elevations.begin(), elevations.end());
-    int group = 0;
-    for (size_t j = 0; j < elevations.size(); ++j) {
-      if (j > 0 && elevations[j].first - elevations[j - 1].first > 0.15 * kDegToRad) ++group;
-      ring[elevations[j].second] = group;
-    }
+    ring = ElevationGroups(cloud, indices);
   }
   const Eigen::Matrix<double, 3, 2> basis = PlaneTangentBasis(plane.normal);
   Mat3 normal_matrix = Mat3::Zero();

@@ -276,16 +276,16 @@ TEST(LidarModels, RealBoardOnlySegmentsWithoutRings) {
       apart.translation_m * 1e3, apart.rotation_rad * kRadToDeg, sigma_t * 1e3,
       to_reference.translation_m * 1e3, to_reference.rotation_rad * kRadToDeg);
   EXPECT_LT(apart.translation_m, 0.5 * sigma_t);
-  // σ at every pair count on the segments (issue 46): first k and 5 random subsets of 4-30 pairs,
-  // each against the 40-pair result. The goal is 90 % within 3σ on every axis; the segment model
-  // (isotropic point-to-plane, rings unknown) reaches 32 of 42 (76 %): at 6-10 pairs the
-  // real segments scatter about 1.3x more than σ says. This floor keeps it from getting worse.
+  // σ honest at every pair count on the segments (issue 46): first k and 5 random subsets of 4-30
+  // pairs, each within 3σ of the 40-pair result on every axis in at least 90 % of the cases. The
+  // rings' range biases, found again in the returns' elevations, are what makes it so (without
+  // them: 32 of 42).
   const SubsetCoverageOptions coverage;
   const SubsetCoverage subsets = RunSubsetCoverage(detected.pairs, PipelineOptions{}, coverage);
   std::printf("%s", FormatSubsetCoverage(subsets, coverage.coverage_sigmas).c_str());
   const int cases = static_cast<int>(subsets.cases.size());
   ASSERT_EQ(cases, 7 + 7 * 5);
-  EXPECT_GE(subsets.covered, static_cast<int>(std::ceil(0.75 * cases)));
+  EXPECT_GE(subsets.covered, static_cast<int>(std::ceil(0.9 * cases)));
 }
 
 }  // namespace
