@@ -49,6 +49,9 @@ RecordingUpdate GrowingRecording::Poll() {
   }
   const bool closed = reader_->FollowNewMessages([&](const BagMessage& message) {
     update.data_arrived = true;
+    // The topics are chosen as soon as they are all there, within the call: a finished recording
+    // is read in one call, and kept pending its messages would lose all but the last kMaxPending.
+    if (!finder_) ChooseTopicsWhenPresent(/*closed=*/false, &update);
     if (finder_) {
       Route(message.topic, message.log_time_ns, message.data);
     } else {

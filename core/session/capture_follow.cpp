@@ -146,7 +146,9 @@ class Follower {
       bool added = false;
       const FeedUpdate update = feed_->Poll(now);
       // A recording that grows is alive even while no pair comes out of it (its board unknown).
-      if (update.data_arrived) last_activity = now;
+      // The data came during the look, which may take long (a finished recording read whole, the
+      // presets tried on its images): the silence starts when the look ends.
+      if (update.data_arrived) last_activity = SteadySeconds();
       for (const std::string& note : update.notes) Say(sink_, "note", "", note);
       for (const FolderEvent& event : update.events) {
         last_activity = now;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -274,6 +275,88 @@ TEST(RecordingImport, ARecordingCutShortImportsItsCompletePart) {
         0)
         << output;
     EXPECT_NE(output.find("cut short"), std::string::npos) << output;
+  }
+}
+
+// The peak resident memory (kB) of `command` by /usr/bin/time -v, -1 when unreadable; its exit
+// code in *code.
+long PeakKb(const std::string& command, int* code) {
+  std::string output;
+  *code = test::RunCommand("/usr/bin/time -v " + command, &output);
+  const std::string key = "Maximum resident set size (kbytes): ";
+  const auto at = output.find(key);
+  return at == std::string::npos ? -1 : std::stol(output.substr(at + key.size()));
+}
+
+// Issue 46's recording at full length: a Mid-40 at 10 Hz as CustomMsg, 20 poses held 6 s each
+// (ROS 1 bag and MCAP, ~160 s, ~1 GB each). `import` and `watch` (following the finished file)
+// give one integrated pair per hold, the same pairs; import's peak memory against a VLP-16
+// PointCloud2 recording of the same length. Minutes and gigabytes: run by
+// scripts/long_recordings.sh (CALIBENCH_LONG=1), not by CI.
+TEST(RecordingImport, LongLivoxRecordingAsUsersRecordIt) {
+  if (!std::getenv("CALIBENCH_LONG"))
+    GTEST_SKIP() << "a long measurement: scripts/long_recordings.sh runs it (CALIBENCH_LONG=1)";
+  const fs::path dir = test::TempDir("recording_import_livox_long");
+  test::SimRecordingOptions options;  // 6 s holds, 2 s moves, 10 Hz clouds, 15 Hz images
+  options.poses = 20;
+  options.image_width = 640;
+  options.image_height = 360;
+  options.max_distance_m = 3.0;
+  test::SimRecordingOptions spinning = options;
+  options.lidar = LidarModel::kMid40;
+  options.lidar_range_noise_m = 0.02;
+  struct Run {
+    const char* name;
+    const test::SimRecordingOptions* recording;
+  };
+  long spinning_peak_kb = 0;
+  std::vector<std::string> livox_clouds;
+  for (const Run run :
+       {Run{"vlp16.mcap", &spinning}, Run{"livox.mcap", &options}, Run{"livox.bag", &options}}) {
+    SCOPED_TRACE(run.name);
+    const test::SimRecordingTruth truth = Record(dir / run.name, *run.recording);
+    const fs::path imported = dir / (std::string(run.name) + ".imported");
+    int code = 0;
+    const long peak_kb = PeakKb(test::CalibenchExe() + " import " + (dir / run.name).string() +
+                                    " --board a3 -o " + imported.string(),
+                                &code);
+    ASSERT_EQ(code, 0);
+    const Dataset dataset = LoadDataset(imported);
+    PipelineOptions pipeline;
+    pipeline.threads = 2;
+    const CalibrationOutcome outcome = CalibrateDataset(dataset, pipeline);
+    ASSERT_TRUE(outcome.solution) << outcome.failure;
+    int accepted = 0;
+    for (const PairFeatures& p : outcome.pairs) accepted += p.status == PairStatus::kAccepted;
+    const PoseError error =
+        ComputePoseError(outcome.solution->cam_from_lidar, truth.cam_from_lidar);
+    std::printf(
+        "%s: %.0f s, %.0f MB; import peak %.0f MB; %zu pairs, %d accepted; error %.2f mm "
+        "%.3f deg\n",
+        run.name, truth.seconds, fs::file_size(dir / run.name) / 1e6, peak_kb / 1e3,
+        dataset.pairs.size(), accepted, error.translation_m * 1e3, error.rotation_rad * kRadToDeg);
+    EXPECT_EQ(dataset.pairs.size(), 20u);
+    EXPECT_GE(accepted, 18);
+    EXPECT_LT(error.translation_m, 0.01);
+    EXPECT_LT(error.rotation_rad * kRadToDeg, 0.3);
+    if (run.recording == &spinning) {
+      spinning_peak_kb = peak_kb;
+      continue;
+    }
+    // Bounded as import's memory is for PointCloud2: a second of sweeps instead of 0.4 s.
+    EXPECT_LT(peak_kb, 2 * spinning_peak_kb);
+    // `watch` on the finished recording: the same pairs, byte for byte.
+    const fs::path watched = dir / (std::string(run.name) + ".watched");
+    ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " watch " + (dir / run.name).string() +
+                               " --board a3 --json-lines --idle-exit 5 --out " + watched.string() +
+                               " > " + (dir / "watch.jsonl").string() + " 2>/dev/null"),
+              0);
+    for (const PairEntry& pair : dataset.pairs) {
+      const fs::path cloud = watched / "clouds" / pair.cloud.filename();
+      ASSERT_TRUE(fs::exists(cloud)) << cloud;
+      EXPECT_EQ(test::ReadFileBytes(cloud), test::ReadFileBytes(pair.cloud)) << cloud;
+      EXPECT_GE(LoadCloud(cloud).size(), 50'000u) << cloud;  // integrated: 10 k in one frame
+    }
   }
 }
 

@@ -214,6 +214,62 @@ TEST(WatchRecording, ALivoxCustomMsgRecordingGivesImportsIntegratedPairs) {
   }
 }
 
+// Passes every message on with `extra` messages of a busy topic the watch does not use (an IMU at
+// a few hundred hertz) before it.
+class WithBusyTopic : public test::RecordingWriter {
+ public:
+  WithBusyTopic(std::unique_ptr<test::RecordingWriter> inner, int extra)
+      : inner_(std::move(inner)), extra_(extra) {}
+  void Add(const test::RecordedMessage& message) override {
+    for (int i = 0; i < extra_; ++i)
+      inner_->Add({"/imu/data", "sensor_msgs/Imu", message.log_time_ns - extra_ + i,
+                   std::vector<std::uint8_t>(64, static_cast<std::uint8_t>(i))});
+    inner_->Add(message);
+  }
+  void Close() override { inner_->Close(); }
+
+ private:
+  std::unique_ptr<test::RecordingWriter> inner_;
+  int extra_;
+};
+
+// A recording already finished when the watch starts (copied from the robot, say) is read in one
+// go: its topics are chosen as soon as they appear, so none of its thousands of messages is held
+// back and lost (the watch once kept the last 2000 and gave the late holds as the first pairs).
+TEST(WatchRecording, AFinishedRecordingIsReadWhole) {
+  const test::SimRecordingOptions options = test::SmallSimRecording(6);
+  const fs::path dir = test::TempDir("watch_recording_finished");
+  const fs::path source = dir / "finished.mcap";
+  WithBusyTopic writer(test::OpenMcapWriter(source, "ros2", "lz4", true, 256 * 1024), 8);
+  const test::SimRecordingTruth truth =
+      test::WriteSimRecording(&writer, MessageEncoding::kCdr, options);
+  writer.Close();
+  ASSERT_GT(truth.messages * 9, 2000);
+  std::string output;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " watch " + source.string() +
+                             " --board a3 --json-lines --idle-exit 10 --out " +
+                             (dir / "watched").string() + " > " + (dir / "stream.jsonl").string() +
+                             " 2>/dev/null"),
+            0);
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " import " + source.string() +
+                                 " --board a3 -o " + (dir / "imported").string(),
+                             &output),
+            0)
+      << output;
+  const std::vector<std::string> watched = Pngs(dir / "watched/images");
+  ASSERT_EQ(watched.size(), 6u) << test::ReadFileBytes(dir / "stream.jsonl");
+  ASSERT_EQ(watched, Pngs(dir / "imported/images"));
+  for (const std::string& png : watched) {
+    EXPECT_EQ(test::ReadFileBytes(dir / "watched/images" / png),
+              test::ReadFileBytes(dir / "imported/images" / png))
+        << png;
+    const std::string pcd = fs::path(png).replace_extension(".pcd");
+    EXPECT_EQ(test::ReadFileBytes(dir / "watched/clouds" / pcd),
+              test::ReadFileBytes(dir / "imported/clouds" / pcd))
+        << pcd;
+  }
+}
+
 // A board no preset explains, on a recording still being written: the true reason said as soon as
 // the presets rule themselves out (not "no new data" while data still comes), the watch follows
 // on, and the pairs come once the board's target file is put beside the recording.
