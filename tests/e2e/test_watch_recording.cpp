@@ -57,6 +57,31 @@ std::vector<std::string> Pngs(const fs::path& images) {
   return files;
 }
 
+// `import` of the finished recording into dir/imported gives the pairs the watch wrote into
+// dir/watched, byte for byte (images and clouds); their images' names.
+std::vector<std::string> ExpectImportGivesTheWatchedPairs(const fs::path& source,
+                                                          const fs::path& dir, size_t pairs) {
+  std::string output;
+  EXPECT_EQ(test::RunCommand(test::CalibenchExe() + " import " + source.string() +
+                                 " --board a3 -o " + (dir / "imported").string(),
+                             &output),
+            0)
+      << output;
+  const std::vector<std::string> watched = Pngs(dir / "watched/images");
+  EXPECT_EQ(watched, Pngs(dir / "imported/images"));
+  EXPECT_EQ(watched.size(), pairs) << test::ReadFileBytes(dir / "stream.jsonl");
+  for (const std::string& png : watched) {
+    EXPECT_EQ(test::ReadFileBytes(dir / "watched/images" / png),
+              test::ReadFileBytes(dir / "imported/images" / png))
+        << png;
+    const std::string pcd = fs::path(png).replace_extension(".pcd");
+    EXPECT_EQ(test::ReadFileBytes(dir / "watched/clouds" / pcd),
+              test::ReadFileBytes(dir / "imported/clouds" / pcd))
+        << pcd;
+  }
+  return watched;
+}
+
 TEST(WatchRecording, FollowsRecordingsWhileWrittenAndEndsWithImportsPairs) {
   const test::SimRecordingOptions options = test::SmallSimRecording(4);
   struct Case {
@@ -126,24 +151,8 @@ TEST(WatchRecording, FollowsRecordingsWhileWrittenAndEndsWithImportsPairs) {
     EXPECT_EQ(lines.back()["reason"], "the recording was closed by its recorder");
 
     // `import` of the finished recording: the same pairs, byte for byte.
+    ExpectImportGivesTheWatchedPairs(source, dir, 4);
     std::string output;
-    ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " import " + source.string() +
-                                   " --board a3 -o " + (dir / "imported").string(),
-                               &output),
-              0)
-        << output;
-    const std::vector<std::string> watched = Pngs(dir / "watched/images");
-    ASSERT_EQ(watched, Pngs(dir / "imported/images"));
-    ASSERT_EQ(watched.size(), 4u);
-    for (const std::string& png : watched) {
-      EXPECT_EQ(test::ReadFileBytes(dir / "watched/images" / png),
-                test::ReadFileBytes(dir / "imported/images" / png))
-          << png;
-      const std::string pcd = fs::path(png).replace_extension(".pcd");
-      EXPECT_EQ(test::ReadFileBytes(dir / "watched/clouds" / pcd),
-                test::ReadFileBytes(dir / "imported/clouds" / pcd))
-          << pcd;
-    }
     // `calibrate` on the imported recording ends where the watch's last solve ended.
     ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
                                    (dir / "imported").string() + " --out " +
@@ -196,20 +205,9 @@ TEST(WatchRecording, ALivoxCustomMsgRecordingGivesImportsIntegratedPairs) {
   EXPECT_EQ(pairs, 5) << test::ReadFileBytes(stream);
   EXPECT_EQ(accepted, 5) << test::ReadFileBytes(stream);
   EXPECT_EQ(lines.back()["reason"], "the recording was closed by its recorder");
-  std::string output;
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " import " + source.string() +
-                                 " --board a3 -o " + (dir / "imported").string(),
-                             &output),
-            0)
-      << output;
-  const std::vector<std::string> watched = Pngs(dir / "watched/images");
-  ASSERT_EQ(watched, Pngs(dir / "imported/images"));
-  ASSERT_EQ(watched.size(), 5u);
-  for (const std::string& png : watched) {
+  // Integrated: a 0.1 s Mid-40 frame holds ~10 k returns, the hold's second several times that.
+  for (const std::string& png : ExpectImportGivesTheWatchedPairs(source, dir, 5)) {
     const std::string pcd = fs::path(png).replace_extension(".pcd");
-    const std::string cloud = test::ReadFileBytes(dir / "watched/clouds" / pcd);
-    EXPECT_EQ(cloud, test::ReadFileBytes(dir / "imported/clouds" / pcd)) << pcd;
-    // Integrated: a 0.1 s Mid-40 frame holds ~10 k returns, the hold's second several times that.
     EXPECT_GE(LoadCloud(dir / "watched/clouds" / pcd).size(), 40'000u) << pcd;
   }
 }
@@ -245,29 +243,12 @@ TEST(WatchRecording, AFinishedRecordingIsReadWhole) {
       test::WriteSimRecording(&writer, MessageEncoding::kCdr, options);
   writer.Close();
   ASSERT_GT(truth.messages * 9, 2000);
-  std::string output;
   ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " watch " + source.string() +
                              " --board a3 --json-lines --idle-exit 10 --out " +
                              (dir / "watched").string() + " > " + (dir / "stream.jsonl").string() +
                              " 2>/dev/null"),
             0);
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " import " + source.string() +
-                                 " --board a3 -o " + (dir / "imported").string(),
-                             &output),
-            0)
-      << output;
-  const std::vector<std::string> watched = Pngs(dir / "watched/images");
-  ASSERT_EQ(watched.size(), 6u) << test::ReadFileBytes(dir / "stream.jsonl");
-  ASSERT_EQ(watched, Pngs(dir / "imported/images"));
-  for (const std::string& png : watched) {
-    EXPECT_EQ(test::ReadFileBytes(dir / "watched/images" / png),
-              test::ReadFileBytes(dir / "imported/images" / png))
-        << png;
-    const std::string pcd = fs::path(png).replace_extension(".pcd");
-    EXPECT_EQ(test::ReadFileBytes(dir / "watched/clouds" / pcd),
-              test::ReadFileBytes(dir / "imported/clouds" / pcd))
-        << pcd;
-  }
+  ExpectImportGivesTheWatchedPairs(source, dir, 6);
 }
 
 // A board no preset explains, on a recording still being written: the true reason said as soon as
