@@ -13,6 +13,7 @@
 #include "core/lidar/lidar_image.h"
 #include "core/target/board.h"
 #include "core/target/board_edges.h"
+#include "core/target/ring_bias.h"
 
 namespace calibench {
 
@@ -91,13 +92,6 @@ std::vector<int> SelectBrushRegion(const LidarImage& image, const std::vector<in
 std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
                                            const std::vector<int>& candidates,
                                            const LidarPlaneOptions& options, std::string* why);
-
-// The (n, d) covariance that a range bias common to each ring's returns (b_r ~ N(0, σ²) along the
-// rays, independent between rings) gives the least-squares plane through `indices`: the sandwich
-// σ² (AᵀA)⁻¹ (Σ_r s_r s_rᵀ) (AᵀA)⁻¹ over the point-to-plane rows a_i, s_r = Σ_{i∈r} a_i (n·u_i).
-// Rings: the cloud's own, else the returns' elevations split at gaps over 0.15°.
-Mat4 RingBiasCovariance(const LidarCloud& cloud, const std::vector<int>& indices,
-                        const Plane& plane, double ring_bias_sigma_m);
 
 // Least-squares (total least squares) plane through points with its (n, d) covariance, the
 // residual variance estimated from the fit. Needs >= 4 points not on a line.
