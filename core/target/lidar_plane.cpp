@@ -370,6 +370,31 @@ std::optional<Plane> FacingPlane(const LidarCloud& cloud, const std::vector<int>
   return Plane{normal, -normal.dot(centroid)};
 }
 
+// The unbiased estimate (see LidarPlaneOptions::fit_ranges_ml) from the point-to-plane `fit`. The
+// inlier band is re-drawn around the maximum-likelihood plane in range units
+// (|r − r̂| ≤ max(threshold, 3σ̂_r)): a band around the biased least-squares plane would truncate
+// the range noise on one side and carry the bias into the ML fit.
+// The point-to-plane start takes the returns' thinnest direction for the normal. On a few strokes
+// of a non-repetitive scan (returns along a curve, range noise wider than the curve) that lies
+// across the strokes: a plane holding the rays, whose ML fit stays in its own basin. Started again
+// from the plane that faces the sensor through the strokes, the ML fit that keeps more returns
+// within the band (then the smaller RMS) is the board.
+std::optional<LidarPlaneFit> RefineAlongRays(const LidarCloud& cloud,
+                                             const std::vector<int>& candidates,
+                                             const LidarPlaneFit& fit,
+                                             const LidarPlaneOptions& options) {
+  std::optional<LidarPlaneFit> ml = RefineRangeMl(cloud, candidates, fit, options);
+  const std::optional<Plane> facing = FacingPlane(cloud, fit.inliers);
+  if (!facing) return ml;
+  LidarPlaneFit start = fit;
+  start.plane = *facing;
+  std::optional<LidarPlaneFit> again = RefineRangeMl(cloud, candidates, start, options);
+  if (again && (!ml || again->inliers.size() > ml->inliers.size() ||
+                (again->inliers.size() == ml->inliers.size() && again->rms_m < 0.99 * ml->rms_m)))
+    return again;
+  return ml;
+}
+
 }  // namespace
 
 std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
@@ -426,26 +451,7 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
     band = next_band;
   }
   if (AlongRays(options)) {
-    // The unbiased estimate (see LidarPlaneOptions::fit_ranges_ml). The inlier band is re-drawn
-    // around the maximum-likelihood plane in range units (|r − r̂| ≤ max(threshold, 3σ̂_r)): a
-    // band around the biased least-squares plane would truncate the range noise on one side and
-    // carry the bias into the ML fit.
-    std::optional<LidarPlaneFit> ml = RefineRangeMl(cloud, candidates, *fit, options);
-    // The point-to-plane start takes the returns' thinnest direction for the normal. On a few
-    // strokes of a non-repetitive scan (returns along a curve, range noise wider than the curve)
-    // that lies across the strokes: a plane holding the rays, whose ML fit stays in its own basin.
-    // Started again from the plane that faces the sensor through the strokes, the ML fit that
-    // keeps more returns within the band (then the smaller RMS) is the board.
-    if (const std::optional<Plane> facing = FacingPlane(cloud, fit->inliers)) {
-      LidarPlaneFit start = *fit;
-      start.plane = *facing;
-      std::optional<LidarPlaneFit> again = RefineRangeMl(cloud, candidates, start, options);
-      if (again &&
-          (!ml || again->inliers.size() > ml->inliers.size() ||
-           (again->inliers.size() == ml->inliers.size() && again->rms_m < 0.99 * ml->rms_m)))
-        ml = again;
-    }
-    if (ml) fit = ml;
+    if (auto ml = RefineAlongRays(cloud, candidates, *fit, options)) fit = ml;
   }
   fit->num_candidates = static_cast<int>(candidates.size());
   const int n = static_cast<int>(fit->inliers.size());
