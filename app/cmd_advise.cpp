@@ -135,6 +135,13 @@ int RunAdvise(int argc, char** argv) {
                  "nearest usable board distance from the camera [m] (default: from the data)");
   app.add_option("--max-distance", options.max_distance_m,
                  "farthest usable board distance from the camera [m] (default: from the data)");
+  app.add_option("--hand-tolerance-m", options.guidance.hand_tolerance_m,
+                 "how far the person may miss the suggested pose, ± per axis [m]: the next pose "
+                 "is one that stays usable within it")
+      ->capture_default_str();
+  app.add_option("--hand-tolerance-deg", options.guidance.hand_tolerance_deg,
+                 "how far the person may turn the board from the suggested pose, at most [deg]")
+      ->capture_default_str();
   app.add_flag("--json", json, "print exactly one JSON object on stdout");
   std::string intrinsics_model = "pinhole";
   app.add_flag("--estimate-intrinsics", options.estimate_intrinsics,

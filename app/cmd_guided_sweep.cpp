@@ -35,6 +35,9 @@ int RunSweepGuided(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--hand-deg", options.hand_rotation_deg, "the hand's turn, at most [deg]")
       ->capture_default_str();
+  bool no_hand_model = false;
+  app.add_flag("--no-hand-model", no_hand_model,
+               "guidance scores poses as if they were held exactly (as before it knew the hand)");
   app.add_option("--table", table_path, "also write the markdown table here");
   SimFlags sim_flags;
   AddSimFlags(app, sim_flags);
@@ -49,6 +52,10 @@ int RunSweepGuided(int argc, char** argv) {
   options.pipeline = flags.options;
   options.threads = flags.options.threads;
   options.hand_translation_m = hand_cm / 100.0;
+  // Guidance expects the hand the protocol simulates (advise --hand-tolerance-m/-deg).
+  options.guidance.hand_tolerance_m = no_hand_model ? 0.0 : options.hand_translation_m;
+  options.guidance.hand_tolerance_deg = no_hand_model ? 0.0 : options.hand_rotation_deg;
+  if (no_hand_model) options.guidance.hand_samples = 1;
   if (!options.Check(&why)) {
     std::fprintf(stderr, "calibench sweep --guided: %s\n", why.c_str());
     return kUsage;

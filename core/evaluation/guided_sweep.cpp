@@ -26,7 +26,9 @@ bool GuidedSweepOptions::Check(std::string* why) const {
 namespace {
 
 // The pose as a hand holds it: the target pose moved by up to hand_translation_m per axis and
-// turned by up to hand_rotation_deg; tried until the simulator can place it (else the target).
+// turned by up to hand_rotation_deg. Drawn again only when the board would stand in a wall: a
+// pose the hand pushes out of the image or out of the detector's reach is kept, and the pair it
+// gives is lost, as it would be on site.
 Pose AsHeld(const SimOptions& sim, const Pose& target, const GuidedSweepOptions& options,
             std::mt19937_64& rng) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -36,16 +38,17 @@ Pose AsHeld(const SimOptions& sim, const Pose& target, const GuidedSweepOptions&
     const Vec3 axis = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
     const double angle = options.hand_rotation_deg * kDegToRad * std::abs(unit(rng));
     held.linear() = Eigen::AngleAxisd(angle, axis).toRotationMatrix() * target.linear();
-    if (PlaceableInSimulation(sim, held)) return held;
+    if (FitsInSimulatedRoom(sim, held)) return held;
   }
   return target;
 }
 
-// The sensors as guidance learns them from the pairs so far, the distance range as the user
-// gives it.
+// The sensors as guidance learns them from the pairs so far (the detector's reach too, as
+// `advise` does), the distance range as the user gives it.
 std::optional<SensorGeometry> SensorsFromData(const SimOptions& sim,
                                               const std::vector<LidarCloud>& clouds,
-                                              const std::vector<PairFeatures>& features) {
+                                              const std::vector<PairFeatures>& features,
+                                              const std::optional<SolverResult>& solution) {
   std::vector<const LidarCloud*> views;
   for (const LidarCloud& c : clouds) views.push_back(&c);
   std::string why;
@@ -53,6 +56,9 @@ std::optional<SensorGeometry> SensorsFromData(const SimOptions& sim,
   if (!sensors) return std::nullopt;
   sensors->min_distance_m = sim.min_distance_m;
   sensors->max_distance_m = sim.max_distance_m;
+  sensors->reach = LearnDetectionReach(
+      sim.camera, sim.board, features,
+      solution ? std::optional<Pose>(solution->cam_from_lidar) : std::nullopt, {});
   return sensors;
 }
 
@@ -94,7 +100,7 @@ GuidedRun RunGuidedCapture(const GuidedSweepOptions& options, std::uint64_t seed
   for (int k = 0; k < options.max_pairs; ++k) {
     Pose cam_from_board = RandomPlacement(sim, k);
     if (guided) {
-      std::optional<SensorGeometry> sensors = SensorsFromData(sim, clouds, features);
+      std::optional<SensorGeometry> sensors = SensorsFromData(sim, clouds, features, solution);
       if (!sensors) {
         // Nothing learnt yet: the camera alone, the simulator's LiDAR for its rings.
         sensors = SensorGeometry{};
@@ -135,6 +141,12 @@ GuidedRun RunGuidedCapture(const GuidedSweepOptions& options, std::uint64_t seed
     }
   }
   if (solution) {
+    // Why the camera missed the boards it missed, as `advise` would say it now.
+    std::vector<MissedBoard> missed;
+    LearnDetectionReach(sim.camera, sim.board, features, solution->cam_from_lidar, {}, &missed);
+    for (const MissedBoard& m : missed)
+      for (std::string& failure : run.failures)
+        if (failure.rfind("pose " + m.id + ":", 0) == 0) failure += " — " + m.words;
     run.error_t_mm =
         (solution->cam_from_lidar.translation() - sim.cam_from_lidar.translation()) * 1e3;
     run.error_r_deg =
@@ -186,17 +198,22 @@ std::string FormatGuidedSweepTable(const GuidedSweepResult& result) {
                 o.hand_translation_m * 100, o.hand_rotation_deg);
   std::string out = line;
   out +=
-      "| placement | median poses to done | done | true error within 3× goal | within 3σ | "
-      "median error (mm / deg) |\n|---|---|---|---|---|---|\n";
+      "| placement | median poses to done (range) | done | unusable poses (most in a run) | true "
+      "error within 3× goal | within 3σ | median error (mm / deg) |\n"
+      "|---|---|---|---|---|---|---|\n";
   for (const char* placement : {"guided", "random"}) {
     std::vector<double> poses, error_t, error_r;
     int done = 0, within_goal = 0, within_sigma = 0, runs = 0;
+    int held = 0, unusable = 0, most_unusable = 0;
     for (const GuidedRun& r : result.runs) {
       if (r.placement != placement) continue;
       ++runs;
       // A run never done counts as needing more than the cap (it sorts last in the median).
       poses.push_back(r.done ? r.poses : o.max_pairs + 1);
       done += r.done;
+      held += r.poses;
+      unusable += r.poses - r.accepted;
+      most_unusable = std::max(most_unusable, r.poses - r.accepted);
       within_goal += r.done && r.within_goal;
       within_sigma += r.done && r.within_sigma;
       error_t.push_back(r.error_t_mm.norm());
@@ -208,15 +225,22 @@ std::string FormatGuidedSweepTable(const GuidedSweepResult& result) {
       const size_t n = v.size();
       return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
     };
-    const double median_poses = median(poses);
-    char poses_text[40];
-    if (median_poses > o.max_pairs)
-      std::snprintf(poses_text, sizeof(poses_text), "> %d", o.max_pairs);
-    else
-      std::snprintf(poses_text, sizeof(poses_text), "%.1f", median_poses);
-    std::snprintf(line, sizeof(line), "| %s | %s | %d / %d | %d / %d | %d / %d | %.1f / %.3f |\n",
-                  placement, poses_text, done, runs, within_goal, done, within_sigma, done,
-                  median(error_t), median(error_r));
+    auto poses_text = [&](double value) {
+      char text[24];
+      if (value > o.max_pairs)
+        std::snprintf(text, sizeof(text), "> %d", o.max_pairs);
+      else
+        std::snprintf(text, sizeof(text), "%.1f", value);
+      return std::string(text);
+    };
+    const auto [fewest, most] = std::minmax_element(poses.begin(), poses.end());
+    std::snprintf(line, sizeof(line),
+                  "| %s | %s (%s-%s) | %d / %d | %d of %d, %.0f %% (%d) | %d / %d | %d / %d | "
+                  "%.1f / %.3f |\n",
+                  placement, poses_text(median(poses)).c_str(), poses_text(*fewest).c_str(),
+                  poses_text(*most).c_str(), done, runs, unusable, held,
+                  held > 0 ? 100.0 * unusable / held : 0.0, most_unusable, within_goal, done,
+                  within_sigma, done, median(error_t), median(error_r));
     out += line;
   }
   return out;

@@ -160,6 +160,15 @@ CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& ou
     }
     if (advice.state && !(advice.intrinsics && advice.intrinsics->good)) advice.state->done = false;
   }
+  // Where the camera missed a board the LiDAR placed: why, and the reach that guidance keeps to.
+  std::vector<MissedBoard> missed;
+  advice.reach = LearnDetectionReach(
+      dataset.camera, dataset.target, pairs,
+      advice.solution ? std::optional<Pose>(advice.solution->cam_from_lidar) : std::nullopt, {},
+      &missed);
+  for (const MissedBoard& m : missed)
+    for (PairAdvice& pair : advice.pairs)
+      if (pair.id == m.id) pair.findings.push_back({"reach", PreflightSeverity::kReject, m.words});
   if (advice.state && advice.state->done) return advice;
   const std::vector<LidarCloud> clouds = RingClouds(dataset, pairs, options.clouds_for_beams);
   std::vector<const LidarCloud*> cloud_views;
@@ -175,6 +184,7 @@ CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& ou
     sensors->min_distance_m = options.min_distance_m;
     sensors->max_distance_m = options.max_distance_m;
   }
+  sensors->reach = advice.reach;
   // Guidance needs a solution that fixes all six degrees of freedom.
   std::optional<SolverResult> usable = advice.solution;
   if (usable && !usable->observability.well_constrained) usable.reset();
@@ -209,11 +219,26 @@ std::string CaptureAdviceJson(const CaptureAdvice& advice) {
       n["predicted_rings"] = next.feasibility.rings;
       n["predicted_points"] = next.feasibility.points;
     }
+    n["usable_share"] = next.usable_share;
+    n["tolerance"] = {{"translation_m", next.tolerance.translation_m},
+                      {"rotation_deg", next.tolerance.rotation_deg},
+                      {"usable_share", next.tolerance.usable_share},
+                      {"words", next.tolerance.words}};
     out["next"] = n;
   } else {
     out["next"] = nullptr;
     if (!(advice.state && advice.state->done)) out["next_failure"] = advice.next_failure;
   }
+  const DetectionReach& reach = advice.reach;
+  auto measured = [](bool known, double value) {
+    return known ? nlohmann::json(value) : nlohmann::json();
+  };
+  out["detection_reach"] = {
+      {"min_square_px", measured(reach.min_square_px > 0, reach.min_square_px)},
+      {"max_incidence_deg", measured(reach.max_incidence_deg < 90, reach.max_incidence_deg)},
+      {"max_off_axis_deg", measured(reach.max_off_axis_deg < 180, reach.max_off_axis_deg)},
+      {"boards_found", reach.boards_found},
+      {"boards_missed", reach.boards_missed}};
   nlohmann::json pairs = nlohmann::json::array();
   for (const PairAdvice& p : advice.pairs) {
     nlohmann::json findings = nlohmann::json::array();

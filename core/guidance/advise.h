@@ -46,6 +46,9 @@ struct CaptureAdvice {
   std::optional<CaptureState> state;  // with a solution
   CaptureGoal goal;
   std::vector<PairAdvice> pairs;
+  // The camera detector's reach measured on these pairs (LearnDetectionReach); a pair it missed
+  // also gets a "reach" finding saying why, in words.
+  DetectionReach reach;
   std::optional<PoseSuggestion> next;  // absent when done, or when nothing feasible was found
   std::string next_failure;            // why `next` is absent while not done
   // AdviseOptions::estimate_intrinsics: the camera from the pairs' corners, or why not; the
@@ -61,7 +64,10 @@ CaptureAdvice AdviseCapture(const Dataset& dataset, const CalibrationOutcome& ou
 // The JSON object of `advise --json` (one object, no trailing newline): pairs_used,
 // cam_from_lidar (4x4 nested rows, null without a solution), sigma_t_mm, sigma_r_deg, goal
 // {t_mm, r_deg}, done, trustworthy, trust_note, weakest, next (null when done, else
-// {lidar_from_board, cam_from_board, words, predicted_sigma_t_mm, predicted_sigma_r_deg}) and
+// {lidar_from_board, cam_from_board, words, predicted_sigma_t_mm, predicted_sigma_r_deg,
+// usable_share, tolerance {translation_m, rotation_deg, usable_share, words}}), detection_reach
+// {min_square_px, max_incidence_deg, max_off_axis_deg (null where nothing was measured),
+// boards_found, boards_missed} and
 // pairs [{name, status, reason, findings [{check, severity, words}]}]; with estimate_intrinsics,
 // intrinsics {good, verdict, rms_px, parameters {name: value}, sigmas {name: σ}, cells_covered,
 // border_covered, missing [words]} or {failure}.

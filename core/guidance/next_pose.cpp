@@ -9,6 +9,7 @@
 
 #include "core/estimation/fisher_information.h"
 #include "core/estimation/uncertainty.h"
+#include "core/guidance/candidate_grid.h"
 #include "core/lidar_camera/solver.h"
 
 namespace calibench {
@@ -43,6 +44,22 @@ bool GuidanceOptions::Check(std::string* why) const {
   if (yaw_deg.empty() || pitch_deg.empty() || roll_deg.empty())
     return *why = "the candidate tilts must not be empty", false;
   if (!(intrinsics_cover_weight >= 0)) return *why = "intrinsics_cover_weight must be >= 0", false;
+  if (!(hand_tolerance_m >= 0 && hand_tolerance_m <= 1.0))
+    return *why = "the hand's tolerance must be in [0, 1] m", false;
+  if (!(hand_tolerance_deg >= 0 && hand_tolerance_deg <= 45.0))
+    return *why = "the hand's tolerance must be in [0, 45] degrees", false;
+  if (hand_samples < 1 || robust_candidates < 1)
+    return *why = "hand_samples and robust_candidates must be >= 1", false;
+  if (!(reach_square_margin >= 1.0) || !(reach_angle_margin_deg >= 0))
+    return *why = "the margins inside the detector's reach must be >= 1 and >= 0 deg", false;
+  if (!(usable_max_incidence_deg >= max_incidence_deg && usable_max_incidence_deg < 90) ||
+      !(usable_min_square_px >= 0 && usable_min_square_px <= min_square_px) ||
+      !(usable_image_margin_fraction >= 0 &&
+        usable_image_margin_fraction <= image_margin_fraction) ||
+      !usable_lidar_returns.Check(why))
+    return *why = "the usable limits must be at least as wide as the suggestions' limits", false;
+  if (!(tolerance_usable_share > 0 && tolerance_usable_share <= 1))
+    return *why = "tolerance_usable_share must be in (0, 1]", false;
   return true;
 }
 
@@ -57,18 +74,6 @@ std::vector<Vec3> SheetCorners(const BoardSpec& board) {
 // The angle between a plane's normal and the ray from the sensor to a point on it.
 double IncidenceDeg(const Vec3& normal, const Vec3& point) {
   return std::acos(std::min(1.0, std::abs(normal.dot(point.normalized())))) * kRadToDeg;
-}
-
-// Facing the camera along `bearing` (z away from the camera, x near camera x), turned by yaw
-// about the board's vertical axis, pitch about its horizontal axis and roll in its plane.
-Mat3 BoardRotation(const Vec3& bearing, double yaw_deg, double pitch_deg, double roll_deg) {
-  const Vec3 z = bearing.normalized();
-  const Vec3 x = (Vec3::UnitX() - Vec3::UnitX().dot(z) * z).normalized();
-  Mat3 facing;
-  facing << x, z.cross(x), z;
-  return facing * Eigen::AngleAxisd(yaw_deg * kDegToRad, Vec3::UnitY()).toRotationMatrix() *
-         Eigen::AngleAxisd(pitch_deg * kDegToRad, Vec3::UnitX()).toRotationMatrix() *
-         Eigen::AngleAxisd(roll_deg * kDegToRad, Vec3::UnitZ()).toRotationMatrix();
 }
 
 Vec3 SigmaT(const Mat6& covariance, const Pose& cam_from_lidar) {
@@ -107,10 +112,13 @@ Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pos
     f.why = text;
     return f;
   }
-  // The sheet must face the camera (its back would show no pattern).
+  // The sheet must face the camera (its back would show no pattern), within the detector's reach
+  // measured on this rig where it is narrower than the options'.
+  const double max_camera_incidence = std::min(
+      options.max_incidence_deg, sensors.reach.max_incidence_deg - options.reach_angle_margin_deg);
   if (camera_normal.dot(cam_from_board.translation()) <= 0 ||
-      f.camera_incidence_deg > options.max_incidence_deg) {
-    f.why = TooOblique("camera", f.camera_incidence_deg, options.max_incidence_deg);
+      f.camera_incidence_deg > max_camera_incidence) {
+    f.why = TooOblique("camera", f.camera_incidence_deg, max_camera_incidence);
     return f;
   }
   const double margin = options.image_margin_fraction * sensors.camera.width;
@@ -126,14 +134,22 @@ Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pos
       }
     }
   }
-  // The smallest square's width in pixels, at the pattern's centre.
-  const double s = sensors.board.square_size;
-  const auto a = sensors.camera.Project(cam_from_board * Vec3(0, 0, 0));
-  const auto b = sensors.camera.Project(cam_from_board * Vec3(s, 0, 0));
-  const auto c = sensors.camera.Project(cam_from_board * Vec3(0, s, 0));
-  if (a && b && c && std::min((*b - *a).norm(), (*c - *a).norm()) < options.min_square_px) {
-    std::snprintf(text, sizeof(text), "the squares would be under %.0f px wide in the image",
-                  options.min_square_px);
+  const BoardAppearance look = AppearanceOf(sensors.camera, sensors.board, cam_from_board);
+  const double min_square_px =
+      std::max(options.min_square_px,
+               options.reach_square_margin *
+                   std::max(DetectableSquarePx(sensors.board), sensors.reach.min_square_px));
+  if (look.square_px < min_square_px) {
+    std::snprintf(text, sizeof(text), "the squares would be %.0f px wide in the image, under %.0f",
+                  look.square_px, min_square_px);
+    f.why = text;
+    return f;
+  }
+  const double max_off_axis = sensors.reach.max_off_axis_deg - options.reach_angle_margin_deg;
+  if (look.off_axis_deg > max_off_axis) {
+    std::snprintf(text, sizeof(text),
+                  "%.0f deg off the optical axis, beyond the %.0f deg this rig's detector reaches",
+                  look.off_axis_deg, max_off_axis);
     f.why = text;
     return f;
   }
@@ -186,68 +202,6 @@ PlanePair PlannedPair(const SensorGeometry& sensors, const Pose& cam_from_lidar,
 
 namespace {
 
-// One pose of the candidate grid (camera frame, BoardSpec's board frame).
-struct Candidate {
-  Pose cam_from_board = Pose::Identity();
-  bool middle_row = false;    // in the image's middle band
-  double turn_deg = 0.0;      // |yaw| + |pitch| + |roll| of the grid
-  double off_axis = 0.0;      // |bearing − optical axis|
-  double off_centre_m = 0.0;  // distance from the middle of the usable range
-  bool moderate = false;      // |yaw|, |pitch| <= 30 degrees
-};
-
-// Distances across the usable range × image cells × the tilts of GuidanceOptions.
-std::vector<Candidate> CandidateGrid(const SensorGeometry& sensors,
-                                     const GuidanceOptions& options) {
-  std::vector<Candidate> grid;
-  const double middle = 0.5 * (sensors.min_distance_m + sensors.max_distance_m);
-  for (int di = 0; di < options.distance_steps; ++di) {
-    const double distance =
-        options.distance_steps == 1
-            ? middle
-            : sensors.min_distance_m + (sensors.max_distance_m - sensors.min_distance_m) * di /
-                                           (options.distance_steps - 1);
-    for (int col = 0; col < options.image_columns; ++col) {
-      for (int row = 0; row < options.image_rows; ++row) {
-        const Vec2 pixel(sensors.camera.width * (col + 0.5) / options.image_columns,
-                         sensors.camera.height * (row + 0.5) / options.image_rows);
-        const auto bearing = sensors.camera.Unproject(pixel);
-        if (!bearing) continue;
-        for (double yaw : options.yaw_deg) {
-          for (double pitch : options.pitch_deg) {
-            for (double roll : options.roll_deg) {
-              Candidate c;
-              c.cam_from_board.linear() = BoardRotation(*bearing, yaw, pitch, roll);
-              c.cam_from_board.translation() = distance * bearing->normalized();
-              c.middle_row = options.image_rows == 1 || row == options.image_rows / 2;
-              c.turn_deg = std::abs(yaw) + std::abs(pitch) + std::abs(roll);
-              c.off_axis = (bearing->normalized() - Vec3::UnitZ()).norm();
-              c.off_centre_m = std::abs(distance - middle);
-              c.moderate = std::abs(yaw) <= 30 && std::abs(pitch) <= 30;
-              grid.push_back(c);
-            }
-          }
-        }
-      }
-    }
-  }
-  return grid;
-}
-
-// A board where one was already held adds what that pose added: if the model over-promises there
-// (a detection noisier than its bound), suggesting it again would repeat the disappointment.
-bool NearAHeldBoard(const Pose& cam_from_board, const std::vector<Pose>& seen,
-                    const GuidanceOptions& options) {
-  for (const Pose& held : seen)
-    if ((held.translation() - cam_from_board.translation()).norm() < options.repeat_distance_m &&
-        RotationAngle(held.linear(), cam_from_board.linear()) <
-            options.repeat_angle_deg * kDegToRad)
-      return true;
-  return false;
-}
-
-// Without a solution: unlike what was seen (normals and positions), frontal first; ties by the
-// distance from the middle of the usable range. Lower is better.
 // What a new pair's model information is expected to be worth, as the map D of I ↦ D I Dᵀ. In
 // the coordinates where the model's covariance is the identity (T = H^½, H the model's
 // information), the reported covariance reads W = T C T: how much wider than the model each
@@ -266,30 +220,6 @@ Mat6 InformationDiscount(const SolverResult& solution) {
   const Vec6 shrink = widening.eigenvalues().cwiseMax(1.0).cwiseInverse().cwiseSqrt();
   return root * widening.eigenvectors() * shrink.asDiagonal() *
          widening.eigenvectors().transpose() * root_inverse;
-}
-
-// How many of the cells the intrinsics still need a candidate puts board corners in.
-int CellsCovered(const SensorGeometry& sensors, const Pose& cam_from_board,
-                 const std::vector<Eigen::AlignedBox2d>& cells) {
-  if (cells.empty()) return 0;
-  std::vector<char> hit(cells.size(), 0);
-  for (const Vec3& corner : BoardCornerPoints(sensors.board)) {
-    const auto pixel = sensors.camera.Project(cam_from_board * corner);
-    if (!pixel) continue;
-    for (size_t k = 0; k < cells.size(); ++k) hit[k] |= cells[k].contains(*pixel);
-  }
-  return static_cast<int>(std::count(hit.begin(), hit.end(), 1));
-}
-
-std::pair<double, double> StarterScore(const Candidate& c, const std::vector<Pose>& seen) {
-  if (seen.empty()) return {c.turn_deg + c.off_axis, c.off_centre_m};
-  double nearest = 1e9;
-  for (const Pose& s : seen) {
-    const double angle =
-        std::acos(std::clamp(s.linear().col(2).dot(c.cam_from_board.linear().col(2)), -1.0, 1.0));
-    nearest = std::min(nearest, angle + (s.translation() - c.cam_from_board.translation()).norm());
-  }
-  return {-nearest, c.off_centre_m};
 }
 
 // The feasible candidate (with its tie-breaker) of the lowest score, after the intrinsics' wish
@@ -320,6 +250,151 @@ std::optional<PoseSuggestion> LowestScore(std::vector<std::pair<PoseSuggestion, 
 
 }  // namespace
 
+namespace {
+
+// A candidate's worth under the solver's model: the predicted covariance after adding it.
+struct InformationModel {
+  const SensorGeometry* sensors = nullptr;
+  const SolverResult* solution = nullptr;
+  const SolverOptions* solver_options = nullptr;
+  const CaptureGoal* goal = nullptr;
+  Mat6 current_information = Mat6::Zero();
+  Mat6 discount = Mat6::Identity();
+  double current_score = 0.0;  // Σ (σ/goal)² now
+
+  // The model's information of a pair held at cam_from_board, discounted by how much wider than
+  // the model the reported covariance is (the pairs' scatter on real sensors): a new pair is
+  // expected to help as much as the ones seen so far did.
+  Mat6 PredictedCovariance(const Pose& cam_from_board, const BoardReturns& returns) const {
+    const Pose& cam_from_lidar = solution->cam_from_lidar;
+    const Mat6 model_added = ExpectedPoseInformation(
+        {PlannedPair(*sensors, cam_from_lidar, cam_from_board, returns)}, cam_from_lidar,
+        *solver_options, solution->plane_variance_factor, solution->edge_variance_factor);
+    return (current_information + discount * model_added * discount.transpose()).inverse();
+  }
+};
+
+// The options that judge a held placement: the pipeline's reach instead of the suggestions'.
+GuidanceOptions UsableLimits(const GuidanceOptions& options) {
+  GuidanceOptions usable = options;
+  usable.max_incidence_deg = options.usable_max_incidence_deg;
+  usable.min_square_px = options.usable_min_square_px;
+  usable.image_margin_fraction = options.usable_image_margin_fraction;
+  usable.lidar_returns = options.usable_lidar_returns;
+  usable.reach_square_margin = 1.0;
+  usable.reach_angle_margin_deg = 0.0;
+  return usable;
+}
+
+// The expected Σ (σ/goal)² after a board is held where a hand puts it for `target` (a placement
+// the sensors cannot use adds nothing), and the share of usable placements. Without a model
+// (no solution), the share only.
+std::pair<double, double> UnderTheHand(const InformationModel& model,
+                                       const std::optional<Pose>& cam_from_lidar,
+                                       const std::vector<Pose>& placements,
+                                       const GuidanceOptions& suggestion_options, bool with_score) {
+  const GuidanceOptions options = UsableLimits(suggestion_options);
+  double expected = 0.0;
+  int usable = 0;
+  for (const Pose& held : placements) {
+    BoardReturns returns;
+    const Feasibility f = CheckFeasible(*model.sensors, cam_from_lidar, held, options, &returns);
+    usable += f.feasible;
+    if (!with_score || !model.solution) continue;
+    expected += f.feasible ? GoalScore(model.PredictedCovariance(held, returns), *cam_from_lidar,
+                                       *model.goal)
+                                 .second
+                           : model.current_score;
+  }
+  const double n = static_cast<double>(placements.size());
+  return {expected / n, usable / n};
+}
+
+// The widest of the hand's tolerance, halved in turn or place, halved in both, quartered, within
+// which options.tolerance_usable_share of placements are usable; in words a person can follow.
+HoldTolerance ToleranceOf(const InformationModel& model, const std::optional<Pose>& cam_from_lidar,
+                          const Pose& target, double usable_share, const GuidanceOptions& options) {
+  const double t = options.hand_tolerance_m, r = options.hand_tolerance_deg;
+  const std::vector<std::pair<double, double>> steps{
+      {t, r}, {t, 0.5 * r}, {0.5 * t, r}, {0.5 * t, 0.5 * r}, {0.25 * t, 0.25 * r}};
+  HoldTolerance tolerance;
+  char text[240];
+  for (size_t k = 0; k < steps.size(); ++k) {
+    const auto [metres, degrees] = steps[k];
+    const double share =
+        k == 0 ? usable_share
+               : UnderTheHand(model, cam_from_lidar,
+                              HandPlacements(target, metres, degrees, options.hand_samples),
+                              options, /*with_score=*/false)
+                     .second;
+    if (share < options.tolerance_usable_share) continue;
+    tolerance = {metres, degrees, share, ""};
+    if (k == 0)
+      std::snprintf(text, sizeof(text),
+                    "anywhere within a hand's width of it is fine (±%.0f cm, ±%.0f°)", metres * 100,
+                    degrees);
+    else if (metres == t)
+      std::snprintf(text, sizeof(text), "keep the tilt within %.0f° of it", degrees);
+    else if (degrees == r)
+      std::snprintf(text, sizeof(text), "keep it within %.0f cm of the spot", metres * 100);
+    else
+      std::snprintf(text, sizeof(text), "hold it within %.0f cm and %.0f° of it", metres * 100,
+                    degrees);
+    tolerance.words = text;
+    return tolerance;
+  }
+  tolerance = {steps.back().first, steps.back().second, usable_share, ""};
+  std::snprintf(text, sizeof(text),
+                "hold it as exactly as you can: only %.0f %% of placements within a hand's width "
+                "are usable",
+                100 * usable_share);
+  tolerance.words = text;
+  return tolerance;
+}
+
+// Each feasible candidate scored again where a hand would hold it. With a solution: the
+// robust_candidates best by their nominal score, by their expected score under the hand (the rest
+// leave: their nominal scores do not compare), and among those whose expected gain is within 2 %
+// of the best, the one usable most often. Without: only the candidates usable about as often as
+// the most robust one stay.
+void RobustToTheHand(const InformationModel& model, const std::optional<Pose>& cam_from_lidar,
+                     const GuidanceOptions& options,
+                     std::vector<std::pair<PoseSuggestion, double>>* feasible) {
+  auto& list = *feasible;
+  if (cam_from_lidar) {
+    std::sort(list.begin(), list.end(),
+              [](const auto& a, const auto& b) { return a.first.score < b.first.score; });
+    if (static_cast<int>(list.size()) > options.robust_candidates)
+      list.resize(options.robust_candidates);
+  }
+  double best_share = 0.0, best_expected = std::numeric_limits<double>::infinity();
+  for (auto& [suggestion, tie] : list) {
+    const auto [expected, share] =
+        UnderTheHand(model, cam_from_lidar,
+                     HandPlacements(suggestion.cam_from_board, options.hand_tolerance_m,
+                                    options.hand_tolerance_deg, options.hand_samples),
+                     options, /*with_score=*/true);
+    suggestion.usable_share = share;
+    best_share = std::max(best_share, share);
+    if (cam_from_lidar) {
+      suggestion.score = expected;
+      best_expected = std::min(best_expected, expected);
+    }
+  }
+  if (!cam_from_lidar) {
+    std::erase_if(list, [&](const auto& s) { return s.first.usable_share < best_share - 0.05; });
+    return;
+  }
+  const double best_gain = model.current_score - best_expected;
+  for (auto& [suggestion, tie] : list) {
+    if (model.current_score - suggestion.score < 0.98 * best_gain) continue;
+    suggestion.score = best_expected;
+    tie = -suggestion.usable_share;
+  }
+}
+
+}  // namespace
+
 std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
                                            const std::optional<SolverResult>& solution,
                                            const std::vector<Pose>& seen, const CaptureGoal& goal,
@@ -328,13 +403,18 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
   if (!sensors.Check(why) || !goal.Check(why) || !options.Check(why)) return std::nullopt;
   const std::optional<Pose> cam_from_lidar =
       solution ? std::optional<Pose>(solution->cam_from_lidar) : std::nullopt;
-  Mat6 current_information = Mat6::Zero();
+  InformationModel model;
+  model.sensors = &sensors;
+  model.solver_options = &solver_options;
+  model.goal = &goal;
   if (solution) {
+    model.solution = &*solution;
     Eigen::LDLT<Mat6> ldlt(solution->covariance);
     if (ldlt.info() == Eigen::Success && ldlt.isPositive())
-      current_information = ldlt.solve(Mat6::Identity());
+      model.current_information = ldlt.solve(Mat6::Identity());
+    model.discount = InformationDiscount(*solution);
+    model.current_score = GoalScore(solution->covariance, *cam_from_lidar, goal).second;
   }
-  const Mat6 discount = solution ? InformationDiscount(*solution) : Mat6::Identity();
   const std::vector<Candidate> grid = CandidateGrid(sensors, options);
   std::vector<std::pair<PoseSuggestion, double>> feasible;  // with its tie-breaker
   std::string last_reason;
@@ -355,18 +435,11 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
     suggestion.feasibility = f;
     std::pair<double, double> score;
     if (cam_from_lidar) {
-      // The model's information, discounted by how much wider than the model the reported
-      // covariance is (the pairs' scatter on real sensors): a new pair is expected to help as
-      // much as the ones seen so far did.
-      const Mat6 model_added = ExpectedPoseInformation(
-          {PlannedPair(sensors, *cam_from_lidar, c.cam_from_board, returns)}, *cam_from_lidar,
-          solver_options, solution->plane_variance_factor, solution->edge_variance_factor);
-      const Mat6 added = discount * model_added * discount.transpose();
-      const Mat6 predicted = (current_information + added).inverse();
       // The sum of squared σ/goal over the six axes (A-optimal in units of the goal: the weakest
       // axis dominates it), the largest ratio breaking ties. Chasing the largest ratio alone
       // alternates between axes and took more poses in the guided sweep (OS0-128 + fisheye: 16
       // against 11.5 poses, median of 4 seeds).
+      const Mat6 predicted = model.PredictedCovariance(c.cam_from_board, returns);
       const auto [largest, sum_of_squares] = GoalScore(predicted, *cam_from_lidar, goal);
       score = {sum_of_squares, largest};
       suggestion.lidar_from_board =
@@ -382,41 +455,24 @@ std::optional<PoseSuggestion> NextBestPose(const SensorGeometry& sensors,
     suggestion.score = score.first;
     feasible.push_back({std::move(suggestion), score.second});
   }
-  std::optional<PoseSuggestion> best =
-      LowestScore(&feasible, cam_from_lidar.has_value(), options.intrinsics_cover_weight);
-  if (!best) {
+  if (feasible.empty()) {
     *why = "none of the " + std::to_string(grid.size()) +
            " candidate board poses is feasible or new" +
            (last_reason.empty() ? std::string() : " (the last refused: " + last_reason + ")");
     return std::nullopt;
   }
-  best->words = DescribeBoardPose(sensors.camera, best->cam_from_board);
+  RobustToTheHand(model, cam_from_lidar, options, &feasible);
+  std::optional<PoseSuggestion> best =
+      LowestScore(&feasible, cam_from_lidar.has_value(), options.intrinsics_cover_weight);
+  best->tolerance =
+      ToleranceOf(model, cam_from_lidar, best->cam_from_board, best->usable_share, options);
+  best->words =
+      DescribeBoardPose(sensors.camera, best->cam_from_board) + "; " + best->tolerance.words;
   if (best->intrinsics_cells_covered > 0)
     best->words += "; it puts corners in " + std::to_string(best->intrinsics_cells_covered) +
                    " of the " + std::to_string(options.intrinsics_cells_to_cover.size()) +
                    " image cells the intrinsics still lack";
   return best;
-}
-
-SuggestionMatch MatchSuggestion(const Pose& cam_from_board, const PoseSuggestion& suggestion,
-                                const GuidanceOptions& options) {
-  SuggestionMatch match;
-  match.offset_m = (cam_from_board.translation() - suggestion.cam_from_board.translation()).norm();
-  const double cosine =
-      cam_from_board.linear().col(2).dot(suggestion.cam_from_board.linear().col(2));
-  match.angle_deg = std::acos(std::clamp(cosine, -1.0, 1.0)) * kRadToDeg;
-  match.matches =
-      match.offset_m <= options.repeat_distance_m && match.angle_deg <= options.repeat_angle_deg;
-  char tolerance[80] = "";
-  if (!match.matches)
-    std::snprintf(tolerance, sizeof(tolerance), " (within %.0f mm and %.0f deg counts)",
-                  options.repeat_distance_m * 1e3, options.repeat_angle_deg);
-  char text[200];
-  std::snprintf(text, sizeof(text), "%s the ghost board: %.0f mm from it, tilted %.0f deg%s",
-                match.matches ? "matches" : "does not match", match.offset_m * 1e3, match.angle_deg,
-                tolerance);
-  match.words = text;
-  return match;
 }
 
 }  // namespace calibench

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/camera/camera.h"
+#include "core/guidance/detection_reach.h"
 #include "core/lidar/beam_table.h"
 #include "core/lidar/board_returns.h"
 #include "core/lidar/cloud.h"
@@ -33,6 +34,7 @@ struct SensorGeometry {
   double max_distance_m = 4.0;
   double range_sigma_m = 0.01;   // LiDAR range noise (1σ along the ray)
   double corner_sigma_px = 0.3;  // corner noise (1σ per coordinate)
+  DetectionReach reach;          // the camera detector's reach measured on this rig, if any
   bool Check(std::string* why) const;
 };
 
@@ -60,8 +62,8 @@ struct GuidanceOptions {
   int image_columns = 3;
   int image_rows = 3;
   std::vector<double> yaw_deg{-45, -25, 0, 25, 45};
-  std::vector<double> pitch_deg{-30, 0, 30};
-  std::vector<double> roll_deg{0, 45};
+  std::vector<double> pitch_deg{-40, -20, 0, 20, 40};
+  std::vector<double> roll_deg{0, 45, -45};
   // Candidates this close to a board already held (camera frame) are not suggested again.
   double repeat_distance_m = 0.15;
   double repeat_angle_deg = 10.0;
@@ -71,6 +73,29 @@ struct GuidanceOptions {
   // a solution; without one, that is added): the best-covering keeps its score.
   std::vector<Eigen::AlignedBox2d> intrinsics_cells_to_cover;
   double intrinsics_cover_weight = 1.0;
+  // The hand that holds the board misses the suggested pose by up to this much: uniform in
+  // ±hand_tolerance_m per axis (camera frame) and a turn of up to hand_tolerance_deg about any
+  // axis. A candidate is scored by its expected Σ (σ/goal)² over hand_samples such placements (a
+  // placement the sensors cannot use adds nothing), so a pose at the edge of the detector's reach
+  // loses to a robust one; the robust_candidates best by their nominal score are scored so.
+  // A placement counts as usable within the pipeline's own reach, wider than the limits above
+  // that suggestions keep to (a suggestion keeps a margin; a pose the hand moved a little beyond
+  // it is not lost): these, tightened by the reach measured on the rig (SensorGeometry::reach).
+  // Suggestions also keep this far inside the detector's reach (DetectableSquarePx and
+  // SensorGeometry::reach): squares this much wider, angles this much smaller.
+  double reach_square_margin = 1.25;
+  double reach_angle_margin_deg = 5.0;
+  double usable_max_incidence_deg = 75.0;
+  double usable_min_square_px = 8.0;
+  double usable_image_margin_fraction = 0.0;
+  BoardReturnsRule usable_lidar_returns{3, 3, 20};
+  double hand_tolerance_m = 0.10;
+  double hand_tolerance_deg = 10.0;
+  int hand_samples = 16;
+  int robust_candidates = 40;
+  // The tolerance told with a suggestion is the widest (of the hand's, halved in turn or place,
+  // halved in both, quartered) within which this share of placements is usable.
+  double tolerance_usable_share = 0.9;
   bool Check(std::string* why) const;
 };
 
@@ -98,6 +123,15 @@ Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pos
 PlanePair PlannedPair(const SensorGeometry& sensors, const Pose& cam_from_lidar,
                       const Pose& cam_from_board, const BoardReturns& returns);
 
+// How precisely a suggested pose must be held: placements within ±translation_m per axis and
+// rotation_deg of turn are usable with probability usable_share (by the sampled hand model).
+struct HoldTolerance {
+  double translation_m = 0.0;
+  double rotation_deg = 0.0;
+  double usable_share = 1.0;
+  std::string words;  // "anywhere within a hand's width of it is fine (±10 cm, ±10°)"
+};
+
 struct PoseSuggestion {
   Pose cam_from_board = Pose::Identity();    // BoardSpec frame
   std::optional<Pose> lidar_from_board;      // shown frame (ShownFromBoardSpec); with a solution
@@ -107,6 +141,10 @@ struct PoseSuggestion {
   // Of GuidanceOptions::intrinsics_cells_to_cover, the cells this pose puts corners in.
   int intrinsics_cells_covered = 0;
   Feasibility feasibility;
+  // Of placements within the hand's error (GuidanceOptions::hand_tolerance_*), the share the
+  // sensors can use; and the tolerance to tell the person.
+  double usable_share = 1.0;
+  HoldTolerance tolerance;
   std::string words;
 };
 
@@ -136,15 +174,20 @@ std::string TooOblique(const char* sensor, double angle_deg, double max_deg);
 std::string DescribeBoardPose(const CameraModel& camera, const Pose& cam_from_board);
 
 // A board held (cam_from_board, BoardSpec frame) against the pose suggested for it: it matches
-// within options.repeat_distance_m of the suggested centre and options.repeat_angle_deg between
-// the normals (the tolerance within which the suggestion counts as taken and is not suggested
-// again). `words` say by how much, either way.
+// within the suggestion's tolerance (per axis of the centre, and between the normals; without
+// one, options.repeat_distance_m of the centre and options.repeat_angle_deg). `words` say by how
+// much, either way.
 struct SuggestionMatch {
   bool matches = false;
   double offset_m = 0.0;
   double angle_deg = 0.0;
   std::string words;
 };
+// Placements a hand gives for `target`: hand_samples draws (fixed, so advice is repeatable and
+// candidates are compared on the same draws), scaled to the tolerance given.
+std::vector<Pose> HandPlacements(const Pose& target, double translation_m, double rotation_deg,
+                                 int samples);
+
 SuggestionMatch MatchSuggestion(const Pose& cam_from_board, const PoseSuggestion& suggestion,
                                 const GuidanceOptions& options);
 

@@ -1,4 +1,5 @@
 // People's side of a board pose: the frame shown to them and the words to hold it by.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -71,6 +72,33 @@ std::string DescribeBoardPose(const CameraModel& camera, const Pose& cam_from_bo
     words += text;
   }
   return words;
+}
+
+SuggestionMatch MatchSuggestion(const Pose& cam_from_board, const PoseSuggestion& suggestion,
+                                const GuidanceOptions& options) {
+  SuggestionMatch match;
+  const Vec3 offset = cam_from_board.translation() - suggestion.cam_from_board.translation();
+  match.offset_m = offset.norm();
+  const double cosine =
+      cam_from_board.linear().col(2).dot(suggestion.cam_from_board.linear().col(2));
+  match.angle_deg = std::acos(std::clamp(cosine, -1.0, 1.0)) * kRadToDeg;
+  // The suggestion's own tolerance (per axis, as the hand's error is drawn), else the repeat
+  // distance (of the centre).
+  const bool own = suggestion.tolerance.translation_m > 0 || suggestion.tolerance.rotation_deg > 0;
+  const double metres = own ? suggestion.tolerance.translation_m : options.repeat_distance_m;
+  const double degrees = own ? suggestion.tolerance.rotation_deg : options.repeat_angle_deg;
+  match.matches = (own ? offset.cwiseAbs().maxCoeff() : match.offset_m) <= metres + 1e-9 &&
+                  match.angle_deg <= degrees + 1e-9;
+  char tolerance[80] = "";
+  if (!match.matches)
+    std::snprintf(tolerance, sizeof(tolerance), " (within %.0f mm%s and %.0f deg counts)",
+                  metres * 1e3, own ? " per axis" : "", degrees);
+  char text[200];
+  std::snprintf(text, sizeof(text), "%s the ghost board: %.0f mm from it, tilted %.0f deg%s",
+                match.matches ? "matches" : "does not match", match.offset_m * 1e3, match.angle_deg,
+                tolerance);
+  match.words = text;
+  return match;
 }
 
 }  // namespace calibench

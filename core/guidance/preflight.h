@@ -27,7 +27,9 @@ struct PreflightOptions {
 enum class PreflightSeverity { kWeak, kReject };
 
 struct PreflightFinding {
-  std::string check;  // "image-border", "rings", "oblique", "blur", "stamps", "moved", "duplicate"
+  // "image-border", "rings", "oblique", "blur", "stamps", "moved", "duplicate"; and from advise,
+  // "reach": why the camera missed a board the LiDAR placed (LearnDetectionReach).
+  std::string check;
   PreflightSeverity severity = PreflightSeverity::kWeak;
   std::string words;
 };

@@ -171,6 +171,11 @@ void CalibrationJob::SetSolverOptions(const SolverOptions& solver) {
 
 void CalibrationJob::SetGoal(const CaptureGoal& goal) { options_.advise.goal = goal; }
 
+void CalibrationJob::SetHandTolerance(double translation_m, double rotation_deg) {
+  options_.advise.guidance.hand_tolerance_m = translation_m;
+  options_.advise.guidance.hand_tolerance_deg = rotation_deg;
+}
+
 std::vector<PairFeatures> CalibrationJob::DetectedPairs() const {
   std::vector<PairFeatures> features;
   for (const JobPair& pair : pairs_) {

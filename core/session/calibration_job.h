@@ -78,6 +78,8 @@ class CalibrationJob {
   void SetRejected(const std::string& pair_id, bool rejected, const std::string& reason = "");
   void SetSolverOptions(const SolverOptions& solver);
   void SetGoal(const CaptureGoal& goal);
+  // How precisely the person holds a suggested pose (GuidanceOptions::hand_tolerance_*).
+  void SetHandTolerance(double translation_m, double rotation_deg);
 
   // Solves every detected pair from what detection found, with the user's decisions: the steps
   // `calibrate` runs after extraction (SolveExtractedPairs: solve, camera-guided completion, the

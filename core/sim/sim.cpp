@@ -497,6 +497,11 @@ bool PlaceableInSimulation(const SimOptions& resolved, const Pose& cam_from_boar
   return true;
 }
 
+bool FitsInSimulatedRoom(const SimOptions& resolved, const Pose& cam_from_board) {
+  return SheetFitsRoom(resolved, RoomScene(resolved),
+                       resolved.cam_from_lidar.inverse() * cam_from_board);
+}
+
 Pose RandomPlacement(const SimOptions& resolved, int pair_index) {
   const BeamTable beams = SimBeamTable(resolved);
   const BoardPrint print(resolved.board);

@@ -157,6 +157,10 @@ SimulatedPair SimulatePairAt(const SimOptions& resolved, const Pose& cam_from_bo
 bool PlaceableInSimulation(const SimOptions& resolved, const Pose& cam_from_board,
                            std::string* why = nullptr);
 
+// Whether a board there would stand inside the simulated room (a hand cannot push it through a
+// wall); unlike PlaceableInSimulation, nothing about what the sensors would see.
+bool FitsInSimulatedRoom(const SimOptions& resolved, const Pose& cam_from_board);
+
 // The board pose SimulateDataset's pair `pair_index` gets (random placement).
 Pose RandomPlacement(const SimOptions& resolved, int pair_index);
 

@@ -7,6 +7,7 @@
 
 #include "core/estimation/uncertainty.h"
 #include "core/evaluation/guided_sweep.h"
+#include "core/guidance/detection_reach.h"
 #include "core/guidance/next_pose.h"
 #include "core/io/dataset.h"
 #include "core/sim/subset_coverage.h"
@@ -41,6 +42,19 @@ json ExpectAdviceContract(const std::string& stdout_text) {
   EXPECT_TRUE(advice.at("done").is_boolean());
   EXPECT_TRUE(advice.at("next").is_null() || advice.at("next").is_object());
   EXPECT_EQ(advice.at("done").get<bool>(), advice.at("next").is_null());
+  const json& reach = advice.at("detection_reach");
+  for (const char* key : {"min_square_px", "max_incidence_deg", "max_off_axis_deg"})
+    EXPECT_TRUE(reach.at(key).is_null() || reach.at(key).is_number()) << key;
+  EXPECT_TRUE(reach.at("boards_found").is_number_integer());
+  EXPECT_TRUE(reach.at("boards_missed").is_number_integer());
+  if (advice.at("next").is_object()) {
+    const json& tolerance = advice.at("next").at("tolerance");
+    EXPECT_TRUE(tolerance.at("translation_m").is_number());
+    EXPECT_TRUE(tolerance.at("rotation_deg").is_number());
+    EXPECT_TRUE(tolerance.at("usable_share").is_number());
+    EXPECT_TRUE(tolerance.at("words").is_string());
+    EXPECT_TRUE(advice.at("next").at("usable_share").is_number());
+  }
   return advice;
 }
 
@@ -175,6 +189,52 @@ TEST(GuidanceCli, AdviseJsonOnASimulatedDatasetAndItsWords) {
   EXPECT_NE(bad.find("goal must be > 0"), std::string::npos) << bad;
 }
 
+// A fisheye of 848 × 800 with an A3 ChArUco at 1-2 m: the detector misses the far and steep boards
+// of random placement. `advise` says why for each miss the LiDAR places, learns the reach from
+// them, and suggests a pose inside it with its tolerance; `--hand-tolerance-*` are taken.
+TEST(GuidanceCli, AdviseSaysWhyTheCameraMissedABoardAndKeepsInsideTheReach) {
+  const auto dir = test::TempDir("guidance_reach");
+  int code = test::RunCommand(test::CalibenchExe() + " simulate --out " + (dir / "sim").string() +
+                              " --lidar os0-128 --camera fisheye --board charuco-a3 --image-size "
+                              "848x800 --min-distance 1.0 --max-distance 2.0 --pairs 12 --seed 3 "
+                              ">/dev/null 2>&1");
+  ASSERT_EQ(code, 0);
+  const std::string manifest = (dir / "sim/dataset.json").string();
+  const std::string out =
+      StdoutOf(test::CalibenchExe() + " advise --dataset " + manifest +
+                   " --json --threads 2 --goal-mm 0.3 --goal-deg 0.02 --hand-tolerance-m 0.08",
+               &code);
+  ASSERT_EQ(code, 0) << out;
+  const json advice = ExpectAdviceContract(out);
+  int told = 0;
+  for (const json& p : advice.at("pairs"))
+    for (const json& f : p.at("findings"))
+      if (f.at("check") == "reach") {
+        ++told;
+        EXPECT_EQ(p.at("status"), "failed") << p.dump();
+        const std::string words = f.at("words");
+        EXPECT_TRUE(words.find("board too small in the image at") != std::string::npos ||
+                    words.find("the camera missed the board at") != std::string::npos)
+            << words;
+      }
+  const json& reach = advice.at("detection_reach");
+  EXPECT_EQ(told, reach.at("boards_missed").get<int>());
+  EXPECT_GE(told, 3);  // of 12 random boards, 5 are missed (4 too small)
+  ASSERT_TRUE(reach.at("min_square_px").is_number());
+  ASSERT_TRUE(advice.at("next").is_object());
+  const json& tolerance = advice.at("next").at("tolerance");
+  EXPECT_LE(tolerance.at("translation_m").get<double>(), 0.08 + 1e-12);
+  EXPECT_GE(tolerance.at("usable_share").get<double>(), 0.9);
+  // The suggested pose keeps inside the learnt reach, with the suggestions' margin.
+  Dataset dataset = LoadDataset(manifest);
+  Pose cam_from_board;
+  cam_from_board.matrix() = MatrixFrom(advice.at("next").at("cam_from_board"));
+  const double square_px =
+      AppearanceOf(dataset.camera, dataset.target, cam_from_board * ShownFromBoardSpec().inverse())
+          .square_px;
+  EXPECT_GE(square_px, 1.25 * reach.at("min_square_px").get<double>()) << out;
+}
+
 TEST(GuidanceCli, TheLrfMeterFollowsAlgorithmOne) {
   const auto dir = test::TempDir("guidance_lrf");
   int code =
@@ -231,6 +291,48 @@ TEST(GuidanceSweep, GuidedCaptureStopsWithAnHonestResult) {
     (run.placement == "guided" ? guided_poses : random_poses) += run.poses;
   }
   EXPECT_LT(guided_poses, random_poses);
+}
+
+// The rig where a hand's error loses pairs: OS0-128, a fisheye of 848 × 800 and an A3 ChArUco at
+// 1-2 m, each guided board moved by up to ±10 cm and 10°. Guided placement keeps the boards inside
+// what the detector reads (few lost) and needs fewer poses than random placement.
+TEST(GuidanceSweep, OnAFisheyeChArUcoRigTheHandLosesFewPairs) {
+  GuidedSweepOptions options;
+  options.sim.lidar = LidarModel::kOs0_128;
+  options.sim.fisheye = true;
+  // The default fisheye, its focal length scaled with the width (as `--image-size 848x800`).
+  CameraModel camera = DefaultSimCamera(/*fisheye=*/true);
+  const double scale = 848.0 / camera.width;
+  camera.fx *= scale;
+  camera.fy *= scale;
+  camera.cx = 0.5 * (848 - 1);
+  camera.cy = 0.5 * (800 - 1);
+  camera.width = 848;
+  camera.height = 800;
+  options.sim.camera = camera;
+  options.sim.board = BoardPreset("charuco-a3");
+  options.sim.min_distance_m = 1.0;
+  options.sim.max_distance_m = 2.0;
+  options.sim.lidar_range_noise_m = 0.01;
+  options.goal = CaptureGoal{0.5, 0.03};
+  options.seeds = 2;
+  options.max_pairs = 60;
+  options.threads = 2;
+  const GuidedSweepResult result = RunGuidedSweep(options);
+  std::printf("%s", FormatGuidedSweepTable(result).c_str());
+  int guided_poses = 0, guided_lost = 0, random_poses = 0;
+  for (const GuidedRun& run : result.runs) {
+    if (run.placement == "guided") {
+      ASSERT_TRUE(run.done) << "seed " << run.seed;
+      EXPECT_TRUE(run.within_goal) << "seed " << run.seed;
+      guided_poses += run.poses;
+      guided_lost += run.poses - run.accepted;
+    } else {
+      random_poses += run.done ? run.poses : options.max_pairs + 1;
+    }
+  }
+  EXPECT_LE(guided_lost, 0.15 * guided_poses);
+  EXPECT_LT(2 * guided_poses, random_poses);
 }
 
 }  // namespace

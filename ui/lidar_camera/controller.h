@@ -85,9 +85,12 @@ struct SaveSessionAs {
 };
 struct Undo {};
 struct Redo {};
-// The user's goal for the meter (σ per axis).
+// The user's goal for the meter (σ per axis), and how precisely the person can hold a suggested
+// pose (GuidanceOptions::hand_tolerance_*: the next pose is chosen robust to it).
 struct SetGoal {
   CaptureGoal goal;
+  double hand_tolerance_m = 0.10;
+  double hand_tolerance_deg = 10.0;
 };
 // The camera's intrinsics from every loaded pair's board corners (as `calibench intrinsics`),
 // on the worker; the dataset's camera is not changed.

@@ -37,8 +37,21 @@ void Controller::Handle(const SetGoal& request) {
     SetStatus("goal: " + why, true);
     return;
   }
+  if (!(request.hand_tolerance_m >= 0 && request.hand_tolerance_m <= 1.0) ||
+      !(request.hand_tolerance_deg >= 0 && request.hand_tolerance_deg <= 45.0)) {
+    SetStatus("hand tolerance: must be within 0-100 cm and 0-45 deg", true);
+    return;
+  }
   state_.goal = request.goal;
   JudgeMeter(/*record=*/false);
+  if (request.hand_tolerance_m != state_.hand_tolerance_m ||
+      request.hand_tolerance_deg != state_.hand_tolerance_deg) {
+    state_.hand_tolerance_m = request.hand_tolerance_m;
+    state_.hand_tolerance_deg = request.hand_tolerance_deg;
+    // The next pose again, robust to the new tolerance.
+    state_.next_pose.reset();
+    worker_.Enqueue([this] { AdviseFromState(); });
+  }
   ++state_.generation;
 }
 

@@ -158,6 +158,8 @@ struct Snapshot : SnapshotHeader {
   // The meter (core/guidance's stop rule, as `advise` and `watch` judge): σ per direction against
   // the user's goal, the weakest in words, done; its history over the solves.
   CaptureGoal goal;
+  double hand_tolerance_m = 0.10;  // the hand's error the next pose is chosen robust to
+  double hand_tolerance_deg = 10.0;
   std::optional<CaptureState> meter;
   std::vector<MeterPoint> meter_history;
   // Where to hold the board next (`advise` after every solve): the ghost board in the camera and

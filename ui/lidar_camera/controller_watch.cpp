@@ -301,6 +301,7 @@ void Controller::Advise(const std::optional<SolverResult>& at) {
   {
     std::lock_guard lock(mutex_);
     job_->SetGoal(state_.goal);
+    job_->SetHandTolerance(state_.hand_tolerance_m, state_.hand_tolerance_deg);
   }
   // The job's solve (pairs that joined since are judged after the next solve).
   const CaptureAdvice& advice = job_->Advise(at);

@@ -95,7 +95,9 @@ void DrawGhost(ImDrawList* draw, const Snapshot& s, const CameraShown& shown) {
   ImVec2 top = outline.front();
   for (const ImVec2& p : outline)
     if (p.y < top.y) top = p;
-  const char* label = "next pose: hold the board here";
+  // What it says and how precisely it matters ("keep the tilt within 5°").
+  const std::string text = "next pose: hold the board here; " + s.next_pose->tolerance.words;
+  const char* label = text.c_str();
   const ImVec2 size = ImGui::CalcTextSize(label);
   const float x = std::clamp(top.x - size.x / 2, shown.at.origin.x + 4,
                              shown.at.origin.x + shown.at.size.x - size.x - 4);

@@ -38,7 +38,20 @@ void Workbench::MeterRows(const Snapshot& s, std::vector<Intent>* intents) {
   ImGui::SameLine();
   ImGui::SetNextItemWidth(70);
   ImGui::InputDouble("deg", &goal.rotation_deg, 0, 0, "%.3f");
-  if (mm_done || ImGui::IsItemDeactivatedAfterEdit()) intents->push_back(SetGoal{goal});
+  bool edited = mm_done || ImGui::IsItemDeactivatedAfterEdit();
+  // How precisely the board is held: the next pose is chosen so a hand's error keeps it usable.
+  double hand_cm = 100 * s.hand_tolerance_m, hand_deg = s.hand_tolerance_deg;
+  ImGui::SameLine();
+  ImGui::TextUnformatted("  hand within +-");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(50);
+  ImGui::InputDouble("cm##hand", &hand_cm, 0, 0, "%.0f");
+  edited |= ImGui::IsItemDeactivatedAfterEdit();
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(50);
+  ImGui::InputDouble("deg##hand", &hand_deg, 0, 0, "%.0f");
+  edited |= ImGui::IsItemDeactivatedAfterEdit();
+  if (edited) intents->push_back(SetGoal{goal, hand_cm / 100, hand_deg});
   if (!s.meter) return GuideRows(s);
   const CaptureState& m = *s.meter;
   ImGui::SameLine();

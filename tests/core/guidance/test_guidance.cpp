@@ -11,35 +11,11 @@
 #include "core/guidance/preflight.h"
 #include "core/guidance/stop_rule.h"
 #include "core/sim/sim.h"
+#include "tests/core/guidance/guidance_fixtures.h"
 #include "tests/test_support.h"
 
 namespace calibench {
 namespace {
-
-// VLP-16, the simulator's camera, an A3 checkerboard, the default mount.
-SensorGeometry Vlp16Sensors(bool fisheye = false) {
-  SensorGeometry s;
-  s.camera = DefaultSimCamera(fisheye);
-  s.board = BoardPreset("a3");
-  s.lidar = MakeBeamTable(LidarModel::kVlp16);
-  s.min_distance_m = 1.0;
-  s.max_distance_m = 4.0;
-  s.range_sigma_m = 0.01;
-  s.corner_sigma_px = 0.2;
-  return s;
-}
-
-// A board facing the camera at `centre` (camera frame), turned by yaw about its vertical axis.
-Pose FacingBoard(const Vec3& centre, double yaw_deg = 0.0) {
-  const Vec3 z = centre.normalized();
-  const Vec3 x = (Vec3::UnitX() - Vec3::UnitX().dot(z) * z).normalized();
-  Mat3 facing;
-  facing << x, z.cross(x), z;
-  Pose pose = Pose::Identity();
-  pose.linear() = facing * Eigen::AngleAxisd(yaw_deg * kDegToRad, Vec3::UnitY()).toRotationMatrix();
-  pose.translation() = centre;
-  return pose;
-}
 
 SolverResult ResultWithSigma(const Vec3& sigma_t_m, const Vec3& sigma_r_rad) {
   SolverResult r;
@@ -129,7 +105,8 @@ TEST(GuidanceFeasibility, EachCheckRefusesWhatItNames) {
   fisheye.max_distance_m = 5.0;
   f = CheckFeasible(fisheye, cam_from_lidar, FacingBoard(Vec3(0, 0, 4.0)), options);
   EXPECT_FALSE(f.feasible);
-  EXPECT_NE(f.why.find("squares would be under 12 px"), std::string::npos) << f.why;
+  EXPECT_NE(f.why.find("squares would be 4 px wide in the image, under 12"), std::string::npos)
+      << f.why;
   // Above the VLP-16's ±15° field of view, yet inside the fisheye's image (squares of 9 px
   // allowed here: the check under test is the LiDAR's).
   options.min_square_px = 5;
@@ -162,28 +139,14 @@ TEST(GuidanceFeasibility, BoardReturnsMatchTheSimulatorsScan) {
   }
 }
 
-// Three boards, all frontal near the image centre (planned pairs, as the solver would see them),
-// and the solution they would give: the translation along the view is well fixed, the rest
-// weakly.
-void ThreeFrontalBoards(const SensorGeometry& sensors, const Pose& cam_from_lidar,
-                        const SolverOptions& solver, std::vector<PlanePair>* pairs,
-                        std::vector<Pose>* seen, SolverResult* solution) {
-  for (const Pose& pose : {FacingBoard(Vec3(0, 0, 1.6), 10), FacingBoard(Vec3(0.1, 0, 2.0), -10),
-                           FacingBoard(Vec3(-0.1, 0.05, 2.2), 15)}) {
-    BoardReturns returns;
-    const Feasibility f = CheckFeasible(sensors, cam_from_lidar, pose, GuidanceOptions{}, &returns);
-    ASSERT_TRUE(f.feasible) << f.why;
-    pairs->push_back(PlannedPair(sensors, cam_from_lidar, pose, returns));
-    seen->push_back(pose);
-  }
-  solution->cam_from_lidar = cam_from_lidar;
-  solution->covariance = ExpectedPoseInformation(*pairs, cam_from_lidar, solver).inverse();
-}
-
 TEST(GuidanceNextPose, TheSuggestionIsFeasibleAndShrinksTheWeakestDirection) {
   const SensorGeometry sensors = Vlp16Sensors();
   const Pose cam_from_lidar = DefaultCamFromLidar();
   GuidanceOptions options;
+  // Held exactly: the score is the model's prediction at the pose itself (the hand's error is
+  // tested in test_hand_guidance.cpp).
+  options.hand_tolerance_m = 0.0;
+  options.hand_tolerance_deg = 0.0;
   SolverOptions solver;
   std::vector<PlanePair> pairs;
   std::vector<Pose> seen;

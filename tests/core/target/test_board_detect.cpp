@@ -115,10 +115,10 @@ Pose Jittered(const Pose& pose, int k, double distance_m) {
 
 // Plane error against the truth: angle (deg), distance (mm), Mahalanobis over the 3 free dims,
 // and the predicted standard deviation of the normal in its worst direction (deg).
-struct PlaneError {
+struct CameraPlaneError {
   double angle_deg, distance_mm, mahalanobis, normal_sigma_deg;
 };
-PlaneError ComparePlane(const CameraBoardObservation& obs, const Pose& truth) {
+CameraPlaneError ComparePlane(const CameraBoardObservation& obs, const Pose& truth) {
   const Vec4 e = obs.plane.Coefficients() - PlaneOf(truth);
   const Eigen::SelfAdjointEigenSolver<Mat4> eig(obs.plane_covariance);
   double m = 0.0;
@@ -133,7 +133,7 @@ PlaneError ComparePlane(const CameraBoardObservation& obs, const Pose& truth) {
 // A nearly fronto-parallel small board leaves its tilt weakly observed (about 1 deg at 45-65 px
 // across) and its pixel errors are systematic, not independent: the check is 4 sigma in the
 // worst direction of the predicted covariance, plus absolute bounds where the tilt is observable.
-void ExpectPlaneNearTruth(const PlaneError& plane) {
+void ExpectPlaneNearTruth(const CameraPlaneError& plane) {
   EXPECT_LT(plane.angle_deg, std::max(0.2, 4.0 * plane.normal_sigma_deg));
 }
 
@@ -177,7 +177,7 @@ TEST(BoardDetect, RenderedCheckerboardCornersAreUnbiased) {
           if (detected > 1) continue;  // the plane check on the first detected render
           const auto obs = EstimateBoardPose(camera, *detection, PnpOptions{}, &why);
           ASSERT_TRUE(obs) << why;
-          const PlaneError plane = ComparePlane(*obs, pose);
+          const CameraPlaneError plane = ComparePlane(*obs, pose);
           std::printf(
               "[ checker ] %s %.1f m %2.0f deg: plane %.3f deg (sigma %.3f) %+.2f mm, "
               "Mahalanobis %.1f\n",
@@ -259,7 +259,7 @@ TEST(BoardDetect, RenderedCharucoOffsetIsMeasuredAndCorrected) {
         if (k > 0) continue;
         const auto obs = EstimateBoardPose(camera, *corrected, PnpOptions{}, &why);
         ASSERT_TRUE(obs) << why;
-        const PlaneError plane = ComparePlane(*obs, pose);
+        const CameraPlaneError plane = ComparePlane(*obs, pose);
         std::printf("[ charuco ] %s %s %.1f m %2.0f deg: plane %.3f deg (sigma %.3f) %+.2f mm\n",
                     c.dictionary, c.fisheye ? "fisheye" : "pinhole", c.distance, tilt,
                     plane.angle_deg, plane.normal_sigma_deg, plane.distance_mm);
