@@ -105,8 +105,8 @@ Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pos
   f.distance_m = cam_from_board.translation().norm();
   const Vec3 camera_normal = cam_from_board.linear().col(2);
   f.camera_incidence_deg = IncidenceDeg(camera_normal, cam_from_board.translation());
-  if (f.distance_m < sensors.min_distance_m - 1e-9 ||
-      f.distance_m > sensors.max_distance_m + 1e-9) {
+  if (options.keep_to_distance_range && (f.distance_m < sensors.min_distance_m - 1e-9 ||
+                                         f.distance_m > sensors.max_distance_m + 1e-9)) {
     std::snprintf(text, sizeof(text), "%.1f m from the camera, outside the usable %.1f-%.1f m",
                   f.distance_m, sensors.min_distance_m, sensors.max_distance_m);
     f.why = text;
@@ -282,6 +282,7 @@ GuidanceOptions UsableLimits(const GuidanceOptions& options) {
   usable.image_margin_fraction = options.usable_image_margin_fraction;
   usable.lidar_returns = options.usable_lidar_returns;
   usable.reach_square_margin = 1.0;
+  usable.keep_to_distance_range = false;  // where boards were held, not what the sensors reach
   usable.reach_angle_margin_deg = 0.0;
   return usable;
 }

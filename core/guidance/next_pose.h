@@ -86,6 +86,7 @@ struct GuidanceOptions {
   double reach_square_margin = 1.25;
   double reach_angle_margin_deg = 5.0;
   double usable_max_incidence_deg = 75.0;
+  bool keep_to_distance_range = true;  // SensorGeometry's distances (false: judged by reach only)
   double usable_min_square_px = 8.0;
   double usable_image_margin_fraction = 0.0;
   BoardReturnsRule usable_lidar_returns{3, 3, 20};

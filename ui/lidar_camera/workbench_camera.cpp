@@ -95,14 +95,19 @@ void DrawGhost(ImDrawList* draw, const Snapshot& s, const CameraShown& shown) {
   ImVec2 top = outline.front();
   for (const ImVec2& p : outline)
     if (p.y < top.y) top = p;
-  // What it says and how precisely it matters ("keep the tilt within 5°").
-  const std::string text = "next pose: hold the board here; " + s.next_pose->tolerance.words;
-  const char* label = text.c_str();
-  const ImVec2 size = ImGui::CalcTextSize(label);
-  const float x = std::clamp(top.x - size.x / 2, shown.at.origin.x + 4,
-                             shown.at.origin.x + shown.at.size.x - size.x - 4);
-  const float y = std::max(top.y - size.y - 4, shown.at.origin.y + 4);
-  draw->AddText(ImVec2(x, y), edge, label);
+  // What it says, and how precisely it matters ("keep the tilt within 5° of it") on a second
+  // line: each kept inside the view (a line wider than the view starts at its left edge).
+  const std::string lines[] = {"next pose: hold the board here", s.next_pose->tolerance.words};
+  float y = top.y - 4;
+  for (int k = 1; k >= 0; --k) {
+    if (lines[k].empty()) continue;
+    const ImVec2 size = ImGui::CalcTextSize(lines[k].c_str());
+    y -= size.y;
+    const float right = shown.at.origin.x + shown.at.size.x - size.x - 4;
+    const float x = std::max(shown.at.origin.x + 4, std::min(top.x - size.x / 2, right));
+    draw->AddText(ImVec2(x, std::max(y, shown.at.origin.y + 4 + k * size.y)), edge,
+                  lines[k].c_str());
+  }
 }
 
 // Over the picture: the detected corners, the board or why there is none.

@@ -196,6 +196,13 @@ void Workbench::PairRow(const Snapshot& s, int index, std::vector<Intent>* inten
     ImGui::PopStyleColor();
   } else if (!pair.reason.empty()) {
     ImGui::TextWrapped("%s", pair.reason.c_str());
+    // Why the camera missed a board the LiDAR placed (advise's "reach" finding).
+    for (const PreflightFinding& f : pair.findings) {
+      if (f.check != "reach") continue;
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.95f, 0.85f, 0.4f, 1));
+      ImGui::TextWrapped("%s", f.words.c_str());
+      ImGui::PopStyleColor();
+    }
   } else if (const PreflightFinding* finding = WorstFinding(pair.findings)) {
     // Pre-flight's word on an accepted pair (rejections apply by themselves only while a
     // capture is followed; on a dataset the user decides).

@@ -24,6 +24,7 @@ double UsableShareUnderAHand(const SensorGeometry& sensors, const Pose& cam_from
   usable.lidar_returns = usable.usable_lidar_returns;
   usable.reach_square_margin = 1.0;
   usable.reach_angle_margin_deg = 0.0;
+  usable.keep_to_distance_range = false;
   int ok = 0;
   const std::vector<Pose> placements = HandPlacements(target, 0.10, 10.0, 64);
   for (const Pose& held : placements)
@@ -151,7 +152,10 @@ TEST(DetectionReach, MissesBeyondTheBoardsFoundSetTheReachAndSayWhy) {
 }
 
 TEST(DetectionReach, AMeasuredReachChangesTheNextSuggestion) {
-  const SensorGeometry sensors = Vlp16Sensors();
+  // An A3 ChArUco, held exactly, the usable distances 3-5 m: what the detector reads out there
+  // decides where the next board can go.
+  SensorGeometry sensors = Vlp16Sensors();
+  sensors.board = BoardPreset("charuco-a3");
   const Pose cam_from_lidar = DefaultCamFromLidar();
   SolverOptions solver;
   std::vector<PlanePair> pairs;
@@ -159,31 +163,39 @@ TEST(DetectionReach, AMeasuredReachChangesTheNextSuggestion) {
   SolverResult solution;
   ASSERT_NO_FATAL_FAILURE(
       ThreeFrontalBoards(sensors, cam_from_lidar, solver, &pairs, &seen, &solution));
+  sensors.min_distance_m = 3.0;
+  sensors.max_distance_m = 5.0;
   const CaptureGoal goal{0.5, 0.01};
+  GuidanceOptions exact;
+  exact.hand_tolerance_m = 0.0;
+  exact.hand_tolerance_deg = 0.0;
   std::string why;
-  const auto first = NextBestPose(sensors, solution, seen, goal, GuidanceOptions{}, solver, &why);
+  const auto first = NextBestPose(sensors, solution, seen, goal, exact, solver, &why);
   ASSERT_TRUE(first) << why;
   // The board held there was missed by the camera (the rig's detector reaches less far than
   // guidance assumed): learnt from that miss, the next suggestion keeps inside the reach.
   std::vector<PairFeatures> features;
   for (const Pose& pose : seen) features.push_back(Found("seen", pose));
-  features.push_back(Missed("missed", first->cam_from_board, cam_from_lidar));
+  const Pose far = FacingBoard(first->cam_from_board.translation().normalized() * 4.8, 10);
+  features.push_back(Missed("missed", far, cam_from_lidar));
   SensorGeometry learnt = sensors;
   learnt.reach = LearnDetectionReach(sensors.camera, sensors.board, features, cam_from_lidar, {});
-  const double missed_px =
+  const double missed_px = AppearanceOf(sensors.camera, sensors.board, far).square_px;
+  const double first_px =
       AppearanceOf(sensors.camera, sensors.board, first->cam_from_board).square_px;
   ASSERT_GT(learnt.reach.min_square_px, missed_px);
-  const auto next = NextBestPose(learnt, solution, seen, goal, GuidanceOptions{}, solver, &why);
+  // The first suggestion lies beyond the reach now measured.
+  ASSERT_LT(first_px, exact.reach_square_margin * learnt.reach.min_square_px);
+  const auto next = NextBestPose(learnt, solution, seen, goal, exact, solver, &why);
   ASSERT_TRUE(next) << why;
   const double next_px =
       AppearanceOf(sensors.camera, sensors.board, next->cam_from_board).square_px;
-  std::printf("suggested squares: %.1f px, missed there; learnt reach %.1f px; next %.1f px\n",
-              missed_px, learnt.reach.min_square_px, next_px);
-  EXPECT_GE(next_px, GuidanceOptions{}.reach_square_margin * learnt.reach.min_square_px - 1e-9);
-  EXPECT_TRUE((next->cam_from_board.translation() - first->cam_from_board.translation()).norm() >
-                  0.05 ||
-              RotationAngle(next->cam_from_board.linear(), first->cam_from_board.linear()) >
-                  5 * kDegToRad);
+  std::printf("suggested squares %.1f px; missed at %.1f px; learnt reach %.1f px; next %.1f px\n",
+              first_px, missed_px, learnt.reach.min_square_px, next_px);
+  EXPECT_GE(next_px, exact.reach_square_margin * learnt.reach.min_square_px - 1e-9);
+  EXPECT_TRUE(
+      (next->cam_from_board.translation() - first->cam_from_board.translation()).norm() > 0.05 ||
+      RotationAngle(next->cam_from_board.linear(), first->cam_from_board.linear()) > 5 * kDegToRad);
 }
 
 TEST(HandGuidance, TheGhostMatchesWithinTheSuggestionsOwnTolerance) {
