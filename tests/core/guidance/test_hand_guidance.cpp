@@ -52,23 +52,31 @@ TEST(HandGuidance, PlacementsStayWithinTheHandsError) {
                                placements[7].matrix(), 0.0));
 }
 
-// An A3 ChArUco at up to 5 m: far boards sit at the edge of what the detector can read, where a
-// hand's 10 cm and 10° decide whether the pair is lost.
-TEST(HandGuidance, TheSuggestionSurvivesTheHandBetterThanTheExactOne) {
+// The VLP-16 rig with an A3 ChArUco after three frontal boards, a tight goal, and options that
+// plan for a board held exactly.
+class GuidedCharucoRig : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    sensors.board = BoardPreset("charuco-a3");
+    ASSERT_NO_FATAL_FAILURE(
+        ThreeFrontalBoards(sensors, cam_from_lidar, solver, &pairs, &seen, &solution));
+    exact.hand_tolerance_m = 0.0;
+    exact.hand_tolerance_deg = 0.0;
+  }
   SensorGeometry sensors = Vlp16Sensors();
-  sensors.board = BoardPreset("charuco-a3");
-  sensors.max_distance_m = 5.0;
   const Pose cam_from_lidar = DefaultCamFromLidar();
   SolverOptions solver;
   std::vector<PlanePair> pairs;
   std::vector<Pose> seen;
   SolverResult solution;
-  ASSERT_NO_FATAL_FAILURE(
-      ThreeFrontalBoards(sensors, cam_from_lidar, solver, &pairs, &seen, &solution));
   const CaptureGoal goal{0.5, 0.01};
   GuidanceOptions exact;
-  exact.hand_tolerance_m = 0.0;
-  exact.hand_tolerance_deg = 0.0;
+};
+
+// Boards up to 5 m: the far ones sit at the edge of what the detector can read, where a hand's
+// 10 cm and 10° decide whether the pair is lost.
+TEST_F(GuidedCharucoRig, TheSuggestionSurvivesTheHandBetterThanTheExactOne) {
+  sensors.max_distance_m = 5.0;
   std::string why;
   const auto held_exactly = NextBestPose(sensors, solution, seen, goal, exact, solver, &why);
   ASSERT_TRUE(held_exactly) << why;
@@ -151,24 +159,11 @@ TEST(DetectionReach, MissesBeyondTheBoardsFoundSetTheReachAndSayWhy) {
       << missed[1].words;
 }
 
-TEST(DetectionReach, AMeasuredReachChangesTheNextSuggestion) {
-  // An A3 ChArUco, held exactly, the usable distances 3-5 m: what the detector reads out there
-  // decides where the next board can go.
-  SensorGeometry sensors = Vlp16Sensors();
-  sensors.board = BoardPreset("charuco-a3");
-  const Pose cam_from_lidar = DefaultCamFromLidar();
-  SolverOptions solver;
-  std::vector<PlanePair> pairs;
-  std::vector<Pose> seen;
-  SolverResult solution;
-  ASSERT_NO_FATAL_FAILURE(
-      ThreeFrontalBoards(sensors, cam_from_lidar, solver, &pairs, &seen, &solution));
+TEST_F(GuidedCharucoRig, AMeasuredReachChangesTheNextSuggestion) {
+  // Held exactly, the usable distances 3-5 m: what the detector reads out there decides where the
+  // next board can go.
   sensors.min_distance_m = 3.0;
   sensors.max_distance_m = 5.0;
-  const CaptureGoal goal{0.5, 0.01};
-  GuidanceOptions exact;
-  exact.hand_tolerance_m = 0.0;
-  exact.hand_tolerance_deg = 0.0;
   std::string why;
   const auto first = NextBestPose(sensors, solution, seen, goal, exact, solver, &why);
   ASSERT_TRUE(first) << why;
