@@ -363,8 +363,19 @@ void RobustToTheHand(const InformationModel& model, const std::optional<Pose>& c
                      std::vector<std::pair<PoseSuggestion, double>>* feasible) {
   auto& list = *feasible;
   if (cam_from_lidar) {
+    // By the nominal score as LowestScore will weigh it (the intrinsics' wish for corners where
+    // none are yet), so the truncation keeps the poses that cover them.
+    int most_covered = 0;
+    for (const auto& [s, tie] : list)
+      most_covered = std::max(most_covered, s.intrinsics_cells_covered);
+    auto weighed = [&](const PoseSuggestion& s) {
+      if (most_covered == 0) return s.score;
+      return s.score *
+             (1.0 + options.intrinsics_cover_weight *
+                        (1.0 - static_cast<double>(s.intrinsics_cells_covered) / most_covered));
+    };
     std::sort(list.begin(), list.end(),
-              [](const auto& a, const auto& b) { return a.first.score < b.first.score; });
+              [&](const auto& a, const auto& b) { return weighed(a.first) < weighed(b.first); });
     if (static_cast<int>(list.size()) > options.robust_candidates)
       list.resize(options.robust_candidates);
   }
