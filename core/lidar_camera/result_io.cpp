@@ -43,7 +43,8 @@ std::string ModelMeaning(LidarGeometry geometry) {
   if (geometry == LidarGeometry::kSpinning)
     return "planes fitted on the ranges along the rays, with ring biases and board edges";
   if (geometry == LidarGeometry::kNonRepetitive)
-    return "planes fitted on the ranges along the rays, no rings: no ring biases or board edges";
+    return "planes fitted on the ranges along the rays, no rings: no ring biases; board edges "
+           "where the beam's path crosses the sheet's border";
   if (geometry == LidarGeometry::kSegment)
     return "planes fitted point-to-plane (isotropic, their own covariance, widened by a range bias "
            "per ring where the returns' elevations fall into rings), no board edges";
@@ -467,7 +468,7 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
   out << "residuals: board planes from " << counts.plane_pairs << " pairs";
   if (counts.edges_in_model)
     out << ", board edges from " << counts.edge_pairs << " pairs (" << counts.edge_points
-        << " ring crossings of the sheet's edges)";
+        << " crossings of the sheet's edges)";
   out << "\n";
   if (!counts.note.empty()) out << "  " << counts.note << "\n";
   PrintModelFigures(s, out);

@@ -22,6 +22,15 @@ struct BoardEdgeOptions {
   // Neighbouring returns further apart than this (degrees of azimuth) leave the crossing too
   // uncertain (a dropped return): no edge point there.
   double max_azimuth_gap_deg = 0.6;
+  // A ring-less scan (a Livox-class rosette, a nodding fan) stored in firing order: consecutive
+  // returns further apart than this (degrees between their rays) are not neighbours on the beam's
+  // path (a dropped return, the pattern's jump), so no crossing lies between them.
+  double max_firing_step_deg = 0.6;
+  // The cloud counts as stored in firing order when the median angle between consecutive board
+  // returns is below this (degrees) and at least min_consecutive_fraction of the board's returns
+  // are followed by another: a cloud sorted or filtered otherwise keeps no beam path.
+  double max_median_firing_step_deg = 0.3;
+  double min_consecutive_fraction = 0.5;
   bool Check(std::string* why) const;
 };
 
@@ -43,6 +52,18 @@ std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
                                                    const Plane& plane,
                                                    const BoardEdgeOptions& options,
                                                    BoardEdgeEnds* ends = nullptr);
+
+// Where the beam of a ring-less scan crosses the sheet's border: the returns of a fitted board
+// plane whose neighbour in firing order (the cloud's storage order) missed the board and lies well
+// behind it. A rosette crosses a board's border hundreds of times in a second's hold, every
+// crossing an edge point like a ring's end. Returns none, with *no_search saying why, when the
+// cloud does not keep its firing order (judged from the board's own returns).
+std::vector<LidarEdgePoint> ExtractBeamCrossingEdgePoints(const LidarCloud& cloud,
+                                                          const std::vector<int>& inliers,
+                                                          const Plane& plane,
+                                                          const BoardEdgeOptions& options,
+                                                          BoardEdgeEnds* ends,
+                                                          std::string* no_search);
 
 // Residual of one edge point against the sheet (half sizes in metres, board frame as BoardSpec):
 // the signed distance, in the board plane, from the point to the sheet edge nearest to it

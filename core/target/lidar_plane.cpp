@@ -321,14 +321,20 @@ int DistinctRings(const LidarCloud& cloud, const std::vector<int>& indices) {
 // were not looked for), its rings and their range biases' covariance (spinning LiDARs only).
 void AddBoardExtent(const LidarCloud& cloud, const LidarPlaneOptions& options, LidarPlaneFit* fit) {
   const bool spinning = options.geometry == LidarGeometry::kSpinning;
+  // A ring-less scan crosses the sheet's border along its beam's path (a rosette's strokes, a
+  // nodding fan's lines): where the cloud keeps its firing order, each crossing is an edge point.
+  const bool beam_path = options.geometry == LidarGeometry::kNonRepetitive;
   // Edge points need the whole board's returns (the ends of a brushed patch are not its edges)
-  // and rings whose ends they are.
-  if (!spinning) {
+  // and rings, or a beam's path, whose ends they are.
+  if (!spinning && !beam_path) {
     fit->no_edge_search =
         "the LiDAR model is " + LidarGeometryName(options.geometry) + ": no rings to end on it";
   } else if (fit->grown && options.sheet_size_m.minCoeff() > 0) {
     fit->edge_points =
-        ExtractBoardEdgePoints(cloud, fit->inliers, fit->plane, options.edges, &fit->edge_ends);
+        spinning ? ExtractBoardEdgePoints(cloud, fit->inliers, fit->plane, options.edges,
+                                          &fit->edge_ends)
+                 : ExtractBeamCrossingEdgePoints(cloud, fit->inliers, fit->plane, options.edges,
+                                                 &fit->edge_ends, &fit->no_edge_search);
     fit->sheet_size_m = options.sheet_size_m;
   } else {
     fit->no_edge_search = options.sheet_size_m.minCoeff() > 0

@@ -38,7 +38,7 @@ TEST(ResidualsAvailable, FullScansGiveEdgesInEveryPair) {
   EXPECT_EQ(counts.note, "");
   const std::string summary = FormatSummary(outcome);
   EXPECT_NE(summary.find("residuals: board planes from 6 pairs, board edges from 6 pairs (" +
-                         std::to_string(counts.edge_points) + " ring crossings"),
+                         std::to_string(counts.edge_points) + " crossings of the sheet"),
             std::string::npos)
       << summary;
 }
@@ -55,7 +55,7 @@ TEST(ResidualsAvailable, BoardOnlyCloudsSayEdgesAreUnusedAndWhy) {
       << counts.note;
   EXPECT_NE(counts.note.find("the pose rests on the planes alone"), std::string::npos);
   const std::string summary = FormatSummary(outcome);
-  EXPECT_NE(summary.find("board edges from 0 pairs (0 ring crossings"), std::string::npos)
+  EXPECT_NE(summary.find("board edges from 0 pairs (0 crossings of the sheet"), std::string::npos)
       << summary;
   EXPECT_NE(summary.find(counts.note), std::string::npos);
 
