@@ -126,22 +126,11 @@ int RunAdvise(int argc, char** argv) {
   AddDatasetOption(app, &dataset_path,
                    "a LiDAR-camera or 2D LRF dataset, or a rig (every camera against the goal)")
       ->required();
-  app.add_option("--goal-mm", options.goal.translation_mm,
-                 "goal: 1σ of the translation per axis [mm]")
-      ->capture_default_str();
-  app.add_option("--goal-deg", options.goal.rotation_deg, "goal: 1σ of the rotation per axis [deg]")
-      ->capture_default_str();
+  AddGoalFlags(app, &options);
   app.add_option("--min-distance", options.min_distance_m,
                  "nearest usable board distance from the camera [m] (default: from the data)");
   app.add_option("--max-distance", options.max_distance_m,
                  "farthest usable board distance from the camera [m] (default: from the data)");
-  app.add_option("--hand-tolerance-m", options.guidance.hand_tolerance_m,
-                 "how far the person may miss the suggested pose, ± per axis [m]: the next pose "
-                 "is one that stays usable within it")
-      ->capture_default_str();
-  app.add_option("--hand-tolerance-deg", options.guidance.hand_tolerance_deg,
-                 "how far the person may turn the board from the suggested pose, at most [deg]")
-      ->capture_default_str();
   app.add_flag("--json", json, "print exactly one JSON object on stdout");
   std::string intrinsics_model = "pinhole";
   app.add_flag("--estimate-intrinsics", options.estimate_intrinsics,

@@ -75,18 +75,7 @@ void AddWatchFlags(CLI::App& app, WatchFlags* w) {
                  "recordings: CameraInfo topic (default: the one beside the image topic)");
   app.add_option("--camera", w->camera_file,
                  "recordings: intrinsics file instead of the recording's CameraInfo");
-  app.add_option("--goal-mm", w->options.advise.goal.translation_mm,
-                 "goal: 1σ of the translation per axis [mm]")
-      ->capture_default_str();
-  app.add_option("--goal-deg", w->options.advise.goal.rotation_deg,
-                 "goal: 1σ of the rotation per axis [deg]")
-      ->capture_default_str();
-  app.add_option("--hand-tolerance-m", w->options.advise.guidance.hand_tolerance_m,
-                 "how far the person may miss the suggested pose, ± per axis [m]")
-      ->capture_default_str();
-  app.add_option("--hand-tolerance-deg", w->options.advise.guidance.hand_tolerance_deg,
-                 "how far the person may turn the board from it, at most [deg]")
-      ->capture_default_str();
+  AddGoalFlags(app, &w->options.advise);
   app.add_flag("--json-lines", w->json_lines,
                "one JSON object per line: {\"event\": \"pair\", ...} per pair, {\"event\": "
                "\"solve\", ...advise --json's fields} per solve");

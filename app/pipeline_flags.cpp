@@ -7,6 +7,7 @@
 
 #include "app/commands.h"
 #include "app/progress_listener.h"
+#include "core/guidance/advise.h"
 #include "core/lidar_camera/joint_intrinsics.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/session/calibration_job.h"
@@ -79,6 +80,22 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
       "--no-board-growing", [&o] { o.grow_to_board = false; },
       "fit the LiDAR plane on the brushed / seeded returns only, instead of growing the "
       "region to the whole board (limited by the target's sheet size)");
+}
+
+void AddGoalFlags(CLI::App& app, AdviseOptions* options) {
+  app.add_option("--goal-mm", options->goal.translation_mm,
+                 "goal: 1σ of the translation per axis [mm]")
+      ->capture_default_str();
+  app.add_option("--goal-deg", options->goal.rotation_deg,
+                 "goal: 1σ of the rotation per axis [deg]")
+      ->capture_default_str();
+  app.add_option("--hand-tolerance-m", options->guidance.hand_tolerance_m,
+                 "how far the person may miss the suggested pose, ± per axis [m]: the next pose "
+                 "is one that stays usable within it")
+      ->capture_default_str();
+  app.add_option("--hand-tolerance-deg", options->guidance.hand_tolerance_deg,
+                 "how far the person may turn the board from the suggested pose, at most [deg]")
+      ->capture_default_str();
 }
 
 bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {

@@ -7,6 +7,10 @@
 
 #include "core/lidar_camera/pipeline.h"
 
+namespace calibench {
+struct AdviseOptions;
+}
+
 namespace calibench::app {
 
 struct PipelineFlags {
@@ -21,6 +25,9 @@ struct PipelineFlags {
 
 // with_selection adds --pairs and --initial-guess (not wanted where pairs are simulated).
 void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection = true);
+
+// --goal-mm, --goal-deg, --hand-tolerance-m and --hand-tolerance-deg of `advise` and `watch`.
+void AddGoalFlags(CLI::App& app, AdviseOptions* options);
 
 // Applies the string flags; false with *why when they are malformed or the options fail Check.
 bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why);

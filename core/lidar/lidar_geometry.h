@@ -4,7 +4,8 @@
 // steered by prisms) fires from one centre too but follows no rings; a swept single-line laser's
 // rays start on a mirror that moves with the stage; a board-only segment holds too little to
 // tell. Spinning and non-repetitive clouds are fitted on the ranges along their rays (only rings
-// add ring biases and board edges); swept and segment clouds get an isotropic point-to-plane
+// add ring biases; board edges come from rings' ends or the beam's path across the sheet's
+// border, core/target/board_edges.h); swept and segment clouds get an isotropic point-to-plane
 // model (the plane's own covariance).
 #pragma once
 

@@ -20,9 +20,10 @@ namespace calibench {
 struct LidarPlaneOptions {
   // The sensor's geometry decides the noise model (core/lidar/lidar_geometry.h): a spinning
   // LiDAR's planes are fitted on the ranges along its rays (fit_ranges_ml), grown over the board
-  // by ray, with ring biases and board edges; a swept laser's or a segment's by total least
-  // squares (isotropic point-to-plane, the plane's own covariance), grown by distance to the
-  // plane, without ring biases or edges (they have no rings).
+  // by ray, with ring biases and board edges (a ring's ends); a non-repetitive scan's the same
+  // way, its edges where the beam's path crosses the sheet's border, no ring biases; a swept
+  // laser's or a segment's by total least squares (isotropic point-to-plane, the plane's own
+  // covariance), grown by distance to the plane, without ring biases or edges.
   LidarGeometry geometry = LidarGeometry::kSpinning;
   double ransac_threshold_m = 0.03;  // inlier distance; ~3σ of typical spinning-LiDAR range noise
   int ransac_iterations = 500;       // enough for > 50% inliers with a 1e-9 failure chance
