@@ -88,14 +88,14 @@ std::vector<std::uint8_t> SerializeLivoxCustomMsg(const LidarCloud& cloud, std::
         cloud.HasIntensity() ? static_cast<std::uint8_t>(std::clamp(cloud.intensity[i], 0.f, 255.f))
                              : 0);
     out.Put<std::uint8_t>(tags.empty() ? 0 : tags[i]);  // tag
-    out.Put<std::uint8_t>(0);                           // line
+    out.Put<std::uint8_t>(cloud.HasRing() ? static_cast<std::uint8_t>(cloud.ring[i]) : 0);  // line
   }
   return out.Take();
 }
 
 std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int64_t stamp_ns,
                                                const std::string& frame, MessageEncoding encoding,
-                                               bool big_endian) {
+                                               bool big_endian, const char* ring_field) {
   MessageWriter out(encoding, big_endian);
   out.Header(stamp_ns, frame);
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(cloud.height));
@@ -107,7 +107,7 @@ std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int
   };
   std::vector<Field> fields = {{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}};
   if (cloud.HasIntensity()) fields.push_back({"intensity", 16, 7});
-  if (cloud.HasRing()) fields.push_back({"ring", 20, 4});
+  if (cloud.HasRing()) fields.push_back({ring_field, 20, 4});
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(fields.size()));
   for (const Field& field : fields) {
     out.String(field.name);

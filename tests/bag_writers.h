@@ -25,13 +25,15 @@ struct RecordedMessage {
 };
 
 // Little-endian float32 x y z [intensity float32] [ring uint16]; point_step padded to 32 bytes
-// like Velodyne's driver. With big_endian the same layout in network order (CDR only).
+// like Velodyne's driver. With big_endian the same layout in network order (CDR only). The ring
+// field is named `ring_field` ("line": a Livox driver's laser index).
 std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int64_t stamp_ns,
                                                const std::string& frame, MessageEncoding encoding,
-                                               bool big_endian = false);
+                                               bool big_endian = false,
+                                               const char* ring_field = "ring");
 // livox_ros_driver(2)/CustomMsg from its definition: the cloud's points in order, offset_time
-// from `offsets_ns` (or 10 µs apart), reflectivity from the intensity, tag 0, line 0; `tags`
-// (optional) per point.
+// from `offsets_ns` (or 10 µs apart), reflectivity from the intensity, tag 0, line from the
+// cloud's ring (the laser; 0 without); `tags` (optional) per point.
 std::vector<std::uint8_t> SerializeLivoxCustomMsg(const LidarCloud& cloud, std::int64_t stamp_ns,
                                                   const std::string& frame,
                                                   MessageEncoding encoding,

@@ -197,6 +197,28 @@ std::vector<PointField> ReadPointFields(MessageCursor& cursor) {
   return fields;
 }
 
+// Stores the returns laser by laser (stable: each laser's in firing order), `line` holding each
+// return's laser. A Livox driver interleaves its lasers' returns; a beam's path is one laser's.
+template <typename Extra>
+void OrderByLaserLine(const std::vector<int>& line, LidarCloud* cloud, std::vector<Extra>* extra) {
+  if (line.empty() || std::all_of(line.begin(), line.end(), [&](int l) { return l == line[0]; }))
+    return;
+  std::vector<std::size_t> order(line.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return line[a] < line[b]; });
+  auto permute = [&](auto& values) {
+    if (values.size() != order.size()) return;
+    std::remove_reference_t<decltype(values)> sorted;
+    sorted.reserve(values.size());
+    for (std::size_t i : order) sorted.push_back(values[i]);
+    values = std::move(sorted);
+  };
+  permute(cloud->points);
+  permute(cloud->intensity);
+  if (extra) permute(*extra);
+}
+
 void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>& fields,
                std::uint32_t width, std::uint32_t height, std::uint32_t point_step,
                std::uint32_t row_step, bool swap, LidarCloud* cloud) {
@@ -205,7 +227,11 @@ void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>
   const PointField* z = FindField(fields, {"z"});
   if (!x || !y || !z) Bad("PointCloud2: no x, y and z fields");
   const PointField* intensity = FindField(fields, {"intensity", "reflectivity", "i"});
-  const PointField* ring = FindField(fields, {"ring", "laser_id", "channel", "line"});
+  const PointField* ring = FindField(fields, {"ring", "laser_id", "channel"});
+  // A Livox driver's PointCloud2 names its laser "line": not a ring (its returns follow the
+  // rosette, not a cone), but the order its beam's path is stored in.
+  const PointField* line = ring ? nullptr : FindField(fields, {"line"});
+  std::vector<int> lines;
   const std::size_t total = static_cast<std::size_t>(width) * height;
   if (total == 0) return;  // no points: not 4 billion empty rows walked through
   cloud->points.reserve(total);
@@ -230,8 +256,10 @@ void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>
               ring->name + " " + std::to_string(index) + ", not a laser index");
         cloud->ring.push_back(static_cast<int>(index));
       }
+      if (line) lines.push_back(static_cast<int>(ReadField(point, *line, swap)));
     }
   }
+  OrderByLaserLine<int>(lines, cloud, nullptr);
   const bool complete = cloud->points.size() == total;
   cloud->width =
       complete && height > 1 ? static_cast<int>(width) : static_cast<int>(cloud->points.size());
@@ -458,12 +486,14 @@ LivoxCustomMessage DecodeLivoxCustomMsg(std::span<const std::uint8_t> data,
   cloud.points.reserve(count);
   cloud.intensity.reserve(count);
   message.offset_time_ns.reserve(count);
+  std::vector<int> lines;
+  lines.reserve(count);
   for (std::uint32_t i = 0; i < count; ++i) {
     const std::uint32_t offset_time = cursor.Read<std::uint32_t>();
     const float x = cursor.Read<float>(), y = cursor.Read<float>(), z = cursor.Read<float>();
     const std::uint8_t reflectivity = cursor.Read<std::uint8_t>();
     const std::uint8_t tag = cursor.Read<std::uint8_t>();
-    cursor.Read<std::uint8_t>();  // line
+    const std::uint8_t laser = cursor.Read<std::uint8_t>();  // line
     const Eigen::Vector3f point(x, y, z);
     if (!point.allFinite() || point.squaredNorm() < 1e-12f) continue;  // no return
     if ((tag & 0x03) == 0x01) {
@@ -473,7 +503,9 @@ LivoxCustomMessage DecodeLivoxCustomMsg(std::span<const std::uint8_t> data,
     cloud.points.push_back(point);
     cloud.intensity.push_back(reflectivity);
     message.offset_time_ns.push_back(offset_time);
+    lines.push_back(laser);
   }
+  OrderByLaserLine(lines, &cloud, &message.offset_time_ns);
   cloud.width = static_cast<int>(cloud.size());
   cloud.height = 1;
   return message;

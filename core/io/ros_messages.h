@@ -75,7 +75,9 @@ struct LivoxCustomMessage {
   int declared_points = 0;  // point_num
   // Finite, non-zero returns whose tag does not mark them high-confidence noise (tag bits 0-1 =
   // 01); intensity = reflectivity. No ring: a Livox "line" is a laser of the prism head, whose
-  // returns follow the rosette, not a cone.
+  // returns follow the rosette, not a cone. The driver interleaves its lasers (an Avia's 6, a
+  // Mid-360's 4); the returns are stored laser by laser, each in firing order, so that
+  // consecutive returns are neighbours on one beam's path (board edges from its crossings).
   LidarCloud cloud;
   std::vector<std::uint32_t> offset_time_ns;  // per kept return
   int noise_dropped = 0;                      // returns tagged as noise

@@ -97,6 +97,42 @@ TEST(RosMessages, MalformedCloudsAreRefusedWithTheReason) {
 
 // Issue 46 item 3: livox_ros_driver(2)/CustomMsg in both serializations. The sizes follow from
 // the definition alone: ROS 1 packs a point in 19 bytes, CDR aligns each to 20.
+// A multi-laser Livox (an Avia's 6 lines, a Mid-360's 4) interleaves its lasers' returns; each
+// laser's own order is its beam's path. Both the CustomMsg and a Livox driver's PointCloud2 with
+// its "line" field come back laser by laser, each in firing order, and without rings (a laser of
+// a prism head follows the rosette, not a cone).
+TEST(RosMessages, LivoxLinesAreStoredLaserByLaserNotAsRings) {
+  LidarCloud cloud;
+  for (int i = 0; i < 12; ++i) {
+    cloud.points.emplace_back(2.f + 0.01f * i, 0.1f * (i % 3), 0.2f);
+    cloud.intensity.push_back(static_cast<float>(i));
+    cloud.ring.push_back(i % 3);  // the laser, interleaved as the driver sends them
+  }
+  cloud.width = static_cast<int>(cloud.size());
+  const std::vector<int> expected_order = {0, 3, 6, 9, 1, 4, 7, 10, 2, 5, 8, 11};
+  for (MessageEncoding encoding : {MessageEncoding::kRos1, MessageEncoding::kCdr}) {
+    SCOPED_TRACE(encoding == MessageEncoding::kRos1 ? "ROS 1" : "CDR");
+    const LivoxCustomMessage custom = DecodeLivoxCustomMsg(
+        test::SerializeLivoxCustomMsg(cloud, 1'000, "livox_frame", encoding), encoding);
+    const PointCloud2Message pc2 = DecodePointCloud2(
+        test::SerializePointCloud2(cloud, 1'000, "livox_frame", encoding, false, "line"), encoding);
+    for (const LidarCloud* decoded : {&custom.cloud, &pc2.cloud}) {
+      EXPECT_FALSE(decoded->HasRing());
+      ASSERT_EQ(decoded->size(), cloud.size());
+      for (std::size_t k = 0; k < expected_order.size(); ++k) {
+        EXPECT_EQ(decoded->points[k], cloud.points[expected_order[k]]) << k;
+        EXPECT_EQ(decoded->intensity[k], cloud.intensity[expected_order[k]]) << k;
+      }
+    }
+    for (std::size_t k = 0; k < expected_order.size(); ++k)
+      EXPECT_EQ(custom.offset_time_ns[k], expected_order[k] * 10'000u) << k;
+    // A ring field by its own name stays a ring.
+    const PointCloud2Message rings =
+        DecodePointCloud2(test::SerializePointCloud2(cloud, 1'000, "velodyne", encoding), encoding);
+    EXPECT_EQ(rings.cloud.ring, cloud.ring);
+  }
+}
+
 TEST(RosMessages, LivoxCustomMsgInBothSerializations) {
   LidarCloud cloud = MessageTestCloud(5, 1);
   cloud.ring.clear();
