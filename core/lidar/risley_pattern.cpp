@@ -1,5 +1,6 @@
 #include "core/lidar/risley_pattern.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -23,6 +24,8 @@ RisleyPattern MakeRisleyPattern(const std::string& name) {
     p.points_per_s = 200000.0;
     p.prism1_hz = 97.3;
     p.prism2_hz = -61.9;
+    p.lasers = 6;
+    p.laser_spacing_deg = 2.0;  // assumed: a column spanning 10°, filling between the petals
     return p;
   }
   if (name == "mid360") {
@@ -33,6 +36,7 @@ RisleyPattern MakeRisleyPattern(const std::string& name) {
     p.prism1_hz = 173.1;  // the elevation sweep's rate, incommensurate with the spin
     p.max_range_m = 40.0;
     p.min_range_m = 0.1;
+    p.lasers = 4;
     return p;
   }
   throw std::invalid_argument("unknown Livox-class pattern \"" + name +
@@ -55,28 +59,42 @@ bool InRisleyField(const RisleyPattern& pattern, const Vec3& direction) {
 RisleyRays FireRisleyPattern(const RisleyPattern& pattern, double start_s, double duration_s) {
   RisleyRays rays;
   const long n = std::lround(duration_s * pattern.points_per_s);
+  const int lasers = std::max(1, pattern.lasers);
   if (n <= 0) return rays;
   rays.directions.reserve(n);
   rays.time_offsets_s.reserve(n);
+  rays.laser.reserve(n);
   const double w1 = 2.0 * M_PI * pattern.prism1_hz, w2 = 2.0 * M_PI * pattern.prism2_hz;
-  for (long k = 0; k < n; ++k) {
-    const double dt = k / pattern.points_per_s, t = start_s + dt;
-    Vec3 direction;
-    if (pattern.spinning) {
-      const double azimuth = 2.0 * M_PI * pattern.spin_hz * t;
-      const double elevation =
-          (pattern.centre_elevation_deg + pattern.half_fov_v_deg * std::sin(w1 * t)) * kDegToRad;
-      direction = FromAzimuthElevation(azimuth, elevation);
-    } else {
-      // Each wedge deflects the beam by half of the half field; their sum sweeps a rosette that
-      // reaches the rim when the two deflections line up.
-      const double u = 0.5 * (std::cos(w1 * t) + std::cos(w2 * t));
-      const double v = 0.5 * (std::sin(w1 * t) + std::sin(w2 * t));
-      direction = FromAzimuthElevation(u * pattern.half_fov_h_deg * kDegToRad,
-                                       v * pattern.half_fov_v_deg * kDegToRad);
+  for (int laser = 0; laser < lasers; ++laser) {
+    // The lasers fire in turn: laser b's m-th ray is the (m·lasers + b)-th of the scanner.
+    const double shift_deg = (laser - 0.5 * (lasers - 1)) * pattern.laser_spacing_deg;
+    // The rosette shrinks by the largest shift, so that every laser's stays inside the field.
+    const double max_shift_deg = 0.5 * (lasers - 1) * pattern.laser_spacing_deg;
+    const double shrink =
+        pattern.spinning ? 1.0 : std::max(0.0, 1.0 - max_shift_deg / pattern.half_fov_v_deg);
+    const double phase = 2.0 * M_PI * laser / lasers;
+    for (long k = laser; k < n; k += lasers) {
+      const double dt = k / pattern.points_per_s, t = start_s + dt;
+      Vec3 direction;
+      if (pattern.spinning) {
+        const double azimuth = 2.0 * M_PI * pattern.spin_hz * t;
+        const double elevation =
+            (pattern.centre_elevation_deg + pattern.half_fov_v_deg * std::sin(w1 * t + phase)) *
+            kDegToRad;
+        direction = FromAzimuthElevation(azimuth, elevation);
+      } else {
+        // Each wedge deflects the beam by half of the half field; their sum sweeps a rosette
+        // that reaches the rim when the two deflections line up.
+        const double u = 0.5 * (std::cos(w1 * t) + std::cos(w2 * t));
+        const double v = 0.5 * (std::sin(w1 * t) + std::sin(w2 * t));
+        direction =
+            FromAzimuthElevation(shrink * u * pattern.half_fov_h_deg * kDegToRad,
+                                 (shrink * v * pattern.half_fov_v_deg + shift_deg) * kDegToRad);
+      }
+      rays.directions.push_back(direction);
+      rays.time_offsets_s.push_back(dt);
+      rays.laser.push_back(laser);
     }
-    rays.directions.push_back(direction);
-    rays.time_offsets_s.push_back(dt);
   }
   return rays;
 }

@@ -25,19 +25,27 @@ struct RisleyPattern {
   double spin_hz = 10.0;  // spinning only
   double max_range_m = 90.0;
   double min_range_m = 0.5;
+  // Lasers sharing the prisms (a Livox driver's "line": Avia 6, Mid-360 4, Mid-40 1), sharing
+  // points_per_s. A cone's lasers sit in a column: each draws the rosette shifted by
+  // laser_spacing_deg in elevation. The 360° kind's lasers are spread over its elevation sweep's
+  // phase instead. (Their exact layout is not published: an assumed geometry, denser per frame.)
+  int lasers = 1;
+  double laser_spacing_deg = 0.0;
 };
 
-// "mid40" (38.4° circle, 100 k points/s), "avia" (70.4° × 77.2°, 240 k/s as its triple echo;
-// here 200 k/s), "mid360" (360° × 59°, −7° to 52°, 200 k/s). Throws std::invalid_argument naming
+// "mid40" (38.4° circle, 100 k points/s, 1 laser), "avia" (70.4° × 77.2°, 240 k/s as its triple
+// echo; here 200 k/s, 6 lasers), "mid360" (360° × 59°, −7° to 52°, 200 k/s, 4 lasers). Throws std::invalid_argument naming
 // the known ones for any other name.
 RisleyPattern MakeRisleyPattern(const std::string& name);
 std::string RisleyPatternNames();  // "mid40, avia, mid360"
 
 // The unit ray directions (LiDAR frame: x forward, z up) fired from time start_s for duration_s,
-// each with its time offset from start_s (seconds), in firing order.
+// each with its time offset from start_s (seconds): laser by laser, each laser's in firing order
+// (as `import` stores a Livox driver's interleaved returns), with each ray's laser.
 struct RisleyRays {
   std::vector<Vec3> directions;
   std::vector<double> time_offsets_s;
+  std::vector<int> laser;
 };
 // Whether a direction (LiDAR frame, any length) lies inside the pattern's field of view: the
 // rosette's ellipse of azimuth × elevation about +x, or the 360° kind's band of elevation.

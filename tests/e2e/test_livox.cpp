@@ -92,6 +92,12 @@ TEST(Livox, AviaHoldsSeedless) {
   CheckLivoxSet({LidarModel::kAvia, 1.0, 19, 2.0}, test::TempDir("livox_avia_hold"));
 }
 
+// An Avia's six lasers draw six rosettes a frame: enough strokes over a board at 2-6 m for a
+// plane (one laser's frame left most boards one stroke or none: 2/20).
+TEST(Livox, AviaFramesSeedless) {
+  CheckLivoxSet({LidarModel::kAvia, 0.1, 18, 2.0}, test::TempDir("livox_avia_frame"));
+}
+
 TEST(Livox, Mid360HoldsSeedless) {
   CheckLivoxSet({LidarModel::kMid360, 1.0, 19, 2.5}, test::TempDir("livox_mid360_hold"));
 }

@@ -4,6 +4,7 @@
 // reads their clouds (a scan from one centre, not a segment; a board crop still a segment).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/io/cloud_io.h"
@@ -26,8 +27,22 @@ TEST(LivoxSim, RaysStayInTheirFieldAndFillIt) {
     int inside = 0;
     for (const Vec3& d : rays.directions) inside += InRisleyField(pattern, d);
     EXPECT_EQ(inside, static_cast<int>(rays.directions.size()));
-    EXPECT_NEAR(rays.time_offsets_s.back(), 0.1, 2.0 / pattern.points_per_s);
+    // Laser by laser (Avia 6, Mid-360 4), each in firing order, together the whole 0.1 s.
+    ASSERT_EQ(rays.laser.size(), rays.directions.size());
+    std::vector<int> per_laser(pattern.lasers, 0);
+    for (size_t i = 0; i < rays.laser.size(); ++i) {
+      ++per_laser.at(rays.laser[i]);
+      if (i > 0 && rays.laser[i] == rays.laser[i - 1])
+        EXPECT_GT(rays.time_offsets_s[i], rays.time_offsets_s[i - 1]);
+      if (i > 0) EXPECT_GE(rays.laser[i], rays.laser[i - 1]);
+    }
+    for (int count : per_laser) EXPECT_NEAR(count, rays.directions.size() / pattern.lasers, 1);
+    EXPECT_NEAR(*std::max_element(rays.time_offsets_s.begin(), rays.time_offsets_s.end()), 0.1,
+                2.0 / pattern.points_per_s);
   }
+  EXPECT_EQ(MakeRisleyPattern("mid40").lasers, 1);
+  EXPECT_EQ(MakeRisleyPattern("avia").lasers, 6);
+  EXPECT_EQ(MakeRisleyPattern("mid360").lasers, 4);
   // Mid-40: a 38.4° circle; a direction 20° off the axis lies outside, 18° inside.
   const RisleyPattern mid40 = MakeRisleyPattern("mid40");
   EXPECT_FALSE(InRisleyField(mid40, Vec3(std::cos(20 * kDegToRad), std::sin(20 * kDegToRad), 0)));
