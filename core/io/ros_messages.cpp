@@ -4,120 +4,20 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 #include "core/io/camera_file.h"
-#include "core/io/image_io.h"
+#include "core/io/ros_message_cursor.h"
 
 namespace calibench {
 namespace {
 
-[[noreturn]] void Bad(const std::string& what) { throw std::invalid_argument(what); }
-
-// A message's rows (PointCloud2, Image): the declared stride holds a row of row_bytes, and the
-// data holds stride x height bytes. Both products of uint32 fit in 64 unsigned bits.
-void CheckRows(const char* type, const char* stride_name, std::uint32_t stride,
-               const char* row_name, std::uint64_t row_bytes, std::uint32_t height,
-               std::size_t data_bytes) {
-  if (stride < row_bytes)
-    Bad(std::string(type) + ": " + stride_name + " " + std::to_string(stride) +
-        " is shorter than " + row_name + " = " + std::to_string(row_bytes) + " bytes");
-  if (static_cast<std::uint64_t>(stride) * height > data_bytes)
-    Bad(std::string(type) + ": " + std::to_string(data_bytes) + " bytes of data for " +
-        stride_name + " x height = " + std::to_string(static_cast<std::uint64_t>(stride) * height));
-}
-
-template <typename T>
-T ByteSwapped(T value) {
-  std::uint8_t bytes[sizeof(T)];
-  std::memcpy(bytes, &value, sizeof(T));
-  std::reverse(bytes, bytes + sizeof(T));
-  std::memcpy(&value, bytes, sizeof(T));
-  return value;
-}
-
-// Reads one message's fields in order. ROS 1: little-endian, packed. CDR: a 4-byte
-// encapsulation header giving the byte order, then every primitive aligned to its size counted
-// from the end of that header (OMG CDR as ROS 2's rmw implementations write it).
-class MessageCursor {
- public:
-  MessageCursor(std::span<const std::uint8_t> data, MessageEncoding encoding, const char* type)
-      : data_(data), type_(type) {
-    if (encoding == MessageEncoding::kCdr) {
-      cdr_ = true;
-      if (data.size() < 4) Bad(std::string(type) + ": shorter than the CDR header");
-      // 0x0000 CDR big-endian, 0x0001 CDR little-endian; ROS 2 writes plain CDR only.
-      if (data[0] != 0 || data[1] > 1)
-        Bad(std::string(type) + ": CDR encapsulation " + std::to_string(data[0] * 256 + data[1]) +
-            " (only plain CDR, 0 and 1, is what ROS 2 records)");
-      big_endian_ = data[1] == 0;
-      origin_ = position_ = 4;
-    } else if (encoding != MessageEncoding::kRos1) {
-      Bad(std::string(type) + ": neither ROS 1 nor CDR serialization");
-    }
-  }
-
-  template <typename T>
-  T Read() {
-    Align(sizeof(T));
-    Need(sizeof(T), "a number");
-    T value;
-    std::memcpy(&value, data_.data() + position_, sizeof(T));
-    position_ += sizeof(T);
-    return big_endian_ ? ByteSwapped(value) : value;
-  }
-  std::string String(const char* what) {
-    const std::uint32_t length = Read<std::uint32_t>();
-    Need(length, what);
-    const char* text = reinterpret_cast<const char*>(data_.data() + position_);
-    position_ += length;
-    std::size_t size = length;
-    if (cdr_ && size > 0 && text[size - 1] == '\0') --size;  // CDR counts the terminator
-    return std::string(text, size);
-  }
-  std::span<const std::uint8_t> ByteSequence(const char* what) {
-    const std::uint32_t length = Read<std::uint32_t>();
-    Need(length, what);
-    auto bytes = data_.subspan(position_, length);
-    position_ += length;
-    return bytes;
-  }
-  void ReadDoubles(double* out, std::size_t count) {
-    for (std::size_t i = 0; i < count; ++i) out[i] = Read<double>();
-  }
-
- private:
-  void Align(std::size_t size) {
-    if (!cdr_) return;
-    const std::size_t from_origin = position_ - origin_;
-    position_ = origin_ + (from_origin + size - 1) / size * size;
-  }
-  void Need(std::uint64_t size, const char* what) const {
-    if (position_ > data_.size() || size > data_.size() - position_)
-      Bad(std::string(type_) + ": the message ends inside " + what + " (byte " +
-          std::to_string(position_) + " of " + std::to_string(data_.size()) + ")");
-  }
-
-  std::span<const std::uint8_t> data_;
-  const char* type_;
-  bool cdr_ = false;
-  bool big_endian_ = false;
-  std::size_t origin_ = 0;
-  std::size_t position_ = 0;
-};
-
-RosHeader ReadHeader(MessageCursor& cursor, MessageEncoding encoding) {
-  RosHeader header;
-  if (encoding == MessageEncoding::kRos1) cursor.Read<std::uint32_t>();  // seq, gone in ROS 2
-  const std::int64_t seconds = encoding == MessageEncoding::kRos1 ? cursor.Read<std::uint32_t>()
-                                                                  : cursor.Read<std::int32_t>();
-  const std::uint32_t nanoseconds = cursor.Read<std::uint32_t>();
-  header.stamp_ns = seconds * 1'000'000'000 + nanoseconds;
-  header.frame_id = cursor.String("the frame id");
-  return header;
-}
+// The cursor over a message and its checks: core/io/ros_message_cursor.h.
+using ros_detail::Bad;
+using ros_detail::ByteSwapped;
+using ros_detail::CheckRows;
+using ros_detail::MessageCursor;
+using ros_detail::ReadHeader;
 
 // sensor_msgs/PointField datatypes.
 enum PointFieldType : std::uint8_t {
@@ -266,62 +166,6 @@ void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>
   cloud->height = complete && height > 1 ? static_cast<int>(height) : 1;
 }
 
-ImageU8 FromMat(const cv::Mat& mat) {
-  ImageU8 image;
-  image.width = mat.cols;
-  image.height = mat.rows;
-  image.channels = mat.channels();
-  const std::size_t row_bytes = static_cast<std::size_t>(mat.cols) * mat.channels();
-  image.data.resize(row_bytes * mat.rows);
-  for (int row = 0; row < mat.rows; ++row)
-    std::memcpy(image.data.data() + row * row_bytes, mat.ptr(row), row_bytes);
-  return image;
-}
-
-// 16-bit grey scaled so that the image's largest value becomes 255: a 12-bit camera's data in
-// 16-bit words would otherwise be a black picture after a plain shift.
-cv::Mat ScaledToEightBits(const cv::Mat& sixteen) {
-  double largest = 0;
-  cv::minMaxLoc(sixteen, nullptr, &largest);
-  cv::Mat eight;
-  sixteen.convertTo(eight, CV_8U, largest > 0 ? 255.0 / largest : 1.0);
-  return eight;
-}
-
-struct RawEncoding {
-  const char* name;
-  int cv_type;
-  int conversion;  // cv::COLOR_*, or -1 to keep the pixels as they are
-};
-// cv_bridge's table for the Bayer patterns: ROS names the first 2x2 block from the top left,
-// OpenCV names the second row's pair, hence rggb -> BayerBG.
-constexpr RawEncoding kRawEncodings[] = {
-    {"mono8", CV_8UC1, -1},
-    {"8UC1", CV_8UC1, -1},
-    {"mono16", CV_16UC1, -1},
-    {"16UC1", CV_16UC1, -1},
-    {"bgr8", CV_8UC3, -1},
-    {"8UC3", CV_8UC3, -1},
-    {"rgb8", CV_8UC3, cv::COLOR_RGB2BGR},
-    {"bgra8", CV_8UC4, cv::COLOR_BGRA2BGR},
-    {"rgba8", CV_8UC4, cv::COLOR_RGBA2BGR},
-    {"bayer_rggb8", CV_8UC1, cv::COLOR_BayerBG2BGR},
-    {"bayer_bggr8", CV_8UC1, cv::COLOR_BayerRG2BGR},
-    {"bayer_gbrg8", CV_8UC1, cv::COLOR_BayerGR2BGR},
-    {"bayer_grbg8", CV_8UC1, cv::COLOR_BayerGB2BGR},
-    {"yuv422", CV_8UC2, cv::COLOR_YUV2BGR_UYVY},
-    {"uyvy", CV_8UC2, cv::COLOR_YUV2BGR_UYVY},
-    {"yuv422_yuy2", CV_8UC2, cv::COLOR_YUV2BGR_YUYV},
-    {"yuyv", CV_8UC2, cv::COLOR_YUV2BGR_YUYV},
-};
-
-std::string KnownEncodings() {
-  std::string names;
-  for (const RawEncoding& encoding : kRawEncodings)
-    names += (names.empty() ? "" : ", ") + std::string(encoding.name);
-  return names;
-}
-
 }  // namespace
 
 RosHeader DecodeRosHeader(std::span<const std::uint8_t> data, MessageEncoding encoding) {
@@ -360,77 +204,6 @@ PointCloud2Message DecodePointCloud2(std::span<const std::uint8_t> data, Message
   message.declared_points = static_cast<int>(declared);
   const bool swap = big_endian != (std::endian::native == std::endian::big);
   FillCloud(points, fields, width, height, point_step, row_step, swap, &message.cloud);
-  return message;
-}
-
-ImageMessage DecodeImage(std::span<const std::uint8_t> data, MessageEncoding encoding,
-                         const LoadLimits& limits) {
-  MessageCursor cursor(data, encoding, "Image");
-  ImageMessage message;
-  message.header = ReadHeader(cursor, encoding);
-  const std::uint32_t height = cursor.Read<std::uint32_t>();
-  const std::uint32_t width = cursor.Read<std::uint32_t>();
-  message.encoding = cursor.String("the encoding");
-  const bool big_endian = cursor.Read<std::uint8_t>() != 0;
-  const std::uint32_t step = cursor.Read<std::uint32_t>();
-  const std::span<const std::uint8_t> pixels = cursor.ByteSequence("the pixel data");
-  const RawEncoding* raw = nullptr;
-  for (const RawEncoding& candidate : kRawEncodings)
-    if (message.encoding == candidate.name) raw = &candidate;
-  if (!raw)
-    Bad("Image: encoding '" + message.encoding + "' is not one Calibench reads (" +
-        KnownEncodings() + ")");
-  const std::uint64_t pixel_count = static_cast<std::uint64_t>(width) * height;
-  if (pixel_count > static_cast<std::uint64_t>(limits.max_image_pixels))
-    Bad("Image: " + std::to_string(width) + " x " + std::to_string(height) +
-        " pixels is over the limit of " + std::to_string(limits.max_image_pixels) +
-        " (max_image_pixels)");
-  if (width == 0 || height == 0 || width > 1u << 20 || height > 1u << 20)
-    Bad("Image: size " + std::to_string(width) + " x " + std::to_string(height));
-  CheckRows("Image", "step", step, "a row of width x pixel size",
-            static_cast<std::uint64_t>(width) * CV_ELEM_SIZE(raw->cv_type), height, pixels.size());
-  cv::Mat view(static_cast<int>(height), static_cast<int>(width), raw->cv_type,
-               const_cast<std::uint8_t*>(pixels.data()), step);
-  cv::Mat converted = view;
-  if (CV_MAT_DEPTH(raw->cv_type) == CV_16U) {
-    cv::Mat native = view.clone();
-    if (big_endian != (std::endian::native == std::endian::big))
-      for (int row = 0; row < native.rows; ++row)
-        for (auto& value : std::span(native.ptr<std::uint16_t>(row), native.cols))
-          value = ByteSwapped(value);
-    converted = ScaledToEightBits(native);
-  } else if (raw->conversion >= 0) {
-    cv::cvtColor(view, converted, raw->conversion);
-  }
-  message.image = FromMat(converted);
-  return message;
-}
-
-ImageMessage DecodeCompressedImage(std::span<const std::uint8_t> data, MessageEncoding encoding,
-                                   const LoadLimits& limits) {
-  MessageCursor cursor(data, encoding, "CompressedImage");
-  ImageMessage message;
-  message.header = ReadHeader(cursor, encoding);
-  message.encoding = cursor.String("the format");
-  const std::span<const std::uint8_t> bytes = cursor.ByteSequence("the compressed data");
-  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-  try {
-    const ImageHeader header = ReadImageHeader("CompressedImage", text);
-    CheckLoadLimit("CompressedImage", "pixel count", header.Pixels(), limits.max_image_pixels,
-                   "max_image_pixels");
-  } catch (const IoError& error) {
-    Bad(error.what());
-  }
-  const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1,
-                        const_cast<std::uint8_t*>(bytes.data()));
-  cv::Mat decoded = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);
-  if (decoded.empty()) Bad("CompressedImage: the " + message.encoding + " data does not decode");
-  if (decoded.depth() == CV_16U)
-    decoded = ScaledToEightBits(decoded.channels() == 1 ? decoded : decoded.reshape(1));
-  if (decoded.channels() == 4) cv::cvtColor(decoded, decoded, cv::COLOR_BGRA2BGR);
-  if (decoded.depth() != CV_8U || (decoded.channels() != 1 && decoded.channels() != 3))
-    Bad("CompressedImage: pixels of a kind Calibench does not read");
-  message.image = FromMat(decoded);
   return message;
 }
 
