@@ -25,6 +25,7 @@ kinds=(
   "segments:--lidar vlp16 --board-only-clouds"
   "mid40-frame:--lidar mid40 --lidar-frame 0.1"
   "mid40-hold:--lidar mid40 --lidar-frame 1"
+  "avia-frame:--lidar avia --lidar-frame 0.1"
   "avia-hold:--lidar avia --lidar-frame 1"
   "mid360-hold:--lidar mid360 --lidar-frame 1"
 )
