@@ -87,7 +87,7 @@ std::vector<std::uint8_t> SerializeLivoxCustomMsg(const LidarCloud& cloud, std::
     out.Put<std::uint8_t>(
         cloud.HasIntensity() ? static_cast<std::uint8_t>(std::clamp(cloud.intensity[i], 0.f, 255.f))
                              : 0);
-    out.Put<std::uint8_t>(tags.empty() ? 0 : tags[i]);  // tag
+    out.Put<std::uint8_t>(tags.empty() ? 0 : tags[i]);                                      // tag
     out.Put<std::uint8_t>(cloud.HasRing() ? static_cast<std::uint8_t>(cloud.ring[i]) : 0);  // line
   }
   return out.Take();

@@ -34,8 +34,8 @@ struct RisleyPattern {
 };
 
 // "mid40" (38.4° circle, 100 k points/s, 1 laser), "avia" (70.4° × 77.2°, 240 k/s as its triple
-// echo; here 200 k/s, 6 lasers), "mid360" (360° × 59°, −7° to 52°, 200 k/s, 4 lasers). Throws std::invalid_argument naming
-// the known ones for any other name.
+// echo; here 200 k/s, 6 lasers), "mid360" (360° × 59°, −7° to 52°, 200 k/s, 4 lasers). Throws
+// std::invalid_argument naming the known ones for any other name.
 RisleyPattern MakeRisleyPattern(const std::string& name);
 std::string RisleyPatternNames();  // "mid40, avia, mid360"
 

@@ -129,12 +129,9 @@ std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
   return edges;
 }
 
-std::vector<LidarEdgePoint> ExtractBeamCrossingEdgePoints(const LidarCloud& cloud,
-                                                          const std::vector<int>& inliers,
-                                                          const Plane& plane,
-                                                          const BoardEdgeOptions& options,
-                                                          BoardEdgeEnds* ends,
-                                                          std::string* no_search) {
+std::vector<LidarEdgePoint> ExtractBeamCrossingEdgePoints(
+    const LidarCloud& cloud, const std::vector<int>& inliers, const Plane& plane,
+    const BoardEdgeOptions& options, BoardEdgeEnds* ends, std::string* no_search) {
   std::vector<LidarEdgePoint> edges;
   BoardEdgeEnds tally;
   if (ends) *ends = tally;
@@ -198,7 +195,8 @@ std::vector<LidarEdgePoint> ExtractBeamCrossingEdgePoints(const LidarCloud& clou
       const Vec3 stroke = *board_on_plane - *before_on_plane;
       const Vec3 gap = stroke * (out_step_deg / board_step_deg);
       if (!(gap.norm() > 0)) continue;
-      edges.push_back({*board_on_plane + 0.5 * gap, gap.normalized(), gap.norm() / std::sqrt(12.0)});
+      edges.push_back(
+          {*board_on_plane + 0.5 * gap, gap.normalized(), gap.norm() / std::sqrt(12.0)});
     }
   }
   tally.edge_points = static_cast<int>(edges.size());

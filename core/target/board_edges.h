@@ -58,12 +58,9 @@ std::vector<LidarEdgePoint> ExtractBoardEdgePoints(const LidarCloud& cloud,
 // behind it. A rosette crosses a board's border hundreds of times in a second's hold, every
 // crossing an edge point like a ring's end. Returns none, with *no_search saying why, when the
 // cloud does not keep its firing order (judged from the board's own returns).
-std::vector<LidarEdgePoint> ExtractBeamCrossingEdgePoints(const LidarCloud& cloud,
-                                                          const std::vector<int>& inliers,
-                                                          const Plane& plane,
-                                                          const BoardEdgeOptions& options,
-                                                          BoardEdgeEnds* ends,
-                                                          std::string* no_search);
+std::vector<LidarEdgePoint> ExtractBeamCrossingEdgePoints(
+    const LidarCloud& cloud, const std::vector<int>& inliers, const Plane& plane,
+    const BoardEdgeOptions& options, BoardEdgeEnds* ends, std::string* no_search);
 
 // Residual of one edge point against the sheet (half sizes in metres, board frame as BoardSpec):
 // the signed distance, in the board plane, from the point to the sheet edge nearest to it
