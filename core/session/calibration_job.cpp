@@ -33,8 +33,7 @@ CalibrationJob::CalibrationJob(Dataset dataset, CalibrationJobOptions options, P
 PairEdit CalibrationJob::EditOf(const std::string& pair_id) const {
   const auto found = brushes_.find(pair_id);
   PairEdit edit = found == brushes_.end() ? PairEdit{} : found->second;
-  for (const JobPair& pair : pairs_)
-    if (pair.detected.id == pair_id) edit.rejected = pair.rejected;
+  edit.rejected = rejections_.count(pair_id) > 0;
   return edit;
 }
 
@@ -158,11 +157,22 @@ void CalibrationJob::SetBrush(const std::string& pair_id, std::optional<PairEdit
 
 void CalibrationJob::SetRejected(const std::string& pair_id, bool rejected,
                                  const std::string& reason) {
-  for (JobPair& pair : pairs_) {
-    if (pair.detected.id != pair_id) continue;
-    pair.rejected = rejected;
-    pair.rejected_reason = rejected && !reason.empty() ? reason : kRejectedByUser;
+  if (rejected)
+    rejections_[pair_id] = reason.empty() ? kRejectedByUser : reason;
+  else
+    rejections_.erase(pair_id);
+}
+
+void CalibrationJob::Resume(const Session& session) {
+  ApplySessionOptions(session, &options_.advise.pipeline);
+  for (const PairState& pair : session.pairs) {
+    SetRejected(pair.id, pair.status == PairStatus::kRejected, pair.reason);
+    if (pair.brush && !pair.brush_from_seed)
+      SetBrush(pair.id, PairEdit{pair.brush->pixels, pair.brush->rows, pair.brush->columns});
+    else
+      SetBrush(pair.id, std::nullopt);
   }
+  view_json_ = session.view_json;
 }
 
 void CalibrationJob::SetSolverOptions(const SolverOptions& solver) {
@@ -180,9 +190,10 @@ std::vector<PairFeatures> CalibrationJob::DetectedPairs() const {
   std::vector<PairFeatures> features;
   for (const JobPair& pair : pairs_) {
     features.push_back(pair.detected);
-    if (!pair.rejected) continue;
+    const auto rejected = rejections_.find(pair.detected.id);
+    if (rejected == rejections_.end()) continue;
     features.back().status = PairStatus::kRejected;
-    features.back().reason = pair.rejected_reason;
+    features.back().reason = rejected->second;
   }
   return features;
 }
@@ -195,8 +206,7 @@ const CalibrationOutcome& CalibrationJob::Solve() {
   std::vector<const PairEntry*> entries;
   for (const PairEntry& pair : dataset_.pairs) entries.push_back(&pair);
   PairEdits edits = brushes_;
-  for (const JobPair& pair : pairs_)
-    if (pair.rejected) edits[pair.detected.id].rejected = true;
+  for (const auto& [id, reason] : rejections_) edits[id].rejected = true;
   // Every solve starts from what detection found, as `calibrate` does: a board completion
   // rescued is rescued again, one the camera disagrees with is looked at again.
   outcome_ =
@@ -236,7 +246,13 @@ Session CalibrationJob::ToSession(const std::filesystem::path& dataset_path) con
     const bool judged = advice_ && i < advice_->pairs.size();
     session.pairs[i].status = judged ? advice_->pairs[i].status : last->status;
     session.pairs[i].reason = judged ? advice_->pairs[i].reason : last->reason;
+    const auto brush = brushes_.find(session.pairs[i].id);
+    if (brush != brushes_.end())
+      session.pairs[i].brush =
+          BrushMask{brush->second.brush_rows, brush->second.brush_columns,
+                    *brush->second.brush_pixels};
   }
+  session.view_json = view_json_;
   const std::optional<SolverResult>& solution = advice_ ? advice_->solution : last_solution_;
   if (solution) session.result = SessionResultFromSolver(*solution);
   return session;

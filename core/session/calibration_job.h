@@ -12,6 +12,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -76,6 +77,13 @@ class CalibrationJob {
   // shown for it) at the next solve.
   void SetBrush(const std::string& pair_id, std::optional<PairEdit> brush);
   void SetRejected(const std::string& pair_id, bool rejected, const std::string& reason = "");
+  // A saved session's word (the workbench's, an earlier watch's): its brushes, rejections (with
+  // their reasons) and solver settings, by pair id (pairs that have not arrived yet take theirs
+  // when they do), and what its views showed, carried into ToSession. Call before detection.
+  void Resume(const Session& session);
+  // Whether the user painted pair `pair_id`'s board: its features must come from the brush, not
+  // from a detection cached without it.
+  bool HasBrush(const std::string& pair_id) const { return brushes_.count(pair_id) > 0; }
   void SetSolverOptions(const SolverOptions& solver);
   void SetGoal(const CaptureGoal& goal);
   // How precisely the person holds a suggested pose (GuidanceOptions::hand_tolerance_*).
@@ -102,8 +110,9 @@ class CalibrationJob {
   const std::string& background_note() const { return background_note_; }
 
   // The job as a workbench session over `dataset_path`: each pair's status and reason as the last
-  // solve and guidance left them, the last solution. `calibrate --session` and `gui --session`
-  // reopen it.
+  // solve and guidance left them, the user's brushes, the solver settings, the last solution and
+  // the views a resumed session showed. `calibrate --session`, `watch` and `gui --session` reopen
+  // it: one state, whichever front end wrote it last.
   Session ToSession(const std::filesystem::path& dataset_path) const;
 
  private:
@@ -111,8 +120,6 @@ class CalibrationJob {
     PairFeatures detected;  // planes as detection found them, status from them
     std::string lidar_failure = "not detected yet";
     std::string camera_failure = "not detected yet";
-    bool rejected = false;
-    std::string rejected_reason;
   };
   void Restatus(JobPair* pair) const;  // status and reason from the planes and the rejection
   PairEdit EditOf(const std::string& pair_id) const;
@@ -121,6 +128,8 @@ class CalibrationJob {
   Dataset dataset_;
   CalibrationJobOptions options_;
   PairEdits brushes_;
+  std::map<std::string, std::string> rejections_;  // the user's, by pair id: the reason shown
+  std::string view_json_ = "{}";                   // a resumed session's views (Session::view_json)
   JobEvents events_;
   std::vector<JobPair> pairs_;
   SceneBackground background_accumulator_;

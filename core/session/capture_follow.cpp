@@ -4,6 +4,7 @@
 #include <map>
 #include <thread>
 
+#include "core/base/file_lock.h"
 #include "core/io/capture_feed.h"
 #include "core/io/dataset_source.h"
 #include "core/io/recording_watch.h"
@@ -126,6 +127,32 @@ class FeatureCacheKeeper {
   int resumed_ = 0;
 };
 
+// Whether `dataset` (a session's) is the capture in `folder`: the folder itself, or a manifest in
+// it (the workbench opened the folder's manifest).
+bool IsCaptureIn(const fs::path& dataset, const fs::path& folder) {
+  const fs::path normal_folder = NormalizeSessionPath(folder);
+  const fs::path normal_dataset = NormalizeSessionPath(dataset);
+  return normal_dataset == normal_folder || normal_dataset.parent_path() == normal_folder;
+}
+
+// Locks the session as the workbench locks it (core/base/file_lock.h): a session open in a
+// workbench is not followed into, or the two would overwrite each other's edits. False with *why
+// when another process holds it.
+bool LockFollowedSession(const fs::path& session, std::optional<FileLock>* lock,
+                         const FollowSink& sink, std::string* why) {
+  std::string holder;
+  try {
+    *lock = FileLock::TryLock(session, &holder);
+  } catch (const IoError& e) {  // no lock file can be made: saving will fail and say so
+    Say(sink, "note", "", std::string("cannot lock the session (") + e.what() + ")");
+    return true;
+  }
+  if (*lock) return true;
+  *why = session.string() + ": the session is open in a Calibench workbench (" + holder +
+         "); close it there, or give watch another --session";
+  return false;
+}
+
 // The loop: look, add the completed pairs, solve, say what changed, save; until idle or done.
 class Follower {
  public:
@@ -135,6 +162,7 @@ class Follower {
       : request_(request),
         options_(options),
         sink_(sink),
+        session_path_(session_path),
         autosaver_(session_path),
         cache_(session_path),
         feed_(std::move(feed)) {}
@@ -155,7 +183,7 @@ class Follower {
         if (event.kind == FolderEvent::Kind::kPairComplete) {
           // The job starts with the first pair: a recording's camera and board are known then.
           if (!job_) StartJob();
-          job_->AddPair(event.pair, cache_.Earlier(event.pair));
+          AddPair(event.pair);
           added = true;
         } else {
           Say(sink_, event.kind == FolderEvent::Kind::kIncomplete ? "incomplete" : "removed",
@@ -179,13 +207,53 @@ class Follower {
   }
 
  private:
-  // The job over the feed's camera and board; the pairs it already holds join as new ones.
+  // The job over the feed's camera and board, with the user's word from the session there; the
+  // pairs the feed already holds join as new ones.
   void StartJob() {
     Dataset setup = *feed_->Setup();
     std::vector<PairEntry> known = std::move(setup.pairs);
     setup.pairs.clear();
     job_.emplace(std::move(setup), options_);
-    for (const PairEntry& pair : known) job_->AddPair(pair, cache_.Earlier(pair));
+    ResumeSession();
+    for (const PairEntry& pair : known) AddPair(pair);
+  }
+
+  // A painted pair is detected from its brush again: the cache holds detection without it.
+  void AddPair(const PairEntry& pair) {
+    job_->AddPair(pair, job_->HasBrush(pair.id) ? nullptr : cache_.Earlier(pair));
+  }
+
+  // The session the workbench or an earlier watch left for this capture: its brushes, rejections
+  // and solver settings hold here as there (one state, whichever front end wrote it). One of
+  // another dataset, or one that does not load, is kept as the autosave's first backup.
+  void ResumeSession() {
+    std::error_code error;
+    if (!fs::exists(session_path_, error)) return;
+    const fs::path kept = SessionBackupPath(session_path_, 1);
+    try {
+      const Session saved = LoadSession(session_path_);
+      if (!saved.camera.empty() || !IsCaptureIn(saved.dataset, feed_->DatasetFolder())) {
+        Say(sink_, "note", "",
+            session_path_.string() + " is a session of " + saved.dataset.string() +
+                (saved.camera.empty() ? "" : " (camera " + saved.camera + ")") + ", not of " +
+                feed_->DatasetFolder().string() + ": a new one starts, that one is kept as " +
+                kept.string());
+        return;
+      }
+      job_->Resume(saved);
+      int brushed = 0, rejected = 0;
+      for (const PairState& pair : saved.pairs) {
+        brushed += pair.brush && !pair.brush_from_seed;
+        rejected += pair.status == PairStatus::kRejected;
+      }
+      Say(sink_, "resumed", "",
+          "the session in " + session_path_.string() + ": " + std::to_string(brushed) +
+              " painted boards, " + std::to_string(rejected) +
+              " rejected pairs and the solver settings hold here");
+    } catch (const IoError& e) {
+      Say(sink_, "note", "",
+          std::string(e.what()) + ": a new session starts, that one is kept as " + kept.string());
+    }
   }
 
   // Solves, then says the verdicts that changed and the solve, and saves; true when the watch
@@ -233,6 +301,7 @@ class Follower {
   const CaptureFollowRequest& request_;
   CalibrationJobOptions options_;
   const FollowSink& sink_;
+  fs::path session_path_;
   Autosaver autosaver_;
   FeatureCacheKeeper cache_;
   std::unique_ptr<CaptureFeed> feed_;
@@ -259,6 +328,8 @@ bool FollowCapture(CaptureFollowRequest request, const CalibrationJobOptions& op
     fs::create_directories(request.out);
     const fs::path session =
         request.session.empty() ? request.out / "calibench.session.json" : request.session;
+    std::optional<FileLock> lock;
+    if (!LockFollowedSession(session, &lock, sink, why)) return false;
     Follower(FollowRecording(request.source, request.out, request.board, request.import), options,
              request, session, sink)
         .Run();
@@ -284,6 +355,8 @@ bool FollowCapture(CaptureFollowRequest request, const CalibrationJobOptions& op
   }
   const fs::path session =
       request.session.empty() ? folder / "calibench.session.json" : request.session;
+  std::optional<FileLock> lock;
+  if (!LockFollowedSession(session, &lock, sink, why)) return false;
   Follower(FollowFolder(std::move(*setup), folder, request.folder), options, request, session, sink)
       .Run();
   return true;

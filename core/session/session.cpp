@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -169,16 +171,40 @@ SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_p
   Dataset dataset = session.camera.empty()
                         ? LoadDataset(session.dataset, CameraFile::kRequired, TargetFile::kOptional)
                         : LoadRigCamera(session.dataset, session.camera);
-  if (session.pairs.size() != dataset.pairs.size())
-    throw IoError(session_path.string() + ": the session has " +
-                  std::to_string(session.pairs.size()) + " pairs but " + dataset.manifest.string() +
-                  " has " + std::to_string(dataset.pairs.size()));
-  for (size_t i = 0; i < dataset.pairs.size(); ++i)
-    if (session.pairs[i].id != dataset.pairs[i].id)
-      throw IoError(session_path.string() + ": pair " + std::to_string(i) + " is '" +
-                    session.pairs[i].id + "' in the session but '" + dataset.pairs[i].id +
-                    "' in the dataset");
+  session = SessionOverDataset(std::move(session), dataset, session_path);
   return {std::move(session), std::move(dataset)};
+}
+
+Session SessionOverDataset(Session saved, const Dataset& dataset,
+                           const std::filesystem::path& session_path) {
+  std::set<std::string> in_dataset;
+  for (const PairEntry& entry : dataset.pairs) in_dataset.insert(entry.id);
+  for (const PairState& pair : saved.pairs)
+    if (!in_dataset.count(pair.id))
+      throw IoError(session_path.string() + ": the session's pair '" + pair.id + "' is not in " +
+                    dataset.manifest.string() + " (" + std::to_string(dataset.pairs.size()) +
+                    " pairs there, " + std::to_string(saved.pairs.size()) + " in the session)");
+  std::map<std::string, size_t> saved_index;
+  for (size_t i = 0; i < saved.pairs.size(); ++i) saved_index[saved.pairs[i].id] = i;
+  std::vector<PairState> pairs;
+  size_t next_saved = 0;  // the saved pairs must come in the dataset's order
+  for (const PairEntry& entry : dataset.pairs) {
+    const auto found = saved_index.find(entry.id);
+    if (found == saved_index.end()) {
+      PairState added;
+      added.id = entry.id;
+      pairs.push_back(std::move(added));
+      continue;
+    }
+    if (found->second != next_saved)
+      throw IoError(session_path.string() + ": pair '" + entry.id + "' comes before '" +
+                    saved.pairs[next_saved].id + "' in " + dataset.manifest.string() +
+                    " but after it in the session");
+    ++next_saved;
+    pairs.push_back(std::move(saved.pairs[found->second]));
+  }
+  saved.pairs = std::move(pairs);
+  return saved;
 }
 
 void SaveSession(const std::filesystem::path& path, const Session& session) {

@@ -143,14 +143,23 @@ Session SessionFromJson(const std::string& text, const std::filesystem::path& so
 
 // Reads a session file; never writes it. Throws IoError naming the file and the problem.
 Session LoadSession(const std::filesystem::path& path);
-// A session with the dataset it names, checked to be that dataset's: the same pairs in the same
-// order (a session's edits and view are by pair; reopened on other pairs they would mislabel).
+// A session with the dataset it names, checked to be that dataset's: its pairs in the same order
+// (a session's edits and view are by pair; reopened on other pairs they would mislabel).
 // Throws IoError naming the session, the manifest and the first difference.
+// A capture that grew since the session was saved (a watched folder, a recording imported
+// again) is that dataset still: the saved pairs keep their state and the new ones join as pending
+// (SessionOverDataset).
 struct SessionWithDataset {
   Session session;
   Dataset dataset;
 };
 SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_path);
+// `saved` over the pairs `dataset` holds now: each saved pair keeps its state, the dataset's other
+// pairs join as pending, in the dataset's order. Throws IoError naming `session_path` when a saved
+// pair is missing from the dataset or the two order them differently (another dataset, or files
+// removed: the session's edits would land on other pairs).
+Session SessionOverDataset(Session saved, const Dataset& dataset,
+                           const std::filesystem::path& session_path);
 // Whether the file is a session (its first 4 KB name calibench.session.v1): what `export`,
 // `report` and the workbench's Open tell a session from a result or a manifest by. False for a
 // file that cannot be read.

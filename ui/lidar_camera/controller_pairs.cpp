@@ -53,7 +53,9 @@ std::string StartBrush(const PairEntry& entry, const LidarCloud& cloud, const Li
                        PairView* loaded) {
   std::string dropped;
   if (painted && BrushFitsImage(*painted, image.rows, image.columns, &dropped)) {
+    // Still the user's word once loaded: the job refits from it, the next autosave keeps it.
     loaded->brush_pixels = painted_pixels;
+    loaded->brush_edited = true;
     return "";
   }
   if (entry.lidar_seed) {
