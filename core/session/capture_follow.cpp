@@ -1,6 +1,7 @@
 #include "core/session/capture_follow.h"
 
 #include <chrono>
+#include <functional>
 #include <map>
 #include <thread>
 
@@ -35,7 +36,7 @@ void Say(const FollowSink& sink, const std::string& event, const std::string& na
 // looked for). Another kind of dataset is refused at once (IoError naming the command for it).
 std::optional<Dataset> WaitForSetup(const fs::path& folder, const fs::path& manifest,
                                     const CaptureFollowRequest& request, const FollowSink& sink,
-                                    std::string* why) {
+                                    const std::function<bool()>& stopped, std::string* why) {
   const double start = SteadySeconds();
   bool said = false;
   for (;;) {
@@ -60,6 +61,10 @@ std::optional<Dataset> WaitForSetup(const fs::path& folder, const fs::path& mani
     }
     if (request.idle_exit_s > 0 && SteadySeconds() - start >= request.idle_exit_s)
       return std::nullopt;
+    if (stopped && stopped()) {
+      *why = "stopped while waiting for the camera and the target of " + folder.string();
+      return std::nullopt;
+    }
     std::this_thread::sleep_for(std::chrono::duration<double>(request.poll_s));
   }
 }
@@ -318,9 +323,9 @@ bool CaptureFollowRequest::Check(std::string* why) const {
   return true;
 }
 
-bool FollowCapture(CaptureFollowRequest request, const CalibrationJobOptions& options,
-                   const FollowSink& sink, std::string* why) {
-  if (!request.Check(why)) return false;
+std::optional<OpenedFeed> OpenCaptureFeed(CaptureFollowRequest request, const FollowSink& sink,
+                                          const std::function<bool()>& stopped,
+                                          std::string* why) {
   if (IsRecordingSource(request.source)) {
     // A recording: import's pairs, written to the dataset folder; a capture has no cap.
     request.import.max_pairs = 0;
@@ -328,12 +333,8 @@ bool FollowCapture(CaptureFollowRequest request, const CalibrationJobOptions& op
     fs::create_directories(request.out);
     const fs::path session =
         request.session.empty() ? request.out / "calibench.session.json" : request.session;
-    std::optional<FileLock> lock;
-    if (!LockFollowedSession(session, &lock, sink, why)) return false;
-    Follower(FollowRecording(request.source, request.out, request.board, request.import), options,
-             request, session, sink)
-        .Run();
-    return true;
+    return OpenedFeed{FollowRecording(request.source, request.out, request.board, request.import),
+                      session};
   }
   fs::path manifest;
   fs::path folder = request.source;
@@ -346,19 +347,27 @@ bool FollowCapture(CaptureFollowRequest request, const CalibrationJobOptions& op
     *why = folder.string() +
            " is not a folder (watch follows a folder in the folder form: clouds/, images/, "
            "camera.yaml, target.json)";
-    return false;
+    return std::nullopt;
   }
-  std::optional<Dataset> setup = WaitForSetup(fs::absolute(folder), manifest, request, sink, why);
+  folder = fs::absolute(folder);
+  std::optional<Dataset> setup = WaitForSetup(folder, manifest, request, sink, stopped, why);
   if (!setup) {
-    Say(sink, "end", "", *why);
-    return false;
+    Say(sink, "end", "", *why);  // the camera and the target never came
+    return std::nullopt;
   }
   const fs::path session =
       request.session.empty() ? folder / "calibench.session.json" : request.session;
+  return OpenedFeed{FollowFolder(std::move(*setup), folder, request.folder), session};
+}
+
+bool FollowCapture(CaptureFollowRequest request, const CalibrationJobOptions& options,
+                   const FollowSink& sink, std::string* why) {
+  if (!request.Check(why)) return false;
+  std::optional<OpenedFeed> opened = OpenCaptureFeed(request, sink, nullptr, why);
+  if (!opened) return false;
   std::optional<FileLock> lock;
-  if (!LockFollowedSession(session, &lock, sink, why)) return false;
-  Follower(FollowFolder(std::move(*setup), folder, request.folder), options, request, session, sink)
-      .Run();
+  if (!LockFollowedSession(opened->session, &lock, sink, why)) return false;
+  Follower(std::move(opened->feed), options, request, opened->session, sink).Run();
   return true;
 }
 

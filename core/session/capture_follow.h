@@ -8,10 +8,12 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "core/io/bag_import.h"
+#include "core/io/capture_feed.h"
 #include "core/io/folder_watch.h"
 #include "core/session/calibration_job.h"
 #include "core/target/board.h"
@@ -46,6 +48,18 @@ struct CaptureFollowRequest {
   double poll_s = 0.1;             // between looks [s]
   bool Check(std::string* why) const;
 };
+
+// The source as a feed, and where its session goes unless request.session says: a recording's
+// pairs written to request.out (default: as `import`'s), a folder's camera and target waited for
+// (told to `sink` as "waiting") until idle_exit_s passes or `stopped` (may be empty) says so.
+// nullopt with *why when it cannot be followed. What FollowCapture and the workbench's live
+// session both follow.
+struct OpenedFeed {
+  std::unique_ptr<CaptureFeed> feed;
+  std::filesystem::path session;
+};
+std::optional<OpenedFeed> OpenCaptureFeed(CaptureFollowRequest request, const FollowSink& sink,
+                                          const std::function<bool()>& stopped, std::string* why);
 
 // Follows until done (with exit_when_done), the recording is closed, or idle; the "end" event
 // says which. False with *why when it cannot start: the source is not a folder or a recording,

@@ -25,6 +25,7 @@
 #include "core/lidar_camera/rig.h"
 #include "core/results/export.h"
 #include "core/session/calibration_job.h"         // the job, with the guidance and the session
+#include "core/session/capture_follow.h"
 #include "ui/lidar_camera/controller_snapshot.h"  // Snapshot and the views it holds
 #include "ui/state/view_state.h"
 
@@ -195,6 +196,9 @@ class Controller : public ControllerState<Snapshot> {
   // through FollowLoop (the one that ran stops first).
   void Follow(const std::filesystem::path& source,
               std::function<std::unique_ptr<CaptureFeed>()> make_feed);
+  // The source as `watch` opens it (OpenCaptureFeed); null, said on the status line, when it
+  // cannot be followed or following stopped first (watch thread).
+  std::unique_ptr<CaptureFeed> OpenFeed(const CaptureFollowRequest& request);
   // Opens the feed's dataset once its first look caught up (resuming an earlier watch's session),
   // then adds each pair as it lands.
   void FollowLoop(CaptureFeed* feed);

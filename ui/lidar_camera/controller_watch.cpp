@@ -60,42 +60,41 @@ void Controller::Follow(const std::filesystem::path& source,
 }
 
 void Controller::WatchFolder(const std::filesystem::path& folder, FolderWatchOptions options) {
-  Follow(folder, [this, options, folder = std::filesystem::absolute(folder)] {
-    // The capture's camera and target first (a capture script may write them after starting).
-    bool said = false;
-    for (;;) {
-      if (stop_watch_) return std::unique_ptr<CaptureFeed>();
-      std::error_code error;
-      if (std::filesystem::exists(folder / "camera.yaml", error) &&
-          std::filesystem::exists(folder / "target.json", error))
-        break;
-      if (!said) {
-        std::lock_guard lock(mutex_);
-        SetStatus("watching " + folder.string() + ": waiting for camera.yaml and target.json",
-                  false);
-        said = true;
-      }
-      std::this_thread::sleep_for(kPollPeriod);
-    }
-    try {
-      return FollowFolder(LoadFolderSetup(folder), folder, options);
-    } catch (const IoError& e) {
-      std::lock_guard lock(mutex_);
-      SetStatus(std::string("cannot watch: ") + e.what(), true);
-      return std::unique_ptr<CaptureFeed>();
-    }
-  });
+  CaptureFollowRequest request;
+  request.source = std::filesystem::absolute(folder).string();
+  request.folder = options;
+  Follow(folder, [this, request] { return OpenFeed(request); });
 }
 
 void Controller::WatchRecording(const std::filesystem::path& recording,
                                 const std::filesystem::path& out, std::optional<BoardSpec> board,
                                 BagImportOptions options) {
-  options.max_pairs = 0;  // a capture has no cap: every hold is a pair
-  Follow(recording, [recording = std::filesystem::absolute(recording), out, board, options] {
-    std::error_code error;
-    std::filesystem::create_directories(out, error);
-    return FollowRecording(recording, out, board, options);
-  });
+  CaptureFollowRequest request;
+  request.source = std::filesystem::absolute(recording).string();
+  request.out = out;
+  request.board = std::move(board);
+  request.import = std::move(options);
+  Follow(recording, [this, request] { return OpenFeed(request); });
+}
+
+std::unique_ptr<CaptureFeed> Controller::OpenFeed(const CaptureFollowRequest& request) {
+  // As `watch` opens it (core/session/capture_follow.h): a folder's camera and target waited for
+  // (the status line says so), a recording's pairs written to the dataset folder.
+  const FollowSink say = [this](const FollowEvent& event) {
+    std::lock_guard lock(mutex_);
+    SetStatus((event.event == "waiting" ? "watching: " : "") + event.reason, false);
+  };
+  std::string why;
+  try {
+    if (std::optional<OpenedFeed> opened =
+            OpenCaptureFeed(request, say, [this] { return stop_watch_.load(); }, &why))
+      return std::move(opened->feed);
+  } catch (const std::exception& e) {  // IoError naming the file, a folder not made
+    why = e.what();
+  }
+  std::lock_guard lock(mutex_);
+  if (!stop_watch_) SetStatus("cannot watch: " + why, true);
+  return nullptr;
 }
 
 void Controller::FollowLoop(CaptureFeed* feed) {

@@ -147,5 +147,63 @@ TEST(CalibrationJob, TheUsersRejectionsAndBrushesAreItsWord) {
                  "pair 1 erased");
 }
 
+// A session is the job's state on disk: resumed, its brushes, rejections (with their reasons),
+// solver settings and views are the job's, before and after the pairs arrive, and ToSession
+// writes them back as they were.
+TEST(CalibrationJob, ResumedFromASessionItKeepsTheUsersWordAndWritesItBack) {
+  const auto dir = test::TempDir("calibration_job_resume");
+  const Dataset dataset = test::CompletionMattersScene(dir / "set");
+  std::string why;
+  auto inputs = LoadPairInputs(dataset, dataset.pairs[1], &why);
+  ASSERT_TRUE(inputs) << why;
+  const LidarImage image = ProjectById(inputs->cloud, LidarImageOptions{});
+
+  Session saved = NewSession(dataset);
+  saved.pairs[0].status = PairStatus::kRejected;
+  saved.pairs[0].reason = "pre-flight: the board is cut by the image border";
+  saved.pairs[1].brush = BrushMask{image.rows, image.columns, {}};  // erased: no board there
+  saved.pairs[2].brush = BrushMask{image.rows, image.columns, {5, 6}};
+  saved.pairs[2].brush_from_seed = true;  // a seed's picture, not the user's word
+  saved.huber_delta = 0.25;
+  saved.max_iterations = 40;
+  saved.view_json = R"({"selected_pair":"0002"})";
+
+  // The pairs arrive after the session is resumed, one by one as a capture's.
+  Dataset setup = dataset;
+  setup.pairs.clear();
+  CalibrationJob job(setup, {});
+  job.Resume(saved);
+  EXPECT_TRUE(job.HasBrush(dataset.pairs[1].id));
+  EXPECT_FALSE(job.HasBrush(dataset.pairs[2].id));
+  EXPECT_EQ(job.options().advise.pipeline.solver.huber_delta, 0.25);
+  EXPECT_EQ(job.options().advise.pipeline.solver.max_iterations, 40);
+  for (const PairEntry& entry : dataset.pairs) job.AddPair(entry);
+  const CalibrationOutcome& outcome = job.Solve();
+  ASSERT_TRUE(outcome.solution) << outcome.failure;
+  EXPECT_EQ(outcome.pairs[0].status, PairStatus::kRejected);
+  EXPECT_EQ(outcome.pairs[0].reason, saved.pairs[0].reason);
+  EXPECT_EQ(outcome.pairs[1].status, PairStatus::kFailed);  // its erased brush holds
+  EXPECT_FALSE(outcome.pairs[1].lidar);
+
+  // `calibrate --session` on the same file: the same solve.
+  PipelineOptions options;
+  ApplySessionOptions(saved, &options);
+  const CalibrationOutcome cli = CalibrateDataset(dataset, options, {}, EditsFromSession(saved));
+  ASSERT_TRUE(cli.solution) << cli.failure;
+  ExpectSamePose(outcome.solution->cam_from_lidar, cli.solution->cam_from_lidar, 1e-12,
+                 "resumed job against calibrate --session");
+
+  const Session written = job.ToSession(dataset.manifest);
+  ASSERT_EQ(written.pairs.size(), saved.pairs.size());
+  EXPECT_EQ(written.pairs[0].status, PairStatus::kRejected);
+  EXPECT_EQ(written.pairs[0].reason, saved.pairs[0].reason);
+  EXPECT_EQ(written.pairs[1].brush, saved.pairs[1].brush);
+  EXPECT_FALSE(written.pairs[2].brush);  // no seed picture: the seed is the manifest's
+  EXPECT_EQ(written.huber_delta, 0.25);
+  EXPECT_EQ(written.max_iterations, 40);
+  EXPECT_EQ(written.view_json, saved.view_json);
+  EXPECT_EQ(EditsFromSession(written).size(), 2u);  // the rejection and the erased brush
+}
+
 }  // namespace
 }  // namespace calibench

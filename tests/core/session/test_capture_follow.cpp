@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "core/session/capture_follow.h"
+#include "core/session/session.h"
 #include "core/sim/sim.h"
 #include "tests/test_support.h"
 
@@ -90,6 +92,58 @@ TEST(CaptureFollow, WhatCannotBeFollowedIsSaid) {
   request.idle_exit_s = -1;
   EXPECT_FALSE(FollowCapture(request, CalibrationJobOptions{}, sink, &why));
   EXPECT_NE(why.find("--idle-exit must be >= 0"), std::string::npos) << why;
+}
+
+// A session that is not this capture's (another dataset's, or one that does not load) is not
+// resumed: the follower says so, naming it, and it is kept as the autosave's first backup.
+TEST(CaptureFollow, ASessionOfAnotherDatasetIsSaidAndKeptNotResumed) {
+  SimOptions sim = SimPreset("demo");
+  sim.num_pairs = 5;
+  sim.seed = 11;
+  const fs::path dir = test::TempDir("capture_follow_foreign");
+  SimulateDataset(sim, dir / "capture");
+  const fs::path session_path = dir / "capture" / "calibench.session.json";
+  for (const bool damaged : {false, true}) {
+    Session foreign;
+    foreign.dataset = dir / "elsewhere" / "dataset.json";
+    foreign.pairs.resize(1);
+    foreign.pairs[0].id = "0000";
+    foreign.pairs[0].status = PairStatus::kRejected;
+    const std::string text = damaged ? std::string("{\"format\": \"calibench.sess")
+                                     : SessionToJson(foreign, session_path);
+    fs::remove(SessionBackupPath(session_path, 1));
+    std::ofstream(session_path) << text;
+    Heard heard;
+    CaptureFollowRequest request;
+    request.source = (dir / "capture").string();
+    request.idle_exit_s = 0.5;
+    request.folder.settle_s = 0.05;
+    std::string why;
+    ASSERT_TRUE(FollowCapture(
+        request, CalibrationJobOptions{},
+        [&](const FollowEvent& e) {
+          FollowEvent copy = e;
+          copy.advice = nullptr;
+          heard.events.push_back(copy);
+        },
+        &why))
+        << why;
+    const std::vector<std::string> notes = heard.said("note");
+    const std::string kept = SessionBackupPath(session_path, 1).string();
+    bool said = false;
+    for (const std::string& note : notes)
+      said |= note.find(session_path.string()) != std::string::npos &&
+              note.find("kept as " + kept) != std::string::npos;
+    EXPECT_TRUE(said) << ::testing::PrintToString(notes);
+    for (const std::string& resumed : heard.said("resumed"))  // the feature cache may be
+      EXPECT_EQ(resumed.find("the session in"), std::string::npos) << resumed;
+    EXPECT_EQ(test::ReadFileBytes(kept), text);
+    const Session written = LoadSession(session_path);
+    EXPECT_EQ(written.dataset, NormalizeSessionPath(dir / "capture"));
+    ASSERT_EQ(written.pairs.size(), 5u);
+    for (const PairState& pair : written.pairs)  // nothing of the other session's word
+      EXPECT_EQ(pair.status, PairStatus::kAccepted) << (damaged ? "damaged: " : "") << pair.id;
+  }
 }
 
 }  // namespace

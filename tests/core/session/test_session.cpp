@@ -491,5 +491,49 @@ TEST(SessionTest, ResultIsTakenFromTheSolver) {
   EXPECT_FALSE(r.well_constrained);
 }
 
+// A capture that grew since its session was saved is still that session's dataset: the saved
+// pairs keep their state, the new ones join pending; a pair gone or reordered is another dataset.
+TEST(SessionTest, ASessionReopensOverItsCaptureGrownButNotOverAnotherDataset) {
+  Dataset dataset;
+  dataset.manifest = "/data/capture";
+  for (const char* id : {"pose1", "pose2", "pose3", "pose4"}) {
+    PairEntry entry;
+    entry.id = id;
+    dataset.pairs.push_back(entry);
+  }
+  Session saved;
+  saved.dataset = "/data/capture";
+  saved.pairs.resize(2);
+  saved.pairs[0].id = "pose1";
+  saved.pairs[1].id = "pose3";
+  saved.pairs[1].status = PairStatus::kRejected;
+  saved.pairs[1].reason = kRejectedByUser;
+  const Session grown = SessionOverDataset(saved, dataset, "/data/capture/s.json");
+  ASSERT_EQ(grown.pairs.size(), 4u);
+  EXPECT_EQ(grown.pairs[1].id, "pose2");
+  EXPECT_EQ(grown.pairs[1].status, PairStatus::kPending);
+  EXPECT_EQ(grown.pairs[2], saved.pairs[1]);
+
+  Session reordered = saved;
+  std::swap(reordered.pairs[0], reordered.pairs[1]);
+  try {
+    SessionOverDataset(reordered, dataset, "/data/capture/s.json");
+    FAIL() << "a session whose pairs come in another order opened";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("'pose1' comes before 'pose3'"), std::string::npos)
+        << e.what();
+  }
+  Session gone = saved;
+  gone.pairs[1].id = "pose9";
+  try {
+    SessionOverDataset(gone, dataset, "/data/capture/s.json");
+    FAIL() << "a session with a pair the dataset lacks opened";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("/data/capture/s.json: the session's pair 'pose9' is not in"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace calibench
