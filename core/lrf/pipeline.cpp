@@ -2,11 +2,9 @@
 
 #include <cmath>
 #include <cstdio>
-#include <set>
 #include <sstream>
 
 #include "core/base/image.h"
-#include "core/base/parallel.h"
 #include "core/io/image_io.h"
 
 namespace calibench {
@@ -85,23 +83,6 @@ LrfPairFeatures ExtractLrfPairFeatures(const LrfDataset& dataset, const LrfPairE
   }
   features.status = PairStatus::kAccepted;
   return features;
-}
-
-LrfCalibrationOutcome CalibrateLrfDataset(const LrfDataset& dataset,
-                                          const LrfPipelineOptions& options,
-                                          const ProgressCallback& progress) {
-  std::vector<const LrfPairEntry*> selected;
-  const std::set<std::string> wanted(options.pair_ids.begin(), options.pair_ids.end());
-  for (const LrfPairEntry& pair : dataset.pairs)
-    if (wanted.empty() || wanted.count(pair.id)) selected.push_back(&pair);
-  std::vector<LrfPairFeatures> features(selected.size());
-  ParallelFor(
-      selected.size(), options.threads,
-      [&](size_t i) { features[i] = ExtractLrfPairFeatures(dataset, *selected[i], options); },
-      [&](int finished, size_t i) {
-        if (progress) progress(finished, static_cast<int>(selected.size()), selected[i]->id);
-      });
-  return SolveLrfFromFeatures(std::move(features), dataset, options);
 }
 
 LrfCalibrationOutcome SolveLrfFromFeatures(std::vector<LrfPairFeatures> pairs,

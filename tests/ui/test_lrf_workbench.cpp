@@ -12,6 +12,7 @@
 
 #include "core/base/image.h"
 #include "core/geometry/geometry.h"
+#include "core/results/result_file.h"
 #include "core/sim/lrf_sim.h"
 #include "tests/test_support.h"
 #include "tests/ui/golden.h"
@@ -132,6 +133,42 @@ TEST(LrfController, RejectedPairsStayOutOfTheSolve) {
   EXPECT_EQ(s.selected, 3);
   controller.Apply(LrfSelectPair{kObservations});  // out of range: ignored
   EXPECT_EQ(controller.GetSnapshot().selected, 3);
+}
+
+// One job (core/lrf/lrf_job.h): the workbench and `calibench lrf-calibrate` run the same
+// extraction and solve, so a rejection made in the workbench and the same pair left out on the
+// command line give the same transform, bit for bit.
+TEST(LrfController, TheWorkbenchAndLrfCalibrateRunOneJob) {
+  LrfController controller;
+  OpenAndWait(controller);
+  const LrfSnapshot opened = controller.GetSnapshot();
+  controller.Apply(LrfSetPairStatus{2, PairStatus::kRejected});
+  controller.Apply(LrfRunSolver{});
+  controller.WaitIdle();
+  const LrfSnapshot gui = controller.GetSnapshot();
+  ASSERT_TRUE(gui.solver.solution) << gui.solver.failure;
+
+  LrfPipelineOptions options;
+  for (const LrfPairView& pair : opened.pairs)
+    if (pair.id != opened.pairs[2].id) options.pair_ids.push_back(pair.id);
+  const LrfCalibrationOutcome cli = CalibrateLrfDataset(*opened.dataset, options);
+  ASSERT_TRUE(cli.solution) << cli.failure;
+  EXPECT_EQ(gui.solver.solution->cam_from_lrf.matrix(), cli.solution->cam_from_lrf.matrix());
+  EXPECT_EQ(gui.solver.solution->covariance, cli.solution->covariance);
+
+  // The command itself, its result file read back.
+  std::string pairs;
+  for (const std::string& id : options.pair_ids) pairs += (pairs.empty() ? "" : ",") + id;
+  const auto out = test::TempDir("lrf_one_job") / "result.json";
+  std::string output;
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " lrf-calibrate --dataset " +
+                                 LrfUiDataset().string() + " --pairs " + pairs + " --out " +
+                                 out.string(),
+                             &output),
+            0)
+      << output;
+  EXPECT_TRUE(test::MatrixNear(LoadResult(out).cam_from_source.matrix(),
+                               gui.solver.solution->cam_from_lrf.matrix(), 0.0));
 }
 
 TEST(LrfController, ABadManifestShowsAnErrorAndKeepsTheOpenDataset) {

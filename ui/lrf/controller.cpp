@@ -90,22 +90,26 @@ bool LrfController::Open(const std::filesystem::path& manifest) {
                   dataset->manifest.string(),
               false);
   }
+  // The job every front end runs (core/lrf/lrf_job.h); the worker alone drives it, each job of
+  // the worker holding the one of its Open.
+  auto job = std::make_shared<LrfCalibrationJob>(*dataset, options_);
+  {
+    std::lock_guard lock(mutex_);
+    job_ = job;
+  }
   for (int i = 0; i < static_cast<int>(dataset->pairs.size()); ++i)
-    worker_.Enqueue([this, open_count, i] { Extract(open_count, i); });
+    worker_.Enqueue([this, job, open_count, i] { Extract(job.get(), open_count, i); });
   if (dataset->target_type == LrfTargetType::kCheckerboard)
     worker_.Enqueue([this] { LoadSelectedImage(); });
   return true;
 }
 
-void LrfController::Extract(std::uint64_t open_count, int index) {
-  std::shared_ptr<const LrfDataset> dataset;
+void LrfController::Extract(LrfCalibrationJob* job, std::uint64_t open_count, int index) {
   {
     std::lock_guard lock(mutex_);
     if (open_count != open_count_) return;
-    dataset = state_.dataset;
   }
-  auto features = std::make_shared<const LrfPairFeatures>(
-      ExtractLrfPairFeatures(*dataset, dataset->pairs[index], options_));
+  const std::shared_ptr<const LrfPairFeatures> features = job->ExtractPair(index);
   std::lock_guard lock(mutex_);
   if (open_count != open_count_) return;
   LrfPairView& pair = state_.pairs[index];
@@ -131,29 +135,26 @@ void LrfController::Extract(std::uint64_t open_count, int index) {
 }
 
 void LrfController::Solve() {
-  std::vector<LrfPairFeatures> pairs;
-  std::shared_ptr<const LrfDataset> dataset;
-  LrfPipelineOptions options = options_;
+  std::shared_ptr<LrfCalibrationJob> job;
+  std::vector<std::pair<std::string, bool>> rejected;  // the user's word, as the rows hold it
+  LrfMethod method;
   {
     std::lock_guard lock(mutex_);
-    if (!state_.dataset) return;
-    dataset = state_.dataset;
-    options.solver.method = state_.solver.method;
-    for (const LrfPairView& view : state_.pairs) {
-      if (!view.features) continue;
-      pairs.push_back(*view.features);
-      pairs.back().status = view.status;
-      pairs.back().reason = view.reason;
-    }
+    if (!state_.dataset || !job_) return;
+    job = job_;
+    method = state_.solver.method;
+    for (const LrfPairView& view : state_.pairs)
+      rejected.emplace_back(view.id, view.status == PairStatus::kRejected);
     state_.solver = LrfSolverView{};
-    state_.solver.method = options.solver.method;
+    state_.solver.method = method;
     state_.solver.running = true;
     outcome_.reset();
     UpdatePairFigures();
-    SetStatus("solving (" + LrfMethodName(options.solver.method) + ") ...", false);
+    SetStatus("solving (" + LrfMethodName(method) + ") ...", false);
   }
-  auto outcome = std::make_shared<LrfCalibrationOutcome>(
-      SolveLrfFromFeatures(std::move(pairs), *dataset, options));
+  for (const auto& [id, is_rejected] : rejected) job->SetRejected(id, is_rejected);
+  job->SetMethod(method);
+  auto outcome = std::make_shared<LrfCalibrationOutcome>(job->Solve());
   std::lock_guard lock(mutex_);
   LrfSolverView& solver = state_.solver;
   solver.running = false;

@@ -1,6 +1,7 @@
 // The 2D LRF workbench's state and the only place that changes it (the LRF counterpart of
-// ui/controller.h). Panels read an LrfSnapshot and return LrfIntents; the controller applies
-// them and runs feature extraction and solving on a worker thread.
+// ui/lidar_camera/controller.h). Panels read an LrfSnapshot and return LrfIntents; the controller
+// applies them and runs the LRF job (core/lrf/lrf_job.h, what `lrf-calibrate` runs: extraction
+// and the solve) on a worker thread.
 // No GL, GLFW or ImGui here: the controller is driven by tests without a window.
 #pragma once
 
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "core/base/image.h"
+#include "core/lrf/lrf_job.h"
 #include "core/lrf/pipeline.h"
 #include "ui/state/controller_state.h"
 
@@ -92,7 +94,8 @@ class LrfController : public ControllerState<LrfSnapshot> {
 
  private:
   void OnJobError() override;
-  void Extract(std::uint64_t open_count, int index);
+  // Pair `index` extracted by `job` (worker; the job of the Open that queued it).
+  void Extract(LrfCalibrationJob* job, std::uint64_t open_count, int index);
   void Solve();
   void LoadSelectedImage();
   void UpdatePairFigures();  // call with mutex_ held
@@ -107,6 +110,10 @@ class LrfController : public ControllerState<LrfSnapshot> {
   void Handle(const LrfExportResult& intent);
 
   LrfPipelineOptions options_;
+  // The pipeline job over the open dataset (core/lrf/lrf_job.h), as `lrf-calibrate` runs it:
+  // extraction and the solve, driven by the worker only; replaced by Open (mutex_ for the
+  // pointer).
+  std::shared_ptr<LrfCalibrationJob> job_;
   std::shared_ptr<const LrfCalibrationOutcome> outcome_;  // of the shown solution, for export
   std::uint64_t open_count_ = 0;  // a job of an earlier Open() discards its result
 };

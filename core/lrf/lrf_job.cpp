@@ -1,0 +1,88 @@
+#include "core/lrf/lrf_job.h"
+
+#include <set>
+
+#include "core/base/parallel.h"
+
+namespace calibench {
+
+LrfCalibrationJob::LrfCalibrationJob(LrfDataset dataset, LrfPipelineOptions options)
+    : options_(std::move(options)) {
+  const std::set<std::string> wanted(options_.pair_ids.begin(), options_.pair_ids.end());
+  std::vector<LrfPairEntry> selected;
+  for (LrfPairEntry& pair : dataset.pairs)
+    if (wanted.empty() || wanted.count(pair.id)) selected.push_back(std::move(pair));
+  dataset.pairs = std::move(selected);
+  dataset_ = std::move(dataset);
+  features_.resize(dataset_.pairs.size());
+}
+
+void LrfCalibrationJob::ExtractAll(const ProgressCallback& progress) {
+  std::vector<size_t> missing;
+  for (size_t i = 0; i < features_.size(); ++i)
+    if (!features_[i]) missing.push_back(i);
+  ParallelFor(
+      missing.size(), options_.threads,
+      [&](size_t k) {
+        const size_t i = missing[k];
+        features_[i] = std::make_shared<const LrfPairFeatures>(
+            ExtractLrfPairFeatures(dataset_, dataset_.pairs[i], options_));
+      },
+      [&](int finished, size_t k) {
+        if (progress)
+          progress(finished, static_cast<int>(missing.size()), dataset_.pairs[missing[k]].id);
+      });
+}
+
+std::shared_ptr<const LrfPairFeatures> LrfCalibrationJob::ExtractPair(int index) {
+  std::shared_ptr<const LrfPairFeatures>& features = features_.at(index);
+  if (!features)
+    features = std::make_shared<const LrfPairFeatures>(
+        ExtractLrfPairFeatures(dataset_, dataset_.pairs[index], options_));
+  return features;
+}
+
+void LrfCalibrationJob::SetRejected(const std::string& pair_id, bool rejected) {
+  if (rejected)
+    rejected_[pair_id] = true;
+  else
+    rejected_.erase(pair_id);
+}
+
+std::vector<LrfPairFeatures> LrfCalibrationJob::ExtractedPairs() const {
+  std::vector<LrfPairFeatures> pairs;
+  for (size_t i = 0; i < features_.size(); ++i) {
+    if (!features_[i]) {
+      LrfPairFeatures pending;
+      pending.id = dataset_.pairs[i].id;
+      pending.reason = "not extracted yet";
+      pairs.push_back(std::move(pending));
+      continue;
+    }
+    pairs.push_back(*features_[i]);
+    if (rejected_.count(pairs.back().id)) {
+      pairs.back().status = PairStatus::kRejected;
+      pairs.back().reason = kRejectedByUser;
+    }
+  }
+  return pairs;
+}
+
+const LrfCalibrationOutcome& LrfCalibrationJob::Solve() {
+  // Pairs not extracted yet stay out (SolveLrfFromFeatures uses accepted ones with features).
+  std::vector<LrfPairFeatures> pairs;
+  for (LrfPairFeatures& pair : ExtractedPairs())
+    if (pair.status != PairStatus::kPending) pairs.push_back(std::move(pair));
+  outcome_ = SolveLrfFromFeatures(std::move(pairs), dataset_, options_);
+  return *outcome_;
+}
+
+LrfCalibrationOutcome CalibrateLrfDataset(const LrfDataset& dataset,
+                                          const LrfPipelineOptions& options,
+                                          const ProgressCallback& progress) {
+  LrfCalibrationJob job(dataset, options);
+  job.ExtractAll(progress);
+  return job.Solve();
+}
+
+}  // namespace calibench
