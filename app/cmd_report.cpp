@@ -5,13 +5,10 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
-#include <fstream>
-#include <nlohmann/json.hpp>
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "core/base/atomic_file.h"
-#include "core/estimation/uncertainty.h"
 #include "core/io/assets.h"
 #include "core/io/dataset.h"
 #include "core/io/rig_folder.h"
@@ -33,15 +30,6 @@ std::string NowUtc() {
   char text[32];
   std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
   return text;
-}
-
-// The solver method a result file records (its "solver"."method"), "" when it names none.
-std::string ResultMethod(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  const auto result = nlohmann::json::parse(in, nullptr, false);
-  if (result.is_discarded() || !result.contains("solver") || !result["solver"].is_object())
-    return "";
-  return result["solver"].value("method", "");
 }
 
 // What a report says when its re-solve is not the reported pose ("" when they agree to 0.1 mm
@@ -107,21 +95,11 @@ int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
 int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const PipelineOptions& options,
                    const ReportRequest& request) {
   CALIBENCH_CHECK(outcome.joint.has_value());
-  RigReportSummary summary;
-  summary.shared_captures = outcome.shared_captures;
+  const RigReportSummary summary = SummarizeRigOutcome(outcome);
   std::vector<RigCameraReport> cameras;
   std::string why;
   for (size_t c = 0; c < outcome.camera_names.size(); ++c) {
     const std::string& name = outcome.camera_names[c];
-    const SolverResult& single = *outcome.single[c].solution;
-    const PoseWithSigmas joint = RigJointPose(outcome, c);
-    int pairs = 0;
-    for (const PairFeatures& p : outcome.single[c].pairs)
-      pairs += p.status == PairStatus::kAccepted;
-    summary.cameras.push_back({name, pairs, joint.pose, joint.sigma_t_mm, joint.sigma_r_deg,
-                               single.cam_from_lidar,
-                               1e3 * TranslationStd(single.covariance, single.cam_from_lidar),
-                               RotationStdDeg(single.covariance, single.cam_from_lidar)});
     RigCameraReport camera;
     camera.name = name;
     camera.prefix = "camera" + std::to_string(c) + "-";  // ids stay valid whatever the name
@@ -133,7 +111,6 @@ int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const Pipeli
     }
     cameras.push_back(std::move(camera));
   }
-  summary.relative = RigRelativePoses(outcome);
   ReportProvenance provenance;
   provenance.source = rig.folder.string() + " (a rig of " +
                       std::to_string(outcome.camera_names.size()) + " cameras)";
@@ -255,7 +232,7 @@ int RunReport(int argc, char** argv) {
   AddPipelineFlags(app, flags);
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
   if (!app.count("--method")) {
-    const std::string method = ResultMethod(result_path);
+    const std::string method = ResultSolverMethod(result_path);
     if (!method.empty()) flags.method = method;  // the result's own method, unless overridden
   }
   std::string why;

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/estimation/uncertainty.h"
 #include "core/results/export.h"
 
 namespace calibench {
@@ -420,6 +421,25 @@ std::string RigReportHtml(const RigReportSummary& rig, const std::vector<RigCame
     data["cameras"].push_back(chart);
   }
   return FillReport("Calibench rig calibration report", body, data, assets);
+}
+
+RigReportSummary SummarizeRigOutcome(const RigOutcome& outcome) {
+  CALIBENCH_CHECK(outcome.joint.has_value());
+  RigReportSummary summary;
+  summary.shared_captures = outcome.shared_captures;
+  for (size_t c = 0; c < outcome.camera_names.size(); ++c) {
+    const SolverResult& single = *outcome.single[c].solution;
+    const PoseWithSigmas joint = RigJointPose(outcome, c);
+    int pairs = 0;
+    for (const PairFeatures& p : outcome.single[c].pairs)
+      pairs += p.status == PairStatus::kAccepted;
+    summary.cameras.push_back({outcome.camera_names[c], pairs, joint.pose, joint.sigma_t_mm,
+                               joint.sigma_r_deg, single.cam_from_lidar,
+                               1e3 * TranslationStd(single.covariance, single.cam_from_lidar),
+                               RotationStdDeg(single.covariance, single.cam_from_lidar)});
+  }
+  summary.relative = RigRelativePoses(outcome);
+  return summary;
 }
 
 }  // namespace calibench

@@ -64,6 +64,10 @@ struct RigReportSummary {
   std::vector<PoseWithSigmas> relative;  // RigRelativePoses
   int shared_captures = 0;
 };
+// The rig's summary from its outcome: per camera, the joint solve's pose and σ beside the
+// camera's own, the accepted pairs; the cameras' relative poses; the captures they share.
+// Requires outcome.joint.
+RigReportSummary SummarizeRigOutcome(const RigOutcome& outcome);
 struct RigCameraReport {
   std::string name;
   std::string prefix;  // of its section's ids ("cam0-"): unique per camera

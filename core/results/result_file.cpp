@@ -1,6 +1,7 @@
 #include "core/results/result_file.h"
 
 #include <cstdio>
+#include <fstream>
 
 #include "core/base/atomic_file.h"
 #include "core/io/json_io.h"
@@ -110,6 +111,15 @@ LoadedResult LoadResult(const std::filesystem::path& path) {
   if (root.Has("observability"))
     result.well_constrained = root.Object("observability").Bool("well_constrained");
   return result;
+}
+
+std::string ResultSolverMethod(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  const json result = json::parse(in, nullptr, false);
+  if (result.is_discarded() || !result.contains("solver") || !result["solver"].is_object())
+    return "";
+  const json& method = result["solver"].value("method", json());
+  return method.is_string() ? method.get<std::string>() : "";
 }
 
 }  // namespace calibench

@@ -25,6 +25,11 @@ struct LoadedResult {
 // Reads cam_from_lidar (or cam_from_lrf) and the covariance. Throws IoError naming the file.
 LoadedResult LoadResult(const std::filesystem::path& path);
 
+// The solver method a result file records (its "solver"."method": a lidar-camera or a rig result
+// alike), "" when the file cannot be read as JSON or names none. Never throws: a report falls
+// back to its own default.
+std::string ResultSolverMethod(const std::filesystem::path& path);
+
 // The transform for a terminal: <target>_from_<source> and its inverse as 3x4 matrices, each with
 // its direction in words, and the standard deviations in camera axes (mm and degrees).
 std::string FormatTransform(const ResultNames& names, const Pose& target_from_source,
