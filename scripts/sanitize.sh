@@ -36,8 +36,9 @@ if [ $mode = thread ]; then
   # Unity builds here: this build looks for races, not for missing includes.
   cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCALIBENCH_UNITY_BUILD=ON \
     -DCALIBENCH_SANITIZE=thread -DCALIBENCH_BUILD_BENCHMARKS=OFF -DCALIBENCH_BUILD_PYTHON=OFF >/dev/null
-  cmake --build build-tsan -j "$JOBS" --target calibench test_core test_ui test_e2e
+  # Before the build: gtest_discover_tests runs each test binary to list its tests.
   export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/tsan.supp"
+  cmake --build build-tsan -j "$JOBS" --target calibench test_core test_ui test_e2e
   # The core and workbench tests, and the end-to-end ones that follow or import a capture (the
   # executable they run is instrumented too).
   ctest --test-dir build-tsan --output-on-failure -j "$JOBS" --timeout 1800 -L 'core|ui' "$@"

@@ -248,9 +248,8 @@ Session CalibrationJob::ToSession(const std::filesystem::path& dataset_path) con
     session.pairs[i].reason = judged ? advice_->pairs[i].reason : last->reason;
     const auto brush = brushes_.find(session.pairs[i].id);
     if (brush != brushes_.end())
-      session.pairs[i].brush =
-          BrushMask{brush->second.brush_rows, brush->second.brush_columns,
-                    *brush->second.brush_pixels};
+      session.pairs[i].brush = BrushMask{brush->second.brush_rows, brush->second.brush_columns,
+                                         *brush->second.brush_pixels};
   }
   session.view_json = view_json_;
   const std::optional<SolverResult>& solution = advice_ ? advice_->solution : last_solution_;

@@ -251,10 +251,12 @@ class Follower {
         brushed += pair.brush && !pair.brush_from_seed;
         rejected += pair.status == PairStatus::kRejected;
       }
+      const auto count = [](int n, const std::string& what) {
+        return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+      };
       Say(sink_, "resumed", "",
-          "the session in " + session_path_.string() + ": " + std::to_string(brushed) +
-              " painted boards, " + std::to_string(rejected) +
-              " rejected pairs and the solver settings hold here");
+          "the session in " + session_path_.string() + ": " + count(brushed, "painted board") +
+              ", " + count(rejected, "rejected pair") + " and the solver settings hold here");
     } catch (const IoError& e) {
       Say(sink_, "note", "",
           std::string(e.what()) + ": a new session starts, that one is kept as " + kept.string());
@@ -324,8 +326,7 @@ bool CaptureFollowRequest::Check(std::string* why) const {
 }
 
 std::optional<OpenedFeed> OpenCaptureFeed(CaptureFollowRequest request, const FollowSink& sink,
-                                          const std::function<bool()>& stopped,
-                                          std::string* why) {
+                                          const std::function<bool()>& stopped, std::string* why) {
   if (IsRecordingSource(request.source)) {
     // A recording: import's pairs, written to the dataset folder; a capture has no cap.
     request.import.max_pairs = 0;

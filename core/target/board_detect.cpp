@@ -16,6 +16,15 @@
 #include "core/target/charuco_board.h"
 
 namespace calibench {
+
+#if defined(__SANITIZE_THREAD__)
+namespace {
+// ThreadSanitizer cannot see oneTBB's synchronisation (libtbb is not instrumented), so every
+// buffer OpenCV hands to its parallel loops would look raced: in a ThreadSanitizer build
+// (scripts/sanitize.sh --thread) OpenCV runs them serially, and the races reported are ours.
+const int kOpenCvSerialUnderThreadSanitizer = (cv::setNumThreads(0), 0);
+}  // namespace
+#endif
 namespace {
 
 // OpenCV 4.6's interpolateCornersCharuco shifts its own cornerSubPix result by +0.5 px in x and

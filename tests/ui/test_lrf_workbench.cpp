@@ -161,11 +161,11 @@ TEST(LrfController, TheWorkbenchAndLrfCalibrateRunOneJob) {
   for (const std::string& id : options.pair_ids) pairs += (pairs.empty() ? "" : ",") + id;
   const auto out = test::TempDir("lrf_one_job") / "result.json";
   std::string output;
-  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " lrf-calibrate --dataset " +
-                                 LrfUiDataset().string() + " --pairs " + pairs + " --out " +
-                                 out.string(),
-                             &output),
-            0)
+  ASSERT_EQ(
+      test::RunCommand(test::CalibenchExe() + " lrf-calibrate --dataset " +
+                           LrfUiDataset().string() + " --pairs " + pairs + " --out " + out.string(),
+                       &output),
+      0)
       << output;
   EXPECT_TRUE(test::MatrixNear(LoadResult(out).cam_from_source.matrix(),
                                gui.solver.solution->cam_from_lrf.matrix(), 0.0));

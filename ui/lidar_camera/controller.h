@@ -24,7 +24,7 @@
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/rig.h"
 #include "core/results/export.h"
-#include "core/session/calibration_job.h"         // the job, with the guidance and the session
+#include "core/session/calibration_job.h"  // the job, with the guidance and the session
 #include "core/session/capture_follow.h"
 #include "ui/lidar_camera/controller_snapshot.h"  // Snapshot and the views it holds
 #include "ui/state/view_state.h"
@@ -211,7 +211,8 @@ class Controller : public ControllerState<Snapshot> {
   void Advise(const std::optional<SolverResult>& at = std::nullopt);
   // The same for a reopened session's result, over the pairs as detected again (worker).
   void AdviseFromState();
-  // The user's rejections and brushes (as the views hold them) into the job (worker).
+  // The user's rejections, brushes and solver settings into the job, from the session as
+  // CommitEdit left it: the job resumes it as `watch` resumes the file (worker).
   void SyncJobDecisions();
   void LoadPair(int index);
   // After the last pair loaded (mutex_ held): detection, the status line with what loading

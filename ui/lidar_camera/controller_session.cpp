@@ -274,6 +274,7 @@ void Controller::CommitEdit() {
   session_.huber_delta = state_.huber_delta;
   session_.max_iterations = state_.max_iterations;
   session_.estimate_range_offset = state_.estimate_range_offset;
+  session_.ransac_threshold_m = pipeline_.lidar_plane.ransac_threshold_m;  // what detection used
   for (size_t i = 0; i < state_.pairs.size(); ++i) {
     PairState& p = session_.pairs[i];
     const PairView& v = state_.pairs[i];

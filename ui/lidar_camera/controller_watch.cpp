@@ -86,8 +86,8 @@ std::unique_ptr<CaptureFeed> Controller::OpenFeed(const CaptureFollowRequest& re
   };
   std::string why;
   try {
-    if (std::optional<OpenedFeed> opened =
-            OpenCaptureFeed(request, say, [this] { return stop_watch_.load(); }, &why))
+    if (std::optional<OpenedFeed> opened = OpenCaptureFeed(
+            request, say, [this] { return stop_watch_.load(); }, &why))
       return std::move(opened->feed);
   } catch (const std::exception& e) {  // IoError naming the file, a folder not made
     why = e.what();
@@ -256,32 +256,22 @@ void Controller::AddPair(const PairEntry& entry) {
 }
 
 void Controller::SyncJobDecisions() {
-  struct Decision {
-    std::string id;
-    bool rejected;
-    std::string reason;
-    std::optional<PairEdit> brush;
-  };
-  std::vector<Decision> decisions;
+  Session decided;
+  SolverOptions solver;
+  CaptureGoal goal;
   {
     std::lock_guard lock(mutex_);
-    for (size_t i = 0; i < state_.pairs.size() && static_cast<int>(i) < job_->size(); ++i) {
-      const PairView& pair = state_.pairs[i];
-      Decision decision{pair.id, pair.status == PairStatus::kRejected, pair.reason, std::nullopt};
-      // A painted brush is the user's word: completion leaves the pair alone (as with
-      // `calibrate --session`, whose edits hold the brush).
-      if (pair.brush_edited && pair.lidar_image)
-        decision.brush =
-            PairEdit{pair.brush_pixels, pair.lidar_image->rows, pair.lidar_image->columns};
-      decisions.push_back(std::move(decision));
-    }
-    job_->SetSolverOptions(SolverOptionsFromState());
-    job_->SetGoal(state_.goal);
+    // The session is the user's word (CommitEdit keeps it after every edit): the job takes it as
+    // `watch` and `calibrate --session` take the file (CalibrationJob::Resume). A painted brush
+    // is the user's word there: completion leaves the pair alone.
+    decided = session_;
+    decided.ransac_threshold_m = pipeline_.lidar_plane.ransac_threshold_m;
+    solver = SolverOptionsFromState();
+    goal = state_.goal;
   }
-  for (const Decision& decision : decisions) {
-    job_->SetRejected(decision.id, decision.rejected, decision.reason);
-    job_->SetBrush(decision.id, decision.brush);
-  }
+  job_->Resume(decided);
+  job_->SetSolverOptions(solver);
+  job_->SetGoal(goal);
 }
 
 void Controller::AdviseFromState() {

@@ -529,8 +529,9 @@ TEST(SessionTest, ASessionReopensOverItsCaptureGrownButNotOverAnotherDataset) {
     SessionOverDataset(gone, dataset, "/data/capture/s.json");
     FAIL() << "a session with a pair the dataset lacks opened";
   } catch (const IoError& e) {
-    EXPECT_NE(std::string(e.what()).find("/data/capture/s.json: the session's pair 'pose9' is not in"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("/data/capture/s.json: the session's pair 'pose9' is not in"),
+        std::string::npos)
         << e.what();
   }
 }
