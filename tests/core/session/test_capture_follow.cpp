@@ -26,6 +26,15 @@ struct Heard {
   }
 };
 
+// A finished folder followed until `idle_exit_s` without new files (its files settle at once).
+CaptureFollowRequest FolderRequest(const fs::path& folder, double idle_exit_s) {
+  CaptureFollowRequest request;
+  request.source = folder.string();
+  request.idle_exit_s = idle_exit_s;
+  request.folder.settle_s = 0.05;
+  return request;
+}
+
 TEST(CaptureFollow, AFolderIsFollowedToItsEndWithEveryPairsVerdict) {
   SimOptions sim = SimPreset("demo");
   sim.num_pairs = 5;
@@ -35,10 +44,7 @@ TEST(CaptureFollow, AFolderIsFollowedToItsEndWithEveryPairsVerdict) {
   const Dataset dataset = SimulateDataset(sim, dir / "capture");
   Heard heard;
   int solves = 0;
-  CaptureFollowRequest request;
-  request.source = (dir / "capture").string();
-  request.idle_exit_s = 1.0;
-  request.folder.settle_s = 0.05;
+  const CaptureFollowRequest request = FolderRequest(dir / "capture", 1.0);
   std::string why;
   ASSERT_TRUE(FollowCapture(
       request, CalibrationJobOptions{},
@@ -114,10 +120,7 @@ TEST(CaptureFollow, ASessionOfAnotherDatasetIsSaidAndKeptNotResumed) {
     fs::remove(SessionBackupPath(session_path, 1));
     std::ofstream(session_path) << text;
     Heard heard;
-    CaptureFollowRequest request;
-    request.source = (dir / "capture").string();
-    request.idle_exit_s = 0.5;
-    request.folder.settle_s = 0.05;
+    const CaptureFollowRequest request = FolderRequest(dir / "capture", 0.5);
     std::string why;
     ASSERT_TRUE(FollowCapture(
         request, CalibrationJobOptions{},
