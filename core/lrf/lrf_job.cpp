@@ -44,7 +44,7 @@ std::shared_ptr<const LrfPairFeatures> LrfCalibrationJob::ExtractPair(int index)
 
 void LrfCalibrationJob::SetRejected(const std::string& pair_id, bool rejected) {
   if (rejected)
-    rejected_[pair_id] = true;
+    rejected_.insert(pair_id);
   else
     rejected_.erase(pair_id);
 }

@@ -7,9 +7,9 @@
 // a job.
 #pragma once
 
-#include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -46,7 +46,7 @@ class LrfCalibrationJob {
   LrfDataset dataset_;
   LrfPipelineOptions options_;
   std::vector<std::shared_ptr<const LrfPairFeatures>> features_;  // by pair; null until extracted
-  std::map<std::string, bool> rejected_;                          // the user's, by pair id
+  std::set<std::string> rejected_;                                // the user's, by pair id
   std::optional<LrfCalibrationOutcome> outcome_;
 };
 

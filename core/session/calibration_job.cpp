@@ -165,12 +165,13 @@ void CalibrationJob::SetRejected(const std::string& pair_id, bool rejected,
 
 void CalibrationJob::Resume(const Session& session) {
   ApplySessionOptions(session, &options_.advise.pipeline);
+  // What is the user's word, as `calibrate --session` reads it; the reasons are the session's.
+  const PairEdits edits = EditsFromSession(session);
   for (const PairState& pair : session.pairs) {
-    SetRejected(pair.id, pair.status == PairStatus::kRejected, pair.reason);
-    if (pair.brush && !pair.brush_from_seed)
-      SetBrush(pair.id, PairEdit{pair.brush->pixels, pair.brush->rows, pair.brush->columns});
-    else
-      SetBrush(pair.id, std::nullopt);
+    const auto edit = edits.find(pair.id);
+    const bool edited = edit != edits.end();
+    SetRejected(pair.id, edited && edit->second.rejected, pair.reason);
+    SetBrush(pair.id, edited ? std::optional(edit->second) : std::nullopt);
   }
   view_json_ = session.view_json;
 }

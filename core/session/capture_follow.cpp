@@ -247,9 +247,9 @@ class Follower {
       }
       job_->Resume(saved);
       int brushed = 0, rejected = 0;
-      for (const PairState& pair : saved.pairs) {
-        brushed += pair.brush && !pair.brush_from_seed;
-        rejected += pair.status == PairStatus::kRejected;
+      for (const auto& [id, edit] : EditsFromSession(saved)) {
+        brushed += edit.brush_pixels.has_value();
+        rejected += edit.rejected;
       }
       const auto count = [](int n, const std::string& what) {
         return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
