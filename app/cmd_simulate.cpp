@@ -30,6 +30,9 @@ void AddSimFlags(CLI::App& app, SimFlags& flags) {
   app.add_option("--lidar-noise", flags.lidar_noise, "LiDAR range noise sigma [m]");
   app.add_option("--lidar-range-offset", flags.lidar_range_offset,
                  "constant LiDAR range error [m]: measured range = true range + offset");
+  app.add_option("--lidar-angular-noise-deg", flags.lidar_angular_noise_deg,
+                 "jitter of each beam's direction [deg, 1 sigma per axis across the ray]: the "
+                 "return comes from the jittered ray, stored along the nominal one");
   app.add_option("--image-noise", flags.image_noise, "image noise sigma in [0,1] intensity units");
   app.add_option("--min-distance", flags.min_distance, "closest board distance [m]");
   app.add_option("--max-distance", flags.max_distance, "farthest board distance [m]");
@@ -98,6 +101,7 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
   if (flags.pairs > 0) options->num_pairs = flags.pairs;
   if (flags.lidar_noise >= 0) options->lidar_range_noise_m = flags.lidar_noise;
   options->lidar_range_offset_m = flags.lidar_range_offset;
+  options->lidar_angular_noise_rad = flags.lidar_angular_noise_deg * kDegToRad;
   if (flags.lidar_frame > 0) options->lidar_frame_s = flags.lidar_frame;
   if (flags.image_noise >= 0) options->image_noise = flags.image_noise;
   if (flags.min_distance > 0) options->min_distance_m = flags.min_distance;

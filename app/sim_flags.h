@@ -16,6 +16,7 @@ struct SimFlags {
   int pairs = 0;            // 0 = the preset's
   double lidar_noise = -1;  // < 0 = the preset's
   double lidar_range_offset = 0;
+  double lidar_angular_noise_deg = 0;
   double lidar_frame = 0;   // 0 = the model's frame (0.1 s)
   double image_noise = -1;  // < 0 = the preset's
   double min_distance = 0;  // 0 = the preset's

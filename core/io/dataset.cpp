@@ -54,6 +54,7 @@ SimulationRecord ParseSimulation(const json_io::Fields& sim) {
   record.lidar_frame_s = sim.GetOr("lidar_frame_s", 0.0);  // Livox-class models only
   // Manifests written before the offset existed have none.
   record.lidar_range_offset_m = sim.GetOr("lidar_range_offset_m", 0.0);
+  record.lidar_angular_noise_rad = sim.GetOr("lidar_angular_noise_rad", 0.0);
   record.image_noise = sim.Number("image_noise");
   record.clutter = sim.Bool("clutter");
   record.board_only_clouds = sim.GetOr("board_only_clouds", false);  // written since issue 32
@@ -190,7 +191,8 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
                           {"board_only_clouds", r.board_only_clouds},
                           {"seed_radius_m", r.seed_radius_m},
                           {"seed", r.seed},
-                          {"lidar_range_offset_m", r.lidar_range_offset_m}};
+                          {"lidar_range_offset_m", r.lidar_range_offset_m},
+                          {"lidar_angular_noise_rad", r.lidar_angular_noise_rad}};
     if (r.lidar_frame_s > 0) root["simulation"]["lidar_frame_s"] = r.lidar_frame_s;
   }
   WriteFileAtomically(manifest_path, root.dump(2) + "\n");

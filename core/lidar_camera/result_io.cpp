@@ -52,6 +52,34 @@ std::string ModelMeaning(LidarGeometry geometry) {
          "edges";
 }
 
+// The LiDAR's noise learned from the accepted pairs' boards fitted along their rays.
+LidarNoiseEstimate LearnedLidarNoise(const CalibrationOutcome& outcome) {
+  std::vector<RangeResidualMoments> boards;
+  for (const PairFeatures& p : outcome.pairs)
+    if (p.status == PairStatus::kAccepted && p.lidar && p.lidar->range_moments.count > 0)
+      boards.push_back(p.lidar->range_moments);
+  return EstimateLidarNoise(boards);
+}
+
+json LidarNoiseJson(const LidarNoiseEstimate& e) {
+  return {{"boards", e.boards},
+          {"returns", e.returns},
+          {"range_sigma_m",
+           {{"median", e.range_sigma_median_m},
+            {"min", e.range_sigma_min_m},
+            {"max", e.range_sigma_max_m}}},
+          {"angular_sigma_deg", e.angular_sigma_rad * kRadToDeg},
+          {"angular_sigma_upper_deg", std::isfinite(e.angular_sigma_upper_rad)
+                                          ? json(e.angular_sigma_upper_rad * kRadToDeg)
+                                          : json(nullptr)},
+          {"angular_resolved", e.angular_resolved},
+          {"equal_weight_efficiency_min", e.equal_weight_efficiency_min},
+          {"meaning",
+           "learned from the accepted boards' range residuals along their rays: variance = "
+           "range_sigma^2 (per board) + (angular_sigma * range * tan(incidence))^2; "
+           "angular_sigma_upper_deg is a 95% bound"}};
+}
+
 json ResidualsAvailable(const CalibrationOutcome& outcome) {
   const ResidualCounts counts = CountResiduals(outcome);
   return {{"plane_pairs", counts.plane_pairs},
@@ -188,6 +216,8 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
   root["pairs"] = PairsJson(outcome);
   root["solver"]["residuals_available"] = ResidualsAvailable(outcome);
   if (const json model = LidarModelJson(outcome); !model.is_null()) root["lidar_model"] = model;
+  if (const LidarNoiseEstimate noise = LearnedLidarNoise(outcome); noise.boards > 0)
+    root["lidar_noise"] = LidarNoiseJson(noise);
   return root;
 }
 
@@ -464,6 +494,8 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
   const SolverResult& s = *outcome.solution;
   out << FormatTransform(names, s.cam_from_lidar, s.covariance);
   if (const std::string model = DescribeLidarModel(outcome); !model.empty()) out << model << "\n";
+  if (const std::string noise = DescribeLidarNoise(LearnedLidarNoise(outcome)); !noise.empty())
+    out << noise << "\n";
   const ResidualCounts counts = CountResiduals(outcome);
   out << "residuals: board planes from " << counts.plane_pairs << " pairs";
   if (counts.edges_in_model)

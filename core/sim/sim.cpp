@@ -258,6 +258,8 @@ bool SimOptions::Check(std::string* why) const {
   if (!(lidar_range_noise_m >= 0.0) || !std::isfinite(lidar_range_noise_m)) {
     return fail("lidar_range_noise_m must be >= 0");
   }
+  if (!(lidar_angular_noise_rad >= 0.0 && lidar_angular_noise_rad <= 0.02))
+    return fail("lidar_angular_noise_rad must be in [0, 0.02] (about 1.1 deg)");
   if (!(std::abs(lidar_range_offset_m) <= 0.5))
     return fail("lidar_range_offset_m must be within ±0.5 m");
   if (!(image_noise >= 0.0) || !std::isfinite(image_noise)) return fail("image_noise must be >= 0");
@@ -378,6 +380,7 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
   if (beams.risley) record.lidar_frame_s = r.lidar_frame_s;
   record.lidar_range_noise_m = r.lidar_range_noise_m;
   record.lidar_range_offset_m = r.lidar_range_offset_m;
+  record.lidar_angular_noise_rad = r.lidar_angular_noise_rad;
   record.image_noise = r.image_noise;
   record.clutter = r.clutter;
   record.board_only_clouds = r.board_only_clouds;
@@ -400,6 +403,8 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
     LidarScanOptions scan_options;
     scan_options.range_noise_m = r.lidar_range_noise_m;
     scan_options.range_offset_m = r.lidar_range_offset_m;
+    scan_options.angular_noise_rad = r.lidar_angular_noise_rad;
+  scan_options.angular_noise_rad = r.lidar_angular_noise_rad;
     scan_options.azimuth_offset_rad = plan.azimuth_offset_rad;
     scan_options.seed = MixSeed(r.seed, k, 1);
     SavePcd(entry.cloud,
@@ -433,6 +438,7 @@ SimulatedPair SimulatePairAt(const SimOptions& resolved, const Pose& cam_from_bo
   LidarScanOptions scan_options;
   scan_options.range_noise_m = r.lidar_range_noise_m;
   scan_options.range_offset_m = r.lidar_range_offset_m;
+  scan_options.angular_noise_rad = r.lidar_angular_noise_rad;
   scan_options.azimuth_offset_rad = azimuth_offset;
   scan_options.seed = MixSeed(r.seed, pair_index, 1);
   pair.cloud = SimulateLidarScan(beams, print, scene, scan_options).ToCloud(r.board_only_clouds);

@@ -29,6 +29,7 @@ struct SimOptions {
   double max_distance_m = 4.0;
   double max_tilt_deg = 40.0;        // board normal vs. the camera viewing ray
   double lidar_range_noise_m = 0.0;  // Gaussian, along each ray
+  double lidar_angular_noise_rad = 0.0;  // Gaussian, across each ray (LidarScanOptions)
   // A Livox-class LiDAR (mid40, avia, mid360): the seconds of returns each pair's cloud holds —
   // one 0.1 s frame, or a still hold integrated (1 s: ten times the points).
   double lidar_frame_s = 0.1;
@@ -82,6 +83,10 @@ struct LidarScene {
 
 struct LidarScanOptions {
   double range_noise_m = 0.0;       // Gaussian, along each ray (metres)
+  // Gaussian jitter of each beam's direction (radians, 1σ per axis across the ray): the return
+  // comes from the jittered ray but is stored along the nominal one, as a sensor's encoder and
+  // beam divergence give (docs/architecture.md, "Noise learned from the data").
+  double angular_noise_rad = 0.0;
   double range_offset_m = 0.0;      // added to every range (metres)
   double azimuth_offset_rad = 0.0;  // azimuth of step 0 (the firing phase of this sweep)
   std::uint64_t seed = 1;           // range and intensity noise

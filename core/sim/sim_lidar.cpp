@@ -84,6 +84,22 @@ LidarCloud LidarScan::ToCloud(bool board_only) const {
   return cloud;
 }
 
+namespace {
+
+// `ray` turned by a Gaussian angle of `sigma_rad` about each of two axes across it.
+BeamRay JitterRay(const BeamRay& ray, double sigma_rad, std::normal_distribution<double>& unit_normal,
+                  std::mt19937_64& rng) {
+  const Vec3 across_1 = ray.direction.unitOrthogonal();
+  const Vec3 across_2 = ray.direction.cross(across_1);
+  BeamRay jittered = ray;
+  const double a = sigma_rad * unit_normal(rng);
+  const double b = sigma_rad * unit_normal(rng);
+  jittered.direction = (ray.direction + std::tan(a) * across_1 + std::tan(b) * across_2).normalized();
+  return jittered;
+}
+
+}  // namespace
+
 LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
                             const LidarScene& scene, const LidarScanOptions& options) {
   CALIBENCH_CHECK(beams.risley || (beams.azimuth_steps > 0 && !beams.elevations_rad.empty()));
@@ -102,12 +118,15 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
   for (int step = 0; step < rays.steps(); ++step) {
     for (int r = 0; r < rays.rings(); ++r) {
       const BeamRay ray = rays.Ray(r, step);
+      const BeamRay cast = options.angular_noise_rad > 0.0
+                               ? JitterRay(ray, options.angular_noise_rad, unit_normal, rng)
+                               : ray;
       RayHit hit;
       hit.range = beams.max_range_m;
-      IntersectRectangle(ray, sheet, SimSurface::kBoard, &hit);
+      IntersectRectangle(cast, sheet, SimSurface::kBoard, &hit);
       for (const LidarRectangle& panel : panels)
-        IntersectRectangle(ray, panel, SimSurface::kWall, &hit);
-      if (scene.clutter) IntersectRoom(ray, scene, &hit);
+        IntersectRectangle(cast, panel, SimSurface::kWall, &hit);
+      if (scene.clutter) IntersectRoom(cast, scene, &hit);
       if (hit.range >= beams.max_range_m || hit.range < MinRangeM(beams)) continue;
       double range = hit.range + options.range_offset_m;
       if (options.range_noise_m > 0.0) range += options.range_noise_m * unit_normal(rng);

@@ -298,6 +298,13 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
   fit.inlier_centroid = Centroid(cloud, indices);
   fit.num_candidates = static_cast<int>(indices.size());
   fit.rms_m = std::sqrt(sum_sq / indices.size());
+  for (size_t k = 0; k < residuals.rays.size(); ++k) {
+    // z = r² tan² α (core/target/lidar_noise.h): how far an angular jitter moves the range.
+    const double cos_incidence = plane.normal.dot(residuals.rays[k]);
+    const double r = residuals.ranges[k];
+    const double tan2 = (1.0 - cos_incidence * cos_incidence) / (cos_incidence * cos_incidence);
+    fit.range_moments.Add(r * r * tan2, r + plane.distance / cos_incidence);
+  }
   const double dof = std::max<double>(1.0, static_cast<double>(indices.size()) - 3.0);
   fit.covariance = TangentToPlaneCovariance((sum_sq / dof) * normal_matrix.inverse(), plane.normal);
   // A range offset b adds b to every residual; the Gauss-Newton solution then moves by

@@ -13,6 +13,7 @@
 #include "core/lidar/lidar_image.h"
 #include "core/target/board.h"
 #include "core/target/board_edges.h"
+#include "core/target/lidar_noise.h"
 #include "core/target/ring_bias.h"
 
 namespace calibench {
@@ -67,6 +68,9 @@ struct LidarPlaneFit {
   // How the fitted (n, d) moves per metre of a range offset added to every return (FitPlaneRangeMl
   // only; zero = unknown): the solver's handle on a LiDAR range offset.
   Vec4 range_offset_jacobian = Vec4::Zero();
+  // The range residuals' sums against the angular term's leverage (FitPlaneRangeMl only; count 0
+  // otherwise), from which the dataset's angular noise is learned (core/target/lidar_noise.h).
+  RangeResidualMoments range_moments;
   // Where the rings leave the board (LidarPlaneOptions::sheet_size_m), with that sheet size.
   std::vector<LidarEdgePoint> edge_points;
   BoardEdgeEnds edge_ends;     // what the rings' ends said (why some gave no edge point)
