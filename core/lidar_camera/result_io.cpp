@@ -257,6 +257,10 @@ std::string DescribeLidarModel(const CalibrationOutcome& outcome) {
   return text;
 }
 
+std::string DescribeLearnedLidarNoise(const CalibrationOutcome& outcome) {
+  return DescribeLidarNoise(LearnedLidarNoise(outcome));
+}
+
 ResidualCounts CountResiduals(const CalibrationOutcome& outcome) {
   CALIBENCH_CHECK(outcome.solution.has_value());
   const SolverResult& s = *outcome.solution;
@@ -494,7 +498,7 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
   const SolverResult& s = *outcome.solution;
   out << FormatTransform(names, s.cam_from_lidar, s.covariance);
   if (const std::string model = DescribeLidarModel(outcome); !model.empty()) out << model << "\n";
-  if (const std::string noise = DescribeLidarNoise(LearnedLidarNoise(outcome)); !noise.empty())
+  if (const std::string noise = DescribeLearnedLidarNoise(outcome); !noise.empty())
     out << noise << "\n";
   const ResidualCounts counts = CountResiduals(outcome);
   out << "residuals: board planes from " << counts.plane_pairs << " pairs";

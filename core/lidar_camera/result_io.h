@@ -31,6 +31,10 @@ ResidualCounts CountResiduals(const CalibrationOutcome& outcome);
 // per model the pairs and why it was chosen, and what it means for the fit. "" without LiDAR fits.
 std::string DescribeLidarModel(const CalibrationOutcome& outcome);
 
+// The LiDAR's noise learned from the accepted pairs' boards (core/target/lidar_noise.h), in
+// words: the summary's line and the workbench's note. "" without boards fitted along their rays.
+std::string DescribeLearnedLidarNoise(const CalibrationOutcome& outcome);
+
 // Human-readable summary: both directions in words, standard deviations, observability, pairs.
 std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& names = {});
 

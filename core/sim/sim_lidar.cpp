@@ -87,14 +87,15 @@ LidarCloud LidarScan::ToCloud(bool board_only) const {
 namespace {
 
 // `ray` turned by a Gaussian angle of `sigma_rad` about each of two axes across it.
-BeamRay JitterRay(const BeamRay& ray, double sigma_rad, std::normal_distribution<double>& unit_normal,
-                  std::mt19937_64& rng) {
+BeamRay JitterRay(const BeamRay& ray, double sigma_rad,
+                  std::normal_distribution<double>& unit_normal, std::mt19937_64& rng) {
   const Vec3 across_1 = ray.direction.unitOrthogonal();
   const Vec3 across_2 = ray.direction.cross(across_1);
   BeamRay jittered = ray;
   const double a = sigma_rad * unit_normal(rng);
   const double b = sigma_rad * unit_normal(rng);
-  jittered.direction = (ray.direction + std::tan(a) * across_1 + std::tan(b) * across_2).normalized();
+  jittered.direction =
+      (ray.direction + std::tan(a) * across_1 + std::tan(b) * across_2).normalized();
   return jittered;
 }
 

@@ -61,8 +61,8 @@ LidarNoiseEstimate EstimateLidarNoise(const std::vector<RangeResidualMoments>& b
     const double spread = b->sum_zz - 2.0 * mean_z * b->sum_z + b->count * mean_z * mean_z;
     slope_variance += 2.0 * v * v * spread;
   }
-  const double se = sxx > 0 ? std::sqrt(slope_variance) / sxx
-                            : std::numeric_limits<double>::infinity();
+  const double se =
+      sxx > 0 ? std::sqrt(slope_variance) / sxx : std::numeric_limits<double>::infinity();
   estimate.angular_sigma_rad = std::sqrt(std::max(slope, 0.0));
   estimate.angular_variance_se = se;
   estimate.angular_sigma_upper_rad = std::sqrt(std::max(slope + 1.96 * se, 0.0));

@@ -24,10 +24,10 @@ namespace calibench {
 // What one board's fit contributes: sums over its returns of the range residual e and of z.
 struct RangeResidualMoments {
   int count = 0;
-  double sum_z = 0.0;      // Σ z_i (m²)
-  double sum_zz = 0.0;     // Σ z_i²
-  double sum_e2 = 0.0;     // Σ e_i² (m²)
-  double sum_z_e2 = 0.0;   // Σ z_i e_i²
+  double sum_z = 0.0;     // Σ z_i (m²)
+  double sum_zz = 0.0;    // Σ z_i²
+  double sum_e2 = 0.0;    // Σ e_i² (m²)
+  double sum_z_e2 = 0.0;  // Σ z_i e_i²
   double min_z = std::numeric_limits<double>::infinity();
   double max_z = 0.0;
   void Add(double z, double residual_m);

@@ -158,7 +158,8 @@ void Controller::Solve() {
   state_.solver.solved_pair_ids.clear();
   for (const PairFeatures& p : outcome.pairs)
     if (p.status == PairStatus::kAccepted) state_.solver.solved_pair_ids.push_back(p.id);
-  for (const std::string& note : {DescribeLidarModel(outcome), CountResiduals(outcome).note})
+  for (const std::string& note : {DescribeLidarModel(outcome), DescribeLearnedLidarNoise(outcome),
+                                  CountResiduals(outcome).note})
     if (!note.empty()) state_.solver.notes.push_back(note);
   RecomputeResiduals();
   JudgeMeter(/*record=*/true);

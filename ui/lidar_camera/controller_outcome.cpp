@@ -72,7 +72,8 @@ Snapshot SnapshotOfOutcome(const Dataset& dataset, const CalibrationOutcome& out
   }
   if (outcome.solution) {
     s.solver.result = outcome.solution;
-    for (const std::string& note : {DescribeLidarModel(outcome), CountResiduals(outcome).note})
+    for (const std::string& note : {DescribeLidarModel(outcome), DescribeLearnedLidarNoise(outcome),
+                                    CountResiduals(outcome).note})
       if (!note.empty()) s.solver.notes.push_back(note);
   } else {
     s.solver.failure = outcome.failure;

@@ -27,11 +27,11 @@ LidarCloud JitteredBoard(double range_m, double tilt_deg, double range_sigma_m,
   *truth = OrientTowardsOrigin(Plane{normal_axis, -normal_axis.dot(centre)});
   LidarCloud cloud;
   for (int i = 0; i < 600; ++i) {
-    const Vec3 nominal = (centre + 0.21 * uniform(*rng) * across + 0.15 * uniform(*rng) * up)
-                             .normalized();
+    const Vec3 nominal =
+        (centre + 0.21 * uniform(*rng) * across + 0.15 * uniform(*rng) * up).normalized();
     const Vec3 a = nominal.unitOrthogonal(), b = nominal.cross(a);
-    const Vec3 cast = (nominal + angular_sigma_rad * (normal(*rng) * a + normal(*rng) * b))
-                          .normalized();
+    const Vec3 cast =
+        (nominal + angular_sigma_rad * (normal(*rng) * a + normal(*rng) * b)).normalized();
     const double hit = -truth->distance / truth->normal.dot(cast);
     cloud.points.push_back(((hit + range_sigma_m * normal(*rng)) * nominal).cast<float>());
   }
@@ -45,8 +45,9 @@ LidarNoiseEstimate LearnFromBoards(double range_sigma_m, double angular_sigma_ra
   std::vector<RangeResidualMoments> moments;
   for (int k = 0; k < 20; ++k) {
     Plane truth;
-    const LidarCloud cloud = JitteredBoard(1.5 + 3.5 * (k % 5) / 4.0, 15.0 * (k % 4) + 3.0 * (k / 5),
-                                           range_sigma_m, angular_sigma_rad, &rng, &truth);
+    const LidarCloud cloud =
+        JitteredBoard(1.5 + 3.5 * (k % 5) / 4.0, 15.0 * (k % 4) + 3.0 * (k / 5), range_sigma_m,
+                      angular_sigma_rad, &rng, &truth);
     std::vector<int> all(cloud.size());
     std::iota(all.begin(), all.end(), 0);
     const auto fit = FitPlaneRangeMl(cloud, all, truth);
