@@ -14,7 +14,7 @@ namespace {
 
 // v2: the LiDAR fits carry their ring-bias covariance, what their rings' ends showed and their
 // noise model.
-constexpr const char* kFeatureCacheFormat = "calibench.features.v3";
+constexpr const char* kFeatureCacheFormat = "calibench.features.v4";
 
 // A matrix as its rows, flattened row by row.
 template <typename Matrix>
@@ -59,11 +59,32 @@ json StampJson(const fs::path& path) {
   return {{"path", path.string()}, {"size", stamp->first}, {"mtime_ns", stamp->second}};
 }
 
+// The fit's range-residual sums (core/target/lidar_noise.h); null when it was not fitted along
+// its rays (count 0: no finite smallest z to write).
+json MomentsToJson(const RangeResidualMoments& m) {
+  if (m.count == 0) return nullptr;
+  return {m.count, m.sum_z, m.sum_zz, m.sum_e2, m.sum_z_e2, m.min_z, m.max_z};
+}
+
+RangeResidualMoments MomentsFromJson(const json& j) {
+  RangeResidualMoments m;
+  if (j.is_null()) return m;
+  m.count = j.at(0).get<int>();
+  m.sum_z = j.at(1).get<double>();
+  m.sum_zz = j.at(2).get<double>();
+  m.sum_e2 = j.at(3).get<double>();
+  m.sum_z_e2 = j.at(4).get<double>();
+  m.min_z = j.at(5).get<double>();
+  m.max_z = j.at(6).get<double>();
+  return m;
+}
+
 json LidarToJson(const LidarPlaneFit& fit) {
   json edges = json::array();
   for (const LidarEdgePoint& e : fit.edge_points)
     edges.push_back({MatrixToJson(e.point), MatrixToJson(e.along_ring), e.sigma_along_m});
   return {
+      {"range_moments", MomentsToJson(fit.range_moments)},
       {"plane", PlaneToJson(fit.plane)},
       {"covariance", MatrixToJson(fit.covariance)},
       {"inliers", fit.inliers},
@@ -93,6 +114,7 @@ LidarPlaneFit LidarFromJson(const json& j) {
   fit.num_candidates = j.at("num_candidates").get<int>();
   fit.grown = j.at("grown").get<bool>();
   MatrixFromJson(j.at("range_offset_jacobian"), &fit.range_offset_jacobian);
+  fit.range_moments = MomentsFromJson(j.at("range_moments"));
   for (const json& e : j.at("edge_points")) {
     LidarEdgePoint point;
     MatrixFromJson(e.at(0), &point.point);

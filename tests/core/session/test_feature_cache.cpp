@@ -32,7 +32,7 @@ TEST(FeatureCache, ReadsBackWhatItWroteAndDropsWhatNoLongerHolds) {
   failed.reason = "LiDAR board disagrees with the camera's";
   writer.Append(dataset.pairs[2], failed);
   // A line cut short by a kill.
-  std::ofstream(cache, std::ios::app) << R"({"format": "calibench.features.v3", "id": "00)";
+  std::ofstream(cache, std::ios::app) << R"({"format": "calibench.features.v4", "id": "00)";
 
   int skipped = -1;
   auto read = LoadFeatureCache(cache, &skipped);
@@ -44,6 +44,11 @@ TEST(FeatureCache, ReadsBackWhatItWroteAndDropsWhatNoLongerHolds) {
   EXPECT_EQ(back.lidar->plane.Coefficients(), written[0].lidar->plane.Coefficients());
   EXPECT_EQ(back.lidar->covariance, written[0].lidar->covariance);
   EXPECT_EQ(back.lidar->inliers, written[0].lidar->inliers);
+  // The sums the LiDAR's noise is learned from (a fit along the rays), exactly.
+  ASSERT_GT(written[0].lidar->range_moments.count, 0);
+  EXPECT_EQ(back.lidar->range_moments.count, written[0].lidar->range_moments.count);
+  EXPECT_EQ(back.lidar->range_moments.sum_z_e2, written[0].lidar->range_moments.sum_z_e2);
+  EXPECT_EQ(back.lidar->range_moments.min_z, written[0].lidar->range_moments.min_z);
   EXPECT_EQ(back.lidar->edge_points.size(), written[0].lidar->edge_points.size());
   EXPECT_EQ(back.camera->cam_from_board.matrix(), written[0].camera->cam_from_board.matrix());
   EXPECT_EQ(back.camera->pose_covariance, written[0].camera->pose_covariance);
