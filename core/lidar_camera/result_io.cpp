@@ -258,7 +258,15 @@ std::string DescribeLidarModel(const CalibrationOutcome& outcome) {
 }
 
 std::string DescribeLearnedLidarNoise(const CalibrationOutcome& outcome) {
-  return DescribeLidarNoise(LearnedLidarNoise(outcome));
+  const LidarNoiseEstimate estimate = LearnedLidarNoise(outcome);
+  if (estimate.boards > 0) return DescribeLidarNoise(estimate);
+  const bool any_fit = std::any_of(outcome.pairs.begin(), outcome.pairs.end(), [](const auto& p) {
+    return p.status == PairStatus::kAccepted && p.lidar.has_value();
+  });
+  // A swept scanner's or a segment's planes are fitted point-to-plane: no ray to measure along.
+  return any_fit ? "LiDAR noise: each plane's own point-to-plane scatter (its model has no rays "
+                   "from one origin, so no range or angular term is learned over the boards)"
+                 : "";
 }
 
 ResidualCounts CountResiduals(const CalibrationOutcome& outcome) {

@@ -100,6 +100,10 @@ TEST(LidarModels, OnASweptLaserTheDefaultIsAtLeastAsAccurateAsThePapersSolver) {
       EXPECT_EQ(model.rfind("LiDAR model: swept for all ", 0), 0u) << model;
       EXPECT_NE(model.find("point-to-plane (isotropic"), std::string::npos) << model;
       EXPECT_NE(FormatSummary(weighted).find(model), std::string::npos);
+      // No rays from one origin: no noise is learned along them, and the summary says so.
+      const std::string noise = DescribeLearnedLidarNoise(weighted);
+      EXPECT_NE(noise.find("no rays from one origin"), std::string::npos) << noise;
+      EXPECT_NE(DescribeLearnedLidarNoise(central).find("angular"), std::string::npos);
       EXPECT_NE(DescribeLidarModel(central).find("chosen by the user (--lidar-model)"),
                 std::string::npos);
     }
