@@ -6,8 +6,8 @@
 namespace calibench {
 
 Mat4 LidarPlaneBoundCovariance(const std::vector<Vec3>& points, const Plane& plane,
-                               double range_sigma_m) {
-  CALIBENCH_CHECK(range_sigma_m > 0);
+                               double range_sigma_m, double angular_sigma_rad) {
+  CALIBENCH_CHECK(range_sigma_m > 0 && angular_sigma_rad >= 0);
   // The Jacobian of FitPlaneRangeMl's range residual, at the true plane.
   const Eigen::Matrix<double, 3, 2> basis = PlaneTangentBasis(plane.normal);
   Mat3 information = Mat3::Zero();
@@ -18,7 +18,11 @@ Mat4 LidarPlaneBoundCovariance(const std::vector<Vec3>& points, const Plane& pla
     Eigen::RowVector3d j;
     j.head<2>() = -plane.distance * ray.transpose() * basis / (cos_incidence * cos_incidence);
     j(2) = 1.0 / cos_incidence;
-    information += j.transpose() * j / (range_sigma_m * range_sigma_m);
+    const double r = x.norm();
+    const double tan2 = (1.0 - cos_incidence * cos_incidence) / (cos_incidence * cos_incidence);
+    const double variance =
+        range_sigma_m * range_sigma_m + angular_sigma_rad * angular_sigma_rad * r * r * tan2;
+    information += j.transpose() * j / variance;
   }
   return TangentToPlaneCovariance(information.inverse(), plane.normal);
 }

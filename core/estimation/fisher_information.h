@@ -16,9 +16,11 @@
 namespace calibench {
 
 // Inverse Fisher information of (n, d) (4x4, rank 3) for a plane measured by range noise
-// `range_sigma_m` (1σ) along the rays from the origin to `points` (noise-free, on `plane`).
+// `range_sigma_m` (1σ) along the rays from the origin to `points` (noise-free, on `plane`), and
+// a beam jitter of `angular_sigma_rad` per axis across the rays, which adds (r σ_θ tan α)² to a
+// return's range variance at range r and incidence α (core/target/lidar_noise.h).
 Mat4 LidarPlaneBoundCovariance(const std::vector<Vec3>& points, const Plane& plane,
-                               double range_sigma_m);
+                               double range_sigma_m, double angular_sigma_rad = 0.0);
 
 // Inverse Fisher information of the board pose (right perturbation, [rho; phi]) for corners
 // `board_corners` (board frame) seen at `cam_from_board` with pixel noise `corner_sigma_px`.

@@ -27,7 +27,7 @@ bool SensorGeometry::Check(std::string* why) const {
   if (!board.Check(why)) return false;
   if (!(min_distance_m > 0 && max_distance_m > min_distance_m))
     return *why = "the distance range must satisfy 0 < min < max", false;
-  if (!(range_sigma_m > 0) || !(corner_sigma_px > 0))
+  if (!(range_sigma_m > 0) || !(corner_sigma_px > 0) || !(angular_sigma_rad >= 0))
     return *why = "the sensors' noise must be > 0", false;
   return true;
 }
@@ -192,7 +192,8 @@ PlanePair PlannedPair(const SensorGeometry& sensors, const Pose& cam_from_lidar,
   const Vec3 lidar_normal = -lidar_from_board.linear().col(2);
   pair.lidar_plane = Plane{lidar_normal, -lidar_normal.dot(lidar_from_board.translation())};
   pair.lidar_covariance =
-      LidarPlaneBoundCovariance(returns.points, pair.lidar_plane, sensors.range_sigma_m);
+      LidarPlaneBoundCovariance(returns.points, pair.lidar_plane, sensors.range_sigma_m,
+                                sensors.angular_sigma_rad);
   pair.lidar_edges = returns.edges;
   pair.camera_from_board = cam_from_board;
   pair.sheet_half_size_m =

@@ -33,6 +33,9 @@ struct SensorGeometry {
   double min_distance_m = 1.0;  // board centre from the camera, the usable range
   double max_distance_m = 4.0;
   double range_sigma_m = 0.01;   // LiDAR range noise (1σ along the ray)
+  // The beam's jitter across the ray (1σ per axis, radians), where the data resolve it
+  // (core/target/lidar_noise.h): oblique and far boards are then noisier along their rays.
+  double angular_sigma_rad = 0.0;
   double corner_sigma_px = 0.3;  // corner noise (1σ per coordinate)
   DetectionReach reach;          // the camera detector's reach measured on this rig, if any
   bool Check(std::string* why) const;
@@ -45,7 +48,9 @@ BeamTable LearnBeamTable(const std::vector<const LidarCloud*>& clouds);
 
 // The rest of SensorGeometry from the pairs' features: the distance range of the boards seen so
 // far (widened by 10 % and to at least 1 m of span, never below the nearest seen − 0.5 m), the
-// median LiDAR plane RMS as range noise and the median PnP corner noise. Needs one accepted pair.
+// LiDAR's noise (the median plane RMS as range noise; where the boards resolve an angular term,
+// EstimateLidarNoise's range and angular σ instead) and the median PnP corner noise. Needs one
+// accepted pair.
 std::optional<SensorGeometry> LearnSensorGeometry(const CameraModel& camera, const BoardSpec& board,
                                                   const BeamTable& lidar,
                                                   const std::vector<PairFeatures>& pairs,

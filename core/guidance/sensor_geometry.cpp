@@ -6,6 +6,7 @@
 
 #include "core/base/statistics.h"
 #include "core/guidance/next_pose.h"
+#include "core/target/lidar_noise.h"
 
 namespace calibench {
 
@@ -42,11 +43,13 @@ std::optional<SensorGeometry> LearnSensorGeometry(const CameraModel& camera, con
                                                   const std::vector<PairFeatures>& pairs,
                                                   std::string* why) {
   std::vector<double> distances, range_rms, corner_sigmas;
+  std::vector<RangeResidualMoments> moments;
   for (const PairFeatures& p : pairs) {
     if (p.status != PairStatus::kAccepted || !p.lidar || !p.camera) continue;
     distances.push_back(p.camera->cam_from_board.translation().norm());
     range_rms.push_back(p.lidar->rms_m);
     corner_sigmas.push_back(p.camera->corner_sigma_px);
+    if (p.lidar->range_moments.count > 0) moments.push_back(p.lidar->range_moments);
   }
   if (distances.empty()) {
     *why = "no accepted pair yet: the distances and the sensors' noise are learnt from the data";
@@ -70,6 +73,12 @@ std::optional<SensorGeometry> LearnSensorGeometry(const CameraModel& camera, con
   sensors.min_distance_m = std::max({low, *nearest - 0.5, 0.3});
   sensors.max_distance_m = std::max(high, sensors.min_distance_m + 0.5);
   sensors.range_sigma_m = std::max(Median(range_rms), 1e-3);
+  // Where the boards resolve a beam jitter, a return's noise grows with its range and incidence:
+  // the intercept is the range term and the slope the angular one (the median RMS held both).
+  if (const LidarNoiseEstimate noise = EstimateLidarNoise(moments); noise.angular_resolved) {
+    sensors.range_sigma_m = std::max(noise.range_sigma_median_m, 1e-3);
+    sensors.angular_sigma_rad = noise.angular_sigma_rad;
+  }
   sensors.corner_sigma_px = std::max(Median(corner_sigmas), 0.05);
   return sensors;
 }

@@ -12,6 +12,7 @@ SimulationBoundInput MakeSimulationBoundInput(const SimOptions& options, double 
   input.board = resolved.board;
   input.cam_from_lidar = resolved.cam_from_lidar;
   input.range_sigma_m = options.lidar_range_noise_m;
+  input.angular_sigma_rad = options.lidar_angular_noise_rad;
   input.corner_sigma_px = corner_sigma_px;
   return input;
 }
@@ -31,7 +32,8 @@ std::vector<PlanePair> BoundPlanePairs(const SimulationBoundInput& input) {
     pair.lidar_plane =
         OrientTowardsOrigin(TransformPlane(input.cam_from_lidar.inverse(), pair.camera_plane));
     pair.lidar_covariance =
-        LidarPlaneBoundCovariance(truth.lidar_board_points, pair.lidar_plane, input.range_sigma_m);
+        LidarPlaneBoundCovariance(truth.lidar_board_points, pair.lidar_plane, input.range_sigma_m,
+                                  input.angular_sigma_rad);
     pair.camera_covariance = CameraPlaneBoundCovariance(input.camera, corners, truth.cam_from_board,
                                                         input.corner_sigma_px);
     pairs.push_back(pair);

@@ -26,6 +26,7 @@ struct SimulationBoundInput {
   BoardSpec board;
   Pose cam_from_lidar = Pose::Identity();
   double range_sigma_m = 0.0;
+  double angular_sigma_rad = 0.0;  // the beam's jitter across the ray (SimOptions)
   double corner_sigma_px = 0.0;
 };
 SimulationBoundInput MakeSimulationBoundInput(const SimOptions& options, double corner_sigma_px);

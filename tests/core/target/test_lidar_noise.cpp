@@ -6,7 +6,11 @@
 #include <numeric>
 #include <random>
 
+#include "core/estimation/fisher_information.h"
 #include "core/geometry/geometry.h"
+#include "core/guidance/next_pose.h"
+#include "core/lidar/beam_table.h"
+#include "core/lidar_camera/pipeline.h"
 #include "core/target/lidar_noise.h"
 #include "core/target/lidar_plane.h"
 
@@ -102,6 +106,87 @@ TEST(LidarNoise, BoardsThatTellNothingGiveNoEstimate) {
   RangeResidualMoments few;
   for (int i = 0; i < 5; ++i) few.Add(i, 0.01);
   EXPECT_EQ(EstimateLidarNoise({few}).boards, 0);  // fewer than 10 returns
+}
+
+// The bound with the angular term is the scatter of the range fit under jittered beams: a board
+// 4 m away turned 60°, 5 mm of range noise and 0.3° of jitter (the jitter's share of a return's
+// range σ reaches 3.6 cm there). Without the term the bound is far too confident.
+TEST(LidarNoise, TheBoundWithTheAngularTermIsTheFitsScatter) {
+  const double range_sigma = 0.005, angular_sigma = 0.3 * kDegToRad;
+  std::mt19937_64 rng(7);
+  Plane truth;
+  const LidarCloud layout = JitteredBoard(4.0, 60.0, 0.0, 0.0, &rng, &truth);  // the nominal rays
+  std::vector<Vec3> nominal;
+  for (const auto& p : layout.points) nominal.push_back(p.cast<double>());
+  std::normal_distribution<double> normal(0.0, 1.0);
+  double sum_d2 = 0.0;
+  const int trials = 300;
+  for (int t = 0; t < trials; ++t) {
+    LidarCloud cloud;
+    for (const Vec3& x : nominal) {
+      const Vec3 u = x.normalized(), a = u.unitOrthogonal(), b = u.cross(a);
+      const Vec3 cast = (u + angular_sigma * (normal(rng) * a + normal(rng) * b)).normalized();
+      const double hit = -truth.distance / truth.normal.dot(cast);
+      cloud.points.push_back(((hit + range_sigma * normal(rng)) * u).cast<float>());
+    }
+    std::vector<int> all(cloud.size());
+    std::iota(all.begin(), all.end(), 0);
+    const auto fit = FitPlaneRangeMl(cloud, all, truth);
+    ASSERT_TRUE(fit);
+    const double dd = fit->plane.distance - truth.distance;
+    sum_d2 += dd * dd;
+  }
+  const double scatter_d = std::sqrt(sum_d2 / trials);
+  const double with_term =
+      std::sqrt(LidarPlaneBoundCovariance(nominal, truth, range_sigma, angular_sigma)(3, 3));
+  const double range_only = std::sqrt(LidarPlaneBoundCovariance(nominal, truth, range_sigma)(3, 3));
+  std::printf("d scatter %.2f mm, bound with the angular term %.2f mm, range only %.2f mm\n",
+              scatter_d * 1e3, with_term * 1e3, range_only * 1e3);
+  EXPECT_NEAR(scatter_d / with_term, 1.0, 0.2);
+  EXPECT_GT(scatter_d / range_only, 2.0);
+}
+
+// Guidance takes the learned term: boards whose residuals resolve a jitter give the sensors an
+// angular σ (and the range σ without it); boards that do not keep the median RMS as before.
+TEST(LidarNoise, GuidanceLearnsTheAngularTermWhereTheBoardsResolveIt) {
+  for (const double jitter_deg : {0.25, 0.0}) {
+    std::mt19937_64 rng(11);
+    std::vector<PairFeatures> pairs;
+    for (int k = 0; k < 20; ++k) {
+      Plane truth;
+      const LidarCloud cloud = JitteredBoard(1.5 + 3.5 * (k % 5) / 4.0, 15.0 * (k % 4), 0.008,
+                                             jitter_deg * kDegToRad, &rng, &truth);
+      std::vector<int> all(cloud.size());
+      std::iota(all.begin(), all.end(), 0);
+      PairFeatures pair;
+      pair.id = "pose" + std::to_string(k);
+      pair.status = PairStatus::kAccepted;
+      pair.lidar = FitPlaneRangeMl(cloud, all, truth);
+      ASSERT_TRUE(pair.lidar);
+      pair.camera = CameraBoardObservation{};
+      pair.camera->cam_from_board = Pose(Eigen::Translation3d(0.0, 0.0, 1.5 + 3.5 * (k % 5) / 4.0));
+      pair.camera->corner_sigma_px = 0.2;
+      pairs.push_back(std::move(pair));
+    }
+    std::string why;
+    CameraModel camera;
+    camera.width = 1440;
+    camera.height = 1080;
+    camera.fx = camera.fy = 1000;
+    camera.cx = 720;
+    camera.cy = 540;
+    camera.distortion = {0, 0, 0, 0};
+    const auto sensors =
+        LearnSensorGeometry(camera, BoardSpec{}, MakeBeamTable(LidarModel::kVlp16), pairs, &why);
+    ASSERT_TRUE(sensors) << why;
+    if (jitter_deg > 0) {
+      EXPECT_NEAR(sensors->angular_sigma_rad, jitter_deg * kDegToRad, 0.2 * jitter_deg * kDegToRad);
+      EXPECT_NEAR(sensors->range_sigma_m, 0.008, 0.0015);
+    } else {
+      EXPECT_EQ(sensors->angular_sigma_rad, 0.0);
+      EXPECT_NEAR(sensors->range_sigma_m, 0.008, 0.001);
+    }
+  }
 }
 
 }  // namespace
