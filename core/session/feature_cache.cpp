@@ -13,7 +13,7 @@ using nlohmann::json;
 namespace {
 
 // v2: the LiDAR fits carry their ring-bias covariance, what their rings' ends showed and their
-// noise model.
+// noise model. v4: their range residuals' sums (the LiDAR's noise is learned from them).
 constexpr const char* kFeatureCacheFormat = "calibench.features.v4";
 
 // A matrix as its rows, flattened row by row.

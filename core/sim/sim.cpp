@@ -404,7 +404,6 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
     scan_options.range_noise_m = r.lidar_range_noise_m;
     scan_options.range_offset_m = r.lidar_range_offset_m;
     scan_options.angular_noise_rad = r.lidar_angular_noise_rad;
-  scan_options.angular_noise_rad = r.lidar_angular_noise_rad;
     scan_options.azimuth_offset_rad = plan.azimuth_offset_rad;
     scan_options.seed = MixSeed(r.seed, k, 1);
     SavePcd(entry.cloud,
