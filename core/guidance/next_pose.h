@@ -32,7 +32,7 @@ struct SensorGeometry {
   BeamTable lidar;              // ring elevations and azimuth steps
   double min_distance_m = 1.0;  // board centre from the camera, the usable range
   double max_distance_m = 4.0;
-  double range_sigma_m = 0.01;   // LiDAR range noise (1σ along the ray)
+  double range_sigma_m = 0.01;  // LiDAR range noise (1σ along the ray)
   // The beam's jitter across the ray (1σ per axis, radians), where the data resolve it
   // (core/target/lidar_noise.h): oblique and far boards are then noisier along their rays.
   double angular_sigma_rad = 0.0;

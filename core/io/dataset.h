@@ -32,10 +32,10 @@ struct SimulationRecord {
   double min_distance_m = 0.0;
   double max_distance_m = 0.0;
   double max_tilt_deg = 0.0;
-  double lidar_range_noise_m = 0.0;   // 1σ along each ray
-  double lidar_range_offset_m = 0.0;  // measured = true range + offset
+  double lidar_range_noise_m = 0.0;      // 1σ along each ray
+  double lidar_range_offset_m = 0.0;     // measured = true range + offset
   double lidar_angular_noise_rad = 0.0;  // 1σ per axis across each ray
-  double image_noise = 0.0;           // [0,1] intensity units
+  double image_noise = 0.0;              // [0,1] intensity units
   bool clutter = true;
   bool board_only_clouds = false;  // clouds cropped to the sheet's returns, without rings
   double seed_radius_m = 0.0;

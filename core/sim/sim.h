@@ -27,8 +27,8 @@ struct SimOptions {
   int num_pairs = 20;
   double min_distance_m = 1.5;  // board centre distance from the camera
   double max_distance_m = 4.0;
-  double max_tilt_deg = 40.0;        // board normal vs. the camera viewing ray
-  double lidar_range_noise_m = 0.0;  // Gaussian, along each ray
+  double max_tilt_deg = 40.0;            // board normal vs. the camera viewing ray
+  double lidar_range_noise_m = 0.0;      // Gaussian, along each ray
   double lidar_angular_noise_rad = 0.0;  // Gaussian, across each ray (LidarScanOptions)
   // A Livox-class LiDAR (mid40, avia, mid360): the seconds of returns each pair's cloud holds —
   // one 0.1 s frame, or a still hold integrated (1 s: ten times the points).
@@ -82,7 +82,7 @@ struct LidarScene {
 };
 
 struct LidarScanOptions {
-  double range_noise_m = 0.0;       // Gaussian, along each ray (metres)
+  double range_noise_m = 0.0;  // Gaussian, along each ray (metres)
   // Gaussian jitter of each beam's direction (radians, 1σ per axis across the ray): the return
   // comes from the jittered ray but is stored along the nominal one, as a sensor's encoder and
   // beam divergence give (docs/architecture.md, "Noise learned from the data").
