@@ -13,6 +13,7 @@
 #include "core/lidar_camera/pipeline.h"
 #include "core/target/lidar_noise.h"
 #include "core/target/lidar_plane.h"
+#include "tests/core/target/board_test_scenes.h"
 
 namespace calibench {
 namespace {
@@ -169,15 +170,8 @@ TEST(LidarNoise, GuidanceLearnsTheAngularTermWhereTheBoardsResolveIt) {
       pairs.push_back(std::move(pair));
     }
     std::string why;
-    CameraModel camera;
-    camera.width = 1440;
-    camera.height = 1080;
-    camera.fx = camera.fy = 1000;
-    camera.cx = 720;
-    camera.cy = 540;
-    camera.distortion = {0, 0, 0, 0};
-    const auto sensors =
-        LearnSensorGeometry(camera, BoardSpec{}, MakeBeamTable(LidarModel::kVlp16), pairs, &why);
+    const auto sensors = LearnSensorGeometry(PinholeCamera(), BoardSpec{},
+                                             MakeBeamTable(LidarModel::kVlp16), pairs, &why);
     ASSERT_TRUE(sensors) << why;
     if (jitter_deg > 0) {
       EXPECT_NEAR(sensors->angular_sigma_rad, jitter_deg * kDegToRad, 0.2 * jitter_deg * kDegToRad);
