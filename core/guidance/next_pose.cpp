@@ -191,9 +191,8 @@ PlanePair PlannedPair(const SensorGeometry& sensors, const Pose& cam_from_lidar,
   const Pose lidar_from_board = cam_from_lidar.inverse() * cam_from_board;
   const Vec3 lidar_normal = -lidar_from_board.linear().col(2);
   pair.lidar_plane = Plane{lidar_normal, -lidar_normal.dot(lidar_from_board.translation())};
-  pair.lidar_covariance =
-      LidarPlaneBoundCovariance(returns.points, pair.lidar_plane, sensors.range_sigma_m,
-                                sensors.angular_sigma_rad);
+  pair.lidar_covariance = LidarPlaneBoundCovariance(
+      returns.points, pair.lidar_plane, sensors.range_sigma_m, sensors.angular_sigma_rad);
   pair.lidar_edges = returns.edges;
   pair.camera_from_board = cam_from_board;
   pair.sheet_half_size_m =

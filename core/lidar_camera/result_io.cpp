@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/lidar_camera/result_intrinsics_json.h"
+#include "core/lidar_camera/result_lidar.h"
 #include "core/results/result_json.h"
 
 namespace calibench {
@@ -16,69 +17,6 @@ using nlohmann::json;
 namespace {
 
 json Vec4ToJson(const Vec4& v) { return {v[0], v[1], v[2], v[3]}; }
-
-// Per LiDAR model, the pairs fitted with it (in the pairs' order) and the first one's reason.
-struct ModelGroup {
-  LidarGeometry geometry;
-  std::vector<std::string> pairs;
-  std::string why;
-  bool forced = false;
-};
-
-std::vector<ModelGroup> GroupByLidarModel(const CalibrationOutcome& outcome) {
-  std::vector<ModelGroup> groups;
-  for (const PairFeatures& p : outcome.pairs) {
-    if (!p.lidar) continue;
-    const LidarGeometryVerdict& model = p.lidar->lidar_model;
-    auto it = std::find_if(groups.begin(), groups.end(),
-                           [&](const ModelGroup& g) { return g.geometry == model.geometry; });
-    if (it == groups.end())
-      it = groups.insert(groups.end(), {model.geometry, {}, model.why, model.forced});
-    it->pairs.push_back(p.id);
-  }
-  return groups;
-}
-
-std::string ModelMeaning(LidarGeometry geometry) {
-  if (geometry == LidarGeometry::kSpinning)
-    return "planes fitted on the ranges along the rays, with ring biases and board edges";
-  if (geometry == LidarGeometry::kNonRepetitive)
-    return "planes fitted on the ranges along the rays, no rings: no ring biases; board edges "
-           "where the beam's path crosses the sheet's border";
-  if (geometry == LidarGeometry::kSegment)
-    return "planes fitted point-to-plane (isotropic, their own covariance, widened by a range bias "
-           "per ring where the returns' elevations fall into rings), no board edges";
-  return "planes fitted point-to-plane (isotropic, their own covariance), no ring biases or board "
-         "edges";
-}
-
-// The LiDAR's noise learned from the accepted pairs' boards fitted along their rays.
-LidarNoiseEstimate LearnedLidarNoise(const CalibrationOutcome& outcome) {
-  std::vector<RangeResidualMoments> boards;
-  for (const PairFeatures& p : outcome.pairs)
-    if (p.status == PairStatus::kAccepted && p.lidar && p.lidar->range_moments.count > 0)
-      boards.push_back(p.lidar->range_moments);
-  return EstimateLidarNoise(boards);
-}
-
-json LidarNoiseJson(const LidarNoiseEstimate& e) {
-  return {{"boards", e.boards},
-          {"returns", e.returns},
-          {"range_sigma_m",
-           {{"median", e.range_sigma_median_m},
-            {"min", e.range_sigma_min_m},
-            {"max", e.range_sigma_max_m}}},
-          {"angular_sigma_deg", e.angular_sigma_rad * kRadToDeg},
-          {"angular_sigma_upper_deg", std::isfinite(e.angular_sigma_upper_rad)
-                                          ? json(e.angular_sigma_upper_rad * kRadToDeg)
-                                          : json(nullptr)},
-          {"angular_resolved", e.angular_resolved},
-          {"equal_weight_efficiency_min", e.equal_weight_efficiency_min},
-          {"meaning",
-           "learned from the accepted boards' range residuals along their rays: variance = "
-           "range_sigma^2 (per board) + (angular_sigma * range * tan(incidence))^2; "
-           "angular_sigma_upper_deg is a 95% bound"}};
-}
 
 json ResidualsAvailable(const CalibrationOutcome& outcome) {
   const ResidualCounts counts = CountResiduals(outcome);
@@ -134,23 +72,6 @@ json PairsJson(const CalibrationOutcome& outcome) {
     pairs.push_back(entry);
   }
   return pairs;
-}
-
-// The model most pairs' planes were fitted with, why, and every model's count; null without fits.
-json LidarModelJson(const CalibrationOutcome& outcome) {
-  const std::vector<ModelGroup> groups = GroupByLidarModel(outcome);
-  if (groups.empty()) return nullptr;
-  // The model most pairs were fitted with leads; every model's count follows.
-  const ModelGroup& main = *std::max_element(
-      groups.begin(), groups.end(),
-      [](const ModelGroup& a, const ModelGroup& b) { return a.pairs.size() < b.pairs.size(); });
-  json counts = json::object();
-  for (const ModelGroup& g : groups) counts[LidarGeometryName(g.geometry)] = g.pairs.size();
-  return {{"geometry", LidarGeometryName(main.geometry)},
-          {"why", main.why},
-          {"forced", main.forced},
-          {"meaning", ModelMeaning(main.geometry)},
-          {"pairs", counts}};
 }
 
 json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& options,
@@ -215,9 +136,8 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
     root["intrinsics"] = IntrinsicsJson(outcome);
   root["pairs"] = PairsJson(outcome);
   root["solver"]["residuals_available"] = ResidualsAvailable(outcome);
-  if (const json model = LidarModelJson(outcome); !model.is_null()) root["lidar_model"] = model;
-  if (const LidarNoiseEstimate noise = LearnedLidarNoise(outcome); noise.boards > 0)
-    root["lidar_noise"] = LidarNoiseJson(noise);
+  if (json model = LidarModelJson(outcome); !model.is_null()) root["lidar_model"] = model;
+  if (json noise = LidarNoiseJson(outcome); !noise.is_null()) root["lidar_noise"] = noise;
   return root;
 }
 
@@ -238,36 +158,6 @@ std::string NoEdgeCause(const PairFeatures& pair, bool down_weighted) {
 }
 
 }  // namespace
-
-std::string DescribeLidarModel(const CalibrationOutcome& outcome) {
-  const std::vector<ModelGroup> groups = GroupByLidarModel(outcome);
-  std::string text;
-  for (const ModelGroup& g : groups) {
-    text += text.empty() ? "LiDAR model: " : "; ";
-    text += LidarGeometryName(g.geometry) + " for ";
-    if (groups.size() == 1) {
-      text += "all " + std::to_string(g.pairs.size()) + " pairs";
-    } else {
-      text += std::to_string(g.pairs.size()) + " pairs (";
-      for (size_t k = 0; k < g.pairs.size() && k < 5; ++k) text += (k ? ", " : "") + g.pairs[k];
-      text += g.pairs.size() > 5 ? ", ...)" : ")";
-    }
-    text += " (" + g.why + "): " + ModelMeaning(g.geometry);
-  }
-  return text;
-}
-
-std::string DescribeLearnedLidarNoise(const CalibrationOutcome& outcome) {
-  const LidarNoiseEstimate estimate = LearnedLidarNoise(outcome);
-  if (estimate.boards > 0) return DescribeLidarNoise(estimate);
-  const bool any_fit = std::any_of(outcome.pairs.begin(), outcome.pairs.end(), [](const auto& p) {
-    return p.status == PairStatus::kAccepted && p.lidar.has_value();
-  });
-  // A swept scanner's or a segment's planes are fitted point-to-plane: no ray to measure along.
-  return any_fit ? "LiDAR noise: each plane's own point-to-plane scatter (its model has no rays "
-                   "from one origin, so no range or angular term is learned over the boards)"
-                 : "";
-}
 
 ResidualCounts CountResiduals(const CalibrationOutcome& outcome) {
   CALIBENCH_CHECK(outcome.solution.has_value());

@@ -31,9 +31,8 @@ std::vector<PlanePair> BoundPlanePairs(const SimulationBoundInput& input) {
     pair.camera_plane = OrientTowardsOrigin(board_in_cam);
     pair.lidar_plane =
         OrientTowardsOrigin(TransformPlane(input.cam_from_lidar.inverse(), pair.camera_plane));
-    pair.lidar_covariance =
-        LidarPlaneBoundCovariance(truth.lidar_board_points, pair.lidar_plane, input.range_sigma_m,
-                                  input.angular_sigma_rad);
+    pair.lidar_covariance = LidarPlaneBoundCovariance(truth.lidar_board_points, pair.lidar_plane,
+                                                      input.range_sigma_m, input.angular_sigma_rad);
     pair.camera_covariance = CameraPlaneBoundCovariance(input.camera, corners, truth.cam_from_board,
                                                         input.corner_sigma_px);
     pairs.push_back(pair);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/base/statistics.h"
 #include "core/base/types.h"
 
 namespace calibench {
@@ -22,12 +23,6 @@ void RangeResidualMoments::Add(double z, double residual_m) {
 namespace {
 
 constexpr int kMinReturns = 10;
-
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
 
 }  // namespace
 
@@ -64,7 +59,6 @@ LidarNoiseEstimate EstimateLidarNoise(const std::vector<RangeResidualMoments>& b
   const double se =
       sxx > 0 ? std::sqrt(slope_variance) / sxx : std::numeric_limits<double>::infinity();
   estimate.angular_sigma_rad = std::sqrt(std::max(slope, 0.0));
-  estimate.angular_variance_se = se;
   estimate.angular_sigma_upper_rad = std::sqrt(std::max(slope + 1.96 * se, 0.0));
   estimate.angular_resolved = slope > 2.0 * se;
   const double angular_variance = std::max(slope, 0.0);

@@ -40,10 +40,9 @@ struct LidarNoiseEstimate {
   double range_sigma_median_m = 0.0;
   double range_sigma_min_m = 0.0;
   double range_sigma_max_m = 0.0;
-  // σ_θ (radians, per axis across the ray) and the standard error of σ_θ² (rad²); the upper
-  // bound is σ_θ at the slope plus 1.96 standard errors (95 %).
+  // σ_θ (radians, per axis across the ray), and its 95 % upper bound: σ_θ at the slope σ_θ² plus
+  // 1.96 of its standard errors (infinite when the boards' z do not vary).
   double angular_sigma_rad = 0.0;
-  double angular_variance_se = 0.0;
   double angular_sigma_upper_rad = 0.0;
   // The slope exceeds twice its standard error: the data show an angular term.
   bool angular_resolved = false;
