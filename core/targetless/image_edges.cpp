@@ -59,6 +59,38 @@ ImageEdgeMap::ImageEdgeMap(int width, int height, int cell_px, std::vector<Image
   edges_.resize(edges.size());
   std::vector<int> next(cell_start_.begin(), cell_start_.end() - 1);
   for (const ImageEdge& e : edges) edges_[next[cell_of(e)]++] = e;
+  ComputeEmptyRings();
+}
+
+// Two passes of the chessboard-distance transform over the cell grid (Rosenfeld and Pfaltz's
+// sequential algorithm): each cell's distance to the nearest cell with an edge.
+void ImageEdgeMap::ComputeEmptyRings() {
+  constexpr int kFar = 255;
+  empty_rings_.assign(static_cast<size_t>(cells_x_) * cells_y_, kFar);
+  if (edges_.empty()) return;
+  auto at = [&](int x, int y) -> std::uint8_t& { return empty_rings_[y * cells_x_ + x]; };
+  for (int y = 0; y < cells_y_; ++y)
+    for (int x = 0; x < cells_x_; ++x) {
+      const int c = y * cells_x_ + x;
+      if (cell_start_[c + 1] > cell_start_[c]) {
+        at(x, y) = 0;
+        continue;
+      }
+      int d = kFar;
+      for (int dx = -1; dx <= 1; ++dx)
+        if (y > 0 && x + dx >= 0 && x + dx < cells_x_) d = std::min(d, at(x + dx, y - 1) + 1);
+      if (x > 0) d = std::min(d, at(x - 1, y) + 1);
+      at(x, y) = static_cast<std::uint8_t>(std::min(d, kFar));
+    }
+  for (int y = cells_y_ - 1; y >= 0; --y)
+    for (int x = cells_x_ - 1; x >= 0; --x) {
+      int d = at(x, y);
+      for (int dx = -1; dx <= 1; ++dx)
+        if (y + 1 < cells_y_ && x + dx >= 0 && x + dx < cells_x_)
+          d = std::min(d, at(x + dx, y + 1) + 1);
+      if (x + 1 < cells_x_) d = std::min(d, at(x + 1, y) + 1);
+      at(x, y) = static_cast<std::uint8_t>(d);
+    }
 }
 
 const ImageEdge* ImageEdgeMap::Nearest(const Vec2& pixel, double radius_px) const {
@@ -66,11 +98,21 @@ const ImageEdge* ImageEdgeMap::Nearest(const Vec2& pixel, double radius_px) cons
   const int cx = static_cast<int>(std::floor((pixel.x() + 0.5) / cell_px_));
   const int cy = static_cast<int>(std::floor((pixel.y() + 0.5) / cell_px_));
   const int max_ring = static_cast<int>(std::ceil(radius_px / cell_px_)) + 1;
+  // Every edge in ring r (the cells r steps away, chessboard distance) lies at least
+  // (r - 1) cells plus `margin` away: the query's distance to its own cell's nearest side.
+  // A query outside the grid (none from the alignment) searches from ring 0 without a margin.
+  int first_ring = 0;
+  double margin = 0.0;
+  if (cx >= 0 && cx < cells_x_ && cy >= 0 && cy < cells_y_) {
+    const double fx = pixel.x() + 0.5 - cx * cell_px_, fy = pixel.y() + 0.5 - cy * cell_px_;
+    margin = std::min({fx, cell_px_ - fx, fy, cell_px_ - fy});
+    first_ring = empty_rings_[cy * cells_x_ + cx];  // the rings before it hold no edge
+    if ((first_ring - 1) * cell_px_ + margin >= radius_px) return nullptr;
+  }
   const ImageEdge* best = nullptr;
   double best_d2 = radius_px * radius_px;
-  for (int ring = 0; ring <= max_ring; ++ring) {
-    // Every edge in a farther ring is at least (ring - 1) cells away.
-    if (best && (ring - 1) * cell_px_ > std::sqrt(best_d2)) break;
+  for (int ring = first_ring; ring <= max_ring; ++ring) {
+    if (best && (ring - 1) * cell_px_ + margin > std::sqrt(best_d2)) break;
     for (int y = cy - ring; y <= cy + ring; ++y) {
       if (y < 0 || y >= cells_y_) continue;
       const bool edge_row = y == cy - ring || y == cy + ring;

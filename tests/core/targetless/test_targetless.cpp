@@ -117,6 +117,38 @@ TEST(TargetlessImageEdges, AStepIsFoundAtItsSubPixelPosition) {
   EXPECT_EQ(map.Nearest(Vec2(60.0, 30.0), 8.0), nullptr);
 }
 
+// The grid's lookup skips empty rings and stops early (image_edges.h): it must still return the
+// edge a brute-force scan returns, for clustered and sparse edges, every cell size and radius,
+// queries inside, on and just outside the image's border.
+TEST(TargetlessImageEdges, NearestIsTheBruteForceNearest) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const int cell_px : {1, 3, 4, 8}) {
+    const int width = 200, height = 120;
+    std::vector<ImageEdge> edges;
+    for (int i = 0; i < 60; ++i) {  // a few dense strokes, the rest of the image empty
+      const Vec2 start(u(rng) * width, u(rng) * height), step(u(rng) - 0.5, u(rng) - 0.5);
+      for (int k = 0; k < 12; ++k) edges.push_back({start + k * step, Vec2::UnitX()});
+    }
+    for (int i = 0; i < 40; ++i) edges.push_back({Vec2(u(rng) * width, u(rng) * height)});
+    const ImageEdgeMap map(width, height, cell_px, edges);
+    for (int q = 0; q < 4000; ++q) {
+      const Vec2 pixel(u(rng) * (width + 10) - 5, u(rng) * (height + 10) - 5);
+      const double radius = 0.5 + u(rng) * 40.0;
+      const ImageEdge* brute = nullptr;
+      double best = radius;
+      for (const ImageEdge& e : map.edges()) {
+        const double d = (e.pixel - pixel).norm();
+        if (d < best) best = d, brute = &e;
+      }
+      const ImageEdge* found = map.Nearest(pixel, radius);
+      ASSERT_EQ(found == nullptr, brute == nullptr) << cell_px << " " << pixel.transpose();
+      if (found)
+        EXPECT_DOUBLE_EQ((found->pixel - pixel).norm(), best) << cell_px << " " << radius;
+    }
+  }
+}
+
 // A scene of 3D segments (LiDAR frame) seen by both sensors: the LiDAR's edge points along them
 // with the scatter of their angular step, the image's edges where the true extrinsic projects
 // them, every 0.5 px, with their normals. vertical_only: every segment vertical and at 6 m, so
