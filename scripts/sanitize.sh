@@ -54,6 +54,9 @@ targets=()
 labels=()
 # The --ci subset, by gtest suite (docs/manual.md "Fuzzing and sanitizers" names it).
 CI_SUBSET='^(Controller|CalibrationJob|OnePipeline|SessionTest|RealBags|BagFormats|LidarPlane|FeatureCache)\.'
+# Left out of the subset: the job fed three ways over one dataset (three whole calibrations, 78 s
+# under ASan, a sixth of the stage); each way runs under ASan in the job's other tests.
+CI_SLOW='^CalibrationJob\.FedAllAtOncePairByPairOrStepByStepItEndsWhereCalibrateEnds$'
 if [ $mode = ci ]; then
   # -O1 and line tables only: faster to compile than RelWithDebInfo's -O2 -g, and a report still
   # names the lines.
@@ -61,7 +64,7 @@ if [ $mode = ci ]; then
   debug=-g1
   # Only the subset's 8 test files (test_sanitize_ci, tests/CMakeLists.txt), not all 58.
   targets=(--target calibench test_sanitize_ci)
-  labels=(-L sanitize_ci -R "$CI_SUBSET")
+  labels=(-L sanitize_ci -R "$CI_SUBSET" -E "$CI_SLOW")
 fi
 subset=OFF
 [ $mode = ci ] && subset=ON
