@@ -44,6 +44,9 @@ void AddSimFlags(CLI::App& app, SimFlags& flags) {
   app.add_flag("--board-only-clouds", flags.board_only_clouds,
                "clouds cropped to the board's returns, without rings (as some public sets ship "
                "them)");
+  app.add_flag("--lidar-viewpoints", flags.lidar_viewpoints,
+               "each return's ray origin in the clouds (fields vp_x, vp_y, vp_z: a swept "
+               "scanner's mirror as its stage turned it), as a driver that knows it writes them");
 }
 
 bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* why) {
@@ -109,6 +112,7 @@ bool BuildSimOptions(const SimFlags& flags, SimOptions* options, std::string* wh
   options->seed = flags.seed;
   if (flags.no_clutter) options->clutter = false;
   if (flags.board_only_clouds) options->board_only_clouds = true;
+  if (flags.lidar_viewpoints) options->lidar_viewpoints = true;
   if (flags.no_lidar_seeds) options->lidar_seeds = false;
   return options->Check(why);
 }

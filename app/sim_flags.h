@@ -24,6 +24,7 @@ struct SimFlags {
   std::uint64_t seed = 1;
   bool no_clutter = false;
   bool board_only_clouds = false;
+  bool lidar_viewpoints = false;
   bool no_lidar_seeds = false;
 };
 

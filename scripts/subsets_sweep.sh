@@ -21,6 +21,7 @@ kinds=(
   "vlp16:--lidar vlp16"
   "os0-128:--lidar os0-128"
   "swept-2d:--lidar swept-2d"
+  "swept-2d-viewpoints:--lidar swept-2d --lidar-viewpoints"
   "nodding-2d:--lidar nodding-2d"
   "segments:--lidar vlp16 --board-only-clouds"
   "mid40-frame:--lidar mid40 --lidar-frame 0.1"

@@ -108,6 +108,9 @@ std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int
   std::vector<Field> fields = {{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}};
   if (cloud.HasIntensity()) fields.push_back({"intensity", 16, 7});
   if (cloud.HasRing()) fields.push_back({ring_field, 20, 4});
+  if (cloud.HasViewpoint())  // PCL's PointWithViewpoint names
+    for (const auto& [name, offset] : {std::pair{"vp_x", 32u}, {"vp_y", 36u}, {"vp_z", 40u}})
+      fields.push_back({name, offset, 7});
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(fields.size()));
   for (const Field& field : fields) {
     out.String(field.name);
@@ -116,7 +119,7 @@ std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int
     out.Put<std::uint32_t>(1);
   }
   out.Put<std::uint8_t>(big_endian ? 1 : 0);
-  constexpr std::uint32_t kStep = 32;
+  const std::uint32_t kStep = cloud.HasViewpoint() ? 48 : 32;
   out.Put<std::uint32_t>(kStep);
   out.Put<std::uint32_t>(kStep * static_cast<std::uint32_t>(cloud.width));
   Bytes points;
@@ -128,6 +131,11 @@ std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int
     if (cloud.HasIntensity()) PutRaw<float>(&points, cloud.intensity[i], big_endian);
     if (cloud.HasRing())
       PutRaw<std::uint16_t>(&points, static_cast<std::uint16_t>(cloud.ring[i]), big_endian);
+    if (cloud.HasViewpoint()) {
+      points.resize(start + 32, 0);
+      for (int axis = 0; axis < 3; ++axis)
+        PutRaw<float>(&points, cloud.viewpoint[i][axis], big_endian);
+    }
     points.resize(start + kStep, 0);
   }
   out.ByteSequence(points.data(), points.size());

@@ -27,6 +27,9 @@ FieldRole RoleOfName(std::string_view name) {
   if (name == "intensity" || name == "i") return kIntensity;
   if (name == "ring") return kRing;
   if (name == "range") return kRange;
+  if (name == "vp_x") return kVpX;
+  if (name == "vp_y") return kVpY;
+  if (name == "vp_z") return kVpZ;
   return kIgnored;
 }
 
@@ -129,11 +132,16 @@ std::vector<std::string_view> SplitWords(std::string_view line) {
 
 CloudBuilder::CloudBuilder(const std::filesystem::path& path, const bool has[kNumRoles],
                            size_t expected)
-    : path_(path), has_intensity_(has[kIntensity]), has_ring_(has[kRing]), has_range_(has[kRange]) {
+    : path_(path),
+      has_intensity_(has[kIntensity]),
+      has_ring_(has[kRing]),
+      has_range_(has[kRange]),
+      has_viewpoint_(has[kVpX] && has[kVpY] && has[kVpZ]) {
   cloud_.points.reserve(expected);
   if (has_intensity_) cloud_.intensity.reserve(expected);
   if (has_ring_) cloud_.ring.reserve(expected);
   if (has_range_) cloud_.range.reserve(expected);
+  if (has_viewpoint_) cloud_.viewpoint.reserve(expected);
 }
 
 void CloudBuilder::Add(const double values[kNumRoles]) {
@@ -157,6 +165,14 @@ void CloudBuilder::Add(const double values[kNumRoles]) {
     cloud_.ring.push_back(static_cast<int>(ring));
   }
   if (has_range_) cloud_.range.push_back(static_cast<float>(values[kRange]));
+  if (has_viewpoint_) {
+    const Eigen::Vector3f viewpoint(static_cast<float>(values[kVpX]),
+                                    static_cast<float>(values[kVpY]),
+                                    static_cast<float>(values[kVpZ]));
+    if (!viewpoint.allFinite())
+      Fail(path_, "point " + std::to_string(index) + " has a viewpoint that is not finite");
+    cloud_.viewpoint.push_back(viewpoint);
+  }
 }
 
 LidarCloud CloudBuilder::Finish(int width, int height) {
@@ -182,6 +198,9 @@ void CheckCloudForWriting(const std::filesystem::path& path, const LidarCloud& c
   if (!cloud.range.empty() && cloud.range.size() != n)
     Fail(path, "cannot write: range has " + std::to_string(cloud.range.size()) + " values for " +
                    std::to_string(n) + " points");
+  if (cloud.HasViewpoint() && cloud.viewpoint.size() != n)
+    Fail(path, "cannot write: viewpoint has " + std::to_string(cloud.viewpoint.size()) +
+                   " values for " + std::to_string(n) + " points");
 }
 
 uint16_t RingAsU16(const std::filesystem::path& path, int ring) {

@@ -21,8 +21,8 @@ struct ScalarType {
 };
 
 // What a named field/property becomes in LidarCloud; the first six index value arrays.
-enum FieldRole { kX = 0, kY, kZ, kIntensity, kRing, kRange, kIgnored };
-inline constexpr int kNumRoles = 6;
+enum FieldRole { kX = 0, kY, kZ, kIntensity, kRing, kRange, kVpX, kVpY, kVpZ, kIgnored };
+inline constexpr int kNumRoles = 9;
 // x, y, z, intensity (or "i"), ring, range; anything else (rgb, t, reflectivity, ...) is ignored.
 FieldRole RoleOfName(std::string_view name);
 
@@ -54,7 +54,7 @@ class CloudBuilder {
 
  private:
   const std::filesystem::path& path_;
-  bool has_intensity_, has_ring_, has_range_;
+  bool has_intensity_, has_ring_, has_range_, has_viewpoint_;
   size_t seen_ = 0;
   size_t dropped_ = 0;
   LidarCloud cloud_;

@@ -32,7 +32,7 @@ struct PcdHeader {
   PcdData data = PcdData::kAscii;
   size_t data_start = 0;  // byte offset of the first data byte
   size_t data_line = 0;   // 1-based line number of the first ascii row
-  int field_of_role[kNumRoles] = {-1, -1, -1, -1, -1, -1};
+  int field_of_role[kNumRoles] = {-1, -1, -1, -1, -1, -1, -1, -1, -1};
 };
 
 // The header keywords, each a list of words, as they appear before DATA.
@@ -352,6 +352,8 @@ std::vector<OutField> OutFields(const LidarCloud& cloud) {
   if (cloud.HasIntensity()) fields.push_back({"intensity", 4, 'F'});
   if (cloud.HasRing()) fields.push_back({"ring", 2, 'U'});
   if (!cloud.range.empty()) fields.push_back({"range", 4, 'F'});
+  if (cloud.HasViewpoint())
+    for (const char* name : {"vp_x", "vp_y", "vp_z"}) fields.push_back({name, 4, 'F'});
   return fields;
 }
 
@@ -388,6 +390,8 @@ std::string AsciiBody(const std::filesystem::path& path, const LidarCloud& cloud
     if (cloud.HasIntensity()) AppendNumber(&(body += ' '), cloud.intensity[i]);
     if (cloud.HasRing()) body += ' ' + std::to_string(RingAsU16(path, cloud.ring[i]));
     if (!cloud.range.empty()) AppendNumber(&(body += ' '), cloud.range[i]);
+    if (cloud.HasViewpoint())
+      for (int k = 0; k < 3; ++k) AppendNumber(&(body += ' '), cloud.viewpoint[i][k]);
     body += '\n';
   }
   return body;
@@ -405,13 +409,16 @@ std::string BinaryBody(const std::filesystem::path& path, const LidarCloud& clou
       AppendBytes(&body, cloud.intensity[i]);
     else if (channel == 4)
       AppendBytes(&body, RingAsU16(path, cloud.ring[i]));
-    else
+    else if (channel == 5)
       AppendBytes(&body, cloud.range[i]);
+    else
+      AppendBytes(&body, cloud.viewpoint[i][channel - 6]);
   };
   std::vector<int> channels = {0, 1, 2};
   if (cloud.HasIntensity()) channels.push_back(3);
   if (cloud.HasRing()) channels.push_back(4);
   if (!cloud.range.empty()) channels.push_back(5);
+  if (cloud.HasViewpoint()) channels.insert(channels.end(), {6, 7, 8});
   if (field_major) {
     for (const int c : channels)
       for (size_t i = 0; i < n; ++i) append_channel(i, c);

@@ -234,6 +234,8 @@ void SavePly(const std::filesystem::path& path, const LidarCloud& cloud) {
   if (cloud.HasIntensity()) header << "property float intensity\n";
   if (cloud.HasRing()) header << "property ushort ring\n";
   if (has_range) header << "property float range\n";
+  if (cloud.HasViewpoint())
+    header << "property float vp_x\nproperty float vp_y\nproperty float vp_z\n";
   header << "end_header\n";
   std::string body = header.str();
   for (size_t i = 0; i < cloud.size(); ++i) {
@@ -241,6 +243,8 @@ void SavePly(const std::filesystem::path& path, const LidarCloud& cloud) {
     if (cloud.HasIntensity()) AppendBytes(&body, cloud.intensity[i]);
     if (cloud.HasRing()) AppendBytes(&body, RingAsU16(path, cloud.ring[i]));
     if (has_range) AppendBytes(&body, cloud.range[i]);
+    if (cloud.HasViewpoint())
+      for (int k = 0; k < 3; ++k) AppendBytes(&body, cloud.viewpoint[i][k]);
   }
   std::ofstream out = OpenForWriting(path);
   out.write(body.data(), static_cast<std::streamsize>(body.size()));

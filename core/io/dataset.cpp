@@ -58,6 +58,7 @@ SimulationRecord ParseSimulation(const json_io::Fields& sim) {
   record.image_noise = sim.Number("image_noise");
   record.clutter = sim.Bool("clutter");
   record.board_only_clouds = sim.GetOr("board_only_clouds", false);  // written since issue 32
+  record.lidar_viewpoints = sim.GetOr("lidar_viewpoints", false);    // written only when true
   record.seed_radius_m = sim.Number("seed_radius_m");
   record.seed = sim.Get<std::uint64_t>("seed");
   return record;
@@ -194,6 +195,7 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
                           {"lidar_range_offset_m", r.lidar_range_offset_m},
                           {"lidar_angular_noise_rad", r.lidar_angular_noise_rad}};
     if (r.lidar_frame_s > 0) root["simulation"]["lidar_frame_s"] = r.lidar_frame_s;
+    if (r.lidar_viewpoints) root["simulation"]["lidar_viewpoints"] = true;
   }
   WriteFileAtomically(manifest_path, root.dump(2) + "\n");
 }

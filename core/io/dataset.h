@@ -38,6 +38,7 @@ struct SimulationRecord {
   double image_noise = 0.0;              // [0,1] intensity units
   bool clutter = true;
   bool board_only_clouds = false;  // clouds cropped to the sheet's returns, without rings
+  bool lidar_viewpoints = false;   // clouds carry each return's ray origin (vp_x, vp_y, vp_z)
   double seed_radius_m = 0.0;
   std::uint64_t seed = 1;
 };

@@ -65,6 +65,12 @@ void IntegrateSweeps(const std::vector<recording_detail::StampedBytes>& sweeps,
       continue;
     const bool intensity = cloud->HasIntensity() && more.HasIntensity();
     if (!intensity) cloud->intensity.clear();
+    // Viewpoints are kept only when every sweep has them: a ray without its own start would
+    // be taken to start at the origin.
+    const bool viewpoint = cloud->HasViewpoint() && more.HasViewpoint();
+    if (!viewpoint) cloud->viewpoint.clear();
+    if (viewpoint)
+      cloud->viewpoint.insert(cloud->viewpoint.end(), more.viewpoint.begin(), more.viewpoint.end());
     cloud->points.insert(cloud->points.end(), more.points.begin(), more.points.end());
     if (intensity)
       cloud->intensity.insert(cloud->intensity.end(), more.intensity.begin(), more.intensity.end());

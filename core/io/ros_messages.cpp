@@ -131,12 +131,18 @@ void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>
   // A Livox driver's PointCloud2 names its laser "line": not a ring (its returns follow the
   // rosette, not a cone), but the order its beam's path is stored in.
   const PointField* line = ring ? nullptr : FindField(fields, {"line"});
+  // Each return's ray origin, as PCL's PointWithViewpoint names it (core/lidar/cloud.h).
+  const PointField* vp_x = FindField(fields, {"vp_x"});
+  const PointField* vp_y = FindField(fields, {"vp_y"});
+  const PointField* vp_z = FindField(fields, {"vp_z"});
+  const bool viewpoint = vp_x && vp_y && vp_z;
   std::vector<int> lines;
   const std::size_t total = static_cast<std::size_t>(width) * height;
   if (total == 0) return;  // no points: not 4 billion empty rows walked through
   cloud->points.reserve(total);
   if (intensity) cloud->intensity.reserve(total);
   if (ring) cloud->ring.reserve(total);
+  if (viewpoint) cloud->viewpoint.reserve(total);
   for (std::uint32_t row = 0; row < height; ++row) {
     const std::uint8_t* row_start = data.data() + static_cast<std::size_t>(row) * row_step;
     for (std::uint32_t column = 0; column < width; ++column) {
@@ -157,6 +163,15 @@ void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>
         cloud->ring.push_back(static_cast<int>(index));
       }
       if (line) lines.push_back(static_cast<int>(ReadField(point, *line, swap)));
+      if (viewpoint) {
+        const Eigen::Vector3f origin(static_cast<float>(ReadField(point, *vp_x, swap)),
+                                     static_cast<float>(ReadField(point, *vp_y, swap)),
+                                     static_cast<float>(ReadField(point, *vp_z, swap)));
+        if (!origin.allFinite())
+          Bad("PointCloud2: point " + std::to_string(cloud->points.size() - 1) +
+              " has a viewpoint that is not finite");
+        cloud->viewpoint.push_back(origin);
+      }
     }
   }
   OrderByLaserLine<int>(lines, cloud, nullptr);

@@ -12,6 +12,10 @@ struct LidarCloud {
   std::vector<float> intensity;         // empty when the file has none
   std::vector<int> ring;                // laser index, 0 = lowest beam; empty when unknown
   std::vector<float> range;             // metres; empty when the file has none
+  // Where each return's ray starts (metres, LiDAR frame): a swept scanner's mirror as the stage
+  // turned it, written by its driver (PCD / PLY / PointCloud2 fields vp_x, vp_y, vp_z, as PCL's
+  // PointWithViewpoint). Empty: every ray starts at the LiDAR's origin.
+  std::vector<Eigen::Vector3f> viewpoint;
   // Organized clouds (height > 1) store rows = rings, columns = firing order.
   int width = 0;
   int height = 1;
@@ -19,6 +23,12 @@ struct LidarCloud {
   size_t size() const { return points.size(); }
   bool HasIntensity() const { return !intensity.empty(); }
   bool HasRing() const { return !ring.empty(); }
+  bool HasViewpoint() const { return !viewpoint.empty(); }
+  // Where return i's ray starts (see viewpoint).
+  Eigen::Vector3d RayOrigin(size_t i) const {
+    if (viewpoint.empty()) return Eigen::Vector3d::Zero();
+    return viewpoint[i].cast<double>();
+  }
   bool IsOrganized() const { return height > 1 && static_cast<size_t>(width) * height == size(); }
 };
 

@@ -19,6 +19,9 @@ struct ModelGroup {
   std::vector<std::string> pairs;
   std::string why;
   bool forced = false;
+  // A model without rays from the origin whose planes were fitted along each return's own ray
+  // (the cloud carried viewpoints): FitPlaneRangeMl alone fills a fit's range sums.
+  bool given_rays = false;
 };
 
 std::vector<ModelGroup> GroupByLidarModel(const CalibrationOutcome& outcome) {
@@ -31,11 +34,15 @@ std::vector<ModelGroup> GroupByLidarModel(const CalibrationOutcome& outcome) {
     if (it == groups.end())
       it = groups.insert(groups.end(), {model.geometry, {}, model.why, model.forced});
     it->pairs.push_back(p.id);
+    it->given_rays |= !RaysFromOrigin(model.geometry) && p.lidar->range_moments.count > 0;
   }
   return groups;
 }
 
-std::string ModelMeaning(LidarGeometry geometry) {
+std::string ModelMeaning(LidarGeometry geometry, bool given_rays) {
+  if (given_rays)
+    return "planes fitted on the ranges along each return's own ray (from the viewpoint the cloud "
+           "gives it), no ring biases or board edges";
   if (geometry == LidarGeometry::kSpinning)
     return "planes fitted on the ranges along the rays, with ring biases and board edges";
   if (geometry == LidarGeometry::kNonRepetitive)
@@ -90,7 +97,7 @@ json LidarModelJson(const CalibrationOutcome& outcome) {
   return {{"geometry", LidarGeometryName(main.geometry)},
           {"why", main.why},
           {"forced", main.forced},
-          {"meaning", ModelMeaning(main.geometry)},
+          {"meaning", ModelMeaning(main.geometry, main.given_rays)},
           {"pairs", counts}};
 }
 
@@ -112,7 +119,7 @@ std::string DescribeLidarModel(const CalibrationOutcome& outcome) {
       for (size_t k = 0; k < g.pairs.size() && k < 5; ++k) text += (k ? ", " : "") + g.pairs[k];
       text += g.pairs.size() > 5 ? ", ...)" : ")";
     }
-    text += " (" + g.why + "): " + ModelMeaning(g.geometry);
+    text += " (" + g.why + "): " + ModelMeaning(g.geometry, g.given_rays);
   }
   return text;
 }

@@ -384,6 +384,7 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
   record.image_noise = r.image_noise;
   record.clutter = r.clutter;
   record.board_only_clouds = r.board_only_clouds;
+  record.lidar_viewpoints = r.lidar_viewpoints;
   record.seed_radius_m = r.seed_radius_m;
   record.seed = r.seed;
   dataset.simulation = record;
@@ -407,7 +408,8 @@ Dataset SimulateDataset(const SimOptions& options, const std::filesystem::path& 
     scan_options.azimuth_offset_rad = plan.azimuth_offset_rad;
     scan_options.seed = MixSeed(r.seed, k, 1);
     SavePcd(entry.cloud,
-            SimulateLidarScan(beams, print, scene, scan_options).ToCloud(r.board_only_clouds),
+            SimulateLidarScan(beams, print, scene, scan_options)
+                .ToCloud(r.board_only_clouds, r.lidar_viewpoints),
             PcdEncoding::kBinary);
 
     RenderOptions render;
@@ -440,7 +442,8 @@ SimulatedPair SimulatePairAt(const SimOptions& resolved, const Pose& cam_from_bo
   scan_options.angular_noise_rad = r.lidar_angular_noise_rad;
   scan_options.azimuth_offset_rad = azimuth_offset;
   scan_options.seed = MixSeed(r.seed, pair_index, 1);
-  pair.cloud = SimulateLidarScan(beams, print, scene, scan_options).ToCloud(r.board_only_clouds);
+  pair.cloud = SimulateLidarScan(beams, print, scene, scan_options)
+                   .ToCloud(r.board_only_clouds, r.lidar_viewpoints);
   RenderOptions render;
   render.image_noise = r.image_noise;
   render.seed = MixSeed(r.seed, pair_index, 2);

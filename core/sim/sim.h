@@ -40,6 +40,9 @@ struct SimOptions {
   // Clouds cropped to the returns on the sheet, without rings, as several public sets and some
   // users' pipelines ship the LiDAR side: no background, nothing beyond the board's edges.
   bool board_only_clouds = false;
+  // Each return's ray origin in its cloud (the fields vp_x, vp_y, vp_z, core/lidar/cloud.h), as a
+  // swept scanner's driver that knows its mirror can write them.
+  bool lidar_viewpoints = false;
   Pose cam_from_lidar = Pose::Identity();  // ground truth; Identity() = the default mount below
   double seed_radius_m = 0.0;              // lidar_seed radius; 0 = 0.4 * the smaller board side
   // Whether each pair carries a lidar_seed (where its board is, as a seeding tool would say). Off:
@@ -101,12 +104,14 @@ struct LidarScan {
   std::vector<float> intensity;     // 0..255
   std::vector<int> ring;            // 0 = lowest beam
   std::vector<SimSurface> surface;  // what each return hit
+  std::vector<Vec3> origin;         // where each return's ray started (a swept scanner's mirror)
   bool has_rings = true;            // false for a swept scanner: its cloud has no ring field
 
   size_t size() const { return points.size(); }
   // Unorganized cloud (height 1) with intensity and ring (when it has rings); board_only: the
-  // sheet's returns alone, without rings (SimOptions::board_only_clouds).
-  LidarCloud ToCloud(bool board_only = false) const;
+  // sheet's returns alone, without rings (SimOptions::board_only_clouds); viewpoints: each
+  // return's ray origin (SimOptions::lidar_viewpoints).
+  LidarCloud ToCloud(bool board_only = false, bool viewpoints = false) const;
 };
 
 // Casts every beam × azimuth step (firing order: azimuth outer, rings inner) and keeps the nearest

@@ -71,13 +71,14 @@ double MinRangeM(const BeamTable& beams) {
 
 }  // namespace
 
-LidarCloud LidarScan::ToCloud(bool board_only) const {
+LidarCloud LidarScan::ToCloud(bool board_only, bool viewpoints) const {
   LidarCloud cloud;
   for (size_t i = 0; i < points.size(); ++i) {
     if (board_only && surface[i] != SimSurface::kBoard) continue;
     cloud.points.push_back(points[i].cast<float>());
     cloud.intensity.push_back(intensity[i]);
     if (has_rings && !board_only) cloud.ring.push_back(ring[i]);
+    if (viewpoints) cloud.viewpoint.push_back(origin[i].cast<float>());
   }
   cloud.width = static_cast<int>(cloud.size());
   cloud.height = 1;
@@ -136,6 +137,7 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
       scan.intensity.push_back(static_cast<float>(std::clamp(intensity, 0.0, 255.0)));
       scan.ring.push_back(r);
       scan.surface.push_back(hit.surface);
+      scan.origin.push_back(ray.origin);
     }
   }
   return scan;

@@ -27,6 +27,7 @@ SimOptions SimOptionsFromDataset(const Dataset& dataset) {
   options.lidar_range_noise_m = record.lidar_range_noise_m;
   options.lidar_range_offset_m = record.lidar_range_offset_m;
   options.lidar_angular_noise_rad = record.lidar_angular_noise_rad;
+  options.lidar_viewpoints = record.lidar_viewpoints;
   options.image_noise = record.image_noise;
   options.clutter = record.clutter;
   options.board_only_clouds = record.board_only_clouds;

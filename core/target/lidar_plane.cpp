@@ -40,12 +40,18 @@ double BoardGrowRadius(const BoardSpec& board) {
 
 namespace {
 
-// Range residual r − r̂ of a return against a plane (r̂ where its ray meets the plane); nullopt
-// for rays within ~1° of the plane.
-std::optional<double> RangeResidual(const Plane& plane, const Vec3& x) {
-  const auto on_plane = RangeOnPlane(plane, x);
+// The plane in coordinates centred on a ray's origin o (x' = x − o): n·x' + (d + n·o) = 0.
+Plane SeenFrom(const Plane& plane, const Vec3& origin) {
+  return Plane{plane.normal, plane.distance + plane.normal.dot(origin)};
+}
+
+// Range residual r − r̂ of a return against a plane (r̂ where its ray, from `origin`, meets the
+// plane); nullopt for rays within ~1° of the plane.
+std::optional<double> RangeResidual(const Plane& plane, const Vec3& x, const Vec3& origin) {
+  const Vec3 ray = x - origin;
+  const auto on_plane = RangeOnPlane(SeenFrom(plane, origin), ray);
   if (!on_plane) return std::nullopt;
-  return x.norm() - *on_plane;
+  return ray.norm() - *on_plane;
 }
 
 // The range band for inliers: 3σ̂ of the fit, at least the RANSAC threshold and at most five
@@ -70,7 +76,8 @@ std::optional<LidarPlaneFit> RefineRangeMl(const LidarCloud& cloud,
     const double band_m = RangeBand(options, ml->rms_m);
     std::vector<int> reselected;
     for (int i : candidates) {
-      const auto residual = RangeResidual(ml->plane, cloud.points[i].cast<double>());
+      const auto residual =
+          RangeResidual(ml->plane, cloud.points[i].cast<double>(), cloud.RayOrigin(i));
       if (residual && std::abs(*residual) <= band_m) reselected.push_back(i);
     }
     if (reselected == inliers || reselected.size() < 4) break;
@@ -103,23 +110,31 @@ std::optional<LidarPlaneFit> RefineLeastSquares(const LidarCloud& cloud,
   return fit;
 }
 
-// Whether the options fit ranges along rays from the origin (a spinning or non-repetitive
-// LiDAR's model).
-bool AlongRays(const LidarPlaneOptions& options) {
-  return options.fit_ranges_ml && RaysFromOrigin(options.geometry);
+// Whether the cloud's rays are known: from the origin (a spinning or non-repetitive LiDAR's
+// model), or from each return's own viewpoint where the cloud carries them (a swept scanner's
+// mirror, core/lidar/cloud.h).
+bool RaysKnown(const LidarPlaneOptions& options, const LidarCloud& cloud) {
+  return RaysFromOrigin(options.geometry) || cloud.HasViewpoint();
 }
 
-// A return's residual against the plane in the options' model: along its ray, or (isotropic)
+// Whether the options fit ranges along those rays.
+bool AlongRays(const LidarPlaneOptions& options, const LidarCloud& cloud) {
+  return options.fit_ranges_ml && RaysKnown(options, cloud);
+}
+
+// Return i's residual against the plane in the options' model: along its ray, or (isotropic)
 // along the normal; and where it lies on the plane.
-std::optional<std::pair<double, Vec3>> ModelResidual(const Plane& plane, const Vec3& x,
-                                                     bool along_rays) {
+std::optional<std::pair<double, Vec3>> ModelResidual(const Plane& plane, const LidarCloud& cloud,
+                                                     size_t i, bool along_rays) {
+  const Vec3 x = cloud.points[i].cast<double>();
   if (!along_rays) {
     const double distance = plane.SignedDistance(x);
     return std::make_pair(distance, Vec3(x - distance * plane.normal));
   }
-  const auto residual = RangeResidual(plane, x);
+  const Vec3 origin = cloud.RayOrigin(i);
+  const auto residual = RangeResidual(plane, x, origin);
   if (!residual) return std::nullopt;
-  return std::make_pair(*residual, Vec3(x - x.normalized() * *residual));
+  return std::make_pair(*residual, Vec3(x - (x - origin).normalized() * *residual));
 }
 
 // Where the inliers meet the plane (along their rays, or projected), averaged: the board centre
@@ -129,11 +144,12 @@ Vec3 InlierCentre(const LidarCloud& cloud, const LidarPlaneFit& fit, bool along_
   int count = 0;
   for (int i : fit.inliers) {
     const Vec3 x = cloud.points[i].cast<double>();
+    const Vec3 origin = cloud.RayOrigin(i);
     if (!along_rays) {
       sum += x - fit.plane.SignedDistance(x) * fit.plane.normal;
       ++count;
-    } else if (const auto range = RangeOnPlane(fit.plane, x)) {
-      sum += x.normalized() * *range;
+    } else if (const auto range = RangeOnPlane(SeenFrom(fit.plane, origin), x - origin)) {
+      sum += origin + (x - origin).normalized() * *range;
       ++count;
     }
   }
@@ -146,13 +162,13 @@ Vec3 InlierCentre(const LidarCloud& cloud, const LidarPlaneFit& fit, bool along_
 // direction and the band only, as for the seed region, so that it does not bias the plane.
 LidarPlaneFit GrowToBoard(const LidarCloud& cloud, LidarPlaneFit fit,
                           const LidarPlaneOptions& options) {
-  const bool along_rays = AlongRays(options);
+  const bool along_rays = AlongRays(options, cloud);
   Vec3 centre = InlierCentre(cloud, fit, along_rays);
   for (int round = 0; round < 4; ++round) {
     const double gate_m = 2.0 * RangeBand(options, fit.rms_m);
     std::vector<int> candidates;
     for (size_t i = 0; i < cloud.size(); ++i) {
-      const auto residual = ModelResidual(fit.plane, cloud.points[i].cast<double>(), along_rays);
+      const auto residual = ModelResidual(fit.plane, cloud, i, along_rays);
       if (!residual || std::abs(residual->first) > gate_m) continue;
       if ((residual->second - centre).norm() <= options.grow_radius_m)
         candidates.push_back(static_cast<int>(i));
@@ -228,14 +244,17 @@ std::optional<LidarPlaneFit> FitPlaneLeastSquares(const LidarCloud& cloud,
 
 namespace {
 
-// The range residuals of FitPlaneRangeMl: each return's ray (unit) and measured range.
+// The range residuals of FitPlaneRangeMl: each return's ray (unit), measured range and the
+// ray's origin (empty: all at the LiDAR's origin).
 struct RangeResiduals {
   std::vector<Vec3> rays;
   std::vector<double> ranges;
+  std::vector<Vec3> origins;
 
   // Gauss-Newton's normal matrix JᵀJ, gradient Jᵀe and Σe² at plane p, over θ = (δ, δ_d) with
-  // n ← n + B δ, d ← d + δ_d; *sum_jacobian = Σ ∂e_i/∂θ. Residual e_i = r_i − r̂_i,
-  // r̂_i = −d/(n·u_i): ∂r̂/∂δ = d (u_iᵀ B)/(n·u_i)², ∂r̂/∂δ_d = −1/(n·u_i); ∂e/∂· = −∂r̂/∂·.
+  // n ← n + B δ, d ← d + δ_d; *sum_jacobian = Σ ∂e_i/∂θ. Residual e_i = r_i − r̂_i, the ray
+  // from o_i meeting the plane at r̂_i = −d_i/(n·u_i), d_i = d + n·o_i (the plane seen from o_i):
+  // ∂r̂/∂δ = d_i (u_iᵀ B)/(n·u_i)² − (o_iᵀ B)/(n·u_i), ∂r̂/∂δ_d = −1/(n·u_i); ∂e/∂· = −∂r̂/∂·.
   // False when a ray grazes the plane (|cos| < 0.02, beyond 88.9°): no finite predicted range.
   bool Linearize(const Plane& p, Mat3* normal_matrix, Vec3* gradient, double* sum_sq,
                  Vec3* sum_jacobian) const {
@@ -247,9 +266,11 @@ struct RangeResiduals {
     for (size_t k = 0; k < rays.size(); ++k) {
       const double cos_incidence = p.normal.dot(rays[k]);
       if (std::abs(cos_incidence) < 0.02) return false;
-      const double e = ranges[k] + p.distance / cos_incidence;
+      const double distance = origins.empty() ? p.distance : p.distance + p.normal.dot(origins[k]);
+      const double e = ranges[k] + distance / cos_incidence;
       Eigen::RowVector3d j;
-      j.head<2>() = -p.distance * rays[k].transpose() * b / (cos_incidence * cos_incidence);
+      j.head<2>() = -distance * rays[k].transpose() * b / (cos_incidence * cos_incidence);
+      if (!origins.empty()) j.head<2>() += origins[k].transpose() * b / cos_incidence;
       j(2) = 1.0 / cos_incidence;
       *normal_matrix += j.transpose() * j;
       *gradient += j.transpose() * e;
@@ -269,12 +290,15 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
   RangeResiduals residuals;
   residuals.rays.reserve(indices.size());
   residuals.ranges.reserve(indices.size());
+  if (cloud.HasViewpoint()) residuals.origins.reserve(indices.size());
   for (int i : indices) {
-    const Vec3 x = cloud.points[i].cast<double>();
-    const double r = x.norm();
+    const Vec3 origin = cloud.RayOrigin(i);
+    const Vec3 ray = cloud.points[i].cast<double>() - origin;
+    const double r = ray.norm();
     if (r <= 0) return std::nullopt;
-    residuals.rays.push_back(x / r);
+    residuals.rays.push_back(ray / r);
     residuals.ranges.push_back(r);
+    if (cloud.HasViewpoint()) residuals.origins.push_back(origin);
   }
   Plane plane = OrientTowardsOrigin(initial);
   Mat3 normal_matrix;
@@ -303,7 +327,10 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
     const double cos_incidence = plane.normal.dot(residuals.rays[k]);
     const double r = residuals.ranges[k];
     const double tan2 = (1.0 - cos_incidence * cos_incidence) / (cos_incidence * cos_incidence);
-    fit.range_moments.Add(r * r * tan2, r + plane.distance / cos_incidence);
+    const double distance = residuals.origins.empty()
+                                ? plane.distance
+                                : plane.distance + plane.normal.dot(residuals.origins[k]);
+    fit.range_moments.Add(r * r * tan2, r + distance / cos_incidence);
   }
   const double dof = std::max<double>(1.0, static_cast<double>(indices.size()) - 3.0);
   fit.covariance = TangentToPlaneCovariance((sum_sq / dof) * normal_matrix.inverse(), plane.normal);
@@ -463,7 +490,7 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
     if (next_band <= band * 1.05) break;
     band = next_band;
   }
-  if (AlongRays(options)) {
+  if (AlongRays(options, cloud)) {
     if (auto ml = RefineAlongRays(cloud, candidates, *fit, options)) fit = ml;
   }
   fit->num_candidates = static_cast<int>(candidates.size());
@@ -474,8 +501,7 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
   if (n < options.min_inlier_fraction * candidates.size())
     return fail("plane explains only " + std::to_string(n) + " of " +
                 std::to_string(candidates.size()) + " selected points");
-  const bool along_rays_model = RaysFromOrigin(options.geometry);
-  if (options.grow_radius_m > 0 && (options.fit_ranges_ml || !along_rays_model))
+  if (options.grow_radius_m > 0 && (options.fit_ranges_ml || !RaysKnown(options, cloud)))
     fit = GrowToBoard(cloud, *fit, options);
   AddBoardExtent(cloud, options, &*fit);
   return fit;

@@ -43,6 +43,7 @@ void ExpectSameCloud(const LidarCloud& actual, const LidarCloud& expected) {
   EXPECT_EQ(actual.intensity, expected.intensity);
   EXPECT_EQ(actual.ring, expected.ring);
   EXPECT_EQ(actual.range, expected.range);
+  EXPECT_EQ(actual.viewpoint, expected.viewpoint);
   EXPECT_EQ(actual.width, expected.width);
   EXPECT_EQ(actual.height, expected.height);
 }
@@ -96,6 +97,49 @@ TEST(CloudIo, PcdRoundTripOptionalChannels) {
       SavePcd(path, cloud, encoding);
       ExpectSameCloud(LoadCloud(path), cloud);
     }
+  }
+}
+
+// Each return's ray origin (a swept scanner's mirror) as PCL's PointWithViewpoint stores it:
+// vp_x, vp_y, vp_z, through every writer and back bit for bit; a reader's own field order.
+TEST(CloudIo, ViewpointsRoundTripEveryWriter) {
+  const fs::path dir = test::TempDir("cloud_io_viewpoints");
+  LidarCloud cloud = RandomCloud(64, true, false, false, 21);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> offset(-0.1f, 0.1f);
+  for (size_t i = 0; i < cloud.size(); ++i)
+    cloud.viewpoint.emplace_back(offset(rng), offset(rng), offset(rng));
+  for (const auto encoding :
+       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+    SavePcd(dir / "cloud.pcd", cloud, encoding);
+    ExpectSameCloud(LoadCloud(dir / "cloud.pcd"), cloud);
+  }
+  EXPECT_NE(test::ReadFileBytes(dir / "cloud.pcd").find("FIELDS x y z intensity vp_x vp_y vp_z"),
+            std::string::npos);
+  SavePly(dir / "cloud.ply", cloud);
+  ExpectSameCloud(LoadCloud(dir / "cloud.ply"), cloud);
+  // PCL writes PointWithViewpoint's fields in its own order; only a complete triple counts.
+  WriteFile(dir / "pcl.pcd",
+            "VERSION .7\nFIELDS x y z vp_x vp_y vp_z\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\n"
+            "COUNT 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n"
+            "1 2 3 0.1 0 0.05\n4 5 6 0.2 0 -0.05\n");
+  const LidarCloud pcl = LoadCloud(dir / "pcl.pcd");
+  ASSERT_TRUE(pcl.HasViewpoint());
+  EXPECT_EQ(pcl.viewpoint[1], Eigen::Vector3f(0.2f, 0.f, -0.05f));
+  EXPECT_EQ(pcl.RayOrigin(0), Eigen::Vector3d(0.1f, 0.f, 0.05f));
+  WriteFile(dir / "partial.pcd",
+            "VERSION .7\nFIELDS x y z vp_x\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+            "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3 0.1\n");
+  EXPECT_FALSE(LoadCloud(dir / "partial.pcd").HasViewpoint());
+  WriteFile(dir / "nan.pcd",
+            "VERSION .7\nFIELDS x y z vp_x vp_y vp_z\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\n"
+            "COUNT 1 1 1 1 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3 nan 0 0\n");
+  try {
+    LoadCloud(dir / "nan.pcd");
+    ADD_FAILURE() << "a viewpoint that is not finite was read";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("nan.pcd"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("viewpoint"), std::string::npos) << e.what();
   }
 }
 

@@ -57,6 +57,26 @@ TEST(RosMessages, PointCloud2InEveryByteOrderAndSerialization) {
   }
 }
 
+// A swept scanner's driver that knows its mirror stores each return's ray origin as PCL's
+// PointWithViewpoint does (vp_x, vp_y, vp_z): read into the cloud, in every serialization.
+TEST(RosMessages, PointCloud2ViewpointsAreEachReturnsRayOrigin) {
+  LidarCloud cloud = MessageTestCloud(6, 2);
+  for (size_t i = 0; i < cloud.size(); ++i)
+    cloud.viewpoint.emplace_back(0.1f, 0.01f * static_cast<float>(i), -0.05f);
+  for (const auto& [encoding, big_endian] :
+       {std::pair{MessageEncoding::kRos1, false}, std::pair{MessageEncoding::kCdr, true}}) {
+    const PointCloud2Message message = DecodePointCloud2(
+        test::SerializePointCloud2(cloud, 1, "lidar", encoding, big_endian), encoding);
+    EXPECT_EQ(message.cloud.points, cloud.points);
+    EXPECT_EQ(message.cloud.viewpoint, cloud.viewpoint);
+  }
+  cloud.viewpoint.clear();
+  EXPECT_FALSE(
+      DecodePointCloud2(test::SerializePointCloud2(cloud, 1, "lidar", MessageEncoding::kRos1),
+                        MessageEncoding::kRos1)
+          .cloud.HasViewpoint());
+}
+
 TEST(RosMessages, NonFinitePointsAreDroppedAndTheGridWithThem) {
   LidarCloud cloud = MessageTestCloud(5, 2);
   cloud.points[3].x() = std::numeric_limits<float>::quiet_NaN();
