@@ -5,8 +5,10 @@
 // rays start on a mirror that moves with the stage; a board-only segment holds too little to
 // tell. Spinning and non-repetitive clouds are fitted on the ranges along their rays (only rings
 // add ring biases; board edges come from rings' ends or the beam's path across the sheet's
-// border, core/target/board_edges.h); swept and segment clouds get an isotropic point-to-plane
-// model (the plane's own covariance).
+// border, core/target/board_edges.h); a swept cloud is fitted along its rays where they are known
+// (the cloud's viewpoints, or its mirror estimated: core/lidar/swept_origin.h), a segment and a
+// swept cloud whose rays are not known get an isotropic point-to-plane model (the plane's own
+// covariance).
 #pragma once
 
 #include <optional>

@@ -17,7 +17,7 @@ namespace calibench {
 
 bool PipelineOptions::Check(std::string* why) const {
   if (!lidar_plane.Check(why) || !detection.Check(why) || !pnp.Check(why) || !solver.Check(why) ||
-      !board_detection.Check(why) || !lidar_geometry.Check(why))
+      !board_detection.Check(why) || !lidar_geometry.Check(why) || !swept_origin.Check(why))
     return false;
   if (!(guided_max_sigmas > 0 && guided_floor_sigma_deg >= 0 && guided_floor_sigma_m >= 0)) {
     if (why) *why = "guided_max_sigmas must be > 0 and the guided floors >= 0";
@@ -171,7 +171,19 @@ std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const 
   else
     model = ClassifyLidarGeometry(cloud, options.lidar_geometry);
   plane_options.geometry = model.geometry;
-  auto fit = FitBoardPlane(cloud, region, plane_options, &fit_failure);
+  // A swept scan's rays start on a mirror the stage turns: where the cloud does not say, the
+  // estimate from the scan gives each return its ray (never the origin, assumed).
+  std::optional<LidarCloud> with_rays;
+  if (model.geometry == LidarGeometry::kSwept && !cloud.HasViewpoint()) {
+    if (const std::optional<SweptOrigin> mirror = EstimateSweptOrigin(cloud, options.swept_origin)) {
+      with_rays = cloud;
+      with_rays->viewpoint = SweptViewpoints(cloud, *mirror);
+      model.why += "; " + DescribeSweptOrigin(*mirror);
+    } else {
+      model.why += "; where its rays start could not be told from the scan: fitted point-to-plane";
+    }
+  }
+  auto fit = FitBoardPlane(with_rays ? *with_rays : cloud, region, plane_options, &fit_failure);
   if (fit) {
     fit->lidar_model = model;
     return fit;

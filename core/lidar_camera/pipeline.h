@@ -13,6 +13,7 @@
 #include "core/io/dataset.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
+#include "core/lidar/swept_origin.h"
 #include "core/lidar_camera/solver.h"
 #include "core/results/pair_status.h"
 #include "core/target/board_camera.h"
@@ -37,6 +38,9 @@ struct PipelineOptions {
   // (ClassifyLidarGeometry) unless the user forces one (--lidar-model).
   std::optional<LidarGeometry> lidar_model;
   LidarGeometryOptions lidar_geometry;
+  // A swept cloud without viewpoints: where its rays start, estimated from the scan
+  // (core/lidar/swept_origin.h), its planes then fitted along them.
+  SweptOriginOptions swept_origin;
   BoardDetectionOptions detection;
   PnpOptions pnp;
   SolverOptions solver;

@@ -42,7 +42,8 @@ std::vector<ModelGroup> GroupByLidarModel(const CalibrationOutcome& outcome) {
 std::string ModelMeaning(LidarGeometry geometry, bool given_rays) {
   if (given_rays)
     return "planes fitted on the ranges along each return's own ray (from the viewpoint the cloud "
-           "gives it), no ring biases or board edges";
+           "gives it, or from the mirror's position estimated from the scan), no ring biases or "
+           "board edges";
   if (geometry == LidarGeometry::kSpinning)
     return "planes fitted on the ranges along the rays, with ring biases and board edges";
   if (geometry == LidarGeometry::kNonRepetitive)

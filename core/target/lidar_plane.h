@@ -24,7 +24,9 @@ struct LidarPlaneOptions {
   // by ray, with ring biases and board edges (a ring's ends); a non-repetitive scan's the same
   // way, its edges where the beam's path crosses the sheet's border, no ring biases; a swept
   // laser's or a segment's by total least squares (isotropic point-to-plane, the plane's own
-  // covariance), grown by distance to the plane, without ring biases or edges.
+  // covariance), grown by distance to the plane, without ring biases or edges — unless the cloud
+  // gives each return's ray origin (LidarCloud::viewpoint): then along those rays, as a spinning
+  // LiDAR's without rings.
   LidarGeometry geometry = LidarGeometry::kSpinning;
   double ransac_threshold_m = 0.03;  // inlier distance; ~3σ of typical spinning-LiDAR range noise
   int ransac_iterations = 500;       // enough for > 50% inliers with a 1e-9 failure chance

@@ -98,11 +98,13 @@ TEST(LidarModels, OnASweptLaserTheDefaultIsAtLeastAsAccurateAsThePapersSolver) {
     if (seed == 1) {
       const std::string model = DescribeLidarModel(weighted);
       EXPECT_EQ(model.rfind("LiDAR model: swept for all ", 0), 0u) << model;
-      EXPECT_NE(model.find("point-to-plane (isotropic"), std::string::npos) << model;
+      // The mirror is estimated from each scan (core/lidar/swept_origin.h) and the planes are
+      // fitted along its rays: the noise along them is learned, the 5 mm the simulator drew.
+      EXPECT_NE(model.find("(estimated: the beams' angles"), std::string::npos) << model;
+      EXPECT_NE(model.find("along each return's own ray"), std::string::npos) << model;
       EXPECT_NE(FormatSummary(weighted).find(model), std::string::npos);
-      // No rays from one origin: no noise is learned along them, and the summary says so.
       const std::string noise = DescribeLearnedLidarNoise(weighted);
-      EXPECT_NE(noise.find("no rays from one origin"), std::string::npos) << noise;
+      EXPECT_NE(noise.find("range sigma 5.0 mm"), std::string::npos) << noise;
       EXPECT_NE(DescribeLearnedLidarNoise(central).find("angular"), std::string::npos);
       EXPECT_NE(DescribeLidarModel(central).find("chosen by the user (--lidar-model)"),
                 std::string::npos);
@@ -223,7 +225,8 @@ TEST(LidarModels, TheAngularNoiseIsLearnedFromTheBoardsAndSaid) {
 
 // A swept scanner whose driver writes each return's ray origin (its mirror as the stage turned it:
 // vp_x, vp_y, vp_z): its planes are fitted along those rays, the noise along them is learned, and
-// the summary says so. 2 cm of range noise, seedless, the mirror 10 cm off the stage's axis.
+// the summary says so. 2 cm of range noise, seedless, the mirror 10 cm off the stage's axis. The
+// same scans without viewpoints: the mirror estimated from each scan gives the same result.
 TEST(LidarModels, ASweptScannersViewpointsAreItsRays) {
   const fs::path dir = test::TempDir("lidar_models_viewpoints");
   SimOptions sim = Swept(3);
@@ -256,6 +259,23 @@ TEST(LidarModels, ASweptScannersViewpointsAreItsRays) {
   EXPECT_NEAR(noise.at("range_sigma_m").at("median").get<double>(), 0.02, 0.002) << noise.dump();
   EXPECT_NE(result.at("lidar_model").at("meaning").get<std::string>().find("own ray"),
             std::string::npos);
+
+  // The same scans without their viewpoints: the mirror is estimated from each scan
+  // (core/lidar/swept_origin.h), and the result is the one the given rays give.
+  sim.lidar_viewpoints = false;
+  const Dataset bare = SimulateDataset(sim, dir / "bare");
+  ASSERT_FALSE(LoadCloud(bare.pairs[0].cloud).HasViewpoint());
+  const CalibrationOutcome estimated = CalibrateDataset(bare, PipelineOptions{});
+  ASSERT_TRUE(estimated.solution) << estimated.failure;
+  const PoseError apart =
+      ComputePoseError(estimated.solution->cam_from_lidar, outcome.solution->cam_from_lidar);
+  std::printf("estimated rays: %.3f mm, %.4f deg from the given ones\n", apart.translation_m * 1e3,
+              apart.rotation_rad * kRadToDeg);
+  EXPECT_LT(apart.translation_m, 0.0005);
+  EXPECT_LT(apart.rotation_rad * kRadToDeg, 0.01);
+  const std::string why = estimated.pairs[0].lidar->lidar_model.why;
+  EXPECT_NE(why.find("cm from the stage's axis and"), std::string::npos) << why;
+  EXPECT_NE(why.find("(estimated: the beams' angles"), std::string::npos) << why;
 }
 
 // Seedless = seeded on the swept laser and on board-only segments: the board is found in every

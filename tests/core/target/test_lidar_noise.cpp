@@ -170,7 +170,7 @@ TEST(LidarNoise, GuidanceLearnsTheAngularTermWhereTheBoardsResolveIt) {
       pairs.push_back(std::move(pair));
     }
     std::string why;
-    const auto sensors = LearnSensorGeometry(PinholeCamera(), BoardSpec{},
+    const auto sensors = LearnSensorGeometry(test::PinholeCamera(), BoardSpec{},
                                              MakeBeamTable(LidarModel::kVlp16), pairs, &why);
     ASSERT_TRUE(sensors) << why;
     if (jitter_deg > 0) {
