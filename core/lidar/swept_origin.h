@@ -18,12 +18,12 @@
 namespace calibench {
 
 struct SweptOriginOptions {
-  double search_m = 0.25;        // |ρ_m|, |z_m| searched up to this (metres)
-  double coarse_step_m = 0.01;   // the first grid's step (metres)
-  double fine_step_m = 0.002;    // the refinement's step, over ± 1.5 coarse steps (metres)
-  double coarse_bin_deg = 0.1;   // the direction histogram's bin on the first grid (degrees)
-  double fine_bin_deg = 0.05;    // and on the refinement (degrees)
-  int max_points = 8000;         // returns used (every k-th), for speed
+  double search_m = 0.25;       // |ρ_m|, |z_m| searched up to this (metres)
+  double coarse_step_m = 0.01;  // the first grid's step (metres)
+  double fine_step_m = 0.002;   // the refinement's step, over ± 1.5 coarse steps (metres)
+  double coarse_bin_deg = 0.1;  // the direction histogram's bin on the first grid (degrees)
+  double fine_bin_deg = 0.05;   // and on the refinement (degrees)
+  int max_points = 8000;        // returns used (every k-th), for speed
   // The estimate is used only when the angles are this many times sharper from it than from the
   // origin (Σ n² over the histogram's bins): a fan on a stage, not a scan that happens to be
   // ring-less.

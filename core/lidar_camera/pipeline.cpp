@@ -175,7 +175,8 @@ std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const 
   // estimate from the scan gives each return its ray (never the origin, assumed).
   std::optional<LidarCloud> with_rays;
   if (model.geometry == LidarGeometry::kSwept && !cloud.HasViewpoint()) {
-    if (const std::optional<SweptOrigin> mirror = EstimateSweptOrigin(cloud, options.swept_origin)) {
+    if (const std::optional<SweptOrigin> mirror =
+            EstimateSweptOrigin(cloud, options.swept_origin)) {
       with_rays = cloud;
       with_rays->viewpoint = SweptViewpoints(cloud, *mirror);
       model.why += "; " + DescribeSweptOrigin(*mirror);
