@@ -68,9 +68,10 @@ void IntegrateSweeps(const std::vector<recording_detail::StampedBytes>& sweeps,
     // Viewpoints are kept only when every sweep has them: a ray without its own start would
     // be taken to start at the origin.
     const bool viewpoint = cloud->HasViewpoint() && more.HasViewpoint();
-    if (!viewpoint) cloud->viewpoint.clear();
     if (viewpoint)
       cloud->viewpoint.insert(cloud->viewpoint.end(), more.viewpoint.begin(), more.viewpoint.end());
+    else
+      cloud->viewpoint.clear();
     cloud->points.insert(cloud->points.end(), more.points.begin(), more.points.end());
     if (intensity)
       cloud->intensity.insert(cloud->intensity.end(), more.intensity.begin(), more.intensity.end());

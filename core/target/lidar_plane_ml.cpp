@@ -17,6 +17,11 @@ struct RangeResiduals {
   std::vector<double> ranges;
   std::vector<Vec3> origins;
 
+  // d_k = d + n·o_k: the plane's distance seen from return k's ray origin.
+  double DistanceFrom(const Plane& p, size_t k) const {
+    return origins.empty() ? p.distance : p.distance + p.normal.dot(origins[k]);
+  }
+
   // Gauss-Newton's normal matrix JᵀJ, gradient Jᵀe and Σe² at plane p, over θ = (δ, δ_d) with
   // n ← n + B δ, d ← d + δ_d; *sum_jacobian = Σ ∂e_i/∂θ. Residual e_i = r_i − r̂_i, the ray
   // from o_i meeting the plane at r̂_i = −d_i/(n·u_i), d_i = d + n·o_i (the plane seen from o_i):
@@ -32,7 +37,7 @@ struct RangeResiduals {
     for (size_t k = 0; k < rays.size(); ++k) {
       const double cos_incidence = p.normal.dot(rays[k]);
       if (std::abs(cos_incidence) < 0.02) return false;
-      const double distance = origins.empty() ? p.distance : p.distance + p.normal.dot(origins[k]);
+      const double distance = DistanceFrom(p, k);
       const double e = ranges[k] + distance / cos_incidence;
       Eigen::RowVector3d j;
       j.head<2>() = -distance * rays[k].transpose() * b / (cos_incidence * cos_incidence);
@@ -95,9 +100,7 @@ std::optional<LidarPlaneFit> FitPlaneRangeMl(const LidarCloud& cloud,
     const double cos_incidence = plane.normal.dot(residuals.rays[k]);
     const double r = residuals.ranges[k];
     const double tan2 = (1.0 - cos_incidence * cos_incidence) / (cos_incidence * cos_incidence);
-    const double distance = residuals.origins.empty()
-                                ? plane.distance
-                                : plane.distance + plane.normal.dot(residuals.origins[k]);
+    const double distance = residuals.DistanceFrom(plane, k);
     fit.range_moments.Add(r * r * tan2, r + distance / cos_incidence);
   }
   const double dof = std::max<double>(1.0, static_cast<double>(indices.size()) - 3.0);

@@ -62,35 +62,18 @@ ImageEdgeMap::ImageEdgeMap(int width, int height, int cell_px, std::vector<Image
   ComputeEmptyRings();
 }
 
-// Two passes of the chessboard-distance transform over the cell grid (Rosenfeld and Pfaltz's
-// sequential algorithm): each cell's distance to the nearest cell with an edge.
+// Each cell's chessboard distance to the nearest cell with an edge (OpenCV's exact DIST_C
+// transform over the cell grid), saturated at 255.
 void ImageEdgeMap::ComputeEmptyRings() {
-  constexpr int kFar = 255;
-  empty_rings_.assign(static_cast<size_t>(cells_x_) * cells_y_, kFar);
+  empty_rings_.assign(static_cast<size_t>(cells_x_) * cells_y_, 255);
   if (edges_.empty()) return;
-  auto at = [&](int x, int y) -> std::uint8_t& { return empty_rings_[y * cells_x_ + x]; };
-  for (int y = 0; y < cells_y_; ++y)
-    for (int x = 0; x < cells_x_; ++x) {
-      const int c = y * cells_x_ + x;
-      if (cell_start_[c + 1] > cell_start_[c]) {
-        at(x, y) = 0;
-        continue;
-      }
-      int d = kFar;
-      for (int dx = -1; dx <= 1; ++dx)
-        if (y > 0 && x + dx >= 0 && x + dx < cells_x_) d = std::min(d, at(x + dx, y - 1) + 1);
-      if (x > 0) d = std::min(d, at(x - 1, y) + 1);
-      at(x, y) = static_cast<std::uint8_t>(std::min(d, kFar));
-    }
-  for (int y = cells_y_ - 1; y >= 0; --y)
-    for (int x = cells_x_ - 1; x >= 0; --x) {
-      int d = at(x, y);
-      for (int dx = -1; dx <= 1; ++dx)
-        if (y + 1 < cells_y_ && x + dx >= 0 && x + dx < cells_x_)
-          d = std::min(d, at(x + dx, y + 1) + 1);
-      if (x + 1 < cells_x_) d = std::min(d, at(x + 1, y) + 1);
-      at(x, y) = static_cast<std::uint8_t>(d);
-    }
+  cv::Mat empty(cells_y_, cells_x_, CV_8UC1);  // 0 where a cell holds an edge
+  for (int c = 0; c < cells_x_ * cells_y_; ++c)
+    empty.data[c] = cell_start_[c + 1] > cell_start_[c] ? 0 : 1;
+  cv::Mat distance;
+  cv::distanceTransform(empty, distance, cv::DIST_C, 3);
+  cv::Mat rings(cells_y_, cells_x_, CV_8UC1, empty_rings_.data());
+  distance.convertTo(rings, CV_8U);  // into empty_rings_, saturating
 }
 
 const ImageEdge* ImageEdgeMap::Nearest(const Vec2& pixel, double radius_px) const {
