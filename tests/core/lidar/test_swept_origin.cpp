@@ -22,7 +22,8 @@ LidarCloud SimulatedCloud(LidarModel lidar, const std::string& name, bool viewpo
   sim.lidar_range_noise_m = 0.02;
   sim.lidar_viewpoints = viewpoints;
   sim.seed = 4;
-  return LoadCloud(SimulateDataset(sim, test::TempDir("swept_origin") / name).pairs[1].cloud);
+  // One folder per test: ctest runs the two at once, and TempDir empties the folder it names.
+  return LoadCloud(SimulateDataset(sim, test::TempDir("swept_origin_" + name)).pairs[1].cloud);
 }
 
 TEST(SweptOrigin, TheMirrorIsFoundFromTheScanAlone) {
