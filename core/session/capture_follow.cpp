@@ -16,19 +16,6 @@ namespace calibench {
 namespace {
 namespace fs = std::filesystem;
 
-double SteadySeconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-void Say(const FollowSink& sink, const std::string& event, const std::string& name,
-         const std::string& reason) {
-  FollowEvent e;
-  e.event = event;
-  e.name = name;
-  e.reason = reason;
-  sink(e);
-}
-
 // The capture's camera and target: the folder form's camera.yaml and target.json, or a
 // LiDAR-camera manifest of any name in the folder (core/io/dataset_source.h; its pairs are the
 // files clouds/ and images/ hold as they come). A capture script may write them after starting:
@@ -173,52 +160,39 @@ class Follower {
         feed_(std::move(feed)) {}
 
   void Run() {
-    double last_activity = SteadySeconds();
-    for (;;) {
-      const double now = SteadySeconds();
-      bool added = false;
-      const FeedUpdate update = feed_->Poll(now);
-      // A recording that grows is alive even while no pair comes out of it (its board unknown).
-      // The data came during the look, which may take long (a finished recording read whole, the
-      // presets tried on its images): the silence starts when the look ends.
-      if (update.data_arrived) last_activity = SteadySeconds();
-      for (const std::string& note : update.notes) Say(sink_, "note", "", note);
-      for (const FolderEvent& event : update.events) {
-        last_activity = now;
-        if (event.kind == FolderEvent::Kind::kPairComplete) {
-          // The job starts with the first pair: a recording's camera and board are known then.
-          if (!job_) StartJob();
-          AddPair(event.pair);
-          added = true;
-        } else {
-          Say(sink_, event.kind == FolderEvent::Kind::kIncomplete ? "incomplete" : "removed",
-              event.stem, event.reason);
-        }
-      }
-      if (added) {
-        if (SolveAndReport(now))
-          return Say(sink_, "end", "", "done: the goal is met with a σ that can be trusted");
-        // Idle means no new data: the time the solve took is not the capture's silence (a slow
-        // solve once ended a watch before the next poll could see the pair already there).
-        last_activity = SteadySeconds();
-      }
-      if (update.closed) return Say(sink_, "end", "", "the recording was closed by its recorder");
-      if (request_.idle_exit_s > 0 && SteadySeconds() - last_activity >= request_.idle_exit_s)
+    FeedLoopOptions loop;
+    loop.poll_s = request_.poll_s;
+    loop.idle_exit_s = request_.idle_exit_s;
+    FeedHandlers handlers;
+    handlers.open = [this](Dataset read, double seen_s) {
+      StartJob(std::move(read));
+      return !job_->dataset().pairs.empty() && SolveAndReport(seen_s);
+    };
+    handlers.add = [this](std::vector<PairEntry> pairs, double seen_s) {
+      for (const PairEntry& pair : pairs) AddPair(pair);
+      return SolveAndReport(seen_s);
+    };
+    switch (FollowFeed(*feed_, loop, handlers, sink_)) {
+      case FeedEnd::kDone:
+        return Say(sink_, "end", "", "done: the goal is met with a σ that can be trusted");
+      case FeedEnd::kClosed:
+        return Say(sink_, "end", "", "the recording was closed by its recorder");
+      case FeedEnd::kIdle:
         return Say(
             sink_, "end", "",
             "no new data for " + std::to_string(static_cast<int>(request_.idle_exit_s)) + " s");
-      std::this_thread::sleep_for(std::chrono::duration<double>(request_.poll_s));
+      case FeedEnd::kStopped:
+        return Say(sink_, "end", "", "stopped");
     }
   }
 
  private:
-  // The job over the feed's camera and board, with the user's word from the session there; the
-  // pairs the feed already holds join as new ones.
-  void StartJob() {
-    Dataset setup = *feed_->Setup();
-    std::vector<PairEntry> known = std::move(setup.pairs);
-    setup.pairs.clear();
-    job_.emplace(std::move(setup), options_);
+  // The job over the capture's camera and board, with the user's word from the session there; the
+  // pairs the first look read join as new ones.
+  void StartJob(Dataset read) {
+    std::vector<PairEntry> known = std::move(read.pairs);
+    read.pairs.clear();
+    job_.emplace(std::move(read), options_);
     ResumeSession();
     for (const PairEntry& pair : known) AddPair(pair);
   }

@@ -16,25 +16,11 @@
 #include "core/io/capture_feed.h"
 #include "core/io/folder_watch.h"
 #include "core/session/calibration_job.h"
+#include "core/session/feed_loop.h"
+#include "core/session/follow_event.h"
 #include "core/target/board.h"
 
 namespace calibench {
-
-// One thing the follower says. `event` names it: "waiting" (for the folder's camera and
-// target), "note", "incomplete" / "removed" (a pair's files), "resumed" (pairs from an earlier
-// watch's feature cache), "error" (a cache or session not written), "pair" (a verdict, new or
-// changed: `accepted`, `reason`), "solve" (`advice`, `latency_s` from seeing the pairs to the
-// advice), "end" (why the watch ended).
-struct FollowEvent {
-  std::string event;
-  std::string name;       // the pair or file it is about ("" when none)
-  std::string reason;     // in words
-  bool accepted = false;  // "pair": its verdict and status
-  PairStatus status = PairStatus::kPending;
-  const CaptureAdvice* advice = nullptr;  // "solve" only; valid during the call
-  double latency_s = 0.0;
-};
-using FollowSink = std::function<void(const FollowEvent&)>;
 
 struct CaptureFollowRequest {
   std::string source;              // a folder, a manifest in one, or a recording being written

@@ -193,7 +193,7 @@ class Controller : public ControllerState<Snapshot> {
 
  private:
   // Follows `source` on the watch thread: the feed make_feed gives (null: nothing to follow),
-  // through FollowLoop (the one that ran stops first).
+  // through FollowLoop, `watch`'s loop (core/session/feed_loop.h; the one that ran stops first).
   void Follow(const std::filesystem::path& source,
               std::function<std::unique_ptr<CaptureFeed>()> make_feed);
   // The source as `watch` opens it (OpenCaptureFeed); null, said on the status line, when it

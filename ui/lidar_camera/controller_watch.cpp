@@ -4,17 +4,16 @@
 #include <chrono>
 #include <functional>
 #include <set>
+#include <utility>
+
+#include "core/session/feed_loop.h"
 
 #include "ui/lidar_camera/controller.h"
 
 namespace calibench::ui {
 namespace {
 
-double SteadySeconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-constexpr auto kPollPeriod = std::chrono::milliseconds(200);
+constexpr double kPollPeriod = 0.2;  // between looks [s]
 // How long the first look at a feed lasts at least: longer than a folder's settle time (0.3 s by
 // default) plus a poll, so that every pair there when following started has been reported before
 // the dataset opens (and an earlier watch's session resumes over all of them).
@@ -98,78 +97,54 @@ std::unique_ptr<CaptureFeed> Controller::OpenFeed(const CaptureFollowRequest& re
 }
 
 void Controller::FollowLoop(CaptureFeed* feed) {
-  bool opened = false;
-  std::vector<PairEntry> read_before_open;  // the pairs read until the reader caught up
-  const double first_look_s = SteadySeconds();
-  while (!stop_watch_) {
-    {
-      // The board the user picked goes to the feed before it reads on: only this thread touches
-      // the feed, and a recording closed meanwhile is finished with it.
-      std::lock_guard lock(mutex_);
-      if (picked_board_) {
-        if (!feed->SetBoard(picked_board_->first, picked_board_->second))
-          SetStatus("this capture's board comes from its target.json", true);
-        picked_board_.reset();
-      }
-    }
-    FeedUpdate update;
-    try {
-      update = feed->Poll(SteadySeconds());
-    } catch (const IoError& e) {
-      std::lock_guard lock(mutex_);
-      SetStatus(std::string("cannot watch: ") + e.what(), true);
-      return;
-    }
-    std::vector<PairEntry> pairs;
-    {
-      std::lock_guard lock(mutex_);
-      const std::string problem = feed->BoardProblem();
-      if (problem != state_.board_problem) {
-        state_.board_problem = problem;
-        ++state_.generation;
-      }
-      if (!update.notes.empty()) SetStatus(update.notes.back(), false);
-      for (const FolderEvent& event : update.events)
-        if (event.kind == FolderEvent::Kind::kPairComplete)
-          pairs.push_back(event.pair);
-        else
-          SetStatus(event.stem + ": " + event.reason, true);
-    }
-    // The dataset opens once the first look has caught up with what is there (and the camera and
-    // the board are known: a recording tells them with its first pair): a session an earlier
-    // watch left is resumed over the pairs read again, the ones written since join as new.
-    if (!opened) {
-      read_before_open.insert(read_before_open.end(), pairs.begin(), pairs.end());
-      const bool caught_up =
-          (pairs.empty() && SteadySeconds() - first_look_s >= kFirstLookSeconds) || update.closed;
-      if (!feed->Setup() || !caught_up) {
-        std::this_thread::sleep_for(kPollPeriod);
-        continue;
-      }
-      try {
-        Dataset read = *feed->Setup();
-        read.manifest = feed->DatasetFolder();
-        read.pairs = read_before_open;
-        if (!ResumeGrownCapture(read)) OpenLoadedDataset(read, {}, ExistingSession::kResume);
-      } catch (const IoError& e) {
-        std::lock_guard lock(mutex_);
-        SetStatus(std::string("cannot watch: ") + e.what(), true);
-        return;
-      }
-      opened = true;
-      pairs = std::move(read_before_open);  // those a resumed session did not know join now
-    }
+  // `watch`'s loop (core/session/feed_loop.h); the workbench's handlers add rows, which load and
+  // solve on the worker, and say what happens on the status line.
+  FeedLoopOptions loop;
+  loop.poll_s = kPollPeriod;
+  loop.first_look_s = kFirstLookSeconds;
+  FeedHandlers handlers;
+  handlers.stopped = [this] { return stop_watch_.load(); };
+  handlers.take_picked_board = [this] {
+    std::lock_guard lock(mutex_);
+    return std::exchange(picked_board_, std::nullopt);
+  };
+  handlers.looked = [this](const CaptureFeed& looked, const FeedUpdate&) {
+    const std::string problem = looked.BoardProblem();
+    std::lock_guard lock(mutex_);
+    if (problem == state_.board_problem) return;
+    state_.board_problem = problem;
+    ++state_.generation;
+  };
+  // A session an earlier watch left is resumed over the pairs read again; the ones written since
+  // join as new.
+  handlers.open = [this](Dataset read, double) {
+    std::vector<PairEntry> pairs = read.pairs;
+    if (!ResumeGrownCapture(read)) OpenLoadedDataset(read, {}, ExistingSession::kResume);
+    for (const PairEntry& pair : pairs) AddPair(pair);  // those a resumed session did not know
+    return false;
+  };
+  handlers.add = [this](std::vector<PairEntry> pairs, double) {
     for (const PairEntry& pair : pairs) AddPair(pair);
-    if (update.closed) {
-      std::lock_guard lock(mutex_);
-      SetStatus("the recording was closed by its recorder; its " +
-                    std::to_string(state_.pairs.size()) + " pairs are in " +
-                    feed->DatasetFolder().string(),
-                false);
-      return;
-    }
-    std::this_thread::sleep_for(kPollPeriod);
+    return false;
+  };
+  const FollowSink say = [this](const FollowEvent& event) {
+    std::lock_guard lock(mutex_);
+    if (event.event == "note" || event.event == "board")
+      SetStatus(event.reason, event.event == "board");
+    else
+      SetStatus(event.name + ": " + event.reason, true);  // a pair's files incomplete or removed
+  };
+  try {
+    if (FollowFeed(*feed, loop, handlers, say) != FeedEnd::kClosed) return;
+  } catch (const IoError& e) {  // damaged data, a dataset folder that cannot be opened
+    std::lock_guard lock(mutex_);
+    SetStatus(std::string("cannot watch: ") + e.what(), true);
+    return;
   }
+  std::lock_guard lock(mutex_);
+  SetStatus("the recording was closed by its recorder; its " + std::to_string(state_.pairs.size()) +
+                " pairs are in " + feed->DatasetFolder().string(),
+            false);
 }
 
 template <>
