@@ -47,7 +47,8 @@ enum class FeedEnd { kStopped, kClosed, kIdle, kDone };
 
 // Follows `feed` until one of FeedEnd. Tells `sink` "note" (the feed's notes), "board" (a picked
 // board the feed does not take) and "incomplete" / "removed" (a pair's files); the caller says the
-// end in its own words. Throws what Poll throws (IoError naming the source) and what the handlers throw.
+// end in its own words. Throws what Poll throws (IoError naming the source) and what the handlers
+// throw.
 FeedEnd FollowFeed(CaptureFeed& feed, const FeedLoopOptions& options, const FeedHandlers& handlers,
                    const FollowSink& sink);
 

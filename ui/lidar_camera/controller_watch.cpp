@@ -1,13 +1,11 @@
-// The controller's live side: solving by itself after every change, following a folder that a
-// capture fills (pairs join the list as they land), and after every solve `advise`'s pre-flight
-// findings and next pose (the ghost board), with whether the newest pair matched the ghost.
-#include <chrono>
+// The controller's live side: solving by itself after every change, following a capture while it
+// is written (`watch`'s loop, FollowFeed: pairs join the list as they land), and after every solve
+// `advise`'s pre-flight findings and next pose (the ghost board), with whether the newest pair
+// matched the ghost.
 #include <functional>
-#include <set>
 #include <utility>
 
 #include "core/session/feed_loop.h"
-
 #include "ui/lidar_camera/controller.h"
 
 namespace calibench::ui {

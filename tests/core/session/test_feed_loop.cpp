@@ -75,7 +75,8 @@ struct Followed {
     return handlers;
   }
   FollowSink Sink() {
-    return [this](const FollowEvent& e) { said.push_back(e.event + " " + e.name + ": " + e.reason); };
+    return
+        [this](const FollowEvent& e) { said.push_back(e.event + " " + e.name + ": " + e.reason); };
   }
   static std::vector<std::string> Ids(const std::vector<PairEntry>& pairs) {
     std::vector<std::string> ids;
@@ -94,8 +95,9 @@ FeedLoopOptions Fast(double first_look_s = 0.0, double idle_exit_s = 0.3) {
 
 TEST(FeedLoop, OpensOnceCaughtUpWithEveryPairReadThenAddsEachBatch) {
   // Two looks bring pairs before the capture is caught up; a quiet look opens it with all three.
-  std::deque<FeedUpdate> script = {Complete({"0000", "0001"}), Complete({"0002"}), FeedUpdate{},
-                                   Complete({"0003"}), FeedUpdate{}, Complete({"0004", "0005"})};
+  std::deque<FeedUpdate> script = {
+      Complete({"0000", "0001"}), Complete({"0002"}), FeedUpdate{},
+      Complete({"0003"}),         FeedUpdate{},       Complete({"0004", "0005"})};
   script.back().closed = true;
   ScriptedFeed feed(script, 0);
   Followed followed;
