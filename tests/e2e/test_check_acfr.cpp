@@ -62,11 +62,12 @@ TEST(CheckAcfr, CalibrationConsistentAndMovedCalibrationsCaughtAndCorrected) {
                                                reference_covariance, options);
   ASSERT_TRUE(unmoved.has_estimate);
   std::mt19937_64 rng(48);
-  for (const auto& [deg, m] :
-       {std::pair{1.0, 0.0}, std::pair{0.0, 0.05}, std::pair{0.5, 0.0}, std::pair{0.0, 0.02}}) {
+  // 1° and 5 cm, 8 random directions each (the smaller moves' figures in docs/targetless.md were
+  // measured by hand: a test would assert nothing on them, and each check is seconds).
+  for (const auto& [deg, m] : {std::pair{1.0, 0.0}, std::pair{0.0, 0.05}}) {
     int caught = 0, back = 0, covered = 0;
     double worst_deg = 0.0, worst_mm = 0.0;
-    const int trials = deg >= 1.0 || m >= 0.05 ? 8 : 2;  // 0.5 deg, 2 cm: figures only
+    const int trials = 8;
     for (int trial = 0; trial < trials; ++trial) {
       const Pose moved = PerturbOnCameraAxes(loaded.cam_from_source, RandomMove(deg, m, rng));
       const CheckReport report =
@@ -88,11 +89,9 @@ TEST(CheckAcfr, CalibrationConsistentAndMovedCalibrationsCaughtAndCorrected) {
         "R %d/%d, the unmoved check's estimate within sigma %d/%d (farthest %.3f deg, "
         "%.1f mm)\n",
         deg, 1e3 * m, caught, trials, back, trials, covered, trials, worst_deg, worst_mm);
-    if (deg >= 1.0 || m >= 0.05) {
-      EXPECT_GE(caught, 7) << deg << " deg, " << m << " m";
-      EXPECT_GE(back, 7);
-      EXPECT_GE(covered, 7);
-    }
+    EXPECT_GE(caught, 7) << deg << " deg, " << m << " m";
+    EXPECT_GE(back, 7);
+    EXPECT_GE(covered, 7);
   }
 }
 
