@@ -65,19 +65,13 @@ if [ $mode = ci ]; then
   # Only the subset's 7 test files (test_sanitize_ci, tests/CMakeLists.txt), not all 58, and no
   # `calibench`: none of the subset runs the command line.
   targets=(--target test_sanitize_ci)
-  # The numeric libraries uninstrumented (core/CMakeLists.txt): the solvers, guidance, the
-  # simulator, the targetless check, the sweeps. The subset's findings come from the loaders, the
-  # session, the job's bookkeeping and the controller; the whole-suite run covers the rest.
-  skip="lidar_camera;guidance;lrf;targetless;sim;evaluation"
   labels=(-L sanitize_ci -R "$CI_SUBSET" -E "$CI_SLOW")
 fi
 subset=OFF
 [ $mode = ci ] && subset=ON
-skip=${skip:-}
 # Unity builds, as bootstrap.sh's: CI's time budget (the default, file-by-file build is where a
 # missing include shows).
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=$build_type -DCALIBENCH_UNITY_BUILD=ON -DCALIBENCH_SANITIZE_CI_SUBSET=$subset \
-  -DCALIBENCH_SANITIZE_SKIP="$skip" \
   -DCMAKE_CXX_FLAGS_CALIBENCHSANITIZECI="-O1" -DCALIBENCH_SANITIZE_DEBUG=$debug \
   -DCALIBENCH_SANITIZE=address,undefined -DCALIBENCH_BUILD_BENCHMARKS=OFF \
   -DCALIBENCH_BUILD_PYTHON=OFF >/dev/null  # an instrumented module would need ASan preloaded into python3
