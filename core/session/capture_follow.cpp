@@ -160,9 +160,6 @@ class Follower {
         feed_(std::move(feed)) {}
 
   void Run() {
-    FeedLoopOptions loop;
-    loop.poll_s = request_.poll_s;
-    loop.idle_exit_s = request_.idle_exit_s;
     FeedHandlers handlers;
     handlers.open = [this](Dataset read, double seen_s) {
       StartJob(std::move(read));
@@ -172,7 +169,7 @@ class Follower {
       for (const PairEntry& pair : pairs) AddPair(pair);
       return SolveAndReport(seen_s);
     };
-    switch (FollowFeed(*feed_, loop, handlers, sink_)) {
+    switch (FollowFeed(*feed_, request_.Loop(), handlers, sink_)) {
       case FeedEnd::kDone:
         return Say(sink_, "end", "", "done: the goal is met with a σ that can be trusted");
       case FeedEnd::kClosed:
@@ -292,11 +289,15 @@ class Follower {
 
 }  // namespace
 
+FeedLoopOptions CaptureFollowRequest::Loop() const {
+  FeedLoopOptions loop;
+  loop.poll_s = poll_s;
+  loop.idle_exit_s = idle_exit_s;
+  return loop;
+}
+
 bool CaptureFollowRequest::Check(std::string* why) const {
-  if (!folder.Check(why)) return false;
-  if (!(idle_exit_s >= 0)) return *why = "--idle-exit must be >= 0 (seconds)", false;
-  if (!(poll_s > 0)) return *why = "the poll period must be > 0 (seconds)", false;
-  return true;
+  return folder.Check(why) && Loop().Check(why);
 }
 
 std::optional<OpenedFeed> OpenCaptureFeed(CaptureFollowRequest request, const FollowSink& sink,

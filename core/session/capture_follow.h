@@ -32,6 +32,7 @@ struct CaptureFollowRequest {
   bool exit_when_done = false;     // end when the stop rule says done
   double idle_exit_s = 0.0;        // end after this long without new data [s] (0 = never)
   double poll_s = 0.1;             // between looks [s]
+  FeedLoopOptions Loop() const;    // the loop's share of the above
   bool Check(std::string* why) const;
 };
 

@@ -19,15 +19,6 @@ bool FeedLoopOptions::Check(std::string* why) const {
   return true;
 }
 
-void Say(const FollowSink& sink, const std::string& event, const std::string& name,
-         const std::string& reason) {
-  FollowEvent e;
-  e.event = event;
-  e.name = name;
-  e.reason = reason;
-  sink(e);
-}
-
 namespace {
 
 // The pairs a look completed, in capture order; the other events told to the sink.

@@ -29,8 +29,14 @@ struct FollowEvent {
 };
 using FollowSink = std::function<void(const FollowEvent&)>;
 
-// Tells `sink` an event that carries only words (core/session/feed_loop.cpp).
-void Say(const FollowSink& sink, const std::string& event, const std::string& name,
-         const std::string& reason);
+// Tells `sink` an event that carries only words.
+inline void Say(const FollowSink& sink, const std::string& event, const std::string& name,
+                const std::string& reason) {
+  FollowEvent e;
+  e.event = event;
+  e.name = name;
+  e.reason = reason;
+  sink(e);
+}
 
 }  // namespace calibench
