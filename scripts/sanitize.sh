@@ -53,7 +53,7 @@ debug=-g
 targets=()
 labels=()
 # The --ci subset, by gtest suite (docs/manual.md "Fuzzing and sanitizers" names it).
-CI_SUBSET='^(Controller|CalibrationJob|SessionTest|RealBags|BagFormats|LidarPlane|FeatureCache)\.'
+CI_SUBSET='^(Controller|CalibrationJob|SessionTest|RealBags|BagFormats|LidarPlane|FeatureCache|FeedLoop)\.'
 # Left out of the subset: the job fed three ways over one dataset (three whole calibrations, 78 s
 # under ASan, a sixth of the stage); each way runs under ASan in the job's other tests.
 CI_SLOW='^CalibrationJob\.FedAllAtOncePairByPairOrStepByStepItEndsWhereCalibrateEnds$'
@@ -62,7 +62,7 @@ if [ $mode = ci ]; then
   # names the lines.
   build_type=CalibenchSanitizeCi
   debug=-g1
-  # Only the subset's 7 test files (test_sanitize_ci, tests/CMakeLists.txt), not all 58, and no
+  # Only the subset's 8 test files (test_sanitize_ci, tests/CMakeLists.txt), not all 58, and no
   # `calibench`: none of the subset runs the command line.
   targets=(--target test_sanitize_ci)
   labels=(-L sanitize_ci -R "$CI_SUBSET" -E "$CI_SLOW")
