@@ -24,17 +24,55 @@ CalibrationJob::CalibrationJob(Dataset dataset, CalibrationJobOptions options, P
     pair.detected.id = entry.id;
     pairs_.push_back(std::move(pair));
   }
-  for (auto& [id, edit] : edits) {
-    SetRejected(id, edit.rejected);
-    if (edit.brush_pixels) SetBrush(id, edit);
+  // The record: a new session over the pairs, with the options' settings and the edits given.
+  Session session = NewSession(dataset_);
+  const PipelineOptions& pipeline = options_.advise.pipeline;
+  session.method = pipeline.solver.method;
+  session.huber_delta = pipeline.solver.huber_delta;
+  session.estimate_range_offset = pipeline.solver.estimate_range_offset;
+  session.max_iterations = pipeline.solver.max_iterations;
+  session.ransac_threshold_m = pipeline.lidar_plane.ransac_threshold_m;
+  for (const auto& [id, edit] : edits) SetEdit(&session, id, edit);
+  record_.Reset(std::move(session));
+}
+
+void CalibrationJob::SetEdit(Session* session, const std::string& pair_id, const PairEdit& edit) {
+  PairState* pair = nullptr;
+  for (PairState& state : session->pairs)
+    if (state.id == pair_id) pair = &state;
+  if (!pair) {  // a pair that has not arrived yet takes its edit when it does
+    session->pairs.emplace_back();
+    pair = &session->pairs.back();
+    pair->id = pair_id;
+  }
+  if (edit.rejected) {
+    pair->status = PairStatus::kRejected;
+    if (pair->reason.empty()) pair->reason = kRejectedByUser;
+  }
+  if (edit.brush_pixels) {
+    pair->brush = BrushMask{edit.brush_rows, edit.brush_columns, *edit.brush_pixels};
+    pair->brush_from_seed = false;
   }
 }
 
 PairEdit CalibrationJob::EditOf(const std::string& pair_id) const {
-  const auto found = brushes_.find(pair_id);
-  PairEdit edit = found == brushes_.end() ? PairEdit{} : found->second;
-  edit.rejected = rejections_.count(pair_id) > 0;
-  return edit;
+  return record_.EditOf(pair_id);
+}
+
+PipelineOptions CalibrationJob::Pipeline() const {
+  PipelineOptions pipeline = options_.advise.pipeline;
+  record_.ApplyOptions(&pipeline);
+  return pipeline;
+}
+
+CalibrationJobOptions CalibrationJob::options() const {
+  CalibrationJobOptions options = options_;
+  options.advise.pipeline = Pipeline();
+  return options;
+}
+
+bool CalibrationJob::HasBrush(const std::string& pair_id) const {
+  return EditOf(pair_id).brush_pixels.has_value();
 }
 
 void CalibrationJob::Restatus(JobPair* pair) const {
@@ -48,8 +86,10 @@ void CalibrationJob::DetectAll() {
   // why there is no background model once all clouds are read: none when it was built, or when no
   // pair needed detection (seeds, brushes).
   background_note_.clear();
+  PairEdits brushes = record_.Edits();
+  for (auto& [id, edit] : brushes) edit.rejected = false;
   std::vector<PairFeatures> features = ExtractDatasetPairs(
-      dataset_, entries, options_.advise.pipeline, events_.detected, brushes_, &background_note_);
+      dataset_, entries, Pipeline(), events_.detected, brushes, &background_note_);
   for (size_t i = 0; i < features.size(); ++i) {
     pairs_[i].detected = std::move(features[i]);
     pairs_[i].lidar_failure = pairs_[i].camera_failure = pairs_[i].detected.reason;
@@ -79,7 +119,7 @@ const PairFeatures& CalibrationJob::AddPair(const PairEntry& entry, const PairFe
   // The cloud is read once: for the background model (as DetectAll reads every cloud first) and
   // then for the pair itself.
   std::optional<LidarCloud> cloud;
-  const PipelineOptions& pipeline = options_.advise.pipeline;
+  const PipelineOptions pipeline = Pipeline();
   if (pipeline.detect_board && pipeline.background_model &&
       background_accumulator_.clouds() < options_.max_background_clouds) {
     try {
@@ -104,6 +144,7 @@ const PairFeatures& CalibrationJob::AddPair(const PairEntry& entry, const PairFe
 
 int CalibrationJob::AppendPair(const PairEntry& entry) {
   dataset_.pairs.push_back(entry);
+  record_.AddPair(entry.id);
   JobPair pair;
   pair.detected.id = entry.id;
   pairs_.push_back(std::move(pair));
@@ -137,7 +178,7 @@ const PairFeatures& CalibrationJob::DetectLidar(int index, const LidarCloud& clo
   std::optional<LidarPlaneFit> fit;
   if (std::optional<BoardHint> hint = BoardHintFor(entry, EditOf(entry.id), image, &why)) {
     hint->background = Background();
-    fit = ExtractLidarFeatures(dataset_, cloud, *hint, options_.advise.pipeline, &why, &origin);
+    fit = ExtractLidarFeatures(dataset_, cloud, *hint, Pipeline(), &why, &origin);
   }
   pair.detected.lidar = std::move(fit);
   pair.detected.board_origin = origin;
@@ -147,37 +188,53 @@ const PairFeatures& CalibrationJob::DetectLidar(int index, const LidarCloud& clo
 }
 
 void CalibrationJob::SetBrush(const std::string& pair_id, std::optional<PairEdit> brush) {
-  if (!brush || !brush->brush_pixels) {
-    brushes_.erase(pair_id);
-    return;
-  }
-  brush->rejected = false;
-  brushes_[pair_id] = std::move(*brush);
+  record_.Edit([&](Session* session) {
+    if (brush && brush->brush_pixels) {
+      brush->rejected = false;
+      SetEdit(session, pair_id, *brush);
+      return;
+    }
+    for (PairState& pair : session->pairs) {
+      if (pair.id != pair_id) continue;
+      pair.brush.reset();
+      pair.brush_from_seed = false;
+    }
+  });
 }
 
 void CalibrationJob::SetRejected(const std::string& pair_id, bool rejected,
                                  const std::string& reason) {
-  if (rejected)
-    rejections_[pair_id] = reason.empty() ? kRejectedByUser : reason;
-  else
-    rejections_.erase(pair_id);
+  record_.Edit([&](Session* session) {
+    if (rejected) {
+      PairEdit rejection;
+      rejection.rejected = true;
+      SetEdit(session, pair_id, rejection);
+      for (PairState& pair : session->pairs)
+        if (pair.id == pair_id) pair.reason = reason.empty() ? kRejectedByUser : reason;
+      return;
+    }
+    // Taken back: the pair's status follows from its planes again.
+    for (PairState& pair : session->pairs) {
+      if (pair.id != pair_id || pair.status != PairStatus::kRejected) continue;
+      pair.status = PairStatus::kPending;
+      pair.reason.clear();
+    }
+  });
 }
 
 void CalibrationJob::Resume(const Session& session) {
-  ApplySessionOptions(session, &options_.advise.pipeline);
-  // What is the user's word, as `calibrate --session` reads it; the reasons are the session's.
-  const PairEdits edits = EditsFromSession(session);
-  for (const PairState& pair : session.pairs) {
-    const auto edit = edits.find(pair.id);
-    const bool edited = edit != edits.end();
-    SetRejected(pair.id, edited && edit->second.rejected, pair.reason);
-    SetBrush(pair.id, edited ? std::optional(edit->second) : std::nullopt);
-  }
-  view_json_ = session.view_json;
+  record_.Reset(session);
+  for (const PairEntry& pair : dataset_.pairs) record_.AddPair(pair.id);
 }
 
 void CalibrationJob::SetSolverOptions(const SolverOptions& solver) {
   options_.advise.pipeline.solver = solver;
+  record_.Edit([&](Session* session) {
+    session->method = solver.method;
+    session->huber_delta = solver.huber_delta;
+    session->max_iterations = solver.max_iterations;
+    session->estimate_range_offset = solver.estimate_range_offset;
+  });
 }
 
 void CalibrationJob::SetGoal(const CaptureGoal& goal) { options_.advise.goal = goal; }
@@ -191,23 +248,22 @@ std::vector<PairFeatures> CalibrationJob::DetectedPairs() const {
   std::vector<PairFeatures> features;
   for (const JobPair& pair : pairs_) {
     features.push_back(pair.detected);
-    const auto rejected = rejections_.find(pair.detected.id);
-    if (rejected == rejections_.end()) continue;
+    std::string reason;
+    if (!record_.Rejected(pair.detected.id, &reason)) continue;
     features.back().status = PairStatus::kRejected;
-    features.back().reason = rejected->second;
+    features.back().reason = reason;
   }
   return features;
 }
 
 const CalibrationOutcome& CalibrationJob::Solve() {
-  PipelineOptions pipeline = options_.advise.pipeline;
+  PipelineOptions pipeline = Pipeline();
   // Warm start: the last solution is a better start than the closed form, and the same minimum.
   if (options_.warm_start && last_solution_ && !pipeline.initial_cam_from_lidar)
     pipeline.initial_cam_from_lidar = last_solution_->cam_from_lidar;
   std::vector<const PairEntry*> entries;
   for (const PairEntry& pair : dataset_.pairs) entries.push_back(&pair);
-  PairEdits edits = brushes_;
-  for (const auto& [id, reason] : rejections_) edits[id].rejected = true;
+  const PairEdits edits = record_.Edits();
   // Every solve starts from what detection found, as `calibrate` does: a board completion
   // rescued is rescued again, one the camera disagrees with is looked at again.
   outcome_ =
@@ -226,19 +282,23 @@ const CaptureAdvice& CalibrationJob::Advise(const std::optional<SolverResult>& a
   // The pairs of that solve: those appended since are judged after the next one.
   Dataset solved = dataset_;
   solved.pairs.resize(outcome.pairs.size());
-  advice_ = AdviseCapture(solved, outcome, options_.advise);
+  AdviseOptions options = options_.advise;
+  options.pipeline = Pipeline();
+  advice_ = AdviseCapture(solved, outcome, options);
   return *advice_;
 }
 
 Session CalibrationJob::ToSession(const std::filesystem::path& dataset_path) const {
+  // The record's settings and views over the job's pairs, with the verdicts of the last solve.
+  const Session record = record_.Current();
   Session session = NewSession(dataset_);
   session.dataset = NormalizeSessionPath(dataset_path);
-  const PipelineOptions& pipeline = options_.advise.pipeline;
-  session.method = pipeline.solver.method;
-  session.huber_delta = pipeline.solver.huber_delta;
-  session.estimate_range_offset = pipeline.solver.estimate_range_offset;
-  session.max_iterations = pipeline.solver.max_iterations;
-  session.ransac_threshold_m = pipeline.lidar_plane.ransac_threshold_m;
+  session.method = record.method;
+  session.huber_delta = record.huber_delta;
+  session.estimate_range_offset = record.estimate_range_offset;
+  session.max_iterations = record.max_iterations;
+  session.ransac_threshold_m = record.ransac_threshold_m;
+  session.view_json = record.view_json;
   // NewSession's pairs, pairs_, the outcome's and the advice's pairs all follow dataset_.pairs.
   const std::vector<PairFeatures> detected = DetectedPairs();
   for (size_t i = 0; i < session.pairs.size(); ++i) {
@@ -247,12 +307,11 @@ Session CalibrationJob::ToSession(const std::filesystem::path& dataset_path) con
     const bool judged = advice_ && i < advice_->pairs.size();
     session.pairs[i].status = judged ? advice_->pairs[i].status : last->status;
     session.pairs[i].reason = judged ? advice_->pairs[i].reason : last->reason;
-    const auto brush = brushes_.find(session.pairs[i].id);
-    if (brush != brushes_.end())
-      session.pairs[i].brush = BrushMask{brush->second.brush_rows, brush->second.brush_columns,
-                                         *brush->second.brush_pixels};
+    // The user's painted brushes; none pictured from a seed (`calibrate` reads the seed itself).
+    for (const PairState& saved : record.pairs)
+      if (saved.id == session.pairs[i].id && saved.brush && !saved.brush_from_seed)
+        session.pairs[i].brush = saved.brush;
   }
-  session.view_json = view_json_;
   const std::optional<SolverResult>& solution = advice_ ? advice_->solution : last_solution_;
   if (solution) session.result = SessionResultFromSolver(*solution);
   return session;

@@ -8,7 +8,11 @@
 // arrive: all at once (DetectAll: `calibrate`, `advise`), one at a time as a capture grows
 // (AddPair: `watch`), or step by step from files a window already decoded for its views
 // (ReadPair / AddToBackground / DetectLidar: the workbench). Progress and each solver
-// iteration are reported as events. Not thread-safe: one thread drives a job.
+// iteration are reported as events.
+// The user's word lives in one place, the job's SessionRecord (session_record.h): the session as
+// its file keeps it, with undo and autosave. The job reads it at every detection and solve; a
+// front end may edit it from any thread (it locks). Everything else in the job is driven by one
+// thread.
 #pragma once
 
 #include <filesystem>
@@ -20,6 +24,7 @@
 
 #include "core/guidance/advise.h"
 #include "core/session/session.h"
+#include "core/session/session_record.h"
 #include "core/target/scene_background.h"
 
 namespace calibench {
@@ -45,7 +50,8 @@ class CalibrationJob {
  public:
   // `dataset`: the camera, the target and the pairs known so far (options.advise.pipeline.pair_ids
   // selects among them), none detected yet. `edits`: the user's brushes and rejections by pair id
-  // (a session's, EditsFromSession).
+  // (a session's, EditsFromSession). The record starts as a new session over those pairs with
+  // the options' solver settings and these edits.
   CalibrationJob(Dataset dataset, CalibrationJobOptions options, PairEdits edits = {},
                  JobEvents events = {});
 
@@ -73,17 +79,20 @@ class CalibrationJob {
   const PairFeatures& DetectLidar(int index, const LidarCloud& cloud, const LidarImage* image,
                                   bool use_seed = true);
 
-  // The user's word. A brush applies at the pair's next detection; a rejection (with the reason
-  // shown for it) at the next solve.
+  // The user's word, each an undo step in the record. A brush applies at the pair's next
+  // detection; a rejection (with the reason shown for it) at the next solve.
   void SetBrush(const std::string& pair_id, std::optional<PairEdit> brush);
   void SetRejected(const std::string& pair_id, bool rejected, const std::string& reason = "");
-  // A saved session's word (the workbench's, an earlier watch's): its brushes, rejections (with
-  // their reasons) and solver settings, by pair id (pairs that have not arrived yet take theirs
-  // when they do), and what its views showed, carried into ToSession. Call before detection.
+  // A saved session (the workbench's, an earlier watch's) becomes the record: its brushes,
+  // rejections (with their reasons) and solver settings, by pair id (pairs that have not arrived
+  // yet take theirs when they do), and what its views showed, carried into ToSession. Call before
+  // detection.
   void Resume(const Session& session);
   // Whether the user painted pair `pair_id`'s board: its features must come from the brush, not
   // from a detection cached without it.
-  bool HasBrush(const std::string& pair_id) const { return brushes_.count(pair_id) > 0; }
+  bool HasBrush(const std::string& pair_id) const;
+  // The solver's options; the four a session keeps (method, Huber threshold, iterations, range
+  // offset) go into the record, as an undo step.
   void SetSolverOptions(const SolverOptions& solver);
   void SetGoal(const CaptureGoal& goal);
   // How precisely the person holds a suggested pose (GuidanceOptions::hand_tolerance_*).
@@ -103,7 +112,11 @@ class CalibrationJob {
   std::vector<PairFeatures> DetectedPairs() const;
   const std::optional<CalibrationOutcome>& outcome() const { return outcome_; }
   const std::optional<CaptureAdvice>& advice() const { return advice_; }
-  const CalibrationJobOptions& options() const { return options_; }
+  // The job's options with the record's solver and RANSAC settings: what the next step runs with.
+  CalibrationJobOptions options() const;
+  // The session's one record: the user's word, the settings, undo and autosave (any thread).
+  SessionRecord& record() { return record_; }
+  const SessionRecord& record() const { return record_; }
   bool background_usable() const { return background_.has_value(); }
   int background_clouds() const { return background_accumulator_.clouds(); }
   // Why no background model is used (yet): fewer than 3 clouds, or the scene does not repeat.
@@ -123,13 +136,14 @@ class CalibrationJob {
   };
   void Restatus(JobPair* pair) const;  // status and reason from the planes and the rejection
   PairEdit EditOf(const std::string& pair_id) const;
+  // `edit` into pair `pair_id`'s state (added when the session has no such pair yet).
+  static void SetEdit(Session* session, const std::string& pair_id, const PairEdit& edit);
+  PipelineOptions Pipeline() const;  // options_'s with the record's settings
   const SceneBackground* Background() const { return background_ ? &*background_ : nullptr; }
 
   Dataset dataset_;
   CalibrationJobOptions options_;
-  PairEdits brushes_;
-  std::map<std::string, std::string> rejections_;  // the user's, by pair id: the reason shown
-  std::string view_json_ = "{}";                   // a resumed session's views (Session::view_json)
+  SessionRecord record_;  // a copied job's record has no autosave file (SessionRecord's copy)
   JobEvents events_;
   std::vector<JobPair> pairs_;
   SceneBackground background_accumulator_;

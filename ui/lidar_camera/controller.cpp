@@ -128,11 +128,10 @@ void Controller::Solve() {
     state_.solver.running = true;
     ++state_.generation;
   }
-  SyncJobDecisions();
   // The job's solve from what detection found: the CLI's steps after extraction (solve,
   // camera-guided completion, the intrinsics' σ), watched iteration by iteration (its events).
   CalibrationOutcome outcome = job_->Solve();
-  const PipelineOptions& options = job_->options().advise.pipeline;
+  const PipelineOptions options = job_->options().advise.pipeline;
   std::lock_guard lock(mutex_);
   state_.solver.running = false;
   // Pairs added meanwhile (a watched folder) are not in this solve; the next one has them.

@@ -211,9 +211,6 @@ class Controller : public ControllerState<Snapshot> {
   void Advise(const std::optional<SolverResult>& at = std::nullopt);
   // The same for a reopened session's result, over the pairs as detected again (worker).
   void AdviseFromState();
-  // The user's rejections, brushes and solver settings into the job, from the session as
-  // CommitEdit left it: the job resumes it as `watch` resumes the file (worker).
-  void SyncJobDecisions();
   void LoadPair(int index);
   // After the last pair loaded (mutex_ held): detection, the status line with what loading
   // noted or refused, the reopened session's reprojection.
@@ -251,8 +248,8 @@ class Controller : public ControllerState<Snapshot> {
   // The meter from the current result and goal; `record` adds the point to the history (a solve).
   // Call with mutex_ held.
   void JudgeMeter(bool record);
-  // session <- state, history + autosave; call with mutex_ held. Within an open brush stroke the
-  // history's last step is amended, so that one stroke is one undo step.
+  // The job's session record <- state, an undo step, autosave; call with mutex_ held. Within an
+  // open brush stroke the last step is amended, so that one stroke is one undo step.
   void CommitEdit();
   void ApplySessionToState(const Session& session);  // call with mutex_ held
   // Rig (controller_rig.cpp), with mutex_ held unless said: the rig view with camera `active`
@@ -285,15 +282,14 @@ class Controller : public ControllerState<Snapshot> {
   void Paint(int index, const std::vector<int>& pixels, bool erase);
   void Restore(const std::optional<Session>& restored);  // undo / redo
 
-  Session session_;  // the editable state as saved; state_ mirrors it plus derived data
-  SessionHistory history_;
-  std::unique_ptr<Autosaver> autosaver_;
   std::optional<FileLock> session_lock_;  // held while session_path is open for editing
   PipelineOptions pipeline_;
   std::string open_note_;  // how the session was opened, for the status line once loaded (mutex_)
   std::vector<std::string> load_warnings_;  // what loading refused, for the status line (mutex_)
   // The pipeline job (core/session/calibration_job.h) over the opened dataset: detection with
-  // the background, the solve, guidance. Worker thread only; made anew by Open.
+  // the background, the solve, guidance, and the session's one record (the user's word, undo,
+  // autosave), which state_ mirrors for the panels. Its steps run on the worker; its record is
+  // edited under mutex_ (it locks itself too). Made anew by Open, after WaitIdle.
   std::optional<CalibrationJob> job_;
   bool stroke_open_ = false;          // BrushStroke / PaintPoints dabs since the last EndStroke
   bool auto_solve_ = false;           // mutex_

@@ -123,9 +123,10 @@ void Controller::LoadPair(int index) {
     std::lock_guard lock(mutex_);
     dataset = *state_.dataset;
     saved_brush = state_.pairs[index].brush_pixels;
-    const PairState& saved = session_.pairs[index];
-    painted = saved.brush.has_value() && !saved.brush_from_seed;
-    saved_mask = saved.brush;
+    if (const std::optional<PairState> saved = job_->record().Pair(state_.pairs[index].id)) {
+      painted = saved->brush.has_value() && !saved->brush_from_seed;
+      saved_mask = saved->brush;
+    }
   }
   const PairEntry& entry = dataset.pairs[index];
   // The job knows the pairs in the order they load (a followed capture's arrive one by one).
@@ -177,8 +178,13 @@ void Controller::LoadPair(int index) {
     ++state_.generation;
     OnLivePairLoaded(index);  // a followed capture: follow it, match it against the ghost
     if (!brush_dropped.empty()) {
-      session_.pairs[index].brush.reset();
-      session_.pairs[index].brush_from_seed = false;
+      job_->record().Adjust([&id = pair.id](Session* session) {
+        for (PairState& saved : session->pairs) {
+          if (saved.id != id) continue;
+          saved.brush.reset();
+          saved.brush_from_seed = false;
+        }
+      });
       load_warnings_.push_back(brush_dropped);
       SetStatus(brush_dropped, true);
     }
@@ -251,23 +257,18 @@ void Controller::RefitLidar(int index) {
   std::shared_ptr<const LidarImage> image;
   std::vector<int> brush;
   bool brush_from_seed = false;
-  bool brush_edited = false;
-  std::string id;
   {
     std::lock_guard lock(mutex_);
     cloud = state_.pairs[index].cloud;
     image = state_.pairs[index].lidar_image;
     brush = state_.pairs[index].brush_pixels;
     brush_from_seed = state_.pairs[index].brush_from_seed;
-    brush_edited = state_.pairs[index].brush_edited;
-    id = state_.pairs[index].id;
   }
   if (!cloud || !image) return;
   // The same choice of region as `calibench calibrate` (the job's BoardHintFor): once painted
-  // (or erased), the brush; else the seed while the brush only pictures it ("detect again"
-  // forgot it); else detection.
-  job_->SetBrush(id, brush_edited ? std::optional(PairEdit{brush, image->rows, image->columns})
-                                  : std::nullopt);
+  // (or erased), the brush, which CommitEdit put in the job's record before this refit was
+  // queued; else the seed while the brush only pictures it ("detect again" forgot it); else
+  // detection.
   const PairFeatures features = job_->DetectLidar(index, *cloud, image.get(), brush_from_seed);
   std::lock_guard lock(mutex_);
   PairView& pair = state_.pairs[index];

@@ -75,7 +75,7 @@ void Controller::StartRigSolve() {
   const std::filesystem::path path = state_.rig->path;
   const std::string active = state_.rig->cameras[state_.rig->active].name;
   RigEdits edits;
-  edits[active] = EditsFromSession(session_);
+  if (job_) edits[active] = job_->record().Edits();
   const PipelineOptions options = PipelineOptionsFromState();
   rig_thread_ = std::thread([this, path, active, edits, options]() mutable {
     std::optional<RigOutcome> outcome;

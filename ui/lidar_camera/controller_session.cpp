@@ -181,10 +181,10 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
                     dataset.missing_target_file.string() +
                     ": no board to find in these pairs (the targetless check needs none: "
                     "Targetless check... in the solver panel)";
-    session_ = std::move(session);
-    ApplySessionToState(session_);
     // The pipeline job over the dataset's pairs as they load (LoadPair appends them), with the
-    // session's options; every solver iteration shows as it happens.
+    // session's options and the session as its record; every solver iteration shows as it
+    // happens.
+    ApplySessionOptions(session, &pipeline_);
     CalibrationJobOptions job_options;
     job_options.advise.pipeline = pipeline_;
     job_options.advise.pipeline.pair_ids.clear();  // the workbench shows every pair
@@ -196,8 +196,9 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
                    state_.solver.iterations.push_back(it);
                    ++state_.generation;
                  }});
-    history_.Reset(session_);
-    autosaver_ = session_path.empty() ? nullptr : std::make_unique<Autosaver>(session_path);
+    job_->Resume(session);
+    job_->record().AutosaveTo(session_path);
+    ApplySessionToState(session);
     if (rig && !SetUpRig(*rig, rig_camera)) StartRigSolve();
     SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
                   dataset.manifest.string(),
@@ -259,24 +260,28 @@ void Controller::ApplySessionToState(const Session& session) {
       if (k >= 0 && k < static_cast<int>(state_.solver.iterations.size()))
         state_.solver.iterations[k].reweighted = true;
   }
-  state_.can_undo = history_.CanUndo();
-  state_.can_redo = history_.CanRedo();
+  state_.can_undo = job_ && job_->record().CanUndo();
+  state_.can_redo = job_ && job_->record().CanRedo();
   ++state_.generation;
 }
 
 void Controller::CommitEdit() {
   mutex_.AssertHeld(__func__);
+  if (!job_) return;  // nothing open
   const bool had_selected =
       state_.selected >= 0 && state_.selected < static_cast<int>(state_.pairs.size());
   state_.view.selected_pair = had_selected ? state_.pairs[state_.selected].id : "";
-  session_.view_json = ViewToJson(state_.view);
-  session_.method = state_.method;
-  session_.huber_delta = state_.huber_delta;
-  session_.max_iterations = state_.max_iterations;
-  session_.estimate_range_offset = state_.estimate_range_offset;
-  session_.ransac_threshold_m = pipeline_.lidar_plane.ransac_threshold_m;  // what detection used
-  for (size_t i = 0; i < state_.pairs.size(); ++i) {
-    PairState& p = session_.pairs[i];
+  Session session = job_->record().Current();
+  session.view_json = ViewToJson(state_.view);
+  session.method = state_.method;
+  session.huber_delta = state_.huber_delta;
+  session.max_iterations = state_.max_iterations;
+  session.estimate_range_offset = state_.estimate_range_offset;
+  session.ransac_threshold_m = pipeline_.lidar_plane.ransac_threshold_m;  // what detection used
+  // The record holds every pair state_ shows, in the same order (Open resumed it over the
+  // dataset; AddPair adds each pair that joins to both).
+  for (size_t i = 0; i < state_.pairs.size() && i < session.pairs.size(); ++i) {
+    PairState& p = session.pairs[i];
     const PairView& v = state_.pairs[i];
     p.status = v.status;
     p.reason = v.reason;
@@ -291,23 +296,20 @@ void Controller::CommitEdit() {
       p.brush_from_seed = false;
     }
   }
-  session_.result.reset();
+  session.result.reset();
   if (state_.solver.result) {
-    session_.result = SessionResultFromSolver(*state_.solver.result);
-    session_.result->notes = state_.solver.notes;
-    session_.result->targetless_provenance = state_.solver.targetless_provenance;
+    session.result = SessionResultFromSolver(*state_.solver.result);
+    session.result->notes = state_.solver.notes;
+    session.result->targetless_provenance = state_.solver.targetless_provenance;
     for (const IterationReport& it : state_.solver.iterations) {
-      session_.result->step_history.push_back(it.step_norm);
-      session_.result->estimate_history.push_back(it.cam_from_lidar);
-      if (it.reweighted) session_.result->reweighted_iterations.push_back(it.iteration);
+      session.result->step_history.push_back(it.step_norm);
+      session.result->estimate_history.push_back(it.cam_from_lidar);
+      if (it.reweighted) session.result->reweighted_iterations.push_back(it.iteration);
     }
   }
-  if (stroke_open_)
-    history_.Amend(session_);
-  else
-    history_.Push(session_);
-  state_.can_undo = history_.CanUndo();
-  state_.can_redo = history_.CanRedo();
+  job_->record().Commit(std::move(session), /*amend=*/stroke_open_);
+  state_.can_undo = job_->record().CanUndo();
+  state_.can_redo = job_->record().CanRedo();
   Autosave();
   ++state_.generation;
 }
@@ -315,7 +317,7 @@ void Controller::CommitEdit() {
 void Controller::Autosave() {
   mutex_.AssertHeld(__func__);
   try {
-    if (autosaver_) autosaver_->Save(session_);
+    if (job_) job_->record().Autosave();
     state_.save_error.clear();
   } catch (const IoError& e) {
     state_.save_error = e.what();
@@ -329,9 +331,9 @@ void Controller::Handle(const SaveSessionAs& save) {
   try {
     std::string note;
     std::optional<FileLock> lock = LockSession(path, &note);  // throws when another has it open
-    SaveSession(path, session_);
+    if (!job_) throw IoError("no session to save: open a dataset first");
+    job_->record().SaveAs(path);
     if (lock) session_lock_ = std::move(lock);
-    autosaver_ = std::make_unique<Autosaver>(path);
     state_.session_path = path;
     state_.save_error.clear();
     SetStatus("saved session " + path.string(), false);
@@ -343,23 +345,19 @@ void Controller::Handle(const SaveSessionAs& save) {
 
 template <>
 void Controller::Handle(const Undo&) {
-  Restore(history_.Undo());
+  if (job_) Restore(job_->record().Undo());
 }
 template <>
 void Controller::Handle(const Redo&) {
-  Restore(history_.Redo());
+  if (job_) Restore(job_->record().Redo());
 }
 
+// The record has restored it already, with the pairs that joined since that step as they are.
 void Controller::Restore(const std::optional<Session>& restored) {
   if (!restored) return;
   std::vector<std::vector<int>> before;
   for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
-  // Pairs that joined since that step (a watched folder) stay as they are.
-  Session session = *restored;
-  for (size_t i = session.pairs.size(); i < session_.pairs.size(); ++i)
-    session.pairs.push_back(session_.pairs[i]);
-  session_ = std::move(session);
-  ApplySessionToState(session_);
+  ApplySessionToState(*restored);
   RecomputeResiduals();
   Autosave();
   for (int i = 0; i < static_cast<int>(state_.pairs.size()); ++i)

@@ -219,32 +219,11 @@ void Controller::AddPair(const PairEntry& entry) {
   PairView view;
   view.id = entry.id;
   state_.pairs.push_back(std::move(view));
-  PairState saved;
-  saved.id = entry.id;
-  session_.pairs.push_back(std::move(saved));
+  if (job_) job_->record().AddPair(entry.id);
   ++state_.loading_total;
   const int index = static_cast<int>(state_.pairs.size()) - 1;
   ++state_.generation;
   worker_.Enqueue([this, index] { LoadPair(index); });  // selects it when it follows (FollowsTo)
-}
-
-void Controller::SyncJobDecisions() {
-  Session decided;
-  SolverOptions solver;
-  CaptureGoal goal;
-  {
-    std::lock_guard lock(mutex_);
-    // The session is the user's word (CommitEdit keeps it after every edit): the job takes it as
-    // `watch` and `calibrate --session` take the file (CalibrationJob::Resume). A painted brush
-    // is the user's word there: completion leaves the pair alone.
-    decided = session_;
-    decided.ransac_threshold_m = pipeline_.lidar_plane.ransac_threshold_m;
-    solver = SolverOptionsFromState();
-    goal = state_.goal;
-  }
-  job_->Resume(decided);
-  job_->SetSolverOptions(solver);
-  job_->SetGoal(goal);
 }
 
 void Controller::AdviseFromState() {
@@ -254,7 +233,6 @@ void Controller::AdviseFromState() {
     if (!job_ || !state_.solver.result || state_.next_pose) return;
     at = ResultForCurrentPairs();
   }
-  SyncJobDecisions();
   Advise(at);
 }
 
