@@ -182,7 +182,8 @@ class SessionHistory {
   void Push(const Session& state);
   // Replaces the current state without a new undo step (and drops the redo branch): the rest of
   // an edit already pushed, such as the later dabs of one brush stroke. Push when nothing is
-  // recorded yet or the current state is the first.
+  // recorded yet or the current state is the first. A state equal to the current one changes
+  // nothing (the redo branch stays: a refit after an undo that finds what the step held).
   void Amend(const Session& state);
   std::optional<Session> Undo();
   std::optional<Session> Redo();

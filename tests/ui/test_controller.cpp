@@ -130,6 +130,42 @@ TEST(Controller, RejectAcceptSolveAndUndo) {
   EXPECT_EQ(s.pairs[2].status, PairStatus::kRejected);
 }
 
+// In the window the workbench solves by itself after each edit. That solve follows the edit: one
+// undo takes back the rejection and the solve it caused (the calibration before it is back), and
+// redo brings both again; the autosaved session says the same.
+TEST(Controller, WithAutoSolveOneUndoTakesBackAnEditAndTheSolveItCaused) {
+  Controller controller;
+  const auto dir = test::TempDir("controller_auto_undo");
+  controller.SetAutoSolve(true);
+  controller.OpenDataset(test::UiDataset(), dir / "s.json");
+  Snapshot s = Loaded(controller);
+  ASSERT_TRUE(s.solver.result) << s.solver.failure;
+  EXPECT_EQ(s.solver.solved_pair_ids.size(), 4u);
+  const Pose all_pairs = s.solver.result->cam_from_lidar;
+
+  controller.Apply(SetPairStatus{2, PairStatus::kRejected});
+  s = Loaded(controller);
+  ASSERT_TRUE(s.solver.result) << s.solver.failure;
+  EXPECT_EQ(s.solver.solved_pair_ids.size(), 3u);  // solved again, by itself
+  const Pose without_pair_2 = s.solver.result->cam_from_lidar;
+  EXPECT_GT((without_pair_2.matrix() - all_pairs.matrix()).cwiseAbs().maxCoeff(), 1e-9);
+
+  controller.Apply(Undo{});
+  s = Loaded(controller);
+  EXPECT_EQ(s.pairs[2].status, PairStatus::kAccepted);
+  ASSERT_TRUE(s.solver.result);
+  EXPECT_EQ(s.solver.result->cam_from_lidar.matrix(), all_pairs.matrix());
+  EXPECT_EQ(LoadSession(dir / "s.json").pairs[2].status, PairStatus::kAccepted);
+
+  controller.Apply(Redo{});
+  s = Loaded(controller);
+  EXPECT_EQ(s.pairs[2].status, PairStatus::kRejected);
+  ASSERT_TRUE(s.solver.result);
+  EXPECT_EQ(s.solver.result->cam_from_lidar.matrix(), without_pair_2.matrix());
+  EXPECT_FALSE(s.can_redo);
+  EXPECT_EQ(LoadSession(dir / "s.json").pairs[2].status, PairStatus::kRejected);
+}
+
 TEST(Controller, FewerThanThreePairsSaySoInsteadOfSolving) {
   Controller controller;
   controller.OpenDataset(test::UiDataset(), test::TempDir("controller_few") / "s.json");

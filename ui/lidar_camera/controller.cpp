@@ -120,7 +120,7 @@ void Controller::ApplyCompletion(const std::vector<PairFeatures>& solved) {
   }
 }
 
-void Controller::Solve() {
+void Controller::Solve(bool asked) {
   {
     std::lock_guard lock(mutex_);
     if (!state_.dataset || !job_) return;
@@ -166,7 +166,7 @@ void Controller::Solve() {
                 std::to_string(result.iterations) + " iterations" +
                 (result.observability.well_constrained ? "" : " (NOT well constrained)"),
             !result.observability.well_constrained);
-  CommitEdit();
+  CommitEdit(/*follows=*/!asked);
   const int selected = state_.selected;
   if (selected >= 0) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
   // Pre-flight and the next pose (the ghost board) from this solve.

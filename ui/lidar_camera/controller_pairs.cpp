@@ -296,7 +296,7 @@ void Controller::RefitLidar(int index) {
   ++state_.generation;
   if (PairsSettled()) {
     RecomputeResiduals();
-    CommitEdit();
+    CommitEdit(/*follows=*/true);
     RequestSolve();
   }
 }

@@ -265,7 +265,7 @@ void Controller::ApplySessionToState(const Session& session) {
   ++state_.generation;
 }
 
-void Controller::CommitEdit() {
+void Controller::CommitEdit(bool follows) {
   mutex_.AssertHeld(__func__);
   if (!job_) return;  // nothing open
   const bool had_selected =
@@ -307,7 +307,7 @@ void Controller::CommitEdit() {
       if (it.reweighted) session.result->reweighted_iterations.push_back(it.iteration);
     }
   }
-  job_->record().Commit(std::move(session), /*amend=*/stroke_open_);
+  job_->record().Commit(std::move(session), /*amend=*/stroke_open_ || follows);
   state_.can_undo = job_->record().CanUndo();
   state_.can_redo = job_->record().CanRedo();
   Autosave();

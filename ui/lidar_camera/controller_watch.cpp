@@ -35,7 +35,7 @@ void Controller::RequestSolve() {
       std::lock_guard lock(mutex_);
       solve_queued_ = false;
     }
-    Solve();
+    Solve(/*asked=*/false);
   });
 }
 
@@ -267,7 +267,7 @@ void Controller::Advise(const std::optional<SolverResult>& at) {
   }
   ++state_.generation;
   if (!rejected) return;
-  CommitEdit();
+  CommitEdit(/*follows=*/true);
   RequestSolve();
 }
 
