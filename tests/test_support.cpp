@@ -1,12 +1,19 @@
 #include "tests/test_support.h"
 
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "core/geometry/geometry.h"
 #include "core/results/result_json.h"
@@ -21,8 +28,42 @@ std::optional<std::filesystem::path> SharedDir() {
   return std::nullopt;
 }
 
+namespace {
+
+// Claims test_tmp/<name> for the running test (TempDir's rule); outside a test, nothing to check.
+void ClaimTempDir(const std::filesystem::path& root, const std::string& name) {
+  const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  if (!test) return;
+  const std::string me = std::string(test->test_suite_name()) + "." + test->name();
+  std::string key = name;
+  std::replace(key.begin(), key.end(), '/', '%');
+  const std::filesystem::path owners = root / ".owners";
+  std::filesystem::create_directories(owners);
+  const std::filesystem::path marker = owners / key;
+  // O_EXCL: of two tests starting at once exactly one creates the marker.
+  if (const int fd = ::open(marker.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644); fd >= 0) {
+    const bool written = ::write(fd, me.data(), me.size()) == static_cast<ssize_t>(me.size());
+    ::close(fd);
+    EXPECT_TRUE(written) << "cannot write " << marker;
+    return;
+  }
+  std::string owner;
+  for (int attempt = 0; attempt < 50 && owner.empty(); ++attempt) {  // its owner is writing it
+    owner = ReadFileBytes(marker);
+    if (owner.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(owner, me) << "test_tmp/" << name << " belongs to test " << owner
+                       << ": give each test a folder of its own (or, if that test no longer "
+                          "exists, delete "
+                       << marker << ")";
+}
+
+}  // namespace
+
 std::filesystem::path TempDir(const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::path(CALIBENCH_BINARY_DIR) / "test_tmp" / name;
+  const std::filesystem::path root = std::filesystem::path(CALIBENCH_BINARY_DIR) / "test_tmp";
+  ClaimTempDir(root, name);
+  const std::filesystem::path dir = root / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

@@ -18,7 +18,10 @@ namespace calibench::test {
 // environment sets CALIBENCH_REQUIRE_SHARED=1 (as .ci/run does), in which case the test fails.
 std::optional<std::filesystem::path> SharedDir();
 
-// A fresh, empty directory under the build tree for one test.
+// A fresh, empty directory under the build tree for one test. The folder is that test's alone:
+// ctest runs tests at once, and two that named one folder would empty it under each other. So the
+// first test to ask for a name owns it (build/test_tmp/.owners/<name>), and any other test asking
+// for it fails at once, naming both, however the two happen to be timed.
 std::filesystem::path TempDir(const std::string& name);
 
 // The calibench executable built next to the tests (from $CALIBENCH_EXE).
