@@ -233,9 +233,7 @@ void SessionHistory::Push(const Session& state) {
 }
 
 void SessionHistory::Amend(const Session& state) {
-  if (cursor_ == 0) return Push(state);
-  if (state == states_[cursor_]) return;  // nothing changed: the redo branch stays
-  states_.erase(states_.begin() + static_cast<std::ptrdiff_t>(cursor_) + 1, states_.end());
+  if (states_.empty()) return Reset(state);
   states_[cursor_] = state;
 }
 

@@ -180,10 +180,9 @@ class SessionHistory {
   // Records the state after an edit and drops the redo branch. A state equal to the current one
   // is ignored (no empty undo steps). The first Push after construction acts as Reset.
   void Push(const Session& state);
-  // Replaces the current state without a new undo step (and drops the redo branch): the rest of
-  // an edit already pushed, such as the later dabs of one brush stroke. Push when nothing is
-  // recorded yet or the current state is the first. A state equal to the current one changes
-  // nothing (the redo branch stays: a refit after an undo that finds what the step held).
+  // Replaces the current state without a new undo step: the rest of an edit already pushed (the
+  // later dabs of one brush stroke, the solve it caused) or a change that is no edit (the pair
+  // selected). The redo branch stays: selecting a pair after an undo does not lose the redo.
   void Amend(const Session& state);
   std::optional<Session> Undo();
   std::optional<Session> Redo();

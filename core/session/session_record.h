@@ -43,8 +43,9 @@ class SessionRecord {
 
   // `session` becomes the record with nothing to undo: a session opened or resumed.
   void Reset(Session session);
-  // An edit: `session` becomes the record and one undo step; with `amend` it replaces the last
-  // step instead (the later dabs of one brush stroke). A state equal to the record adds no step.
+  // An edit: `session` becomes the record and one undo step; with `amend` it replaces the current
+  // step instead (the later dabs of one brush stroke, the solve it caused, the pair selected;
+  // SessionHistory::Amend). A state equal to the record adds no step.
   void Commit(Session session, bool amend = false);
   // The same for a change to the record as it is now. `change` runs under the record's lock and
   // must not call the record.

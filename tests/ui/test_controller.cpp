@@ -132,7 +132,8 @@ TEST(Controller, RejectAcceptSolveAndUndo) {
 
 // In the window the workbench solves by itself after each edit. That solve follows the edit: one
 // undo takes back the rejection and the solve it caused (the calibration before it is back), and
-// redo brings both again; the autosaved session says the same.
+// redo brings both again; the autosaved session says the same. Selecting pairs in between is no
+// undo step.
 TEST(Controller, WithAutoSolveOneUndoTakesBackAnEditAndTheSolveItCaused) {
   Controller controller;
   const auto dir = test::TempDir("controller_auto_undo");
@@ -150,12 +151,18 @@ TEST(Controller, WithAutoSolveOneUndoTakesBackAnEditAndTheSolveItCaused) {
   const Pose without_pair_2 = s.solver.result->cam_from_lidar;
   EXPECT_GT((without_pair_2.matrix() - all_pairs.matrix()).cwiseAbs().maxCoeff(), 1e-9);
 
+  // Looking at another pair is no edit: the undo still takes back the rejection.
+  controller.Apply(SelectPair{0});
   controller.Apply(Undo{});
   s = Loaded(controller);
   EXPECT_EQ(s.pairs[2].status, PairStatus::kAccepted);
   ASSERT_TRUE(s.solver.result);
   EXPECT_EQ(s.solver.result->cam_from_lidar.matrix(), all_pairs.matrix());
   EXPECT_EQ(LoadSession(dir / "s.json").pairs[2].status, PairStatus::kAccepted);
+  // Nor does it lose the redo.
+  controller.Apply(SelectPair{1});
+  EXPECT_EQ(controller.GetSnapshot().selected, 1);
+  EXPECT_TRUE(controller.GetSnapshot().can_redo);
 
   controller.Apply(Redo{});
   s = Loaded(controller);

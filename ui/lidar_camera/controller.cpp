@@ -166,7 +166,7 @@ void Controller::Solve(bool asked) {
                 std::to_string(result.iterations) + " iterations" +
                 (result.observability.well_constrained ? "" : " (NOT well constrained)"),
             !result.observability.well_constrained);
-  CommitEdit(/*follows=*/!asked);
+  CommitEdit(/*same_step=*/!asked);
   const int selected = state_.selected;
   if (selected >= 0) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
   // Pre-flight and the next pose (the ghost board) from this solve.
@@ -228,7 +228,7 @@ void Controller::Handle(const SelectPair& select) {
   state_.selected_image.reset();
   state_.selected_undistorted.reset();
   state_.reprojection.reset();
-  CommitEdit();
+  CommitEdit(/*same_step=*/true);  // saved with the session, but no edit to undo
   worker_.Enqueue([this] { EnsureSelectedImage(); });
   const int index = select.index;
   worker_.Enqueue([this, index] { ComputeReprojection(index); });
@@ -294,7 +294,7 @@ void Controller::Handle(const SetView& view) {
   const bool visibility_changed = view.view.visibility != state_.view.visibility ||
                                   view.view.hpr_radius_exponent != state_.view.hpr_radius_exponent;
   state_.view = view.view;
-  CommitEdit();
+  CommitEdit(/*same_step=*/true);  // saved with the session, but no edit to undo
   if (visibility_changed) {
     const int index = state_.selected;
     worker_.Enqueue([this, index] { ComputeReprojection(index); });

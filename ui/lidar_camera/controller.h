@@ -226,8 +226,8 @@ class Controller : public ControllerState<Snapshot> {
   void RefitLidar(int index);
   // The background model over the loaded clouds, then detection where no seed or brush is.
   void DetectWithBackground();
-  // `asked`: the user's Run, an undo step of its own; otherwise auto-solve's, which follows the
-  // edit that asked for it (the same undo step: undoing a rejection undoes its solve too).
+  // `asked`: the user's Run, an undo step of its own; otherwise auto-solve's, on the same undo
+  // step as the edit that asked for it (undoing a rejection undoes its solve too).
   void Solve(bool asked = true);
   SolverOptions SolverOptionsFromState() const;          // the user's choices over pipeline_.solver
   PipelineOptions PipelineOptionsFromState() const;      // pipeline_ with those solver choices
@@ -251,10 +251,11 @@ class Controller : public ControllerState<Snapshot> {
   // Call with mutex_ held.
   void JudgeMeter(bool record);
   // The job's session record <- state, an undo step, autosave; call with mutex_ held. Within an
-  // open brush stroke the last step is amended, so that one stroke is one undo step; so is it
-  // when the change `follows` the last edit (its refit, its auto-solve, pre-flight's verdicts on
-  // it): one undo takes back the edit and all that followed from it.
-  void CommitEdit(bool follows = false);
+  // open brush stroke the current step is amended, so that one stroke is one undo step; so is it
+  // for a change on the `same_step`: one that follows the last edit (its refit, its auto-solve,
+  // pre-flight's verdicts on it: one undo takes back the edit and all that followed from it) or
+  // that is no edit (the pair selected, the camera moved: undo steps through edits only).
+  void CommitEdit(bool same_step = false);
   void ApplySessionToState(const Session& session);  // call with mutex_ held
   // Rig (controller_rig.cpp), with mutex_ held unless said: the rig view with camera `active`
   // open (true: the other cameras' solves carried from CarryRig); the rig solve on rig_thread_;

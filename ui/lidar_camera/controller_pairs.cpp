@@ -296,7 +296,7 @@ void Controller::RefitLidar(int index) {
   ++state_.generation;
   if (PairsSettled()) {
     RecomputeResiduals();
-    CommitEdit(/*follows=*/true);
+    CommitEdit(/*same_step=*/true);
     RequestSolve();
   }
 }

@@ -265,7 +265,7 @@ void Controller::ApplySessionToState(const Session& session) {
   ++state_.generation;
 }
 
-void Controller::CommitEdit(bool follows) {
+void Controller::CommitEdit(bool same_step) {
   mutex_.AssertHeld(__func__);
   if (!job_) return;  // nothing open
   const bool had_selected =
@@ -307,7 +307,7 @@ void Controller::CommitEdit(bool follows) {
       if (it.reweighted) session.result->reweighted_iterations.push_back(it.iteration);
     }
   }
-  job_->record().Commit(std::move(session), /*amend=*/stroke_open_ || follows);
+  job_->record().Commit(std::move(session), /*amend=*/stroke_open_ || same_step);
   state_.can_undo = job_->record().CanUndo();
   state_.can_redo = job_->record().CanRedo();
   Autosave();

@@ -267,7 +267,7 @@ void Controller::Advise(const std::optional<SolverResult>& at) {
   }
   ++state_.generation;
   if (!rejected) return;
-  CommitEdit(/*follows=*/true);
+  CommitEdit(/*same_step=*/true);
   RequestSolve();
 }
 
