@@ -36,13 +36,11 @@ CalibrationJob::CalibrationJob(Dataset dataset, CalibrationJobOptions options, P
   record_.Reset(std::move(session));
 }
 
-void CalibrationJob::SetEdit(Session* session, const std::string& pair_id, const PairEdit& edit) {
-  PairState* pair = nullptr;
-  for (PairState& state : session->pairs)
-    if (state.id == pair_id) pair = &state;
+PairState& CalibrationJob::SetEdit(Session* session, const std::string& pair_id,
+                                   const PairEdit& edit) {
+  PairState* pair = FindPair(session, pair_id);
   if (!pair) {  // a pair that has not arrived yet takes its edit when it does
-    session->pairs.emplace_back();
-    pair = &session->pairs.back();
+    pair = &session->pairs.emplace_back();
     pair->id = pair_id;
   }
   if (edit.rejected) {
@@ -53,6 +51,7 @@ void CalibrationJob::SetEdit(Session* session, const std::string& pair_id, const
     pair->brush = BrushMask{edit.brush_rows, edit.brush_columns, *edit.brush_pixels};
     pair->brush_from_seed = false;
   }
+  return *pair;
 }
 
 PairEdit CalibrationJob::EditOf(const std::string& pair_id) const {
@@ -192,12 +191,8 @@ void CalibrationJob::SetBrush(const std::string& pair_id, std::optional<PairEdit
     if (brush && brush->brush_pixels) {
       brush->rejected = false;
       SetEdit(session, pair_id, *brush);
-      return;
-    }
-    for (PairState& pair : session->pairs) {
-      if (pair.id != pair_id) continue;
-      pair.brush.reset();
-      pair.brush_from_seed = false;
+    } else {
+      ForgetBrush(session, pair_id);
     }
   });
 }
@@ -208,17 +203,14 @@ void CalibrationJob::SetRejected(const std::string& pair_id, bool rejected,
     if (rejected) {
       PairEdit rejection;
       rejection.rejected = true;
-      SetEdit(session, pair_id, rejection);
-      for (PairState& pair : session->pairs)
-        if (pair.id == pair_id) pair.reason = reason.empty() ? kRejectedByUser : reason;
+      SetEdit(session, pair_id, rejection).reason = reason.empty() ? kRejectedByUser : reason;
       return;
     }
     // Taken back: the pair's status follows from its planes again.
-    for (PairState& pair : session->pairs) {
-      if (pair.id != pair_id || pair.status != PairStatus::kRejected) continue;
-      pair.status = PairStatus::kPending;
-      pair.reason.clear();
-    }
+    PairState* pair = FindPair(session, pair_id);
+    if (!pair || pair->status != PairStatus::kRejected) return;
+    pair->status = PairStatus::kPending;
+    pair->reason.clear();
   });
 }
 
@@ -290,7 +282,7 @@ const CaptureAdvice& CalibrationJob::Advise(const std::optional<SolverResult>& a
 
 Session CalibrationJob::ToSession(const std::filesystem::path& dataset_path) const {
   // The record's settings and views over the job's pairs, with the verdicts of the last solve.
-  const Session record = record_.Current();
+  Session record = record_.Current();
   Session session = NewSession(dataset_);
   session.dataset = NormalizeSessionPath(dataset_path);
   session.method = record.method;
@@ -308,9 +300,8 @@ Session CalibrationJob::ToSession(const std::filesystem::path& dataset_path) con
     session.pairs[i].status = judged ? advice_->pairs[i].status : last->status;
     session.pairs[i].reason = judged ? advice_->pairs[i].reason : last->reason;
     // The user's painted brushes; none pictured from a seed (`calibrate` reads the seed itself).
-    for (const PairState& saved : record.pairs)
-      if (saved.id == session.pairs[i].id && saved.brush && !saved.brush_from_seed)
-        session.pairs[i].brush = saved.brush;
+    const PairState* saved = FindPair(&record, session.pairs[i].id);
+    if (saved && saved->brush && !saved->brush_from_seed) session.pairs[i].brush = saved->brush;
   }
   const std::optional<SolverResult>& solution = advice_ ? advice_->solution : last_solution_;
   if (solution) session.result = SessionResultFromSolver(*solution);

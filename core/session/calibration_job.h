@@ -136,8 +136,8 @@ class CalibrationJob {
   };
   void Restatus(JobPair* pair) const;  // status and reason from the planes and the rejection
   PairEdit EditOf(const std::string& pair_id) const;
-  // `edit` into pair `pair_id`'s state (added when the session has no such pair yet).
-  static void SetEdit(Session* session, const std::string& pair_id, const PairEdit& edit);
+  // `edit` into pair `pair_id`'s state (added when the session has no such pair yet); that state.
+  static PairState& SetEdit(Session* session, const std::string& pair_id, const PairEdit& edit);
   PipelineOptions Pipeline() const;  // options_'s with the record's settings
   const SceneBackground* Background() const { return background_ ? &*background_ : nullptr; }
 

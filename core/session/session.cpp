@@ -124,17 +124,22 @@ void ApplySessionOptions(const Session& session, PipelineOptions* options) {
       session.estimate_range_offset && session.method == SolverMethod::kWeightedMl;
 }
 
+PairEdit EditOfPair(const PairState& pair) {
+  PairEdit edit;
+  edit.rejected = pair.status == PairStatus::kRejected;
+  if (pair.brush && !pair.brush_from_seed) {
+    edit.brush_pixels = pair.brush->pixels;
+    edit.brush_rows = pair.brush->rows;
+    edit.brush_columns = pair.brush->columns;
+  }
+  return edit;
+}
+
 PairEdits EditsFromSession(const Session& session) {
   PairEdits edits;
   for (const PairState& pair : session.pairs) {
-    PairEdit edit;
-    edit.rejected = pair.status == PairStatus::kRejected;
-    if (pair.brush && !pair.brush_from_seed) {
-      edit.brush_pixels = pair.brush->pixels;
-      edit.brush_rows = pair.brush->rows;
-      edit.brush_columns = pair.brush->columns;
-    }
-    if (edit.rejected || edit.brush_pixels) edits[pair.id] = edit;
+    PairEdit edit = EditOfPair(pair);
+    if (edit.rejected || edit.brush_pixels) edits[pair.id] = std::move(edit);
   }
   return edits;
 }

@@ -123,6 +123,9 @@ Session NewSession(const Dataset& dataset);
 // for the weighted method, as the workbench solves).
 void ApplySessionOptions(const Session& session, PipelineOptions* options);
 
+// The user's word on one pair as the pipeline takes it: its painted brush (not one pictured from
+// a seed) and its rejection.
+PairEdit EditOfPair(const PairState& pair);
 // The user's decisions in the session as the pipeline takes them: painted brushes (not those
 // pictured from a seed) and rejections, by pair id. `calibench calibrate --session` and the
 // workbench then compute the same calibration.

@@ -15,6 +15,17 @@ const PairState* FindPair(const Session& session, const std::string& id) {
 
 }  // namespace
 
+PairState* FindPair(Session* session, const std::string& id) {
+  return const_cast<PairState*>(FindPair(*session, id));
+}
+
+void ForgetBrush(Session* session, const std::string& id) {
+  if (PairState* pair = FindPair(session, id)) {
+    pair->brush.reset();
+    pair->brush_from_seed = false;
+  }
+}
+
 SessionRecord::SessionRecord(Session session, std::size_t undo_depth)
     : session_(std::move(session)), history_(undo_depth) {
   history_.Reset(session_);
@@ -39,16 +50,8 @@ std::optional<PairState> SessionRecord::Pair(const std::string& id) const {
 
 PairEdit SessionRecord::EditOf(const std::string& id) const {
   std::lock_guard lock(mutex_);
-  PairEdit edit;
   const PairState* pair = FindPair(session_, id);
-  if (!pair) return edit;
-  edit.rejected = pair->status == PairStatus::kRejected;
-  if (pair->brush && !pair->brush_from_seed) {
-    edit.brush_pixels = pair->brush->pixels;
-    edit.brush_rows = pair->brush->rows;
-    edit.brush_columns = pair->brush->columns;
-  }
-  return edit;
+  return pair ? EditOfPair(*pair) : PairEdit{};
 }
 
 PairEdits SessionRecord::Edits() const {
@@ -78,15 +81,16 @@ void SessionRecord::Reset(Session session) {
 void SessionRecord::Commit(Session session, bool amend) {
   std::lock_guard lock(mutex_);
   session_ = std::move(session);
-  if (amend)
-    history_.Amend(session_);
-  else
-    history_.Push(session_);
+  Record(amend);
 }
 
 void SessionRecord::Edit(const std::function<void(Session*)>& change, bool amend) {
   std::lock_guard lock(mutex_);
   change(&session_);
+  Record(amend);
+}
+
+void SessionRecord::Record(bool amend) {
   if (amend)
     history_.Amend(session_);
   else

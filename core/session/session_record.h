@@ -21,6 +21,10 @@
 
 namespace calibench {
 
+// Pair `id`'s state in `session`, or null; and its brush forgotten (painted or from a seed).
+PairState* FindPair(Session* session, const std::string& id);
+void ForgetBrush(Session* session, const std::string& id);
+
 class SessionRecord {
  public:
   explicit SessionRecord(Session session = {}, std::size_t undo_depth = 100);
@@ -73,6 +77,7 @@ class SessionRecord {
 
  private:
   std::optional<Session> Restore(std::optional<Session> restored);  // lock held
+  void Record(bool amend);  // session_ as a new undo step, or amending the current one (lock held)
 
   mutable std::mutex mutex_;
   Session session_;

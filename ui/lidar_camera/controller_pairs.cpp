@@ -178,13 +178,7 @@ void Controller::LoadPair(int index) {
     ++state_.generation;
     OnLivePairLoaded(index);  // a followed capture: follow it, match it against the ghost
     if (!brush_dropped.empty()) {
-      job_->record().Adjust([&id = pair.id](Session* session) {
-        for (PairState& saved : session->pairs) {
-          if (saved.id != id) continue;
-          saved.brush.reset();
-          saved.brush_from_seed = false;
-        }
-      });
+      job_->record().Adjust([&id = pair.id](Session* session) { ForgetBrush(session, id); });
       load_warnings_.push_back(brush_dropped);
       SetStatus(brush_dropped, true);
     }
