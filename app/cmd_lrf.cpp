@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "app/commands.h"
@@ -14,6 +15,7 @@
 #include "core/lidar_camera/result_io.h"
 #include "core/lrf/pipeline.h"
 #include "core/lrf/result_io.h"
+#include "core/session/lrf_calibration_job.h"
 #include "core/sim/lrf_sim.h"
 #include "core/sim/lrf_sweep.h"
 
@@ -35,6 +37,24 @@ void PrintPoseError(const char* what, const Pose& estimate, const Pose& referenc
               e.rotation_rad * kRadToDeg);
 }
 
+// --session's LRF session, its dataset into *dataset_path (which, when given, must be the
+// session's); nullopt (said on stderr) when `method` is given and is not the session's.
+std::optional<Session> ReadSessionFlag(const std::string& session_path, const std::string& method,
+                                       std::string* dataset_path) {
+  LrfSessionWithDataset opened = LoadLrfSessionWithDataset(session_path);
+  if (!dataset_path->empty() &&
+      NormalizeSessionPath(LoadLrfDataset(*dataset_path).manifest) != opened.session.dataset)
+    throw IoError(session_path + ": the session of " + opened.session.dataset.string() +
+                  ", not of " + *dataset_path);
+  if (!method.empty() && method != opened.session.lrf_method) {
+    std::fprintf(stderr, "calibench lrf-calibrate: %s solves with %s; --method %s disagrees\n",
+                 session_path.c_str(), opened.session.lrf_method.c_str(), method.c_str());
+    return std::nullopt;
+  }
+  *dataset_path = opened.session.dataset.string();
+  return std::move(opened.session);
+}
+
 }  // namespace
 
 bool IsLrfManifest(const std::string& path) {
@@ -49,9 +69,13 @@ int RunLrfCalibrate(int argc, char** argv) {
       "constraints) or to an RGB camera (checkerboard, Zhang & Pless); writes "
       "calibench.result.v1 with cam_from_lrf.",
       "calibench lrf-calibrate"};
-  std::string dataset_path, out_path, method = "refined", pairs_text;
+  std::string dataset_path, session_path, out_path, method = "refined", pairs_text;
   LrfPipelineOptions options;
-  AddDatasetOption(app, &dataset_path, "a 2D LRF dataset (calibench.lrf-dataset.v1)")->required();
+  AddDatasetOption(app, &dataset_path, "a 2D LRF dataset (calibench.lrf-dataset.v1)");
+  app.add_option("--session", session_path,
+                 "an LRF workbench session (calibench.lrf-session.json beside the manifest): its "
+                 "rejections and method are used, so the result is the workbench's; its dataset "
+                 "unless --dataset is given");
   app.add_option("--out,-o", out_path, "result file (calibench.result.v1)");
   app.add_option("--method", method,
                  "refined (SE(3) Gauss-Newton over every scan point, seeded by paper-linear) | "
@@ -85,9 +109,21 @@ int RunLrfCalibrate(int argc, char** argv) {
     std::fprintf(stderr, "calibench lrf-calibrate: %s\n", why.c_str());
     return kUsage;
   }
-  const LrfDataset dataset = LoadLrfDataset(dataset_path);
-  const LrfCalibrationOutcome outcome =
-      CalibrateLrfDataset(dataset, options, StderrProgress("extracted"));
+  if (dataset_path.empty() && session_path.empty()) {
+    std::fprintf(stderr, "calibench lrf-calibrate: give --dataset or --session\n");
+    return kUsage;
+  }
+  std::optional<Session> session;
+  if (!session_path.empty()) {
+    session = ReadSessionFlag(session_path, app.count("--method") ? method : "", &dataset_path);
+    if (!session) return kUsage;
+  }
+  // The job the LRF workbench runs (core/session/lrf_calibration_job.h), all pairs at once.
+  LrfCalibrationJob job(LoadLrfDataset(dataset_path), options, std::move(session));
+  job.ExtractAll(StderrProgress("extracted"));
+  const LrfCalibrationOutcome outcome = job.Solve();
+  options = job.options();  // the session's method
+  const LrfDataset& dataset = job.dataset();
   std::printf("%s", FormatLrfSummary(outcome).c_str());
   bool input_error = false;
   for (const LrfPairFeatures& p : outcome.pairs) input_error |= p.input_error;

@@ -11,6 +11,7 @@
 #include "core/io/bag.h"
 #include "core/io/image_io.h"
 #include "core/lidar_camera/rig.h"
+#include "core/session/lrf_calibration_job.h"
 #include "ui/gfx/context.h"
 #include "ui/lidar_camera/controller.h"
 #include "ui/lidar_camera/window_shell.h"
@@ -84,9 +85,10 @@ ui::WindowOptions WindowOptionsOf(int width, int height, const char* title,
 
 // The last save failed (the window showed it on its status line): say so on stderr too, with
 // an exit code, so that a script or a terminal user does not take the session for saved.
-int ReportSaveFailure(ui::Controller& controller, const char* command) {
+template <typename AnyController>
+int ReportSaveFailure(AnyController& controller, const char* command) {
   controller.WaitIdle();
-  const ui::Snapshot snapshot = controller.GetSnapshot();
+  const auto snapshot = controller.GetSnapshot();
   if (snapshot.save_error.empty()) return kOk;
   std::fprintf(stderr, "calibench %s: the session was not saved: %s\n", command,
                snapshot.save_error.c_str());
@@ -112,16 +114,24 @@ int FinishWindow(const ui::WindowRun& run, const std::string& screenshot) {
   return kOk;
 }
 
-// The LRF workbench in a window (a calibench.lrf-dataset.v1 manifest), with its File menu.
-int RunLrfGuiWindow(const std::string& dataset, const ui::WindowOptions& window,
-                    const std::string& screenshot) {
+// The LRF workbench in a window (a calibench.lrf-dataset.v1 manifest, or an LRF session), with
+// its File and Edit menus; it resumes the session beside the manifest unless `fresh`.
+int RunLrfGuiWindow(const std::string& dataset, const std::string& session,
+                    const ui::WindowOptions& window, const std::string& screenshot, bool fresh) {
   ui::LrfController controller;
-  controller.Open(dataset);  // a bad manifest shows its error in the window's status line
+  // A bad manifest or session shows its error in the window's status line.
+  if (!session.empty())
+    controller.OpenSession(session);
+  else
+    controller.Open(dataset, fresh ? ui::LrfController::SessionUse::kFresh
+                                   : ui::LrfController::SessionUse::kResume);
   std::string error;
-  const int code = FinishWindow(ui::RunLrfWindow(window, controller, &error), screenshot);
+  int code = FinishWindow(ui::RunLrfWindow(window, controller, &error), screenshot);
   if (!error.empty()) std::fprintf(stderr, "calibench gui: %s\n", error.c_str());
   const ui::LrfSnapshot last = controller.GetSnapshot();
   if (!last.manifest.empty()) std::printf("open at the end: %s\n", last.manifest.c_str());
+  if (!last.session_path.empty()) std::printf("session: %s\n", last.session_path.c_str());
+  if (code == kOk) code = ReportSaveFailure(controller, "gui");
   return code;
 }
 
@@ -161,7 +171,8 @@ int RenderLrfHeadless(const std::string& dataset, const ui::HeadlessShot& shot,
   const auto context = OpenHeadless(backend, "calibench render: no headless OpenGL");
   if (!context) return kInputError;
   ui::LrfController controller;
-  if (!controller.Open(dataset)) {
+  // In memory: render leaves the session beside the manifest alone.
+  if (!controller.Open(dataset, ui::LrfController::SessionUse::kInMemory)) {
     std::fprintf(stderr, "calibench render: %s\n", controller.GetSnapshot().status_line.c_str());
     return kInputError;
   }
@@ -245,10 +256,10 @@ int RunGui(int argc, char** argv) {
                  "close after S seconds, drawing only on input or work as usual (tests)");
   int width = 0, height = 0;
   if (const auto code = ParseFlags(app, argc, argv, size, "gui", &width, &height)) return *code;
-  if (!dataset.empty() && IsLrfManifest(dataset))
-    return RunLrfGuiWindow(dataset,
+  if ((!dataset.empty() && IsLrfManifest(dataset)) || (!session.empty() && IsLrfSession(session)))
+    return RunLrfGuiWindow(dataset, session,
                            WindowOptionsOf(width, height, "Calibench (2D LRF)", screenshot, quit),
-                           screenshot);
+                           screenshot, quit.fresh);
   return RunGuiWindow(dataset, session, width, height, screenshot, quit);
 }
 

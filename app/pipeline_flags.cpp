@@ -177,6 +177,7 @@ PairEdits ApplySessionFlag(const std::string& session_path, std::string* dataset
                            PipelineOptions* options) {
   if (session_path.empty()) return {};
   const Session session = LoadSession(session_path);
+  RefuseLrfSession(session, session_path);
   if (dataset_path->empty()) *dataset_path = session.dataset.string();
   ApplySessionOptions(session, options);
   return EditsFromSession(session);

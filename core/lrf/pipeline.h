@@ -62,8 +62,8 @@ struct LrfCalibrationOutcome {
   std::optional<AdaptiveLrfResult> adaptive;  // when options.adaptive_error_threshold_m > 0
 };
 
-// Every selected pair extracted on options.threads workers, then solved: an LrfCalibrationJob
-// (core/lrf/lrf_job.h) run at once.
+// Every selected pair extracted on options.threads workers, then solved: an LrfPairExtraction
+// (core/lrf/pair_extraction.h) run at once.
 LrfCalibrationOutcome CalibrateLrfDataset(const LrfDataset& dataset,
                                           const LrfPipelineOptions& options,
                                           const ProgressCallback& progress = {});

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <fstream>
 #include <map>
 #include <set>
@@ -170,8 +171,17 @@ Session LoadSession(const std::filesystem::path& path) {
   return SessionFromJson(text.str(), path);
 }
 
+void RefuseLrfSession(const Session& session, const std::filesystem::path& path) {
+  if (!session.lrf_method.empty())
+    throw IoError(path.string() + ": a 2D LRF session (options.lrf_method \"" + session.lrf_method +
+                  "\") of " + session.dataset.string() +
+                  ", not a LiDAR-camera one; `calibench lrf-calibrate --session` and "
+                  "`calibench gui --session` open it");
+}
+
 SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_path) {
   Session session = LoadSession(session_path);
+  RefuseLrfSession(session, session_path);
   // A folder without a board (a drive kept for the targetless check) reopens too.
   Dataset dataset = session.camera.empty()
                         ? LoadDataset(session.dataset, CameraFile::kRequired, TargetFile::kOptional)
@@ -182,34 +192,56 @@ SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_p
 
 Session SessionOverDataset(Session saved, const Dataset& dataset,
                            const std::filesystem::path& session_path) {
-  std::set<std::string> in_dataset;
-  for (const PairEntry& entry : dataset.pairs) in_dataset.insert(entry.id);
+  std::vector<std::string> ids;
+  for (const PairEntry& entry : dataset.pairs) ids.push_back(entry.id);
+  return SessionOverPairs(std::move(saved), ids, dataset.manifest, session_path);
+}
+
+Session SessionOverPairs(Session saved, const std::vector<std::string>& ids,
+                         const std::filesystem::path& manifest,
+                         const std::filesystem::path& session_path) {
+  const std::set<std::string> in_dataset(ids.begin(), ids.end());
   for (const PairState& pair : saved.pairs)
     if (!in_dataset.count(pair.id))
       throw IoError(session_path.string() + ": the session's pair '" + pair.id + "' is not in " +
-                    dataset.manifest.string() + " (" + std::to_string(dataset.pairs.size()) +
-                    " pairs there, " + std::to_string(saved.pairs.size()) + " in the session)");
+                    manifest.string() + " (" + std::to_string(ids.size()) + " pairs there, " +
+                    std::to_string(saved.pairs.size()) + " in the session)");
   std::map<std::string, size_t> saved_index;
   for (size_t i = 0; i < saved.pairs.size(); ++i) saved_index[saved.pairs[i].id] = i;
   std::vector<PairState> pairs;
   size_t next_saved = 0;  // the saved pairs must come in the dataset's order
-  for (const PairEntry& entry : dataset.pairs) {
-    const auto found = saved_index.find(entry.id);
+  for (const std::string& id : ids) {
+    const auto found = saved_index.find(id);
     if (found == saved_index.end()) {
       PairState added;
-      added.id = entry.id;
+      added.id = id;
       pairs.push_back(std::move(added));
       continue;
     }
     if (found->second != next_saved)
-      throw IoError(session_path.string() + ": pair '" + entry.id + "' comes before '" +
-                    saved.pairs[next_saved].id + "' in " + dataset.manifest.string() +
+      throw IoError(session_path.string() + ": pair '" + id + "' comes before '" +
+                    saved.pairs[next_saved].id + "' in " + manifest.string() +
                     " but after it in the session");
     ++next_saved;
     pairs.push_back(std::move(saved.pairs[found->second]));
   }
   saved.pairs = std::move(pairs);
   return saved;
+}
+
+std::filesystem::path MoveSessionAside(const std::filesystem::path& path) {
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", std::localtime(&now));
+  std::filesystem::path backup = path.string() + "." + stamp + ".bak";
+  for (int n = 2; std::filesystem::exists(backup); ++n)
+    backup = path.string() + "." + stamp + "-" + std::to_string(n) + ".bak";
+  std::error_code ec;
+  std::filesystem::rename(path, backup, ec);
+  if (ec)
+    throw IoError(path.string() + ": cannot move the session aside to " + backup.string() + " (" +
+                  ec.message() + "); it was left as it is");
+  return backup;
 }
 
 void SaveSession(const std::filesystem::path& path, const Session& session) {

@@ -98,6 +98,11 @@ struct Session {
   bool estimate_range_offset = false;  // weighted-ml: LiDAR range offset (see SolverOptions)
   int max_iterations = SolverOptions{}.max_iterations;                 // Gauss-Newton iterations
   double ransac_threshold_m = LidarPlaneOptions{}.ransac_threshold_m;  // LiDAR plane inliers
+  // A 2D LRF session (the LRF workbench's, `calibench lrf-calibrate --session`): the LRF method's
+  // name ("refined", "paper-linear"; the file's "options"."lrf_method"), `dataset` an LRF manifest
+  // and `result` the last LRF solve (cam_from_lidar holding cam_from_lrf). Empty for a LiDAR-camera
+  // session, whose solver settings above are then the ones that apply.
+  std::string lrf_method;
   // What the workbench's views showed (ui/state/view_state.h reads and writes it): the file's
   // "view" object as JSON text, which core keeps as it is and never reads.
   std::string view_json = "{}";
@@ -144,6 +149,10 @@ std::string SessionToJson(const Session& session, const std::filesystem::path& s
 // pair ids, or brush masks that are unsorted or outside their image.
 Session SessionFromJson(const std::string& text, const std::filesystem::path& source_path);
 
+// Throws IoError naming `path` and what opens it when `session` is a 2D LRF session: what reads
+// LiDAR-camera sessions calls it.
+void RefuseLrfSession(const Session& session, const std::filesystem::path& path);
+
 // Reads a session file; never writes it. Throws IoError naming the file and the problem.
 Session LoadSession(const std::filesystem::path& path);
 // A session with the dataset it names, checked to be that dataset's: its pairs in the same order
@@ -156,6 +165,7 @@ struct SessionWithDataset {
   Session session;
   Dataset dataset;
 };
+// An LRF session (Session::lrf_method) is refused (RefuseLrfSession).
 SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_path);
 // `saved` over the pairs `dataset` holds now: each saved pair keeps its state, the dataset's other
 // pairs join as pending, in the dataset's order. Throws IoError naming `session_path` when a saved
@@ -163,10 +173,19 @@ SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_p
 // removed: the session's edits would land on other pairs).
 Session SessionOverDataset(Session saved, const Dataset& dataset,
                            const std::filesystem::path& session_path);
+// The same over the pair ids `manifest` holds now, in its order (an LRF dataset's).
+Session SessionOverPairs(Session saved, const std::vector<std::string>& ids,
+                         const std::filesystem::path& manifest,
+                         const std::filesystem::path& session_path);
 // Whether the file is a session (its first 4 KB name calibench.session.v1): what `export`,
 // `report` and the workbench's Open tell a session from a result or a manifest by. False for a
 // file that cannot be read.
 bool IsSessionFile(const std::filesystem::path& path);
+
+// Moves a session file that will not be resumed aside, to `<path>.<YYYYmmdd-HHMMSS>.bak` (a new
+// name each time), and returns that name. Throws IoError naming both when the move fails (the file
+// is then left as it is).
+std::filesystem::path MoveSessionAside(const std::filesystem::path& path);
 
 // Writes atomically (temporary + rename); throws IoError naming the file.
 void SaveSession(const std::filesystem::path& path, const Session& session);

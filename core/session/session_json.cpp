@@ -10,6 +10,7 @@
 #include "core/base/names.h"
 #include "core/io/json_fields.h"
 #include "core/io/json_io.h"
+#include "core/lrf/solver.h"
 #include "core/results/result_json.h"
 #include "core/session/session.h"
 
@@ -323,6 +324,12 @@ void ReadOptions(const Fields& f, Session* s) {
   s->max_iterations = f.Int("max_iterations");
   if (s->max_iterations < 1) f.Fail("max_iterations", "must be at least 1");
   s->ransac_threshold_m = f.Positive("ransac_threshold_m");
+  // Only an LRF session has it (Session::lrf_method).
+  if (f.Has("lrf_method")) {
+    s->lrf_method = f.String("lrf_method");
+    if (!ParseLrfMethod(s->lrf_method))
+      f.Fail("lrf_method", "'" + s->lrf_method + "' is not refined or paper-linear");
+  }
 }
 
 void CheckFormatAndVersion(const Fields& f) {
@@ -370,6 +377,7 @@ Session ReadSession(const json& root, const std::filesystem::path& source_path) 
 
 std::string SessionToJson(const Session& session, const std::filesystem::path& session_path) {
   CALIBENCH_CHECK(!session.dataset.empty() && session.version == kVersion);
+  CALIBENCH_CHECK(session.lrf_method.empty() || ParseLrfMethod(session.lrf_method));
   Json pairs = Json::array();
   for (const PairState& p : session.pairs)
     pairs.push_back({{"id", p.id},
@@ -390,6 +398,7 @@ std::string SessionToJson(const Session& session, const std::filesystem::path& s
                {"view", ViewObject(session.view_json)},
                {"result", session.result ? ResultToJson(*session.result) : Json(nullptr)}};
   if (!session.camera.empty()) root["camera"] = session.camera;
+  if (!session.lrf_method.empty()) root["options"]["lrf_method"] = session.lrf_method;
   std::string text;
   Pretty(root, 0, &text);
   return text + "\n";

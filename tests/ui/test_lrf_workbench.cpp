@@ -39,9 +39,12 @@ std::filesystem::path LrfUiDataset() {
   return manifest;
 }
 
-// Opens the dataset and waits for every pair's features.
+// Opens the dataset and waits for every pair's features. In memory: the tests of one process share
+// the dataset, and a session one of them left beside it would carry into the next (the session's
+// own tests are in test_lrf_session.cpp).
 void OpenAndWait(LrfController& controller) {
-  ASSERT_TRUE(controller.Open(LrfUiDataset())) << controller.GetSnapshot().status_line;
+  ASSERT_TRUE(controller.Open(LrfUiDataset(), LrfController::SessionUse::kInMemory))
+      << controller.GetSnapshot().status_line;
   controller.WaitIdle();
 }
 
@@ -135,8 +138,8 @@ TEST(LrfController, RejectedPairsStayOutOfTheSolve) {
   EXPECT_EQ(controller.GetSnapshot().selected, 3);
 }
 
-// One job (core/lrf/lrf_job.h): the workbench and `calibench lrf-calibrate` run the same
-// extraction and solve, so a rejection made in the workbench and the same pair left out on the
+// One job (core/session/lrf_calibration_job.h): the workbench and `calibench lrf-calibrate` run the
+// same extraction and solve, so a rejection made in the workbench and the same pair left out on the
 // command line give the same transform, bit for bit.
 TEST(LrfController, TheWorkbenchAndLrfCalibrateRunOneJob) {
   LrfController controller;
@@ -257,11 +260,12 @@ TEST_F(LrfWorkbenchRender, GoldenLayoutsAfterASolve) {
 
 // One frame with a key held; returns the intents the panels produced (not yet applied).
 std::vector<LrfIntent> FrameWithKey(LrfController& controller, LrfWorkbench& workbench,
-                                    ImGuiHost& host, int key) {
+                                    ImGuiHost& host, int key, bool ctrl = false) {
   ImGuiIO& io = ImGui::GetIO();
   io.MousePos = {-1, -1};
   for (bool& k : io.KeysDown) k = false;
   if (key >= 0) io.KeysDown[key] = true;
+  io.KeyCtrl = ctrl;
   controller.WaitIdle();
   host.NewFrame(1280, 720, 1.0 / 60.0);
   auto intents =
@@ -270,19 +274,25 @@ std::vector<LrfIntent> FrameWithKey(LrfController& controller, LrfWorkbench& wor
   return intents;
 }
 
-TEST_F(LrfWorkbenchRender, KeysRejectAcceptSelectAndSolve) {
+TEST_F(LrfWorkbenchRender, KeysRejectAcceptUndoRedoSelectAndSolve) {
   LrfController controller;
   OpenAndWait(controller);
   LrfWorkbench workbench;
-  auto press = [&](int key) {
+  auto press = [&](int key, bool ctrl = false) {
     FrameWithKey(controller, workbench, *host_, -1);  // release first: presses are edges
-    auto intents = FrameWithKey(controller, workbench, *host_, key);
+    auto intents = FrameWithKey(controller, workbench, *host_, key, ctrl);
     for (const LrfIntent& intent : intents) controller.Apply(intent);
     return intents;
   };
   ASSERT_EQ(press('R').size(), 1u);
   EXPECT_EQ(controller.GetSnapshot().pairs[0].status, PairStatus::kRejected);
   ASSERT_EQ(press('A').size(), 1u);
+  EXPECT_EQ(controller.GetSnapshot().pairs[0].status, PairStatus::kAccepted);
+  // Ctrl+Z takes the acceptance back, Ctrl+Y makes it again.
+  ASSERT_EQ(press('Z', true).size(), 1u);
+  EXPECT_EQ(controller.GetSnapshot().pairs[0].status, PairStatus::kRejected);
+  EXPECT_TRUE(controller.GetSnapshot().can_redo);
+  ASSERT_EQ(press('Y', true).size(), 1u);
   EXPECT_EQ(controller.GetSnapshot().pairs[0].status, PairStatus::kAccepted);
   ASSERT_EQ(press(ImGui::GetIO().KeyMap[ImGuiKey_DownArrow]).size(), 1u);
   EXPECT_EQ(controller.GetSnapshot().selected, 1);

@@ -3,7 +3,6 @@
 // save-as, undo and redo.
 #include <algorithm>
 #include <cmath>
-#include <ctime>
 
 #include "core/base/allocator.h"
 #include "core/base/atomic_file.h"
@@ -14,26 +13,6 @@
 #include "ui/lidar_camera/controller.h"
 
 namespace calibench::ui {
-
-namespace {
-
-// Moves `path` aside to `<path>.<YYYYmmdd-HHMMSS>.bak` (a new name each time) and returns it.
-std::filesystem::path BackUpSession(const std::filesystem::path& path) {
-  const std::time_t now = std::time(nullptr);
-  char stamp[32];
-  std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", std::localtime(&now));
-  std::filesystem::path backup = path.string() + "." + stamp + ".bak";
-  for (int n = 2; std::filesystem::exists(backup); ++n)
-    backup = path.string() + "." + stamp + "-" + std::to_string(n) + ".bak";
-  std::error_code ec;
-  std::filesystem::rename(path, backup, ec);
-  if (ec)
-    throw IoError(path.string() + ": cannot move the session aside to " + backup.string() + " (" +
-                  ec.message() + "); it was left as it is");
-  return backup;
-}
-
-}  // namespace
 
 void Controller::OpenDataset(const std::filesystem::path& dataset_path,
                              std::filesystem::path session_path, ExistingSession existing,
@@ -79,7 +58,7 @@ void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path
       }
       if (ResumeBackup(session_path, note, &lock)) return;
     }
-    note += "kept the old session as " + BackUpSession(session_path).string();
+    note += "kept the old session as " + MoveSessionAside(session_path).string();
   }
   Open(dataset, std::move(session), session_path, note, std::move(lock));
 }
@@ -124,7 +103,7 @@ bool Controller::ResumeBackup(const std::filesystem::path& session_path, const s
     if (!std::filesystem::exists(backup)) continue;
     try {
       auto [session, dataset] = LoadSessionWithDataset(backup);
-      const std::string kept = BackUpSession(session_path).string();
+      const std::string kept = MoveSessionAside(session_path).string();
       Open(dataset, std::move(session), session_path,
            note + "resumed its newest backup that opens, " + backup.string() +
                "; the one that did not open is kept as " + kept,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
 #include "core/estimation/uncertainty.h"
 #include "core/io/image_io.h"
@@ -59,51 +60,6 @@ LrfController::~LrfController() { StopWorker(); }
 
 void LrfController::OnJobError() { state_.solver.running = false; }
 
-bool LrfController::Open(const std::filesystem::path& manifest) {
-  std::string why;
-  std::shared_ptr<const LrfDataset> dataset;
-  try {
-    if (!options_.Check(&why)) throw IoError("LRF pipeline options: " + why);
-    dataset = std::make_shared<const LrfDataset>(LoadLrfDataset(manifest));
-  } catch (const IoError& e) {
-    std::lock_guard lock(mutex_);
-    SetStatus(std::string("cannot open: ") + e.what(), true);
-    return false;
-  }
-  // Jobs of the previous dataset are dropped; one still running discards its result.
-  worker_.DropQueued();
-  std::uint64_t open_count;
-  {
-    std::lock_guard lock(mutex_);
-    open_count = ++open_count_;
-    const std::uint64_t generation = state_.generation;
-    state_ = LrfSnapshot{};
-    state_.generation = generation;
-    state_.solver.method = options_.solver.method;
-    state_.manifest = dataset->manifest;
-    state_.dataset = dataset;
-    for (const LrfPairEntry& entry : dataset->pairs) state_.pairs.emplace_back().id = entry.id;
-    state_.selected = state_.pairs.empty() ? -1 : 0;
-    state_.extracted_total = static_cast<int>(state_.pairs.size());
-    outcome_.reset();
-    SetStatus("extracting features of " + std::to_string(state_.pairs.size()) + " pairs from " +
-                  dataset->manifest.string(),
-              false);
-  }
-  // The job every front end runs (core/lrf/lrf_job.h); the worker alone drives it, each job of
-  // the worker holding the one of its Open.
-  auto job = std::make_shared<LrfCalibrationJob>(*dataset, options_);
-  {
-    std::lock_guard lock(mutex_);
-    job_ = job;
-  }
-  for (int i = 0; i < static_cast<int>(dataset->pairs.size()); ++i)
-    worker_.Enqueue([this, job, open_count, i] { Extract(job.get(), open_count, i); });
-  if (dataset->target_type == LrfTargetType::kCheckerboard)
-    worker_.Enqueue([this] { LoadSelectedImage(); });
-  return true;
-}
-
 void LrfController::Extract(LrfCalibrationJob* job, std::uint64_t open_count, int index) {
   {
     std::lock_guard lock(mutex_);
@@ -115,12 +71,7 @@ void LrfController::Extract(LrfCalibrationJob* job, std::uint64_t open_count, in
   LrfPairView& pair = state_.pairs[index];
   pair.features = features;
   pair.extracted = true;
-  // Usable pairs are accepted unless the user rejected them; the others fail with the reason.
-  if (pair.status != PairStatus::kRejected) {
-    const bool usable = HasFeatures(*features);
-    pair.status = usable ? PairStatus::kAccepted : PairStatus::kFailed;
-    pair.reason = usable ? "" : FeatureFailure(*features);
-  }
+  if (pair.status != PairStatus::kRejected) SetExtractedStatus(&pair);
   if (++state_.extracted_done == state_.extracted_total) {
     const int accepted = static_cast<int>(
         std::count_if(state_.pairs.begin(), state_.pairs.end(),
@@ -136,15 +87,11 @@ void LrfController::Extract(LrfCalibrationJob* job, std::uint64_t open_count, in
 
 void LrfController::Solve() {
   std::shared_ptr<LrfCalibrationJob> job;
-  std::vector<std::pair<std::string, bool>> rejected;  // the user's word, as the rows hold it
-  LrfMethod method;
   {
     std::lock_guard lock(mutex_);
     if (!state_.dataset || !job_) return;
     job = job_;
-    method = state_.solver.method;
-    for (const LrfPairView& view : state_.pairs)
-      rejected.emplace_back(view.id, view.status == PairStatus::kRejected);
+    const LrfMethod method = state_.solver.method;
     state_.solver = LrfSolverView{};
     state_.solver.method = method;
     state_.solver.running = true;
@@ -152,10 +99,11 @@ void LrfController::Solve() {
     UpdatePairFigures();
     SetStatus("solving (" + LrfMethodName(method) + ") ...", false);
   }
-  for (const auto& [id, is_rejected] : rejected) job->SetRejected(id, is_rejected);
-  job->SetMethod(method);
+  // The job reads the user's rejections and method from its record, where the intents put them.
   auto outcome = std::make_shared<LrfCalibrationOutcome>(job->Solve());
   std::lock_guard lock(mutex_);
+  if (job != job_) return;  // another dataset opened while it solved
+  Autosave();               // the solve is the record's now
   LrfSolverView& solver = state_.solver;
   solver.running = false;
   if (!outcome->solution || !outcome->solution->ok) {
@@ -184,6 +132,18 @@ void LrfController::Solve() {
                     .c_str(),
                 well ? "" : " (NOT well constrained)");
   SetStatus(line, !well);
+}
+
+void LrfController::SetExtractedStatus(LrfPairView* pair) {
+  // Usable pairs are accepted unless the user rejected them; the others fail with the reason.
+  if (!pair->features) {
+    pair->status = PairStatus::kPending;
+    pair->reason.clear();
+    return;
+  }
+  const bool usable = HasFeatures(*pair->features);
+  pair->status = usable ? PairStatus::kAccepted : PairStatus::kFailed;
+  pair->reason = usable ? "" : FeatureFailure(*pair->features);
 }
 
 void LrfController::UpdatePairFigures() {
@@ -225,6 +185,10 @@ void LrfController::Handle(const LrfSelectPair& select) {
   state_.selected = select.index;
   state_.selected_image.reset();
   ++state_.generation;
+  // Saved with the session, but no undo step (as in the LiDAR-camera workbench).
+  const std::string view = nlohmann::json{{"selected_pair", state_.pairs[select.index].id}}.dump();
+  job_->record().Edit([&](Session* session) { session->view_json = view; }, /*amend=*/true);
+  Autosave();
   if (state_.dataset->target_type == LrfTargetType::kCheckerboard)
     worker_.Enqueue([this] { LoadSelectedImage(); });
 }
@@ -240,6 +204,8 @@ void LrfController::Handle(const LrfSetPairStatus& status) {
   }
   pair.status = status.status;
   pair.reason = status.status == PairStatus::kRejected ? kRejectedByUser : "";
+  job_->SetRejected(pair.id, status.status == PairStatus::kRejected);
+  AfterEdit();
   SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
                 (state_.solver.solution ? "; press Run to re-solve" : ""),
             false);
@@ -258,11 +224,15 @@ void LrfController::Handle(const LrfResetSolver&) {
   state_.solver.method = method;
   outcome_.reset();
   UpdatePairFigures();
+  job_->record().Edit([](Session* session) { session->result.reset(); }, /*amend=*/true);
+  Autosave();
 }
 
 void LrfController::Handle(const LrfSetMethod& method) {
   if (method.method == state_.solver.method) return;
   state_.solver.method = method.method;
+  job_->SetMethod(method.method);
+  AfterEdit();
   SetStatus("method " + LrfMethodName(method.method) + "; press Run to solve with it", false);
 }
 

@@ -1,7 +1,9 @@
 // The 2D LRF workbench's state and the only place that changes it (the LRF counterpart of
 // ui/lidar_camera/controller.h). Panels read an LrfSnapshot and return LrfIntents; the controller
-// applies them and runs the LRF job (core/lrf/lrf_job.h, what `lrf-calibrate` runs: extraction
-// and the solve) on a worker thread.
+// applies them and runs the LRF job (core/session/lrf_calibration_job.h, what `lrf-calibrate`
+// runs: extraction and the solve) on a worker thread. The job's record is the session: the user's
+// rejections, the method, the selected pair and the last solve, with undo and an autosave beside
+// the manifest (calibench.lrf-session.json), resumed when the manifest opens again.
 // No GL, GLFW or ImGui here: the controller is driven by tests without a window.
 #pragma once
 
@@ -15,9 +17,10 @@
 #include <variant>
 #include <vector>
 
+#include "core/base/file_lock.h"
 #include "core/base/image.h"
-#include "core/lrf/lrf_job.h"
 #include "core/lrf/pipeline.h"
+#include "core/session/lrf_calibration_job.h"
 #include "ui/state/controller_state.h"
 
 namespace calibench::ui {
@@ -53,6 +56,10 @@ struct LrfSnapshot : SnapshotHeader {
   std::shared_ptr<const ImageU8> selected_image;  // checkerboard case: the RGB image of `selected`
   LrfSolverView solver;
   int extracted_done = 0, extracted_total = 0;
+  std::filesystem::path session_path;  // where the session autosaves; empty: nowhere
+  bool can_undo = false, can_redo = false;
+  std::string save_error;    // the last autosave's failure; empty when it saved
+  std::string session_note;  // what opening did with the session there (resumed, moved aside)
 };
 
 struct LrfSelectPair {
@@ -70,8 +77,11 @@ struct LrfSetMethod {
 struct LrfExportResult {
   std::filesystem::path path;  // a relative path is taken from the manifest's folder
 };
+// Takes back the last rejection or method change (Ctrl+Z); Redo (Ctrl+Y) makes it again.
+struct LrfUndo {};
+struct LrfRedo {};
 using LrfIntent = std::variant<LrfSelectPair, LrfSetPairStatus, LrfRunSolver, LrfResetSolver,
-                               LrfSetMethod, LrfExportResult>;
+                               LrfSetMethod, LrfExportResult, LrfUndo, LrfRedo>;
 
 // Appends an intent constructed in place (a moved temporary variant trips GCC 12's
 // -Wmaybe-uninitialized).
@@ -87,18 +97,42 @@ class LrfController : public ControllerState<LrfSnapshot> {
   LrfController(const LrfController&) = delete;
   LrfController& operator=(const LrfController&) = delete;
 
-  // Loads the manifest and queues feature extraction of every pair. A manifest that cannot be
-  // read leaves the open dataset as it was and shows the error in the status line (false).
-  bool Open(const std::filesystem::path& manifest);
+  // What Open does with the session beside the manifest (DefaultLrfSessionPath).
+  enum class SessionUse {
+    kResume,    // resumes it, or starts one there; autosaves to it
+    kFresh,     // moves it aside (<session>.<date-time>.bak) and starts a new one there
+    kInMemory,  // neither reads nor writes it (`calibench render`)
+  };
+  // Loads the manifest, opens its session as `use` says, and queues feature extraction of every
+  // pair. A session that does not open is moved aside too, and a new one starts (the status line
+  // says so). A manifest that cannot be read, or a session open in another workbench, leaves the
+  // open dataset as it was and shows the error in the status line (false).
+  bool Open(const std::filesystem::path& manifest, SessionUse use = SessionUse::kResume);
+  // Opens a saved LRF session (calibench.session.v1 with options.lrf_method) with the manifest it
+  // names, and autosaves to it from then on; false with the error shown, as Open.
+  bool OpenSession(const std::filesystem::path& session_path);
   void Apply(const LrfIntent& intent);
 
  private:
   void OnJobError() override;
+  // Starts on `dataset` with the record `saved` (nullopt: a new session), autosaving to
+  // `session_path` under `lock`; `note` opens the status line.
+  void Start(std::shared_ptr<const LrfDataset> dataset, std::optional<Session> saved,
+             const std::filesystem::path& session_path, std::optional<FileLock> lock,
+             const std::string& note);
+  // The record's rejections, method and selected pair onto the rows (mutex_ held).
+  void ApplySessionToState(const Session& session);
+  void Autosave();   // call with mutex_ held; a failure shows, and is retried at the next edit
+  void AfterEdit();  // undo state and autosave after a record change (mutex_ held)
+  bool Fail(const std::string& message);  // the status line says it; false
   // Pair `index` extracted by `job` (worker; the job of the Open that queued it).
   void Extract(LrfCalibrationJob* job, std::uint64_t open_count, int index);
   void Solve();
   void LoadSelectedImage();
   void UpdatePairFigures();  // call with mutex_ held
+  // A pair not rejected: accepted when extraction gave what the solver needs, failed with the
+  // reason when not, pending before.
+  static void SetExtractedStatus(LrfPairView* pair);
   bool ValidPair(int index) const;
   // One handler per intent type, as the lidar-camera controller has (Apply visits them with
   // mutex_ held and a dataset open).
@@ -108,12 +142,16 @@ class LrfController : public ControllerState<LrfSnapshot> {
   void Handle(const LrfResetSolver& intent);
   void Handle(const LrfSetMethod& intent);
   void Handle(const LrfExportResult& intent);
+  void Handle(const LrfUndo& intent);
+  void Handle(const LrfRedo& intent);
+  void Restore(const std::optional<Session>& restored, const char* what);
 
   LrfPipelineOptions options_;
-  // The pipeline job over the open dataset (core/lrf/lrf_job.h), as `lrf-calibrate` runs it:
-  // extraction and the solve, driven by the worker only; replaced by Open (mutex_ for the
-  // pointer).
+  // The pipeline job over the open dataset (core/session/lrf_calibration_job.h), as
+  // `lrf-calibrate` runs it: extraction and the solve, driven by the worker only; its record is
+  // edited here too (it locks itself). Replaced by Open (mutex_ for the pointer).
   std::shared_ptr<LrfCalibrationJob> job_;
+  std::optional<FileLock> session_lock_;                  // held while the session is open here
   std::shared_ptr<const LrfCalibrationOutcome> outcome_;  // of the shown solution, for export
   std::uint64_t open_count_ = 0;  // a job of an earlier Open() discards its result
 };

@@ -83,6 +83,16 @@ class LrfWindowShell {
       if (ImGui::MenuItem("Quit")) quit_ = true;
       ImGui::EndMenu();
     }
+    if (ImGui::BeginMenu("Edit")) {
+      const LrfSnapshot s = controller_.GetSnapshot();
+      if (ImGui::MenuItem("Undo", "Ctrl+Z", false, s.can_undo)) controller_.Apply(LrfUndo{});
+      if (ImGui::MenuItem("Redo", "Ctrl+Y", false, s.can_redo)) controller_.Apply(LrfRedo{});
+      ImGui::Separator();
+      ImGui::TextDisabled("session (saved as you go): %s",
+                          s.session_path.empty() ? "none" : s.session_path.c_str());
+      if (!s.session_note.empty()) ImGui::TextDisabled("%s", s.session_note.c_str());
+      ImGui::EndMenu();
+    }
     const float height = ImGui::GetWindowSize().y;
     ImGui::EndMainMenuBar();
     return height;

@@ -137,6 +137,9 @@ void LrfWorkbench::HandleKeys(const LrfSnapshot& s, std::vector<LrfIntent>* inte
   if (keys.next) EmitLrfIntent<LrfSelectPair>(intents, std::min(n - 1, s.selected + 1));
   if (keys.previous) EmitLrfIntent<LrfSelectPair>(intents, std::max(0, s.selected - 1));
   if (keys.run) EmitLrfIntent<LrfRunSolver>(intents);
+  const bool ctrl = ImGui::GetIO().KeyCtrl;
+  if (ctrl && KeyPressed('Z')) EmitLrfIntent<LrfUndo>(intents);
+  if (ctrl && KeyPressed('Y')) EmitLrfIntent<LrfRedo>(intents);
 }
 
 }  // namespace calibench::ui

@@ -1,12 +1,10 @@
-#include "core/lrf/lrf_job.h"
-
-#include <set>
+#include "core/lrf/pair_extraction.h"
 
 #include "core/base/parallel.h"
 
 namespace calibench {
 
-LrfCalibrationJob::LrfCalibrationJob(LrfDataset dataset, LrfPipelineOptions options)
+LrfPairExtraction::LrfPairExtraction(LrfDataset dataset, LrfPipelineOptions options)
     : options_(std::move(options)) {
   const std::set<std::string> wanted(options_.pair_ids.begin(), options_.pair_ids.end());
   std::vector<LrfPairEntry> selected;
@@ -17,7 +15,7 @@ LrfCalibrationJob::LrfCalibrationJob(LrfDataset dataset, LrfPipelineOptions opti
   features_.resize(dataset_.pairs.size());
 }
 
-void LrfCalibrationJob::ExtractAll(const ProgressCallback& progress) {
+void LrfPairExtraction::ExtractAll(const ProgressCallback& progress) {
   std::vector<size_t> missing;
   for (size_t i = 0; i < features_.size(); ++i)
     if (!features_[i]) missing.push_back(i);
@@ -34,7 +32,7 @@ void LrfCalibrationJob::ExtractAll(const ProgressCallback& progress) {
       });
 }
 
-std::shared_ptr<const LrfPairFeatures> LrfCalibrationJob::ExtractPair(int index) {
+std::shared_ptr<const LrfPairFeatures> LrfPairExtraction::ExtractPair(int index) {
   std::shared_ptr<const LrfPairFeatures>& features = features_.at(index);
   if (!features)
     features = std::make_shared<const LrfPairFeatures>(
@@ -42,14 +40,7 @@ std::shared_ptr<const LrfPairFeatures> LrfCalibrationJob::ExtractPair(int index)
   return features;
 }
 
-void LrfCalibrationJob::SetRejected(const std::string& pair_id, bool rejected) {
-  if (rejected)
-    rejected_.insert(pair_id);
-  else
-    rejected_.erase(pair_id);
-}
-
-std::vector<LrfPairFeatures> LrfCalibrationJob::ExtractedPairs() const {
+std::vector<LrfPairFeatures> LrfPairExtraction::Pairs(const std::set<std::string>& rejected) const {
   std::vector<LrfPairFeatures> pairs;
   for (size_t i = 0; i < features_.size(); ++i) {
     if (!features_[i]) {
@@ -60,7 +51,7 @@ std::vector<LrfPairFeatures> LrfCalibrationJob::ExtractedPairs() const {
       continue;
     }
     pairs.push_back(*features_[i]);
-    if (rejected_.count(pairs.back().id)) {
+    if (rejected.count(pairs.back().id)) {
       pairs.back().status = PairStatus::kRejected;
       pairs.back().reason = kRejectedByUser;
     }
@@ -68,21 +59,21 @@ std::vector<LrfPairFeatures> LrfCalibrationJob::ExtractedPairs() const {
   return pairs;
 }
 
-const LrfCalibrationOutcome& LrfCalibrationJob::Solve() {
+LrfCalibrationOutcome LrfPairExtraction::Solve(const std::set<std::string>& rejected,
+                                               const LrfPipelineOptions& options) const {
   // Pairs not extracted yet stay out (SolveLrfFromFeatures uses accepted ones with features).
   std::vector<LrfPairFeatures> pairs;
-  for (LrfPairFeatures& pair : ExtractedPairs())
+  for (LrfPairFeatures& pair : Pairs(rejected))
     if (pair.status != PairStatus::kPending) pairs.push_back(std::move(pair));
-  outcome_ = SolveLrfFromFeatures(std::move(pairs), dataset_, options_);
-  return *outcome_;
+  return SolveLrfFromFeatures(std::move(pairs), dataset_, options);
 }
 
 LrfCalibrationOutcome CalibrateLrfDataset(const LrfDataset& dataset,
                                           const LrfPipelineOptions& options,
                                           const ProgressCallback& progress) {
-  LrfCalibrationJob job(dataset, options);
-  job.ExtractAll(progress);
-  return job.Solve();
+  LrfPairExtraction extraction(dataset, options);
+  extraction.ExtractAll(progress);
+  return extraction.Solve({}, options);
 }
 
 }  // namespace calibench

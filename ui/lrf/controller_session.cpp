@@ -1,0 +1,215 @@
+// The LRF controller's session lifecycle: opening a manifest (its session resumed, or moved aside)
+// or a session file, the record mirrored into the rows, autosave, undo and redo. The record is the
+// LRF job's (core/session/lrf_calibration_job.h).
+#include <nlohmann/json.hpp>
+
+#include "ui/lrf/controller.h"
+
+namespace calibench::ui {
+namespace {
+
+// The session's selected pair (its view's "selected_pair"), or the first one.
+int SelectedInView(const Session& session) {
+  const nlohmann::json view = nlohmann::json::parse(session.view_json, nullptr, false);
+  const auto found = view.is_object() ? view.find("selected_pair") : view.end();
+  if (found != view.end() && found->is_string())
+    for (size_t i = 0; i < session.pairs.size(); ++i)
+      if (session.pairs[i].id == found->get<std::string>()) return static_cast<int>(i);
+  return session.pairs.empty() ? -1 : 0;
+}
+
+// The session file locked for this workbench, or an IoError naming who holds it. A folder where no
+// lock file can be made gets none: editing goes on, and autosave says why it fails.
+std::optional<FileLock> LockSession(const std::filesystem::path& session, std::string* note) {
+  std::string holder;
+  try {
+    std::optional<FileLock> lock = FileLock::TryLock(session, &holder);
+    if (!lock)
+      throw IoError(session.string() + ": the session is open in another Calibench workbench (" +
+                    holder + "); close it there first");
+    return lock;
+  } catch (const IoError& e) {
+    if (!holder.empty()) throw;
+    *note = std::string("cannot lock the session (") + e.what() + "); ";
+    return std::nullopt;
+  }
+}
+
+// The session at `session_path` when `use` resumes it and it is `dataset`'s; otherwise the file is
+// moved aside (said in *note) and nullopt. Throws IoError when it cannot be moved.
+std::optional<Session> ResumeOrMoveAside(const LrfDataset& dataset,
+                                         const std::filesystem::path& session_path,
+                                         LrfController::SessionUse use, std::string* note) {
+  std::string why = "started over";
+  if (use == LrfController::SessionUse::kResume) {
+    try {
+      LrfSessionWithDataset opened = LoadLrfSessionWithDataset(session_path);
+      if (opened.session.dataset != NormalizeSessionPath(dataset.manifest))
+        throw IoError(session_path.string() + " is the session of " +
+                      opened.session.dataset.string());
+      *note += "resumed the session in " + session_path.string() +
+               " (--fresh starts over and keeps it as a backup); ";
+      return std::move(opened.session);
+    } catch (const IoError& e) {
+      why = "the session there did not open (" + std::string(e.what()) + ")";
+    }
+  }
+  *note += why + ": kept the old one as " + MoveSessionAside(session_path).string() + "; ";
+  return std::nullopt;
+}
+
+}  // namespace
+
+bool LrfController::Fail(const std::string& message) {
+  std::lock_guard lock(mutex_);
+  SetStatus(message, true);
+  return false;
+}
+
+bool LrfController::Open(const std::filesystem::path& manifest, SessionUse use) {
+  std::string why;
+  std::shared_ptr<const LrfDataset> dataset;
+  std::filesystem::path session_path;
+  std::optional<FileLock> lock;
+  std::optional<Session> saved;
+  std::string note;
+  try {
+    if (!options_.Check(&why)) throw IoError("LRF pipeline options: " + why);
+    dataset = std::make_shared<const LrfDataset>(LoadLrfDataset(manifest));
+    if (use != SessionUse::kInMemory) {
+      session_path = DefaultLrfSessionPath(dataset->manifest);
+      if (!(session_lock_ && session_lock_->locked() == session_path))
+        lock = LockSession(session_path, &note);
+      if (std::filesystem::exists(session_path))
+        saved = ResumeOrMoveAside(*dataset, session_path, use, &note);
+    }
+  } catch (const IoError& e) {
+    return Fail(std::string("cannot open: ") + e.what());
+  }
+  Start(dataset, std::move(saved), session_path, std::move(lock), note);
+  return true;
+}
+
+bool LrfController::OpenSession(const std::filesystem::path& session_path) {
+  std::string why, note;
+  std::optional<FileLock> lock;
+  LrfSessionWithDataset opened;
+  try {
+    if (!options_.Check(&why)) throw IoError("LRF pipeline options: " + why);
+    if (!(session_lock_ && session_lock_->locked() == session_path))
+      lock = LockSession(session_path, &note);
+    opened = LoadLrfSessionWithDataset(session_path);
+  } catch (const IoError& e) {
+    return Fail(std::string("cannot open: ") + e.what());
+  }
+  Start(std::make_shared<const LrfDataset>(std::move(opened.dataset)), std::move(opened.session),
+        session_path, std::move(lock), "opened the session " + session_path.string() + "; ");
+  return true;
+}
+
+void LrfController::Start(std::shared_ptr<const LrfDataset> dataset, std::optional<Session> saved,
+                          const std::filesystem::path& session_path, std::optional<FileLock> lock,
+                          const std::string& note) {
+  // Jobs of the previous dataset are dropped; one still running discards its result.
+  worker_.DropQueued();
+  const bool resolve = saved && saved->result.has_value();  // what was on screen: a solve
+  // The job every front end runs; the worker alone drives its extraction and solve, each job of
+  // the worker holding the one of its Open.
+  auto job = std::make_shared<LrfCalibrationJob>(*dataset, options_, std::move(saved));
+  std::uint64_t open_count;
+  {
+    std::lock_guard guard(mutex_);
+    open_count = ++open_count_;
+    if (lock)
+      session_lock_ = std::move(lock);
+    else if (!session_lock_ || session_lock_->locked() != session_path)
+      session_lock_.reset();
+    const std::uint64_t generation = state_.generation;
+    state_ = LrfSnapshot{};
+    state_.generation = generation;
+    state_.manifest = dataset->manifest;
+    state_.dataset = dataset;
+    state_.session_path = session_path;
+    state_.session_note = note.empty() ? "" : note.substr(0, note.size() - 2);  // less "; "
+    for (const LrfPairEntry& entry : dataset->pairs) state_.pairs.emplace_back().id = entry.id;
+    state_.extracted_total = static_cast<int>(state_.pairs.size());
+    outcome_.reset();
+    job_ = job;
+    job_->record().AutosaveTo(session_path);
+    const Session session = job_->record().Current();
+    ApplySessionToState(session);
+    state_.selected = SelectedInView(session);
+    Autosave();
+    SetStatus(note + "extracting features of " + std::to_string(state_.pairs.size()) +
+                  " pairs from " + dataset->manifest.string(),
+              false);
+  }
+  for (int i = 0; i < static_cast<int>(dataset->pairs.size()); ++i)
+    worker_.Enqueue([this, job, open_count, i] { Extract(job.get(), open_count, i); });
+  if (dataset->target_type == LrfTargetType::kCheckerboard)
+    worker_.Enqueue([this] { LoadSelectedImage(); });
+  if (resolve) worker_.Enqueue([this] { Solve(); });  // the same features and word: the same solve
+}
+
+void LrfController::ApplySessionToState(const Session& session) {
+  mutex_.AssertHeld(__func__);
+  state_.solver.method = *ParseLrfMethod(session.lrf_method);
+  for (size_t i = 0; i < state_.pairs.size() && i < session.pairs.size(); ++i) {
+    LrfPairView& pair = state_.pairs[i];
+    if (session.pairs[i].status == PairStatus::kRejected) {
+      pair.status = PairStatus::kRejected;
+      pair.reason = session.pairs[i].reason.empty() ? kRejectedByUser : session.pairs[i].reason;
+    } else if (pair.status == PairStatus::kRejected) {
+      SetExtractedStatus(&pair);
+    }
+  }
+  state_.can_undo = job_->record().CanUndo();
+  state_.can_redo = job_->record().CanRedo();
+  ++state_.generation;
+}
+
+void LrfController::Autosave() {
+  mutex_.AssertHeld(__func__);
+  try {
+    if (job_) job_->record().Autosave();
+    state_.save_error.clear();
+  } catch (const IoError& e) {
+    state_.save_error = e.what();
+    SetStatus(std::string("autosave failed: ") + e.what(), true);
+  }
+}
+
+void LrfController::AfterEdit() {
+  mutex_.AssertHeld(__func__);
+  state_.can_undo = job_->record().CanUndo();
+  state_.can_redo = job_->record().CanRedo();
+  Autosave();
+  ++state_.generation;
+}
+
+void LrfController::Handle(const LrfUndo&) { Restore(job_->record().Undo(), "undid"); }
+void LrfController::Handle(const LrfRedo&) { Restore(job_->record().Redo(), "redid"); }
+
+void LrfController::Restore(const std::optional<Session>& restored, const char* what) {
+  if (!restored) {
+    SetStatus(std::string("nothing to ") + (what[0] == 'u' ? "undo" : "redo"), false);
+    return;
+  }
+  ApplySessionToState(*restored);
+  Autosave();
+  // The solve shown is the restored state's: solved again from its word (the same features give
+  // the same solve), or none when that state had none.
+  if (restored->result) {
+    state_.solver.running = true;
+    worker_.Enqueue([this] { Solve(); });
+  } else {
+    const LrfMethod method = state_.solver.method;
+    state_.solver = LrfSolverView{};
+    state_.solver.method = method;
+    outcome_.reset();
+    UpdatePairFigures();
+  }
+  SetStatus(std::string(what) + " the last change", false);
+}
+
+}  // namespace calibench::ui
