@@ -229,6 +229,21 @@ Session SessionOverPairs(Session saved, const std::vector<std::string>& ids,
   return saved;
 }
 
+std::optional<FileLock> LockSessionFile(const std::filesystem::path& session, std::string* note) {
+  std::string holder;
+  try {
+    std::optional<FileLock> lock = FileLock::TryLock(session, &holder);
+    if (!lock)
+      throw IoError(session.string() + ": the session is open in another Calibench workbench (" +
+                    holder + "); close it there first, or open a copy of the file");
+    return lock;
+  } catch (const IoError& e) {
+    if (!holder.empty()) throw;
+    *note = std::string("cannot lock the session (") + e.what() + ")";
+    return std::nullopt;
+  }
+}
+
 std::filesystem::path MoveSessionAside(const std::filesystem::path& path) {
   const std::time_t now = std::time(nullptr);
   char stamp[32];

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/base/file_lock.h"
 #include "core/base/types.h"
 #include "core/io/dataset.h"
 #include "core/lidar/colormap.h"
@@ -181,6 +182,11 @@ Session SessionOverPairs(Session saved, const std::vector<std::string>& ids,
 // `report` and the workbench's Open tell a session from a result or a manifest by. False for a
 // file that cannot be read.
 bool IsSessionFile(const std::filesystem::path& path);
+
+// Locks a session file for one workbench (FileLock on <session>.lock). Throws IoError naming the
+// file and the holder when another workbench has it. A folder where no lock file can be made gets
+// none (nullopt, *note says why): editing goes on there, and autosave says why it fails.
+std::optional<FileLock> LockSessionFile(const std::filesystem::path& session, std::string* note);
 
 // Moves a session file that will not be resumed aside, to `<path>.<YYYYmmdd-HHMMSS>.bak` (a new
 // name each time), and returns that name. Throws IoError naming both when the move fails (the file

@@ -364,13 +364,22 @@ def calibrate(dataset: Optional[PathLike] = None, method: str = "weighted-ml", *
     return _solve("calibrate", args + _flag_args(options), out, progress)
 
 
-def lrf_calibrate(dataset: PathLike, method: str = "refined", *, out: Optional[PathLike] = None,
+def lrf_calibrate(dataset: Optional[PathLike] = None, method: Optional[str] = None, *,
+                  session: Optional[PathLike] = None, out: Optional[PathLike] = None,
                   progress: Optional[Progress] = None, **options: Any) -> Result:
     """`calibench lrf-calibrate`: a 2D laser rangefinder to a depth camera (three-face target) or
-    an RGB camera (checkerboard). method: refined | paper-linear. Options: ``error_threshold``,
-    ``huber_delta``, ``pairs``, ``threads``. The result's ``cam_from_lidar`` is cam_from_lrf."""
-    args = ["--dataset", os.fspath(dataset), "--method", method] + _flag_args(options)
-    return _solve("lrf-calibrate", args, out, progress)
+    an RGB camera (checkerboard). method: refined (the default) | paper-linear; or give
+    ``session`` (the LRF workbench's calibench.lrf-session.json: its rejections and method, and its
+    dataset unless ``dataset`` is given). Options: ``error_threshold``, ``huber_delta``, ``pairs``,
+    ``threads``. The result's ``cam_from_lidar`` is cam_from_lrf."""
+    args = []
+    if dataset is not None:
+        args += ["--dataset", os.fspath(dataset)]
+    if session is not None:
+        args += ["--session", os.fspath(session)]
+    if method is not None:
+        args += ["--method", method]
+    return _solve("lrf-calibrate", args + _flag_args(options), out, progress)
 
 
 def advise(dataset: PathLike, *, progress: Optional[Progress] = None,

@@ -90,6 +90,35 @@ def test_lrf_calibrate_equals_the_command_line(exe, tmp_path):
                                atol=1e-12)
 
 
+def test_lrf_calibrate_with_a_workbench_session(exe, tmp_path):
+    dataset = tmp_path / "lrf"
+    assert cli(exe, "simulate", "--kind", "lrf", "--observations", "6", "--out",
+               dataset).returncode == 0
+    ids = [p["id"] for p in json.loads((dataset / "manifest.json").read_text())["pairs"]]
+    # The LRF workbench's session as it writes one: pair 2 rejected, the closed-form method.
+    session = {
+        "format": "calibench.session.v1", "version": 1, "dataset": "manifest.json",
+        "options": {"method": "weighted-ml", "huber_delta": 0.05, "estimate_range_offset": False,
+                    "max_iterations": 50, "ransac_threshold_m": 0.02,
+                    "lrf_method": "paper-linear"},
+        "pairs": [{"id": i, "status": "rejected" if k == 2 else "pending",
+                   "reason": "rejected by the user" if k == 2 else "", "brush": None,
+                   "brush_from_seed": False} for k, i in enumerate(ids)],
+        "view": {}, "result": None}
+    session_file = dataset / "calibench.lrf-session.json"
+    session_file.write_text(json.dumps(session))
+    result = calibench.lrf_calibrate(session=session_file, out=tmp_path / "py.json")
+    kept = ",".join(i for k, i in enumerate(ids) if k != 2)
+    printed = cli(exe, "lrf-calibrate", "--dataset", dataset, "--method", "paper-linear",
+                  "--pairs", kept, "--out", tmp_path / "cli.json")
+    assert printed.returncode == 0, printed.stderr
+    cli_result = calibench.load_result(tmp_path / "cli.json")
+    np.testing.assert_array_equal(result.cam_from_lidar, cli_result.cam_from_lidar)
+    with pytest.raises(calibench.UsageError) as error:
+        calibench.lrf_calibrate(session=session_file, method="refined")
+    assert "disagrees" in str(error.value)
+
+
 def test_run_and_version(exe):
     code, out, err = calibench.run("--version")
     assert code == 0 and out.startswith(f"calibench {calibench.__version__}\n")

@@ -80,20 +80,7 @@ std::optional<FileLock> Controller::LockSession(const std::filesystem::path& ses
   if (session_lock_ && std::filesystem::weakly_canonical(session_lock_->locked(), ec) ==
                            std::filesystem::weakly_canonical(session, ec))
     return std::nullopt;  // this controller has it open already
-  std::string holder;
-  try {
-    std::optional<FileLock> lock = FileLock::TryLock(session, &holder);
-    if (!lock)
-      throw IoError(session.string() + ": the session is open in another Calibench workbench (" +
-                    holder + "); close it there first, or open a copy of the file");
-    return lock;
-  } catch (const IoError& e) {
-    if (!holder.empty()) throw;
-    // No lock file can be made, so no session file either: editing goes on, saving will fail
-    // and say so.
-    *note = std::string("cannot lock the session (") + e.what() + ")";
-    return std::nullopt;
-  }
+  return LockSessionFile(session, note);
 }
 
 bool Controller::ResumeBackup(const std::filesystem::path& session_path, const std::string& note,

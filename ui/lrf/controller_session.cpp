@@ -18,21 +18,16 @@ int SelectedInView(const Session& session) {
   return session.pairs.empty() ? -1 : 0;
 }
 
-// The session file locked for this workbench, or an IoError naming who holds it. A folder where no
-// lock file can be made gets none: editing goes on, and autosave says why it fails.
-std::optional<FileLock> LockSession(const std::filesystem::path& session, std::string* note) {
-  std::string holder;
-  try {
-    std::optional<FileLock> lock = FileLock::TryLock(session, &holder);
-    if (!lock)
-      throw IoError(session.string() + ": the session is open in another Calibench workbench (" +
-                    holder + "); close it there first");
-    return lock;
-  } catch (const IoError& e) {
-    if (!holder.empty()) throw;
-    *note = std::string("cannot lock the session (") + e.what() + "); ";
+// The session file locked for this workbench (LockSessionFile), or nullopt when it already is.
+std::optional<FileLock> LockSession(const std::optional<FileLock>& held,
+                                    const std::filesystem::path& session, std::string* note) {
+  std::error_code ec;
+  if (held && std::filesystem::weakly_canonical(held->locked(), ec) ==
+                  std::filesystem::weakly_canonical(session, ec))
     return std::nullopt;
-  }
+  std::optional<FileLock> lock = LockSessionFile(session, note);
+  if (!note->empty()) *note += "; ";
+  return lock;
 }
 
 // The session at `session_path` when `use` resumes it and it is `dataset`'s; otherwise the file is
@@ -78,8 +73,7 @@ bool LrfController::Open(const std::filesystem::path& manifest, SessionUse use) 
     dataset = std::make_shared<const LrfDataset>(LoadLrfDataset(manifest));
     if (use != SessionUse::kInMemory) {
       session_path = DefaultLrfSessionPath(dataset->manifest);
-      if (!(session_lock_ && session_lock_->locked() == session_path))
-        lock = LockSession(session_path, &note);
+      lock = LockSession(session_lock_, session_path, &note);
       if (std::filesystem::exists(session_path))
         saved = ResumeOrMoveAside(*dataset, session_path, use, &note);
     }
@@ -96,8 +90,7 @@ bool LrfController::OpenSession(const std::filesystem::path& session_path) {
   LrfSessionWithDataset opened;
   try {
     if (!options_.Check(&why)) throw IoError("LRF pipeline options: " + why);
-    if (!(session_lock_ && session_lock_->locked() == session_path))
-      lock = LockSession(session_path, &note);
+    lock = LockSession(session_lock_, session_path, &note);
     opened = LoadLrfSessionWithDataset(session_path);
   } catch (const IoError& e) {
     return Fail(std::string("cannot open: ") + e.what());
