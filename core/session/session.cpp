@@ -244,6 +244,37 @@ std::optional<FileLock> LockSessionFile(const std::filesystem::path& session, st
   }
 }
 
+std::filesystem::path ResumeSessionBeside(
+    const std::filesystem::path& path, bool fresh,
+    const std::function<void(const std::filesystem::path&)>& load, std::string* note) {
+  if (fresh) {
+    *note = "started over: kept the old session as " + MoveSessionAside(path).string();
+    return {};
+  }
+  try {
+    load(path);
+    *note = "resumed the session in " + path.string() +
+            " (--fresh starts over and keeps it as a backup)";
+    return path;
+  } catch (const IoError& e) {
+    *note = "the session there did not open (" + std::string(e.what()) + "): ";
+  }
+  for (int n = 1; n <= AutosaveOptions{}.backups; ++n) {
+    const std::filesystem::path backup = SessionBackupPath(path, n);
+    if (!std::filesystem::exists(backup)) continue;
+    try {
+      load(backup);
+    } catch (const IoError&) {
+      continue;  // an older backup, then
+    }
+    *note += "resumed its newest backup that opens, " + backup.string() +
+             "; the one that did not open is kept as " + MoveSessionAside(path).string();
+    return backup;
+  }
+  *note += "kept the old session as " + MoveSessionAside(path).string();
+  return {};
+}
+
 std::filesystem::path MoveSessionAside(const std::filesystem::path& path) {
   const std::time_t now = std::time(nullptr);
   char stamp[32];

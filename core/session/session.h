@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <deque>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -187,6 +188,16 @@ bool IsSessionFile(const std::filesystem::path& path);
 // file and the holder when another workbench has it. A folder where no lock file can be made gets
 // none (nullopt, *note says why): editing goes on there, and autosave says why it fails.
 std::optional<FileLock> LockSessionFile(const std::filesystem::path& session, std::string* note);
+
+// What a workbench does with the session a dataset it opens finds beside it (`path`): `load` reads
+// a candidate file and checks it opens (it throws IoError when not, and keeps what it read). The
+// file itself is tried, then its autosave backups newest first (SessionBackupPath); when none
+// opens, or `fresh`, the file is moved aside (MoveSessionAside). Returns the file `load` last read
+// successfully (empty: none, a new session starts) and, in *note, what happened in words the
+// status line shows. Throws IoError when the file cannot be moved aside.
+std::filesystem::path ResumeSessionBeside(
+    const std::filesystem::path& path, bool fresh,
+    const std::function<void(const std::filesystem::path&)>& load, std::string* note);
 
 // Moves a session file that will not be resumed aside, to `<path>.<YYYYmmdd-HHMMSS>.bak` (a new
 // name each time), and returns that name. Throws IoError naming both when the move fails (the file

@@ -116,7 +116,7 @@ TEST(LrfSession, TheWorkbenchSavesItsWordAndResumesItWhereTheCommandLineReadsItT
   EXPECT_TRUE(Says(output, "--method refined disagrees")) << output;
 }
 
-TEST(LrfSession, ASessionThatDoesNotOpenIsMovedAsideAndFreshStartsOver) {
+TEST(LrfSession, ASessionThatDoesNotOpenIsMovedAsideOrItsBackupResumedAndFreshStartsOver) {
   const std::filesystem::path manifest = LrfDatasetIn("lrf_session_aside");
   const std::filesystem::path session_file = DefaultLrfSessionPath(manifest);
   std::ofstream(session_file) << "{\"format\": \"calibench.session.v1\", \"version\": 1, tru";
@@ -140,6 +140,18 @@ TEST(LrfSession, ASessionThatDoesNotOpenIsMovedAsideAndFreshStartsOver) {
   EXPECT_TRUE(Says(s.session_note, "started over")) << s.session_note;
   EXPECT_EQ(s.pairs[0].status, PairStatus::kAccepted);
   EXPECT_EQ(LoadSession(session_file).pairs[0].status, PairStatus::kPending);
+
+  // Resumed, the file as found becomes the newest backup; when the file later does not open, that
+  // backup is resumed instead and the file is kept aside.
+  controller.Apply(LrfSetPairStatus{1, PairStatus::kRejected});
+  OpenAndWait(controller, manifest);
+  ASSERT_TRUE(std::filesystem::exists(SessionBackupPath(session_file, 1)));
+  std::ofstream(session_file, std::ios::trunc) << "{";
+  OpenAndWait(controller, manifest);
+  s = controller.GetSnapshot();
+  EXPECT_TRUE(Says(s.session_note, "resumed its newest backup that opens")) << s.session_note;
+  EXPECT_EQ(s.pairs[1].status, PairStatus::kRejected);
+  EXPECT_EQ(LoadSession(session_file).pairs[1].status, PairStatus::kRejected);
 }
 
 TEST(LrfSession, ALidarCameraCommandRefusesAnLrfSessionNamingIt) {

@@ -273,9 +273,6 @@ class Controller : public ControllerState<Snapshot> {
   // Locks `session` for this controller (kept when it holds that lock already). Throws IoError
   // when another process holds it; *note says so when the folder cannot hold a lock file.
   std::optional<FileLock> LockSession(const std::filesystem::path& session, std::string* note);
-  // Under kResume: the newest backup of `session` that opens, resumed; false when none does.
-  bool ResumeBackup(const std::filesystem::path& session, const std::string& note,
-                    std::optional<FileLock>* lock);
 
   // One handler per intent type, each an explicit specialization declared after the class and
   // defined by concern in controller*.cpp (Apply visits them with mutex_ held).

@@ -33,6 +33,25 @@ void Controller::OpenDataset(const std::filesystem::path& dataset_path,
                     std::move(session_path), existing);
 }
 
+namespace {
+
+// What Open reads beyond the session and its dataset, before anything changes: the view (the
+// workbench's to read, core keeps it as text: a malformed one is `source`'s error) and, for a
+// rig's camera, the rig and the camera's index in it. Throws IoError naming the file.
+std::pair<std::optional<RigFolder>, size_t> ReadViewAndRig(const Session& session,
+                                                           const Dataset& dataset,
+                                                           const std::filesystem::path& source) {
+  std::vector<std::string> ids;
+  for (const PairState& pair : session.pairs) ids.push_back(pair.id);
+  ViewFromJson(session.view_json, source, ids);
+  if (dataset.camera_name.empty()) return {std::nullopt, 0};
+  RigFolder rig = LoadRig(dataset.manifest);
+  const size_t camera = RigCameraIndex(rig, dataset.camera_name);
+  return {std::move(rig), camera};
+}
+
+}  // namespace
+
 void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path session_path,
                                    ExistingSession existing) {
   Session session = NewSession(dataset);
@@ -46,19 +65,20 @@ void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path
   std::string note;
   std::optional<FileLock> lock = LockSession(session_path, &note);
   if (existing != ExistingSession::kReplace && std::filesystem::exists(session_path)) {
-    if (existing == ExistingSession::kResume) {
-      try {
-        OpenSessionFile(session_path,
-                        "resumed the session in " + session_path.string() +
-                            " (calibench gui --fresh starts over and keeps it as a backup)",
-                        &lock);
-        return;
-      } catch (const IoError& e) {
-        note = "the session there did not open (" + std::string(e.what()) + "): ";
-      }
-      if (ResumeBackup(session_path, note, &lock)) return;
+    std::optional<SessionWithDataset> opened;
+    std::string resume_note;
+    const std::filesystem::path resumed = ResumeSessionBeside(
+        session_path, existing == ExistingSession::kStartFresh,
+        [&](const std::filesystem::path& file) {
+          opened = LoadSessionWithDataset(file);
+          ReadViewAndRig(opened->session, opened->dataset, file);  // as Open will: it opens
+        },
+        &resume_note);
+    note += (note.empty() ? "" : "; ") + resume_note;
+    if (!resumed.empty()) {
+      Open(opened->dataset, std::move(opened->session), session_path, note, std::move(lock));
+      return;
     }
-    note += "kept the old session as " + MoveSessionAside(session_path).string();
   }
   Open(dataset, std::move(session), session_path, note, std::move(lock));
 }
@@ -83,26 +103,6 @@ std::optional<FileLock> Controller::LockSession(const std::filesystem::path& ses
   return LockSessionFile(session, note);
 }
 
-bool Controller::ResumeBackup(const std::filesystem::path& session_path, const std::string& note,
-                              std::optional<FileLock>* lock) {
-  for (int n = 1; n <= AutosaveOptions{}.backups; ++n) {
-    const std::filesystem::path backup = SessionBackupPath(session_path, n);
-    if (!std::filesystem::exists(backup)) continue;
-    try {
-      auto [session, dataset] = LoadSessionWithDataset(backup);
-      const std::string kept = MoveSessionAside(session_path).string();
-      Open(dataset, std::move(session), session_path,
-           note + "resumed its newest backup that opens, " + backup.string() +
-               "; the one that did not open is kept as " + kept,
-           std::move(*lock));
-      return true;
-    } catch (const IoError&) {
-      // An older backup, then.
-    }
-  }
-  return false;
-}
-
 void Controller::OpenSessionFile(const std::filesystem::path& session_path, const std::string& note,
                                  std::optional<FileLock>* lock) {
   auto [session, dataset] = LoadSessionWithDataset(session_path);
@@ -111,18 +111,8 @@ void Controller::OpenSessionFile(const std::filesystem::path& session_path, cons
 
 void Controller::Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
                       const std::string& note, std::optional<FileLock> session_lock) {
-  // The view is the workbench's to read (core keeps it as text): a malformed one is the file's
-  // error, said before anything changes.
-  std::vector<std::string> ids;
-  for (const PairState& pair : session.pairs) ids.push_back(pair.id);
-  ViewFromJson(session.view_json, session_path.empty() ? dataset.manifest : session_path, ids);
-  // A rig's camera: the rig read (and the camera found in it) before anything changes.
-  std::optional<RigFolder> rig;
-  size_t rig_camera = 0;
-  if (!dataset.camera_name.empty()) {
-    rig = LoadRig(dataset.manifest);
-    rig_camera = RigCameraIndex(*rig, dataset.camera_name);
-  }
+  const auto [rig, rig_camera] =
+      ReadViewAndRig(session, dataset, session_path.empty() ? dataset.manifest : session_path);
   WaitIdle();
   {
     std::lock_guard lock(mutex_);

@@ -30,29 +30,6 @@ std::optional<FileLock> LockSession(const std::optional<FileLock>& held,
   return lock;
 }
 
-// The session at `session_path` when `use` resumes it and it is `dataset`'s; otherwise the file is
-// moved aside (said in *note) and nullopt. Throws IoError when it cannot be moved.
-std::optional<Session> ResumeOrMoveAside(const LrfDataset& dataset,
-                                         const std::filesystem::path& session_path,
-                                         LrfController::SessionUse use, std::string* note) {
-  std::string why = "started over";
-  if (use == LrfController::SessionUse::kResume) {
-    try {
-      LrfSessionWithDataset opened = LoadLrfSessionWithDataset(session_path);
-      if (opened.session.dataset != NormalizeSessionPath(dataset.manifest))
-        throw IoError(session_path.string() + " is the session of " +
-                      opened.session.dataset.string());
-      *note += "resumed the session in " + session_path.string() +
-               " (--fresh starts over and keeps it as a backup); ";
-      return std::move(opened.session);
-    } catch (const IoError& e) {
-      why = "the session there did not open (" + std::string(e.what()) + ")";
-    }
-  }
-  *note += why + ": kept the old one as " + MoveSessionAside(session_path).string() + "; ";
-  return std::nullopt;
-}
-
 }  // namespace
 
 bool LrfController::Fail(const std::string& message) {
@@ -74,8 +51,21 @@ bool LrfController::Open(const std::filesystem::path& manifest, SessionUse use) 
     if (use != SessionUse::kInMemory) {
       session_path = DefaultLrfSessionPath(dataset->manifest);
       lock = LockSession(session_lock_, session_path, &note);
-      if (std::filesystem::exists(session_path))
-        saved = ResumeOrMoveAside(*dataset, session_path, use, &note);
+      if (std::filesystem::exists(session_path)) {
+        std::string resume_note;
+        const std::filesystem::path resumed = ResumeSessionBeside(
+            session_path, use == SessionUse::kFresh,
+            [&](const std::filesystem::path& file) {
+              LrfSessionWithDataset opened = LoadLrfSessionWithDataset(file);
+              if (opened.session.dataset != NormalizeSessionPath(dataset->manifest))
+                throw IoError(file.string() + " is the session of " +
+                              opened.session.dataset.string());
+              saved = std::move(opened.session);
+            },
+            &resume_note);
+        if (resumed.empty()) saved.reset();
+        note += resume_note + "; ";
+      }
     }
   } catch (const IoError& e) {
     return Fail(std::string("cannot open: ") + e.what());
