@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "core/io/dataset_source.h"
+#include "core/session/lrf_calibration_job.h"
 #include "ui/lrf/workbench.h"
 #include "ui/widgets/error_popup.h"
 #include "ui/widgets/file_browser.h"
@@ -56,7 +57,8 @@ class LrfWindowShell {
 
  private:
   void Open(const fs::path& manifest) {
-    if (controller_.Open(manifest)) {
+    // An LRF session (a dropped calibench.lrf-session.json) opens with the manifest it names.
+    if (IsLrfSession(manifest) ? controller_.OpenSession(manifest) : controller_.Open(manifest)) {
       workbench_.reset();  // its textures and view keys show the old dataset
       return;
     }
@@ -68,11 +70,13 @@ class LrfWindowShell {
   float MenuBar() {
     const fs::path here = controller_.GetSnapshot().manifest;
     if (ImGui::GetIO().KeyCtrl && ImGui::IsKeyPressed('O', false))
-      browser_.Open(here, "Open an LRF dataset (calibench.lrf-dataset.v1 manifest)");
+      browser_.Open(here,
+                    "Open an LRF dataset (calibench.lrf-dataset.v1 manifest) or an LRF session");
     if (!ImGui::BeginMainMenuBar()) return 0.0f;
     if (ImGui::BeginMenu("File")) {
-      if (ImGui::MenuItem("Open LRF dataset...", "Ctrl+O"))
-        browser_.Open(here, "Open an LRF dataset (calibench.lrf-dataset.v1 manifest)");
+      if (ImGui::MenuItem("Open LRF dataset or session...", "Ctrl+O"))
+        browser_.Open(here,
+                      "Open an LRF dataset (calibench.lrf-dataset.v1 manifest) or an LRF session");
       ImGui::Separator();
       const bool solved = controller_.GetSnapshot().solver.solution.has_value();
       const std::string label = std::string("Export result (") + kMenuExportFile + ")";
