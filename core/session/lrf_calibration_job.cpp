@@ -13,6 +13,14 @@ std::vector<std::string> PairIds(const LrfDataset& dataset) {
   return ids;
 }
 
+// The pairs the user rejected in `session`, by id.
+std::set<std::string> RejectedIn(const Session& session) {
+  std::set<std::string> rejected;
+  for (const PairState& pair : session.pairs)
+    if (pair.status == PairStatus::kRejected) rejected.insert(pair.id);
+  return rejected;
+}
+
 }  // namespace
 
 std::filesystem::path DefaultLrfSessionPath(const std::filesystem::path& manifest) {
@@ -105,12 +113,7 @@ void LrfCalibrationJob::SetMethod(LrfMethod method) {
   record_.Edit([&](Session* session) { session->lrf_method = LrfMethodName(method); });
 }
 
-std::set<std::string> LrfCalibrationJob::Rejected() const {
-  std::set<std::string> rejected;
-  for (const PairState& pair : record_.Current().pairs)
-    if (pair.status == PairStatus::kRejected) rejected.insert(pair.id);
-  return rejected;
-}
+std::set<std::string> LrfCalibrationJob::Rejected() const { return RejectedIn(record_.Current()); }
 
 LrfPipelineOptions LrfCalibrationJob::options() const {
   LrfPipelineOptions options = options_;
@@ -123,8 +126,10 @@ std::vector<LrfPairFeatures> LrfCalibrationJob::ExtractedPairs() const {
 }
 
 const LrfCalibrationOutcome& LrfCalibrationJob::Solve() {
-  const std::set<std::string> rejected = Rejected();
-  const LrfPipelineOptions solved_with = options();
+  const Session word = record_.Current();  // one read: the rejections and the method together
+  const std::set<std::string> rejected = RejectedIn(word);
+  LrfPipelineOptions solved_with = options_;
+  solved_with.solver.method = *ParseLrfMethod(word.lrf_method);
   outcome_ = extraction_.Solve(rejected, solved_with);
   std::optional<SessionResult> result;
   if (outcome_->solution && outcome_->solution->ok)
@@ -132,11 +137,8 @@ const LrfCalibrationOutcome& LrfCalibrationJob::Solve() {
   record_.Edit(
       [&](Session* session) {
         // An edit made while it solved (from another thread) makes this solve not the record's.
-        std::set<std::string> now;
-        for (const PairState& pair : session->pairs)
-          if (pair.status == PairStatus::kRejected) now.insert(pair.id);
         const bool current =
-            now == rejected && session->lrf_method == LrfMethodName(solved_with.solver.method);
+            RejectedIn(*session) == rejected && session->lrf_method == word.lrf_method;
         session->result = current ? result : std::nullopt;
       },
       /*amend=*/true);

@@ -104,9 +104,10 @@ class LrfController : public ControllerState<LrfSnapshot> {
     kInMemory,  // neither reads nor writes it (`calibench render`)
   };
   // Loads the manifest, opens its session as `use` says, and queues feature extraction of every
-  // pair. A session that does not open is moved aside too, and a new one starts (the status line
-  // says so). A manifest that cannot be read, or a session open in another workbench, leaves the
-  // open dataset as it was and shows the error in the status line (false).
+  // pair. A session that does not open gives way to its newest backup that opens, else is moved
+  // aside and a new one starts (ResumeSessionBeside; session_note says which). A manifest that
+  // cannot be read, or a session open in another workbench, leaves the open dataset as it was and
+  // shows the error in the status line (false).
   bool Open(const std::filesystem::path& manifest, SessionUse use = SessionUse::kResume);
   // Opens a saved LRF session (calibench.session.v1 with options.lrf_method) with the manifest it
   // names, and autosaves to it from then on; false with the error shown, as Open.
@@ -120,7 +121,8 @@ class LrfController : public ControllerState<LrfSnapshot> {
   void Start(std::shared_ptr<const LrfDataset> dataset, std::optional<Session> saved,
              const std::filesystem::path& session_path, std::optional<FileLock> lock,
              const std::string& note);
-  // The record's rejections, method and selected pair onto the rows (mutex_ held).
+  // The record's rejections and method onto the rows and the solver panel (mutex_ held); the
+  // selected pair is the view's, read once at Start (an undo does not move it).
   void ApplySessionToState(const Session& session);
   void Autosave();   // call with mutex_ held; a failure shows, and is retried at the next edit
   void AfterEdit();  // undo state and autosave after a record change (mutex_ held)
