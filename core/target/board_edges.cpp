@@ -21,8 +21,10 @@ bool BoardEdgeOptions::Check(std::string* why) const {
     return fail("max_azimuth_gap_deg must be in (0, 10) degrees");
   if (!(max_firing_step_deg > 0 && max_firing_step_deg < 10))
     return fail("max_firing_step_deg must be in (0, 10) degrees");
-  if (!(max_median_firing_step_deg > 0 && max_median_firing_step_deg <= max_firing_step_deg))
-    return fail("max_median_firing_step_deg must be in (0, max_firing_step_deg] degrees");
+  if (!(firing_step_over_median >= 1 && firing_step_over_median < 10))
+    return fail("firing_step_over_median must be in [1, 10)");
+  if (!(max_median_firing_step_deg > 0 && max_median_firing_step_deg < 10))
+    return fail("max_median_firing_step_deg must be in (0, 10) degrees");
   if (!(min_consecutive_fraction >= 0 && min_consecutive_fraction <= 1))
     return fail("min_consecutive_fraction must be in [0, 1]");
   return true;
@@ -163,6 +165,8 @@ std::vector<LidarEdgePoint> ExtractBeamCrossingEdgePoints(
     }
     return edges;
   }
+  const double max_step_deg =
+      std::max(options.max_firing_step_deg, options.firing_step_over_median * median_step);
   const int n = static_cast<int>(cloud.size());
   for (int i : inliers) {
     // j: the neighbour beyond the board; k: the board return before i on the same stroke.
@@ -170,7 +174,7 @@ std::vector<LidarEdgePoint> ExtractBeamCrossingEdgePoints(
       if (j < 0 || j >= n || is_inlier[j]) continue;
       ++tally.ends;
       const double out_step_deg = AngleBetweenDeg(cloud.points[i], cloud.points[j]);
-      if (out_step_deg > options.max_firing_step_deg || k < 0 || k >= n || !is_inlier[k]) {
+      if (out_step_deg > max_step_deg || k < 0 || k >= n || !is_inlier[k]) {
         ++tally.no_return;
         continue;
       }
@@ -181,7 +185,7 @@ std::vector<LidarEdgePoint> ExtractBeamCrossingEdgePoints(
       const auto before_on_plane = OnPlane(plane, cloud.points[k].cast<double>());
       const auto outer_on_plane = OnPlane(plane, outer_x);
       if (!board_on_plane || !before_on_plane || !outer_on_plane || !(board_step_deg > 0) ||
-          board_step_deg > options.max_firing_step_deg)
+          board_step_deg > max_step_deg)
         continue;
       if (outer_x.norm() - outer_on_plane->norm() < options.min_background_gap_m) {
         ++tally.not_behind;

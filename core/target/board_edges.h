@@ -23,13 +23,16 @@ struct BoardEdgeOptions {
   // uncertain (a dropped return): no edge point there.
   double max_azimuth_gap_deg = 0.6;
   // A ring-less scan (a Livox-class rosette, a nodding fan) stored in firing order: consecutive
-  // returns further apart than this (degrees between their rays) are not neighbours on the beam's
-  // path (a dropped return, the pattern's jump), so no crossing lies between them.
+  // returns further apart than this (degrees between their rays), or than firing_step_over_median
+  // times the board's median step when that is wider, are not neighbours on the beam's path (a
+  // dropped return, the pattern's jump), so no crossing lies between them. A laser of a scanner
+  // that shares its point rate among several (an Avia's six) steps farther than one alone.
   double max_firing_step_deg = 0.6;
+  double firing_step_over_median = 2.0;
   // The cloud counts as stored in firing order when the median angle between consecutive board
   // returns is below this (degrees) and at least min_consecutive_fraction of the board's returns
   // are followed by another: a cloud sorted or filtered otherwise keeps no beam path.
-  double max_median_firing_step_deg = 0.3;
+  double max_median_firing_step_deg = 0.8;
   double min_consecutive_fraction = 0.5;
   bool Check(std::string* why) const;
 };

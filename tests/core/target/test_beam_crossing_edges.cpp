@@ -128,9 +128,13 @@ TEST(BeamCrossingEdges, OptionsAreChecked) {
   BoardEdgeOptions options;
   std::string why;
   EXPECT_TRUE(options.Check(&why)) << why;
-  options.max_median_firing_step_deg = 2 * options.max_firing_step_deg;
+  options.max_median_firing_step_deg = 0;
   EXPECT_FALSE(options.Check(&why));
   EXPECT_NE(why.find("max_median_firing_step_deg"), std::string::npos);
+  options = BoardEdgeOptions{};
+  options.firing_step_over_median = 0.5;  // a step limit below the beam's own median step
+  EXPECT_FALSE(options.Check(&why));
+  EXPECT_NE(why.find("firing_step_over_median"), std::string::npos);
 }
 
 }  // namespace
