@@ -270,16 +270,7 @@ void Controller::CommitEdit(bool same_step) {
   ++state_.generation;
 }
 
-void Controller::Autosave() {
-  mutex_.AssertHeld(__func__);
-  try {
-    if (job_) job_->record().Autosave();
-    state_.save_error.clear();
-  } catch (const IoError& e) {
-    state_.save_error = e.what();
-    SetStatus(std::string("autosave failed: ") + e.what(), true);
-  }
-}
+void Controller::Autosave() { AutosaveRecord(job_ ? &job_->record() : nullptr); }
 
 template <>
 void Controller::Handle(const SaveSessionAs& save) {

@@ -151,16 +151,7 @@ void LrfController::ApplySessionToState(const Session& session) {
   ++state_.generation;
 }
 
-void LrfController::Autosave() {
-  mutex_.AssertHeld(__func__);
-  try {
-    if (job_) job_->record().Autosave();
-    state_.save_error.clear();
-  } catch (const IoError& e) {
-    state_.save_error = e.what();
-    SetStatus(std::string("autosave failed: ") + e.what(), true);
-  }
-}
+void LrfController::Autosave() { AutosaveRecord(job_ ? &job_->record() : nullptr); }
 
 void LrfController::AfterEdit() {
   mutex_.AssertHeld(__func__);

@@ -72,6 +72,20 @@ class ControllerState {
     state_.status_is_error = error;
     ++state_.generation;
   }
+  // Writes the session record's autosave (a SessionRecord, core/session/session_record.h; none
+  // when null); a failure shows on the status line and in state_.save_error, and is retried at the
+  // next edit. Call with mutex_ held.
+  template <typename Record>
+  void AutosaveRecord(Record* record) {
+    mutex_.AssertHeld(__func__);
+    try {
+      if (record) record->Autosave();
+      state_.save_error.clear();
+    } catch (const IoError& e) {
+      state_.save_error = e.what();
+      SetStatus(std::string("autosave failed: ") + e.what(), true);
+    }
+  }
   // The selected pair's image, read on the worker: *path gets its file (empty when nothing with
   // an image is selected); nullptr with the status line set when the file cannot be read.
   std::shared_ptr<const ImageU8> LoadSelectedImageFile(std::filesystem::path* path) {
