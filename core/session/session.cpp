@@ -229,7 +229,12 @@ Session SessionOverPairs(Session saved, const std::vector<std::string>& ids,
   return saved;
 }
 
-std::optional<FileLock> LockSessionFile(const std::filesystem::path& session, std::string* note) {
+std::optional<FileLock> LockSessionFile(const std::filesystem::path& session,
+                                        const std::optional<FileLock>& held, std::string* note) {
+  std::error_code ec;
+  if (held && std::filesystem::weakly_canonical(held->locked(), ec) ==
+                  std::filesystem::weakly_canonical(session, ec))
+    return std::nullopt;
   std::string holder;
   try {
     std::optional<FileLock> lock = FileLock::TryLock(session, &holder);

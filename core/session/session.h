@@ -184,10 +184,12 @@ Session SessionOverPairs(Session saved, const std::vector<std::string>& ids,
 // file that cannot be read.
 bool IsSessionFile(const std::filesystem::path& path);
 
-// Locks a session file for one workbench (FileLock on <session>.lock). Throws IoError naming the
-// file and the holder when another workbench has it. A folder where no lock file can be made gets
-// none (nullopt, *note says why): editing goes on there, and autosave says why it fails.
-std::optional<FileLock> LockSessionFile(const std::filesystem::path& session, std::string* note);
+// Locks a session file for one workbench (FileLock on <session>.lock); nullopt when `held` (the
+// workbench's lock) is that file's already. Throws IoError naming the file and the holder when
+// another workbench has it. A folder where no lock file can be made gets none (nullopt, *note says
+// why): editing goes on there, and autosave says why it fails.
+std::optional<FileLock> LockSessionFile(const std::filesystem::path& session,
+                                        const std::optional<FileLock>& held, std::string* note);
 
 // What a workbench does with the session a dataset it opens finds beside it (`path`): `load` reads
 // a candidate file and checks it opens (it throws IoError when not, and keeps what it read). The

@@ -96,11 +96,7 @@ void Controller::OpenSession(const std::filesystem::path& session_path, bool sav
 
 std::optional<FileLock> Controller::LockSession(const std::filesystem::path& session,
                                                 std::string* note) {
-  std::error_code ec;
-  if (session_lock_ && std::filesystem::weakly_canonical(session_lock_->locked(), ec) ==
-                           std::filesystem::weakly_canonical(session, ec))
-    return std::nullopt;  // this controller has it open already
-  return LockSessionFile(session, note);
+  return LockSessionFile(session, session_lock_, note);
 }
 
 void Controller::OpenSessionFile(const std::filesystem::path& session_path, const std::string& note,

@@ -117,7 +117,8 @@ class LrfController : public ControllerState<LrfSnapshot> {
  private:
   void OnJobError() override;
   // Starts on `dataset` with the record `saved` (nullopt: a new session), autosaving to
-  // `session_path` under `lock`; `note` opens the status line.
+  // `session_path` under `lock`; `note` (what was done with the session) opens the status
+  // line and is the snapshot's session_note.
   void Start(std::shared_ptr<const LrfDataset> dataset, std::optional<Session> saved,
              const std::filesystem::path& session_path, std::optional<FileLock> lock,
              const std::string& note);

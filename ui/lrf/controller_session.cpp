@@ -1,6 +1,6 @@
-// The LRF controller's session lifecycle: opening a manifest (its session resumed, or moved aside)
-// or a session file, the record mirrored into the rows, autosave, undo and redo. The record is the
-// LRF job's (core/session/lrf_calibration_job.h).
+// The LRF controller's session lifecycle: opening a manifest (its session resumed, else its newest
+// backup that opens, else moved aside) or a session file, the record mirrored into the rows,
+// autosave, undo and redo. The record is the LRF job's (core/session/lrf_calibration_job.h).
 #include <nlohmann/json.hpp>
 
 #include "ui/lrf/controller.h"
@@ -16,18 +16,6 @@ int SelectedInView(const Session& session) {
     for (size_t i = 0; i < session.pairs.size(); ++i)
       if (session.pairs[i].id == found->get<std::string>()) return static_cast<int>(i);
   return session.pairs.empty() ? -1 : 0;
-}
-
-// The session file locked for this workbench (LockSessionFile), or nullopt when it already is.
-std::optional<FileLock> LockSession(const std::optional<FileLock>& held,
-                                    const std::filesystem::path& session, std::string* note) {
-  std::error_code ec;
-  if (held && std::filesystem::weakly_canonical(held->locked(), ec) ==
-                  std::filesystem::weakly_canonical(session, ec))
-    return std::nullopt;
-  std::optional<FileLock> lock = LockSessionFile(session, note);
-  if (!note->empty()) *note += "; ";
-  return lock;
 }
 
 }  // namespace
@@ -50,10 +38,10 @@ bool LrfController::Open(const std::filesystem::path& manifest, SessionUse use) 
     dataset = std::make_shared<const LrfDataset>(LoadLrfDataset(manifest));
     if (use != SessionUse::kInMemory) {
       session_path = DefaultLrfSessionPath(dataset->manifest);
-      lock = LockSession(session_lock_, session_path, &note);
+      lock = LockSessionFile(session_path, session_lock_, &note);
       if (std::filesystem::exists(session_path)) {
         std::string resume_note;
-        const std::filesystem::path resumed = ResumeSessionBeside(
+        ResumeSessionBeside(
             session_path, use == SessionUse::kFresh,
             [&](const std::filesystem::path& file) {
               LrfSessionWithDataset opened = LoadLrfSessionWithDataset(file);
@@ -63,8 +51,7 @@ bool LrfController::Open(const std::filesystem::path& manifest, SessionUse use) 
               saved = std::move(opened.session);
             },
             &resume_note);
-        if (resumed.empty()) saved.reset();
-        note += resume_note + "; ";
+        note += (note.empty() ? "" : "; ") + resume_note;
       }
     }
   } catch (const IoError& e) {
@@ -80,13 +67,14 @@ bool LrfController::OpenSession(const std::filesystem::path& session_path) {
   LrfSessionWithDataset opened;
   try {
     if (!options_.Check(&why)) throw IoError("LRF pipeline options: " + why);
-    lock = LockSession(session_lock_, session_path, &note);
+    lock = LockSessionFile(session_path, session_lock_, &note);
     opened = LoadLrfSessionWithDataset(session_path);
+    note += std::string(note.empty() ? "" : "; ") + "opened the session " + session_path.string();
   } catch (const IoError& e) {
     return Fail(std::string("cannot open: ") + e.what());
   }
   Start(std::make_shared<const LrfDataset>(std::move(opened.dataset)), std::move(opened.session),
-        session_path, std::move(lock), "opened the session " + session_path.string() + "; ");
+        session_path, std::move(lock), note);
   return true;
 }
 
@@ -113,7 +101,7 @@ void LrfController::Start(std::shared_ptr<const LrfDataset> dataset, std::option
     state_.manifest = dataset->manifest;
     state_.dataset = dataset;
     state_.session_path = session_path;
-    state_.session_note = note.empty() ? "" : note.substr(0, note.size() - 2);  // less "; "
+    state_.session_note = note;
     for (const LrfPairEntry& entry : dataset->pairs) state_.pairs.emplace_back().id = entry.id;
     state_.extracted_total = static_cast<int>(state_.pairs.size());
     outcome_.reset();
@@ -123,8 +111,8 @@ void LrfController::Start(std::shared_ptr<const LrfDataset> dataset, std::option
     ApplySessionToState(session);
     state_.selected = SelectedInView(session);
     Autosave();
-    SetStatus(note + "extracting features of " + std::to_string(state_.pairs.size()) +
-                  " pairs from " + dataset->manifest.string(),
+    SetStatus((note.empty() ? "" : note + "; ") + "extracting features of " +
+                  std::to_string(state_.pairs.size()) + " pairs from " + dataset->manifest.string(),
               false);
   }
   for (int i = 0; i < static_cast<int>(dataset->pairs.size()); ++i)
