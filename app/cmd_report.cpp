@@ -231,6 +231,14 @@ int RunReport(int argc, char** argv) {
   PipelineFlags flags;
   AddPipelineFlags(app, flags);
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
+  if (IsLrfResultFile(result_path)) {
+    std::fprintf(stderr,
+                 "calibench report: %s is a 2D LRF result (cam_from_lrf); report writes "
+                 "LiDAR-camera reports only. `calibench lrf-calibrate` prints the LRF solve's "
+                 "per-pair figures, `calibench export` writes the transform for a robot\n",
+                 result_path.c_str());
+    return kInputError;
+  }
   if (!app.count("--method")) {
     const std::string method = ResultSolverMethod(result_path);
     if (!method.empty()) flags.method = method;  // the result's own method, unless overridden

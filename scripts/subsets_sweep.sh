@@ -2,17 +2,19 @@
 # σ honesty on every simulated range-sensor kind: `calibench evaluate --subsets` (first k and random
 # subsets of 4-30 pairs) on a 32-pair simulated set per kind and seed, against the all-pairs result
 # and the ground truth. A sweep, not a CI test: ~15 s per kind and seed on 2 cores.
-#   scripts/subsets_sweep.sh [--seeds N] [--out DIR] [--calibench PATH]
+#   scripts/subsets_sweep.sh [--seeds N] [--out DIR] [--calibench PATH] [--kinds a,b,...]
 set -euo pipefail
 seeds=3
 out=/tmp/calibench-subsets
 calibench=build/calibench
+only=""
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --seeds) seeds="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --calibench) calibench="$2"; shift 2 ;;
-    *) echo "usage: $0 [--seeds N] [--out DIR] [--calibench PATH]" >&2; exit 2 ;;
+    --kinds) only=",$2,"; shift 2 ;;
+    *) echo "usage: $0 [--seeds N] [--out DIR] [--calibench PATH] [--kinds a,b,...]" >&2; exit 2 ;;
   esac
 done
 mkdir -p "$out"
@@ -28,12 +30,14 @@ kinds=(
   "mid40-hold:--lidar mid40 --lidar-frame 1"
   "avia-frame:--lidar avia --lidar-frame 0.1"
   "avia-hold:--lidar avia --lidar-frame 1"
+  "mid360-frame:--lidar mid360 --lidar-frame 0.1"
   "mid360-hold:--lidar mid360 --lidar-frame 1"
 )
 printf "| kind | seed | within 3σ of all pairs | within 3σ of the truth |\n|---|---|---|---|\n"
 total=0; truth_total=0; cases_total=0
 for entry in "${kinds[@]}"; do
   label="${entry%%:*}"; flags="${entry#*:}"
+  [[ -z "$only" || "$only" == *",$label,"* ]] || continue
   for seed in $(seq 1 "$seeds"); do
     dir="$out/$label-$seed"
     # shellcheck disable=SC2086

@@ -122,4 +122,10 @@ std::string ResultSolverMethod(const std::filesystem::path& path) {
   return method.is_string() ? method.get<std::string>() : "";
 }
 
+bool IsLrfResultFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  const json result = json::parse(in, nullptr, false);
+  return result.is_object() && result.contains("cam_from_lrf");
+}
+
 }  // namespace calibench

@@ -30,6 +30,10 @@ LoadedResult LoadResult(const std::filesystem::path& path);
 // back to its own default.
 std::string ResultSolverMethod(const std::filesystem::path& path);
 
+// Whether the file is an LRF method's result (it holds cam_from_lrf); false when it cannot be read
+// as JSON. Never throws: the reader that follows names the file's own problem.
+bool IsLrfResultFile(const std::filesystem::path& path);
+
 // The transform for a terminal: <target>_from_<source> and its inverse as 3x4 matrices, each with
 // its direction in words, and the standard deviations in camera axes (mm and degrees).
 std::string FormatTransform(const ResultNames& names, const Pose& target_from_source,

@@ -7,12 +7,14 @@
 #include <map>
 
 #include "core/base/text.h"
+#include "core/target/lidar_board_clusters.h"
 #include "core/target/lidar_board_grid.h"
 
 namespace calibench {
 namespace {
 
 using board_grid::AngularGrid;
+using board_grid::LinkDistance;
 
 struct LocalPlane {
   Vec3 normal = Vec3::Zero();
@@ -21,12 +23,6 @@ struct LocalPlane {
 };
 
 Vec3 PointAt(const LidarCloud& cloud, int index) { return cloud.points[index].cast<double>(); }
-
-// How far apart two neighbouring returns on one surface may be: a ring step at this range on a
-// surface tilted up to ~65 degrees, plus noise.
-double LinkDistance(const AngularGrid& grid, double range) {
-  return 2.5 * range * std::max(grid.row_step_rad, grid.column_step_rad) + 0.05;
-}
 
 // Each grid cell's return in double precision (NaN where the cell is empty): the neighbourhood
 // loops below read it contiguously, without going through the cloud's index.
@@ -467,6 +463,20 @@ LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& b
       result.candidates.push_back(std::move(c));
     else
       result.near_misses.push_back(std::move(c));
+  }
+  // A sparse ring-less frame (strokes a cell apart, not surfaces) leaves no neighbourhood planar
+  // enough to grow from; there the clusters that stand apart in range are the segments.
+  if (result.candidates.empty() && !grid.from_rings) {
+    board_grid::ClusterOptions clusters;
+    clusters.min_points = options.min_points;
+    clusters.max_diameter_m = sheet.max.norm() + 2 * options.size_tolerance_m;
+    for (const std::vector<int>& cells : board_grid::RangeClusters(grid, cell_points, clusters)) {
+      LidarBoardCandidate c = Evaluate(cloud, grid, cells, &in_segment, sheet, options, background);
+      if (c.rejection.empty())
+        result.candidates.push_back(std::move(c));
+      else
+        result.near_misses.push_back(std::move(c));
+    }
   }
   auto by_score = [](const auto& a, const auto& b) { return a.score > b.score; };
   std::sort(result.candidates.begin(), result.candidates.end(), by_score);

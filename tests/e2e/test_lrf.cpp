@@ -65,6 +65,16 @@ TEST_F(LrfCli, RefinedAndPaperLinearCalibrateAndEvaluate) {
                                &out),
               0)
         << method << ": " << out;
+    // `report` writes LiDAR-camera reports: an LRF result is refused in words naming it (it read
+    // the LRF method's name as a solver flag: "--method must be weighted-ml, ... not 'refined'").
+    EXPECT_EQ(test::RunCommand(Exe() + " report --no-views --result " + result.string() +
+                                   " --out " + (*dir_ / "report.html").string(),
+                               &out),
+              2)
+        << out;
+    EXPECT_NE(out.find(result.string() + " is a 2D LRF result"), std::string::npos) << out;
+    EXPECT_EQ(out.find("--method must be"), std::string::npos) << out;
+    EXPECT_FALSE(fs::exists(*dir_ / "report.html"));
   }
 }
 
