@@ -37,25 +37,25 @@ void PrintPoseError(const char* what, const Pose& estimate, const Pose& referenc
               e.rotation_rad * kRadToDeg);
 }
 
-// --session's LRF session, its dataset into *dataset_path (which, when given, must be the
-// session's); nullopt (said on stderr) when `method` is given and is not the session's.
-std::optional<Session> ReadSessionFlag(const std::string& session_path, const std::string& method,
-                                       std::string* dataset_path) {
+}  // namespace
+
+std::optional<Session> ReadLrfSessionFlag(const std::string& command,
+                                          const std::string& session_path,
+                                          const std::string& method, std::string* dataset_path) {
   LrfSessionWithDataset opened = LoadLrfSessionWithDataset(session_path);
   if (!dataset_path->empty() &&
       NormalizeSessionPath(LoadLrfDataset(*dataset_path).manifest) != opened.session.dataset)
     throw IoError(session_path + ": the session of " + opened.session.dataset.string() +
                   ", not of " + *dataset_path);
   if (!method.empty() && method != opened.session.lrf_method) {
-    std::fprintf(stderr, "calibench lrf-calibrate: %s solves with %s; --method %s disagrees\n",
-                 session_path.c_str(), opened.session.lrf_method.c_str(), method.c_str());
+    std::fprintf(stderr, "calibench %s: %s solves with %s; --method %s disagrees\n",
+                 command.c_str(), session_path.c_str(), opened.session.lrf_method.c_str(),
+                 method.c_str());
     return std::nullopt;
   }
   *dataset_path = opened.session.dataset.string();
   return std::move(opened.session);
 }
-
-}  // namespace
 
 bool IsLrfManifest(const std::string& path) {
   std::string ignored;
@@ -115,7 +115,8 @@ int RunLrfCalibrate(int argc, char** argv) {
   }
   std::optional<Session> session;
   if (!session_path.empty()) {
-    session = ReadSessionFlag(session_path, app.count("--method") ? method : "", &dataset_path);
+    session = ReadLrfSessionFlag("lrf-calibrate", session_path, app.count("--method") ? method : "",
+                                 &dataset_path);
     if (!session) return kUsage;
   }
   // The job the LRF workbench runs (core/session/lrf_calibration_job.h), all pairs at once.

@@ -13,7 +13,10 @@
 #include "core/io/dataset.h"
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
+#include "core/lrf/dataset.h"
+#include "core/report/lrf_report.h"
 #include "core/results/result_file.h"
+#include "core/session/lrf_calibration_job.h"
 #include "core/session/session.h"
 #include "ui/lidar_camera/report_figures.h"
 
@@ -202,6 +205,79 @@ int ReportDataset(const std::string& result_path, std::string session_path,
   return WriteReport(dataset, outcome, options, request);
 }
 
+// `report` on a 2D LRF result: the observations extracted and solved again as `lrf-calibrate`
+// does (with the session's rejections and method when given), analysed and written.
+int ReportLrf(const std::string& result_path, std::string dataset_path,
+              const std::string& session_path, std::string method, ReportRequest request) {
+  if (request.check) {
+    std::fprintf(stderr, "calibench report: --check goes with a LiDAR-camera report\n");
+    return kUsage;
+  }
+  std::string session_file = session_path;
+  if (session_file.empty() && IsLrfSession(result_path)) session_file = result_path;
+  if (!IsLrfResultFile(result_path) && !IsLrfSession(result_path)) {
+    std::fprintf(
+        stderr, "calibench report: %s is not an LRF result (cam_from_lrf), but %s is LRF\n",
+        result_path.c_str(), session_path.empty() ? dataset_path.c_str() : session_path.c_str());
+    return kInputError;
+  }
+  std::optional<Session> session;
+  if (!session_file.empty()) {
+    session = ReadLrfSessionFlag("report", session_file, method, &dataset_path);
+    if (!session) return kUsage;
+  }
+  if (dataset_path.empty()) {
+    std::fprintf(stderr, "calibench report: give --dataset or --session (the result's data)\n");
+    return kUsage;
+  }
+  LrfPipelineOptions options;
+  if (method.empty()) method = ResultSolverMethod(result_path);
+  const std::optional<LrfMethod> parsed = ParseLrfMethod(method.empty() ? "refined" : method);
+  if (!parsed) {
+    std::fprintf(stderr, "calibench report: --method must be refined or paper-linear, not '%s'\n",
+                 method.c_str());
+    return kUsage;
+  }
+  options.solver.method = *parsed;
+  LrfCalibrationJob job(LoadLrfDataset(dataset_path), options, std::move(session));
+  job.ExtractAll(StderrProgress("extracted"));
+  const LrfCalibrationOutcome outcome = job.Solve();
+  if (!outcome.solution) {
+    std::fprintf(stderr, "calibench report: the data gives no calibration: %s\n",
+                 outcome.failure.c_str());
+    return kNoCalibration;
+  }
+  const std::string note = ResolveNote(
+      outcome.solution->cam_from_lrf, CalibrationOf(result_path), result_path,
+      "this data with these options",
+      "the result, per-observation figures and scans below are the re-solve's. Pass the method "
+      "lrf-calibrate was run with (or its session).");
+  if (!note.empty()) {
+    request.notes.push_back(note);
+    std::fprintf(stderr, "calibench report: %s\n", note.c_str());
+  }
+  ReportProvenance provenance;
+  provenance.source = session_file.empty()
+                          ? job.dataset().manifest.string()
+                          : session_file + " (session of " + job.dataset().manifest.string() + ")";
+  provenance.result_file = request.result_file;
+  provenance.created_utc = NowUtc();
+  provenance.calibench_version = CALIBENCH_VERSION;
+  provenance.notes = request.notes;
+  LrfReportOptions report_options;
+  report_options.cross_validate = request.options.cross_validate;
+  const LrfReport report =
+      AnalyseLrfCalibration(job.dataset(), outcome, job.options(), report_options);
+  WriteFileAtomically(request.out_path,
+                      LrfReportHtml(report, provenance, LoadReportAssets(FindAsset("report"))));
+  std::printf("wrote %s (%zu observations): %s%s\n", request.out_path.c_str(), report.pairs.size(),
+              report.folds ? "" : "no cross-validation: ",
+              report.folds ? report.verdict.c_str() : report.cross_validation_skipped.c_str());
+  if (!report.well_constrained)
+    std::printf("not well constrained: the report says along which directions\n");
+  return kOk;
+}
+
 }  // namespace
 
 int RunReport(int argc, char** argv) {
@@ -209,7 +285,10 @@ int RunReport(int argc, char** argv) {
       "Write a self-contained HTML report of a LiDAR-camera result: both directions with sigma, "
       "the method and the data's provenance, export snippets, one row per pair (residuals, "
       "weight, leave-one-out influence), held-out cross-validation with a verdict, plots, and "
-      "the workbench's views. The pairs are extracted and solved again with the same pipeline.",
+      "the workbench's views. The pairs are extracted and solved again with the same pipeline. "
+      "A 2D LRF result (cam_from_lrf, with its LRF dataset or session) gets the same: each "
+      "observation's residual, weight, influence and held-out residual, and each scan drawn "
+      "from above with the camera's target carried into it.",
       "calibench report"};
   std::string result_path, dataset_path, session_path;
   ReportRequest request;
@@ -231,14 +310,17 @@ int RunReport(int argc, char** argv) {
   PipelineFlags flags;
   AddPipelineFlags(app, flags);
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
-  if (IsLrfResultFile(result_path)) {
-    std::fprintf(stderr,
-                 "calibench report: %s is a 2D LRF result (cam_from_lrf); report writes "
-                 "LiDAR-camera reports only. `calibench lrf-calibrate` prints the LRF solve's "
-                 "per-pair figures, `calibench export` writes the transform for a robot\n",
-                 result_path.c_str());
-    return kInputError;
-  }
+  request.renders = !no_renders;
+  request.options.cross_validate = !no_cross_validation;
+  if (!check_path.empty()) request.check = LoadTargetlessCheck(check_path);
+  request.result_file = result_path;
+  // The LRF method's result, dataset or session: its own report (its methods are not the
+  // LiDAR-camera solver's).
+  if (IsLrfResultFile(result_path) || IsLrfSession(result_path) ||
+      (!dataset_path.empty() && IsLrfManifest(dataset_path)) ||
+      (!session_path.empty() && IsLrfSession(session_path)))
+    return ReportLrf(result_path, dataset_path, session_path,
+                     app.count("--method") ? flags.method : "", request);
   if (!app.count("--method")) {
     const std::string method = ResultSolverMethod(result_path);
     if (!method.empty()) flags.method = method;  // the result's own method, unless overridden
@@ -248,10 +330,6 @@ int RunReport(int argc, char** argv) {
     std::fprintf(stderr, "calibench report: %s\n", why.c_str());
     return kUsage;
   }
-  request.renders = !no_renders;
-  request.options.cross_validate = !no_cross_validation;
-  if (!check_path.empty()) request.check = LoadTargetlessCheck(check_path);
-  request.result_file = result_path;
   if (IsRigResultFile(result_path) || (!dataset_path.empty() && IsRig(dataset_path))) {
     if (dataset_path.empty()) {
       std::fprintf(stderr, "calibench report: a rig result: give --dataset <the rig>\n");

@@ -12,6 +12,7 @@
 #include "core/intrinsics/intrinsics.h"
 #include "core/report/report_html.h"
 #include "core/report/targetless_section.h"
+#include "core/session/session.h"
 #include "core/target/board.h"
 #include "core/targetless/check_follow.h"
 
@@ -95,6 +96,12 @@ int RunEvaluateLrf(int argc, char** argv);
 int RunSweepLrf(int argc, char** argv);
 // True when the file is a calibench.lrf-dataset.v1 manifest.
 bool IsLrfManifest(const std::string& path);
+// `command`'s --session flag of an LRF session: the session, its dataset into *dataset_path
+// (which, when given, must be the session's; IoError otherwise); nullopt (said on stderr) when
+// `method` is given and is not the session's.
+std::optional<Session> ReadLrfSessionFlag(const std::string& command,
+                                          const std::string& session_path,
+                                          const std::string& method, std::string* dataset_path);
 int RunGui(int argc, char** argv);
 int RunRender(int argc, char** argv);
 int RunExport(int argc, char** argv);

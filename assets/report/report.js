@@ -9,6 +9,7 @@
 })();
 
 function draw(REPORT, prefix) {
+  if (REPORT.kind === "lrf") return drawLrf(REPORT);
   const solved = REPORT.pairs.filter(p => p.solved);
   const ids = solved.map(p => p.id);
   const colour = p => (p.disagrees ? "#c0392b" : "#3b6ea5");
@@ -56,4 +57,32 @@ function draw(REPORT, prefix) {
     data: { datasets: [{ label: "board centre seen from the LiDAR", data: solved.filter(p => p.lidar).map(p => ({ x: p.lidar[0], y: p.lidar[1], id: p.id })), backgroundColor: solved.filter(p => p.lidar).map(colour), pointRadius: 5 }] },
     options: { plugins: { title: title("Coverage: the LiDAR's field"), tooltip: { callbacks: { label: c => c.raw.id } } },
                scales: { x: { reverse: true, title: title("azimuth [deg] (left is +)") }, y: { title: title("elevation [deg]") } } } });
+}
+
+// A 2D LRF report: the target's residual per observation (training and held out), the robust
+// weights and the solver's convergence.
+function drawLrf(REPORT) {
+  const solved = REPORT.pairs.filter(p => p.solved);
+  const ids = solved.map(p => p.id);
+  const title = text => ({ display: true, text: text });
+  function chart(id, config) {
+    const canvas = document.getElementById(id);
+    if (!canvas) return;
+    config.options = Object.assign({ responsive: true, maintainAspectRatio: false }, config.options);
+    new Chart(canvas, config);
+  }
+  chart("lrf-residuals", {
+    type: "bar",
+    data: { labels: ids, datasets: [
+      { label: "training [mm]", data: solved.map(p => p.residual_mm), backgroundColor: "#3b6ea5" },
+      { label: "held out [mm]", data: solved.map(p => p.heldout_mm), backgroundColor: solved.map(p => (p.disagrees ? "#c0392b" : "#9db7d5")) } ] },
+    options: { plugins: { title: title(REPORT.residual + " per observation") }, scales: { y: { title: title("mm") } } } });
+  chart("weights", {
+    type: "bar",
+    data: { labels: ids, datasets: [{ label: "robust weight", data: solved.map(p => p.weight), backgroundColor: "#3b6ea5" }] },
+    options: { plugins: { title: title("Robust weight per observation (refined)") }, scales: { y: { min: 0, max: 1.05 } } } });
+  chart("convergence", {
+    type: "line",
+    data: { labels: REPORT.cost.map((_, i) => i), datasets: [{ label: "cost", data: REPORT.cost, borderColor: "#3b6ea5", pointRadius: 2 }] },
+    options: { plugins: { title: title("Solver convergence") }, scales: { x: { title: title("iteration") }, y: { type: "logarithmic", title: title("cost") } } } });
 }

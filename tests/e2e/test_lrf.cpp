@@ -12,6 +12,7 @@
 
 #include "core/lrf/pipeline.h"
 #include "core/lrf/result_io.h"
+#include "core/report/lrf_report.h"
 #include "core/sim/lrf_sim.h"
 #include "tests/test_support.h"
 
@@ -65,17 +66,43 @@ TEST_F(LrfCli, RefinedAndPaperLinearCalibrateAndEvaluate) {
                                &out),
               0)
         << method << ": " << out;
-    // `report` writes LiDAR-camera reports: an LRF result is refused in words naming it (it read
-    // the LRF method's name as a solver flag: "--method must be weighted-ml, ... not 'refined'").
-    EXPECT_EQ(test::RunCommand(Exe() + " report --no-views --result " + result.string() +
-                                   " --out " + (*dir_ / "report.html").string(),
-                               &out),
-              2)
+    // `report` on the LRF result (it read the LRF method's name as a LiDAR-camera solver flag:
+    // "--method must be weighted-ml, ... not 'refined'"): the re-solve is the result, bit for bit
+    // in what the page prints, and every observation is cross-validated.
+    const fs::path report = *dir_ / ("report_" + method + ".html");
+    ASSERT_EQ(
+        test::RunCommand(Exe() + " report --result " + result.string() + " --dataset " +
+                             (*dir_ / "sim/manifest.json").string() + " --out " + report.string(),
+                         &out),
+        0)
         << out;
-    EXPECT_NE(out.find(result.string() + " is a 2D LRF result"), std::string::npos) << out;
-    EXPECT_EQ(out.find("--method must be"), std::string::npos) << out;
-    EXPECT_FALSE(fs::exists(*dir_ / "report.html"));
+    EXPECT_NE(out.find("(8 observations): consistent"), std::string::npos) << out;
+    EXPECT_EQ(out.find("differs from a re-solve"), std::string::npos) << out;
+    std::ifstream page(report);
+    const std::string html((std::istreambuf_iterator<char>(page)), {});
+    EXPECT_NE(html.find("Calibench 2D LRF calibration report"), std::string::npos);
+    EXPECT_NE(html.find("method " + method), std::string::npos);
+    EXPECT_EQ(html.find("Not computed"), std::string::npos);
   }
+  // Without its data the report cannot re-solve; a LiDAR-camera method is no LRF method.
+  std::string out;
+  const std::string result = (*dir_ / "result_refined.json").string();
+  EXPECT_EQ(
+      test::RunCommand(
+          Exe() + " report --result " + result + " --out " + (*dir_ / "r.html").string(), &out),
+      1)
+      << out;
+  EXPECT_NE(out.find("give --dataset or --session"), std::string::npos) << out;
+  EXPECT_EQ(test::RunCommand(Exe() + " report --result " + result + " --dataset " +
+                                 (*dir_ / "sim/manifest.json").string() +
+                                 " --method weighted-ml --out " + (*dir_ / "r.html").string(),
+                             &out),
+            1)
+      << out;
+  EXPECT_NE(out.find("--method must be refined or paper-linear, not 'weighted-ml'"),
+            std::string::npos)
+      << out;
+  EXPECT_FALSE(fs::exists(*dir_ / "r.html"));
 }
 
 TEST_F(LrfCli, StereoBaselineCheckComposesLeftAndRight) {
@@ -277,6 +304,20 @@ TEST(LrfRealData, AcfrRpgFivePairsLoadExtractAndSolve) {
   const Mat3 nominal = (Mat3() << 0, -1, 0, 0, 0, -1, 1, 0, 0).finished();
   EXPECT_LT(RotationAngle(s.cam_from_lrf.linear(), nominal) * 180 / M_PI, 10.0);
   EXPECT_LT(s.cam_from_lrf.translation().z(), 0.0);
+  // Its report says so at the top and leaves no observation out: a solve of four upright boards
+  // moves freely along what none fixes (it moved 35 m and blamed two boards before this check).
+  const LrfReport report = AnalyseLrfCalibration(dataset, outcome, LrfPipelineOptions{});
+  EXPECT_FALSE(report.well_constrained);
+  EXPECT_EQ(report.folds, 0);
+  EXPECT_NE(report.cross_validation_skipped.find("not well constrained"), std::string::npos);
+  for (const LrfPairReportRow& row : report.pairs) {
+    EXPECT_FALSE(row.disagrees) << row.id;
+    EXPECT_NE(row.svg.find("<svg"), std::string::npos) << row.id;  // the board's returns drawn
+  }
+  const std::string html =
+      LrfReportHtml(report, {}, LoadReportAssets(fs::path(CALIBENCH_SOURCE_DIR) / "assets/report"));
+  EXPECT_NE(html.find("Not well constrained: rotation about camera"), std::string::npos);
+  EXPECT_NE(html.find("board plane cut with the scan"), std::string::npos);
 }
 
 }  // namespace

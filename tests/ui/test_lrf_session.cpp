@@ -114,6 +114,19 @@ TEST(LrfSession, TheWorkbenchSavesItsWordAndResumesItWhereTheCommandLineReadsItT
                              &output),
             0);
   EXPECT_TRUE(Says(output, "--method refined disagrees")) << output;
+  // `report --session` re-solves with the session's rejection and method: the result's transform
+  // (no "differs from a re-solve" note), pair 2 listed as the user rejected it.
+  const auto page = out.parent_path() / "report.html";
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " report --session " + session_file.string() +
+                                 " --result " + out.string() + " --out " + page.string(),
+                             &output),
+            0)
+      << output;
+  EXPECT_FALSE(Says(output, "differs from a re-solve")) << output;
+  std::ifstream in(page);
+  const std::string html((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_TRUE(Says(html, "method paper-linear")) << output;
+  EXPECT_TRUE(Says(html, "rejected")) << output;
 }
 
 TEST(LrfSession, ASessionThatDoesNotOpenIsMovedAsideOrItsBackupResumedAndFreshStartsOver) {

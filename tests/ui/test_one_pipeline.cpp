@@ -19,7 +19,7 @@
 #include "tests/test_support.h"
 #include "tests/ui/ui_fixture.h"
 #include "ui/lidar_camera/controller.h"
-#include "ui/lidar_camera/report_job.h"
+#include "ui/widgets/report_job.h"
 
 namespace calibench::ui {
 namespace {

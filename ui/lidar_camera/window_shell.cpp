@@ -13,9 +13,9 @@
 #include "core/io/dataset.h"
 #include "core/io/recording_watch.h"
 #include "core/results/export.h"
-#include "ui/lidar_camera/report_job.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/widgets/error_popup.h"
+#include "ui/widgets/report_runner.h"
 
 namespace calibench::ui {
 
@@ -230,7 +230,7 @@ bool WindowShell::Frame(Window& window, int width, int height, double seconds) {
   if (!browser_.IsOpen()) choosing_watch_ = false;
   Popups();
   if (quit_) window.RequestClose();
-  return importing || report_ != nullptr || !intents.empty() || workbench_->Animating(snapshot) ||
+  return importing || report_.Running() || !intents.empty() || workbench_->Animating(snapshot) ||
          workbench_->NeedsAnotherFrame() || pending_open_.has_value() ||
          pending_camera_.has_value();
 }
@@ -307,50 +307,13 @@ void WindowShell::ExportMenu() {
 void WindowShell::ReportMenuItem() {
   const Snapshot snapshot = controller_->GetSnapshot();
   drawn_generation_ = snapshot.generation;
-  const bool ready = snapshot.solver.result && !snapshot.session_path.empty() && !report_;
-  if (!ImGui::MenuItem("Report... (calibench_report.html beside the session)", nullptr, false,
-                       ready))
-    return;
-  // The session on disk is current: every edit and solve is autosaved.
-  report_ =
-      std::make_unique<ReportJob>(CalibenchExecutable(), snapshot.session_path,
-                                  snapshot.session_path.parent_path() / "calibench_report.html");
-}
-
-void WindowShell::ReportPopups() {
-  if (report_ && report_->Done()) {
-    std::string lines;  // what the command said, without its progress
-    std::istringstream output(report_->output());
-    for (std::string line; std::getline(output, line);)
-      if (!line.empty() && line[0] != '[') lines += line + "\n";
-    report_message_ = report_->exit_code() == 0 ? lines : "the report failed:\n" + lines;
-    if (report_->exit_code() != 0) error_ = report_message_, show_error_ = true;
-    show_report_ = report_->exit_code() == 0;
-    report_.reset();
-  }
-  if (report_) {
-    ImGui::SetNextWindowPos(ImVec2(8, 28));
-    ImGui::Begin("##report", nullptr,
-                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize);
-    ImGui::Text("writing %s (re-solving each pair left out, drawing the views)...",
-                report_->out().c_str());
-    ImGui::End();
-  }
-  if (show_report_) {
-    ImGui::OpenPopup("Report");
-    show_report_ = false;
-  }
-  if (ImGui::BeginPopupModal("Report", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
-    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 45.0f);  // an auto-sized popup needs a width
-    ImGui::TextUnformatted(report_message_.c_str());
-    ImGui::PopTextWrapPos();
-    if (ImGui::Button("OK")) ImGui::CloseCurrentPopup();
-    ImGui::EndPopup();
-  }
+  report_.MenuItem(snapshot.session_path, snapshot.solver.result.has_value(),
+                   "re-solving each pair left out, drawing the views");
 }
 
 void WindowShell::Popups() {
-  ReportPopups();
+  if (std::string failure = report_.Draw(); !failure.empty())
+    error_ = std::move(failure), show_error_ = true;
   if (import_ && !ImGui::IsPopupOpen("Importing")) ImGui::OpenPopup("Importing");
   if (ImGui::BeginPopupModal("Importing", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
     if (!import_) {

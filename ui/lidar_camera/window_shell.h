@@ -17,13 +17,13 @@
 #include "ui/lidar_camera/controller.h"
 #include "ui/state/recent_files.h"
 #include "ui/widgets/file_browser.h"
+#include "ui/widgets/report_runner.h"
 #include "ui/widgets/window_loop.h"
 
 namespace calibench::ui {
 
 class Workbench;
 struct ImportJob;  // a recording importing on its thread (window_shell.cpp)
-class ReportJob;   // File → Report… (report_job.h)
 
 struct ShellOptions {
   PipelineOptions pipeline;
@@ -81,7 +81,6 @@ class WindowShell {
   void BoardMenu();  // the board of recordings opened from the menu
   void ExportMenu();
   void ReportMenuItem();  // File → Report…: `calibench report` on the saved session
-  void ReportPopups();
   void Popups();
   // Opens what a finished import wrote; true while an import runs.
   bool PollImport();
@@ -96,11 +95,9 @@ class WindowShell {
   RecentFiles recent_;
   FileBrowser browser_;
   std::unique_ptr<ImportJob> import_;
-  std::unique_ptr<ReportJob> report_;
+  ReportRunner report_;
   // The board presets (assets/targets), read when the menu first opens, not every frame.
   std::vector<std::pair<std::string, BoardSpec>> presets_;
-  std::string report_message_;  // the last report's outcome, shown once in a popup
-  bool show_report_ = false;
   std::optional<BagImportSummary> last_import_;
   std::optional<std::filesystem::path> pending_open_;   // chosen during a frame, opened at the next
   std::optional<std::filesystem::path> pending_watch_;  // the same, to be watched

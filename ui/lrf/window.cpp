@@ -13,6 +13,7 @@
 #include "ui/lrf/workbench.h"
 #include "ui/widgets/error_popup.h"
 #include "ui/widgets/file_browser.h"
+#include "ui/widgets/report_runner.h"
 
 namespace calibench::ui {
 namespace {
@@ -44,13 +45,16 @@ class LrfWindowShell {
         workbench_->Frame(snapshot, width, height, LrfLayout::kWorkbench, seconds, top);
     for (const LrfIntent& intent : intents) controller_.Apply(intent);
     if (const auto chosen = browser_.Draw()) pending_open_ = *chosen;
+    if (std::string failure = report_.Draw(); !failure.empty())
+      error_ = std::move(failure), show_error_ = true, lidar_camera_refused_ = false;
     ErrorPopup(
         "Cannot open", error_, &show_error_,
         lidar_camera_refused_
             ? "a LiDAR-camera dataset: it opens in its own window, calibench gui --dataset PATH"
             : nullptr);
     if (quit_) window.RequestClose();
-    return !intents.empty() || workbench_->Animating(snapshot) || pending_open_.has_value();
+    return !intents.empty() || workbench_->Animating(snapshot) || pending_open_.has_value() ||
+           report_.Running();
   }
 
   const std::string& error() const { return error_; }
@@ -83,6 +87,9 @@ class LrfWindowShell {
       if (ImGui::MenuItem(label.c_str(), nullptr, false, solved))
         controller_.Apply(LrfExportResult{kMenuExportFile});  // relative: beside the manifest
       ImGui::TextDisabled("beside the manifest; the solver panel exports anywhere");
+      const LrfSnapshot s = controller_.GetSnapshot();
+      report_.MenuItem(s.session_path, s.solver.solution.has_value() && s.save_error.empty(),
+                       "re-solving each observation left out");
       ImGui::Separator();
       if (ImGui::MenuItem("Quit")) quit_ = true;
       ImGui::EndMenu();
@@ -105,6 +112,7 @@ class LrfWindowShell {
   LrfController& controller_;
   std::unique_ptr<LrfWorkbench> workbench_;
   FileBrowser browser_;
+  ReportRunner report_;  // File → Report…
   std::optional<fs::path> pending_open_;
   std::string error_;
   bool show_error_ = false;

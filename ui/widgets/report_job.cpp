@@ -1,4 +1,4 @@
-#include "ui/lidar_camera/report_job.h"
+#include "ui/widgets/report_job.h"
 
 #include <sys/wait.h>
 
