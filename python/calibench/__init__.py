@@ -420,8 +420,8 @@ def check(dataset: PathLike, result: Union[Result, PathLike], *,
 def report(out: PathLike, result: Union[Result, PathLike], *, dataset: Optional[PathLike] = None,
            session: Optional[PathLike] = None, views: bool = True,
            progress: Optional[Progress] = None, **options: Any) -> Path:
-    """`calibench report`: the self-contained HTML report of a result (a Result or its file) on
-    its dataset (or session). views=False leaves out the rendered views (no OpenGL needed);
+    """`calibench report`: the self-contained HTML report of a result (a Result or its file, of
+    either method: LiDAR-camera or 2D LRF) on its dataset (or session). views=False leaves out the rendered views (no OpenGL needed);
     ``no_cross_validation=True`` skips the leave-one-out re-solves. Returns the report's path."""
     with tempfile.TemporaryDirectory(prefix="calibench-") as tmp:
         if isinstance(result, Result):

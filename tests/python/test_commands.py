@@ -88,6 +88,9 @@ def test_lrf_calibrate_equals_the_command_line(exe, tmp_path):
     assert np.linalg.norm(error[:3, 3]) < 0.02  # the paper's simulation: ~5 mm
     np.testing.assert_allclose(result.cam_from_lidar @ result.lidar_from_cam, np.eye(4),
                                atol=1e-12)
+    # Its report, from the Result itself: the LRF method's page.
+    page = calibench.report(tmp_path / "lrf.html", result, dataset=dataset)
+    assert "Calibench 2D LRF calibration report" in page.read_text(encoding="utf-8")
 
 
 def test_lrf_calibrate_with_a_workbench_session(exe, tmp_path):
