@@ -10,6 +10,7 @@
 #include "core/lidar_camera/rig.h"
 #include "core/results/export.h"
 #include "core/results/result_file.h"
+#include "core/session/lrf_calibration_job.h"
 #include "core/session/session.h"
 
 namespace calibench::app {
@@ -71,10 +72,13 @@ int RunExport(int argc, char** argv) {
   app.add_option("--result,-r", result, "calibench.result.v1 file, or a session with a result")
       ->required();
   app.add_option("--format,-f", format_name, FormatNames())->required();
-  app.add_option("--parent-frame", frames.lidar, "the parent frame's name (the LiDAR's)")
-      ->capture_default_str();
-  app.add_option("--child-frame", frames.camera, "the child frame's name (the camera's)")
-      ->capture_default_str();
+  std::string parent_frame, child_frame;
+  app.add_option("--parent-frame", parent_frame,
+                 "the parent frame's name (the LiDAR's: default lidar, or lrf for an LRF result; "
+                 "with --swap the camera's: default camera)");
+  app.add_option("--child-frame", child_frame,
+                 "the child frame's name (the camera's: default camera; with --swap the "
+                 "sensor's)");
   app.add_flag("--swap", frames.camera_is_parent,
                "the camera is the parent and the LiDAR the child (--parent-frame then names the "
                "camera's frame and --child-frame the LiDAR's)");
@@ -85,7 +89,13 @@ int RunExport(int argc, char** argv) {
   app.add_option("--out,-o", out,
                  "file to write (default: the format's usual name next to the result)");
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
-  if (frames.camera_is_parent) std::swap(frames.lidar, frames.camera);
+  // The names given go to the roles --swap assigns; those not given keep their frame's name (an
+  // LRF result's sensor frame is the LRF's).
+  if (IsLrfResultFile(result) || IsLrfSession(result)) frames.lidar = "lrf";
+  std::string& parent = frames.camera_is_parent ? frames.camera : frames.lidar;
+  std::string& child = frames.camera_is_parent ? frames.lidar : frames.camera;
+  if (app.count("--parent-frame")) parent = parent_frame;
+  if (app.count("--child-frame")) child = child_frame;
   const auto format = ParseExportFormat(format_name);
   const auto camera = ParseCameraFrame(camera_frame);
   std::string why;

@@ -95,6 +95,31 @@ TEST_F(ExportCli, TheWrongConventionShowsAsALargeDifference) {
   EXPECT_NE(output.find("rotation 120.000 deg"), std::string::npos) << output;
 }
 
+// --swap makes the camera the parent: the frames keep their own names whichever flags name them
+// (it named the camera's frame "lidar" without them), and the file reads back to the result.
+TEST_F(ExportCli, SwappedTheCameraIsTheParentUnderItsOwnName) {
+  const Pose cam_from_lidar = LoadResult(Result()).cam_from_source;
+  for (const std::string names : {"", " --parent-frame cam0 --child-frame velodyne"}) {
+    const fs::path out = *dir_ / "swapped.urdf";
+    std::string output;
+    ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " export --swap --format urdf --result " +
+                                   Result().string() + names + " --out " + out.string(),
+                               &output),
+              0)
+        << output;
+    ExportFrames frames;
+    frames.camera_is_parent = true;
+    if (!names.empty()) frames.camera = "cam0", frames.lidar = "velodyne";
+    EXPECT_NE(output.find("the pose of '" + frames.lidar + "' in '" + frames.camera + "'"),
+              std::string::npos)
+        << output;
+    const ImportedTransform imported = ReadExportedTransform(out);
+    EXPECT_TRUE(test::MatrixNear(CamFromLidarOf(imported.parent_from_child, frames).matrix(),
+                                 cam_from_lidar.matrix(), 1e-12))
+        << names;
+  }
+}
+
 TEST_F(ExportCli, BadFlagsAndASessionWithoutAResult) {
   std::string output;
   EXPECT_EQ(test::RunCommand(

@@ -83,6 +83,23 @@ TEST_F(LrfCli, RefinedAndPaperLinearCalibrateAndEvaluate) {
     EXPECT_NE(html.find("Calibench 2D LRF calibration report"), std::string::npos);
     EXPECT_NE(html.find("method " + method), std::string::npos);
     EXPECT_EQ(html.find("Not computed"), std::string::npos);
+    // Exported, the sensor's frame is the LRF's unless named otherwise.
+    const fs::path urdf = *dir_ / ("lrf_" + method + ".urdf");
+    ASSERT_EQ(test::RunCommand(Exe() + " export --format urdf --result " + result.string() +
+                                   " --out " + urdf.string(),
+                               &out),
+              0)
+        << out;
+    EXPECT_NE(out.find("the pose of 'camera' in 'lrf'"), std::string::npos) << out;
+    ASSERT_EQ(test::RunCommand(Exe() + " export --format urdf --swap --result " + result.string() +
+                                   " --out " + urdf.string(),
+                               &out),
+              0)
+        << out;
+    EXPECT_NE(out.find("the pose of 'lrf' in 'camera'"), std::string::npos) << out;
+    std::ifstream swapped(urdf);
+    const std::string joint((std::istreambuf_iterator<char>(swapped)), {});
+    EXPECT_NE(joint.find("<parent link=\"camera\"/>"), std::string::npos) << joint;
   }
   // Without its data the report cannot re-solve; a LiDAR-camera method is no LRF method.
   std::string out;
