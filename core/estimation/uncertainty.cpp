@@ -66,7 +66,7 @@ std::string Termination::Describe() const {
 }
 
 ObservabilityReport AnalyseObservability(const Mat6& information, const Pose& cam_from_lidar,
-                                         double weak_eigenvalue_ratio) {
+                                         double weak_eigenvalue_ratio, const std::string& sensor) {
   ObservabilityReport report;
   Eigen::SelfAdjointEigenSolver<Mat6> eigen(information);
   report.eigenvalues = eigen.eigenvalues();
@@ -90,7 +90,7 @@ ObservabilityReport AnalyseObservability(const Mat6& information, const Pose& ca
       if ((weak_basis.transpose() * motion).squaredNorm() < 0.5) continue;
       report.weak_directions.push_back(
           std::string(kind == 0 ? "translation along camera " : "rotation about camera ") +
-          kAxisNames[axis] + (kind == 1 ? " through the LiDAR origin" : ""));
+          kAxisNames[axis] + (kind == 1 ? " through the " + sensor + " origin" : ""));
     }
   }
   for (int i = 0; i < num_weak && report.weak_directions.size() < static_cast<size_t>(num_weak);

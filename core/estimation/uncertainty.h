@@ -56,9 +56,11 @@ struct ObservabilityReport {
 };
 
 // Observability of cam_from_<sensor> from its information matrix (right perturbation, [rho; phi])
-// at an estimate: eigenvalues, and the weak directions named in camera axes.
+// at an estimate: eigenvalues, and the weak directions named in camera axes (a rotation "through
+// the <sensor> origin": "LiDAR", "LRF").
 ObservabilityReport AnalyseObservability(const Mat6& information, const Pose& cam_from_lidar,
-                                         double weak_eigenvalue_ratio);
+                                         double weak_eigenvalue_ratio,
+                                         const std::string& sensor = "LiDAR");
 
 // Standard deviations of cam_from_lidar along the camera axes, from the covariance of its right
 // perturbation: the translation of T·Exp([rho; phi]) moves by R·rho and its rotation by R·phi to

@@ -375,7 +375,7 @@ LrfSolution PointPlaneSolver::Summarize() const {
   solution.covariance = Covariance(lin, redundancy);
   // Observability is geometry, not noise: judged on the unweighted information JᵀJ.
   solution.observability = AnalyseObservability(lin.geometric_information, cam_from_lrf_,
-                                                options_.weak_eigenvalue_ratio);
+                                                options_.weak_eigenvalue_ratio, "LRF");
   if (redundancy <= 0) {
     solution.observability.well_constrained = false;
     solution.observability.weak_directions.push_back(

@@ -334,6 +334,7 @@ TEST(LrfRealData, AcfrRpgFivePairsLoadExtractAndSolve) {
   const std::string html =
       LrfReportHtml(report, {}, LoadReportAssets(fs::path(CALIBENCH_SOURCE_DIR) / "assets/report"));
   EXPECT_NE(html.find("Not well constrained: rotation about camera"), std::string::npos);
+  EXPECT_NE(html.find("through the LRF origin"), std::string::npos);  // not "the LiDAR origin"
   EXPECT_NE(html.find("board plane cut with the scan"), std::string::npos);
 }
 
