@@ -491,9 +491,9 @@ TEST(LrfSolver, VerticalBoardsAndALevelScanReportThreeWeakDirections) {
   ASSERT_TRUE(solution.ok) << solution.reason;
   EXPECT_FALSE(solution.observability.well_constrained);
   const std::vector<std::string> expected = {"translation along camera y (down)",
-                                             "rotation about camera x (right) through the LiDAR "
+                                             "rotation about camera x (right) through the LRF "
                                              "origin",
-                                             "rotation about camera z (forward) through the LiDAR "
+                                             "rotation about camera z (forward) through the LRF "
                                              "origin"};
   EXPECT_EQ(solution.observability.weak_directions, expected);
   // The observable part (x, z translation and rotation about y) is recovered.
