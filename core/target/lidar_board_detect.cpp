@@ -14,6 +14,7 @@ namespace calibench {
 namespace {
 
 using board_grid::AngularGrid;
+using board_grid::FreeEdgeFraction;
 using board_grid::LinkDistance;
 
 struct LocalPlane {
@@ -217,84 +218,6 @@ SheetBounds BoundsFor(const BoardSpec& board, const LidarBoardDetectionOptions& 
   return bounds;
 }
 
-enum class Border { kFree, kAttached, kOccluded };
-
-// What lies at `cell` seen from a segment with `plane`: nothing or something behind (free),
-// something on the plane (attached) or in front (occluded).
-Border Classify(const LidarCloud& cloud, const AngularGrid& grid, int cell, const Plane& plane,
-                double jump_m) {
-  if (grid.point[cell] < 0) return Border::kFree;
-  const Vec3 p = PointAt(cloud, grid.point[cell]);
-  const double range = p.norm();
-  const double along = plane.normal.dot(p / range);
-  if (along >= -1e-6) return Border::kFree;  // the ray never meets the plane's front
-  const double predicted = -plane.distance / along;
-  if (range > predicted + jump_m) return Border::kFree;
-  return range < predicted - jump_m ? Border::kOccluded : Border::kAttached;
-}
-
-// The fraction of a segment's border with nothing right behind it: the row ends (along rings) and
-// the column ends (across rings), each half of the answer.
-double FreeEdgeFraction(const LidarCloud& cloud, const AngularGrid& grid,
-                        const std::vector<int>& cells, const std::vector<char>& in_segment,
-                        const Plane& plane, double jump_m) {
-  std::map<int, std::pair<int, int>> row_ends;     // row -> columns unwrapped about the first cell
-  std::map<int, std::pair<int, int>> column_ends;  // column -> rows
-  const int reference = cells.front() % grid.columns;
-  for (int cell : cells) {
-    const int row = cell / grid.columns, column = cell % grid.columns;
-    int unwrapped = column - reference;
-    if (unwrapped > grid.columns / 2) unwrapped -= grid.columns;
-    if (unwrapped < -grid.columns / 2) unwrapped += grid.columns;
-    auto [it, fresh] = row_ends.try_emplace(row, unwrapped, unwrapped);
-    it->second = {std::min(it->second.first, unwrapped), std::max(it->second.second, unwrapped)};
-    auto [ct, cfresh] = column_ends.try_emplace(column, row, row);
-    ct->second = {std::min(ct->second.first, row), std::max(ct->second.second, row)};
-  }
-  // Walking outward, the first return off the plane decides; a fringe of the sheet's own returns
-  // that the segment left out (noise at its border) is stepped over, a wall is not (it stays on
-  // the plane for the whole reach).
-  const int reach = grid.HalfWindowColumns() + 3;
-  // Cells without a return (a dropout on black ink) are stepped over too; a row end with no
-  // return at all within the reach has nothing behind it (a cloud of the board alone).
-  auto along_row = [&](int row, int from, int step) {
-    bool any_return = false;
-    for (int k = 1; k <= reach; ++k) {
-      const int cell = grid.Cell(row, grid.Wrap(reference + from + step * k));
-      if (in_segment[cell] || grid.point[cell] < 0) continue;
-      any_return = true;
-      const Border border = Classify(cloud, grid, cell, plane, jump_m);
-      if (border != Border::kAttached) return border;
-    }
-    return any_return ? Border::kAttached : Border::kFree;
-  };
-  auto along_column = [&](int column, int from, int step) {
-    for (int k = 1; k <= 3; ++k) {
-      const int row = from + step * k;
-      if (row < 0 || row >= grid.rows) return Border::kFree;
-      const int cell = grid.Cell(row, column);
-      if (in_segment[cell]) continue;
-      const Border border = Classify(cloud, grid, cell, plane, jump_m);
-      if (border != Border::kAttached) return border;
-    }
-    return Border::kAttached;
-  };
-  int free_h = 0, total_h = 0, free_v = 0, total_v = 0;
-  for (const auto& [row, ends] : row_ends) {
-    free_h += (along_row(row, ends.first, -1) == Border::kFree) +
-              (along_row(row, ends.second, +1) == Border::kFree);
-    total_h += 2;
-  }
-  for (const auto& [column, ends] : column_ends) {
-    free_v += (along_column(column, ends.first, -1) == Border::kFree) +
-              (along_column(column, ends.second, +1) == Border::kFree);
-    total_v += 2;
-  }
-  const double h = total_h ? double(free_h) / total_h : 0.0;
-  const double v = total_v ? double(free_v) / total_v : 0.0;
-  return 0.5 * (h + v);
-}
-
 // Fits, measures and tests one segment. The candidate's `rejection` says why it is not the board.
 // The plane, centre, RMS and outline of a set of returns.
 void Measure(const LidarCloud& cloud, LidarBoardCandidate* c) {
@@ -456,27 +379,20 @@ LidarBoardDetection DetectLidarBoard(const LidarCloud& cloud, const BoardSpec& b
   const std::vector<LocalPlane> planes =
       ScaleToNoise(std::move(local), result.local_rms_m, &options);
   std::vector<char> in_segment(grid.point.size(), 0);
-  for (const std::vector<int>& cells : GrowSegments(grid, cell_points, planes, options)) {
-    if (static_cast<int>(cells.size()) < options.min_points) continue;
+  auto consider = [&](const std::vector<int>& cells) {
     LidarBoardCandidate c = Evaluate(cloud, grid, cells, &in_segment, sheet, options, background);
-    if (c.rejection.empty())
-      result.candidates.push_back(std::move(c));
-    else
-      result.near_misses.push_back(std::move(c));
-  }
+    (c.rejection.empty() ? result.candidates : result.near_misses).push_back(std::move(c));
+  };
+  for (const std::vector<int>& cells : GrowSegments(grid, cell_points, planes, options))
+    if (static_cast<int>(cells.size()) >= options.min_points) consider(cells);
   // A sparse ring-less frame (strokes a cell apart, not surfaces) leaves no neighbourhood planar
   // enough to grow from; there the clusters that stand apart in range are the segments.
   if (result.candidates.empty() && !grid.from_rings) {
     board_grid::ClusterOptions clusters;
     clusters.min_points = options.min_points;
     clusters.max_diameter_m = sheet.max.norm() + 2 * options.size_tolerance_m;
-    for (const std::vector<int>& cells : board_grid::RangeClusters(grid, cell_points, clusters)) {
-      LidarBoardCandidate c = Evaluate(cloud, grid, cells, &in_segment, sheet, options, background);
-      if (c.rejection.empty())
-        result.candidates.push_back(std::move(c));
-      else
-        result.near_misses.push_back(std::move(c));
-    }
+    for (const std::vector<int>& cells : board_grid::RangeClusters(grid, cell_points, clusters))
+      consider(cells);
   }
   auto by_score = [](const auto& a, const auto& b) { return a.score > b.score; };
   std::sort(result.candidates.begin(), result.candidates.end(), by_score);

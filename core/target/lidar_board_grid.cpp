@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <unordered_set>
 
 #include "core/lidar/lidar_image.h"
@@ -181,6 +182,88 @@ Vec2 MinAreaRectangle(const std::vector<Vec2>& hull) {
     }
   }
   return best;
+}
+
+namespace {
+
+enum class Border { kFree, kAttached, kOccluded };
+
+// What lies at `cell` seen from a segment with `plane`: nothing or something behind (free),
+// something on the plane (attached) or in front (occluded).
+Border Classify(const LidarCloud& cloud, const AngularGrid& grid, int cell, const Plane& plane,
+                double jump_m) {
+  if (grid.point[cell] < 0) return Border::kFree;
+  const Vec3 p = cloud.points[grid.point[cell]].cast<double>();
+  const double range = p.norm();
+  const double along = plane.normal.dot(p / range);
+  if (along >= -1e-6) return Border::kFree;  // the ray never meets the plane's front
+  const double predicted = -plane.distance / along;
+  if (range > predicted + jump_m) return Border::kFree;
+  return range < predicted - jump_m ? Border::kOccluded : Border::kAttached;
+}
+
+}  // namespace
+
+// The fraction of a segment's border with nothing right behind it: the row ends (along rings) and
+// the column ends (across rings), each half of the answer.
+double FreeEdgeFraction(const LidarCloud& cloud, const AngularGrid& grid,
+                        const std::vector<int>& cells, const std::vector<char>& in_segment,
+                        const Plane& plane, double jump_m) {
+  std::map<int, std::pair<int, int>> row_ends;     // row -> columns unwrapped about the first cell
+  std::map<int, std::pair<int, int>> column_ends;  // column -> rows
+  const int reference = cells.front() % grid.columns;
+  for (int cell : cells) {
+    const int row = cell / grid.columns, column = cell % grid.columns;
+    int unwrapped = column - reference;
+    if (unwrapped > grid.columns / 2) unwrapped -= grid.columns;
+    if (unwrapped < -grid.columns / 2) unwrapped += grid.columns;
+    auto [it, fresh] = row_ends.try_emplace(row, unwrapped, unwrapped);
+    it->second = {std::min(it->second.first, unwrapped), std::max(it->second.second, unwrapped)};
+    auto [ct, cfresh] = column_ends.try_emplace(column, row, row);
+    ct->second = {std::min(ct->second.first, row), std::max(ct->second.second, row)};
+  }
+  // Walking outward, the first return off the plane decides; a fringe of the sheet's own returns
+  // that the segment left out (noise at its border) is stepped over, a wall is not (it stays on
+  // the plane for the whole reach).
+  const int reach = grid.HalfWindowColumns() + 3;
+  // Cells without a return (a dropout on black ink) are stepped over too; a row end with no
+  // return at all within the reach has nothing behind it (a cloud of the board alone).
+  auto along_row = [&](int row, int from, int step) {
+    bool any_return = false;
+    for (int k = 1; k <= reach; ++k) {
+      const int cell = grid.Cell(row, grid.Wrap(reference + from + step * k));
+      if (in_segment[cell] || grid.point[cell] < 0) continue;
+      any_return = true;
+      const Border border = Classify(cloud, grid, cell, plane, jump_m);
+      if (border != Border::kAttached) return border;
+    }
+    return any_return ? Border::kAttached : Border::kFree;
+  };
+  auto along_column = [&](int column, int from, int step) {
+    for (int k = 1; k <= 3; ++k) {
+      const int row = from + step * k;
+      if (row < 0 || row >= grid.rows) return Border::kFree;
+      const int cell = grid.Cell(row, column);
+      if (in_segment[cell]) continue;
+      const Border border = Classify(cloud, grid, cell, plane, jump_m);
+      if (border != Border::kAttached) return border;
+    }
+    return Border::kAttached;
+  };
+  int free_h = 0, total_h = 0, free_v = 0, total_v = 0;
+  for (const auto& [row, ends] : row_ends) {
+    free_h += (along_row(row, ends.first, -1) == Border::kFree) +
+              (along_row(row, ends.second, +1) == Border::kFree);
+    total_h += 2;
+  }
+  for (const auto& [column, ends] : column_ends) {
+    free_v += (along_column(column, ends.first, -1) == Border::kFree) +
+              (along_column(column, ends.second, +1) == Border::kFree);
+    total_v += 2;
+  }
+  const double h = total_h ? double(free_h) / total_h : 0.0;
+  const double v = total_v ? double(free_v) / total_v : 0.0;
+  return 0.5 * (h + v);
 }
 
 }  // namespace calibench::board_grid

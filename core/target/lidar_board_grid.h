@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/base/types.h"
+#include "core/geometry/geometry.h"
 #include "core/lidar/cloud.h"
 
 namespace calibench::board_grid {
@@ -33,6 +34,13 @@ struct AngularGrid {
 // Rings (the cloud's own, its organized rows, or clear elevation clusters) where they exist, else
 // an azimuth x elevation grid of `cell_deg` (0 = about one return per cell).
 AngularGrid BuildAngularGrid(const LidarCloud& cloud, double cell_deg);
+
+// The fraction of a segment's border (its cells, marked in `in_segment`) with nothing right
+// behind its plane: a return more than `jump_m` behind, or none (lidar_board_detect.cpp's
+// "standing free").
+double FreeEdgeFraction(const LidarCloud& cloud, const AngularGrid& grid,
+                        const std::vector<int>& cells, const std::vector<char>& in_segment,
+                        const Plane& plane, double jump_m);
 
 // A convex hull (counter-clockwise) and its minimum-area enclosing rectangle.
 std::vector<Vec2> ConvexHull(std::vector<Vec2> points);
