@@ -53,43 +53,62 @@ std::string TranslationText(const Pose& pose) {
 
 }  // namespace
 
-RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
-                        const ProgressCallback& progress, const RigEdits& edits) {
-  RigOutcome outcome;
-  outcome.camera_names = rig.camera_names;
-  std::vector<RigCameraPrior> cameras;
-  // Captures by stem: every camera's view of the board. Each camera's own calibration (with the
-  // LiDAR's planes, the board's edges, the range offset and its honest σ) is its prior; the
-  // boards two cameras saw at once tie the cameras to each other on top of it
-  // (SolveRigFromCameras).
-  std::map<std::string, RigCapture, NaturalOrder> captures;
-  for (size_t c = 0; c < rig.cameras.size(); ++c) {
-    const auto camera_edits = edits.find(rig.camera_names[c]);
-    outcome.single.push_back(
-        CalibrateDataset(rig.cameras[c], options, progress,
-                         camera_edits == edits.end() ? PairEdits{} : camera_edits->second));
-    const CalibrationOutcome& single = outcome.single.back();
+RigCalibration::RigCalibration(RigFolder rig, PipelineOptions options, RigEdits edits,
+                               ProgressCallback progress)
+    : rig_(std::move(rig)),
+      options_(std::move(options)),
+      edits_(std::move(edits)),
+      progress_(std::move(progress)) {
+  outcome_.camera_names = rig_.camera_names;
+}
+
+size_t RigCalibration::StepsLeft() const {
+  return solved_ ? 0 : rig_.cameras.size() - next_camera_ + 1;
+}
+
+bool RigCalibration::Step() {
+  if (solved_) return false;
+  if (next_camera_ < rig_.cameras.size()) {
+    // Each camera's own calibration (with the LiDAR's planes, the board's edges, the range
+    // offset and its honest σ) is its prior; the boards two cameras saw at once tie the cameras
+    // to each other on top of it (SolveRigFromCameras).
+    const size_t c = next_camera_++;
+    const auto camera_edits = edits_.find(rig_.camera_names[c]);
+    outcome_.single.push_back(
+        CalibrateDataset(rig_.cameras[c], options_, progress_,
+                         camera_edits == edits_.end() ? PairEdits{} : camera_edits->second));
+    const CalibrationOutcome& single = outcome_.single.back();
     if (!single.solution) {
-      outcome.failure = "camera '" + rig.camera_names[c] + "': " + single.failure;
-      continue;
+      outcome_.failure = "camera '" + rig_.camera_names[c] + "': " + single.failure;
+      return true;
     }
-    cameras.push_back({single.solution->cam_from_lidar, single.solution->covariance});
+    priors_.push_back({single.solution->cam_from_lidar, single.solution->covariance});
     for (const PairFeatures& pair : single.pairs) {
       if (pair.status != PairStatus::kAccepted || !pair.lidar || !pair.camera) continue;
-      RigCapture& capture = captures[pair.id];
+      RigCapture& capture = captures_[pair.id];
       capture.id = pair.id;
       capture.views.push_back(
           {static_cast<int>(c), pair.camera->cam_from_board, pair.camera->pose_covariance});
     }
+    return true;
   }
-  if (!outcome.failure.empty()) return outcome;
+  solved_ = true;
+  if (!outcome_.failure.empty()) return false;
   std::vector<RigCapture> all;
-  for (auto& [stem, capture] : captures) all.push_back(std::move(capture));
+  for (auto& [stem, capture] : captures_) all.push_back(std::move(capture));
   std::string why;
-  outcome.joint =
-      SolveRigFromCameras(all, cameras, RigSolverOptions{}, &why, &outcome.shared_captures);
-  if (!outcome.joint) outcome.failure = "rig solve: " + why;
-  return outcome;
+  outcome_.joint =
+      SolveRigFromCameras(all, priors_, RigSolverOptions{}, &why, &outcome_.shared_captures);
+  if (!outcome_.joint) outcome_.failure = "rig solve: " + why;
+  return false;
+}
+
+RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
+                        const ProgressCallback& progress, const RigEdits& edits) {
+  RigCalibration calibration(rig, options, edits, progress);
+  while (calibration.Step()) {
+  }
+  return calibration.Outcome();
 }
 
 PoseWithSigmas RigJointPose(const RigOutcome& outcome, size_t c) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/base/names.h"
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/rig_solver.h"
@@ -40,9 +41,35 @@ PoseWithSigmas RigJointPose(const RigOutcome& outcome, size_t c);
 // x_in_first), from the rig solve with σ (needs outcome.joint).
 std::vector<PoseWithSigmas> RigRelativePoses(const RigOutcome& outcome);
 
-// Calibrates every camera of the rig, then the rig. A camera whose own solve fails leaves the
-// rig without a joint solution (failure says which and why). `edits` apply to their camera's
-// pairs, as `calibrate --session` applies one session's.
+// CalibrateRig one step at a time, for a front end that must not block on it for long (the
+// workbench's worker runs each step between the user's edits): each camera's own calibration is
+// a step, the rig solve the last. Holds its copies of the arguments.
+class RigCalibration {
+ public:
+  RigCalibration(RigFolder rig, PipelineOptions options, RigEdits edits = {},
+                 ProgressCallback progress = {});
+  // Runs the next step; false when that was the last, or none was left (Outcome() is final).
+  bool Step();
+  // Steps left: one per camera not yet calibrated, and the rig solve.
+  size_t StepsLeft() const;
+  const RigOutcome& Outcome() const { return outcome_; }
+
+ private:
+  RigFolder rig_;
+  PipelineOptions options_;
+  RigEdits edits_;
+  ProgressCallback progress_;
+  RigOutcome outcome_;
+  size_t next_camera_ = 0;
+  bool solved_ = false;
+  std::vector<RigCameraPrior> priors_;
+  // Captures by stem: every camera's view of the board (NaturalOrder: the files' order).
+  std::map<std::string, RigCapture, NaturalOrder> captures_;
+};
+
+// Calibrates every camera of the rig, then the rig (RigCalibration's steps, in a row). A camera
+// whose own solve fails leaves the rig without a joint solution (failure says which and why).
+// `edits` apply to their camera's pairs, as `calibrate --session` applies one session's.
 RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
                         const ProgressCallback& progress = {}, const RigEdits& edits = {});
 

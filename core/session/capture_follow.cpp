@@ -16,44 +16,27 @@ namespace calibench {
 namespace {
 namespace fs = std::filesystem;
 
-// The capture's camera and target: the folder form's camera.yaml and target.json, or a
-// LiDAR-camera manifest of any name in the folder (core/io/dataset_source.h; its pairs are the
-// files clouds/ and images/ hold as they come). A capture script may write them after starting:
-// waits, and when idle_exit_s passes first, returns nullopt with the resolver's *why (what was
-// looked for). Another kind of dataset is refused at once (IoError naming the command for it).
-std::optional<Dataset> WaitForSetup(const fs::path& folder, const fs::path& manifest,
-                                    const CaptureFollowRequest& request, const FollowSink& sink,
-                                    const std::function<bool()>& stopped, std::string* why) {
-  const double start = SteadySeconds();
-  bool said = false;
-  for (;;) {
-    std::error_code error;
-    if (manifest.empty() && fs::exists(folder / "camera.yaml", error) &&
-        fs::exists(folder / "target.json", error))
-      return LoadFolderSetup(folder);
-    const std::optional<DatasetSource> source =
-        manifest.empty() ? RecogniseDataset(folder, why) : std::nullopt;
-    if (!manifest.empty() || (source && !source->folder_form)) {
-      const DatasetSource lidar_camera =
-          ResolveDataset(manifest.empty() ? folder : manifest, DatasetKind::kLidarCamera);
-      Dataset setup = LoadDataset(lidar_camera.path);
-      setup.pairs.clear();
-      setup.manifest = folder;
-      return setup;
-    }
-    if (!said) {
-      Say(sink, "waiting", "",
-          "waiting for camera.yaml and target.json (or a dataset manifest) in " + folder.string());
-      said = true;
-    }
-    if (request.idle_exit_s > 0 && SteadySeconds() - start >= request.idle_exit_s)
-      return std::nullopt;
-    if (stopped && stopped()) {
-      *why = "stopped while waiting for the camera and the target of " + folder.string();
-      return std::nullopt;
-    }
-    std::this_thread::sleep_for(std::chrono::duration<double>(request.poll_s));
+// One look for the capture's camera and target: the folder form's camera.yaml and target.json,
+// or a LiDAR-camera manifest of any name in the folder (core/io/dataset_source.h). nullopt while
+// neither is there (*why: what was looked for). Another kind of dataset is refused (IoError
+// naming the command for it).
+std::optional<Dataset> LookForSetup(const fs::path& folder, const fs::path& manifest,
+                                    std::string* why) {
+  std::error_code error;
+  if (manifest.empty() && fs::exists(folder / "camera.yaml", error) &&
+      fs::exists(folder / "target.json", error))
+    return LoadFolderSetup(folder);
+  const std::optional<DatasetSource> source =
+      manifest.empty() ? RecogniseDataset(folder, why) : std::nullopt;
+  if (!manifest.empty() || (source && !source->folder_form)) {
+    const DatasetSource lidar_camera =
+        ResolveDataset(manifest.empty() ? folder : manifest, DatasetKind::kLidarCamera);
+    Dataset setup = LoadDataset(lidar_camera.path);
+    setup.pairs.clear();
+    setup.manifest = folder;
+    return setup;
   }
+  return std::nullopt;
 }
 
 // The features a watch detected, kept beside its session (core/session/feature_cache.h): what an
@@ -300,40 +283,71 @@ bool CaptureFollowRequest::Check(std::string* why) const {
   return folder.Check(why) && Loop().Check(why);
 }
 
-std::optional<OpenedFeed> OpenCaptureFeed(CaptureFollowRequest request, const FollowSink& sink,
-                                          const std::function<bool()>& stopped, std::string* why) {
-  if (IsRecordingSource(request.source)) {
+CaptureFeedOpener::CaptureFeedOpener(CaptureFollowRequest request, FollowSink sink)
+    : request_(std::move(request)), sink_(std::move(sink)), start_s_(SteadySeconds()) {}
+
+std::optional<OpenedFeed> CaptureFeedOpener::Try(std::string* why) {
+  why->clear();
+  if (IsRecordingSource(request_.source)) {
     // A recording: import's pairs, written to the dataset folder; a capture has no cap.
-    request.import.max_pairs = 0;
-    if (request.out.empty()) request.out = DefaultImportFolder(request.source);
-    fs::create_directories(request.out);
+    request_.import.max_pairs = 0;
+    if (request_.out.empty()) request_.out = DefaultImportFolder(request_.source);
+    fs::create_directories(request_.out);
     const fs::path session =
-        request.session.empty() ? request.out / "calibench.session.json" : request.session;
-    return OpenedFeed{FollowRecording(request.source, request.out, request.board, request.import),
-                      session};
+        request_.session.empty() ? request_.out / "calibench.session.json" : request_.session;
+    return OpenedFeed{
+        FollowRecording(request_.source, request_.out, request_.board, request_.import), session};
   }
-  fs::path manifest;
-  fs::path folder = request.source;
-  std::error_code error;
-  if (fs::is_regular_file(folder, error)) {  // a manifest, named: its folder is watched
-    manifest = ResolveDataset(folder, DatasetKind::kLidarCamera).path;
-    folder = fs::absolute(manifest).parent_path();
+  if (!resolved_) {
+    folder_ = request_.source;
+    std::error_code error;
+    if (fs::is_regular_file(folder_, error)) {  // a manifest, named: its folder is watched
+      manifest_ = ResolveDataset(folder_, DatasetKind::kLidarCamera).path;
+      folder_ = fs::absolute(manifest_).parent_path();
+    }
+    if (!fs::is_directory(folder_, error)) {
+      *why = folder_.string() +
+             " is not a folder (watch follows a folder in the folder form: clouds/, images/, "
+             "camera.yaml, target.json)";
+      return std::nullopt;
+    }
+    folder_ = fs::absolute(folder_);
+    resolved_ = true;
   }
-  if (!fs::is_directory(folder, error)) {
-    *why = folder.string() +
-           " is not a folder (watch follows a folder in the folder form: clouds/, images/, "
-           "camera.yaml, target.json)";
-    return std::nullopt;
-  }
-  folder = fs::absolute(folder);
-  std::optional<Dataset> setup = WaitForSetup(folder, manifest, request, sink, stopped, why);
+  std::string looked_for;
+  std::optional<Dataset> setup = LookForSetup(folder_, manifest_, &looked_for);
   if (!setup) {
-    Say(sink, "end", "", *why);  // the camera and the target never came
+    // A capture script may write the camera and the target after starting: waited for.
+    if (!said_)
+      Say(sink_, "waiting", "",
+          "waiting for camera.yaml and target.json (or a dataset manifest) in " + folder_.string());
+    said_ = true;
+    if (request_.idle_exit_s > 0 && SteadySeconds() - start_s_ >= request_.idle_exit_s) {
+      *why = looked_for;
+      Say(sink_, "end", "", *why);  // the camera and the target never came
+    }
     return std::nullopt;
   }
   const fs::path session =
-      request.session.empty() ? folder / "calibench.session.json" : request.session;
-  return OpenedFeed{FollowFolder(std::move(*setup), folder, request.folder), session};
+      request_.session.empty() ? folder_ / "calibench.session.json" : request_.session;
+  return OpenedFeed{FollowFolder(std::move(*setup), folder_, request_.folder), session};
+}
+
+std::optional<OpenedFeed> OpenCaptureFeed(CaptureFollowRequest request, const FollowSink& sink,
+                                          const std::function<bool()>& stopped, std::string* why) {
+  const double poll_s = request.poll_s;
+  const std::string source = request.source;
+  CaptureFeedOpener opener(std::move(request), sink);
+  for (;;) {
+    if (std::optional<OpenedFeed> opened = opener.Try(why)) return opened;
+    if (!why->empty()) return std::nullopt;
+    if (stopped && stopped()) {
+      *why = "stopped while waiting for the camera and the target of " + source;
+      Say(sink, "end", "", *why);
+      return std::nullopt;
+    }
+    std::this_thread::sleep_for(std::chrono::duration<double>(poll_s));
+  }
 }
 
 bool FollowCapture(CaptureFollowRequest request, const CalibrationJobOptions& options,

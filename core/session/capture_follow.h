@@ -48,6 +48,24 @@ struct OpenedFeed {
 std::optional<OpenedFeed> OpenCaptureFeed(CaptureFollowRequest request, const FollowSink& sink,
                                           const std::function<bool()>& stopped, std::string* why);
 
+// OpenCaptureFeed one look at a time, for a front end that runs each look as a step (the
+// workbench's worker): Try() every request.poll_s until it gives the feed or a reason.
+class CaptureFeedOpener {
+ public:
+  CaptureFeedOpener(CaptureFollowRequest request, FollowSink sink);
+  // The feed once it opens. nullopt with *why empty while a folder's camera and target are
+  // awaited ("waiting", said once), with *why when the source cannot be followed or idle_exit_s
+  // passed first. Throws IoError naming a file that does not read.
+  std::optional<OpenedFeed> Try(std::string* why);
+
+ private:
+  CaptureFollowRequest request_;
+  FollowSink sink_;
+  double start_s_ = 0;
+  bool resolved_ = false, said_ = false;
+  std::filesystem::path folder_, manifest_;
+};
+
 // Follows until done (with exit_when_done), the recording is closed, or idle; the "end" event
 // says which. False with *why when it cannot start: the source is not a folder or a recording,
 // or the folder's camera and target never came (idle_exit_s passed first). Unreadable files

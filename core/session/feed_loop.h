@@ -27,8 +27,8 @@ struct FeedLoopOptions {
   bool Check(std::string* why) const;
 };
 
-// What a front end does with what the feed gives. Called on the loop's thread; empty functions
-// are skipped.
+// What a front end does with what the feed gives. Called from the look (the loop's thread, or the
+// step that runs FeedFollower::Look); empty functions are skipped.
 struct FeedHandlers {
   // Before each look: a board the user picked for the held pairs, and where it came from.
   std::function<std::optional<std::pair<BoardSpec, std::string>>()> take_picked_board;
@@ -45,10 +45,31 @@ struct FeedHandlers {
 
 enum class FeedEnd { kStopped, kClosed, kIdle, kDone };
 
-// Follows `feed` until one of FeedEnd. Tells `sink` "note" (the feed's notes), "board" (a picked
-// board the feed does not take) and "incomplete" / "removed" (a pair's files); the caller says the
-// end in its own words. Throws what Poll throws (IoError naming the source) and what the handlers
-// throw.
+// The loop one look at a time, for a front end that runs each look as a step of its own (the
+// workbench's worker, between its other jobs) rather than on a thread that sleeps: Look() once per
+// poll period until it returns an end. Holds references to its arguments, which must outlive it.
+class FeedFollower {
+ public:
+  FeedFollower(CaptureFeed& feed, const FeedLoopOptions& options, const FeedHandlers& handlers,
+               const FollowSink& sink);
+  // One look: asks `stopped`, hands a picked board to the feed, polls it, opens the capture or
+  // adds the pairs. An end when following is over; nullopt: look again after options.poll_s.
+  std::optional<FeedEnd> Look();
+
+ private:
+  CaptureFeed& feed_;
+  const FeedLoopOptions& options_;
+  const FeedHandlers& handlers_;
+  const FollowSink& sink_;
+  double first_look_start_ = 0, last_activity_ = 0;
+  bool opened_ = false;
+  std::vector<PairEntry> read_before_open_;  // the pairs read until the first look caught up
+};
+
+// Follows `feed` until one of FeedEnd (FeedFollower's looks, options.poll_s apart). Tells `sink`
+// "note" (the feed's notes), "board" (a picked board the feed does not take) and "incomplete" /
+// "removed" (a pair's files); the caller says the end in its own words. Throws what Poll throws
+// (IoError naming the source) and what the handlers throw.
 FeedEnd FollowFeed(CaptureFeed& feed, const FeedLoopOptions& options, const FeedHandlers& handlers,
                    const FollowSink& sink);
 

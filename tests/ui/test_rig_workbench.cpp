@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "core/geometry/geometry.h"
 #include "core/io/rig_folder.h"
@@ -207,6 +209,49 @@ TEST(RigWorkbench, ACameraTheRigHasNotIsAnErrorNamingItsCameras) {
         << e.what();
   }
   EXPECT_FALSE(controller.GetSnapshot().dataset.has_value());
+}
+
+// The rig solve runs in steps below the user's work on the one worker: an edit and its solve wait
+// for the step that runs (one camera's calibration), not for the whole rig solve.
+TEST(RigWorkbench, AnEditWhileTheRigSolvesWaitsForOneStepNotForTheSolve) {
+  const fs::path rig_path = CopyOfRig("rig_workbench_steps");
+  ui::Controller controller;
+  controller.OpenDataset(rig_path, {}, ui::Controller::ExistingSession::kReplace, "cam0");
+  // The open camera's pairs load first (queued jobs); the rig's steps wait below them.
+  ui::Snapshot s = controller.GetSnapshot();
+  for (int i = 0; i < 60000 && s.loading_done < s.loading_total; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    s = controller.GetSnapshot();
+  }
+  ASSERT_EQ(s.loading_done, s.loading_total);
+  ASSERT_TRUE(s.rig && s.rig->solving) << "4 steps: the rig read, cam0, cam1, the joint solve";
+  // Reject a pair and solve: the solve lands while the rig still solves (at most one camera's
+  // step ran meanwhile; cam1's and the joint solve are left).
+  controller.Apply(ui::SetPairStatus{1, PairStatus::kRejected});
+  controller.Apply(ui::RunSolver{});
+  std::vector<std::string> progress_seen;
+  for (int i = 0; i < 120000 && !s.solver.result; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    s = controller.GetSnapshot();
+    if (s.rig && (progress_seen.empty() || progress_seen.back() != s.rig->progress))
+      progress_seen.push_back(s.rig->progress);
+  }
+  ASSERT_TRUE(s.solver.result.has_value()) << s.status_line;
+  EXPECT_TRUE(s.rig->solving) << "the solve waited for the whole rig solve";
+  EXPECT_NE(s.rig->progress, "") << "the strip says which step the rig is at";
+  for (const std::string& step : progress_seen) std::printf("rig step seen: '%s'\n", step.c_str());
+  s = Settled(controller);
+  EXPECT_FALSE(s.rig->solving);
+  EXPECT_EQ(s.rig->progress, "");
+  EXPECT_EQ(s.pairs[1].status, PairStatus::kRejected);
+  // The rig solve took cam0's edits as they were when it started (none), as `calibrate` does
+  // with an empty session: the joint pose is the command line's.
+  const RigOutcome cli = CalibrateRig(LoadRig(rig_path), PipelineOptions{});
+  ASSERT_TRUE(cli.joint && s.rig->cameras[1].joint_cam_from_lidar) << s.rig->failure;
+  EXPECT_LT(
+      (s.rig->cameras[1].joint_cam_from_lidar->matrix() - cli.joint->cam_from_lidar[1].matrix())
+          .norm(),
+      1e-9);
 }
 
 }  // namespace

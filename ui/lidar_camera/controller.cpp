@@ -21,8 +21,7 @@ Controller::Controller(PipelineOptions options) : pipeline_(std::move(options)) 
 
 Controller::~Controller() {
   StopWatching();
-  WaitRig();
-  StopWorker();
+  StopWorker();  // drops a rig solve's steps not yet run
 }
 
 bool Controller::SolvesWith(const PairView& pair) {

@@ -1,6 +1,7 @@
 // The workbench's state and the only place that changes it. Panels read a Snapshot and return
 // Intents; the controller applies them, runs the slow work (loading, plane fits, detection,
-// solving, visibility) on a worker thread, and autosaves the session after every edit.
+// solving, visibility; a rig's joint solve and a followed capture's looks as background steps) on
+// its one worker thread, and autosaves the session after every edit.
 // No GL, GLFW or ImGui here: the controller is driven by tests without a window.
 #pragma once
 
@@ -13,7 +14,6 @@
 #include <optional>
 #include <set>
 #include <string>
-#include <thread>
 #include <variant>
 #include <vector>
 
@@ -109,7 +109,7 @@ struct SelectCamera {
   std::string camera;
 };
 // The rig's joint solve over every camera, with each camera's session edits (the open one's as
-// they are now), on its own thread; the meter and the frustums follow.
+// they are now), in background steps on the worker; the meter and the frustums follow.
 struct SolveRig {};
 // A followed recording whose board no preset explains (Snapshot::board_problem): the board the
 // user picks, a preset's name (core/target/board.h) or a target file; the pairs held for want of
@@ -154,8 +154,9 @@ class Controller : public ControllerState<Snapshot> {
   // A session file is locked (FileLock) while open: one that another workbench has open throws
   // IoError naming that process.
   // A rig (a rig folder or manifest) opens one camera: `camera`, else the first; its session is
-  // calibench.session.<camera>.json beside the rig, and the rig's other cameras are solved on a
-  // thread of their own (RigView) for the meter, the frustums and the strip.
+  // calibench.session.<camera>.json beside the rig, and the rig's other cameras are solved in
+  // background steps on the worker, below the edits' jobs (RigView), for the meter, the frustums
+  // and the strip.
   enum class ExistingSession { kReplace, kResume, kStartFresh, kInMemory };
   void OpenDataset(const std::filesystem::path& dataset, std::filesystem::path session_path = {},
                    ExistingSession existing = ExistingSession::kReplace,
@@ -175,33 +176,35 @@ class Controller : public ControllerState<Snapshot> {
   // window; tests and renders solve when asked). F5 / Run stays.
   void SetAutoSolve(bool on);
   // Follows a folder that a capture fills (the folder form: camera.yaml, target.json, clouds/,
-  // images/; core/io/folder_watch.h) on a thread: waits for its camera and target, opens it
-  // (resuming the session beside it), then adds each pair as it lands — loaded, detected and, with
-  // auto-solve, solved as the others. Pre-flight's rejections apply to the pairs as `watch`
-  // applies them. Stops with StopWatching or the controller.
+  // images/; core/io/folder_watch.h) in background steps on the worker, a look every 0.2 s: waits
+  // for its camera and target, opens it (resuming the session beside it), then adds each pair as it
+  // lands — loaded, detected and, with auto-solve, solved as the others. Pre-flight's rejections
+  // apply to the pairs as `watch` applies them. Stops with StopWatching or the controller.
   void WatchFolder(const std::filesystem::path& folder, FolderWatchOptions options = {});
   // The same for a recording being written (.bag, .mcap, .db3, a rosbag2 folder): its pairs
   // chosen as `import` and `watch` choose them (core/io/recording_watch.h) and written to `out`
   // (the folder form), which opens once the first pair tells the camera and the board.
   void WatchRecording(const std::filesystem::path& recording, const std::filesystem::path& out,
                       std::optional<BoardSpec> board, BagImportOptions options);
+  // Stops following; returns once no look runs. Not with mutex_ held (a look takes it).
   void StopWatching();
-  // Waits for the rig solve's thread (tests, renders).
+  // Waits for the rig solve's steps (tests, renders).
   void WaitRig();
   // One pair more, loaded and detected on the worker (a watched folder; any thread).
   void AddPair(const PairEntry& entry);
 
  private:
-  // Follows `source` on the watch thread: the feed make_feed gives (null: nothing to follow),
-  // through FollowLoop, `watch`'s loop (core/session/feed_loop.h; the one that ran stops first).
-  void Follow(const std::filesystem::path& source,
-              std::function<std::unique_ptr<CaptureFeed>()> make_feed);
-  // The source as `watch` opens it (OpenCaptureFeed); null, said on the status line, when it
-  // cannot be followed or following stopped first (watch thread).
-  std::unique_ptr<CaptureFeed> OpenFeed(const CaptureFollowRequest& request);
-  // Opens the feed's dataset once its first look caught up (resuming an earlier watch's session),
-  // then adds each pair as it lands.
-  void FollowLoop(CaptureFeed* feed);
+  // Follows the request's source as `watch` does (core/session/capture_follow.h), one look per
+  // background step (FollowStep); the capture followed before stops first.
+  struct FollowRun;
+  void Follow(const CaptureFollowRequest& request);
+  // One step (worker): a look for the feed until it opens (why it cannot goes to the status
+  // line), then `watch`'s loop's look (FeedFollower); the next step is enqueued 0.2 s on unless
+  // following ended.
+  void FollowStep(const std::shared_ptr<FollowRun>& run);
+  // The feed opened: the loop's handlers open the feed's dataset once its first look caught up
+  // (resuming an earlier watch's session), then add each pair as it lands (worker).
+  void StartLooking(FollowRun* run);
   // The session an earlier watch left, when its pairs are the first of `dataset`'s (a capture that
   // grew while the workbench was closed, a recording read again): opened over them, edits kept.
   bool ResumeGrownCapture(Dataset dataset);
@@ -258,11 +261,16 @@ class Controller : public ControllerState<Snapshot> {
   void CommitEdit(bool same_step = false);
   void ApplySessionToState(const Session& session);  // call with mutex_ held
   // Rig (controller_rig.cpp), with mutex_ held unless said: the rig view with camera `active`
-  // open (true: the other cameras' solves carried from CarryRig); the rig solve on rig_thread_;
-  // the open camera's entry from the latest solve and every camera's meter; the strip's frames of
-  // the selected capture (worker, mutex_ not held).
+  // open (true: the other cameras' solves carried from CarryRig); the rig solve started as
+  // background steps (RigStep: the rig read, each camera, the joint solve; RigCalibration), its
+  // outcome published by the last; the open camera's entry from the latest solve and every
+  // camera's meter; the strip's frames of the selected capture (worker, mutex_ not held).
+  struct RigRun;
   bool SetUpRig(const RigFolder& rig, size_t active);
   void StartRigSolve();
+  void RigStep(const std::shared_ptr<RigRun>& run);                       // worker, mutex_ not held
+  void PublishRigOutcome(const RigRun& run, const std::string& failure);  // mutex_ not held
+  void CancelRigSolve();  // drops its steps; waits for a running one (mutex_ not held)
   void UpdateActiveRigCamera();
   void LoadRigFrames();
   // `note` (how the session came to be opened) joins the status line once the pairs have loaded.
@@ -293,19 +301,17 @@ class Controller : public ControllerState<Snapshot> {
   // autosave), which state_ mirrors for the panels. Its steps run on the worker; its record is
   // edited under mutex_ (it locks itself too). Made anew by Open, after WaitIdle.
   std::optional<CalibrationJob> job_;
-  bool stroke_open_ = false;          // BrushStroke / PaintPoints dabs since the last EndStroke
-  bool auto_solve_ = false;           // mutex_
-  std::filesystem::path watching_;    // the folder WatchFolder follows (set before its thread)
-  bool solve_queued_ = false;         // mutex_
-  bool follow_newest_ = true;         // a followed capture's views move to each new pair (mutex_)
-  bool opened_pairs_loaded_ = false;  // every pair Open started with has loaded (mutex_)
-  std::thread watch_thread_;
-  std::thread rig_thread_;              // the rig solve (SolveRig, and at open)
+  bool stroke_open_ = false;            // BrushStroke / PaintPoints dabs since the last EndStroke
+  bool auto_solve_ = false;             // mutex_
+  std::filesystem::path watching_;      // the source followed (set before the first look)
+  bool solve_queued_ = false;           // mutex_
+  bool follow_newest_ = true;           // a followed capture's views move to each new pair (mutex_)
+  bool opened_pairs_loaded_ = false;    // every pair Open started with has loaded (mutex_)
   std::optional<RigView> carried_rig_;  // CarryRig's, for the next Open
   std::map<std::string, std::shared_ptr<const ImageU8>> rig_frames_;  // "<camera>/<pair>" (worker)
   std::vector<std::map<std::string, std::filesystem::path>> rig_images_;  // per camera (mutex_)
   std::atomic<bool> stop_watch_{false};
-  // PickBoard's board and its words, for the follow thread to give its feed (mutex_).
+  // PickBoard's board and its words, for the next look to give its feed (mutex_).
   std::optional<std::pair<BoardSpec, std::string>> picked_board_;
 };
 

@@ -1,7 +1,7 @@
 // The controller's rig: a rig camera opened in the views with the rig's other cameras beside it.
 // Each camera's own solve and the rig's joint solve (core/lidar_camera/rig.h, as `calibrate` runs
-// them) on a thread of their own; the meter over every camera; the strip of the selected capture's
-// frames.
+// them), one step each, as background jobs on the worker (below the edits' jobs); the meter over
+// every camera; the strip of the selected capture's frames.
 #include <algorithm>
 
 #include "core/io/image_io.h"
@@ -15,8 +15,19 @@ namespace calibench::ui {
 namespace {
 
 constexpr int kRigFrameWidth = 160;  // pixels, as the pairs' thumbnails
+const std::string kRigLane = "rig";  // the worker's background lane for the rig solve's steps
 
 }  // namespace
+
+// One rig solve in progress: its steps hold it (shared) from job to job.
+struct Controller::RigRun {
+  std::filesystem::path path;
+  std::string active;
+  RigEdits edits;
+  PipelineOptions options;
+  std::string notes;  // the other cameras' sessions that did not read
+  std::optional<RigCalibration> calibration;
+};
 
 bool RigView::AllDone() const {
   return !cameras.empty() && std::all_of(cameras.begin(), cameras.end(), [](const auto& camera) {
@@ -37,8 +48,14 @@ void Controller::CarryRig(const RigView& rig) {
   carried_rig_ = rig;
 }
 
+void Controller::CancelRigSolve() {
+  worker_.CancelBackground(kRigLane);
+  std::lock_guard lock(mutex_);
+  if (state_.rig) state_.rig->solving = false;
+}
+
 void Controller::WaitRig() {
-  if (rig_thread_.joinable()) rig_thread_.join();
+  while (worker_.BackgroundPending(kRigLane)) worker_.WaitIdle();
 }
 
 bool Controller::SetUpRig(const RigFolder& rig, size_t active) {
@@ -58,6 +75,7 @@ bool Controller::SetUpRig(const RigFolder& rig, size_t active) {
     for (RigCameraView& camera : carried.cameras) camera.frame.reset();
     carried.frames_pair.clear();
     carried.solving = false;
+    carried.progress.clear();
     view = std::move(carried);
   }
   carried_rig_.reset();
@@ -68,49 +86,75 @@ bool Controller::SetUpRig(const RigFolder& rig, size_t active) {
 void Controller::StartRigSolve() {
   mutex_.AssertHeld(__func__);
   if (!state_.rig || state_.rig->solving) return;
-  // Not solving: the last run has set that under mutex_ and does nothing after it.
-  if (rig_thread_.joinable()) rig_thread_.join();
   state_.rig->solving = true;
+  state_.rig->progress = "reading the rig";
   ++state_.generation;
-  const std::filesystem::path path = state_.rig->path;
-  const std::string active = state_.rig->cameras[state_.rig->active].name;
-  RigEdits edits;
-  if (job_) edits[active] = job_->record().Edits();
-  const PipelineOptions options = PipelineOptionsFromState();
-  rig_thread_ = std::thread([this, path, active, edits, options]() mutable {
-    std::optional<RigOutcome> outcome;
-    std::string failure, notes;
-    try {
-      const RigFolder rig = LoadRig(path);
+  auto run = std::make_shared<RigRun>();
+  run->path = state_.rig->path;
+  run->active = state_.rig->cameras[state_.rig->active].name;
+  if (job_) run->edits[run->active] = job_->record().Edits();
+  run->options = PipelineOptionsFromState();
+  worker_.EnqueueBackground(kRigLane, [this, run] { RigStep(run); });
+}
+
+void Controller::RigStep(const std::shared_ptr<RigRun>& run) {
+  std::string failure;
+  try {
+    if (!run->calibration) {
+      const RigFolder rig = LoadRig(run->path);
       // The other cameras' edits: their sessions beside the rig, where the workbench left them.
       for (const std::string& name : rig.camera_names) {
-        const std::filesystem::path session = DefaultSessionPath(path, name);
+        const std::filesystem::path session = DefaultSessionPath(run->path, name);
         std::error_code error;
-        if (name == active || !std::filesystem::exists(session, error)) continue;
+        if (name == run->active || !std::filesystem::exists(session, error)) continue;
         try {
-          edits[name] = EditsFromSession(LoadSession(session));
+          run->edits[name] = EditsFromSession(LoadSession(session));
         } catch (const IoError& e) {
-          notes += std::string(notes.empty() ? "" : "; ") + e.what();
+          run->notes += std::string(run->notes.empty() ? "" : "; ") + e.what();
         }
       }
-      outcome = CalibrateRig(rig, options, {}, edits);
-    } catch (const std::exception& e) {  // IoError, or a filesystem error reading the rig
-      failure = e.what();
+      run->calibration.emplace(rig, run->options, run->edits);
+    } else if (!run->calibration->Step()) {
+      return PublishRigOutcome(*run, "");
     }
-    std::lock_guard lock(mutex_);
-    if (!state_.rig || state_.rig->path != path) return;
-    state_.rig->solving = false;
-    if (outcome) {
-      ApplyRigOutcome(*outcome, state_.solver.result.has_value(), &*state_.rig);
-      JudgeMeter(/*record=*/false);
-    } else {
-      state_.rig->failure = failure;
+    // What the next step does, for the strip; then the step itself, below the edits' jobs.
+    const size_t left = run->calibration->StepsLeft(),
+                 cameras = run->calibration->Outcome().camera_names.size();
+    std::string next = "the joint solve";
+    if (left > 1) {
+      const size_t c = cameras + 1 - left;
+      next = "camera " + run->calibration->Outcome().camera_names[c] + " (" +
+             std::to_string(c + 1) + " of " + std::to_string(cameras) + ")";
     }
-    if (!notes.empty())
-      SetStatus("rig solve without some cameras' edits (their sessions did not read): " + notes,
-                true);
-    ++state_.generation;
-  });
+    {
+      std::lock_guard lock(mutex_);
+      if (!state_.rig || state_.rig->path != run->path) return;  // another rig opened since
+      state_.rig->progress = next;
+      ++state_.generation;
+    }
+    worker_.EnqueueBackground(kRigLane, [this, run] { RigStep(run); });
+    return;
+  } catch (const std::exception& e) {  // IoError, or a filesystem error reading the rig
+    failure = e.what();
+  }
+  PublishRigOutcome(*run, failure);
+}
+
+void Controller::PublishRigOutcome(const RigRun& run, const std::string& failure) {
+  std::lock_guard lock(mutex_);
+  if (!state_.rig || state_.rig->path != run.path) return;
+  state_.rig->solving = false;
+  state_.rig->progress.clear();
+  if (failure.empty() && run.calibration) {
+    ApplyRigOutcome(run.calibration->Outcome(), state_.solver.result.has_value(), &*state_.rig);
+    JudgeMeter(/*record=*/false);
+  } else {
+    state_.rig->failure = failure;
+  }
+  if (!run.notes.empty())
+    SetStatus("rig solve without some cameras' edits (their sessions did not read): " + run.notes,
+              true);
+  ++state_.generation;
 }
 
 void Controller::UpdateActiveRigCamera() {

@@ -109,6 +109,9 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
                       const std::string& note, std::optional<FileLock> session_lock) {
   const auto [rig, rig_camera] =
       ReadViewAndRig(session, dataset, session_path.empty() ? dataset.manifest : session_path);
+  // The last dataset's work first: a rig solve of it is dropped (a new one starts below), its
+  // queued jobs run out. From a followed capture's look (on the worker) nothing else is queued.
+  CancelRigSolve();
   WaitIdle();
   {
     std::lock_guard lock(mutex_);

@@ -117,7 +117,8 @@ struct RigView {
   int active = 0;              // the camera open in the views
   std::vector<RigCameraView> cameras;
   std::string frames_pair;  // the capture the strip's frames show
-  bool solving = false;     // the rig solve runs (on its own thread)
+  bool solving = false;     // the rig solve runs (background steps on the worker)
+  std::string progress;     // while solving: the step it is at ("camera cam1 (2 of 3)")
   int shared_captures = 0;  // at the last rig solve: captures two or more cameras saw the board in
   // Each camera after the first relative to the first, from the joint solve (RigRelativePoses).
   std::vector<PoseWithSigmas> relative;

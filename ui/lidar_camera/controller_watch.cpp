@@ -1,7 +1,7 @@
 // The controller's live side: solving by itself after every change, following a capture while it
-// is written (`watch`'s loop, FollowFeed: pairs join the list as they land), and after every solve
-// `advise`'s pre-flight findings and next pose (the ghost board), with whether the newest pair
-// matched the ghost.
+// is written (`watch`'s loop one look at a time, FeedFollower, as background jobs on the worker:
+// pairs join the list as they land), and after every solve `advise`'s pre-flight findings and
+// next pose (the ghost board), with whether the newest pair matched the ghost.
 #include <functional>
 #include <utility>
 
@@ -16,8 +16,20 @@ constexpr double kPollPeriod = 0.2;  // between looks [s]
 // default) plus a poll, so that every pair there when following started has been reported before
 // the dataset opens (and an earlier watch's session resumes over all of them).
 constexpr double kFirstLookSeconds = 1.0;
+const std::string kFollowLane = "follow";  // the worker's background lane for the looks
 
 }  // namespace
+
+// One followed capture: the opener until its feed opens, then `watch`'s loop one look at a time.
+// Its steps hold it (shared) from job to job; the follower holds references into it.
+struct Controller::FollowRun {
+  std::optional<CaptureFeedOpener> opener;
+  std::unique_ptr<CaptureFeed> feed;
+  FeedLoopOptions loop;
+  FeedHandlers handlers;
+  FollowSink say;
+  std::optional<FeedFollower> follower;
+};
 
 void Controller::SetAutoSolve(bool on) {
   std::lock_guard lock(mutex_);
@@ -39,28 +51,31 @@ void Controller::RequestSolve() {
   });
 }
 
-void Controller::Follow(const std::filesystem::path& source,
-                        std::function<std::unique_ptr<CaptureFeed>()> make_feed) {
+void Controller::Follow(const CaptureFollowRequest& request) {
   StopWatching();
   stop_watch_ = false;
   // Pairs land while the user looks: the window's frames before the pairs' processing.
   worker_.LowerPriority();
   {
     std::lock_guard lock(mutex_);
-    watching_ = std::filesystem::absolute(source);
+    watching_ = std::filesystem::absolute(request.source);
     state_.watching = watching_;
   }
-  watch_thread_ = std::thread([this, make_feed = std::move(make_feed)] {
-    std::unique_ptr<CaptureFeed> feed = make_feed();
-    if (feed) FollowLoop(feed.get());
+  auto run = std::make_shared<FollowRun>();
+  // As `watch` opens it (core/session/capture_follow.h): a folder's camera and target waited for
+  // (the status line says so), a recording's pairs written to the dataset folder.
+  run->opener.emplace(request, [this](const FollowEvent& event) {
+    std::lock_guard lock(mutex_);
+    SetStatus((event.event == "waiting" ? "watching: " : "") + event.reason, false);
   });
+  worker_.EnqueueBackground(kFollowLane, [this, run] { FollowStep(run); });
 }
 
 void Controller::WatchFolder(const std::filesystem::path& folder, FolderWatchOptions options) {
   CaptureFollowRequest request;
   request.source = std::filesystem::absolute(folder).string();
   request.folder = options;
-  Follow(folder, [this, request] { return OpenFeed(request); });
+  Follow(request);
 }
 
 void Controller::WatchRecording(const std::filesystem::path& recording,
@@ -71,36 +86,54 @@ void Controller::WatchRecording(const std::filesystem::path& recording,
   request.out = out;
   request.board = std::move(board);
   request.import = std::move(options);
-  Follow(recording, [this, request] { return OpenFeed(request); });
+  Follow(request);
 }
 
-std::unique_ptr<CaptureFeed> Controller::OpenFeed(const CaptureFollowRequest& request) {
-  // As `watch` opens it (core/session/capture_follow.h): a folder's camera and target waited for
-  // (the status line says so), a recording's pairs written to the dataset folder.
-  const FollowSink say = [this](const FollowEvent& event) {
-    std::lock_guard lock(mutex_);
-    SetStatus((event.event == "waiting" ? "watching: " : "") + event.reason, false);
-  };
-  std::string why;
-  try {
-    if (std::optional<OpenedFeed> opened = OpenCaptureFeed(
-            request, say, [this] { return stop_watch_.load(); }, &why))
-      return std::move(opened->feed);
-  } catch (const std::exception& e) {  // IoError naming the file, a folder not made
-    why = e.what();
+void Controller::FollowStep(const std::shared_ptr<FollowRun>& run) {
+  if (stop_watch_) return;
+  if (!run->follower) {
+    std::string why;
+    try {
+      if (std::optional<OpenedFeed> opened = run->opener->Try(&why)) {
+        run->feed = std::move(opened->feed);
+        StartLooking(run.get());
+      }
+    } catch (const std::exception& e) {  // IoError naming the file, a folder not made
+      why = e.what();
+    }
+    if (!run->follower && !why.empty()) {
+      std::lock_guard lock(mutex_);
+      if (!stop_watch_) SetStatus("cannot watch: " + why, true);
+      return;
+    }
+    if (!run->follower)  // the folder's camera and target not there yet
+      return worker_.EnqueueBackground(
+          kFollowLane, [this, run] { FollowStep(run); }, kPollPeriod);
   }
+  std::optional<FeedEnd> end;
+  try {
+    end = run->follower->Look();
+  } catch (const IoError& e) {  // damaged data, a dataset folder that cannot be opened
+    std::lock_guard lock(mutex_);
+    SetStatus(std::string("cannot watch: ") + e.what(), true);
+    return;
+  }
+  if (!end)
+    return worker_.EnqueueBackground(
+        kFollowLane, [this, run] { FollowStep(run); }, kPollPeriod);
+  if (*end != FeedEnd::kClosed) return;
   std::lock_guard lock(mutex_);
-  if (!stop_watch_) SetStatus("cannot watch: " + why, true);
-  return nullptr;
+  SetStatus("the recording was closed by its recorder; its " + std::to_string(state_.pairs.size()) +
+                " pairs are in " + run->feed->DatasetFolder().string(),
+            false);
 }
 
-void Controller::FollowLoop(CaptureFeed* feed) {
+void Controller::StartLooking(FollowRun* run) {
   // `watch`'s loop (core/session/feed_loop.h); the workbench's handlers add rows, which load and
   // solve on the worker, and say what happens on the status line.
-  FeedLoopOptions loop;
-  loop.poll_s = kPollPeriod;
-  loop.first_look_s = kFirstLookSeconds;
-  FeedHandlers handlers;
+  run->loop.poll_s = kPollPeriod;
+  run->loop.first_look_s = kFirstLookSeconds;
+  FeedHandlers& handlers = run->handlers;
   handlers.stopped = [this] { return stop_watch_.load(); };
   handlers.take_picked_board = [this] {
     std::lock_guard lock(mutex_);
@@ -125,24 +158,14 @@ void Controller::FollowLoop(CaptureFeed* feed) {
     for (const PairEntry& pair : pairs) AddPair(pair);
     return false;
   };
-  const FollowSink say = [this](const FollowEvent& event) {
+  run->say = [this](const FollowEvent& event) {
     std::lock_guard lock(mutex_);
     if (event.event == "note" || event.event == "board")
       SetStatus(event.reason, event.event == "board");
     else
       SetStatus(event.name + ": " + event.reason, true);  // a pair's files incomplete or removed
   };
-  try {
-    if (FollowFeed(*feed, loop, handlers, say) != FeedEnd::kClosed) return;
-  } catch (const IoError& e) {  // damaged data, a dataset folder that cannot be opened
-    std::lock_guard lock(mutex_);
-    SetStatus(std::string("cannot watch: ") + e.what(), true);
-    return;
-  }
-  std::lock_guard lock(mutex_);
-  SetStatus("the recording was closed by its recorder; its " + std::to_string(state_.pairs.size()) +
-                " pairs are in " + feed->DatasetFolder().string(),
-            false);
+  run->follower.emplace(*run->feed, run->loop, run->handlers, run->say);
 }
 
 template <>
@@ -161,7 +184,8 @@ void Controller::Handle(const PickBoard& intent) {
 
 void Controller::StopWatching() {
   stop_watch_ = true;
-  if (watch_thread_.joinable()) watch_thread_.join();
+  // Waits for a look that runs (it may be adding pairs) and drops the next one.
+  worker_.CancelBackground(kFollowLane);
 }
 
 bool Controller::ResumeGrownCapture(Dataset dataset) {

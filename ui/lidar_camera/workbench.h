@@ -85,7 +85,7 @@ class Workbench : public WorkbenchFrame<Snapshot, Intent, Layout> {
   void BoardPicker(const Snapshot& s, std::vector<Intent>* intents);
 
  public:
-  // A window that appeared without input (the board picker, opened by the follow thread) is
+  // A window that appeared without input (the board picker, opened by a followed capture's look) is
   // sized in its first frame and shown in the next: the window must draw that next one too.
   bool NeedsAnotherFrame() const { return picker_frames_ == 1; }
 

@@ -45,9 +45,10 @@ void Workbench::RigStrip(const Snapshot& s, std::vector<Intent>* intents) {
     ImGui::SetTooltip(rig.solving ? "the rig solves; the cameras can be switched once it is done"
                                   : "the camera in the views; each camera keeps its own session");
   ImGui::SameLine();
-  ImGui::TextDisabled("one of %zu in %s; capture %s", rig.cameras.size(),
+  ImGui::TextDisabled("one of %zu in %s; capture %s%s%s", rig.cameras.size(),
                       rig.path.filename().string().c_str(),
-                      rig.frames_pair.empty() ? "-" : rig.frames_pair.c_str());
+                      rig.frames_pair.empty() ? "-" : rig.frames_pair.c_str(),
+                      rig.solving ? "; the rig solves: " : "", rig.progress.c_str());
   // The strip: every camera's frame of the selected capture, the open one framed.
   for (size_t c = 0; c < rig.cameras.size(); ++c) {
     const RigCameraView& camera = rig.cameras[c];
