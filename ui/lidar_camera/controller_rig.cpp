@@ -87,7 +87,7 @@ void Controller::StartRigSolve() {
   mutex_.AssertHeld(__func__);
   if (!state_.rig || state_.rig->solving) return;
   state_.rig->solving = true;
-  state_.rig->progress = "reading the rig";
+  state_.rig->progress = "waiting for the open camera's work";
   ++state_.generation;
   auto run = std::make_shared<RigRun>();
   run->path = state_.rig->path;
