@@ -257,19 +257,6 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
   return features;
 }
 
-namespace {
-
-// Whether some pair will need detection: no brush painted and no seed in the manifest.
-bool AnyPairToDetect(const std::vector<const PairEntry*>& pairs, const PairEdits& edits) {
-  return std::any_of(pairs.begin(), pairs.end(), [&](const PairEntry* pair) {
-    const auto edit = edits.find(pair->id);
-    const bool brushed = edit != edits.end() && edit->second.brush_pixels;
-    return !brushed && !pair->lidar_seed;
-  });
-}
-
-}  // namespace
-
 std::optional<SceneBackground> BuildSceneBackground(const std::vector<const PairEntry*>& pairs,
                                                     int threads, std::string* why,
                                                     std::vector<std::optional<LidarCloud>>* kept) {
@@ -295,46 +282,6 @@ std::vector<const PairEntry*> SelectedPairs(const Dataset& dataset,
   for (const PairEntry& pair : dataset.pairs)
     if (wanted.empty() || wanted.count(pair.id)) selected.push_back(&pair);
   return selected;
-}
-
-std::vector<PairFeatures> ExtractDatasetPairs(const Dataset& dataset,
-                                              const std::vector<const PairEntry*>& selected,
-                                              const PipelineOptions& options,
-                                              const ProgressCallback& progress,
-                                              const PairEdits& edits,
-                                              std::string* background_note) {
-  std::optional<SceneBackground> background;
-  std::vector<std::optional<LidarCloud>> clouds;  // read once, for the background and the pair
-  if (options.detect_board && options.background_model && AnyPairToDetect(selected, edits))
-    background = BuildSceneBackground(selected, options.threads, background_note, &clouds);
-
-  std::vector<PairFeatures> features(selected.size());
-  ParallelFor(
-      selected.size(), options.threads,
-      [&](size_t i) {
-        const auto edit = edits.find(selected[i]->id);
-        LidarCloud* preloaded = i < clouds.size() && clouds[i] ? &*clouds[i] : nullptr;
-        features[i] = ExtractPairFeatures(dataset, *selected[i], options,
-                                          edit == edits.end() ? PairEdit{} : edit->second,
-                                          background ? &*background : nullptr, preloaded);
-        if (preloaded) clouds[i].reset();  // its memory goes with the pair
-      },
-      [&](int finished, size_t i) {
-        if (progress) progress(finished, static_cast<int>(selected.size()), selected[i]->id);
-      });
-  return features;
-}
-
-CalibrationOutcome CalibrateDataset(const Dataset& dataset, const PipelineOptions& options,
-                                    const ProgressCallback& progress, const PairEdits& edits) {
-  const std::vector<const PairEntry*> selected = SelectedPairs(dataset, options);
-  std::string background_note;
-  std::vector<PairFeatures> features =
-      ExtractDatasetPairs(dataset, selected, options, progress, edits, &background_note);
-  CalibrationOutcome outcome =
-      SolveExtractedPairs(dataset, selected, std::move(features), options, edits);
-  outcome.background_note = background_note;
-  return outcome;
 }
 
 CalibrationOutcome SolveExtractedPairs(const Dataset& dataset,

@@ -62,9 +62,7 @@ RigCalibration::RigCalibration(RigFolder rig, PipelineOptions options, RigEdits 
   outcome_.camera_names = rig_.camera_names;
 }
 
-size_t RigCalibration::StepsLeft() const {
-  return solved_ ? 0 : rig_.cameras.size() - next_camera_ + 1;
-}
+RigCalibration::~RigCalibration() = default;
 
 bool RigCalibration::Step() {
   if (solved_) return false;
@@ -72,24 +70,18 @@ bool RigCalibration::Step() {
     // Each camera's own calibration (with the LiDAR's planes, the board's edges, the range
     // offset and its honest σ) is its prior; the boards two cameras saw at once tie the cameras
     // to each other on top of it (SolveRigFromCameras).
-    const size_t c = next_camera_++;
-    const auto camera_edits = edits_.find(rig_.camera_names[c]);
-    outcome_.single.push_back(
-        CalibrateDataset(rig_.cameras[c], options_, progress_,
-                         camera_edits == edits_.end() ? PairEdits{} : camera_edits->second));
-    const CalibrationOutcome& single = outcome_.single.back();
-    if (!single.solution) {
-      outcome_.failure = "camera '" + rig_.camera_names[c] + "': " + single.failure;
-      return true;
+    const size_t c = next_camera_;
+    if (!camera_) {
+      const auto camera_edits = edits_.find(rig_.camera_names[c]);
+      camera_ = std::make_unique<DatasetCalibration>(
+          rig_.cameras[c], options_,
+          camera_edits == edits_.end() ? PairEdits{} : camera_edits->second, progress_);
     }
-    priors_.push_back({single.solution->cam_from_lidar, single.solution->covariance});
-    for (const PairFeatures& pair : single.pairs) {
-      if (pair.status != PairStatus::kAccepted || !pair.lidar || !pair.camera) continue;
-      RigCapture& capture = captures_[pair.id];
-      capture.id = pair.id;
-      capture.views.push_back(
-          {static_cast<int>(c), pair.camera->cam_from_board, pair.camera->pose_covariance});
-    }
+    if (camera_->Step()) return true;
+    CalibrationOutcome single = camera_->Take();
+    camera_.reset();
+    ++next_camera_;
+    FinishCamera(c, std::move(single));
     return true;
   }
   solved_ = true;
@@ -101,6 +93,23 @@ bool RigCalibration::Step() {
       SolveRigFromCameras(all, priors_, RigSolverOptions{}, &why, &outcome_.shared_captures);
   if (!outcome_.joint) outcome_.failure = "rig solve: " + why;
   return false;
+}
+
+void RigCalibration::FinishCamera(size_t c, CalibrationOutcome single_outcome) {
+  outcome_.single.push_back(std::move(single_outcome));
+  const CalibrationOutcome& single = outcome_.single.back();
+  if (!single.solution) {
+    outcome_.failure = "camera '" + rig_.camera_names[c] + "': " + single.failure;
+    return;
+  }
+  priors_.push_back({single.solution->cam_from_lidar, single.solution->covariance});
+  for (const PairFeatures& pair : single.pairs) {
+    if (pair.status != PairStatus::kAccepted || !pair.lidar || !pair.camera) continue;
+    RigCapture& capture = captures_[pair.id];
+    capture.id = pair.id;
+    capture.views.push_back(
+        {static_cast<int>(c), pair.camera->cam_from_board, pair.camera->pose_covariance});
+  }
 }
 
 RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,

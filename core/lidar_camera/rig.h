@@ -7,12 +7,14 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "core/base/names.h"
 #include "core/io/rig_folder.h"
+#include "core/lidar_camera/dataset_calibration.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/rig_solver.h"
 
@@ -42,25 +44,32 @@ PoseWithSigmas RigJointPose(const RigOutcome& outcome, size_t c);
 std::vector<PoseWithSigmas> RigRelativePoses(const RigOutcome& outcome);
 
 // CalibrateRig one step at a time, for a front end that must not block on it for long (the
-// workbench's worker runs each step between the user's edits): each camera's own calibration is
-// a step, the rig solve the last. Holds its copies of the arguments.
+// workbench's worker runs each step between the user's edits): each camera's own calibration in
+// its steps (DatasetCalibration, core/lidar_camera/dataset_calibration.h: the background, a few
+// pairs at a time, its solve), the rig solve last. Holds its copies of the arguments.
 class RigCalibration {
  public:
   RigCalibration(RigFolder rig, PipelineOptions options, RigEdits edits = {},
                  ProgressCallback progress = {});
+  ~RigCalibration();
+  RigCalibration(const RigCalibration&) = delete;
+  RigCalibration& operator=(const RigCalibration&) = delete;
   // Runs the next step; false when that was the last, or none was left (Outcome() is final).
   bool Step();
-  // Steps left: one per camera not yet calibrated, and the rig solve.
-  size_t StepsLeft() const;
+  // The camera the next step works on; camera_names.size() for the joint solve (or done).
+  size_t NextCamera() const { return next_camera_; }
   const RigOutcome& Outcome() const { return outcome_; }
 
  private:
+  void FinishCamera(size_t c, CalibrationOutcome single);
+
   RigFolder rig_;
   PipelineOptions options_;
   RigEdits edits_;
   ProgressCallback progress_;
   RigOutcome outcome_;
   size_t next_camera_ = 0;
+  std::unique_ptr<DatasetCalibration> camera_;  // the camera being calibrated
   bool solved_ = false;
   std::vector<RigCameraPrior> priors_;
   // Captures by stem: every camera's view of the board (NaturalOrder: the files' order).

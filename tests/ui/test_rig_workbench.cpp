@@ -224,9 +224,9 @@ TEST(RigWorkbench, AnEditWhileTheRigSolvesWaitsForOneStepNotForTheSolve) {
     s = controller.GetSnapshot();
   }
   ASSERT_EQ(s.loading_done, s.loading_total);
-  ASSERT_TRUE(s.rig && s.rig->solving) << "4 steps: the rig read, cam0, cam1, the joint solve";
+  ASSERT_TRUE(s.rig && s.rig->solving) << "steps: the rig read, each camera's, the joint solve";
   // Reject a pair and solve: the solve lands while the rig still solves (at most one camera's
-  // step ran meanwhile; cam1's and the joint solve are left).
+  // step ran meanwhile: a background read, or a few pairs' extraction).
   controller.Apply(ui::SetPairStatus{1, PairStatus::kRejected});
   controller.Apply(ui::RunSolver{});
   std::vector<std::string> progress_seen;

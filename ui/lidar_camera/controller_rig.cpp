@@ -117,20 +117,20 @@ void Controller::RigStep(const std::shared_ptr<RigRun>& run) {
     } else if (!run->calibration->Step()) {
       return PublishRigOutcome(*run, "");
     }
-    // What the next step does, for the strip; then the step itself, below the edits' jobs.
-    const size_t left = run->calibration->StepsLeft(),
-                 cameras = run->calibration->Outcome().camera_names.size();
-    std::string next = "the joint solve";
-    if (left > 1) {
-      const size_t c = cameras + 1 - left;
-      next = "camera " + run->calibration->Outcome().camera_names[c] + " (" +
-             std::to_string(c + 1) + " of " + std::to_string(cameras) + ")";
-    }
+    // What the next step works on, for the strip; then the step itself, below the edits' jobs.
+    const size_t c = run->calibration->NextCamera();
+    const std::vector<std::string>& names = run->calibration->Outcome().camera_names;
+    const std::string next = c < names.size()
+                                 ? "camera " + names[c] + " (" + std::to_string(c + 1) + " of " +
+                                       std::to_string(names.size()) + ")"
+                                 : "the joint solve";
     {
       std::lock_guard lock(mutex_);
       if (!state_.rig || state_.rig->path != run->path) return;  // another rig opened since
-      state_.rig->progress = next;
-      ++state_.generation;
+      if (state_.rig->progress != next) {
+        state_.rig->progress = next;
+        ++state_.generation;
+      }
     }
     worker_.EnqueueBackground(kRigLane, [this, run] { RigStep(run); });
     return;
