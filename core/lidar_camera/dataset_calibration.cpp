@@ -7,11 +7,6 @@
 namespace calibench {
 namespace {
 
-// Pairs per extraction step, per thread: a step lasts about one pair's extraction (0.1-0.3 s for a
-// pinhole camera's, up to 0.9 s for a fisheye's on the simulated rig), which is what an edit
-// waiting behind it waits.
-constexpr size_t kPairsPerThreadAndStep = 1;
-
 // Whether some pair will need detection: no brush painted and no seed in the manifest.
 bool AnyPairToDetect(const std::vector<const PairEntry*>& pairs, const PairEdits& edits) {
   return std::any_of(pairs.begin(), pairs.end(), [&](const PairEntry* pair) {
@@ -25,13 +20,15 @@ bool AnyPairToDetect(const std::vector<const PairEntry*>& pairs, const PairEdits
 
 DatasetExtraction::DatasetExtraction(const Dataset& dataset, std::vector<const PairEntry*> selected,
                                      const PipelineOptions& options, ProgressCallback progress,
-                                     PairEdits edits)
+                                     PairEdits edits, size_t pairs_per_thread)
     : dataset_(dataset),
       selected_(std::move(selected)),
       options_(options),
       progress_(std::move(progress)),
       edits_(std::move(edits)),
-      features_(selected_.size()) {}
+      features_(selected_.size()),
+      pairs_per_step_(pairs_per_thread *
+                      static_cast<size_t>(options.threads > 0 ? options.threads : 1)) {}
 
 bool DatasetExtraction::Step() {
   if (!background_done_) {
@@ -43,10 +40,8 @@ bool DatasetExtraction::Step() {
     return next_pair_ < selected_.size();
   }
   if (next_pair_ >= selected_.size()) return false;
-  const int threads = options_.threads > 0 ? options_.threads : DefaultThreads();
-  const size_t first = next_pair_,
-               count = std::min(selected_.size() - first,
-                                kPairsPerThreadAndStep * static_cast<size_t>(threads));
+  const size_t first = next_pair_, left = selected_.size() - first,
+               count = pairs_per_step_ > 0 ? std::min(left, pairs_per_step_) : left;
   next_pair_ += count;
   ParallelFor(
       count, options_.threads,
@@ -86,12 +81,13 @@ std::vector<PairFeatures> ExtractDatasetPairs(const Dataset& dataset,
 }
 
 DatasetCalibration::DatasetCalibration(const Dataset& dataset, const PipelineOptions& options,
-                                       PairEdits edits, ProgressCallback progress)
+                                       PairEdits edits, ProgressCallback progress,
+                                       size_t pairs_per_thread)
     : dataset_(dataset),
       options_(options),
       edits_(edits),
       extraction_(dataset, SelectedPairs(dataset, options), options, std::move(progress),
-                  std::move(edits)) {}
+                  std::move(edits), pairs_per_thread) {}
 
 bool DatasetCalibration::Step() {
   if (outcome_) return false;

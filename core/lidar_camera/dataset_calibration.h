@@ -19,8 +19,12 @@ namespace calibench {
 class DatasetExtraction {
  public:
   // `dataset` and the entries `selected` points to must outlive the extraction, in place.
+  // pairs_per_thread: how many pairs a step extracts per thread (options.threads); 0: all in one
+  // step, which balances the threads best (a slow pair does not hold the others' next chunk), for
+  // a caller that runs the steps in a row anyway.
   DatasetExtraction(const Dataset& dataset, std::vector<const PairEntry*> selected,
-                    const PipelineOptions& options, ProgressCallback progress, PairEdits edits);
+                    const PipelineOptions& options, ProgressCallback progress, PairEdits edits,
+                    size_t pairs_per_thread = 0);
   DatasetExtraction(const DatasetExtraction&) = delete;
   DatasetExtraction& operator=(const DatasetExtraction&) = delete;
 
@@ -43,14 +47,15 @@ class DatasetExtraction {
   std::string background_note_;
   std::vector<std::optional<LidarCloud>> clouds_;  // read once, for the background and the pair
   std::vector<PairFeatures> features_;
+  size_t pairs_per_step_ = 0;  // 0: every pair in one step
   size_t next_pair_ = 0;
 };
 
 class DatasetCalibration {
  public:
-  // `dataset` must outlive the calibration, in place.
+  // `dataset` must outlive the calibration, in place. pairs_per_thread as DatasetExtraction's.
   DatasetCalibration(const Dataset& dataset, const PipelineOptions& options, PairEdits edits = {},
-                     ProgressCallback progress = {});
+                     ProgressCallback progress = {}, size_t pairs_per_thread = 0);
   // Runs the next step (extraction's, then the solve, a step of its own); false when that was the
   // last.
   bool Step();

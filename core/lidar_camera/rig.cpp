@@ -54,11 +54,12 @@ std::string TranslationText(const Pose& pose) {
 }  // namespace
 
 RigCalibration::RigCalibration(RigFolder rig, PipelineOptions options, RigEdits edits,
-                               ProgressCallback progress)
+                               ProgressCallback progress, size_t pairs_per_thread)
     : rig_(std::move(rig)),
       options_(std::move(options)),
       edits_(std::move(edits)),
-      progress_(std::move(progress)) {
+      progress_(std::move(progress)),
+      pairs_per_thread_(pairs_per_thread) {
   outcome_.camera_names = rig_.camera_names;
 }
 
@@ -75,7 +76,8 @@ bool RigCalibration::Step() {
       const auto camera_edits = edits_.find(rig_.camera_names[c]);
       camera_ = std::make_unique<DatasetCalibration>(
           rig_.cameras[c], options_,
-          camera_edits == edits_.end() ? PairEdits{} : camera_edits->second, progress_);
+          camera_edits == edits_.end() ? PairEdits{} : camera_edits->second, progress_,
+          pairs_per_thread_);
     }
     if (camera_->Step()) return true;
     CalibrationOutcome single = camera_->Take();

@@ -46,11 +46,13 @@ std::vector<PoseWithSigmas> RigRelativePoses(const RigOutcome& outcome);
 // CalibrateRig one step at a time, for a front end that must not block on it for long (the
 // workbench's worker runs each step between the user's edits): each camera's own calibration in
 // its steps (DatasetCalibration, core/lidar_camera/dataset_calibration.h: the background, a few
-// pairs at a time, its solve), the rig solve last. Holds its copies of the arguments.
+// pairs at a time, its solve), the rig solve last. The results do not depend on the steps' size.
+// Holds its copies of the arguments.
 class RigCalibration {
  public:
+  // pairs_per_thread: each camera's extraction steps (DatasetCalibration's); 0: one step.
   RigCalibration(RigFolder rig, PipelineOptions options, RigEdits edits = {},
-                 ProgressCallback progress = {});
+                 ProgressCallback progress = {}, size_t pairs_per_thread = 0);
   ~RigCalibration();
   RigCalibration(const RigCalibration&) = delete;
   RigCalibration& operator=(const RigCalibration&) = delete;
@@ -67,6 +69,7 @@ class RigCalibration {
   PipelineOptions options_;
   RigEdits edits_;
   ProgressCallback progress_;
+  size_t pairs_per_thread_ = 0;
   RigOutcome outcome_;
   size_t next_camera_ = 0;
   std::unique_ptr<DatasetCalibration> camera_;  // the camera being calibrated

@@ -16,6 +16,9 @@ namespace {
 
 constexpr int kRigFrameWidth = 160;  // pixels, as the pairs' thumbnails
 const std::string kRigLane = "rig";  // the worker's background lane for the rig solve's steps
+// A rig step extracts this many pairs per thread: about one pair's extraction (0.1-0.3 s for a
+// pinhole camera's, up to 1.5 s for a fisheye pair the detector searches hard for).
+constexpr size_t kPairsPerThreadAndStep = 1;
 
 }  // namespace
 
@@ -113,7 +116,9 @@ void Controller::RigStep(const std::shared_ptr<RigRun>& run) {
           run->notes += std::string(run->notes.empty() ? "" : "; ") + e.what();
         }
       }
-      run->calibration.emplace(rig, run->options, run->edits);
+      // A pair per thread and step: an edit waits for one pair's extraction at most.
+      run->calibration.emplace(rig, run->options, run->edits, ProgressCallback{},
+                               kPairsPerThreadAndStep);
     } else if (!run->calibration->Step()) {
       return PublishRigOutcome(*run, "");
     }

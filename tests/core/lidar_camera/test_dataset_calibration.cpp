@@ -26,12 +26,14 @@ TEST(DatasetCalibration, StepsTakeAPairPerThreadAndGiveTheOneCallOutcome) {
   two_threads.threads = 2;
   std::vector<int> done_seen;
   std::set<std::string> pairs_seen;
-  DatasetCalibration calibration(dataset, two_threads, {},
-                                 [&](int done, int total, const std::string& pair) {
-                                   EXPECT_EQ(total, 9);
-                                   done_seen.push_back(done);
-                                   pairs_seen.insert(pair);
-                                 });
+  DatasetCalibration calibration(
+      dataset, two_threads, {},
+      [&](int done, int total, const std::string& pair) {
+        EXPECT_EQ(total, 9);
+        done_seen.push_back(done);
+        pairs_seen.insert(pair);
+      },
+      /*pairs_per_thread=*/1);
   int steps = 1;  // the last Step() runs too
   std::vector<size_t> extracted_after_step;
   while (calibration.Step()) {
@@ -71,6 +73,14 @@ TEST(DatasetCalibration, StepsTakeAPairPerThreadAndGiveTheOneCallOutcome) {
       ComputePoseError(stepped.solution->cam_from_lidar, *dataset.cam_from_lidar_ground_truth);
   EXPECT_LT(error.translation_m, 0.02);
   EXPECT_LT(error.rotation_rad, 0.5 * kDegToRad);
+
+  // By default (CalibrateDataset) extraction is one step: the background, the pairs, the solve.
+  DatasetCalibration in_one(dataset, two_threads);
+  int default_steps = 1;
+  while (in_one.Step()) ++default_steps;
+  EXPECT_EQ(default_steps, 3);
+  EXPECT_EQ(in_one.Take().solution->cam_from_lidar.matrix(),
+            one_call.solution->cam_from_lidar.matrix());
 }
 
 }  // namespace
