@@ -323,7 +323,11 @@ std::optional<OpenedFeed> CaptureFeedOpener::Try(std::string* why) {
           "waiting for camera.yaml and target.json (or a dataset manifest) in " + folder_.string());
     said_ = true;
     if (request_.idle_exit_s > 0 && SteadySeconds() - start_s_ >= request_.idle_exit_s) {
-      *why = looked_for;
+      // Never empty: an empty *why means "still waiting" to the caller.
+      *why = looked_for.empty()
+                 ? "no camera.yaml and target.json (nor a dataset manifest) came to " +
+                       folder_.string()
+                 : looked_for;
       Say(sink_, "end", "", *why);  // the camera and the target never came
     }
     return std::nullopt;
