@@ -84,8 +84,6 @@ DatasetCalibration::DatasetCalibration(const Dataset& dataset, const PipelineOpt
                                        PairEdits edits, ProgressCallback progress,
                                        size_t pairs_per_thread)
     : dataset_(dataset),
-      options_(options),
-      edits_(edits),
       extraction_(dataset, SelectedPairs(dataset, options), options, std::move(progress),
                   std::move(edits), pairs_per_thread) {}
 
@@ -97,8 +95,8 @@ bool DatasetCalibration::Step() {
   }
   std::string background_note;
   std::vector<PairFeatures> features = extraction_.Take(&background_note);
-  outcome_ =
-      SolveExtractedPairs(dataset_, extraction_.selected(), std::move(features), options_, edits_);
+  outcome_ = SolveExtractedPairs(dataset_, extraction_.selected(), std::move(features),
+                                 extraction_.options(), extraction_.edits());
   outcome_->background_note = background_note;
   return false;
 }

@@ -35,6 +35,8 @@ class DatasetExtraction {
   // was used when one was wanted (*background_note).
   std::vector<PairFeatures> Take(std::string* background_note);
   const std::vector<const PairEntry*>& selected() const { return selected_; }
+  const PipelineOptions& options() const { return options_; }
+  const PairEdits& edits() const { return edits_; }
 
  private:
   const Dataset& dataset_;
@@ -64,10 +66,8 @@ class DatasetCalibration {
 
  private:
   const Dataset& dataset_;
-  PipelineOptions options_;
-  PairEdits edits_;
-  DatasetExtraction extraction_;
-  bool extracted_ = false;  // every extraction step ran; the solve is next
+  DatasetExtraction extraction_;  // holds the options and the edits the solve takes too
+  bool extracted_ = false;        // every extraction step ran; the solve is next
   std::optional<CalibrationOutcome> outcome_;
 };
 

@@ -91,6 +91,10 @@ void Controller::WatchRecording(const std::filesystem::path& recording,
 
 void Controller::FollowStep(const std::shared_ptr<FollowRun>& run) {
   if (stop_watch_) return;
+  const auto look_again = [&] {
+    worker_.EnqueueBackground(
+        kFollowLane, [this, run] { FollowStep(run); }, kPollPeriod);
+  };
   if (!run->follower) {
     std::string why;
     try {
@@ -107,8 +111,7 @@ void Controller::FollowStep(const std::shared_ptr<FollowRun>& run) {
       return;
     }
     if (!run->follower)  // the folder's camera and target not there yet
-      return worker_.EnqueueBackground(
-          kFollowLane, [this, run] { FollowStep(run); }, kPollPeriod);
+      return look_again();
   }
   std::optional<FeedEnd> end;
   try {
@@ -118,9 +121,7 @@ void Controller::FollowStep(const std::shared_ptr<FollowRun>& run) {
     SetStatus(std::string("cannot watch: ") + e.what(), true);
     return;
   }
-  if (!end)
-    return worker_.EnqueueBackground(
-        kFollowLane, [this, run] { FollowStep(run); }, kPollPeriod);
+  if (!end) return look_again();
   if (*end != FeedEnd::kClosed) return;
   std::lock_guard lock(mutex_);
   SetStatus("the recording was closed by its recorder; its " + std::to_string(state_.pairs.size()) +
