@@ -13,6 +13,7 @@
 #include "core/io/rig_folder.h"
 #include "core/lrf/dataset.h"
 #include "core/session/calibration_job.h"
+#include "core/session/job.h"
 
 namespace calibench::app {
 
@@ -155,7 +156,7 @@ int RunAdvise(int argc, char** argv) {
   }
   options.pipeline = flags.options;
   MachineStdout out(json);  // from here on, only the JSON object reaches stdout
-  if (IsLrfManifest(dataset_path))
+  if (JobKindOf(dataset_path, "") == JobKind::kLrf)
     return AdviseLrf(dataset_path, options, lrf_threshold_mm, flags.options.threads, json, out);
   if (!options.Check(&why)) {
     std::fprintf(stderr, "calibench advise: %s\n", why.c_str());

@@ -1,11 +1,15 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <memory>
+#include <set>
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "core/io/dataset.h"
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
+#include "core/session/job.h"
+#include "core/session/lrf_calibration_job.h"
 #include "core/session/session.h"
 
 namespace calibench::app {
@@ -80,6 +84,45 @@ int CalibrateOneCamera(Dataset* dataset, const PairEdits& edits,
   return code != kOk ? code : written;
 }
 
+// A 2D LRF dataset or session given to `calibrate`: the LRF method's job, solved as
+// `lrf-calibrate` solves it, through the one Job interface (SolveAndSay). Only the flags both
+// methods mean the same by apply; any other given is refused rather than ignored.
+int CalibrateLrf(const CLI::App& app, const std::string& dataset_path, const std::string& session,
+                 const PipelineOptions& lidar_camera, const std::string& out_path,
+                 const std::string& report_path) {
+  static const std::set<std::string> kShared = {"--dataset", "--session", "--out",
+                                                "--report",  "--pairs",   "--threads"};
+  for (const CLI::Option* option : app.get_options()) {
+    if (option->count() == 0 || kShared.count(option->get_name())) continue;
+    std::fprintf(stderr,
+                 "calibench calibrate: %s is the LiDAR-camera method's, and %s is a 2D LRF %s: "
+                 "give it --out, --report, --pairs or --threads only (`calibench lrf-calibrate` "
+                 "has the LRF method's own flags)\n",
+                 option->get_name().c_str(),
+                 session.empty() ? dataset_path.c_str() : session.c_str(),
+                 session.empty() ? "dataset" : "session");
+    return kUsage;
+  }
+  LrfPipelineOptions options;
+  options.threads = lidar_camera.threads;
+  options.pair_ids = lidar_camera.pair_ids;
+  std::string why;
+  if (!options.Check(&why)) {
+    std::fprintf(stderr, "calibench calibrate: %s\n", why.c_str());
+    return kUsage;
+  }
+  const std::unique_ptr<LrfCalibrationJob> job = OpenLrfJob(dataset_path, session, options);
+  job->ExtractAll(StderrProgress("extracted"));
+  const int code = SolveAndSay(*job, "calibrate", out_path);
+  if (report_path.empty() || !job->outcome()->solution) return code;
+  ReportRequest request;
+  request.out_path = report_path;
+  request.session_path = session;
+  request.result_file = out_path;
+  const int written = WriteLrfReport(*job, request);
+  return code != kOk ? code : written;
+}
+
 }  // namespace
 
 int RunCalibrate(int argc, char** argv) {
@@ -119,6 +162,15 @@ int RunCalibrate(int argc, char** argv) {
   if (!FinalizePipelineFlags(flags, &why)) {
     std::fprintf(stderr, "calibench calibrate: %s\n", why.c_str());
     return kUsage;
+  }
+  // Either method's dataset or session (core/session/job.h): a 2D LRF one runs the LRF job.
+  if (JobKindOf(dataset_path, sessions.empty() ? "" : sessions.front()) == JobKind::kLrf) {
+    if (sessions.size() > 1) {
+      std::fprintf(stderr, "calibench calibrate: one --session for a 2D LRF dataset\n");
+      return kUsage;
+    }
+    return CalibrateLrf(app, dataset_path, sessions.empty() ? "" : sessions.front(), flags.options,
+                        out_path, report_path);
   }
   if (dataset_path.empty() && !sessions.empty())
     dataset_path = LoadSession(sessions.front()).dataset.string();

@@ -21,15 +21,6 @@
 namespace calibench::app {
 namespace {
 
-void PrintError(const PoseError& error, const Mat6& covariance, const Pose& cam_from_lidar) {
-  const Vec3 st = TranslationStd(covariance, cam_from_lidar) * 1000.0;
-  const Vec3 sr = RotationStdDeg(covariance, cam_from_lidar);
-  std::printf("error against ground truth: translation %.2f mm, rotation %.3f deg\n",
-              error.translation_m * 1000.0, error.rotation_rad * kRadToDeg);
-  std::printf("reported std: translation %.2f mm, rotation %.3f deg (root of summed variances)\n",
-              st.norm(), sr.norm());
-}
-
 // The corner noise of a simulated dataset, measured as the mean of the PnP residual-based
 // estimates over its pairs (the renderer's noise has no closed-form pixel σ).
 double MeasureCornerSigma(const Dataset& dataset) {
@@ -228,7 +219,7 @@ int RunEvaluate(int argc, char** argv) {
   }
   const PoseError error =
       ComputePoseError(result.cam_from_source, *dataset.cam_from_lidar_ground_truth);
-  PrintError(error, result.covariance, result.cam_from_source);
+  PrintErrorAgainstTruth(error, result.covariance, result.cam_from_source);
   if (bound)
     std::printf("error / bound: translation %.2f, rotation %.2f\n",
                 error.translation_m / bound->translation_rms_m,
@@ -263,11 +254,8 @@ int RunDemo(int argc, char** argv) {
   const Dataset dataset = SimulateDataset(sim, out_dir);
   PipelineOptions options;
   CalibrationOutcome outcome;
+  // The error against the simulation's truth is printed with the summary (SolveAndSay).
   const int code = CalibrateAndReport(dataset, options, out_dir + "/result.json", &outcome);
-  if (outcome.solution && dataset.cam_from_lidar_ground_truth)
-    PrintError(
-        ComputePoseError(outcome.solution->cam_from_lidar, *dataset.cam_from_lidar_ground_truth),
-        outcome.solution->covariance, outcome.solution->cam_from_lidar);
   if (code != kOk) return code;
   // With a display the workbench opens on the demo; without one its views are rendered to PNG.
   const char* display = std::getenv("DISPLAY");

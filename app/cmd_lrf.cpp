@@ -39,24 +39,6 @@ void PrintPoseError(const char* what, const Pose& estimate, const Pose& referenc
 
 }  // namespace
 
-std::optional<Session> ReadLrfSessionFlag(const std::string& command,
-                                          const std::string& session_path,
-                                          const std::string& method, std::string* dataset_path) {
-  LrfSessionWithDataset opened = LoadLrfSessionWithDataset(session_path);
-  if (!dataset_path->empty() &&
-      NormalizeSessionPath(LoadLrfDataset(*dataset_path).manifest) != opened.session.dataset)
-    throw IoError(session_path + ": the session of " + opened.session.dataset.string() +
-                  ", not of " + *dataset_path);
-  if (!method.empty() && method != opened.session.lrf_method) {
-    std::fprintf(stderr, "calibench %s: %s solves with %s; --method %s disagrees\n",
-                 command.c_str(), session_path.c_str(), opened.session.lrf_method.c_str(),
-                 method.c_str());
-    return std::nullopt;
-  }
-  *dataset_path = opened.session.dataset.string();
-  return std::move(opened.session);
-}
-
 bool IsLrfManifest(const std::string& path) {
   std::string ignored;
   const auto source = RecogniseDataset(path, &ignored);
@@ -113,34 +95,16 @@ int RunLrfCalibrate(int argc, char** argv) {
     std::fprintf(stderr, "calibench lrf-calibrate: give --dataset or --session\n");
     return kUsage;
   }
-  std::optional<Session> session;
-  if (!session_path.empty()) {
-    session = ReadLrfSessionFlag("lrf-calibrate", session_path, app.count("--method") ? method : "",
-                                 &dataset_path);
-    if (!session) return kUsage;
-  }
   // The job the LRF workbench runs (core/session/lrf_calibration_job.h), all pairs at once.
-  LrfCalibrationJob job(LoadLrfDataset(dataset_path), options, std::move(session));
-  job.ExtractAll(StderrProgress("extracted"));
-  const LrfCalibrationOutcome outcome = job.Solve();
-  options = job.options();  // the session's method
-  const LrfDataset& dataset = job.dataset();
-  std::printf("%s", FormatLrfSummary(outcome).c_str());
-  bool input_error = false;
-  for (const LrfPairFeatures& p : outcome.pairs) input_error |= p.input_error;
-  if (!outcome.solution) {
-    std::fprintf(stderr, "calibench lrf-calibrate: no calibration for %s: %s\n",
-                 dataset_path.c_str(), outcome.failure.c_str());
-    return input_error ? kInputError : kNoCalibration;
+  const std::unique_ptr<LrfCalibrationJob> job = OpenLrfJob(dataset_path, session_path, options);
+  if (app.count("--method") && job->options().solver.method != *parsed) {
+    std::fprintf(stderr, "calibench lrf-calibrate: %s solves with %s; --method %s disagrees\n",
+                 session_path.c_str(), LrfMethodName(job->options().solver.method).c_str(),
+                 method.c_str());
+    return kUsage;
   }
-  if (!out_path.empty()) {
-    WriteLrfResult(out_path, outcome, options);
-    std::printf("wrote %s\n", out_path.c_str());
-  }
-  if (dataset.cam_from_lrf_ground_truth)
-    PrintPoseError("error against ground truth", outcome.solution->cam_from_lrf,
-                   *dataset.cam_from_lrf_ground_truth);
-  return outcome.solution->observability.well_constrained ? kOk : kNotConstrained;
+  job->ExtractAll(StderrProgress("extracted"));
+  return SolveAndSay(*job, "lrf-calibrate", out_path);
 }
 
 int RunSimulateLrf(int argc, char** argv) {

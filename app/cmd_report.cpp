@@ -16,6 +16,7 @@
 #include "core/lrf/dataset.h"
 #include "core/report/lrf_report.h"
 #include "core/results/result_file.h"
+#include "core/session/job.h"
 #include "core/session/lrf_calibration_job.h"
 #include "core/session/session.h"
 #include "ui/lidar_camera/report_figures.h"
@@ -221,17 +222,12 @@ int ReportLrf(const std::string& result_path, std::string dataset_path,
         result_path.c_str(), session_path.empty() ? dataset_path.c_str() : session_path.c_str());
     return kInputError;
   }
-  std::optional<Session> session;
-  if (!session_file.empty()) {
-    session = ReadLrfSessionFlag("report", session_file, method, &dataset_path);
-    if (!session) return kUsage;
-  }
-  if (dataset_path.empty()) {
+  if (dataset_path.empty() && session_file.empty()) {
     std::fprintf(stderr, "calibench report: give --dataset or --session (the result's data)\n");
     return kUsage;
   }
   LrfPipelineOptions options;
-  if (method.empty()) method = ResultSolverMethod(result_path);
+  if (method.empty() && session_file.empty()) method = ResultSolverMethod(result_path);
   const std::optional<LrfMethod> parsed = ParseLrfMethod(method.empty() ? "refined" : method);
   if (!parsed) {
     std::fprintf(stderr, "calibench report: --method must be refined or paper-linear, not '%s'\n",
@@ -239,9 +235,15 @@ int ReportLrf(const std::string& result_path, std::string dataset_path,
     return kUsage;
   }
   options.solver.method = *parsed;
-  LrfCalibrationJob job(LoadLrfDataset(dataset_path), options, std::move(session));
-  job.ExtractAll(StderrProgress("extracted"));
-  const LrfCalibrationOutcome outcome = job.Solve();
+  const std::unique_ptr<LrfCalibrationJob> job = OpenLrfJob(dataset_path, session_file, options);
+  if (!method.empty() && job->options().solver.method != *parsed) {
+    std::fprintf(stderr, "calibench report: %s solves with %s; --method %s disagrees\n",
+                 session_file.c_str(), LrfMethodName(job->options().solver.method).c_str(),
+                 method.c_str());
+    return kUsage;
+  }
+  job->ExtractAll(StderrProgress("extracted"));
+  const LrfCalibrationOutcome outcome = job->Solve();
   if (!outcome.solution) {
     std::fprintf(stderr, "calibench report: the data gives no calibration: %s\n",
                  outcome.failure.c_str());
@@ -256,10 +258,19 @@ int ReportLrf(const std::string& result_path, std::string dataset_path,
     request.notes.push_back(note);
     std::fprintf(stderr, "calibench report: %s\n", note.c_str());
   }
+  request.session_path = session_file;
+  return WriteLrfReport(*job, request);
+}
+
+}  // namespace
+
+int WriteLrfReport(const LrfCalibrationJob& job, const ReportRequest& request) {
+  CALIBENCH_CHECK(job.outcome() && job.outcome()->solution);
+  const std::string manifest = job.dataset().manifest.string();
   ReportProvenance provenance;
-  provenance.source = session_file.empty()
-                          ? job.dataset().manifest.string()
-                          : session_file + " (session of " + job.dataset().manifest.string() + ")";
+  provenance.source = request.session_path.empty()
+                          ? manifest
+                          : request.session_path + " (session of " + manifest + ")";
   provenance.result_file = request.result_file;
   provenance.created_utc = NowUtc();
   provenance.calibench_version = CALIBENCH_VERSION;
@@ -267,7 +278,7 @@ int ReportLrf(const std::string& result_path, std::string dataset_path,
   LrfReportOptions report_options;
   report_options.cross_validate = request.options.cross_validate;
   const LrfReport report =
-      AnalyseLrfCalibration(job.dataset(), outcome, job.options(), report_options);
+      AnalyseLrfCalibration(job.dataset(), *job.outcome(), job.options(), report_options);
   WriteFileAtomically(request.out_path,
                       LrfReportHtml(report, provenance, LoadReportAssets(FindAsset("report"))));
   std::printf("wrote %s (%zu observations): %s%s\n", request.out_path.c_str(), report.pairs.size(),
@@ -277,8 +288,6 @@ int ReportLrf(const std::string& result_path, std::string dataset_path,
     std::printf("not well constrained: the report says along which directions\n");
   return kOk;
 }
-
-}  // namespace
 
 int RunReport(int argc, char** argv) {
   CLI::App app{
@@ -316,9 +325,9 @@ int RunReport(int argc, char** argv) {
   request.result_file = result_path;
   // The LRF method's result, dataset or session: its own report (its methods are not the
   // LiDAR-camera solver's).
-  if (IsLrfResultFile(result_path) || IsLrfSession(result_path) ||
-      (!dataset_path.empty() && IsLrfManifest(dataset_path)) ||
-      (!session_path.empty() && IsLrfSession(session_path)))
+  const bool result_is_session = session_path.empty() && IsSessionFile(result_path);
+  if (IsLrfResultFile(result_path) ||
+      JobKindOf(dataset_path, result_is_session ? result_path : session_path) == JobKind::kLrf)
     return ReportLrf(result_path, dataset_path, session_path,
                      app.count("--method") ? flags.method : "", request);
   if (!app.count("--method")) {

@@ -11,6 +11,7 @@
 #include "core/io/bag.h"
 #include "core/io/image_io.h"
 #include "core/lidar_camera/rig.h"
+#include "core/session/job.h"
 #include "core/session/lrf_calibration_job.h"
 #include "ui/gfx/context.h"
 #include "ui/lidar_camera/controller.h"
@@ -256,7 +257,7 @@ int RunGui(int argc, char** argv) {
                  "close after S seconds, drawing only on input or work as usual (tests)");
   int width = 0, height = 0;
   if (const auto code = ParseFlags(app, argc, argv, size, "gui", &width, &height)) return *code;
-  if ((!dataset.empty() && IsLrfManifest(dataset)) || (!session.empty() && IsLrfSession(session)))
+  if (JobKindOf(dataset, session) == JobKind::kLrf)
     return RunLrfGuiWindow(dataset, session,
                            WindowOptionsOf(width, height, "Calibench (2D LRF)", screenshot, quit),
                            screenshot, quit.fresh);
@@ -316,7 +317,7 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
                    const std::string& save_session, bool intrinsics, const std::string& camera) {
   gfx::HeadlessBackend backend;
   const ui::HeadlessShot shot{pair, solve, width, height};
-  const bool lrf = !dataset.empty() && IsLrfManifest(dataset);
+  const bool lrf = JobKindOf(dataset, "") == JobKind::kLrf;
   ui::Layout layout;
   if (!lrf && !ui::ParseLayout(view, &layout)) {
     std::fprintf(stderr,

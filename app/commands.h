@@ -22,8 +22,9 @@ class Option;
 }  // namespace CLI
 
 namespace calibench {
-struct RigFolder;   // core/io/rig_folder.h
-struct RigOutcome;  // core/lidar_camera/rig.h
+struct RigFolder;         // core/io/rig_folder.h
+struct RigOutcome;        // core/lidar_camera/rig.h
+class LrfCalibrationJob;  // core/session/lrf_calibration_job.h
 }  // namespace calibench
 
 namespace calibench::ui {
@@ -96,12 +97,6 @@ int RunEvaluateLrf(int argc, char** argv);
 int RunSweepLrf(int argc, char** argv);
 // True when the file is a calibench.lrf-dataset.v1 manifest.
 bool IsLrfManifest(const std::string& path);
-// `command`'s --session flag of an LRF session: the session, its dataset into *dataset_path
-// (which, when given, must be the session's; IoError otherwise); nullopt (said on stderr) when
-// `method` is given and is not the session's.
-std::optional<Session> ReadLrfSessionFlag(const std::string& command,
-                                          const std::string& session_path,
-                                          const std::string& method, std::string* dataset_path);
 int RunGui(int argc, char** argv);
 int RunRender(int argc, char** argv);
 int RunExport(int argc, char** argv);
@@ -178,6 +173,9 @@ struct ReportRequest {
 // atomically; kOk (an unreadable asset throws IoError).
 int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
                 const PipelineOptions& options, const ReportRequest& request);
+// `report` and `calibrate --report` on a 2D LRF job that has solved: analyses its outcome (the
+// leave-one-out folds) and writes the HTML atomically; kOk.
+int WriteLrfReport(const LrfCalibrationJob& job, const ReportRequest& request);
 // `options` set to keep each pair's files for the report's views as the extraction reads them
 // (request->kept_inputs; PipelineOptions::on_pair_inputs), when the report is written with views;
 // unchanged otherwise. The returned options refer to request->kept_inputs.

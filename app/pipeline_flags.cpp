@@ -7,10 +7,13 @@
 
 #include "app/commands.h"
 #include "app/progress_listener.h"
+#include "core/estimation/uncertainty.h"
+#include "core/geometry/geometry.h"
 #include "core/guidance/advise.h"
 #include "core/lidar_camera/joint_intrinsics.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/session/calibration_job.h"
+#include "core/session/job.h"
 #include "core/session/session.h"
 
 namespace calibench::app {
@@ -183,48 +186,61 @@ PairEdits ApplySessionFlag(const std::string& session_path, std::string* dataset
   return EditsFromSession(session);
 }
 
+void PrintErrorAgainstTruth(const PoseError& error, const Mat6& covariance,
+                            const Pose& cam_from_source) {
+  const Vec3 st = TranslationStd(covariance, cam_from_source) * 1000.0;
+  const Vec3 sr = RotationStdDeg(covariance, cam_from_source);
+  std::printf("error against ground truth: translation %.2f mm, rotation %.3f deg\n",
+              error.translation_m * 1000.0, error.rotation_rad * kRadToDeg);
+  std::printf("reported std: translation %.2f mm, rotation %.3f deg (root of summed variances)\n",
+              st.norm(), sr.norm());
+}
+
+int SolveAndSay(Job& job, const std::string& command, const std::string& out_path) {
+  const JobVerdict verdict = job.Calibrate();
+  std::printf("%s", verdict.summary.c_str());
+  const std::string prefix = "calibench " + command + ": ";
+  const bool input_error = verdict.input_error();
+  if (!verdict.solved) {
+    std::fprintf(stderr, "%sno calibration for %s: %s%s%s\n", prefix.c_str(),
+                 job.manifest().string().c_str(), verdict.failure.c_str(),
+                 input_error ? "; unreadable:" : "", verdict.Unreadable().c_str());
+    return input_error ? kInputError : kNoCalibration;
+  }
+  if (!out_path.empty()) {
+    job.WriteResultFile(out_path);
+    std::printf("wrote %s\n", out_path.c_str());
+  }
+  if (verdict.ground_truth)
+    PrintErrorAgainstTruth(ComputePoseError(verdict.cam_from_source, *verdict.ground_truth),
+                           verdict.covariance, verdict.cam_from_source);
+  if (input_error) {
+    std::fprintf(stderr,
+                 "%ssome pair files could not be read; the result uses the remaining pairs:%s\n",
+                 prefix.c_str(), verdict.Unreadable().c_str());
+    return kInputError;
+  }
+  if (!verdict.well_constrained) {
+    std::fprintf(stderr,
+                 "%sthe result is NOT well constrained (weak directions listed above): add pairs "
+                 "with the target tilted and turned differently\n",
+                 prefix.c_str());
+    return kNotConstrained;
+  }
+  return kOk;
+}
+
 int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,
                        const std::string& out_path, CalibrationOutcome* outcome_out,
                        const PairEdits& edits, const std::optional<IntrinsicsResult>& estimated) {
   // The job every front end runs (core/session/calibration_job.h), all pairs at once.
   CalibrationJobOptions job_options;
   job_options.advise.pipeline = options;
-  CalibrationJob job(dataset, job_options, edits, {.detected = StderrProgress("extracted")});
-  job.DetectAll();
-  CalibrationOutcome outcome = job.Solve();
-  outcome.estimated_intrinsics = estimated;
-  std::printf("%s", FormatSummary(outcome).c_str());
-  bool input_error = false;
-  std::string unreadable;  // "pair 0003: cannot read image '...': ..." per line
-  for (const PairFeatures& p : outcome.pairs) {
-    input_error |= p.input_error;
-    if (p.input_error) unreadable += "\n  pair " + p.id + ": " + p.reason;
-  }
-  int code = kOk;
-  if (!outcome.solution) {
-    std::fprintf(stderr, "calibench: no calibration for %s: %s%s%s\n",
-                 dataset.manifest.string().c_str(), outcome.failure.c_str(),
-                 input_error ? "; unreadable:" : "", unreadable.c_str());
-    code = input_error ? kInputError : kNoCalibration;
-  } else {
-    if (!out_path.empty()) {
-      WriteResult(out_path, outcome, options.solver);
-      std::printf("wrote %s\n", out_path.c_str());
-    }
-    if (input_error) {
-      std::fprintf(stderr,
-                   "calibench: some pair files could not be read; the result uses the remaining "
-                   "pairs:%s\n",
-                   unreadable.c_str());
-      code = kInputError;
-    } else if (!outcome.solution->observability.well_constrained) {
-      std::fprintf(stderr,
-                   "calibench: the result is NOT well constrained (weak directions listed "
-                   "above): add pairs with differently tilted boards\n");
-      code = kNotConstrained;
-    }
-  }
-  if (outcome_out) *outcome_out = std::move(outcome);
+  job_options.estimated_intrinsics = estimated;
+  CalibrationJob job(dataset, job_options, edits);
+  job.ExtractAll(StderrProgress("extracted"));
+  const int code = SolveAndSay(job, "calibrate", out_path);
+  if (outcome_out) *outcome_out = *job.outcome();
   return code;
 }
 

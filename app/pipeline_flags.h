@@ -5,11 +5,13 @@
 #include <optional>
 #include <string>
 
+#include "core/geometry/geometry.h"
 #include "core/lidar_camera/pipeline.h"
 
 namespace calibench {
 struct AdviseOptions;
-}
+class Job;
+}  // namespace calibench
 
 namespace calibench::app {
 
@@ -40,6 +42,16 @@ PairEdits ApplySessionFlag(const std::string& session_path, std::string* dataset
 
 // Prints "[k/n] pair ID" progress to stderr (one line per pair when stderr is not a terminal).
 ProgressCallback StderrProgress(const std::string& verb);
+
+// "error against ground truth" and the σ the result reports beside it.
+void PrintErrorAgainstTruth(const PoseError& error, const Mat6& covariance,
+                            const Pose& cam_from_source);
+
+// A job's extracted pairs solved (Job::Calibrate, any method), its summary printed, its result
+// written to out_path (when not empty), the error against the dataset's ground truth printed when
+// it has one; what went wrong said on stderr as "calibench <command>: ...". The exit code: kOk,
+// kInputError when any pair file was unreadable, kNoCalibration, kNotConstrained.
+int SolveAndSay(Job& job, const std::string& command, const std::string& out_path);
 
 // Calibrates and prints the summary; writes the result when out_path is not empty (with the
 // intrinsics `estimated` from the images before, when given). Returns the exit code (kOk,

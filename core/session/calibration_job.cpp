@@ -1,6 +1,9 @@
 #include "core/session/calibration_job.h"
 
+#include <utility>
+
 #include "core/io/cloud_io.h"
+#include "core/lidar_camera/result_io.h"
 
 namespace calibench {
 
@@ -261,9 +264,40 @@ const CalibrationOutcome& CalibrationJob::Solve() {
   outcome_ =
       SolveExtractedPairs(dataset_, entries, DetectedPairs(), pipeline, edits, events_.iteration);
   outcome_->background_note = background_note_;
+  outcome_->estimated_intrinsics = options_.estimated_intrinsics;
+  solved_with_ = pipeline.solver;
   if (outcome_->solution) last_solution_ = outcome_->solution;
   advice_.reset();
   return *outcome_;
+}
+
+void CalibrationJob::ExtractAll(const ProgressCallback& progress) {
+  if (!progress) return DetectAll();
+  const ProgressCallback detected = std::exchange(events_.detected, progress);
+  DetectAll();
+  events_.detected = detected;
+}
+
+JobVerdict CalibrationJob::Calibrate() {
+  const CalibrationOutcome& outcome = Solve();
+  JobVerdict verdict;
+  verdict.solved = outcome.solution.has_value();
+  verdict.failure = outcome.failure;
+  if (outcome.solution) {
+    verdict.cam_from_source = outcome.solution->cam_from_lidar;
+    verdict.covariance = outcome.solution->covariance;
+    verdict.well_constrained = outcome.solution->observability.well_constrained;
+  }
+  for (const PairFeatures& pair : outcome.pairs)
+    verdict.pairs.push_back({pair.id, pair.status, pair.reason, pair.input_error});
+  verdict.summary = FormatSummary(outcome);
+  verdict.ground_truth = dataset_.cam_from_lidar_ground_truth;
+  return verdict;
+}
+
+void CalibrationJob::WriteResultFile(const std::filesystem::path& path) const {
+  CALIBENCH_CHECK(outcome_ && outcome_->solution);
+  WriteResult(path, *outcome_, solved_with_);
 }
 
 const CaptureAdvice& CalibrationJob::Advise(const std::optional<SolverResult>& at) {

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/guidance/advise.h"
+#include "core/session/job.h"
 #include "core/session/session.h"
 #include "core/session/session_record.h"
 #include "core/target/scene_background.h"
@@ -37,6 +38,9 @@ struct CalibrationJobOptions {
   // Each solve starts from the last solution (a capture that grows: the same minimum, fewer
   // iterations) instead of the closed form `calibrate` starts from.
   bool warm_start = false;
+  // The camera's intrinsics as estimated from the pairs' images before the calibration
+  // (`calibrate --estimate-intrinsics`): each outcome carries them, for the result file to say so.
+  std::optional<IntrinsicsResult> estimated_intrinsics;
   bool Check(std::string* why) const;
 };
 
@@ -46,7 +50,7 @@ struct JobEvents {
   IterationCallback iteration;  // every solver iteration, as it happens
 };
 
-class CalibrationJob {
+class CalibrationJob final : public Job {
  public:
   // `dataset`: the camera, the target and the pairs known so far (options.advise.pipeline.pair_ids
   // selects among them), none detected yet. `edits`: the user's brushes and rejections by pair id
@@ -82,7 +86,8 @@ class CalibrationJob {
   // The user's word, each an undo step in the record. A brush applies at the pair's next
   // detection; a rejection (with the reason shown for it) at the next solve.
   void SetBrush(const std::string& pair_id, std::optional<PairEdit> brush);
-  void SetRejected(const std::string& pair_id, bool rejected, const std::string& reason = "");
+  void SetRejected(const std::string& pair_id, bool rejected,
+                   const std::string& reason = "") override;
   // A saved session (the workbench's, an earlier watch's) becomes the record: its brushes,
   // rejections (with their reasons) and solver settings, by pair id (pairs that have not arrived
   // yet take theirs when they do), and what its views showed, carried into ToSession. Call before
@@ -107,16 +112,12 @@ class CalibrationJob {
   const CaptureAdvice& Advise(const std::optional<SolverResult>& at = std::nullopt);
 
   const Dataset& dataset() const { return dataset_; }
-  int size() const { return static_cast<int>(dataset_.pairs.size()); }
   // The pairs as detection found them (status from their planes and the user's rejections).
   std::vector<PairFeatures> DetectedPairs() const;
   const std::optional<CalibrationOutcome>& outcome() const { return outcome_; }
   const std::optional<CaptureAdvice>& advice() const { return advice_; }
   // The job's options with the record's solver and RANSAC settings: what the next step runs with.
   CalibrationJobOptions options() const;
-  // The session's one record: the user's word, the settings, undo and autosave (any thread).
-  SessionRecord& record() { return record_; }
-  const SessionRecord& record() const { return record_; }
   bool background_usable() const { return background_.has_value(); }
   int background_clouds() const { return background_accumulator_.clouds(); }
   // Why no background model is used (yet): fewer than 3 clouds, or the scene does not repeat.
@@ -127,6 +128,18 @@ class CalibrationJob {
   // the views a resumed session showed. `calibrate --session`, `watch` and `gui --session` reopen
   // it: one state, whichever front end wrote it last.
   Session ToSession(const std::filesystem::path& dataset_path) const;
+
+  // Job: what any front end asks of a job, whatever its method.
+  JobKind kind() const override { return JobKind::kLidarCamera; }
+  std::filesystem::path manifest() const override { return dataset_.manifest; }
+  int size() const override { return static_cast<int>(dataset_.pairs.size()); }
+  // DetectAll, with `progress` (when given) in place of the events' `detected` for this call.
+  void ExtractAll(const ProgressCallback& progress = {}) override;
+  JobVerdict Calibrate() override;  // Solve, in the interface's words
+  // WriteResult of the last solve with the solver settings it ran with (cam_from_lidar).
+  void WriteResultFile(const std::filesystem::path& path) const override;
+  SessionRecord& record() override { return record_; }
+  const SessionRecord& record() const override { return record_; }
 
  private:
   struct JobPair {
@@ -152,6 +165,7 @@ class CalibrationJob {
   std::string background_note_ = "fewer than 3 clouds so far";
   std::optional<CalibrationOutcome> outcome_;
   std::optional<SolverResult> last_solution_;
+  SolverOptions solved_with_;  // the solver settings of outcome_'s solve (the record's)
   std::optional<CaptureAdvice> advice_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "core/lrf/result_io.h"
 #include "core/results/pair_status.h"
 
 namespace calibench {
@@ -19,6 +20,16 @@ std::set<std::string> RejectedIn(const Session& session) {
   for (const PairState& pair : session.pairs)
     if (pair.status == PairStatus::kRejected) rejected.insert(pair.id);
   return rejected;
+}
+
+// The reason the user gave for each rejected pair (the extraction marks them "rejected by the
+// user").
+void GiveRejectionReasons(const Session& session, std::vector<LrfPairFeatures>* pairs) {
+  for (LrfPairFeatures& pair : *pairs) {
+    if (pair.status != PairStatus::kRejected) continue;
+    for (const PairState& state : session.pairs)
+      if (state.id == pair.id && !state.reason.empty()) pair.reason = state.reason;
+  }
 }
 
 }  // namespace
@@ -100,12 +111,13 @@ LrfCalibrationJob::LrfCalibrationJob(LrfDataset dataset, LrfPipelineOptions opti
   record_.Reset(std::move(*saved));
 }
 
-void LrfCalibrationJob::SetRejected(const std::string& pair_id, bool rejected) {
+void LrfCalibrationJob::SetRejected(const std::string& pair_id, bool rejected,
+                                    const std::string& reason) {
   record_.Edit([&](Session* session) {
     PairState* pair = FindPair(session, pair_id);
     if (!pair) return;
     pair->status = rejected ? PairStatus::kRejected : PairStatus::kPending;
-    pair->reason = rejected ? kRejectedByUser : "";
+    pair->reason = !rejected ? "" : reason.empty() ? kRejectedByUser : reason;
   });
 }
 
@@ -122,7 +134,10 @@ LrfPipelineOptions LrfCalibrationJob::options() const {
 }
 
 std::vector<LrfPairFeatures> LrfCalibrationJob::ExtractedPairs() const {
-  return extraction_.Pairs(Rejected());
+  const Session word = record_.Current();
+  std::vector<LrfPairFeatures> pairs = extraction_.Pairs(RejectedIn(word));
+  GiveRejectionReasons(word, &pairs);
+  return pairs;
 }
 
 const LrfCalibrationOutcome& LrfCalibrationJob::Solve() {
@@ -131,6 +146,8 @@ const LrfCalibrationOutcome& LrfCalibrationJob::Solve() {
   LrfPipelineOptions solved_with = options_;
   solved_with.solver.method = *ParseLrfMethod(word.lrf_method);
   outcome_ = extraction_.Solve(rejected, solved_with);
+  GiveRejectionReasons(word, &outcome_->pairs);
+  solved_with_ = solved_with;
   std::optional<SessionResult> result;
   if (outcome_->solution && outcome_->solution->ok)
     result = SessionResultFromLrf(*outcome_->solution);
@@ -143,6 +160,42 @@ const LrfCalibrationOutcome& LrfCalibrationJob::Solve() {
       },
       /*amend=*/true);
   return *outcome_;
+}
+
+JobVerdict LrfCalibrationJob::Calibrate() {
+  const LrfCalibrationOutcome& outcome = Solve();
+  JobVerdict verdict;
+  verdict.solved = outcome.solution.has_value();
+  verdict.failure = outcome.failure;
+  if (outcome.solution) {
+    verdict.cam_from_source = outcome.solution->cam_from_lrf;
+    verdict.covariance = outcome.solution->covariance;
+    verdict.well_constrained = outcome.solution->observability.well_constrained;
+  }
+  for (const LrfPairFeatures& pair : outcome.pairs)
+    verdict.pairs.push_back({pair.id, pair.status, pair.reason, pair.input_error});
+  verdict.summary = FormatLrfSummary(outcome);
+  verdict.ground_truth = dataset().cam_from_lrf_ground_truth;
+  return verdict;
+}
+
+void LrfCalibrationJob::WriteResultFile(const std::filesystem::path& path) const {
+  CALIBENCH_CHECK(outcome_ && outcome_->solution);
+  WriteLrfResult(path, *outcome_, solved_with_);
+}
+
+std::unique_ptr<LrfCalibrationJob> OpenLrfJob(const std::filesystem::path& dataset,
+                                              const std::filesystem::path& session,
+                                              const LrfPipelineOptions& options) {
+  CALIBENCH_CHECK(!dataset.empty() || !session.empty());
+  if (session.empty()) return std::make_unique<LrfCalibrationJob>(LoadLrfDataset(dataset), options);
+  LrfSessionWithDataset opened = LoadLrfSessionWithDataset(session);
+  if (!dataset.empty() &&
+      NormalizeSessionPath(LoadLrfDataset(dataset).manifest) != opened.session.dataset)
+    throw IoError(session.string() + ": the session of " + opened.session.dataset.string() +
+                  ", not of " + dataset.string());
+  return std::make_unique<LrfCalibrationJob>(std::move(opened.dataset), options,
+                                             std::move(opened.session));
 }
 
 }  // namespace calibench

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/lrf/pair_extraction.h"
+#include "core/session/job.h"
 #include "core/session/session_record.h"
 
 namespace calibench {
@@ -48,7 +49,7 @@ bool IsLrfSession(const std::filesystem::path& path);
 // The part of an LRF solve the session keeps (SessionResult's cam_from_lidar is cam_from_lrf).
 SessionResult SessionResultFromLrf(const LrfSolution& solution);
 
-class LrfCalibrationJob {
+class LrfCalibrationJob final : public Job {
  public:
   // `dataset`'s pairs that options.pair_ids selects, none extracted yet. The record starts as
   // `saved` (an LRF session of this dataset; its method then replaces options.solver.method), or
@@ -56,14 +57,14 @@ class LrfCalibrationJob {
   LrfCalibrationJob(LrfDataset dataset, LrfPipelineOptions options,
                     std::optional<Session> saved = std::nullopt);
 
-  void ExtractAll(const ProgressCallback& progress = {}) { extraction_.ExtractAll(progress); }
   std::shared_ptr<const LrfPairFeatures> ExtractPair(int index) {
     return extraction_.ExtractPair(index);
   }
 
   // The user's word, each one undo step in the record: a rejected pair stays out of the solve
-  // until taken back; the method solves from now on.
-  void SetRejected(const std::string& pair_id, bool rejected);
+  // until taken back (Job::SetRejected); the method solves from now on.
+  void SetRejected(const std::string& pair_id, bool rejected,
+                   const std::string& reason = "") override;
   void SetMethod(LrfMethod method);
 
   // Solves from the extracted pairs with the record's rejections and method; the result becomes
@@ -76,16 +77,35 @@ class LrfCalibrationJob {
   const LrfDataset& dataset() const { return extraction_.dataset(); }
   // The job's options with the record's method.
   LrfPipelineOptions options() const;
-  int size() const { return extraction_.size(); }
   const std::optional<LrfCalibrationOutcome>& outcome() const { return outcome_; }
-  SessionRecord& record() { return record_; }
-  const SessionRecord& record() const { return record_; }
+
+  // Job: what any front end asks of a job, whatever its method.
+  JobKind kind() const override { return JobKind::kLrf; }
+  std::filesystem::path manifest() const override { return dataset().manifest; }
+  int size() const override { return extraction_.size(); }
+  void ExtractAll(const ProgressCallback& progress = {}) override {
+    extraction_.ExtractAll(progress);
+  }
+  JobVerdict Calibrate() override;  // Solve, in the interface's words
+  // WriteLrfResult of the last solve with the options it solved with (cam_from_lrf).
+  void WriteResultFile(const std::filesystem::path& path) const override;
+  SessionRecord& record() override { return record_; }
+  const SessionRecord& record() const override { return record_; }
 
  private:
   LrfPairExtraction extraction_;
   LrfPipelineOptions options_;
   SessionRecord record_;
   std::optional<LrfCalibrationOutcome> outcome_;
+  LrfPipelineOptions solved_with_;  // the options of outcome_'s solve (the record's method)
 };
+
+// The LRF job that `dataset` and `session` name, as `lrf-calibrate`, `calibrate` and `report`
+// take them (either may be empty, not both): a session's rejections and method over its dataset,
+// which `dataset`, when given, must be; else a new session over `dataset` with
+// options.solver.method. Throws IoError naming the file.
+std::unique_ptr<LrfCalibrationJob> OpenLrfJob(const std::filesystem::path& dataset,
+                                              const std::filesystem::path& session,
+                                              const LrfPipelineOptions& options);
 
 }  // namespace calibench

@@ -175,8 +175,8 @@ void RefuseLrfSession(const Session& session, const std::filesystem::path& path)
   if (!session.lrf_method.empty())
     throw IoError(path.string() + ": a 2D LRF session (options.lrf_method \"" + session.lrf_method +
                   "\") of " + session.dataset.string() +
-                  ", not a LiDAR-camera one; `calibench lrf-calibrate --session` and "
-                  "`calibench gui --session` open it");
+                  ", not a LiDAR-camera one; `calibench calibrate --session`, "
+                  "`calibench lrf-calibrate --session` and `calibench gui --session` open it");
 }
 
 SessionWithDataset LoadSessionWithDataset(const std::filesystem::path& session_path) {

@@ -338,7 +338,7 @@ def _solve(command: str, args: list[str], out: Optional[PathLike],
 # ---- the commands ------------------------------------------------------------------------------
 
 
-def calibrate(dataset: Optional[PathLike] = None, method: str = "weighted-ml", *,
+def calibrate(dataset: Optional[PathLike] = None, method: Optional[str] = None, *,
               session: Optional[PathLike] = None, out: Optional[PathLike] = None,
               report: Optional[PathLike] = None, progress: Optional[Progress] = None,
               **options: Any) -> Result:
@@ -346,7 +346,8 @@ def calibrate(dataset: Optional[PathLike] = None, method: str = "weighted-ml", *
 
     dataset: a folder (clouds/, images/, camera.yaml, target.json), a manifest, a recording, or a
     rig's camera with ``camera="cam0"``; or give ``session`` (a workbench session: its brushes,
-    rejections and solver choices). method: weighted-ml | ca2lib-gn | kim. out: also write the
+    rejections and solver choices). A 2D LRF dataset or session runs the LRF method's job, as
+    ``lrf_calibrate`` does. method: weighted-ml (the default) | ca2lib-gn | kim. out: also write the
     result file there; report: the HTML report. Other options: the command's flags
     (``huber_delta``, ``pairs``, ``initial_guess``, ``no_jackknife``, ``estimate_range_offset``,
     ``estimate_intrinsics``, ``lidar_model``, ``threads``, ...).
@@ -354,7 +355,7 @@ def calibrate(dataset: Optional[PathLike] = None, method: str = "weighted-ml", *
     Raises NotConstrainedError (with ``.result``) when the boards leave a direction free,
     NoCalibrationError when too few pairs are usable, InputError for unreadable files.
     """
-    args = ["--method", method]
+    args = [] if method is None else ["--method", method]
     if dataset is not None:
         args += ["--dataset", os.fspath(dataset)]
     if session is not None:

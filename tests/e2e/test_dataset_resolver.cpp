@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "core/io/dataset_source.h"
+#include "core/results/result_file.h"
 #include "core/sim/lrf_sim.h"
 #include "core/sim/sim.h"
 #include "tests/test_support.h"
@@ -180,8 +181,15 @@ TEST_F(DatasetResolver, EveryCommandRefusesAFolderOfNeitherKindAlike) {
 
 TEST_F(DatasetResolver, AnotherKindIsRefusedWithTheCommandThatOpensIt) {
   std::string out;
-  EXPECT_NE(
-      Run("calibrate --dataset " + Path("lrf_dataset") + " --out " + Path("never.json"), &out), 0);
+  // `calibrate` runs either method's job (core/session/job.h): an LRF dataset solves as
+  // `lrf-calibrate` solves it.
+  const std::string lrf_result = Path("lrf_result.json");
+  ASSERT_EQ(Run("calibrate --dataset " + Path("lrf_dataset") + " --out " + lrf_result, &out), 0)
+      << out;
+  EXPECT_NE(out.find("cam_from_lrf"), std::string::npos) << out;
+  EXPECT_TRUE(IsLrfResultFile(lrf_result));
+  // A command of the LiDAR-camera method alone refuses it, naming the one that opens it.
+  EXPECT_NE(Run("check --dataset " + Path("lrf_dataset") + " --result " + lrf_result, &out), 0);
   EXPECT_NE(out.find("2D LRF dataset (calibench.lrf-dataset.v1)"), std::string::npos) << out;
   EXPECT_NE(out.find("calibench lrf-calibrate --dataset"), std::string::npos) << out;
   EXPECT_NE(

@@ -193,7 +193,8 @@ TEST_F(LrfCli, BadInputNamesTheFileAndKeepsTheOtherObservations) {
     p["scan"] = (*dir_ / "sim" / p["scan"].get<std::string>()).string();
     p["depth"] = (*dir_ / "sim" / p["depth"].get<std::string>()).string();
   }
-  // One missing depth file and one all-invalid scan: both named, the other six still solve.
+  // One missing depth file and one all-invalid scan: both named, the other six still solve, and
+  // the exit code says files were unreadable (kInputError, as `calibrate` says it).
   manifest["pairs"][0]["depth"] = (*dir_ / "nowhere.png").string();
   const fs::path empty_scan = *dir_ / "empty_scan.json";
   std::ofstream(empty_scan) << R"({"angle_min": -1.0, "angle_increment": 0.01,
@@ -202,8 +203,16 @@ TEST_F(LrfCli, BadInputNamesTheFileAndKeepsTheOtherObservations) {
   const fs::path edited = *dir_ / "edited.json";
   std::ofstream(edited) << manifest.dump(2);
   std::string out;
-  EXPECT_EQ(test::RunCommand(Exe() + " lrf-calibrate --dataset " + edited.string(), &out), 0)
+  const fs::path kept = *dir_ / "kept.json";
+  EXPECT_EQ(
+      test::RunCommand(
+          Exe() + " lrf-calibrate --dataset " + edited.string() + " --out " + kept.string(), &out),
+      2)
       << out;
+  EXPECT_NE(out.find("some pair files could not be read; the result uses the remaining pairs"),
+            std::string::npos)
+      << out;
+  EXPECT_TRUE(fs::exists(kept));
   EXPECT_NE(out.find("nowhere.png"), std::string::npos) << out;
   EXPECT_NE(out.find("pair 0001 failed"), std::string::npos) << out;
   EXPECT_NE(out.find(" of 8 observations usable"), std::string::npos) << out;

@@ -120,6 +120,12 @@ def test_lrf_calibrate_with_a_workbench_session(exe, tmp_path):
     with pytest.raises(calibench.UsageError) as error:
         calibench.lrf_calibrate(session=session_file, method="refined")
     assert "disagrees" in str(error.value)
+    # calibrate reads either kind of session: the LRF job, the same transform.
+    through_calibrate = calibench.calibrate(session=session_file, out=tmp_path / "calibrate.json")
+    np.testing.assert_array_equal(through_calibrate.cam_from_lidar, cli_result.cam_from_lidar)
+    with pytest.raises(calibench.UsageError) as error:
+        calibench.calibrate(session=session_file, method="kim")
+    assert "LiDAR-camera method's" in str(error.value)
 
 
 def test_run_and_version(exe):

@@ -108,6 +108,17 @@ TEST(LrfSession, TheWorkbenchSavesItsWordAndResumesItWhereTheCommandLineReadsItT
   EXPECT_TRUE(Says(output, "paper-linear")) << output;
   EXPECT_TRUE(test::MatrixNear(LoadResult(out).cam_from_source.matrix(),
                                solved.cam_from_lrf.matrix(), 0.0));
+  // `calibrate --session` reads the LRF session too, through the same job interface: the same
+  // file, the same transform.
+  const auto through_calibrate = out.parent_path() / "calibrate.json";
+  ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --session " +
+                                 session_file.string() + " --out " + through_calibrate.string(),
+                             &output),
+            0)
+      << output;
+  EXPECT_TRUE(Says(output, "paper-linear")) << output;
+  EXPECT_TRUE(test::MatrixNear(LoadResult(through_calibrate).cam_from_source.matrix(),
+                               solved.cam_from_lrf.matrix(), 0.0));
   // Naming another method than the session's is refused.
   EXPECT_NE(test::RunCommand(test::CalibenchExe() + " lrf-calibrate --session " +
                                  session_file.string() + " --method refined",
@@ -167,16 +178,18 @@ TEST(LrfSession, ASessionThatDoesNotOpenIsMovedAsideOrItsBackupResumedAndFreshSt
   EXPECT_EQ(LoadSession(session_file).pairs[1].status, PairStatus::kRejected);
 }
 
-TEST(LrfSession, ALidarCameraCommandRefusesAnLrfSessionNamingIt) {
-  const std::filesystem::path manifest = LrfDatasetIn("lrf_session_refused");
+TEST(LrfSession, CalibrateRefusesALidarCameraFlagOnAnLrfSessionNamingBoth) {
+  const std::filesystem::path manifest = LrfDatasetIn("lrf_session_lidar_camera_flag");
   const std::filesystem::path session_file = DefaultLrfSessionPath(manifest);
   SaveSession(session_file, NewLrfSession(LoadLrfDataset(manifest), LrfMethod::kRefined));
   std::string output;
-  EXPECT_NE(test::RunCommand(test::CalibenchExe() + " calibrate --session " + session_file.string(),
+  EXPECT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --session " +
+                                 session_file.string() + " --method kim",
                              &output),
-            0);
+            1);  // kUsage: nothing solved
   EXPECT_TRUE(Says(output, session_file.string())) << output;
-  EXPECT_TRUE(Says(output, "2D LRF session")) << output;
+  EXPECT_TRUE(Says(output, "--method is the LiDAR-camera method's")) << output;
+  EXPECT_FALSE(Says(output, "wrote")) << output;
 }
 
 }  // namespace

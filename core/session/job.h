@@ -1,0 +1,85 @@
+// The one interface every method's calibration job offers its front ends (docs/architecture.md,
+// "The calibration job"). A job holds a dataset's pairs and its session's one record (the user's
+// word, with undo and autosave); a front end extracts the pairs, gives the user's word, solves
+// and writes the result through it without knowing the method. Two methods implement it: the
+// LiDAR-camera job (calibration_job.h, Ca²Lib's planes) and the 2D LRF job
+// (lrf_calibration_job.h, the three-face target). Each keeps its own typed steps beside these (a
+// workbench's step-by-step detection, guidance), which the interface does not need.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/base/parallel.h"
+#include "core/base/types.h"
+#include "core/results/pair_status.h"
+#include "core/session/session_record.h"
+
+namespace calibench {
+
+enum class JobKind { kLidarCamera, kLrf };
+// "LiDAR-camera", "2D LRF": as messages name them.
+std::string JobKindName(JobKind kind);
+
+// Which method's job a dataset and a session are for (either may be empty). A session says so
+// itself (an LRF session carries options.lrf_method); otherwise the dataset does (an LRF manifest).
+// A session that does not read as one is the LiDAR-camera job's, whose reader then names the
+// problem.
+JobKind JobKindOf(const std::filesystem::path& dataset, const std::filesystem::path& session);
+
+// One pair as the last solve left it, in any method's words.
+struct JobPair {
+  std::string id;
+  PairStatus status = PairStatus::kPending;
+  std::string reason;        // why failed or rejected
+  bool input_error = false;  // its files could not be read (the reason names them)
+};
+
+// What a solve gave: enough for a front end to say it, write it and choose its exit code.
+struct JobVerdict {
+  bool solved = false;  // a calibration the data supports (a refused one is not)
+  std::string failure;  // why not, when !solved
+  // The camera from the range sensor: cam_from_lidar, or cam_from_lrf for a 2D LRF.
+  Pose cam_from_source = Pose::Identity();
+  Mat6 covariance = Mat6::Zero();  // right perturbation of cam_from_source, [rho (m); phi (rad)]
+  bool well_constrained = false;
+  std::vector<JobPair> pairs;        // every pair, as this solve left it
+  std::string summary;               // the method's summary, as its command prints it
+  std::optional<Pose> ground_truth;  // the dataset's cam_from_source, when it has one (simulated)
+
+  bool input_error() const;  // some pair's files could not be read
+  // "pair ID: reason" per unreadable pair, one per line, each line starting with "\n  ".
+  std::string Unreadable() const;
+};
+
+class Job {
+ public:
+  virtual ~Job() = default;
+
+  virtual JobKind kind() const = 0;
+  // The dataset's manifest (or folder), as messages name it.
+  virtual std::filesystem::path manifest() const = 0;
+  // Pairs known so far (the selected ones).
+  virtual int size() const = 0;
+
+  // Every pair's features at once, on the job's workers; `progress` after each pair.
+  virtual void ExtractAll(const ProgressCallback& progress = {}) = 0;
+  // The user's word on pair `pair_id`: rejected (with the reason shown for it; empty: "rejected
+  // by the user") or taken back. One undo step in the record; it applies at the next solve.
+  virtual void SetRejected(const std::string& pair_id, bool rejected,
+                           const std::string& reason = "") = 0;
+  // Solves from the extracted pairs with the record's word: the method's own Solve, told in the
+  // interface's words.
+  virtual JobVerdict Calibrate() = 0;
+  // The last solve's result file (calibench.result.v1), written atomically. Requires a solve that
+  // gave a calibration; IoError naming the file when it cannot be written.
+  virtual void WriteResultFile(const std::filesystem::path& path) const = 0;
+
+  // The session's one record: the user's word, the settings, undo and autosave (any thread).
+  virtual SessionRecord& record() = 0;
+  virtual const SessionRecord& record() const = 0;
+};
+
+}  // namespace calibench
