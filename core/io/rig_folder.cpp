@@ -116,6 +116,14 @@ RigFolder LoadRig(const fs::path& path) {
   return fs::is_directory(path, error) ? LoadRigFolder(path) : LoadRigManifest(path);
 }
 
+RigFolder RigOfOne(const Dataset& dataset) {
+  RigFolder rig;
+  rig.folder = dataset.manifest;
+  rig.camera_names = {dataset.camera_name.empty() ? "camera" : dataset.camera_name};
+  rig.cameras = {dataset};
+  return rig;
+}
+
 size_t RigCameraIndex(const RigFolder& rig, const std::string& camera) {
   const auto at = std::find(rig.camera_names.begin(), rig.camera_names.end(), camera);
   if (at != rig.camera_names.end()) return at - rig.camera_names.begin();

@@ -44,6 +44,11 @@ RigFolder LoadRig(const std::filesystem::path& path);
 // path), what the workbench and a camera's session open. IoError naming the rig and its cameras
 // when it has no camera of that name.
 Dataset LoadRigCamera(const std::filesystem::path& path, const std::string& camera);
+// A single camera's dataset as a rig of one (every camera belongs to a rig, as in COLMAP's rig
+// model): the dataset's manifest for its folder, its one camera named after Dataset::camera_name,
+// else "camera". The workbench sees every dataset this way; the rig's own solve, strip and meter
+// rows need two cameras or more.
+RigFolder RigOfOne(const Dataset& dataset);
 // The index of `camera` in the rig; IoError naming the rig and its cameras when absent.
 size_t RigCameraIndex(const RigFolder& rig, const std::string& camera);
 

@@ -18,6 +18,7 @@
 #include "core/sim/rig_sim.h"
 #include "tests/test_support.h"
 #include "tests/ui/ui_fixture.h"
+#include "ui/lidar_camera/controller_outcome.h"
 #include "ui/lidar_camera/window_shell.h"
 
 namespace calibench {
@@ -252,6 +253,46 @@ TEST(RigWorkbench, AnEditWhileTheRigSolvesWaitsForOneStepNotForTheSolve) {
       (s.rig->cameras[1].joint_cam_from_lidar->matrix() - cli.joint->cam_from_lidar[1].matrix())
           .norm(),
       1e-9);
+}
+
+// One camera is a rig of one: the workbench sees a single camera's dataset as a rig with that
+// camera alone, whose solve and meter are the workbench's own; the rig's solve (and its switch and
+// strip) need a second camera. A report's snapshot of the same solve sees the same rig of one.
+TEST(RigWorkbench, OneCameraIsARigOfOne) {
+  ui::Controller controller;
+  controller.OpenDataset(test::UiDataset(), {}, ui::Controller::ExistingSession::kInMemory);
+  ui::Loaded(controller);
+  controller.Apply(ui::RunSolver{});
+  const ui::Snapshot s = Settled(controller);
+  ASSERT_TRUE(s.rig.has_value());
+  ASSERT_EQ(s.rig->cameras.size(), 1u);
+  EXPECT_FALSE(s.rig->Several());
+  EXPECT_EQ(s.rig->active, 0);
+  EXPECT_EQ(s.rig->cameras[0].name, "camera");
+  EXPECT_EQ(s.rig->path, s.dataset->manifest);
+  EXPECT_EQ(s.rig->cameras[0].captures, static_cast<int>(s.pairs.size()));
+  EXPECT_FALSE(s.rig->solving);
+  ASSERT_TRUE(s.solver.result && s.rig->cameras[0].single);
+  EXPECT_EQ(s.rig->cameras[0].single->cam_from_lidar.matrix(),
+            s.solver.result->cam_from_lidar.matrix());
+  ASSERT_TRUE(s.meter && s.rig->cameras[0].meter);
+  EXPECT_EQ(s.rig->cameras[0].meter->done, s.meter->done);
+
+  controller.Apply(ui::SolveRig{});
+  const ui::Snapshot asked = Settled(controller);
+  EXPECT_FALSE(asked.rig->solving);
+  EXPECT_NE(asked.status_line.find("not a rig: there is one camera"), std::string::npos)
+      << asked.status_line;
+
+  const CalibrationOutcome cli = CalibrateDataset(*s.dataset, PipelineOptions{});
+  ASSERT_TRUE(cli.solution) << cli.failure;
+  const ui::Snapshot report = ui::SnapshotOfOutcome(*s.dataset, cli);
+  ASSERT_TRUE(report.rig.has_value());
+  ASSERT_EQ(report.rig->cameras.size(), 1u);
+  EXPECT_EQ(report.rig->cameras[0].name, "camera");
+  ASSERT_TRUE(report.rig->cameras[0].single);
+  EXPECT_TRUE(test::MatrixNear(report.rig->cameras[0].single->cam_from_lidar.matrix(),
+                               s.solver.result->cam_from_lidar.matrix(), 1e-12));
 }
 
 }  // namespace

@@ -211,7 +211,7 @@ void Controller::EnsureSelectedImage() {
   state_.selected_image_pair = state_.pairs[state_.selected].id;
   state_.selected_undistorted = undistorted;
   ++state_.generation;
-  if (state_.rig) worker_.Enqueue([this] { LoadRigFrames(); });
+  if (state_.rig && state_.rig->Several()) worker_.Enqueue([this] { LoadRigFrames(); });
 }
 
 bool Controller::ValidPair(int index) const {

@@ -45,6 +45,10 @@ Snapshot SnapshotOfOutcome(const Dataset& dataset, const CalibrationOutcome& out
   Snapshot s;
   s.dataset = dataset;
   s.dataset_path = dataset.manifest;
+  // One camera is a rig of one, as the controller sees it; a rig's report replaces it.
+  s.rig = RigViewOf(RigOfOne(dataset), 0);
+  if (outcome.solution)
+    s.rig->cameras[0].single = std::make_shared<const SolverResult>(*outcome.solution);
   // The solution's residuals and weights follow its accepted pairs in order (SolveExtractedPairs).
   size_t solved = 0;
   for (const PairFeatures& features : outcome.pairs) {

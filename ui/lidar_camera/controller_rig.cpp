@@ -88,7 +88,7 @@ bool Controller::SetUpRig(const RigFolder& rig, size_t active) {
 
 void Controller::StartRigSolve() {
   mutex_.AssertHeld(__func__);
-  if (!state_.rig || state_.rig->solving) return;
+  if (!state_.rig || !state_.rig->Several() || state_.rig->solving) return;
   state_.rig->solving = true;
   state_.rig->progress = "waiting for the open camera's work";
   ++state_.generation;
@@ -230,7 +230,8 @@ void Controller::LoadRigFrames() {
 
 template <>
 void Controller::Handle(const SelectCamera& select) {
-  if (!state_.rig) return SetStatus("not a rig: there is one camera", true);
+  if (!state_.rig || !state_.rig->Several())
+    return SetStatus("not a rig: there is one camera", true);
   SetStatus("switching to camera '" + select.camera +
                 "' is the window's: open it with `calibench gui --dataset " +
                 state_.rig->path.string() + " --camera " + select.camera + "`",
@@ -239,7 +240,8 @@ void Controller::Handle(const SelectCamera& select) {
 
 template <>
 void Controller::Handle(const SolveRig&) {
-  if (!state_.rig) return SetStatus("not a rig: there is one camera", true);
+  if (!state_.rig || !state_.rig->Several())
+    return SetStatus("not a rig: there is one camera", true);
   StartRigSolve();
 }
 

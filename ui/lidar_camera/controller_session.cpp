@@ -38,13 +38,12 @@ namespace {
 // What Open reads beyond the session and its dataset, before anything changes: the view (the
 // workbench's to read, core keeps it as text: a malformed one is `source`'s error) and, for a
 // rig's camera, the rig and the camera's index in it. Throws IoError naming the file.
-std::pair<std::optional<RigFolder>, size_t> ReadViewAndRig(const Session& session,
-                                                           const Dataset& dataset,
-                                                           const std::filesystem::path& source) {
+std::pair<RigFolder, size_t> ReadViewAndRig(const Session& session, const Dataset& dataset,
+                                            const std::filesystem::path& source) {
   std::vector<std::string> ids;
   for (const PairState& pair : session.pairs) ids.push_back(pair.id);
   ViewFromJson(session.view_json, source, ids);
-  if (dataset.camera_name.empty()) return {std::nullopt, 0};
+  if (dataset.camera_name.empty()) return {RigOfOne(dataset), 0};
   RigFolder rig = LoadRig(dataset.manifest);
   const size_t camera = RigCameraIndex(rig, dataset.camera_name);
   return {std::move(rig), camera};
@@ -154,7 +153,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     job_->Resume(session);
     job_->record().AutosaveTo(session_path);
     ApplySessionToState(session);
-    if (rig && !SetUpRig(*rig, rig_camera)) StartRigSolve();
+    if (!SetUpRig(rig, rig_camera)) StartRigSolve();
     SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
                   dataset.manifest.string(),
               false);

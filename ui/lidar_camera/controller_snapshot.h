@@ -111,7 +111,9 @@ struct RigCameraView {
   std::shared_ptr<const ImageU8> frame;
 };
 
-// A rig's cameras around the one open (Controller::OpenDataset of a rig).
+// The cameras around the one open: a rig's (Controller::OpenDataset of a rig), or a single
+// camera's dataset as a rig of one (RigOfOne). The rig's own solve, its strip and its meter rows
+// need several.
 struct RigView {
   std::filesystem::path path;  // the rig's folder or manifest
   int active = 0;              // the camera open in the views
@@ -122,7 +124,8 @@ struct RigView {
   int shared_captures = 0;  // at the last rig solve: captures two or more cameras saw the board in
   // Each camera after the first relative to the first, from the joint solve (RigRelativePoses).
   std::vector<PoseWithSigmas> relative;
-  std::string failure;  // the last rig solve's failure
+  std::string failure;                                 // the last rig solve's failure
+  bool Several() const { return cameras.size() > 1; }  // a rig, not a rig of one
   // Every camera's stop rule is met.
   bool AllDone() const;
   // A camera's own solve moved since the rig solve ran (an edit, a solve): it is out of date.

@@ -122,7 +122,7 @@ void SolveExtras(const SolverResult& res) {
 
 void Workbench::MeasurementsPanel(const Snapshot& s, const Rect& r, std::vector<Intent>* intents) {
   if (!BeginPanel("Measurements", r)) return ImGui::End();
-  if (s.rig) RigStrip(s, intents);
+  if (s.rig && s.rig->Several()) RigStrip(s, intents);
   PairProgress("loading", s.loading_done, s.loading_total);
   if (const auto status =
           ReviewButtons(s.selected >= 0, "arrows: previous / next   ctrl+z / ctrl+y: undo / redo"))
@@ -239,7 +239,7 @@ void Workbench::SolverPanel(const Snapshot& s, const Rect& r, std::vector<Intent
     ImGui::SetTooltip(
         "is the calibration still right? check it against the scene's edges, without a board");
   MeterRows(s, intents);
-  if (s.rig) RigMeterRows(s, intents);
+  if (s.rig && s.rig->Several()) RigMeterRows(s, intents);
   if (!s.solver.iterations.empty()) {
     replay().CostPlot(s.solver.iterations, ImVec2(r.w * 0.45f, 70));
     ImGui::SameLine();

@@ -259,12 +259,11 @@ void Workbench::DrawScene(const Snapshot& s, const PairView& pair,
   if (pair.lidar)
     lidar_board.triangles.AddQuad(InlierExtent(cloud, *pair.lidar), {60, 140, 255, 110});
   gfx::SceneLayers::Layer& camera = layers["camera"];
+  // Every camera of the rig (one camera is a rig of one), the open one at the shown estimate.
   if (s.rig) DrawRigFrustums(s, estimate, &camera);
   if (estimate) {
     const Pose lidar_from_cam = estimate->inverse();
     camera.lines.AddAxes(lidar_from_cam, 0.3);
-    if (!s.rig)
-      AddCameraFrustum(s.dataset->camera, lidar_from_cam, 0.35, {255, 150, 40, 255}, &camera.lines);
     if (pair.camera)
       camera.triangles.AddRectangle(lidar_from_cam * pair.camera->cam_from_board,
                                     s.dataset->target.SheetWidth(), s.dataset->target.SheetHeight(),
