@@ -304,14 +304,19 @@ std::string FormatCaptureAdvice(const CaptureAdvice& advice) {
   if (advice.next) {
     out += "next pose: " + advice.next->words + "\n";
     if (advice.next->lidar_from_board) {
-      char text[200];
+      char text[200], returns[64];
+      const Feasibility& f = advice.next->feasibility;
+      if (f.rings > 0)
+        std::snprintf(returns, sizeof(returns), "%d rings, %d points", f.rings, f.points);
+      else  // a ring-less LiDAR's rays
+        std::snprintf(returns, sizeof(returns), "%d returns", f.points);
       std::snprintf(text, sizeof(text),
-                    "  expected σ after it: %.1f/%.1f/%.1f mm, %.3f/%.3f/%.3f deg (%d rings, %d "
-                    "points on the sheet)\n",
+                    "  expected σ after it: %.1f/%.1f/%.1f mm, %.3f/%.3f/%.3f deg (%s on the "
+                    "sheet)\n",
                     advice.next->predicted_sigma_t_mm.x(), advice.next->predicted_sigma_t_mm.y(),
                     advice.next->predicted_sigma_t_mm.z(), advice.next->predicted_sigma_r_deg.x(),
                     advice.next->predicted_sigma_r_deg.y(), advice.next->predicted_sigma_r_deg.z(),
-                    advice.next->feasibility.rings, advice.next->feasibility.points);
+                    returns);
       out += text;
     }
   } else if (!(advice.state && advice.state->done)) {

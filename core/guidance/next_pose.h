@@ -42,8 +42,11 @@ struct SensorGeometry {
 };
 
 // The LiDAR's rings from its clouds: each ring's elevation (median over its returns) and the
-// azimuth step (median gap between neighbouring returns of a ring). Clouds without rings give an
-// empty table. Only rings with at least 20 returns count.
+// azimuth step (median gap between neighbouring returns of a ring). Only rings with at least 20
+// returns count. Clouds without rings (a Livox-class scanner, a swept or nodding one) give their
+// rays instead (LearntRayTable): those of the whole scan with the most returns, in its order, so
+// that a board is predicted to return what that integration's rays would meet of it. Board
+// segments alone give an empty table.
 BeamTable LearnBeamTable(const std::vector<const LidarCloud*>& clouds);
 
 // The rest of SensorGeometry from the pairs' features: the distance range of the boards seen so
@@ -112,7 +115,7 @@ BoardReturns PredictBoardReturns(const SensorGeometry& sensors, const Pose& lida
 struct Feasibility {
   bool feasible = false;
   std::string why;  // the first failed check, in words
-  int rings = 0;
+  int rings = 0;    // rings with enough returns on the sheet; 0 for a ring-less LiDAR
   int points = 0;
   double camera_incidence_deg = 0.0;
   double lidar_incidence_deg = 0.0;

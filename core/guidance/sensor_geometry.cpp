@@ -6,6 +6,7 @@
 
 #include "core/base/statistics.h"
 #include "core/guidance/next_pose.h"
+#include "core/lidar/lidar_geometry.h"
 #include "core/target/lidar_noise.h"
 
 namespace calibench {
@@ -35,7 +36,20 @@ BeamTable LearnBeamTable(const std::vector<const LidarCloud*>& clouds) {
   std::sort(table.elevations_rad.begin(), table.elevations_rad.end());
   const double gap = Median(gaps);
   table.azimuth_steps = gap > 0 ? static_cast<int>(std::lround(2 * M_PI / gap)) : 0;
-  return table;
+  if (table.elevations_rad.size() >= 2 && table.azimuth_steps >= 1) return table;
+  // No rings: the rays of the ring-less scan with the most returns (a whole scan, not a board's
+  // segment, whose rays cover its board alone).
+  const LidarCloud* widest = nullptr;
+  for (const LidarCloud* cloud : clouds)
+    if (cloud && !cloud->HasRing() && (!widest || cloud->size() > widest->size()) &&
+        ClassifyLidarGeometry(*cloud).geometry != LidarGeometry::kSegment)
+      widest = cloud;
+  if (!widest) return table;
+  std::vector<Vec3> returns;
+  returns.reserve(widest->size());
+  for (const Eigen::Vector3f& p : widest->points)
+    if (p.allFinite()) returns.push_back(p.cast<double>());
+  return LearntRayTable(returns);
 }
 
 std::optional<SensorGeometry> LearnSensorGeometry(const CameraModel& camera, const BoardSpec& board,
@@ -55,8 +69,10 @@ std::optional<SensorGeometry> LearnSensorGeometry(const CameraModel& camera, con
     *why = "no accepted pair yet: the distances and the sensors' noise are learnt from the data";
     return std::nullopt;
   }
-  if (lidar.elevations_rad.size() < 2 || lidar.azimuth_steps < 1) {
-    *why = "the clouds carry no ring numbers: the LiDAR's beams cannot be learnt";
+  if (!lidar.Fired() && (lidar.elevations_rad.size() < 2 || lidar.azimuth_steps < 1)) {
+    *why =
+        "the clouds carry no ring numbers and no whole scan (board segments only): the LiDAR's "
+        "rays cannot be learnt";
     return std::nullopt;
   }
   SensorGeometry sensors;

@@ -88,9 +88,48 @@ BeamTable MakeBeamTable(LidarModel model) {
   return table;
 }
 
+namespace {
+
+// The 1° cell (azimuth × elevation) of a unit direction, as LearntRayTable indexes ray_cells.
+int RayCell(const Vec3& d) {
+  const double azimuth = std::atan2(d.y(), d.x()) * 180.0 / M_PI + 180.0;  // [0, 360]
+  const double elevation = std::asin(std::clamp(d.z(), -1.0, 1.0)) * 180.0 / M_PI + 90.0;
+  const int a = std::clamp(static_cast<int>(azimuth), 0, 359);
+  const int e = std::clamp(static_cast<int>(elevation), 0, 179);
+  return e * 360 + a;
+}
+
+}  // namespace
+
+BeamTable LearntRayTable(const std::vector<Vec3>& returns) {
+  BeamTable table;
+  auto rays = std::make_shared<std::vector<Vec3>>();
+  rays->reserve(returns.size());
+  table.ray_cells.assign(360 * 180, 0);
+  for (const Vec3& point : returns) {
+    const double range = point.norm();
+    if (!std::isfinite(range) || range < 0.01) continue;
+    rays->push_back(point / range);
+    table.ray_cells[RayCell(rays->back())] = 1;
+  }
+  table.rays = std::move(rays);
+  return table;
+}
+
 bool BeamTable::InField(const Vec3& direction) const {
   const Vec3 d = direction.normalized();
   if (risley) return InRisleyField(*risley, d);
+  if (rays) {
+    // A cell without a learnt ray may lie between two strokes: its neighbours count.
+    const int cell = RayCell(d), e = cell / 360, a = cell % 360;
+    for (int de = -1; de <= 1; ++de)
+      for (int da = -1; da <= 1; ++da) {
+        const int ne = e + de;
+        if (ne < 0 || ne >= 180) continue;
+        if (ray_cells[ne * 360 + (a + da + 360) % 360]) return true;
+      }
+    return false;
+  }
   if (elevations_rad.empty()) return false;
   const auto [lowest, highest] = std::minmax_element(elevations_rad.begin(), elevations_rad.end());
   if (nodding) {
@@ -107,6 +146,7 @@ bool BeamTable::InField(const Vec3& direction) const {
 
 double BeamTable::PhaseSpanRad() const {
   if (risley) return 2.0 * M_PI;
+  if (rays) return 0.0;  // the learnt rays are one integration, fired once
   if (nodding)
     return azimuth_steps > 1 ? std::abs(tilt_last_rad - tilt_first_rad) / (azimuth_steps - 1) : 0.0;
   return azimuth_steps > 0 ? 2.0 * M_PI / azimuth_steps : 0.0;

@@ -3,6 +3,8 @@
 // the clouds, or a model's); the simulator scans with one.
 #pragma once
 
+#include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,8 +50,18 @@ struct BeamTable {
   // the tilt.
   bool nodding = false;
   double tilt_first_rad = 0.0, tilt_last_rad = 0.0;
+  // A ring-less scanner of no known model, learnt from its own cloud (LearnBeamTable): the
+  // directions of the cloud's returns, unit, from the origin, in the cloud's (firing) order. Over
+  // the cloud's integration these are the rays it fires wherever something returned them; the
+  // board, held where the scene was, returns the rays that fall on it. Shared: tables are copied
+  // per candidate pose.
+  std::shared_ptr<const std::vector<Vec3>> rays;
+  // Which 1° cells of azimuth (360) × elevation (180) the learnt rays fall in: the field.
+  std::vector<std::uint8_t> ray_cells;
 
-  bool HasRings() const { return !swept && !risley; }
+  bool HasRings() const { return !swept && !Fired(); }
+  // Whether its rays are a fired sequence (a Risley pattern's or learnt ones), not rings.
+  bool Fired() const { return risley.has_value() || (rays && !rays->empty()); }
   // Whether a direction (LiDAR frame, any length) lies inside the rays' field.
   bool InField(const Vec3& direction) const;
   // The firing phases one sweep may start at: [0, PhaseSpanRad()) (a table's: one azimuth step;
@@ -57,5 +69,9 @@ struct BeamTable {
   double PhaseSpanRad() const;
 };
 BeamTable MakeBeamTable(LidarModel model);
+
+// A table of learnt rays (BeamTable::rays, ray_cells) from a ring-less cloud's returns: their
+// directions from the origin, in the cloud's order (returns nearer than 1 cm skipped).
+BeamTable LearntRayTable(const std::vector<Vec3>& returns);
 
 }  // namespace calibench

@@ -10,10 +10,14 @@ BeamRays::BeamRays(const BeamTable& beams, double azimuth_offset_rad)
     : steps_(beams.azimuth_steps),
       azimuth_offset_rad_(azimuth_offset_rad),
       mirror_offset_m_(beams.swept ? beams.mirror_offset_m : Vec3::Zero()) {
-  if (beams.risley) {
-    fired_ = FireRisleyPattern(*beams.risley, azimuth_offset_rad / (2.0 * M_PI), beams.frame_s)
-                 .directions;
-    steps_ = static_cast<int>(fired_.size());
+  if (beams.Fired()) {
+    fired_ =
+        beams.rays
+            ? beams.rays
+            : std::make_shared<const std::vector<Vec3>>(
+                  FireRisleyPattern(*beams.risley, azimuth_offset_rad / (2.0 * M_PI), beams.frame_s)
+                      .directions);
+    steps_ = static_cast<int>(fired_->size());
     cos_elevation_ = {1.0};  // one "ring"
     sin_elevation_ = {0.0};
     return;
@@ -36,7 +40,7 @@ double BeamRays::StepRad() const { return steps_ > 0 ? 2.0 * M_PI / steps_ : 0.0
 
 BeamRay BeamRays::Ray(int ring, int step) const {
   const int wrapped = ((step % steps_) + steps_) % steps_;
-  if (fired()) return {Vec3::Zero(), fired_[wrapped]};
+  if (fired()) return {Vec3::Zero(), (*fired_)[wrapped]};
   if (nodding_) {
     // The fan's beam `ring` at tilt step `wrapped`: Ry(tilt) applied to the scan plane's ray and
     // to the mirror's offset.
@@ -111,7 +115,7 @@ std::pair<int, int> StepsOverSheet(const BeamRays& rays, const BeamTable& beams,
 BoardReturns CastBoardReturns(const BeamTable& beams, const LidarRectangle& sheet,
                               double azimuth_offset_rad) {
   BoardReturns out;
-  if (beams.azimuth_steps < 1 && !beams.risley) return out;
+  if (beams.azimuth_steps < 1 && !beams.Fired()) return out;
   const BeamRays rays(beams, azimuth_offset_rad);
   out.points_per_ring.assign(rays.rings(), 0);
   const auto [first, last] = StepsOverSheet(rays, beams, sheet, azimuth_offset_rad);

@@ -5,6 +5,7 @@
 // models").
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,15 +41,16 @@ class BeamRays {
   BeamRays(const BeamTable& beams, double azimuth_offset_rad);
   int rings() const { return static_cast<int>(cos_elevation_.size()); }
   int steps() const { return steps_; }
-  bool fired() const { return !fired_.empty(); }  // a Risley pattern's rays, not a table's
+  bool fired() const { return fired_ != nullptr; }  // a fired sequence (Risley, learnt), not rings
   bool nodding() const { return nodding_; }
   double StepRad() const;
   // Step may be any integer: it wraps around the sweep.
   BeamRay Ray(int ring, int step) const;
 
  private:
-  std::vector<Vec3> fired_;  // a Risley pattern's directions
-  bool nodding_ = false;     // steps tilt a fan (BeamTable::nodding) rather than turn it
+  // A Risley pattern's directions, or a table's learnt rays.
+  std::shared_ptr<const std::vector<Vec3>> fired_;
+  bool nodding_ = false;  // steps tilt a fan (BeamTable::nodding) rather than turn it
   double tilt_first_rad_ = 0.0, tilt_step_rad_ = 0.0;
   std::vector<double> fan_rad_;
   std::vector<double> cos_elevation_, sin_elevation_;
