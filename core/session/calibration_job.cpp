@@ -280,19 +280,9 @@ void CalibrationJob::ExtractAll(const ProgressCallback& progress) {
 
 JobVerdict CalibrationJob::Calibrate() {
   const CalibrationOutcome& outcome = Solve();
-  JobVerdict verdict;
-  verdict.solved = outcome.solution.has_value();
-  verdict.failure = outcome.failure;
-  if (outcome.solution) {
-    verdict.cam_from_source = outcome.solution->cam_from_lidar;
-    verdict.covariance = outcome.solution->covariance;
-    verdict.well_constrained = outcome.solution->observability.well_constrained;
-  }
-  for (const PairFeatures& pair : outcome.pairs)
-    verdict.pairs.push_back({pair.id, pair.status, pair.reason, pair.input_error});
-  verdict.summary = FormatSummary(outcome);
-  verdict.ground_truth = dataset_.cam_from_lidar_ground_truth;
-  return verdict;
+  return VerdictOf(
+      outcome, [](const SolverResult& solution) { return solution.cam_from_lidar; },
+      FormatSummary(outcome), dataset_.cam_from_lidar_ground_truth);
 }
 
 void CalibrationJob::WriteResultFile(const std::filesystem::path& path) const {

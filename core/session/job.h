@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/base/parallel.h"
@@ -53,6 +54,26 @@ struct JobVerdict {
   // "pair ID: reason" per unreadable pair, one per line, each line starting with "\n  ".
   std::string Unreadable() const;
 };
+
+// A method's outcome in the interface's words: its solution's pose (`pose_of` reads it), covariance
+// and observability, its pairs' statuses, its summary and the dataset's ground truth.
+template <typename Outcome, typename PoseOf>
+JobVerdict VerdictOf(const Outcome& outcome, PoseOf pose_of, std::string summary,
+                     std::optional<Pose> ground_truth) {
+  JobVerdict verdict;
+  verdict.solved = outcome.solution.has_value();
+  verdict.failure = outcome.failure;
+  if (outcome.solution) {
+    verdict.cam_from_source = pose_of(*outcome.solution);
+    verdict.covariance = outcome.solution->covariance;
+    verdict.well_constrained = outcome.solution->observability.well_constrained;
+  }
+  for (const auto& pair : outcome.pairs)
+    verdict.pairs.push_back({pair.id, pair.status, pair.reason, pair.input_error});
+  verdict.summary = std::move(summary);
+  verdict.ground_truth = std::move(ground_truth);
+  return verdict;
+}
 
 class Job {
  public:

@@ -164,19 +164,9 @@ const LrfCalibrationOutcome& LrfCalibrationJob::Solve() {
 
 JobVerdict LrfCalibrationJob::Calibrate() {
   const LrfCalibrationOutcome& outcome = Solve();
-  JobVerdict verdict;
-  verdict.solved = outcome.solution.has_value();
-  verdict.failure = outcome.failure;
-  if (outcome.solution) {
-    verdict.cam_from_source = outcome.solution->cam_from_lrf;
-    verdict.covariance = outcome.solution->covariance;
-    verdict.well_constrained = outcome.solution->observability.well_constrained;
-  }
-  for (const LrfPairFeatures& pair : outcome.pairs)
-    verdict.pairs.push_back({pair.id, pair.status, pair.reason, pair.input_error});
-  verdict.summary = FormatLrfSummary(outcome);
-  verdict.ground_truth = dataset().cam_from_lrf_ground_truth;
-  return verdict;
+  return VerdictOf(
+      outcome, [](const LrfSolution& solution) { return solution.cam_from_lrf; },
+      FormatLrfSummary(outcome), dataset().cam_from_lrf_ground_truth);
 }
 
 void LrfCalibrationJob::WriteResultFile(const std::filesystem::path& path) const {
