@@ -111,12 +111,20 @@ TEST(LrfSession, TheWorkbenchSavesItsWordAndResumesItWhereTheCommandLineReadsItT
   // `calibrate --session` reads the LRF session too, through the same job interface: the same
   // file, the same transform.
   const auto through_calibrate = out.parent_path() / "calibrate.json";
+  const auto calibrate_page = out.parent_path() / "calibrate.html";
   ASSERT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --session " +
-                                 session_file.string() + " --out " + through_calibrate.string(),
+                                 session_file.string() + " --out " + through_calibrate.string() +
+                                 " --report " + calibrate_page.string(),
                              &output),
             0)
       << output;
   EXPECT_TRUE(Says(output, "paper-linear")) << output;
+  {  // its report is the LRF method's, of the session's solve
+    std::ifstream in(calibrate_page);
+    const std::string html((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_TRUE(Says(html, "method paper-linear")) << output;
+    EXPECT_TRUE(Says(html, session_file.string())) << output;
+  }
   EXPECT_TRUE(test::MatrixNear(LoadResult(through_calibrate).cam_from_source.matrix(),
                                solved.cam_from_lrf.matrix(), 0.0));
   // Naming another method than the session's is refused.
