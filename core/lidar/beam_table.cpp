@@ -88,45 +88,52 @@ BeamTable MakeBeamTable(LidarModel model) {
   return table;
 }
 
-namespace {
-
-// The 1° cell (azimuth × elevation) of a unit direction, as LearntRayTable indexes ray_cells.
-int RayCell(const Vec3& d) {
-  const double azimuth = std::atan2(d.y(), d.x()) * 180.0 / M_PI + 180.0;  // [0, 360]
-  const double elevation = std::asin(std::clamp(d.z(), -1.0, 1.0)) * 180.0 / M_PI + 90.0;
+int LearntRayCells::CellOf(const Vec3& unit) {
+  const double azimuth = std::atan2(unit.y(), unit.x()) * 180.0 / M_PI + 180.0;  // [0, 360]
+  const double elevation = std::asin(std::clamp(unit.z(), -1.0, 1.0)) * 180.0 / M_PI + 90.0;
   const int a = std::clamp(static_cast<int>(azimuth), 0, 359);
   const int e = std::clamp(static_cast<int>(elevation), 0, 179);
   return e * 360 + a;
 }
 
-}  // namespace
-
 BeamTable LearntRayTable(const std::vector<Vec3>& returns) {
   BeamTable table;
   auto rays = std::make_shared<std::vector<Vec3>>();
   rays->reserve(returns.size());
-  table.ray_cells.assign(360 * 180, 0);
   for (const Vec3& point : returns) {
     const double range = point.norm();
     if (!std::isfinite(range) || range < 0.01) continue;
     rays->push_back(point / range);
-    table.ray_cells[RayCell(rays->back())] = 1;
   }
+  // Counting sort by cell: each cell's rays stay in firing order.
+  auto cells = std::make_shared<LearntRayCells>();
+  std::vector<int> cell_of(rays->size());
+  cells->start.assign(LearntRayCells::kCells + 1, 0);
+  for (size_t k = 0; k < rays->size(); ++k) {
+    cell_of[k] = LearntRayCells::CellOf((*rays)[k]);
+    ++cells->start[cell_of[k] + 1];
+  }
+  for (int c = 0; c < LearntRayCells::kCells; ++c) cells->start[c + 1] += cells->start[c];
+  cells->by_cell.resize(rays->size());
+  std::vector<int> next(cells->start.begin(), cells->start.end() - 1);
+  for (size_t k = 0; k < rays->size(); ++k)
+    cells->by_cell[next[cell_of[k]]++] = static_cast<int>(k);
   table.rays = std::move(rays);
+  table.ray_cells = std::move(cells);
   return table;
 }
 
 bool BeamTable::InField(const Vec3& direction) const {
   const Vec3 d = direction.normalized();
   if (risley) return InRisleyField(*risley, d);
-  if (rays) {
+  if (rays && ray_cells) {
     // A cell without a learnt ray may lie between two strokes: its neighbours count.
-    const int cell = RayCell(d), e = cell / 360, a = cell % 360;
+    const int cell = LearntRayCells::CellOf(d), e = cell / 360, a = cell % 360;
     for (int de = -1; de <= 1; ++de)
       for (int da = -1; da <= 1; ++da) {
         const int ne = e + de;
         if (ne < 0 || ne >= 180) continue;
-        if (ray_cells[ne * 360 + (a + da + 360) % 360]) return true;
+        if (ray_cells->Occupied(ne * 360 + (a + da + 360) % 360)) return true;
       }
     return false;
   }

@@ -3,7 +3,6 @@
 // the clouds, or a model's); the simulator scans with one.
 #pragma once
 
-#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -28,6 +27,17 @@ enum class LidarModel { kHdl64, kVlp16, kOs0_128, kSwept2d, kMid40, kAvia, kMid3
 std::string LidarModelName(LidarModel model);
 std::optional<LidarModel> ParseLidarModelName(const std::string& name);
 std::string LidarModelNames();  // "hdl64, vlp16, ...", for messages
+
+// Learnt rays (BeamTable::rays) by 1° cell of azimuth (360) × elevation (180): the rays' field,
+// and where to look for the rays a sheet can return (CastBoardReturns casts only those).
+struct LearntRayCells {
+  static constexpr int kCells = 360 * 180;
+  std::vector<int> start;    // cell c's rays are by_cell[start[c], start[c + 1]), in firing order
+  std::vector<int> by_cell;  // ray indices
+  // A unit direction's cell: elevation index (0 = straight down) × 360 + azimuth index (0 = −π).
+  static int CellOf(const Vec3& unit);
+  bool Occupied(int cell) const { return start[cell + 1] > start[cell]; }
+};
 
 // A spinning LiDAR's beam table: elevation per ring (radians, ring 0 = lowest) and azimuth bins.
 struct BeamTable {
@@ -56,8 +66,7 @@ struct BeamTable {
   // board, held where the scene was, returns the rays that fall on it. Shared: tables are copied
   // per candidate pose.
   std::shared_ptr<const std::vector<Vec3>> rays;
-  // Which 1° cells of azimuth (360) × elevation (180) the learnt rays fall in: the field.
-  std::vector<std::uint8_t> ray_cells;
+  std::shared_ptr<const LearntRayCells> ray_cells;  // the learnt rays by cell
 
   bool HasRings() const { return !swept && !Fired(); }
   // Whether its rays are a fired sequence (a Risley pattern's or learnt ones), not rings.
@@ -70,7 +79,7 @@ struct BeamTable {
 };
 BeamTable MakeBeamTable(LidarModel model);
 
-// A table of learnt rays (BeamTable::rays, ray_cells) from a ring-less cloud's returns: their
+// A table of learnt rays (BeamTable::rays and their cells) from a ring-less cloud's returns: their
 // directions from the origin, in the cloud's order (returns nearer than 1 cm skipped).
 BeamTable LearntRayTable(const std::vector<Vec3>& returns);
 

@@ -110,6 +110,67 @@ std::pair<int, int> StepsOverSheet(const BeamRays& rays, const BeamTable& beams,
   return {first, last};
 }
 
+// A learnt table's rays that can meet the sheet: those in the 1° cells its outline spans (its
+// border sampled, widened by 2°), each with its neighbours in firing order (a crossing of the
+// border pairs a ray on the sheet with the next), sorted. The elevation and azimuth bounds of a
+// sheet's directions are those of its border unless it surrounds the vertical, where they are not
+// bounded: false then (cast every ray), and for any other table.
+bool LearntRaysNear(const BeamTable& beams, const LidarRectangle& sheet, std::vector<int>* near) {
+  if (!beams.rays || !beams.ray_cells) return false;
+  for (const double z : {1.0, -1.0}) {
+    const auto hit = HitRectangle({Vec3::Zero(), Vec3(0, 0, z)}, sheet);
+    if (hit && hit->inside) return false;
+  }
+  const Pose& pose = sheet.lidar_from_rectangle;
+  const Vec3& centre = pose.translation();
+  if (centre.norm() < 1e-6) return false;
+  constexpr double kDeg = 180.0 / M_PI;
+  const double centre_azimuth = std::atan2(centre.y(), centre.x());
+  double az_lo = 180.0, az_hi = -180.0, el_lo = 90.0, el_hi = -90.0;  // azimuths about the centre's
+  constexpr int kPerEdge = 32;
+  const Vec2& h = sheet.half_size_m;
+  const Vec2 corners[4] = {{-h.x(), -h.y()}, {h.x(), -h.y()}, {h.x(), h.y()}, {-h.x(), h.y()}};
+  for (int edge = 0; edge < 4; ++edge) {
+    for (int k = 0; k < kPerEdge; ++k) {
+      const Vec2 xy = corners[edge] + (corners[(edge + 1) % 4] - corners[edge]) * k / kPerEdge;
+      const Vec3 p = pose * Vec3(xy.x(), xy.y(), 0.0);
+      const double range = p.norm();
+      if (range < 1e-6) return false;
+      const double azimuth =
+          std::remainder(std::atan2(p.y(), p.x()) - centre_azimuth, 2.0 * M_PI) * kDeg;
+      const double elevation = std::asin(std::clamp(p.z() / range, -1.0, 1.0)) * kDeg;
+      az_lo = std::min(az_lo, azimuth);
+      az_hi = std::max(az_hi, azimuth);
+      el_lo = std::min(el_lo, elevation);
+      el_hi = std::max(el_hi, elevation);
+    }
+  }
+  if (az_hi - az_lo > 180.0) return false;
+  constexpr double kMarginDeg = 2.0;
+  const int e_first = std::max(0, static_cast<int>(std::floor(el_lo - kMarginDeg + 90.0)));
+  const int e_last = std::min(179, static_cast<int>(std::floor(el_hi + kMarginDeg + 90.0)));
+  const double a_centre = centre_azimuth * kDeg + 180.0;
+  const int a_first = static_cast<int>(std::floor(a_centre + az_lo - kMarginDeg));
+  const int a_last = static_cast<int>(std::floor(a_centre + az_hi + kMarginDeg));
+  const LearntRayCells& cells = *beams.ray_cells;
+  const int count = static_cast<int>(beams.rays->size());
+  near->clear();
+  for (int e = e_first; e <= e_last; ++e) {
+    for (int a = a_first; a <= a_last; ++a) {
+      const int cell = e * 360 + ((a % 360) + 360) % 360;
+      for (int i = cells.start[cell]; i < cells.start[cell + 1]; ++i) {
+        const int k = cells.by_cell[i];
+        if (k > 0) near->push_back(k - 1);
+        near->push_back(k);
+        if (k + 1 < count) near->push_back(k + 1);
+      }
+    }
+  }
+  std::sort(near->begin(), near->end());
+  near->erase(std::unique(near->begin(), near->end()), near->end());
+  return true;
+}
+
 }  // namespace
 
 BoardReturns CastBoardReturns(const BeamTable& beams, const LidarRectangle& sheet,
@@ -119,10 +180,17 @@ BoardReturns CastBoardReturns(const BeamTable& beams, const LidarRectangle& shee
   const BeamRays rays(beams, azimuth_offset_rad);
   out.points_per_ring.assign(rays.rings(), 0);
   const auto [first, last] = StepsOverSheet(rays, beams, sheet, azimuth_offset_rad);
+  // Learnt rays: only those that can meet the sheet, the same returns and crossings as all of
+  // them give (a gap in firing order is no crossing: neither side of it is on the sheet).
+  std::vector<int> near;
+  const bool indexed = LearntRaysNear(beams, sheet, &near);
   for (int ring = 0; ring < rays.rings(); ++ring) {
     Vec3 previous = Vec3::Zero();
     bool previous_on = false, previous_valid = false;
-    for (int step = first; step <= last; ++step) {
+    const int casts = indexed ? static_cast<int>(near.size()) : last - first + 1;
+    for (int i = 0; i < casts; ++i) {
+      const int step = indexed ? near[i] : first + i;
+      if (indexed && i > 0 && step != near[i - 1] + 1) previous_valid = false;
       const BeamRay ray = rays.Ray(ring, step);
       const auto hit = HitRectangle(ray, sheet);
       const bool valid = hit && hit->range_m >= kLidarMinRangeM && hit->range_m < beams.max_range_m;

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -116,6 +117,56 @@ TEST(LearntRays, AdviseSuggestsANextPoseForALivoxCapture) {
   EXPECT_GE(advice.next->feasibility.points, 40);
   EXPECT_NE(FormatCaptureAdvice(advice).find("returns on the sheet"), std::string::npos)
       << FormatCaptureAdvice(advice);
+}
+
+// Casting only the learnt rays near a sheet (their cells) gives what casting every ray gives: the
+// same returns in the same order and the same crossings, wherever the sheet is — behind the
+// LiDAR across the azimuth's wrap, overhead around the vertical, near, far, turned.
+TEST(LearntRays, CastingTheRaysNearASheetGivesWhatCastingThemAllGives) {
+  const SimOptions sim = Livox(LidarModel::kMid360, 0.5, 1);
+  const LidarCloud cloud =
+      LoadCloud(SimulateDataset(sim, test::TempDir("learnt_rays_near")).pairs[0].cloud);
+  const BeamTable indexed = LearnBeamTable({&cloud});
+  ASSERT_TRUE(indexed.ray_cells);
+  BeamTable every = indexed;
+  every.ray_cells.reset();  // no cells: every ray is cast
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<LidarRectangle> sheets;
+  for (int k = 0; k < 150; ++k) {
+    const double azimuth = (2 * unit(rng) - 1) * M_PI, elevation = (unit(rng) - 0.5) * 1.6;
+    const double distance = 0.5 + 4.5 * unit(rng);
+    LidarRectangle sheet;
+    sheet.half_size_m = Vec2(0.21, 0.297);
+    sheet.lidar_from_rectangle = Pose::Identity();
+    sheet.lidar_from_rectangle.linear() =
+        Eigen::AngleAxisd(2 * M_PI * unit(rng),
+                          Vec3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng)).normalized())
+            .toRotationMatrix();
+    sheet.lidar_from_rectangle.translation() =
+        distance * Vec3(std::cos(elevation) * std::cos(azimuth),
+                        std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+    sheets.push_back(sheet);
+  }
+  // Behind, straddling azimuth ±180°; overhead, around the vertical; facing, close.
+  sheets.push_back(SheetAhead(-2.0, 0.0, 0.0, 0.0));
+  LidarRectangle overhead = SheetAhead(1.0, 0.0, 0.0, 0.0);
+  overhead.lidar_from_rectangle.translation() = Vec3(0.05, 0.0, 1.0);
+  overhead.lidar_from_rectangle.linear() = Mat3::Identity();
+  sheets.push_back(overhead);
+  sheets.push_back(SheetAhead(0.6, 30.0, 10.0, 0.0));
+  int seen = 0;
+  for (size_t k = 0; k < sheets.size(); ++k) {
+    const BoardReturns near = CastBoardReturns(indexed, sheets[k]);
+    const BoardReturns all = CastBoardReturns(every, sheets[k]);
+    ASSERT_EQ(near.points.size(), all.points.size()) << "sheet " << k;
+    for (size_t i = 0; i < all.points.size(); ++i) ASSERT_EQ(near.points[i], all.points[i]);
+    ASSERT_EQ(near.edges.size(), all.edges.size()) << "sheet " << k;
+    for (size_t i = 0; i < all.edges.size(); ++i)
+      ASSERT_EQ(near.edges[i].point, all.edges[i].point) << "sheet " << k;
+    seen += all.points.empty() ? 0 : 1;
+  }
+  EXPECT_GT(seen, 60);  // most sheets return something: the comparison is not of empty sets
 }
 
 }  // namespace
