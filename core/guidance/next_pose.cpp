@@ -163,14 +163,10 @@ Feasibility CheckFeasible(const SensorGeometry& sensors, const std::optional<Pos
       return f;
     }
     BoardReturns predicted = PredictBoardReturns(sensors, lidar_from_board);
-    // A fired sequence (a rosette, learnt rays) is one "ring": its returns count, as the
-    // simulator's ring-less rule counts them.
-    BoardReturnsRule rule = options.lidar_returns;
-    if (sensors.lidar.Fired()) rule.min_rings = 1;
-    f.rings = sensors.lidar.Fired() ? 0 : rule.RingsCovered(predicted);
+    f.rings = options.lidar_returns.RingsCovered(predicted);
     f.points = static_cast<int>(predicted.points.size());
     std::string short_by;
-    if (!rule.Met(predicted, &short_by)) {
+    if (!options.lidar_returns.Met(predicted, &short_by)) {
       f.why = "too few LiDAR returns on the sheet (" + short_by + ")";
       return f;
     }

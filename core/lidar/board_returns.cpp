@@ -179,6 +179,7 @@ BoardReturns CastBoardReturns(const BeamTable& beams, const LidarRectangle& shee
   if (beams.azimuth_steps < 1 && !beams.Fired()) return out;
   const BeamRays rays(beams, azimuth_offset_rad);
   out.points_per_ring.assign(rays.rings(), 0);
+  out.fired = rays.fired();
   const auto [first, last] = StepsOverSheet(rays, beams, sheet, azimuth_offset_rad);
   // Learnt rays: only those that can meet the sheet, the same returns and crossings as all of
   // them give (a gap in firing order is no crossing: neither side of it is on the sheet).
@@ -229,6 +230,7 @@ bool BoardReturnsRule::Check(std::string* why) const {
 }
 
 int BoardReturnsRule::RingsCovered(const BoardReturns& returns) const {
+  if (returns.fired) return 0;
   return static_cast<int>(std::count_if(returns.points_per_ring.begin(),
                                         returns.points_per_ring.end(),
                                         [this](int n) { return n >= min_points_per_ring; }));
@@ -237,9 +239,15 @@ int BoardReturnsRule::RingsCovered(const BoardReturns& returns) const {
 bool BoardReturnsRule::Met(const BoardReturns& returns, std::string* why) const {
   const int rings = RingsCovered(returns);
   const int points = static_cast<int>(returns.points.size());
-  if (rings >= min_rings && points >= min_points) return true;
+  if ((returns.fired || rings >= min_rings) && points >= min_points) return true;
   if (why != nullptr) {
     char text[160];
+    if (returns.fired) {
+      std::snprintf(text, sizeof(text), "%d returns on the board, under the %d it needs", points,
+                    min_points);
+      *why = text;
+      return false;
+    }
     std::snprintf(text, sizeof(text),
                   "%d rings and %d returns on the board, under the %d rings (of %d+ returns each) "
                   "and %d returns it needs",

@@ -87,6 +87,8 @@ struct BoardReturns {
   std::vector<int> ring;
   std::vector<LidarEdgePoint> edges;
   std::vector<int> points_per_ring;  // one entry per ring of the table
+  // A fired sequence's (a rosette, learnt rays: BeamTable::Fired): one "ring", no rings to count.
+  bool fired = false;
 };
 // Casts only the steps whose azimuths the sheet spans (every step when it spans more than half
 // the sweep), plus one each side.
@@ -95,7 +97,7 @@ BoardReturns CastBoardReturns(const BeamTable& beams, const LidarRectangle& shee
 
 // Whether a board's returns are enough to find it and fit its plane: this many rings with at
 // least this many returns each (a ring that only grazes a corner does not help a plane fit), and
-// this many returns in all.
+// this many returns in all. A fired sequence's returns have no rings: their count decides.
 struct BoardReturnsRule {
   int min_rings = 4;
   int min_points_per_ring = 3;

@@ -17,10 +17,9 @@ namespace {
 
 constexpr double kImageMarginFraction = 0.05;  // of the image width, around the whole sheet
 // Simulated boards are placed where the LiDAR's returns leave a margin over what finding the
-// board needs (guidance's BoardReturnsRule asks for 40 returns): 4 rings of 3+ returns, 60 in all.
+// board needs (guidance's BoardReturnsRule asks for 40 returns): 4 rings of 3+ returns, 60 in all
+// (a Livox-class scanner has no rings: 60 returns on the sheet, however its rosette lays them).
 constexpr BoardReturnsRule kSimulatedBoardReturns{4, 3, 60};
-// A Livox-class scanner has no rings: 60 returns on the sheet, however its rosette lays them.
-constexpr BoardReturnsRule kSimulatedRinglessReturns{1, 3, 60};
 constexpr double kMaxIncidenceDeg = 80.0;  // LiDAR ray vs. board normal at the board centre
 constexpr int kMaxTriesPerPair = 5000;
 
@@ -162,8 +161,8 @@ Vec3 BoardHitCentroid(const BeamTable& beams, const BoardPrint& print, const Pos
 
 bool EnoughLidarHits(const BeamTable& beams, const BoardPrint& print, const Pose& lidar_from_board,
                      double azimuth_offset_rad) {
-  const BoardReturnsRule& rule = beams.risley ? kSimulatedRinglessReturns : kSimulatedBoardReturns;
-  return rule.Met(ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad));
+  return kSimulatedBoardReturns.Met(
+      ScanBoardOnly(beams, print, lidar_from_board, azimuth_offset_rad));
 }
 
 PairPlan PlanPair(const SimOptions& r, const BeamTable& beams, const BoardPrint& print,
