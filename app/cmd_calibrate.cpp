@@ -23,17 +23,8 @@ int CalibrateRigDataset(const std::string& path, const std::vector<std::string>&
                         const PipelineOptions& options, const std::string& out_path,
                         const std::string& report_path) {
   const RigFolder rig = LoadRig(path);
-  RigEdits edits;
-  for (const std::string& session_path : sessions) {
-    const Session session = LoadSession(session_path);
-    if (session.camera.empty() ||
-        NormalizeSessionPath(session.dataset) != NormalizeSessionPath(rig.folder))
-      throw IoError(session_path + ": not a session of a camera of the rig " + rig.folder.string() +
-                    " (its dataset is " + session.dataset.string() + ")");
-    RigCameraIndex(rig, session.camera);  // a camera the rig has
-    edits[session.camera] = EditsFromSession(session);
-  }
-  const RigOutcome outcome = CalibrateRig(rig, options, StderrProgress("extracted"), edits);
+  const RigOutcome outcome =
+      CalibrateRig(rig, options, StderrProgress("extracted"), RigEditsOfSessions(rig, sessions));
   std::printf("%s", FormatRigSummary(outcome).c_str());
   if (!outcome.joint) {
     std::fprintf(stderr, "calibench: no calibration for the rig %s: %s\n", path.c_str(),
@@ -48,7 +39,7 @@ int CalibrateRigDataset(const std::string& path, const std::vector<std::string>&
   ReportRequest request;
   request.out_path = report_path;
   request.result_file = out_path;
-  return WriteRigReport(rig, outcome, options, request);
+  return WriteReport(rig, outcome, options, request);
 }
 
 // One camera's dataset: its intrinsics first when `intrinsics_model` names a model (else its
@@ -80,7 +71,8 @@ int CalibrateOneCamera(Dataset* dataset, const PairEdits& edits,
       CalibrateAndReport(*dataset, KeepingInputsForViews(options, dataset->camera, &report),
                          out_path, &outcome, edits, intrinsics);
   if (report.out_path.empty() || !outcome.solution) return code;
-  const int written = WriteReport(*dataset, outcome, options, report);
+  const RigFolder rig = RigOfOne(*dataset);
+  const int written = WriteReport(rig, RigOutcomeOfOne(rig, std::move(outcome)), options, report);
   return code != kOk ? code : written;
 }
 

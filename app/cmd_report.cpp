@@ -15,6 +15,7 @@
 #include "core/lidar_camera/rig.h"
 #include "core/lrf/dataset.h"
 #include "core/report/lrf_report.h"
+#include "core/report/resolve_notes.h"
 #include "core/results/result_file.h"
 #include "core/session/job.h"
 #include "core/session/lrf_calibration_job.h"
@@ -36,19 +37,6 @@ std::string NowUtc() {
   return text;
 }
 
-// What a report says when its re-solve is not the reported pose ("" when they agree to 0.1 mm
-// and 0.01 deg): "<what> differs from a re-solve of <data> by .. mm and .. deg: <consequence>".
-std::string ResolveNote(const Pose& solved, const Pose& reported, const std::string& what,
-                        const std::string& data, const std::string& consequence) {
-  const double moved_mm = 1000.0 * (solved.translation() - reported.translation()).norm();
-  const double turned_deg =
-      Eigen::AngleAxisd(solved.linear().transpose() * reported.linear()).angle() * kRadToDeg;
-  if (moved_mm <= 0.1 && turned_deg <= 0.01) return "";
-  char amount[96];
-  std::snprintf(amount, sizeof(amount), " by %.1f mm and %.3f deg: ", moved_mm, turned_deg);
-  return what + " differs from a re-solve of " + data + amount + consequence;
-}
-
 }  // namespace
 
 PipelineOptions KeepingInputsForViews(const PipelineOptions& options, const CameraModel& camera,
@@ -60,150 +48,167 @@ PipelineOptions KeepingInputsForViews(const PipelineOptions& options, const Came
   return keeping;
 }
 
-int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
-                const PipelineOptions& options, const ReportRequest& request) {
-  const CalibrationReport report = AnalyseCalibration(dataset, outcome, options, request.options);
-  ReportProvenance provenance;
-  provenance.source = request.session_path.empty() ? dataset.manifest.string()
-                                                   : request.session_path + " (session of " +
-                                                         dataset.manifest.string() + ")";
-  provenance.result_file = request.result_file;
-  provenance.created_utc = NowUtc();
-  provenance.calibench_version = CALIBENCH_VERSION;
-  provenance.notes = request.notes;
-  std::vector<ReportFigure> figures;
-  if (request.renders) {
-    std::string why;
-    ui::ReportFigureOptions figure_options;
-    figure_options.threads = options.threads;
-    figures =
-        ui::DrawReportFigures(dataset, outcome, figure_options, request.kept_inputs.get(), &why);
-    if (figures.empty() && !why.empty()) {
-      std::fprintf(stderr, "calibench report: %s; the report has no views\n", why.c_str());
-      provenance.notes.push_back("No views: " + why + ".");
-    } else if (!why.empty()) {
-      std::fprintf(stderr, "calibench report: %s\n", why.c_str());
-      provenance.notes.push_back(why + ".");
-    }
-  }
-  const ReportAssets assets = LoadReportAssets(FindAsset("report"));
-  const std::string sections = request.check ? TargetlessCheckHtml(*request.check) : "";
-  WriteFileAtomically(request.out_path, ReportHtml(report, provenance, figures, assets, sections));
-  std::printf("wrote %s (%zu pairs, %zu views)%s%s\n", request.out_path.c_str(),
-              report.pairs.size(), figures.size(), report.cross_validation ? ": " : "",
-              report.cross_validation ? report.cross_validation->verdict.c_str() : "");
-  if (!report.distrust.empty()) std::printf("%s\n", report.distrust.c_str());
-  return kOk;
-}
+namespace {
 
-int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const PipelineOptions& options,
-                   const ReportRequest& request) {
-  CALIBENCH_CHECK(outcome.joint.has_value());
-  const RigReportSummary summary = SummarizeRigOutcome(outcome);
+// Each camera's analysis and views (none for the rest once one could not be drawn: no OpenGL).
+// *why: what kept views out, "" when none was.
+std::vector<RigCameraReport> AnalyseCameras(const RigFolder& rig, const RigOutcome& outcome,
+                                            const PipelineOptions& options,
+                                            const ReportRequest& request, std::string* why) {
   std::vector<RigCameraReport> cameras;
-  std::string why;
+  bool drawing = request.renders;
   for (size_t c = 0; c < outcome.camera_names.size(); ++c) {
-    const std::string& name = outcome.camera_names[c];
     RigCameraReport camera;
-    camera.name = name;
+    camera.name = outcome.camera_names[c];
     camera.prefix = "camera" + std::to_string(c) + "-";  // ids stay valid whatever the name
     camera.report = AnalyseCalibration(rig.cameras[c], outcome.single[c], options, request.options);
-    if (request.renders && why.empty()) {
+    if (drawing) {
       ui::ReportFigureOptions figure_options;
       figure_options.threads = options.threads;
-      camera.figures = ui::DrawRigReportFigures(rig, outcome, c, figure_options, &why);
+      std::string missing;
+      camera.figures = ui::DrawReportFigures(rig, outcome, c, figure_options,
+                                             request.kept_inputs.get(), &missing);
+      if (!missing.empty() && why->empty()) *why = missing;
+      drawing = missing.empty() || !camera.figures.empty();
     }
     cameras.push_back(std::move(camera));
   }
+  return cameras;
+}
+
+// What the views' absence or gaps say in the report and on stderr.
+void NoteViews(const std::vector<RigCameraReport>& cameras, const std::string& why,
+               ReportProvenance* provenance) {
+  if (why.empty()) return;
+  const bool none = std::all_of(cameras.begin(), cameras.end(),
+                                [](const RigCameraReport& c) { return c.figures.empty(); });
+  if (none) {
+    std::fprintf(stderr, "calibench report: %s; the report has no views\n", why.c_str());
+    provenance->notes.push_back("No views: " + why + ".");
+  } else {
+    std::fprintf(stderr, "calibench report: %s\n", why.c_str());
+    provenance->notes.push_back(why + ".");
+  }
+}
+
+void PrintWritten(const std::string& path, const std::vector<RigCameraReport>& cameras) {
+  auto verdict = [](const CalibrationReport& report) {
+    return report.cross_validation ? report.cross_validation->verdict : std::string();
+  };
+  if (cameras.size() == 1) {
+    const CalibrationReport& report = cameras.front().report;
+    std::printf("wrote %s (%zu pairs, %zu views)%s%s\n", path.c_str(), report.pairs.size(),
+                cameras.front().figures.size(), report.cross_validation ? ": " : "",
+                verdict(report).c_str());
+    if (!report.distrust.empty()) std::printf("%s\n", report.distrust.c_str());
+    return;
+  }
+  std::printf("wrote %s (a rig of %zu cameras", path.c_str(), cameras.size());
+  for (const RigCameraReport& camera : cameras)
+    std::printf("; %s: %zu pairs, %zu views%s%s", camera.name.c_str(), camera.report.pairs.size(),
+                camera.figures.size(), camera.report.cross_validation ? ", " : "",
+                verdict(camera.report).c_str());
+  std::printf(")\n");
+}
+
+}  // namespace
+
+int WriteReport(const RigFolder& rig, const RigOutcome& outcome, const PipelineOptions& options,
+                const ReportRequest& request) {
+  CALIBENCH_CHECK(outcome.joint.has_value() && !(outcome.Several() && request.check));
   ReportProvenance provenance;
-  provenance.source = rig.folder.string() + " (a rig of " +
-                      std::to_string(outcome.camera_names.size()) + " cameras)";
+  const std::string data = rig.folder.string();
+  provenance.source =
+      outcome.Several()
+          ? data + " (a rig of " + std::to_string(outcome.camera_names.size()) + " cameras)"
+      : request.session_path.empty() ? data
+                                     : request.session_path + " (session of " + data + ")";
   provenance.result_file = request.result_file;
   provenance.created_utc = NowUtc();
   provenance.calibench_version = CALIBENCH_VERSION;
   provenance.notes = request.notes;
-  if (!why.empty()) {
-    std::fprintf(stderr, "calibench report: %s; the report has no views\n", why.c_str());
-    provenance.notes.push_back("No views: " + why + ".");
-  }
+  std::string why;
+  const std::vector<RigCameraReport> cameras = AnalyseCameras(rig, outcome, options, request, &why);
+  NoteViews(cameras, why, &provenance);
   const ReportAssets assets = LoadReportAssets(FindAsset("report"));
-  WriteFileAtomically(request.out_path, RigReportHtml(summary, cameras, provenance, assets));
-  std::printf("wrote %s (a rig of %zu cameras", request.out_path.c_str(), cameras.size());
-  for (const RigCameraReport& camera : cameras)
-    std::printf(
-        "; %s: %zu pairs, %zu views%s%s", camera.name.c_str(), camera.report.pairs.size(),
-        camera.figures.size(), camera.report.cross_validation ? ", " : "",
-        camera.report.cross_validation ? camera.report.cross_validation->verdict.c_str() : "");
-  std::printf(")\n");
+  if (outcome.Several()) {
+    WriteFileAtomically(request.out_path,
+                        RigReportHtml(SummarizeRigOutcome(outcome), cameras, provenance, assets));
+  } else {
+    const std::string sections = request.check ? TargetlessCheckHtml(*request.check) : "";
+    WriteFileAtomically(request.out_path, ReportHtml(cameras.front().report, provenance,
+                                                     cameras.front().figures, assets, sections));
+  }
+  PrintWritten(request.out_path, cameras);
   return kOk;
 }
 
 namespace {
 
-// `report` on a rig: the rig solved again (with the sessions' edits), each camera's pose against
-// the result file's, the report written.
-int ReportRig(const std::string& result_path, const std::string& dataset_path,
-              const RigEdits& edits, const PipelineOptions& options, ReportRequest request) {
-  if (request.check) {
-    std::fprintf(stderr, "calibench report: --check goes with one camera's report, not a rig's\n");
-    return kUsage;
-  }
-  const RigFolder rig = LoadRig(dataset_path);
-  const RigOutcome outcome = CalibrateRig(rig, options, StderrProgress("extracted"), edits);
-  if (!outcome.joint) {
-    std::fprintf(stderr, "calibench report: the rig gives no calibration: %s\n",
-                 outcome.failure.c_str());
-    return kNoCalibration;
-  }
-  for (const auto& [name, reported] : LoadRigResult(result_path)) {
-    const auto at = std::find(outcome.camera_names.begin(), outcome.camera_names.end(), name);
-    if (at == outcome.camera_names.end()) {
-      request.notes.push_back(result_path + " has a camera '" + name + "' that " + dataset_path +
-                              " has not.");
-      continue;
+// The data `report` re-solves, as RunReport's flags name it: a rig (with the session's edits for
+// its camera), or one camera's dataset as a rig of one (with its session's edits and options).
+// kOk, or the exit code with the error printed.
+int OpenReportedData(const std::string& result_path, std::string session_path,
+                     std::string dataset_path, PipelineOptions* options, ReportRequest* request,
+                     RigFolder* rig, RigEdits* edits) {
+  if (IsRigResultFile(result_path) || (!dataset_path.empty() && IsRig(dataset_path))) {
+    if (dataset_path.empty()) {
+      std::fprintf(stderr, "calibench report: a rig result: give --dataset <the rig>\n");
+      return kUsage;
     }
-    const std::string note =
-        ResolveNote(outcome.joint->cam_from_lidar[at - outcome.camera_names.begin()], reported,
-                    result_path + ": camera " + name, "this rig with these options",
-                    "the figures below are the re-solve's.");
-    if (note.empty()) continue;
-    request.notes.push_back(note);
-    std::fprintf(stderr, "calibench report: %s\n", note.c_str());
+    *rig = LoadRig(dataset_path);
+    if (!session_path.empty()) *edits = RigEditsOfSessions(*rig, {session_path});
+    return kOk;
   }
-  return WriteRigReport(rig, outcome, options, request);
-}
-
-// The report of one camera's dataset: the pairs extracted and solved again (with the session's
-// edits, when there is one) and reported.
-int ReportDataset(const std::string& result_path, std::string session_path,
-                  std::string dataset_path, PipelineOptions options, ReportRequest request) {
   if (session_path.empty() && IsSessionFile(result_path)) session_path = result_path;
-  const Pose reported = CalibrationOf(result_path);
-  const PairEdits edits = ApplySessionFlag(session_path, &dataset_path, &options);
+  const PairEdits camera_edits = ApplySessionFlag(session_path, &dataset_path, options);
   if (dataset_path.empty()) {
     std::fprintf(stderr, "calibench report: give --dataset or --session (the result's data)\n");
     return kUsage;
   }
-  request.session_path = session_path;
-  const Dataset dataset = LoadDataset(dataset_path);
-  const CalibrationOutcome outcome =
-      CalibrateDataset(dataset, KeepingInputsForViews(options, dataset.camera, &request),
-                       StderrProgress("extracted"), edits);
-  if (!outcome.solution) {
-    std::fprintf(stderr, "calibench report: the data gives no calibration: %s\n",
-                 outcome.failure.c_str());
+  request->session_path = session_path;
+  *rig = RigOfOne(LoadDataset(dataset_path));
+  (*edits)[rig->camera_names.front()] = camera_edits;
+  return kOk;
+}
+
+// The report of a LiDAR-camera result, one camera's or a rig's: the data extracted and solved
+// again (with the sessions' edits), each camera's pose against the result file's, the report
+// written.
+int ReportLidarCamera(const std::string& result_path, const std::string& session_path,
+                      const std::string& dataset_path, PipelineOptions options,
+                      ReportRequest request) {
+  RigFolder rig;
+  RigEdits edits;
+  if (const int code = OpenReportedData(result_path, session_path, dataset_path, &options, &request,
+                                        &rig, &edits);
+      code != kOk)
+    return code;
+  const bool several = rig.cameras.size() > 1;
+  if (several && request.check) {
+    std::fprintf(stderr, "calibench report: --check goes with one camera's report, not a rig's\n");
+    return kUsage;
+  }
+  // The poses the result reports (read first: a wrong file fails before the solve).
+  const auto reported = several || IsRigResultFile(result_path)
+                            ? LoadRigResult(result_path)
+                            : std::vector<std::pair<std::string, Pose>>{
+                                  {rig.camera_names.front(), CalibrationOf(result_path)}};
+  const PipelineOptions solve =
+      several ? options : KeepingInputsForViews(options, rig.cameras.front().camera, &request);
+  const RigOutcome outcome = CalibrateRig(rig, solve, StderrProgress("extracted"), edits);
+  if (!outcome.joint) {
+    std::fprintf(stderr, "calibench report: the %s gives no calibration: %s\n",
+                 several ? "rig" : "data",
+                 several ? outcome.failure.c_str() : outcome.single.front().failure.c_str());
     return kNoCalibration;
   }
-  // The figures are the re-solve's: say so when it is not the result's pose.
-  const std::string note = ResolveNote(
-      outcome.solution->cam_from_lidar, reported, result_path, "this data with these options",
-      "the result, per-pair figures and views below are the re-solve's. Pass the options "
-      "calibrate was run with (or its session).");
-  if (!note.empty()) {
+  // The figures are the re-solve's: say so where it is not the result's pose.
+  for (const std::string& note : ResolveNotes(outcome, reported, result_path, dataset_path)) {
     request.notes.push_back(note);
     std::fprintf(stderr, "calibench report: %s\n", note.c_str());
   }
-  return WriteReport(dataset, outcome, options, request);
+  return WriteReport(rig, outcome, options, request);
 }
 
 // `report` on a 2D LRF result: the observations extracted and solved again as `lrf-calibrate`
@@ -339,19 +344,7 @@ int RunReport(int argc, char** argv) {
     std::fprintf(stderr, "calibench report: %s\n", why.c_str());
     return kUsage;
   }
-  if (IsRigResultFile(result_path) || (!dataset_path.empty() && IsRig(dataset_path))) {
-    if (dataset_path.empty()) {
-      std::fprintf(stderr, "calibench report: a rig result: give --dataset <the rig>\n");
-      return kUsage;
-    }
-    RigEdits edits;
-    if (!session_path.empty()) {
-      const Session session = LoadSession(session_path);
-      edits[session.camera] = EditsFromSession(session);
-    }
-    return ReportRig(result_path, dataset_path, edits, flags.options, request);
-  }
-  return ReportDataset(result_path, session_path, dataset_path, flags.options, request);
+  return ReportLidarCamera(result_path, session_path, dataset_path, flags.options, request);
 }
 
 }  // namespace calibench::app

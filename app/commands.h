@@ -169,10 +169,12 @@ struct ReportRequest {
   // null: the views read them again.
   std::shared_ptr<ui::KeptPairInputs> kept_inputs;
 };
-// `report` and `calibrate --report`: analyses the outcome, draws the views, writes the HTML
-// atomically; kOk (an unreadable asset throws IoError).
-int WriteReport(const Dataset& dataset, const CalibrationOutcome& outcome,
-                const PipelineOptions& options, const ReportRequest& request);
+// `report` and `calibrate --report` on a LiDAR-camera solve, one camera's (a rig of one: RigOfOne,
+// RigOutcomeOfOne) or a rig's: analyses each camera's outcome, draws the views, writes the HTML
+// atomically (a rig's with the rig solve first, core/report/report_html.h RigReportHtml); kOk (an
+// unreadable asset throws IoError). Needs outcome.joint; request.check only for one camera.
+int WriteReport(const RigFolder& rig, const RigOutcome& outcome, const PipelineOptions& options,
+                const ReportRequest& request);
 // `report` and `calibrate --report` on a 2D LRF job that has solved: analyses its outcome (the
 // leave-one-out folds) and writes the HTML atomically; kOk.
 int WriteLrfReport(const LrfCalibrationJob& job, const ReportRequest& request);
@@ -181,9 +183,5 @@ int WriteLrfReport(const LrfCalibrationJob& job, const ReportRequest& request);
 // unchanged otherwise. The returned options refer to request->kept_inputs.
 PipelineOptions KeepingInputsForViews(const PipelineOptions& options, const CameraModel& camera,
                                       ReportRequest* request);
-// The rig's report (core/report/report_html.h RigReportHtml): the rig solve, then every camera
-// as WriteReport has one. Needs outcome.joint.
-int WriteRigReport(const RigFolder& rig, const RigOutcome& outcome, const PipelineOptions& options,
-                   const ReportRequest& request);
 
 }  // namespace calibench::app

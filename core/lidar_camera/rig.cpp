@@ -88,6 +88,10 @@ bool RigCalibration::Step() {
   }
   solved_ = true;
   if (!outcome_.failure.empty()) return false;
+  if (!outcome_.Several()) {  // nothing to tie: the camera's own solve is the rig's
+    outcome_ = RigOutcomeOfOne(rig_, std::move(outcome_.single.front()));
+    return false;
+  }
   std::vector<RigCapture> all;
   for (auto& [stem, capture] : captures_) all.push_back(std::move(capture));
   std::string why;
@@ -112,6 +116,26 @@ void RigCalibration::FinishCamera(size_t c, CalibrationOutcome single_outcome) {
     capture.views.push_back(
         {static_cast<int>(c), pair.camera->cam_from_board, pair.camera->pose_covariance});
   }
+}
+
+RigOutcome RigOutcomeOfOne(const RigFolder& rig, CalibrationOutcome single) {
+  CALIBENCH_CHECK(rig.camera_names.size() == 1);
+  RigOutcome outcome;
+  outcome.camera_names = rig.camera_names;
+  outcome.single.push_back(std::move(single));
+  const CalibrationOutcome& camera = outcome.single.front();
+  if (!camera.solution) {
+    outcome.failure = "camera '" + rig.camera_names.front() + "': " + camera.failure;
+    return outcome;
+  }
+  RigSolution joint;
+  joint.cam_from_lidar = {camera.solution->cam_from_lidar};
+  joint.covariance = camera.solution->covariance;
+  joint.converged = true;
+  for (const PairFeatures& pair : camera.pairs)
+    joint.used_captures += pair.status == PairStatus::kAccepted;
+  outcome.joint = std::move(joint);
+  return outcome;
 }
 
 RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,

@@ -1,8 +1,9 @@
-// A rig of one LiDAR and several cameras calibrated together: each camera's pairs through the
+// A rig of one LiDAR and its cameras calibrated together: each camera's pairs through the
 // single-camera pipeline (CalibrateDataset: detection, its solve, completion), then the rig solve
 // over every capture (core/lidar_camera/rig_solver.h), where a board two cameras saw at once ties
 // them to each other. The result holds every camera's cam_from_lidar with its σ and the cameras'
-// relative poses.
+// relative poses. One camera's dataset is a rig of one (RigOfOne, core/io/rig_folder.h): its rig
+// solution is its own solve, so every front end reads one outcome whatever the rig's size.
 #pragma once
 
 #include <filesystem>
@@ -23,10 +24,19 @@ namespace calibench {
 struct RigOutcome {
   std::vector<std::string> camera_names;
   std::vector<CalibrationOutcome> single;  // each camera alone, as `calibrate` on its pairs
-  std::optional<RigSolution> joint;        // the rig solve, started from the single solutions
-  std::string failure;                     // why `joint` is absent
-  int shared_captures = 0;                 // captures two or more cameras saw the board in
+  // The rig solve, started from the single solutions; a rig of one's is its camera's solve (the
+  // pose and its 6×6 covariance, no iterations).
+  std::optional<RigSolution> joint;
+  std::string failure;      // why `joint` is absent
+  int shared_captures = 0;  // captures two or more cameras saw the board in
+
+  // Two cameras or more: a rig solve, relative poses and a rig's result file (calibench.rig.v1).
+  bool Several() const { return camera_names.size() > 1; }
 };
+
+// A rig of one's outcome (`rig` from RigOfOne) of its camera's calibration: `joint` is that
+// solve, absent with its failure when it failed.
+RigOutcome RigOutcomeOfOne(const RigFolder& rig, CalibrationOutcome single);
 
 // The user's edits per camera (by camera name): each camera's session's brushes and rejections.
 using RigEdits = std::map<std::string, PairEdits>;
@@ -80,7 +90,8 @@ class RigCalibration {
 };
 
 // Calibrates every camera of the rig, then the rig (RigCalibration's steps, in a row). A camera
-// whose own solve fails leaves the rig without a joint solution (failure says which and why).
+// whose own solve fails leaves the rig without a joint solution (failure says which and why). A
+// rig of one is its camera's CalibrateDataset, bit for bit (RigOutcomeOfOne).
 // `edits` apply to their camera's pairs, as `calibrate --session` applies one session's.
 RigOutcome CalibrateRig(const RigFolder& rig, const PipelineOptions& options,
                         const ProgressCallback& progress = {}, const RigEdits& edits = {});

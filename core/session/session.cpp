@@ -145,6 +145,21 @@ PairEdits EditsFromSession(const Session& session) {
   return edits;
 }
 
+std::map<std::string, PairEdits> RigEditsOfSessions(const RigFolder& rig,
+                                                    const std::vector<std::string>& session_paths) {
+  std::map<std::string, PairEdits> edits;
+  for (const std::string& session_path : session_paths) {
+    const Session session = LoadSession(session_path);
+    if (session.camera.empty() ||
+        NormalizeSessionPath(session.dataset) != NormalizeSessionPath(rig.folder))
+      throw IoError(session_path + ": not a session of a camera of the rig " + rig.folder.string() +
+                    " (its dataset is " + session.dataset.string() + ")");
+    RigCameraIndex(rig, session.camera);  // a camera the rig has, else the error names them
+    edits[session.camera] = EditsFromSession(session);
+  }
+  return edits;
+}
+
 bool IsSessionFile(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::string head(4096, '\0');

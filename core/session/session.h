@@ -9,6 +9,7 @@
 #include <deque>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,6 +22,8 @@
 #include "core/lidar_camera/solver.h"
 
 namespace calibench {
+
+struct RigFolder;  // core/io/rig_folder.h
 
 // The board region the user brushed on one pair's LiDAR image (projection by ID, lidar_image.h).
 struct BrushMask {
@@ -137,6 +140,12 @@ PairEdit EditOfPair(const PairState& pair);
 // pictured from a seed) and rejections, by pair id. `calibench calibrate --session` and the
 // workbench then compute the same calibration.
 PairEdits EditsFromSession(const Session& session);
+// The edits of a rig's cameras by camera name (`calibrate --session`, `report --session` on a rig:
+// one session per camera, calibench.session.<camera>.json), each loaded as LoadSession does.
+// IoError naming the session when it is not of a camera of `rig` (another dataset, or a camera the
+// rig has not).
+std::map<std::string, PairEdits> RigEditsOfSessions(const RigFolder& rig,
+                                                    const std::vector<std::string>& session_paths);
 
 // The session as JSON text for a file at session_path: the dataset path is written relative to
 // the session file's folder when it lies under it, absolute otherwise. Doubles round-trip

@@ -156,18 +156,20 @@ std::vector<ReportFigure> DrawReportFigures(const Dataset& dataset,
                      "3D overview: the LiDAR cloud, the boards and the camera", options, kept, why);
 }
 
-std::vector<ReportFigure> DrawRigReportFigures(const RigFolder& rig, const RigOutcome& outcome,
-                                               size_t camera, const ReportFigureOptions& options,
-                                               std::string* why) {
+std::vector<ReportFigure> DrawReportFigures(const RigFolder& rig, const RigOutcome& outcome,
+                                            size_t camera, const ReportFigureOptions& options,
+                                            const KeptPairInputs* kept, std::string* why) {
   CALIBENCH_CHECK(camera < rig.cameras.size() && camera < outcome.single.size());
   const Dataset& dataset = rig.cameras[camera];
+  if (!outcome.Several())
+    return DrawReportFigures(dataset, outcome.single[camera], options, kept, why);
   Snapshot solved = SnapshotOfOutcome(dataset, outcome.single[camera]);
   solved.rig = RigViewOf(rig, camera);
   ApplyRigOutcome(outcome, false, &*solved.rig);
   return DrawFigures(dataset, solved,
                      "3D overview: the LiDAR cloud, the boards and the rig's cameras (" +
                          rig.camera_names[camera] + " in orange)",
-                     options, nullptr, why);
+                     options, kept, why);
 }
 
 }  // namespace calibench::ui

@@ -60,9 +60,10 @@ std::vector<ReportFigure> DrawReportFigures(const Dataset& dataset,
 
 // A rig camera's figures: its own outcome (outcome.single[camera]) drawn as one camera's are, the
 // overview with the rig's other cameras around it (this one in orange), as the workbench shows a
-// rig camera.
-std::vector<ReportFigure> DrawRigReportFigures(const RigFolder& rig, const RigOutcome& outcome,
-                                               size_t camera, const ReportFigureOptions& options,
-                                               std::string* why);
+// rig camera. A rig of one's (RigOfOne) are its dataset's, above. `kept` as above: the files of
+// this camera's pairs.
+std::vector<ReportFigure> DrawReportFigures(const RigFolder& rig, const RigOutcome& outcome,
+                                            size_t camera, const ReportFigureOptions& options,
+                                            const KeptPairInputs* kept, std::string* why);
 
 }  // namespace calibench::ui

@@ -194,6 +194,43 @@ TEST(RigSession, ACamerasSessionNamesItAndOpensThatCamera) {
   EXPECT_NE(SessionToJson(session, path).find("\"camera\": \"cam1\""), std::string::npos);
 }
 
+// `calibrate --session` and `report --session` on a rig read the sessions one way: each edits its
+// own camera; a session of another rig, of one camera's dataset or of a camera the rig has not is
+// refused by name, not applied by its camera's name.
+TEST(RigSession, EachSessionEditsItsCameraAndAnotherDatasetsIsRefused) {
+  const fs::path dir = TwoCameraFolder("rig_session_edits");
+  const RigFolder rig = LoadRigFolder(dir);
+  Session session = NewSession(LoadRigCamera(dir, "cam1"));
+  ASSERT_EQ(session.pairs.size(), 2u);
+  session.pairs[1].status = PairStatus::kRejected;
+  const fs::path path = DefaultSessionPath(dir, "cam1");
+  SaveSession(path, session);
+  const std::map<std::string, PairEdits> edits = RigEditsOfSessions(rig, {path.string()});
+  ASSERT_EQ(edits.size(), 1u);
+  ASSERT_EQ(edits.count("cam1"), 1u);
+  EXPECT_TRUE(edits.at("cam1").at(session.pairs[1].id).rejected);
+  EXPECT_TRUE(RigEditsOfSessions(rig, {}).empty());
+
+  auto refused = [&](const Session& other, const fs::path& file, const std::string& named) {
+    SaveSession(file, other);
+    try {
+      RigEditsOfSessions(rig, {path.string(), file.string()});
+      ADD_FAILURE() << file << " was taken";
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+  };
+  const fs::path elsewhere = TwoCameraFolder("rig_session_elsewhere");
+  refused(NewSession(LoadRigCamera(elsewhere, "cam1")), elsewhere / "calibench.session.cam1.json",
+          (elsewhere / "calibench.session.cam1.json").string());
+  Session no_camera = session;
+  no_camera.camera.clear();
+  refused(no_camera, dir / "one.json", "not a session of a camera of the rig");
+  Session unknown = session;
+  unknown.camera = "cam7";
+  refused(unknown, dir / "cam7.json", "cam7");
+}
+
 TEST(RigImport, CamerasAreNamedAfterTheirTopics) {
   EXPECT_EQ(RigCameraName("/cam1/image_raw"), "cam1");
   EXPECT_EQ(RigCameraName("/front/camera/image/compressed"), "front");
