@@ -1,7 +1,9 @@
 #include "core/lidar/board_returns.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 namespace calibench {
@@ -112,9 +114,9 @@ std::pair<int, int> StepsOverSheet(const BeamRays& rays, const BeamTable& beams,
 
 // A learnt table's rays that can meet the sheet: those in the 1° cells its outline spans (its
 // border sampled, widened by 2°), each with its neighbours in firing order (a crossing of the
-// border pairs a ray on the sheet with the next), sorted. The elevation and azimuth bounds of a
-// sheet's directions are those of its border unless it surrounds the vertical, where they are not
-// bounded: false then (cast every ray), and for any other table.
+// border pairs a ray on the sheet with the next), in firing order, each once. The elevation and
+// azimuth bounds of a sheet's directions are those of its border unless it surrounds the vertical,
+// where they are not bounded: false then (cast every ray), and for any other table.
 bool LearntRaysNear(const BeamTable& beams, const LidarRectangle& sheet, std::vector<int>* near) {
   if (!beams.rays || !beams.ray_cells) return false;
   for (const double z : {1.0, -1.0}) {
@@ -154,20 +156,25 @@ bool LearntRaysNear(const BeamTable& beams, const LidarRectangle& sheet, std::ve
   const int a_last = static_cast<int>(std::floor(a_centre + az_hi + kMarginDeg));
   const LearntRayCells& cells = *beams.ray_cells;
   const int count = static_cast<int>(beams.rays->size());
-  near->clear();
+  // Marked in a bitset and read back in order: a sheet near the scanner spans tens of thousands of
+  // rays, and sorting their indices cost more than casting them.
+  std::vector<std::uint64_t> marked((count + 63) / 64, 0);
+  auto mark = [&marked](int k) { marked[k >> 6] |= std::uint64_t{1} << (k & 63); };
   for (int e = e_first; e <= e_last; ++e) {
     for (int a = a_first; a <= a_last; ++a) {
       const int cell = e * 360 + ((a % 360) + 360) % 360;
       for (int i = cells.start[cell]; i < cells.start[cell + 1]; ++i) {
         const int k = cells.by_cell[i];
-        if (k > 0) near->push_back(k - 1);
-        near->push_back(k);
-        if (k + 1 < count) near->push_back(k + 1);
+        if (k > 0) mark(k - 1);
+        mark(k);
+        if (k + 1 < count) mark(k + 1);
       }
     }
   }
-  std::sort(near->begin(), near->end());
-  near->erase(std::unique(near->begin(), near->end()), near->end());
+  near->clear();
+  for (size_t word = 0; word < marked.size(); ++word)
+    for (std::uint64_t bits = marked[word]; bits != 0; bits &= bits - 1)
+      near->push_back(static_cast<int>(64 * word) + std::countr_zero(bits));
   return true;
 }
 
