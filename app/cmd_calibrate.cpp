@@ -26,20 +26,19 @@ int CalibrateRigDataset(const std::string& path, const std::vector<std::string>&
   const RigOutcome outcome =
       CalibrateRig(rig, options, StderrProgress("extracted"), RigEditsOfSessions(rig, sessions));
   std::printf("%s", FormatRigSummary(outcome).c_str());
-  if (!outcome.joint) {
-    std::fprintf(stderr, "calibench: no calibration for the rig %s: %s\n", path.c_str(),
-                 outcome.failure.c_str());
-    return kNoCalibration;
-  }
-  if (!out_path.empty()) {
+  if (outcome.joint && !out_path.empty()) {
     WriteRigResult(out_path, outcome);
     std::printf("wrote %s\n", out_path.c_str());
   }
-  if (report_path.empty()) return kOk;
+  // Said as one camera's solve is: unreadable files, weak cameras, the error against the truth.
+  const int code = SayVerdicts(CameraVerdicts(rig, outcome), outcome.camera_names, "calibrate",
+                               "the rig " + path);
+  if (!outcome.joint || report_path.empty()) return code;
   ReportRequest request;
   request.out_path = report_path;
   request.result_file = out_path;
-  return WriteReport(rig, outcome, options, request);
+  const int written = WriteReport(rig, outcome, options, request);
+  return code != kOk ? code : written;
 }
 
 // One camera's dataset: its intrinsics first when `intrinsics_model` names a model (else its

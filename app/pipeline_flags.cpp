@@ -196,38 +196,66 @@ void PrintErrorAgainstTruth(const PoseError& error, const Mat6& covariance,
               st.norm(), sr.norm());
 }
 
-int SolveAndSay(Job& job, const std::string& command, const std::string& out_path) {
-  const JobVerdict verdict = job.Calibrate();
-  std::printf("%s", verdict.summary.c_str());
+namespace {
+
+// "\n  pair ID: reason" per unreadable pair of each verdict, a rig's named by camera.
+std::string UnreadableLines(const std::vector<JobVerdict>& verdicts,
+                            const std::vector<std::string>& cameras) {
+  std::string lines;
+  for (size_t c = 0; c < verdicts.size(); ++c) {
+    std::string camera = verdicts.size() > 1 ? "camera " + cameras[c] + " " : "";
+    for (const JobPair& pair : verdicts[c].pairs)
+      if (pair.input_error) lines += "\n  " + camera + "pair " + pair.id + ": " + pair.reason;
+  }
+  return lines;
+}
+
+}  // namespace
+
+int SayVerdicts(const std::vector<JobVerdict>& verdicts, const std::vector<std::string>& cameras,
+                const std::string& command, const std::string& data) {
   const std::string prefix = "calibench " + command + ": ";
-  const bool input_error = verdict.input_error();
-  if (!verdict.solved) {
-    std::fprintf(stderr, "%sno calibration for %s: %s%s%s\n", prefix.c_str(),
-                 job.manifest().string().c_str(), verdict.failure.c_str(),
-                 input_error ? "; unreadable:" : "", verdict.Unreadable().c_str());
-    return input_error ? kInputError : kNoCalibration;
+  const std::string unreadable = UnreadableLines(verdicts, cameras);
+  if (verdicts.empty() || !verdicts.front().solved) {
+    std::fprintf(stderr, "%sno calibration for %s: %s%s%s\n", prefix.c_str(), data.c_str(),
+                 verdicts.empty() ? "no camera" : verdicts.front().failure.c_str(),
+                 unreadable.empty() ? "" : "; unreadable:", unreadable.c_str());
+    return unreadable.empty() ? kNoCalibration : kInputError;
   }
-  if (!out_path.empty()) {
-    job.WriteResultFile(out_path);
-    std::printf("wrote %s\n", out_path.c_str());
-  }
-  if (verdict.ground_truth)
+  for (size_t c = 0; c < verdicts.size(); ++c) {
+    const JobVerdict& verdict = verdicts[c];
+    if (!verdict.ground_truth) continue;
+    if (verdicts.size() > 1) std::printf("camera %s:\n", cameras[c].c_str());
     PrintErrorAgainstTruth(ComputePoseError(verdict.cam_from_source, *verdict.ground_truth),
                            verdict.covariance, verdict.cam_from_source);
-  if (input_error) {
+  }
+  if (!unreadable.empty()) {
     std::fprintf(stderr,
                  "%ssome pair files could not be read; the result uses the remaining pairs:%s\n",
-                 prefix.c_str(), verdict.Unreadable().c_str());
+                 prefix.c_str(), unreadable.c_str());
     return kInputError;
   }
-  if (!verdict.well_constrained) {
+  std::string weak;
+  for (size_t c = 0; c < verdicts.size(); ++c)
+    if (!verdicts[c].well_constrained) weak += (weak.empty() ? " (camera " : ", ") + cameras[c];
+  if (!weak.empty()) {
     std::fprintf(stderr,
-                 "%sthe result is NOT well constrained (weak directions listed above): add pairs "
-                 "with the target tilted and turned differently\n",
-                 prefix.c_str());
+                 "%sthe result is NOT well constrained%s (weak directions listed above): add "
+                 "pairs with the target tilted and turned differently\n",
+                 prefix.c_str(), verdicts.size() > 1 ? (weak + ")").c_str() : "");
     return kNotConstrained;
   }
   return kOk;
+}
+
+int SolveAndSay(Job& job, const std::string& command, const std::string& out_path) {
+  const JobVerdict verdict = job.Calibrate();
+  std::printf("%s", verdict.summary.c_str());
+  if (verdict.solved && !out_path.empty()) {
+    job.WriteResultFile(out_path);
+    std::printf("wrote %s\n", out_path.c_str());
+  }
+  return SayVerdicts({verdict}, {""}, command, job.manifest().string());
 }
 
 int CalibrateAndReport(const Dataset& dataset, const PipelineOptions& options,

@@ -11,6 +11,7 @@
 namespace calibench {
 struct AdviseOptions;
 class Job;
+struct JobVerdict;
 }  // namespace calibench
 
 namespace calibench::app {
@@ -52,6 +53,12 @@ void PrintErrorAgainstTruth(const PoseError& error, const Mat6& covariance,
 // it has one; what went wrong said on stderr as "calibench <command>: ...". The exit code: kOk,
 // kInputError when any pair file was unreadable, kNoCalibration, kNotConstrained.
 int SolveAndSay(Job& job, const std::string& command, const std::string& out_path);
+// SolveAndSay's saying, for a solve already told as verdicts (one per camera of a rig, named by
+// `cameras`; CameraVerdicts, core/session/job.h) of the data `data`: the failure, or each camera's
+// error against its ground truth; unreadable pair files (kInputError) and cameras not well
+// constrained (kNotConstrained) on stderr; kNoCalibration when unsolved, else kOk.
+int SayVerdicts(const std::vector<JobVerdict>& verdicts, const std::vector<std::string>& cameras,
+                const std::string& command, const std::string& data);
 
 // Calibrates and prints the summary; writes the result when out_path is not empty (with the
 // intrinsics `estimated` from the images before, when given). Returns the exit code (kOk,

@@ -75,6 +75,16 @@ JobVerdict VerdictOf(const Outcome& outcome, PoseOf pose_of, std::string summary
   return verdict;
 }
 
+struct RigFolder;   // core/io/rig_folder.h
+struct RigOutcome;  // core/lidar_camera/rig.h
+
+// Each camera of a rig's calibration in the interface's words (one camera's dataset is a rig of
+// one, RigOfOne), so that a rig is said as one camera's solve is: solved when the rig solve gave
+// a pose (joint), that pose and its covariance (the joint's block), well constrained as the
+// camera's own solve's observability says, its pairs, its ground truth; `failure` the rig's when
+// unsolved, `summary` empty. In the rig's camera order.
+std::vector<JobVerdict> CameraVerdicts(const RigFolder& rig, const RigOutcome& outcome);
+
 class Job {
  public:
   virtual ~Job() = default;

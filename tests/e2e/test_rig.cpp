@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "core/geometry/geometry.h"
 #include "core/io/bag.h"
@@ -160,6 +161,28 @@ TEST(Rig, APinholeAndAFisheyeAsideCalibrateTogetherInOneCommand) {
                              &out),
             0);
   EXPECT_NE(out.find("holds one transform"), std::string::npos) << out;
+
+  // A frame that cannot be read is said as for one camera: named with its camera, the rig solved
+  // from the rest, exit 2 (kInputError).
+  std::set<std::filesystem::path> frames;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "rig" / "images" / "cam1"))
+    frames.insert(entry.path());
+  ASSERT_FALSE(frames.empty());
+  const std::filesystem::path broken = *frames.begin();
+  std::ofstream(broken, std::ios::trunc) << "not an image";
+  const auto partial = dir / "partial.json";
+  EXPECT_EQ(test::RunCommand(test::CalibenchExe() + " calibrate --dataset " +
+                                 (dir / "rig").string() + " --out " + partial.string(),
+                             &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("some pair files could not be read; the result uses the remaining pairs:"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("camera cam1 pair " + broken.stem().string() + ": cannot read image"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(partial))["format"], "calibench.rig.v1");
 }
 
 // The rig's manifest (cameras by name, each pair's frames by camera) calibrates as its folder; one

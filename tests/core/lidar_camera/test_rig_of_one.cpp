@@ -7,6 +7,8 @@
 
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
+#include "core/session/calibration_job.h"
+#include "core/session/job.h"
 #include "core/sim/sim.h"
 #include "tests/test_support.h"
 
@@ -52,6 +54,24 @@ TEST(RigOfOne, ItsSolveIsItsCamerasOwnBitForBit) {
   EXPECT_LT(error.rotation_rad, 0.5 * kDegToRad);
   EXPECT_GT(pose.sigma_t_mm.minCoeff(), 0.0);
   EXPECT_GT(pose.sigma_r_deg.minCoeff(), 0.0);
+
+  // Said as the one camera's job says it (what `calibrate` prints and exits with).
+  CalibrationJob job(dataset, CalibrationJobOptions{});
+  job.ExtractAll();
+  const JobVerdict alone_said = job.Calibrate();
+  const std::vector<JobVerdict> said = CameraVerdicts(rig, outcome);
+  ASSERT_EQ(said.size(), 1u);
+  EXPECT_EQ(said[0].solved, alone_said.solved);
+  EXPECT_EQ(said[0].cam_from_source.matrix(), alone_said.cam_from_source.matrix());
+  EXPECT_EQ(said[0].covariance, alone_said.covariance);
+  EXPECT_EQ(said[0].well_constrained, alone_said.well_constrained);
+  ASSERT_EQ(said[0].pairs.size(), alone_said.pairs.size());
+  for (size_t i = 0; i < said[0].pairs.size(); ++i) {
+    EXPECT_EQ(said[0].pairs[i].id, alone_said.pairs[i].id);
+    EXPECT_EQ(said[0].pairs[i].status, alone_said.pairs[i].status);
+  }
+  ASSERT_TRUE(said[0].ground_truth.has_value());
+  EXPECT_EQ(said[0].ground_truth->matrix(), dataset.cam_from_lidar_ground_truth->matrix());
 }
 
 TEST(RigOfOne, ACameraThatDoesNotSolveLeavesNoRigSolutionAndSaysWhy) {
@@ -64,6 +84,10 @@ TEST(RigOfOne, ACameraThatDoesNotSolveLeavesNoRigSolutionAndSaysWhy) {
   ASSERT_EQ(outcome.single.size(), 1u);
   EXPECT_EQ(outcome.single[0].failure, alone.failure);
   EXPECT_EQ(outcome.failure, "camera '" + rig.camera_names[0] + "': " + alone.failure);
+  const std::vector<JobVerdict> said = CameraVerdicts(rig, outcome);
+  ASSERT_EQ(said.size(), 1u);
+  EXPECT_FALSE(said[0].solved);
+  EXPECT_EQ(said[0].failure, outcome.failure);
 }
 
 }  // namespace
