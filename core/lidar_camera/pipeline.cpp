@@ -219,7 +219,9 @@ std::optional<BoardHint> BoardHintFor(const PairEntry& pair, const PairEdit& edi
            " gives " + std::to_string(image->rows) + "x" + std::to_string(image->columns);
     return std::nullopt;
   }
-  BoardHint hint{*edit.brush_pixels, image, std::nullopt};
+  BoardHint hint;
+  hint.brush_pixels = *edit.brush_pixels;
+  hint.image = image;
   hint.detect = false;  // the user's brush, even an erased one, is the word
   return hint;
 }

@@ -105,7 +105,11 @@ LrfCalibrationJob::LrfCalibrationJob(LrfDataset dataset, LrfPipelineOptions opti
   std::vector<PairState> pairs;
   for (const std::string& id : PairIds(extraction_.dataset())) {
     const PairState* found = FindPair(&*saved, id);
-    pairs.push_back(found ? *found : PairState{.id = id});
+    if (found) {
+      pairs.push_back(*found);
+    } else {
+      pairs.emplace_back().id = id;
+    }
   }
   saved->pairs = std::move(pairs);
   record_.Reset(std::move(*saved));

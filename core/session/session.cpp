@@ -64,7 +64,9 @@ SessionResult SessionResultFromSolver(const SolverResult& solver) {
           solver.covariance_inflation,
           solver.plane_variance_factor,
           solver.edge_variance_factor,
-          solver.termination};
+          solver.termination,
+          {},
+          {}};
 }
 
 SolverResult SolverResultFromSession(const SessionResult& session, SolverMethod method) {

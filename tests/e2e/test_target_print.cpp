@@ -355,7 +355,9 @@ TEST(TargetLayout, TheLargestSquareOfEveryPaperComesFromItsPrintableArea) {
       TargetSheet sheet;
       ASSERT_NO_THROW(sheet = LayoutTargetSheet(board, TargetSheetOptions{paper}));
       EXPECT_EQ(sheet.has_ruler, sheet.note.empty()) << sheet.note;
-      if (!sheet.has_ruler) EXPECT_NE(sheet.note.find("measuring a square"), std::string::npos);
+      if (!sheet.has_ruler) {
+        EXPECT_NE(sheet.note.find("measuring a square"), std::string::npos);
+      }
       std::printf("%-6s %-8s largest square %.1f mm, ruler %s\n", PaperName(paper).c_str(),
                   board.type == BoardType::kCharuco ? "charuco" : "checker", largest,
                   !sheet.has_ruler       ? "none (measure a square)"

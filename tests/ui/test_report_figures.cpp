@@ -64,8 +64,9 @@ TEST(ReportFigures, DrawnFromTheOutcomeAsTheWorkbenchShowsIt) {
     EXPECT_EQ(solved.pairs[i].id, workbench.pairs[i].id);
     EXPECT_EQ(solved.pairs[i].status, workbench.pairs[i].status);
     ASSERT_EQ(solved.pairs[i].residual.has_value(), workbench.pairs[i].residual.has_value());
-    if (solved.pairs[i].residual)
+    if (solved.pairs[i].residual) {
       EXPECT_LT((*solved.pairs[i].residual - *workbench.pairs[i].residual).norm(), 1e-9);
+    }
   }
   ASSERT_GE(workbench.selected, 0);
   std::string why;

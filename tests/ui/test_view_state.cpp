@@ -37,7 +37,7 @@ TEST(ViewState, EveryFieldRoundTripsThroughTheSessionFile) {
   const auto dir = test::TempDir("view_state");
   Session session;
   session.dataset = dir / "dataset.json";
-  for (const std::string& id : kPairs) session.pairs.push_back(PairState{.id = id});
+  for (const std::string& id : kPairs) session.pairs.emplace_back().id = id;
   session.view_json = ViewToJson(EveryFieldSet());
   SaveSession(dir / "s.json", session);
   const Session loaded = LoadSession(dir / "s.json");

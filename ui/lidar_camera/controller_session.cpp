@@ -144,12 +144,13 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     job_options.advise.pipeline.pair_ids.clear();  // the workbench shows every pair
     Dataset setup = dataset;
     setup.pairs.clear();
-    job_.emplace(std::move(setup), job_options, PairEdits{},
-                 JobEvents{.iteration = [this](const IterationReport& it) {
-                   std::lock_guard lock(mutex_);
-                   state_.solver.iterations.push_back(it);
-                   ++state_.generation;
-                 }});
+    JobEvents events;
+    events.iteration = [this](const IterationReport& it) {
+      std::lock_guard lock(mutex_);
+      state_.solver.iterations.push_back(it);
+      ++state_.generation;
+    };
+    job_.emplace(std::move(setup), job_options, PairEdits{}, std::move(events));
     job_->Resume(session);
     job_->record().AutosaveTo(session_path);
     ApplySessionToState(session);

@@ -136,8 +136,11 @@ TEST(Job, TheLidarCameraJobSolvesAndWritesThroughTheInterfaceAsItsOwnStepsDo) {
   // Taken back through the interface: the pair is solved with again.
   any.SetRejected(rejected, false);
   const JobVerdict back = any.Calibrate();
-  for (const JobPair& pair : back.pairs)
-    if (pair.id == rejected) EXPECT_EQ(pair.status, PairStatus::kAccepted) << pair.reason;
+  for (const JobPair& pair : back.pairs) {
+    if (pair.id == rejected) {
+      EXPECT_EQ(pair.status, PairStatus::kAccepted) << pair.reason;
+    }
+  }
 }
 
 TEST(Job, WhichJobIsReadFromTheSessionElseFromTheDataset) {

@@ -32,9 +32,12 @@ TEST(LivoxSim, RaysStayInTheirFieldAndFillIt) {
     std::vector<int> per_laser(pattern.lasers, 0);
     for (size_t i = 0; i < rays.laser.size(); ++i) {
       ++per_laser.at(rays.laser[i]);
-      if (i > 0 && rays.laser[i] == rays.laser[i - 1])
+      if (i > 0 && rays.laser[i] == rays.laser[i - 1]) {
         EXPECT_GT(rays.time_offsets_s[i], rays.time_offsets_s[i - 1]);
-      if (i > 0) EXPECT_GE(rays.laser[i], rays.laser[i - 1]);
+      }
+      if (i > 0) {
+        EXPECT_GE(rays.laser[i], rays.laser[i - 1]);
+      }
     }
     for (int count : per_laser) EXPECT_NEAR(count, rays.directions.size() / pattern.lasers, 1);
     EXPECT_NEAR(*std::max_element(rays.time_offsets_s.begin(), rays.time_offsets_s.end()), 0.1,

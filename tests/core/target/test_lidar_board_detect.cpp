@@ -273,7 +273,9 @@ TEST(LidarBoardDetect, ABoardAloneInItsCloudStandsFree) {
         Scan(scene, LidarModel::kVlp16, 21), BoardPreset("a3"), LidarBoardDetectionOptions{});
     EXPECT_TRUE(IsTheBoard(found, scene.lidar_from_board)) << distance << " m";
     // Every side of it is free: along the rings as well as across them.
-    if (found.board) EXPECT_GT(found.board->free_edge_fraction, 0.75) << distance << " m";
+    if (found.board) {
+      EXPECT_GT(found.board->free_edge_fraction, 0.75) << distance << " m";
+    }
     for (const LidarBoardCandidate& miss : found.near_misses)
       EXPECT_EQ(miss.rejection.find("attached"), std::string::npos) << miss.rejection;
   }

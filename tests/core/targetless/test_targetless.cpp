@@ -143,7 +143,9 @@ TEST(TargetlessImageEdges, NearestIsTheBruteForceNearest) {
       }
       const ImageEdge* found = map.Nearest(pixel, radius);
       ASSERT_EQ(found == nullptr, brute == nullptr) << cell_px << " " << pixel.transpose();
-      if (found) EXPECT_DOUBLE_EQ((found->pixel - pixel).norm(), best) << cell_px << " " << radius;
+      if (found) {
+        EXPECT_DOUBLE_EQ((found->pixel - pixel).norm(), best) << cell_px << " " << radius;
+      }
     }
   }
 }
