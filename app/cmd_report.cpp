@@ -66,8 +66,9 @@ std::vector<RigCameraReport> AnalyseCameras(const RigFolder& rig, const RigOutco
       ui::ReportFigureOptions figure_options;
       figure_options.threads = options.threads;
       std::string missing;
-      camera.figures = ui::DrawReportFigures(rig, outcome, c, figure_options,
-                                             request.kept_inputs.get(), &missing);
+      // The kept inputs are one camera's (KeepingInputsForViews): a rig reads its files again.
+      const ui::KeptPairInputs* kept = outcome.Several() ? nullptr : request.kept_inputs.get();
+      camera.figures = ui::DrawReportFigures(rig, outcome, c, figure_options, kept, &missing);
       if (!missing.empty() && why->empty()) *why = missing;
       drawing = missing.empty() || !camera.figures.empty();
     }

@@ -202,11 +202,8 @@ namespace {
 std::string UnreadableLines(const std::vector<JobVerdict>& verdicts,
                             const std::vector<std::string>& cameras) {
   std::string lines;
-  for (size_t c = 0; c < verdicts.size(); ++c) {
-    std::string camera = verdicts.size() > 1 ? "camera " + cameras[c] + " " : "";
-    for (const JobPair& pair : verdicts[c].pairs)
-      if (pair.input_error) lines += "\n  " + camera + "pair " + pair.id + ": " + pair.reason;
-  }
+  for (size_t c = 0; c < verdicts.size(); ++c)
+    lines += verdicts[c].Unreadable(verdicts.size() > 1 ? "camera " + cameras[c] + " " : "");
   return lines;
 }
 

@@ -409,4 +409,10 @@ void EvaluateAtSolution(const std::vector<PairFeatures>& pairs, const SolverOpti
   solution->negligible_weight = options.negligible_weight;
 }
 
+int AcceptedPairs(const CalibrationOutcome& outcome) {
+  return static_cast<int>(
+      std::count_if(outcome.pairs.begin(), outcome.pairs.end(),
+                    [](const PairFeatures& p) { return p.status == PairStatus::kAccepted; }));
+}
+
 }  // namespace calibench

@@ -222,6 +222,8 @@ struct CalibrationOutcome {
   // file gave them.
   std::optional<IntrinsicsResult> estimated_intrinsics;
 };
+// The outcome's pairs accepted for the solve.
+int AcceptedPairs(const CalibrationOutcome& outcome);
 
 // Loads the pair's files and extracts both planes (the steps above; the hint is the pair's edited
 // brush, else its seed). Never throws for bad data: the pair comes back kFailed with the reason

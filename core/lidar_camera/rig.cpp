@@ -132,8 +132,7 @@ RigOutcome RigOutcomeOfOne(const RigFolder& rig, CalibrationOutcome single) {
   joint.cam_from_lidar = {camera.solution->cam_from_lidar};
   joint.covariance = camera.solution->covariance;
   joint.converged = true;
-  for (const PairFeatures& pair : camera.pairs)
-    joint.used_captures += pair.status == PairStatus::kAccepted;
+  joint.used_captures = AcceptedPairs(camera);
   outcome.joint = std::move(joint);
   return outcome;
 }
@@ -173,12 +172,9 @@ void WriteRigResult(const std::filesystem::path& path, const RigOutcome& outcome
   for (size_t c = 0; c < outcome.camera_names.size(); ++c) {
     const Mat6 covariance = joint.covariance.block<6, 6>(6 * c, 6 * c);
     const SolverResult& single = *outcome.single[c].solution;
-    int pairs = 0;
-    for (const PairFeatures& p : outcome.single[c].pairs)
-      pairs += p.status == PairStatus::kAccepted;
     Json camera = PoseWithSigma("cam_from_lidar", joint.cam_from_lidar[c], covariance);
     camera["covariance"] = Matrix6(covariance);
-    camera["pairs"] = pairs;
+    camera["pairs"] = AcceptedPairs(outcome.single[c]);
     camera["single_camera"] = PoseWithSigma("matrix", single.cam_from_lidar, single.covariance);
     cameras[outcome.camera_names[c]] = camera;
   }

@@ -279,11 +279,9 @@ RigReportSummary SummarizeRigOutcome(const RigOutcome& outcome) {
   for (size_t c = 0; c < outcome.camera_names.size(); ++c) {
     const SolverResult& single = *outcome.single[c].solution;
     const PoseWithSigmas joint = RigJointPose(outcome, c);
-    int pairs = 0;
-    for (const PairFeatures& p : outcome.single[c].pairs)
-      pairs += p.status == PairStatus::kAccepted;
-    summary.cameras.push_back({outcome.camera_names[c], pairs, joint.pose, joint.sigma_t_mm,
-                               joint.sigma_r_deg, single.cam_from_lidar,
+    summary.cameras.push_back({outcome.camera_names[c], AcceptedPairs(outcome.single[c]),
+                               joint.pose, joint.sigma_t_mm, joint.sigma_r_deg,
+                               single.cam_from_lidar,
                                1e3 * TranslationStd(single.covariance, single.cam_from_lidar),
                                RotationStdDeg(single.covariance, single.cam_from_lidar)});
   }

@@ -23,10 +23,10 @@ bool JobVerdict::input_error() const {
   return false;
 }
 
-std::string JobVerdict::Unreadable() const {
+std::string JobVerdict::Unreadable(const std::string& camera) const {
   std::string lines;
   for (const JobPair& pair : pairs)
-    if (pair.input_error) lines += "\n  pair " + pair.id + ": " + pair.reason;
+    if (pair.input_error) lines += "\n  " + camera + "pair " + pair.id + ": " + pair.reason;
   return lines;
 }
 

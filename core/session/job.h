@@ -51,8 +51,9 @@ struct JobVerdict {
   std::optional<Pose> ground_truth;  // the dataset's cam_from_source, when it has one (simulated)
 
   bool input_error() const;  // some pair's files could not be read
-  // "pair ID: reason" per unreadable pair, one per line, each line starting with "\n  ".
-  std::string Unreadable() const;
+  // "pair ID: reason" per unreadable pair, one per line, each line starting with "\n  " and
+  // `camera` (a rig's camera: "camera NAME ").
+  std::string Unreadable(const std::string& camera = "") const;
 };
 
 // A method's outcome in the interface's words: its solution's pose (`pose_of` reads it), covariance

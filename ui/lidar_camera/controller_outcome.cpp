@@ -8,16 +8,6 @@
 
 namespace calibench::ui {
 
-namespace {
-
-int AcceptedPairs(const CalibrationOutcome& outcome) {
-  return static_cast<int>(
-      std::count_if(outcome.pairs.begin(), outcome.pairs.end(),
-                    [](const PairFeatures& p) { return p.status == PairStatus::kAccepted; }));
-}
-
-}  // namespace
-
 std::shared_ptr<const Reprojection> ReprojectPair(const CameraModel& camera,
                                                   const Pose& cam_from_lidar,
                                                   const LidarCloud& cloud, const ViewState& view,
