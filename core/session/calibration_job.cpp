@@ -189,15 +189,18 @@ const PairFeatures& CalibrationJob::DetectLidar(int index, const LidarCloud& clo
   return pair.detected;
 }
 
-void CalibrationJob::SetBrush(const std::string& pair_id, std::optional<PairEdit> brush) {
-  record_.Edit([&](Session* session) {
-    if (brush && brush->brush_pixels) {
-      brush->rejected = false;
-      SetEdit(session, pair_id, *brush);
-    } else {
-      ForgetBrush(session, pair_id);
-    }
-  });
+void CalibrationJob::SetBrush(const std::string& pair_id, std::optional<PairEdit> brush,
+                              bool amend) {
+  record_.Edit(
+      [&](Session* session) {
+        if (brush && brush->brush_pixels) {
+          brush->rejected = false;
+          SetEdit(session, pair_id, *brush);
+        } else {
+          ForgetBrush(session, pair_id);
+        }
+      },
+      amend);
 }
 
 void CalibrationJob::SetRejected(const std::string& pair_id, bool rejected,

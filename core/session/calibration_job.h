@@ -84,8 +84,11 @@ class CalibrationJob final : public Job {
                                   bool use_seed = true);
 
   // The user's word, each an undo step in the record. A brush applies at the pair's next
-  // detection; a rejection (with the reason shown for it) at the next solve.
-  void SetBrush(const std::string& pair_id, std::optional<PairEdit> brush);
+  // detection; a rejection (with the reason shown for it) at the next solve. A brush's pixels
+  // (an empty list: erased, the pair then has no board until painted again) replace the seed and
+  // any detection; nullopt forgets the brush (detection again). `amend`: the same undo step as
+  // the last edit (a stroke's later dabs, "detect again" over every pair).
+  void SetBrush(const std::string& pair_id, std::optional<PairEdit> brush, bool amend = false);
   void SetRejected(const std::string& pair_id, bool rejected,
                    const std::string& reason = "") override;
   // A saved session (the workbench's, an earlier watch's) becomes the record: its brushes,

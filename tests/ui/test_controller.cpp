@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "core/session/session.h"
+#include "core/sim/sim.h"
 #include "tests/test_support.h"
 #include "tests/ui/ui_fixture.h"
 #include "ui/lidar_camera/controller.h"
@@ -215,6 +216,68 @@ TEST(Controller, EveryEditAutosavesAndTheSessionReopensExactly) {
   EXPECT_TRUE(s.solver.result->cam_from_lidar.isApprox(saved.result->cam_from_lidar, 0));
   EXPECT_TRUE(s.pairs[0].residual);             // recomputed from the planes on load
   EXPECT_EQ(LoadSession(session_path), saved);  // reopening rewrote nothing
+}
+
+// Every edit goes to the job's record first (its file is the autosave): the rejection, the
+// solver's settings, a brush painted over a detected board. Undoing the brush shows the detected
+// board again, detected again, as before the edit.
+TEST(Controller, EachEditIsInTheJobsRecordAndUndoingABrushDetectsTheBoardAgain) {
+  const auto dir = test::TempDir("controller_record_first");
+  SimOptions sim = SimPreset("demo");
+  sim.num_pairs = 4;
+  sim.seed = 3;
+  sim.lidar_seeds = false;  // every board found by detection
+  const std::filesystem::path manifest = SimulateDataset(sim, dir / "data").manifest;
+  const auto session_path = dir / "s.json";
+  Controller controller;
+  controller.OpenDataset(manifest, session_path);
+  const Snapshot detected = Loaded(controller);
+  ASSERT_TRUE(detected.pairs[1].lidar) << detected.pairs[1].lidar_failure;
+  EXPECT_EQ(detected.pairs[1].board_origin.source, BoardSource::kDetected);
+  EXPECT_TRUE(detected.pairs[1].brush_detected);
+  ASSERT_FALSE(detected.pairs[1].brush_pixels.empty());
+
+  controller.Apply(SetPairStatus{2, PairStatus::kRejected});
+  Loaded(controller);
+  EXPECT_EQ(LoadSession(session_path).pairs[2].status, PairStatus::kRejected);
+  EXPECT_EQ(LoadSession(session_path).pairs[2].reason, kRejectedByUser);
+
+  controller.Apply(SetSolverOptions{0.25, 17, SolverMethod::kWeightedMl, true});
+  Loaded(controller);
+  Session saved = LoadSession(session_path);
+  EXPECT_EQ(saved.huber_delta, 0.25);
+  EXPECT_EQ(saved.max_iterations, 17);
+  EXPECT_TRUE(saved.estimate_range_offset);
+
+  // Erase a disc of the detected board: the record holds the brush the pair now shows.
+  const int columns = detected.pairs[1].lidar_image->columns;
+  const int pixel = detected.pairs[1].brush_pixels[detected.pairs[1].brush_pixels.size() / 2];
+  controller.Apply(BrushStroke{1, pixel / columns, pixel % columns, 4.0f, true});
+  controller.Apply(EndStroke{});
+  const Snapshot painted = Loaded(controller);
+  EXPECT_TRUE(painted.pairs[1].brush_edited);
+  EXPECT_LT(painted.pairs[1].brush_pixels.size(), detected.pairs[1].brush_pixels.size());
+  saved = LoadSession(session_path);
+  ASSERT_TRUE(saved.pairs[1].brush);
+  EXPECT_FALSE(saved.pairs[1].brush_from_seed);
+  EXPECT_EQ(saved.pairs[1].brush->pixels, painted.pairs[1].brush_pixels);
+  EXPECT_EQ(painted.pairs[1].board_origin.source, BoardSource::kBrush);  // refitted from it
+
+  controller.Apply(Undo{});  // the brush
+  const Snapshot undone = Loaded(controller);
+  EXPECT_FALSE(undone.pairs[1].brush_edited);
+  EXPECT_TRUE(undone.pairs[1].brush_detected);
+  EXPECT_EQ(undone.pairs[1].brush_pixels, detected.pairs[1].brush_pixels);
+  ASSERT_TRUE(undone.pairs[1].lidar);
+  EXPECT_EQ(undone.pairs[1].board_origin.source, BoardSource::kDetected);
+  EXPECT_EQ(undone.pairs[1].lidar->inliers, detected.pairs[1].lidar->inliers);
+  EXPECT_FALSE(LoadSession(session_path).pairs[1].brush);
+  controller.Apply(Undo{});  // the solver's settings
+  EXPECT_EQ(Loaded(controller).max_iterations, SolverOptions{}.max_iterations);
+  EXPECT_EQ(LoadSession(session_path).max_iterations, SolverOptions{}.max_iterations);
+  controller.Apply(Undo{});  // the rejection
+  EXPECT_EQ(Loaded(controller).pairs[2].status, PairStatus::kAccepted);
+  EXPECT_NE(LoadSession(session_path).pairs[2].status, PairStatus::kRejected);
 }
 
 // A relative export or save-as path goes next to the session, never into the folder the program

@@ -165,7 +165,7 @@ void Controller::Solve(bool asked) {
                 std::to_string(result.iterations) + " iterations" +
                 (result.observability.well_constrained ? "" : " (NOT well constrained)"),
             !result.observability.well_constrained);
-  CommitEdit(/*same_step=*/!asked);
+  RecordWhatFollowed(/*same_step=*/!asked);
   const int selected = state_.selected;
   if (selected >= 0) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
   // Pre-flight and the next pose (the ghost board) from this solve.
@@ -227,7 +227,7 @@ void Controller::Handle(const SelectPair& select) {
   state_.selected_image.reset();
   state_.selected_undistorted.reset();
   state_.reprojection.reset();
-  CommitEdit(/*same_step=*/true);  // saved with the session, but no edit to undo
+  RecordView();
   worker_.Enqueue([this] { EnsureSelectedImage(); });
   const int index = select.index;
   worker_.Enqueue([this, index] { ComputeReprojection(index); });
@@ -244,12 +244,16 @@ void Controller::Handle(const SetPairStatus& status) {
               true);
     return;
   }
+  const bool rejecting = status.status == PairStatus::kRejected;
+  const bool rejection_changed = rejecting != (pair.status == PairStatus::kRejected);
   pair.status = status.status;
-  pair.reason = status.status == PairStatus::kRejected ? kRejectedByUser : "";
+  pair.reason = rejecting ? kRejectedByUser : "";
   SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
                 (state_.solver.result && !auto_solve_ ? "; press Run to re-solve" : ""),
             false);
-  CommitEdit();
+  // The user's word into the job's record (the next solve reads it there), then the status shown.
+  if (rejection_changed) job_->SetRejected(pair.id, rejecting);
+  RecordWhatFollowed(/*same_step=*/rejection_changed);
   RequestSolve();
 }
 
@@ -264,7 +268,8 @@ void Controller::Handle(const ResetSolver&) {
   state_.reprojection.reset();
   RecomputeResiduals();
   JudgeMeter(/*record=*/false);
-  CommitEdit();
+  job_->record().Edit([](Session* session) { session->result.reset(); });
+  AfterEdit();
 }
 
 template <>
@@ -283,9 +288,17 @@ void Controller::Handle(const SetSolverOptions& options) {
   state_.estimate_range_offset = options.estimate_range_offset;
   state_.huber_delta = options.huber_delta;
   state_.max_iterations = options.max_iterations;
+  // Into the job's record as the user set them (the offset's checkbox keeps its value across
+  // methods; ApplySessionOptions uses it with the weighted method only).
+  SolverOptions solver = pipeline_.solver;
+  solver.method = options.method;
+  solver.huber_delta = options.huber_delta;
+  solver.max_iterations = options.max_iterations;
+  solver.estimate_range_offset = options.estimate_range_offset;
+  job_->SetSolverOptions(solver);
+  AfterEdit();
   // Residuals and weights shown for the current estimate depend on the method.
   if (method_changed) RecomputeResiduals();
-  CommitEdit();
 }
 
 template <>
@@ -293,7 +306,7 @@ void Controller::Handle(const SetView& view) {
   const bool visibility_changed = view.view.visibility != state_.view.visibility ||
                                   view.view.hpr_radius_exponent != state_.view.hpr_radius_exponent;
   state_.view = view.view;
-  CommitEdit(/*same_step=*/true);  // saved with the session, but no edit to undo
+  RecordView();
   if (visibility_changed) {
     const int index = state_.selected;
     worker_.Enqueue([this, index] { ComputeReprojection(index); });

@@ -253,12 +253,23 @@ class Controller : public ControllerState<Snapshot> {
   // The meter from the current result and goal; `record` adds the point to the history (a solve).
   // Call with mutex_ held.
   void JudgeMeter(bool record);
-  // The job's session record <- state, an undo step, autosave; call with mutex_ held. Within an
-  // open brush stroke the current step is amended, so that one stroke is one undo step; so is it
-  // for a change on the `same_step`: one that follows the last edit (its refit, its auto-solve,
-  // pre-flight's verdicts on it: one undo takes back the edit and all that followed from it) or
-  // that is no edit (the pair selected, the camera moved: undo steps through edits only).
-  void CommitEdit(bool same_step = false);
+  // The user's edits go to the job's record first (record-first, as the LRF workbench's): the job's
+  // SetRejected, SetBrush and SetSolverOptions, the record's Edit for the view and a reset solve;
+  // state_ shows what the handler asked for, and undo restores state_ from the record
+  // (ApplySessionToState). Then AfterEdit: the undo buttons, autosave, a new generation. Call
+  // these with mutex_ held.
+  void AfterEdit();
+  // What followed from the edits, into the record beside them as the session file keeps it: each
+  // pair's status and reason as detection, the solve and pre-flight left them, a seed's region as
+  // its brush picture, the solution with its convergence, the view. An undo step of its own (a
+  // Run, an adopted estimate) or, with `same_step` or within an open brush stroke, the same as
+  // the edit it followed from (its refit, its auto-solve, pre-flight's verdicts on it: one undo
+  // takes back the edit and all that followed from it).
+  void RecordWhatFollowed(bool same_step);
+  // The view (the selected pair, the camera, visibility) into the record: saved with the session,
+  // no undo step (undo steps through edits only).
+  void RecordView();
+  std::string ViewJson();  // state_'s view, its selected pair's id set, as the session keeps it
   void ApplySessionToState(const Session& session);  // call with mutex_ held
   // Rig (controller_rig.cpp), with mutex_ held unless said: the rig view with camera `active`
   // open (true: the other cameras' solves carried from CarryRig); the rig solve started as
@@ -290,6 +301,9 @@ class Controller : public ControllerState<Snapshot> {
   // Adds (or, erasing, removes) LiDAR-image pixels to a pair's brush and refits: both brushes'
   // dabs. Call with mutex_ held.
   void Paint(int index, const std::vector<int>& pixels, bool erase);
+  // Pair `pair`'s brush as shown (painted or erased) into the job's record: an undo step, or the
+  // current one amended (a stroke's later dabs). The pair has its LiDAR image.
+  void SetBrushInRecord(const PairView& pair, bool amend);
   void Restore(const std::optional<Session>& restored);  // undo / redo
 
   std::optional<FileLock> session_lock_;  // held while session_path is open for editing

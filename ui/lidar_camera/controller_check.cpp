@@ -110,7 +110,7 @@ void Controller::Handle(const AdoptCheckEstimate&) {
   // The meter judges board captures; an estimate from the scene is not one.
   state_.meter.reset();
   UpdateActiveRigCamera();
-  CommitEdit();
+  RecordWhatFollowed(/*same_step=*/false);  // an undo step of its own
   SetStatus(
       "adopted the targetless estimate as the workbench's calibration (Undo restores the "
       "one before)",

@@ -260,7 +260,7 @@ void Controller::RefitLidar(int index) {
   }
   if (!cloud || !image) return;
   // The same choice of region as `calibench calibrate` (the job's BoardHintFor): once painted
-  // (or erased), the brush, which CommitEdit put in the job's record before this refit was
+  // (or erased), the brush, which the edit put in the job's record before this refit was
   // queued; else the seed while the brush only pictures it ("detect again" forgot it); else
   // detection.
   const PairFeatures features = job_->DetectLidar(index, *cloud, image.get(), brush_from_seed);
@@ -290,7 +290,7 @@ void Controller::RefitLidar(int index) {
   ++state_.generation;
   if (PairsSettled()) {
     RecomputeResiduals();
-    CommitEdit(/*same_step=*/true);
+    RecordWhatFollowed(/*same_step=*/true);
     RequestSolve();
   }
 }
@@ -307,11 +307,13 @@ void Controller::Handle(const BrushStroke& stroke) {
 template <>
 void Controller::Handle(const ClearBrush& clear) {
   if (!ValidPair(clear.index)) return;
-  state_.pairs[clear.index].brush_pixels.clear();
-  state_.pairs[clear.index].brush_from_seed = false;
-  state_.pairs[clear.index].brush_edited = true;
-  state_.pairs[clear.index].brush_detected = false;
-  CommitEdit();
+  PairView& pair = state_.pairs[clear.index];
+  if (!pair.lidar_image) return;
+  pair.brush_pixels.clear();
+  pair.brush_from_seed = false;
+  pair.brush_edited = true;
+  pair.brush_detected = false;
+  SetBrushInRecord(pair, /*amend=*/false);  // erased: no board until painted again
   const int index = clear.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });
 }
@@ -324,6 +326,7 @@ void Controller::Handle(const EndStroke&) {
 template <>
 void Controller::Handle(const DetectBoardAgain& again) {
   if (!again.all && !ValidPair(again.index)) return;
+  bool first = true;  // every pair's brush forgotten in one undo step
   for (size_t i = 0; i < state_.pairs.size(); ++i) {
     if (!again.all && static_cast<int>(i) != again.index) continue;
     PairView& pair = state_.pairs[i];
@@ -332,15 +335,28 @@ void Controller::Handle(const DetectBoardAgain& again) {
     pair.brush_from_seed = false;
     pair.brush_edited = false;
     pair.brush_detected = false;
+    job_->SetBrush(pair.id, std::nullopt, /*amend=*/!first);
+    first = false;
     const int index = static_cast<int>(i);
     worker_.Enqueue([this, index] { RefitLidar(index); });
   }
-  CommitEdit();
+  if (!first) AfterEdit();
 }
 
 template <>
 void Controller::Handle(const PaintPoints& paint) {
-  if (ValidPair(paint.index)) Paint(paint.index, paint.pixels, paint.erase);
+  if (ValidPair(paint.index) && state_.pairs[paint.index].lidar_image)
+    Paint(paint.index, paint.pixels, paint.erase);
+}
+
+void Controller::SetBrushInRecord(const PairView& pair, bool amend) {
+  mutex_.AssertHeld(__func__);
+  PairEdit brush;
+  brush.brush_pixels = pair.brush_pixels;
+  brush.brush_rows = pair.lidar_image->rows;
+  brush.brush_columns = pair.lidar_image->columns;
+  job_->SetBrush(pair.id, brush, amend);
+  AfterEdit();
 }
 
 void Controller::Paint(int index, const std::vector<int>& pixels, bool erase) {
@@ -358,7 +374,7 @@ void Controller::Paint(int index, const std::vector<int>& pixels, bool erase) {
   pair.brush_from_seed = false;  // painted: the brush replaces the seed from now on
   pair.brush_edited = true;
   pair.brush_detected = false;
-  CommitEdit();
+  SetBrushInRecord(pair, /*amend=*/stroke_open_);
   stroke_open_ = true;  // the stroke's later dabs amend this undo step
   worker_.Enqueue([this, index] { RefitLidar(index); });
 }

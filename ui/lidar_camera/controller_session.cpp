@@ -189,11 +189,20 @@ void Controller::ApplySessionToState(const Session& session) {
   state_.estimate_range_offset = session.estimate_range_offset;
   for (size_t i = 0; i < session.pairs.size() && i < state_.pairs.size(); ++i) {
     PairView& pair = state_.pairs[i];
-    pair.status = session.pairs[i].status;
-    pair.reason = session.pairs[i].reason;
-    if (session.pairs[i].brush) pair.brush_pixels = session.pairs[i].brush->pixels;
-    pair.brush_from_seed = session.pairs[i].brush_from_seed;
-    pair.brush_edited = session.pairs[i].brush.has_value() && !pair.brush_from_seed;
+    const PairState& saved = session.pairs[i];
+    pair.status = saved.status;
+    pair.reason = saved.reason;
+    if (saved.brush) {  // painted, erased, or a seed's region pictured
+      pair.brush_pixels = saved.brush->pixels;
+      pair.brush_detected = false;
+    } else if (pair.brush_edited || pair.brush_from_seed) {
+      // Undone back to detection (a board painted over a detected one, "detect again" redone):
+      // the brush goes, and Restore has the board detected again.
+      pair.brush_pixels.clear();
+      pair.brush_detected = false;
+    }
+    pair.brush_from_seed = saved.brush_from_seed;
+    pair.brush_edited = saved.brush.has_value() && !pair.brush_from_seed;
   }
   state_.selected = -1;
   for (size_t i = 0; i < state_.pairs.size(); ++i)
@@ -220,49 +229,66 @@ void Controller::ApplySessionToState(const Session& session) {
   ++state_.generation;
 }
 
-void Controller::CommitEdit(bool same_step) {
+std::string Controller::ViewJson() {
   mutex_.AssertHeld(__func__);
-  if (!job_) return;  // nothing open
   const bool had_selected =
       state_.selected >= 0 && state_.selected < static_cast<int>(state_.pairs.size());
   state_.view.selected_pair = had_selected ? state_.pairs[state_.selected].id : "";
-  Session session = job_->record().Current();
-  session.view_json = ViewToJson(state_.view);
-  session.method = state_.method;
-  session.huber_delta = state_.huber_delta;
-  session.max_iterations = state_.max_iterations;
-  session.estimate_range_offset = state_.estimate_range_offset;
-  session.ransac_threshold_m = pipeline_.lidar_plane.ransac_threshold_m;  // what detection used
-  // The record holds every pair state_ shows, in the same order (Open resumed it over the
-  // dataset; AddPair adds each pair that joins to both).
-  for (size_t i = 0; i < state_.pairs.size() && i < session.pairs.size(); ++i) {
-    PairState& p = session.pairs[i];
-    const PairView& v = state_.pairs[i];
-    p.status = v.status;
-    p.reason = v.reason;
-    // No brush for a pair left to detection: reopened (or calibrated with --session) it is
-    // detected again, while an erased brush stays erased.
-    if (v.lidar_image && (v.brush_edited || v.brush_from_seed)) {
-      BrushMask mask{v.lidar_image->rows, v.lidar_image->columns, v.brush_pixels};
-      p.brush = mask;
-      p.brush_from_seed = v.brush_from_seed;
-    } else if (v.lidar_image) {
-      p.brush.reset();
-      p.brush_from_seed = false;
-    }
-  }
-  session.result.reset();
+  return ViewToJson(state_.view);
+}
+
+void Controller::RecordView() {
+  mutex_.AssertHeld(__func__);
+  if (!job_) return;
+  const std::string view = ViewJson();
+  job_->record().Edit([&](Session* session) { session->view_json = view; }, /*amend=*/true);
+  AfterEdit();
+}
+
+void Controller::RecordWhatFollowed(bool same_step) {
+  mutex_.AssertHeld(__func__);
+  if (!job_) return;
+  std::optional<SessionResult> result;
   if (state_.solver.result) {
-    session.result = SessionResultFromSolver(*state_.solver.result);
-    session.result->notes = state_.solver.notes;
-    session.result->targetless_provenance = state_.solver.targetless_provenance;
+    result = SessionResultFromSolver(*state_.solver.result);
+    result->notes = state_.solver.notes;
+    result->targetless_provenance = state_.solver.targetless_provenance;
     for (const IterationReport& it : state_.solver.iterations) {
-      session.result->step_history.push_back(it.step_norm);
-      session.result->estimate_history.push_back(it.cam_from_lidar);
-      if (it.reweighted) session.result->reweighted_iterations.push_back(it.iteration);
+      result->step_history.push_back(it.step_norm);
+      result->estimate_history.push_back(it.cam_from_lidar);
+      if (it.reweighted) result->reweighted_iterations.push_back(it.iteration);
     }
   }
-  job_->record().Commit(std::move(session), /*amend=*/stroke_open_ || same_step);
+  const std::string view = ViewJson();
+  const double ransac_threshold_m = pipeline_.lidar_plane.ransac_threshold_m;  // detection's
+  job_->record().Edit(
+      [&](Session* session) {
+        session->view_json = view;
+        session->ransac_threshold_m = ransac_threshold_m;
+        // The record holds every pair state_ shows, in the same order (Open resumed it over the
+        // dataset; AddPair adds each pair that joins to both).
+        for (size_t i = 0; i < state_.pairs.size() && i < session->pairs.size(); ++i) {
+          PairState& saved = session->pairs[i];
+          const PairView& shown = state_.pairs[i];
+          saved.status = shown.status;
+          saved.reason = shown.reason;
+          // A painted (or erased) brush is the user's, in the record already. A seed's region is
+          // saved as its picture, which reopening pictures again (EditsFromSession skips it).
+          const bool painted = saved.brush && !saved.brush_from_seed;
+          if (!painted && shown.lidar_image && shown.brush_from_seed) {
+            saved.brush =
+                BrushMask{shown.lidar_image->rows, shown.lidar_image->columns, shown.brush_pixels};
+            saved.brush_from_seed = true;
+          }
+        }
+        session->result = std::move(result);
+      },
+      /*amend=*/stroke_open_ || same_step);
+  AfterEdit();
+}
+
+void Controller::AfterEdit() {
+  mutex_.AssertHeld(__func__);
   state_.can_undo = job_->record().CanUndo();
   state_.can_redo = job_->record().CanRedo();
   Autosave();

@@ -292,7 +292,7 @@ void Controller::Advise(const std::optional<SolverResult>& at) {
   }
   ++state_.generation;
   if (!rejected) return;
-  CommitEdit(/*same_step=*/true);
+  RecordWhatFollowed(/*same_step=*/true);
   RequestSolve();
 }
 
