@@ -185,8 +185,11 @@ int RunCalibrate(int argc, char** argv) {
   Dataset dataset =
       rig ? LoadRigCamera(dataset_path, camera) : LoadDataset(dataset_path, CameraFile::kOptional);
   const std::string intrinsics = estimate_intrinsics ? intrinsics_model : "";
-  return CalibrateOneCamera(&dataset, edits, intrinsics, flags.options,
-                            {report_path, session_path, out_path});
+  ReportRequest request;
+  request.out_path = report_path;
+  request.session_path = session_path;
+  request.result_file = out_path;  // the result file the solve writes and the report reads
+  return CalibrateOneCamera(&dataset, edits, intrinsics, flags.options, request);
 }
 
 }  // namespace calibench::app

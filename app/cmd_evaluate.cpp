@@ -15,26 +15,12 @@
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/results/export.h"
+#include "core/results/reference.h"
 #include "core/sim/crlb.h"
 #include "core/sim/sim.h"
 
 namespace calibench::app {
 namespace {
-
-// The corner noise of a simulated dataset, measured as the mean of the PnP residual-based
-// estimates over its pairs (the renderer's noise has no closed-form pixel σ).
-double MeasureCornerSigma(const Dataset& dataset) {
-  PipelineOptions options;
-  double sum = 0.0;
-  int count = 0;
-  for (const PairEntry& pair : dataset.pairs) {
-    const PairFeatures f = ExtractPairFeatures(dataset, pair, options);
-    if (!f.camera) continue;
-    sum += f.camera->corner_sigma_px;
-    ++count;
-  }
-  return count > 0 ? sum / count : 0.0;
-}
 
 // `evaluate` of an LRF result or the stereo check (cmd_lrf.cpp), or `evaluate --sweep` (the Table 1
 // protocol under the name issue 5 uses); nullopt for the 3D LiDAR evaluation itself.
@@ -101,53 +87,39 @@ struct ReferenceFlags {
   bool swap = false;
 };
 
-// The reference's cam_from_lidar, and a line saying how it was read.
-Pose ReferenceCamFromLidar(const ReferenceFlags& flags, std::string* how) {
-  const ImportedTransform imported = ReadExportedTransform(flags.path);
-  if (!imported.format) {
-    *how = "a calibench result: cam_from_lidar";
-    return imported.parent_from_child.inverse();
-  }
-  ExportFrames frames;
-  frames.camera_is_parent = flags.swap;
-  frames.camera_frame = *ParseCameraFrame(flags.camera_frame);
-  *how = ExportFormatName(*imported.format) + ": the pose of '" + imported.child + "' in '" +
-         imported.parent + "', the camera (" + CameraFrameName(frames.camera_frame) +
-         " frame) being the " + (flags.swap ? "parent" : "child") +
-         " (--reference-swap and --reference-camera-frame say otherwise)";
-  return CamFromLidarOf(imported.parent_from_child, frames);
-}
-
 // `evaluate --reference`: the result against another calibration of the same rig, for real data
 // without ground truth. The difference is also weighed by the result's own covariance (6-dof
 // chi-square: about 6 when the reference lies where the result's uncertainty says the truth is).
-int CompareWithReference(const LoadedResult& result, const ReferenceFlags& flags,
-                         double max_translation_mm, double max_rotation_deg) {
+int EvaluateAgainstReference(const LoadedResult& result, const ReferenceFlags& flags,
+                             double max_translation_mm, double max_rotation_deg) {
   if (!ParseCameraFrame(flags.camera_frame)) {
     std::fprintf(stderr, "calibench evaluate: --reference-camera-frame must be optical or link\n");
     return kUsage;
   }
+  ExportFrames frames;
+  frames.camera_is_parent = flags.swap;
+  frames.camera_frame = *ParseCameraFrame(flags.camera_frame);
   std::string how;
-  const Pose reference = ReferenceCamFromLidar(flags, &how);
-  std::printf("reference %s (%s)\n", flags.path.c_str(), how.c_str());
-  const PoseError error = ComputePoseError(result.cam_from_source, reference);
-  // The result's covariance is of a right perturbation: result = reference * Exp(delta).
-  const Vec6 delta = LogSE3(reference.inverse() * result.cam_from_source);
-  const Vec3 in_camera = reference.rotation() * delta.head<3>();
+  const Pose reference = ReadReferenceCamFromLidar(flags.path, frames, &how);
+  std::printf("reference %s (%s; --reference-swap and --reference-camera-frame say otherwise)\n",
+              flags.path.c_str(), how.c_str());
+  const ReferenceDifference difference =
+      CompareWithReference(result.cam_from_source, result.covariance, reference);
+  const PoseError& error = difference.error;
+  const Vec3& in_camera = difference.translation_in_camera_m;
   std::printf(
       "difference from the reference: translation %.2f mm (camera axes x/y/z %+.2f / %+.2f "
       "/ %+.2f mm), rotation %.3f deg\n",
       error.translation_m * 1e3, in_camera.x() * 1e3, in_camera.y() * 1e3, in_camera.z() * 1e3,
       error.rotation_rad * kRadToDeg);
-  if (result.covariance.isZero()) {
+  if (!difference.chi_square) {
     std::printf("(the result has no covariance: no weighing by its uncertainty)\n");
   } else {
-    const double chi2 = delta.dot(result.covariance.ldlt().solve(delta));
     std::printf(
         "weighed by the result's covariance: chi-square %.1f on 6 dof (about 6 when the "
         "reference is where the result's uncertainty puts the truth; above 16.8 in 1%% "
         "of cases)\n",
-        chi2);
+        *difference.chi_square);
   }
   const bool too_far =
       (max_translation_mm >= 0 && error.translation_m * 1000 > max_translation_mm) ||
@@ -198,8 +170,8 @@ int RunEvaluate(int argc, char** argv) {
     return kUsage;
   }
   if (!reference.path.empty())
-    return CompareWithReference(LoadResult(result_path), reference, max_translation_mm,
-                                max_rotation_deg);
+    return EvaluateAgainstReference(LoadResult(result_path), reference, max_translation_mm,
+                                    max_rotation_deg);
   if (dataset_path.empty()) {
     std::fprintf(stderr, "calibench evaluate: give --dataset (ground truth) or --reference\n");
     return kUsage;

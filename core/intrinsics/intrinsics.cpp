@@ -377,7 +377,9 @@ IntrinsicsResult CalibrateIntrinsics(const std::vector<IntrinsicsView>& views, i
   IntrinsicsResult result;
   std::vector<size_t> used;
   for (size_t i = 0; i < views.size(); ++i) {
-    IntrinsicsImage image{views[i].name, static_cast<int>(views[i].detection.pixels.size())};
+    IntrinsicsImage image;
+    image.name = views[i].name;
+    image.corners = static_cast<int>(views[i].detection.pixels.size());
     if (image.corners < options.min_corners) {
       image.reason = "only " + std::to_string(image.corners) + " corners";
     } else {

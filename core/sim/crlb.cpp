@@ -2,7 +2,22 @@
 
 #include <cmath>
 
+#include "core/io/dataset.h"
+#include "core/lidar_camera/pipeline.h"
+
 namespace calibench {
+
+double MeasureCornerSigma(const Dataset& dataset) {
+  double sum = 0.0;
+  int count = 0;
+  for (const PairEntry& pair : dataset.pairs) {
+    const PairFeatures features = ExtractPairFeatures(dataset, pair, PipelineOptions{});
+    if (!features.camera) continue;
+    sum += features.camera->corner_sigma_px;
+    ++count;
+  }
+  return count > 0 ? sum / count : 0.0;
+}
 
 SimulationBoundInput MakeSimulationBoundInput(const SimOptions& options, double corner_sigma_px) {
   const SimOptions resolved = ResolveSimOptions(options);

@@ -30,6 +30,10 @@ struct SimulationBoundInput {
   double corner_sigma_px = 0.0;
 };
 SimulationBoundInput MakeSimulationBoundInput(const SimOptions& options, double corner_sigma_px);
+// The corner noise of a simulated dataset's images [px]: the mean of the PnP residual-based
+// estimates (CameraBoardObservation::corner_sigma_px) over its pairs, since the renderer's noise
+// has no closed-form pixel σ. 0 when no pair shows the board.
+double MeasureCornerSigma(const Dataset& dataset);
 // Per pair: the true planes with their bound covariances (the weighted solver's input at truth).
 std::vector<PlanePair> BoundPlanePairs(const SimulationBoundInput& input);
 CramerRaoBound SimulationBound(const SimulationBoundInput& input,

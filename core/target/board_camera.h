@@ -62,9 +62,9 @@ BoardFit FitBoard(const ImageU8& image, const BoardSpec& board);
 
 struct CameraBoardObservation {
   Pose cam_from_board;
-  Mat6 pose_covariance;   // of cam_from_board, right perturbation, [rho; phi]
-  Plane plane;            // in the camera frame, oriented towards the camera (d > 0)
-  Mat4 plane_covariance;  // of (n, d); rank 3 (n is unit)
+  Mat6 pose_covariance = Mat6::Zero();   // of cam_from_board, right perturbation, [rho; phi]
+  Plane plane;                           // in the camera frame, oriented towards the camera (d > 0)
+  Mat4 plane_covariance = Mat4::Zero();  // of (n, d); rank 3 (n is unit)
   double reprojection_rms_px = 0.0;
   double corner_sigma_px = 0.0;  // estimated from the residuals (floored), used for covariances
   int num_corners = 0;

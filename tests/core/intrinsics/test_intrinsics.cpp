@@ -91,8 +91,11 @@ TEST(Intrinsics, ABadViewIsRejectedWithItsReason) {
   ASSERT_EQ(r.images.size(), 15u);
   EXPECT_FALSE(r.images[4].used);
   EXPECT_NE(r.images[4].reason.find("corner RMS"), std::string::npos) << r.images[4].reason;
-  for (size_t i = 0; i < r.images.size(); ++i)
-    if (i != 4) EXPECT_TRUE(r.images[i].used) << i;
+  for (size_t i = 0; i < r.images.size(); ++i) {
+    if (i != 4) {
+      EXPECT_TRUE(r.images[i].used) << i;
+    }
+  }
   // Within 4 σ of the truth, which the bad view alone would have pushed far out.
   const std::vector<double> true_values = {truth.fx, truth.fy, truth.cx, truth.cy};
   for (int i = 0; i < 4; ++i)

@@ -49,8 +49,9 @@ int Visit(BagReader& bag) {
   int visited = 0;
   bag.ForEachMessage({}, [&](const BagMessage& message) {
     const BagTopic& topic = bag.Topics()[message.topic];
-    if (topic.type == kPointCloud2Type)
+    if (topic.type == kPointCloud2Type) {
       EXPECT_EQ(DecodePointCloud2(message.data, topic.encoding).cloud.size(), 10u);
+    }
     return ++visited, true;
   });
   return visited;

@@ -64,8 +64,9 @@ TEST(DatasetCalibration, StepsTakeAPairPerThreadAndGiveTheOneCallOutcome) {
     EXPECT_EQ(stepped.pairs[i].id, dataset.pairs[i].id) << "features in the dataset's order";
     EXPECT_EQ(stepped.pairs[i].status, one_call.pairs[i].status) << i;
     ASSERT_EQ(stepped.pairs[i].lidar.has_value(), one_call.pairs[i].lidar.has_value()) << i;
-    if (stepped.pairs[i].lidar)
+    if (stepped.pairs[i].lidar) {
       EXPECT_EQ(stepped.pairs[i].lidar->inliers, one_call.pairs[i].lidar->inliers) << i;
+    }
   }
   EXPECT_EQ(stepped.background_note, one_call.background_note);
   ASSERT_TRUE(dataset.cam_from_lidar_ground_truth.has_value());

@@ -50,7 +50,8 @@ TEST(CalibrationJob, FedAllAtOncePairByPairOrStepByStepItEndsWhereCalibrateEnds)
 
   int progress_calls = 0;
   CalibrationJob batch(dataset, {}, {},
-                       {.detected = [&](int, int, const std::string&) { ++progress_calls; }});
+                       {.detected = [&](int, int, const std::string&) { ++progress_calls; },
+                        .iteration = {}});
   batch.DetectAll();
   const CalibrationOutcome& all = batch.Solve();
   ASSERT_TRUE(all.solution) << all.failure;

@@ -242,10 +242,11 @@ TEST(LidarBoardDetect, ABoardPartlyOutOfTheFieldOfViewIsFoundOrFailsButNeverWron
   scene.lidar_from_board = BoardFacingLidar(1.5, 0.0, 0.0, 0.38);
   const LidarBoardDetection found = DetectLidarBoard(
       Scan(scene, LidarModel::kVlp16, 5), BoardPreset("a3"), LidarBoardDetectionOptions{});
-  if (found.board)
+  if (found.board) {
     EXPECT_TRUE(IsTheBoard(found, scene.lidar_from_board));
-  else
+  } else {
     EXPECT_FALSE(found.reason.empty());
+  }
 }
 
 TEST(LidarBoardDetect, TwoBoardsFailThePairAndNameBoth) {
