@@ -121,14 +121,24 @@ TEST(Controller, RejectAcceptSolveAndUndo) {
       ComputePoseError(s.solver.result->cam_from_lidar, reference.solution->cam_from_lidar);
   EXPECT_LT(difference.translation_m, 0.005);
   EXPECT_LT(difference.rotation_rad, 0.1 * M_PI / 180);
-  // Undo brings the rejected pair back to accepted (the solve is undone first).
+  ASSERT_TRUE(s.meter);  // the solve's σ against the goal
+  // Undo brings the rejected pair back to accepted (the solve is undone first); the meter and the
+  // next pose go with the solve.
   controller.Apply(Undo{});
+  s = Loaded(controller);
+  EXPECT_FALSE(s.solver.result);
+  EXPECT_FALSE(s.meter);
+  EXPECT_FALSE(s.next_pose);
   controller.Apply(Undo{});
   s = Loaded(controller);
   EXPECT_EQ(s.pairs[2].status, PairStatus::kAccepted);
   controller.Apply(Redo{});
   s = Loaded(controller);
   EXPECT_EQ(s.pairs[2].status, PairStatus::kRejected);
+  controller.Apply(Redo{});  // the solve again: its σ judged again
+  s = Loaded(controller);
+  ASSERT_TRUE(s.solver.result);
+  ASSERT_TRUE(s.meter);
 }
 
 // In the window the workbench solves by itself after each edit. That solve follows the edit: one

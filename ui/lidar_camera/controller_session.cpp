@@ -331,6 +331,11 @@ void Controller::Restore(const std::optional<Session>& restored) {
   for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
   ApplySessionToState(*restored);
   RecomputeResiduals();
+  // The meter and the next pose belong to the solve restored (or to none): judged again, asked
+  // again (not while following a capture, where Advise's pre-flight would edit the record).
+  JudgeMeter(/*record=*/false);
+  state_.next_pose.reset();
+  if (state_.solver.result && watching_.empty()) worker_.Enqueue([this] { AdviseFromState(); });
   Autosave();
   for (int i = 0; i < static_cast<int>(state_.pairs.size()); ++i)
     if (state_.pairs[i].brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });
