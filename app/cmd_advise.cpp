@@ -35,7 +35,8 @@ int AdviseLidarCamera(const std::string& dataset_path, const AdviseOptions& opti
   // The job every front end runs (core/session/calibration_job.h), all pairs at once.
   CalibrationJobOptions job_options;
   job_options.advise = options;
-  CalibrationJob job(dataset, job_options, {}, {.detected = StderrProgress("extracted"), .iteration = {}});
+  CalibrationJob job(dataset, job_options, {},
+                     {.detected = StderrProgress("extracted"), .iteration = {}});
   job.DetectAll();
   bool input_error = false;
   for (const PairFeatures& p : job.Solve().pairs) input_error |= p.input_error;
@@ -63,7 +64,8 @@ int AdviseRig(const std::string& rig_path, const AdviseOptions& options, bool js
   for (size_t c = 0; c < rig.cameras.size(); ++c) {
     CalibrationJobOptions job_options;
     job_options.advise = options;
-    CalibrationJob job(rig.cameras[c], job_options, {}, {.detected = StderrProgress("extracted"), .iteration = {}});
+    CalibrationJob job(rig.cameras[c], job_options, {},
+                       {.detected = StderrProgress("extracted"), .iteration = {}});
     job.DetectAll();
     for (const PairFeatures& p : job.Solve().pairs) input_error |= p.input_error;
     const CaptureAdvice& advice = job.Advise();

@@ -92,13 +92,14 @@ struct ReferenceFlags {
 // chi-square: about 6 when the reference lies where the result's uncertainty says the truth is).
 int EvaluateAgainstReference(const LoadedResult& result, const ReferenceFlags& flags,
                              double max_translation_mm, double max_rotation_deg) {
-  if (!ParseCameraFrame(flags.camera_frame)) {
+  const std::optional<CameraFrame> camera_frame = ParseCameraFrame(flags.camera_frame);
+  if (!camera_frame) {
     std::fprintf(stderr, "calibench evaluate: --reference-camera-frame must be optical or link\n");
     return kUsage;
   }
   ExportFrames frames;
   frames.camera_is_parent = flags.swap;
-  frames.camera_frame = *ParseCameraFrame(flags.camera_frame);
+  frames.camera_frame = *camera_frame;
   std::string how;
   const Pose reference = ReadReferenceCamFromLidar(flags.path, frames, &how);
   std::printf("reference %s (%s; --reference-swap and --reference-camera-frame say otherwise)\n",

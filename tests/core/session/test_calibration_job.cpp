@@ -49,9 +49,9 @@ TEST(CalibrationJob, FedAllAtOncePairByPairOrStepByStepItEndsWhereCalibrateEnds)
   ASSERT_EQ(cli.pairs[3].board_origin.source, BoardSource::kCameraGuided);
 
   int progress_calls = 0;
-  CalibrationJob batch(dataset, {}, {},
-                       {.detected = [&](int, int, const std::string&) { ++progress_calls; },
-                        .iteration = {}});
+  CalibrationJob batch(
+      dataset, {}, {},
+      {.detected = [&](int, int, const std::string&) { ++progress_calls; }, .iteration = {}});
   batch.DetectAll();
   const CalibrationOutcome& all = batch.Solve();
   ASSERT_TRUE(all.solution) << all.failure;
