@@ -11,7 +11,7 @@
 #include "core/guidance/lrf_meter.h"
 #include "core/io/dataset.h"
 #include "core/io/rig_folder.h"
-#include "core/lrf/dataset.h"
+#include "core/lrf_data/dataset.h"
 #include "core/session/calibration_job.h"
 #include "core/session/job.h"
 

@@ -10,13 +10,13 @@
 #include "app/pipeline_flags.h"
 #include "app/sim_flags.h"
 #include "core/estimation/uncertainty.h"
+#include "core/evaluation/crlb.h"
 #include "core/geometry/geometry.h"
 #include "core/io/dataset.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/results/export.h"
 #include "core/results/reference.h"
-#include "core/sim/crlb.h"
 #include "core/sim/sim.h"
 
 namespace calibench::app {

@@ -12,15 +12,15 @@
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "app/progress_listener.h"
-#include "core/io/bag.h"
-#include "core/io/bag_import.h"
+#include "core/capture/bag_import.h"
+#include "core/capture/rig_import.h"
 #include "core/io/camera_file.h"
 #include "core/io/dataset.h"
 #include "core/io/json_io.h"
 #include "core/io/rig_folder.h"
-#include "core/io/rig_import.h"
-#include "core/io/ros_messages.h"
 #include "core/lidar_camera/rig.h"
+#include "core/recording/bag.h"
+#include "core/recording/ros_messages.h"
 
 namespace calibench::app {
 namespace fs = std::filesystem;
@@ -79,7 +79,7 @@ ImportProgress ProgressBar() {
   };
 }
 
-// How import chooses its pairs (core/io/recording_pairs.h), as flags.
+// How import chooses its pairs (core/capture/recording_pairs.h), as flags.
 void AddSelectionFlags(CLI::App& app, PairSelectionOptions* options_out) {
   PairSelectionOptions& options = *options_out;
   app.add_option("--max-offset", options.max_pair_offset_s,

@@ -11,13 +11,13 @@
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
+#include "core/evaluation/lrf_sweep.h"
 #include "core/io/dataset_source.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/lrf/pipeline.h"
 #include "core/lrf/result_io.h"
 #include "core/session/lrf_calibration_job.h"
 #include "core/sim/lrf_sim.h"
-#include "core/sim/lrf_sweep.h"
 
 namespace calibench::app {
 namespace {

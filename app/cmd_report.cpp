@@ -13,7 +13,7 @@
 #include "core/io/dataset.h"
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/rig.h"
-#include "core/lrf/dataset.h"
+#include "core/lrf_data/dataset.h"
 #include "core/report/lrf_report.h"
 #include "core/report/resolve_notes.h"
 #include "core/results/result_file.h"

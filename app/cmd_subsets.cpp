@@ -1,12 +1,12 @@
 // `calibench evaluate --subsets`: is the reported σ honest on this dataset?
-// (core/sim/subset_coverage)
+// (core/evaluation/subset_coverage.h)
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
+#include "core/evaluation/subset_coverage.h"
 #include "core/io/dataset.h"
-#include "core/sim/subset_coverage.h"
 
 namespace calibench::app {
 

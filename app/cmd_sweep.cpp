@@ -1,4 +1,5 @@
-// `calibench sweep`: the paper's Table 1 protocol (core/sim/plane_sweep.h) from the command line.
+// `calibench sweep`: the paper's Table 1 protocol (core/evaluation/plane_sweep.h) from the command
+// line.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <sstream>
@@ -6,8 +7,8 @@
 #include "app/commands.h"
 #include "app/pipeline_flags.h"
 #include "app/sim_flags.h"
+#include "core/evaluation/plane_sweep.h"
 #include "core/lidar_camera/pipeline.h"
-#include "core/sim/plane_sweep.h"
 
 namespace calibench::app {
 namespace {

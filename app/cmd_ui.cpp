@@ -8,9 +8,9 @@
 
 #include "app/commands.h"
 #include "core/base/image.h"
-#include "core/io/bag.h"
 #include "core/io/image_io.h"
 #include "core/lidar_camera/rig.h"
+#include "core/recording/bag.h"
 #include "core/session/job.h"
 #include "core/session/lrf_calibration_job.h"
 #include "ui/gfx/context.h"

@@ -8,9 +8,9 @@
 #include "app/commands.h"
 #include "app/machine_stdout.h"
 #include "app/pipeline_flags.h"
+#include "core/capture/recording_watch.h"
 #include "core/guidance/advise.h"
 #include "core/io/camera_file.h"
-#include "core/io/recording_watch.h"
 #include "core/session/capture_follow.h"
 
 namespace calibench::app {

@@ -9,8 +9,8 @@
 
 #include "app/commands.h"
 #include "app/machine_stdout.h"
+#include "core/capture/recording_watch.h"
 #include "core/io/camera_file.h"
-#include "core/io/recording_watch.h"
 #include "core/targetless/check_follow.h"
 #include "core/targetless/check_output.h"
 #include "core/targetless/checked_calibration.h"

@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "core/board/board.h"
 #include "core/intrinsics/intrinsics.h"
 #include "core/report/report_html.h"
 #include "core/report/targetless_section.h"
 #include "core/session/session.h"
-#include "core/target/board.h"
 #include "core/targetless/check_follow.h"
 
 namespace CLI {
@@ -83,7 +83,7 @@ void AddDriftMeterFlags(CLI::App& app, WatchCheckRequest* request);
 // Checks the request's options (kUsage with the reason on stderr), then follows the recording.
 int WatchCheck(WatchCheckRequest request);
 int RunEvaluate(int argc, char** argv);
-// `evaluate --subsets`: the σ-honesty protocol (core/sim/subset_coverage.h).
+// `evaluate --subsets`: the σ-honesty protocol (core/evaluation/subset_coverage.h).
 int RunEvaluateSubsets(int argc, char** argv);
 int RunSimulate(int argc, char** argv);
 int RunDemo(int argc, char** argv);

@@ -182,7 +182,7 @@ PairEdits ApplySessionFlag(const std::string& session_path, std::string* dataset
   const Session session = LoadSession(session_path);
   RefuseLrfSession(session, session_path);
   if (dataset_path->empty()) *dataset_path = session.dataset.string();
-  ApplySessionOptions(session, options);
+  session.settings.Apply(options);
   return EditsFromSession(session);
 }
 

@@ -14,7 +14,14 @@ BUILD_DIR=${CALIBENCH_BUILD_DIR:-build}
 JOBS=${CALIBENCH_JOBS:-$(nproc)}
 # Unity builds: the fresh build about 0.6x the time (CMakeLists.txt says why they are off otherwise).
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCALIBENCH_UNITY_BUILD=ON
-cmake --build "$BUILD_DIR" -j "$JOBS"
+# The demo needs the executable, the Python module and its files, the man page and completion;
+# the test suites and benchmarks (most of a fresh build) only with --test.
+if [ $run_tests -eq 1 ]; then
+  cmake --build "$BUILD_DIR" -j "$JOBS"
+else
+  cmake --build "$BUILD_DIR" -j "$JOBS" --target calibench calibench_python calibench_python_files \
+    calibench_docs
+fi
 
 # The main job: the demo (simulate, calibrate, print the result and its error), then the
 # workbench on it when there is a display, or its views rendered to PNG when there is none.

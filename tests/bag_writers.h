@@ -12,8 +12,8 @@
 
 #include "core/base/image.h"
 #include "core/camera/camera.h"
-#include "core/io/bag.h"
 #include "core/lidar/cloud.h"
+#include "core/recording/bag.h"
 
 namespace calibench::test {
 

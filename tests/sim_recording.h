@@ -13,7 +13,7 @@
 
 #include "core/base/types.h"
 #include "core/camera/camera.h"
-#include "core/io/bag.h"
+#include "core/recording/bag.h"
 #include "core/sim/sim.h"
 #include "tests/bag_writers.h"
 

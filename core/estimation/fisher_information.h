@@ -1,7 +1,7 @@
 // Fisher information of board observations and the Cramér–Rao bound it gives: the LiDAR's board
 // plane under range noise along its rays, the camera's board pose and plane under corner noise.
 // Guidance scores a candidate board pose with it (core/guidance/next_pose.h); the simulator bounds
-// a dataset with it (core/sim/crlb.h). The extrinsic's information is Σ Jᵢᵀ Sᵢ⁻¹ Jᵢ of the
+// a dataset with it (core/evaluation/crlb.h). The extrinsic's information is Σ Jᵢᵀ Sᵢ⁻¹ Jᵢ of the
 // weighted plane residual at the truth (WeightedPlaneInformation, core/lidar_camera/solver.h):
 // the bound for estimators that use the board planes; board edges and corners seen by the LiDAR
 // carry information it leaves out.

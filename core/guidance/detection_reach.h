@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "core/board/board.h"
 #include "core/camera/camera.h"
 #include "core/lidar_camera/pipeline.h"
-#include "core/target/board.h"
 
 namespace calibench {
 

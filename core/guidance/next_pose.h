@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "core/board/board.h"
 #include "core/camera/camera.h"
 #include "core/guidance/detection_reach.h"
 #include "core/lidar/beam_table.h"
 #include "core/lidar/board_returns.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar_camera/pipeline.h"
-#include "core/target/board.h"
 
 namespace calibench {
 

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "core/base/types.h"
+#include "core/board/board.h"
 #include "core/camera/camera.h"
-#include "core/target/board.h"
 
 namespace calibench {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "core/base/types.h"
-#include "core/io/bag.h"
+#include "core/io/recording_kind.h"
 
 namespace calibench {
 namespace {

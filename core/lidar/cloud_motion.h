@@ -1,7 +1,7 @@
 // Whether the scene moved between two sweeps of a spinning LiDAR, from the sweeps alone: each
 // sweep is reduced to a range grid (rows = rings or elevation bins, columns = azimuth bins) and
 // two grids are compared cell by cell. Import uses it to find the moments a board is held still
-// before it looks at a single image (core/io/recording_pairs.h).
+// before it looks at a single image (core/capture/recording_pairs.h).
 #pragma once
 
 #include <string>

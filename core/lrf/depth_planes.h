@@ -11,7 +11,7 @@
 #include <optional>
 #include <string>
 
-#include "core/lrf/types.h"
+#include "core/lrf_data/types.h"
 
 namespace calibench {
 

@@ -15,10 +15,10 @@
 
 #include "core/base/parallel.h"
 #include "core/lrf/board_in_scan.h"
-#include "core/lrf/dataset.h"
 #include "core/lrf/depth_planes.h"
 #include "core/lrf/scan_lines.h"
 #include "core/lrf/solver.h"
+#include "core/lrf_data/dataset.h"
 #include "core/results/pair_status.h"
 #include "core/target/board_camera.h"
 

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "core/estimation/uncertainty.h"
-#include "core/lrf/types.h"
+#include "core/lrf_data/types.h"
 
 namespace calibench {
 

@@ -29,12 +29,7 @@ CalibrationJob::CalibrationJob(Dataset dataset, CalibrationJobOptions options, P
   }
   // The record: a new session over the pairs, with the options' settings and the edits given.
   Session session = NewSession(dataset_);
-  const PipelineOptions& pipeline = options_.advise.pipeline;
-  session.method = pipeline.solver.method;
-  session.huber_delta = pipeline.solver.huber_delta;
-  session.estimate_range_offset = pipeline.solver.estimate_range_offset;
-  session.max_iterations = pipeline.solver.max_iterations;
-  session.ransac_threshold_m = pipeline.lidar_plane.ransac_threshold_m;
+  session.settings = JobSettings::Of(options_.advise.pipeline);
   for (const auto& [id, edit] : edits) SetEdit(&session, id, edit);
   record_.Reset(std::move(session));
 }
@@ -225,14 +220,9 @@ void CalibrationJob::Resume(const Session& session) {
   for (const PairEntry& pair : dataset_.pairs) record_.AddPair(pair.id);
 }
 
-void CalibrationJob::SetSolverOptions(const SolverOptions& solver) {
-  options_.advise.pipeline.solver = solver;
-  record_.Edit([&](Session* session) {
-    session->method = solver.method;
-    session->huber_delta = solver.huber_delta;
-    session->max_iterations = solver.max_iterations;
-    session->estimate_range_offset = solver.estimate_range_offset;
-  });
+void CalibrationJob::SetSettings(const JobSettings& settings) {
+  settings.Apply(&options_.advise.pipeline);
+  record_.Edit([&](Session* session) { session->settings = settings; });
 }
 
 void CalibrationJob::SetGoal(const CaptureGoal& goal) { options_.advise.goal = goal; }
@@ -312,11 +302,7 @@ Session CalibrationJob::ToSession(const std::filesystem::path& dataset_path) con
   Session record = record_.Current();
   Session session = NewSession(dataset_);
   session.dataset = NormalizeSessionPath(dataset_path);
-  session.method = record.method;
-  session.huber_delta = record.huber_delta;
-  session.estimate_range_offset = record.estimate_range_offset;
-  session.max_iterations = record.max_iterations;
-  session.ransac_threshold_m = record.ransac_threshold_m;
+  session.settings = record.settings;
   session.view_json = record.view_json;
   // NewSession's pairs, pairs_, the outcome's and the advice's pairs all follow dataset_.pairs.
   const std::vector<PairFeatures> detected = DetectedPairs();

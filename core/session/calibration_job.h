@@ -99,9 +99,8 @@ class CalibrationJob final : public Job {
   // Whether the user painted pair `pair_id`'s board: its features must come from the brush, not
   // from a detection cached without it.
   bool HasBrush(const std::string& pair_id) const;
-  // The solver's options; the four a session keeps (method, Huber threshold, iterations, range
-  // offset) go into the record, as an undo step.
-  void SetSolverOptions(const SolverOptions& solver);
+  // The settings the next steps run with, into the record as one undo step.
+  void SetSettings(const JobSettings& settings);
   void SetGoal(const CaptureGoal& goal);
   // How precisely the person holds a suggested pose (GuidanceOptions::hand_tolerance_*).
   void SetHandTolerance(double translation_m, double rotation_deg);

@@ -6,9 +6,9 @@
 #include <thread>
 
 #include "core/base/file_lock.h"
-#include "core/io/capture_feed.h"
+#include "core/capture/capture_feed.h"
+#include "core/capture/recording_watch.h"
 #include "core/io/dataset_source.h"
-#include "core/io/recording_watch.h"
 #include "core/session/feature_cache.h"
 #include "core/session/session.h"
 

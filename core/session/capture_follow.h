@@ -12,13 +12,13 @@
 #include <optional>
 #include <string>
 
-#include "core/io/bag_import.h"
-#include "core/io/capture_feed.h"
-#include "core/io/folder_watch.h"
+#include "core/board/board.h"
+#include "core/capture/bag_import.h"
+#include "core/capture/capture_feed.h"
+#include "core/capture/folder_watch.h"
 #include "core/session/calibration_job.h"
 #include "core/session/feed_loop.h"
 #include "core/session/follow_event.h"
-#include "core/target/board.h"
 
 namespace calibench {
 

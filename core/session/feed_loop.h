@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/io/capture_feed.h"
+#include "core/capture/capture_feed.h"
 #include "core/session/follow_event.h"
 
 namespace calibench {

@@ -118,13 +118,35 @@ Session NewSession(const Dataset& dataset) {
   return session;
 }
 
-void ApplySessionOptions(const Session& session, PipelineOptions* options) {
-  options->solver.method = session.method;
-  options->solver.huber_delta = session.huber_delta;
-  options->solver.max_iterations = session.max_iterations;
-  options->lidar_plane.ransac_threshold_m = session.ransac_threshold_m;
+JobSettings JobSettings::Of(const PipelineOptions& options) {
+  JobSettings settings;
+  settings.method = options.solver.method;
+  settings.huber_delta = options.solver.huber_delta;
+  settings.max_iterations = options.solver.max_iterations;
+  settings.estimate_range_offset = options.solver.estimate_range_offset;
+  settings.ransac_threshold_m = options.lidar_plane.ransac_threshold_m;
+  return settings;
+}
+
+void JobSettings::Apply(PipelineOptions* options) const {
+  options->solver.method = method;
+  options->solver.huber_delta = huber_delta;
+  options->solver.max_iterations = max_iterations;
+  options->lidar_plane.ransac_threshold_m = ransac_threshold_m;
+  // Only the weighted method has a range offset to estimate (SolverOptions); the choice stays.
   options->solver.estimate_range_offset =
-      session.estimate_range_offset && session.method == SolverMethod::kWeightedMl;
+      estimate_range_offset && method == SolverMethod::kWeightedMl;
+}
+
+bool JobSettings::Check(std::string* why) const {
+  PipelineOptions options;
+  Apply(&options);
+  if (!options.solver.Check(why)) return false;
+  if (!(ransac_threshold_m > 0)) {
+    if (why) *why = "ransac_threshold_m must be > 0 (metres)";
+    return false;
+  }
+  return true;
 }
 
 PairEdit EditOfPair(const PairState& pair) {

@@ -90,6 +90,31 @@ SessionResult SessionResultFromSolver(const SolverResult& solver);
 // no observability eigenvalues); `method` is the session's solver method.
 SolverResult SolverResultFromSession(const SessionResult& session, SolverMethod method);
 
+// The settings a calibration job runs with and a session file keeps (its "options"): the session,
+// the job's record and the workbench's snapshot each hold them as one field, and what they make of
+// the pipeline's options is Apply's alone (docs/architecture.md, "One state").
+struct JobSettings {
+  SolverMethod method = SolverOptions{}.method;
+  double huber_delta = SolverOptions{}.huber_delta;     // Huber threshold (see SolverOptions)
+  int max_iterations = SolverOptions{}.max_iterations;  // Gauss-Newton iterations
+  // A LiDAR range offset, as the user asked for it: kept across methods (the workbench's checkbox
+  // keeps its value), estimated by the weighted method alone (Apply).
+  bool estimate_range_offset = false;
+  double ransac_threshold_m = LidarPlaneOptions{}.ransac_threshold_m;  // LiDAR plane inliers [m]
+
+  // The settings of pipeline options (the command line's flags, a job's options).
+  static JobSettings Of(const PipelineOptions& options);
+  // `options` with these settings: the one place the range-offset rule is written.
+  void Apply(PipelineOptions* options) const;
+  PipelineOptions Over(PipelineOptions options) const {
+    Apply(&options);
+    return options;
+  }
+  // False with *why naming the setting when the solver would refuse it.
+  bool Check(std::string* why) const;
+  bool operator==(const JobSettings&) const = default;
+};
+
 struct Session {
   int version = 1;  // of the file format; this build reads and writes 1
   // The manifest (or shorthand folder); absolute and lexically normal in memory.
@@ -97,12 +122,8 @@ struct Session {
   // The camera of a rig this session edits (Dataset::camera_name; the file's "camera", written
   // only for a rig): `dataset` is then the rig's folder or manifest. Empty for one camera.
   std::string camera;
-  std::vector<PairState> pairs;                      // in the dataset's order
-  SolverMethod method = SolverOptions{}.method;      // solver (see SolverOptions)
-  double huber_delta = SolverOptions{}.huber_delta;  // Huber threshold (see SolverOptions)
-  bool estimate_range_offset = false;  // weighted-ml: LiDAR range offset (see SolverOptions)
-  int max_iterations = SolverOptions{}.max_iterations;                 // Gauss-Newton iterations
-  double ransac_threshold_m = LidarPlaneOptions{}.ransac_threshold_m;  // LiDAR plane inliers
+  std::vector<PairState> pairs;  // in the dataset's order
+  JobSettings settings;          // the file's "options"
   // A 2D LRF session (the LRF workbench's, `calibench lrf-calibrate --session`): the LRF method's
   // name ("refined", "paper-linear"; the file's "options"."lrf_method"), `dataset` an LRF manifest
   // and `result` the last LRF solve (cam_from_lidar holding cam_from_lrf). Empty for a LiDAR-camera
@@ -128,10 +149,6 @@ std::filesystem::path DefaultSessionPath(const std::filesystem::path& dataset,
 // One pending PairState per dataset pair, default options, an empty view (the workbench then
 // selects the first pair).
 Session NewSession(const Dataset& dataset);
-
-// Copies the session's solver and RANSAC options into pipeline options (the range offset only
-// for the weighted method, as the workbench solves).
-void ApplySessionOptions(const Session& session, PipelineOptions* options);
 
 // The user's word on one pair as the pipeline takes it: its painted brush (not one pictured from
 // a seed) and its rejection.

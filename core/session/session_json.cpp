@@ -88,6 +88,14 @@ Json RangeOffsetToJson(const RangeOffsetEstimate& o) {
           {"well_determined", o.well_determined}};
 }
 
+Json OptionsToJson(const JobSettings& settings) {
+  return {{"method", SolverMethodName(settings.method)},
+          {"huber_delta", Number(settings.huber_delta)},
+          {"estimate_range_offset", settings.estimate_range_offset},
+          {"max_iterations", settings.max_iterations},
+          {"ransac_threshold_m", Number(settings.ransac_threshold_m)}};
+}
+
 Json ResultToJson(const SessionResult& r) {
   Json json = {
       {"direction", kDirection},
@@ -311,19 +319,21 @@ SessionResult ReadResult(const Fields& f) {
 }
 
 void ReadOptions(const Fields& f, Session* s) {
+  JobSettings& settings = s->settings;
   // Sessions written before the method was selectable have no "method": the default applies.
   if (f.Has("method")) {
     const std::string name = f.String("method");
     const auto method = ParseSolverMethod(name);
     if (!method) f.Fail("method", "'" + name + "' is not weighted-ml, ca2lib-gn or kim");
-    s->method = *method;
+    settings.method = *method;
   }
   // Optional: sessions written before the range offset existed do not estimate it.
-  if (f.Has("estimate_range_offset")) s->estimate_range_offset = f.Bool("estimate_range_offset");
-  s->huber_delta = f.Positive("huber_delta");
-  s->max_iterations = f.Int("max_iterations");
-  if (s->max_iterations < 1) f.Fail("max_iterations", "must be at least 1");
-  s->ransac_threshold_m = f.Positive("ransac_threshold_m");
+  if (f.Has("estimate_range_offset"))
+    settings.estimate_range_offset = f.Bool("estimate_range_offset");
+  settings.huber_delta = f.Positive("huber_delta");
+  settings.max_iterations = f.Int("max_iterations");
+  if (settings.max_iterations < 1) f.Fail("max_iterations", "must be at least 1");
+  settings.ransac_threshold_m = f.Positive("ransac_threshold_m");
   // Only an LRF session has it (Session::lrf_method).
   if (f.Has("lrf_method")) {
     s->lrf_method = f.String("lrf_method");
@@ -388,12 +398,7 @@ std::string SessionToJson(const Session& session, const std::filesystem::path& s
   Json root = {{"format", kFormat},
                {"version", session.version},
                {"dataset", DatasetPathForFile(session.dataset, session_path)},
-               {"options",
-                {{"method", SolverMethodName(session.method)},
-                 {"huber_delta", Number(session.huber_delta)},
-                 {"estimate_range_offset", session.estimate_range_offset},
-                 {"max_iterations", session.max_iterations},
-                 {"ransac_threshold_m", Number(session.ransac_threshold_m)}}},
+               {"options", OptionsToJson(session.settings)},
                {"pairs", pairs},
                {"view", ViewObject(session.view_json)},
                {"result", session.result ? ResultToJson(*session.result) : Json(nullptr)}};

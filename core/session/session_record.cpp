@@ -69,7 +69,7 @@ bool SessionRecord::Rejected(const std::string& id, std::string* reason) const {
 
 void SessionRecord::ApplyOptions(PipelineOptions* options) const {
   std::lock_guard lock(mutex_);
-  ApplySessionOptions(session_, options);
+  session_.settings.Apply(options);
 }
 
 void SessionRecord::Reset(Session session) {

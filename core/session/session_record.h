@@ -42,7 +42,7 @@ class SessionRecord {
   PairEdits Edits() const;
   // Whether the user rejected pair `id`; *reason (optional) gets the reason shown for it.
   bool Rejected(const std::string& id, std::string* reason = nullptr) const;
-  // The record's solver and RANSAC settings onto `options` (ApplySessionOptions).
+  // The record's solver and RANSAC settings onto `options` (JobSettings::Apply).
   void ApplyOptions(PipelineOptions* options) const;
 
   // `session` becomes the record with nothing to undo: a session opened or resumed.

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "core/lrf/dataset.h"
-#include "core/lrf/types.h"
+#include "core/lrf_data/dataset.h"
+#include "core/lrf_data/types.h"
 
 namespace calibench {
 

@@ -8,9 +8,9 @@
 
 #include "core/base/image.h"
 #include "core/base/types.h"
+#include "core/board/board.h"
 #include "core/camera/camera.h"
 #include "core/geometry/geometry.h"
-#include "core/target/board.h"
 
 namespace calibench {
 

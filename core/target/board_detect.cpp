@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "core/board/charuco_board.h"
 #include "core/target/board_camera.h"
-#include "core/target/charuco_board.h"
 
 namespace calibench {
 

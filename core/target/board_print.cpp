@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "core/target/charuco_board.h"
+#include "core/board/charuco_board.h"
 
 namespace calibench {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/base/types.h"
-#include "core/target/board.h"
+#include "core/board/board.h"
 
 namespace calibench {
 

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "core/board/board.h"
 #include "core/geometry/geometry.h"
 #include "core/lidar/cloud.h"
-#include "core/target/board.h"
 #include "core/target/scene_background.h"
 
 namespace calibench {

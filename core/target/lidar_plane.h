@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "core/board/board.h"
 #include "core/geometry/geometry.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_geometry.h"
 #include "core/lidar/lidar_image.h"
-#include "core/target/board.h"
 #include "core/target/board_edges.h"
 #include "core/target/lidar_noise.h"
 #include "core/target/ring_bias.h"

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "core/base/types.h"
-#include "core/target/board.h"
+#include "core/board/board.h"
 
 namespace calibench {
 

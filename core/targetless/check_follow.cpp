@@ -1,8 +1,8 @@
 #include "core/targetless/check_follow.h"
 
-#include "core/io/bag.h"
-#include "core/io/bag_import.h"
-#include "core/io/ros_messages.h"
+#include "core/capture/bag_import.h"
+#include "core/recording/bag.h"
+#include "core/recording/ros_messages.h"
 #include "core/targetless/frame_pairer.h"
 
 namespace calibench {

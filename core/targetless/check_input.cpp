@@ -5,13 +5,13 @@
 #include <mutex>
 
 #include "core/base/parallel.h"
-#include "core/io/bag.h"
-#include "core/io/bag_import.h"
+#include "core/capture/bag_import.h"
 #include "core/io/cloud_io.h"
 #include "core/io/dataset.h"
 #include "core/io/dataset_source.h"
 #include "core/io/image_io.h"
-#include "core/io/ros_messages.h"
+#include "core/recording/bag.h"
+#include "core/recording/ros_messages.h"
 #include "core/targetless/frame_pairer.h"
 
 namespace calibench {

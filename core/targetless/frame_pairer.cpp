@@ -2,9 +2,9 @@
 
 #include <cstdlib>
 
-#include "core/io/bag.h"
-#include "core/io/bag_import.h"
-#include "core/io/ros_messages.h"
+#include "core/capture/bag_import.h"
+#include "core/recording/bag.h"
+#include "core/recording/ros_messages.h"
 
 namespace calibench {
 

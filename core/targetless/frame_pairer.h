@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/io/recording_pairs.h"
+#include "core/capture/recording_pairs.h"
 #include "core/targetless/check_input.h"
 
 namespace calibench {

@@ -13,11 +13,11 @@
 
 #include <filesystem>
 
-#include "core/io/bag.h"
-#include "core/io/bag_import.h"
+#include "core/capture/bag_import.h"
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
-#include "core/io/ros_messages.h"
+#include "core/recording/bag.h"
+#include "core/recording/ros_messages.h"
 #include "core/sim/sim.h"
 #include "tests/bag_writers.h"
 

@@ -23,9 +23,9 @@
 #include <filesystem>
 #include <map>
 
-#include "core/io/bag_import.h"
-#include "core/io/ros_messages.h"
+#include "core/capture/bag_import.h"
 #include "core/lidar/cloud_motion.h"
+#include "core/recording/ros_messages.h"
 #include "core/target/board_camera.h"
 #include "tests/sim_recording.h"
 

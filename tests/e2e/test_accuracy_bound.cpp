@@ -9,8 +9,8 @@
 #include <random>
 #include <vector>
 
+#include "core/evaluation/crlb.h"
 #include "core/lidar_camera/pipeline.h"
-#include "core/sim/crlb.h"
 #include "core/sim/sim.h"
 #include "tests/test_support.h"
 

@@ -6,7 +6,7 @@
 
 #include <algorithm>
 
-#include "core/io/bag_import.h"
+#include "core/capture/bag_import.h"
 #include "core/io/camera_file.h"
 #include "core/io/cloud_io.h"
 #include "core/io/dataset.h"

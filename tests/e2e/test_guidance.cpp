@@ -7,10 +7,10 @@
 
 #include "core/estimation/uncertainty.h"
 #include "core/evaluation/guided_sweep.h"
+#include "core/evaluation/subset_coverage.h"
 #include "core/guidance/detection_reach.h"
 #include "core/guidance/next_pose.h"
 #include "core/io/dataset.h"
-#include "core/sim/subset_coverage.h"
 #include "tests/acfr_manifest.h"
 #include "tests/test_support.h"
 

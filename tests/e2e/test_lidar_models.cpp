@@ -10,11 +10,11 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "core/evaluation/subset_coverage.h"
 #include "core/io/cloud_io.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/sim/sim.h"
-#include "core/sim/subset_coverage.h"
 #include "tests/acfr_manifest.h"
 #include "tests/test_support.h"
 

@@ -7,9 +7,9 @@
 
 #include <cstdio>
 
+#include "core/evaluation/crlb.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/result_io.h"
-#include "core/sim/crlb.h"
 #include "core/sim/sim.h"
 #include "tests/test_support.h"
 

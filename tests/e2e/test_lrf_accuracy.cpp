@@ -6,7 +6,7 @@
 
 #include <cstdio>
 
-#include "core/sim/lrf_sweep.h"
+#include "core/evaluation/lrf_sweep.h"
 
 namespace calibench {
 namespace {

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/io/bag_import.h"
+#include "core/capture/bag_import.h"
 #include "core/io/cloud_io.h"
 #include "core/io/dataset.h"
 #include "core/io/image_io.h"

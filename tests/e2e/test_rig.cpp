@@ -10,10 +10,10 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "core/capture/bag_import.h"
 #include "core/geometry/geometry.h"
-#include "core/io/bag.h"
-#include "core/io/bag_import.h"
 #include "core/io/dataset.h"
+#include "core/recording/bag.h"
 #include "core/sim/rig_sim.h"
 #include "tests/bag_writers.h"
 #include "tests/sim_recording.h"

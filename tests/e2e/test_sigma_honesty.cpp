@@ -9,9 +9,9 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/evaluation/subset_coverage.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/sim/sim.h"
-#include "core/sim/subset_coverage.h"
 #include "tests/test_support.h"
 
 namespace calibench {

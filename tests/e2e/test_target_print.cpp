@@ -16,8 +16,8 @@
 #include <set>
 #include <string>
 
+#include "core/board/charuco_board.h"
 #include "core/io/dataset.h"
-#include "core/target/charuco_board.h"
 #include "core/target/target_sheet.h"
 #include "tests/test_support.h"
 

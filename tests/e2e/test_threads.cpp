@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "core/sim/lrf_sweep.h"
-#include "core/sim/plane_sweep.h"
+#include "core/evaluation/lrf_sweep.h"
+#include "core/evaluation/plane_sweep.h"
 #include "core/sim/sim.h"
 #include "tests/test_support.h"
 

@@ -7,13 +7,13 @@
 #include <string>
 
 #include "core/base/types.h"
-#include "core/io/bag.h"
 #include "core/io/camera_file.h"
 #include "core/io/cloud_io.h"
 #include "core/io/dataset.h"
 #include "core/io/image_io.h"
-#include "core/io/ros_messages.h"
-#include "core/lrf/dataset.h"
+#include "core/lrf_data/dataset.h"
+#include "core/recording/bag.h"
+#include "core/recording/ros_messages.h"
 #include "core/results/result_file.h"
 #include "core/session/session.h"
 #include "tests/fuzz/harness.h"

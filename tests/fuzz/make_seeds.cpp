@@ -12,7 +12,7 @@
 
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
-#include "core/lrf/dataset.h"
+#include "core/lrf_data/dataset.h"
 #include "tests/bag_writers.h"
 
 namespace calibench {

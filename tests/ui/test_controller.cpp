@@ -252,12 +252,17 @@ TEST(Controller, EachEditIsInTheJobsRecordAndUndoingABrushDetectsTheBoardAgain) 
   EXPECT_EQ(LoadSession(session_path).pairs[2].status, PairStatus::kRejected);
   EXPECT_EQ(LoadSession(session_path).pairs[2].reason, kRejectedByUser);
 
-  controller.Apply(SetSolverOptions{0.25, 17, SolverMethod::kWeightedMl, true});
+  JobSettings settings = LoadSession(session_path).settings;
+  settings.huber_delta = 0.25;
+  settings.max_iterations = 17;
+  settings.method = SolverMethod::kWeightedMl;
+  settings.estimate_range_offset = true;
+  controller.Apply(SetSettings{settings});
   Loaded(controller);
   Session saved = LoadSession(session_path);
-  EXPECT_EQ(saved.huber_delta, 0.25);
-  EXPECT_EQ(saved.max_iterations, 17);
-  EXPECT_TRUE(saved.estimate_range_offset);
+  EXPECT_EQ(saved.settings.huber_delta, 0.25);
+  EXPECT_EQ(saved.settings.max_iterations, 17);
+  EXPECT_TRUE(saved.settings.estimate_range_offset);
 
   // Erase a disc of the detected board: the record holds the brush the pair now shows.
   const int columns = detected.pairs[1].lidar_image->columns;
@@ -283,8 +288,8 @@ TEST(Controller, EachEditIsInTheJobsRecordAndUndoingABrushDetectsTheBoardAgain) 
   EXPECT_EQ(undone.pairs[1].lidar->inliers, detected.pairs[1].lidar->inliers);
   EXPECT_FALSE(LoadSession(session_path).pairs[1].brush);
   controller.Apply(Undo{});  // the solver's settings
-  EXPECT_EQ(Loaded(controller).max_iterations, SolverOptions{}.max_iterations);
-  EXPECT_EQ(LoadSession(session_path).max_iterations, SolverOptions{}.max_iterations);
+  EXPECT_EQ(Loaded(controller).settings.max_iterations, SolverOptions{}.max_iterations);
+  EXPECT_EQ(LoadSession(session_path).settings.max_iterations, SolverOptions{}.max_iterations);
   controller.Apply(Undo{});  // the rejection
   EXPECT_EQ(Loaded(controller).pairs[2].status, PairStatus::kAccepted);
   EXPECT_NE(LoadSession(session_path).pairs[2].status, PairStatus::kRejected);

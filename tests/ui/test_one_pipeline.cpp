@@ -79,7 +79,7 @@ TEST(OnePipeline, WorkbenchAndCalibrateAgreeBitForBit) {
   // The CLI's path over what the workbench autosaved: `calibench calibrate --session`.
   const Session session = LoadSession(session_path);
   PipelineOptions options;
-  ApplySessionOptions(session, &options);
+  session.settings.Apply(&options);
   const PairEdits edits = EditsFromSession(session);
   ASSERT_EQ(edits.size(), 2u);  // the painted brush and the rejection
   const CalibrationOutcome cli = CalibrateDataset(LoadDataset(session.dataset), options, {}, edits);

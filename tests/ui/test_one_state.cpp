@@ -97,7 +97,10 @@ TEST(OneState, AWorkbenchEditHoldsInTheReopenedSessionInWatchAndInCalibrate) {
                                    (pixel % columns + dc + columns) % columns, 2.0f, false});
     controller.Apply(EndStroke{});
     controller.Apply(SetPairStatus{pose3, PairStatus::kRejected});
-    controller.Apply(SetSolverOptions{kHuberDelta, opened.max_iterations, opened.method, false});
+    JobSettings settings = opened.settings;
+    settings.huber_delta = kHuberDelta;
+    settings.estimate_range_offset = false;
+    controller.Apply(SetSettings{settings});
     controller.Apply(RunSolver{});
     const Snapshot solved = Loaded(controller);
     ASSERT_TRUE(solved.solver.result) << solved.solver.failure;
@@ -118,7 +121,7 @@ TEST(OneState, AWorkbenchEditHoldsInTheReopenedSessionInWatchAndInCalibrate) {
     EXPECT_TRUE(reopened.pairs[IndexOf(reopened, "pose2")].brush_edited);
     EXPECT_EQ(reopened.pairs[IndexOf(reopened, "pose2")].board_origin.source, BoardSource::kBrush);
     EXPECT_EQ(reopened.pairs[IndexOf(reopened, "pose3")].status, PairStatus::kRejected);
-    EXPECT_EQ(reopened.huber_delta, kHuberDelta);
+    EXPECT_EQ(reopened.settings.huber_delta, kHuberDelta);
     ASSERT_TRUE(reopened.solver.result);
     EXPECT_EQ(reopened.solver.result->cam_from_lidar.matrix(), workbench_solution);
   }
@@ -153,7 +156,7 @@ TEST(OneState, AWorkbenchEditHoldsInTheReopenedSessionInWatchAndInCalibrate) {
   ASSERT_TRUE(StateOf(after_watch, "pose2")->brush);
   EXPECT_EQ(StateOf(after_watch, "pose2")->brush->pixels, painted);
   EXPECT_EQ(StateOf(after_watch, "pose3")->status, PairStatus::kRejected);
-  EXPECT_EQ(after_watch.huber_delta, kHuberDelta);
+  EXPECT_EQ(after_watch.settings.huber_delta, kHuberDelta);
   ASSERT_TRUE(after_watch.result);
 
   // 4. `calibrate --session` on what watch left: watch's own solve (each started from the last)
@@ -187,7 +190,7 @@ TEST(OneState, AWorkbenchEditHoldsInTheReopenedSessionInWatchAndInCalibrate) {
   EXPECT_EQ(last.pairs[IndexOf(last, "pose2")].brush_pixels, painted);
   EXPECT_TRUE(last.pairs[IndexOf(last, "pose2")].brush_edited);
   EXPECT_EQ(last.pairs[IndexOf(last, "pose3")].status, PairStatus::kRejected);
-  EXPECT_EQ(last.huber_delta, kHuberDelta);
+  EXPECT_EQ(last.settings.huber_delta, kHuberDelta);
   controller.Apply(RunSolver{});
   const Snapshot solved = Loaded(controller);
   ASSERT_TRUE(solved.solver.result) << solved.solver.failure;

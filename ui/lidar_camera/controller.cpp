@@ -41,7 +41,7 @@ SolverResult Controller::ResultForCurrentPairs() const {
     return result;
   std::vector<PairFeatures> features;
   for (const PairView& pair : state_.pairs) features.push_back(FeaturesOf(pair));
-  EvaluateAtSolution(features, SolverOptionsFromState(), &result);
+  EvaluateAtSolution(features, state_.settings.Over(pipeline_).solver, &result);
   return result;
 }
 
@@ -71,23 +71,6 @@ PairFeatures Controller::FeaturesOf(const PairView& pair) {
   if (features.status == PairStatus::kAccepted && !SolvesWith(pair))
     features.status = PairStatus::kFailed;
   return features;
-}
-
-PipelineOptions Controller::PipelineOptionsFromState() const {
-  PipelineOptions options = pipeline_;
-  options.solver = SolverOptionsFromState();
-  return options;
-}
-
-SolverOptions Controller::SolverOptionsFromState() const {
-  SolverOptions options = pipeline_.solver;
-  options.method = state_.method;
-  options.huber_delta = state_.huber_delta;
-  options.max_iterations = state_.max_iterations;
-  // The offset belongs to the weighted method; the checkbox keeps its value across methods.
-  options.estimate_range_offset =
-      state_.estimate_range_offset && state_.method == SolverMethod::kWeightedMl;
-  return options;
 }
 
 void Controller::ApplyCompletion(const std::vector<PairFeatures>& solved) {
@@ -273,29 +256,19 @@ void Controller::Handle(const ResetSolver&) {
 }
 
 template <>
-void Controller::Handle(const SetSolverOptions& options) {
-  SolverOptions check;
-  check.huber_delta = options.huber_delta;
-  check.max_iterations = options.max_iterations;
+void Controller::Handle(const SetSettings& intent) {
+  const JobSettings& settings = intent.settings;
   std::string why;
-  if (!check.Check(&why)) {
+  if (!settings.Check(&why)) {
     SetStatus("solver options: " + why, true);
     return;
   }
-  const bool method_changed = state_.method != options.method ||
-                              state_.estimate_range_offset != options.estimate_range_offset;
-  state_.method = options.method;
-  state_.estimate_range_offset = options.estimate_range_offset;
-  state_.huber_delta = options.huber_delta;
-  state_.max_iterations = options.max_iterations;
-  // Into the job's record as the user set them (the offset's checkbox keeps its value across
-  // methods; ApplySessionOptions uses it with the weighted method only).
-  SolverOptions solver = pipeline_.solver;
-  solver.method = options.method;
-  solver.huber_delta = options.huber_delta;
-  solver.max_iterations = options.max_iterations;
-  solver.estimate_range_offset = options.estimate_range_offset;
-  job_->SetSolverOptions(solver);
+  const bool method_changed =
+      state_.settings.method != settings.method ||
+      state_.settings.estimate_range_offset != settings.estimate_range_offset;
+  state_.settings = settings;
+  // Into the job's record as the user set them (JobSettings::Apply reads them).
+  job_->SetSettings(settings);
   AfterEdit();
   // Residuals and weights shown for the current estimate depend on the method.
   if (method_changed) RecomputeResiduals();
@@ -358,7 +331,7 @@ void Controller::Handle(const ExportResult& export_result) {
       SetStatus("exported " + path.string() + " (the adopted targetless estimate)", false);
       return;
     }
-    WriteResult(path, outcome, SolverOptionsFromState());
+    WriteResult(path, outcome, state_.settings.Over(pipeline_).solver);
     SetStatus("exported " + path.string(), false);
   } catch (const IoError& e) {
     SetStatus(e.what(), true);

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "core/base/file_lock.h"
+#include "core/capture/capture_feed.h"
 #include "core/io/camera_file.h"
-#include "core/io/capture_feed.h"
 #include "core/io/rig_folder.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/rig.h"
@@ -64,11 +64,8 @@ struct PaintPoints {
 };
 struct RunSolver {};
 struct ResetSolver {};
-struct SetSolverOptions {
-  double huber_delta;
-  int max_iterations;
-  SolverMethod method = SolverOptions{}.method;
-  bool estimate_range_offset = false;
+struct SetSettings {  // the solver's settings and the LiDAR plane's RANSAC threshold
+  JobSettings settings;
 };
 struct SetView {
   ViewState view;
@@ -112,7 +109,7 @@ struct SelectCamera {
 // they are now), in background steps on the worker; the meter and the frustums follow.
 struct SolveRig {};
 // A followed recording whose board no preset explains (Snapshot::board_problem): the board the
-// user picks, a preset's name (core/target/board.h) or a target file; the pairs held for want of
+// user picks, a preset's name (core/board/board.h) or a target file; the pairs held for want of
 // it are searched with it.
 struct PickBoard {
   std::string board;
@@ -128,7 +125,7 @@ struct RunCheck {
 struct AdoptCheckEstimate {};
 using Intent =
     std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush, DetectBoardAgain,
-                 PaintPoints, RunSolver, ResetSolver, SetSolverOptions, SetView, ExportResult,
+                 PaintPoints, RunSolver, ResetSolver, SetSettings, SetView, ExportResult,
                  SaveSessionAs, Undo, Redo, EstimateIntrinsics, SaveIntrinsics, SetGoal,
                  SelectCamera, SolveRig, PickBoard, RunCheck, AdoptCheckEstimate>;
 
@@ -176,14 +173,15 @@ class Controller : public ControllerState<Snapshot> {
   // window; tests and renders solve when asked). F5 / Run stays.
   void SetAutoSolve(bool on);
   // Follows a folder that a capture fills (the folder form: camera.yaml, target.json, clouds/,
-  // images/; core/io/folder_watch.h) in background steps on the worker, a look every 0.2 s: waits
-  // for its camera and target, opens it (resuming the session beside it), then adds each pair as it
-  // lands — loaded, detected and, with auto-solve, solved as the others. Pre-flight's rejections
-  // apply to the pairs as `watch` applies them. Stops with StopWatching or the controller.
+  // images/; core/capture/folder_watch.h) in background steps on the worker, a look every 0.2 s:
+  // waits for its camera and target, opens it (resuming the session beside it), then adds each pair
+  // as it lands — loaded, detected and, with auto-solve, solved as the others. Pre-flight's
+  // rejections apply to the pairs as `watch` applies them. Stops with StopWatching or the
+  // controller.
   void WatchFolder(const std::filesystem::path& folder, FolderWatchOptions options = {});
   // The same for a recording being written (.bag, .mcap, .db3, a rosbag2 folder): its pairs
-  // chosen as `import` and `watch` choose them (core/io/recording_watch.h) and written to `out`
-  // (the folder form), which opens once the first pair tells the camera and the board.
+  // chosen as `import` and `watch` choose them (core/capture/recording_watch.h) and written to
+  // `out` (the folder form), which opens once the first pair tells the camera and the board.
   void WatchRecording(const std::filesystem::path& recording, const std::filesystem::path& out,
                       std::optional<BoardSpec> board, BagImportOptions options);
   // Stops following; returns once no look runs. Not with mutex_ held (a look takes it).
@@ -232,8 +230,6 @@ class Controller : public ControllerState<Snapshot> {
   // `asked`: the user's Run, an undo step of its own; otherwise auto-solve's, on the same undo
   // step as the edit that asked for it (undoing a rejection undoes its solve too).
   void Solve(bool asked = true);
-  SolverOptions SolverOptionsFromState() const;          // the user's choices over pipeline_.solver
-  PipelineOptions PipelineOptionsFromState() const;      // pipeline_ with those solver choices
   static PairFeatures FeaturesOf(const PairView& pair);  // the pipeline's view of a pair
   // The solve's pairs back into the view: completion's boards and verdicts. Call with mutex_ held.
   void ApplyCompletion(const std::vector<PairFeatures>& solved);
@@ -254,7 +250,7 @@ class Controller : public ControllerState<Snapshot> {
   // Call with mutex_ held.
   void JudgeMeter(bool record);
   // The user's edits go to the job's record first (record-first, as the LRF workbench's): the job's
-  // SetRejected, SetBrush and SetSolverOptions, the record's Edit for the view and a reset solve;
+  // SetRejected, SetBrush and SetSettings, the record's Edit for the view and a reset solve;
   // state_ shows what the handler asked for, and undo restores state_ from the record
   // (ApplySessionToState). Then AfterEdit: the undo buttons, autosave, a new generation. Call
   // these with mutex_ held.
@@ -307,6 +303,8 @@ class Controller : public ControllerState<Snapshot> {
   void Restore(const std::optional<Session>& restored);  // undo / redo
 
   std::optional<FileLock> session_lock_;  // held while session_path is open for editing
+  // The options the workbench was started with; the session's settings (state_.settings, the
+  // record's) apply over them: JobSettings::Over.
   PipelineOptions pipeline_;
   std::string open_note_;  // how the session was opened, for the status line once loaded (mutex_)
   std::vector<std::string> load_warnings_;  // what loading refused, for the status line (mutex_)
@@ -349,7 +347,7 @@ void Controller::Handle(const RunSolver&);
 template <>
 void Controller::Handle(const ResetSolver&);
 template <>
-void Controller::Handle(const SetSolverOptions&);
+void Controller::Handle(const SetSettings&);
 template <>
 void Controller::Handle(const SetView&);
 template <>

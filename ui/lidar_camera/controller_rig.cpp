@@ -96,7 +96,7 @@ void Controller::StartRigSolve() {
   run->path = state_.rig->path;
   run->active = state_.rig->cameras[state_.rig->active].name;
   if (job_) run->edits[run->active] = job_->record().Edits();
-  run->options = PipelineOptionsFromState();
+  run->options = state_.settings.Over(pipeline_);
   worker_.EnqueueBackground(kRigLane, [this, run] { RigStep(run); });
 }
 

@@ -138,9 +138,8 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     // The pipeline job over the dataset's pairs as they load (LoadPair appends them), with the
     // session's options and the session as its record; every solver iteration shows as it
     // happens.
-    ApplySessionOptions(session, &pipeline_);
     CalibrationJobOptions job_options;
-    job_options.advise.pipeline = pipeline_;
+    job_options.advise.pipeline = session.settings.Over(pipeline_);
     job_options.advise.pipeline.pair_ids.clear();  // the workbench shows every pair
     Dataset setup = dataset;
     setup.pairs.clear();
@@ -175,7 +174,6 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
 
 void Controller::ApplySessionToState(const Session& session) {
   mutex_.AssertHeld(__func__);
-  ApplySessionOptions(session, &pipeline_);
   std::vector<std::string> ids;
   for (const PairState& pair : session.pairs) ids.push_back(pair.id);
   try {
@@ -183,10 +181,7 @@ void Controller::ApplySessionToState(const Session& session) {
   } catch (const IoError&) {  // Open checked it; undo restores views this controller wrote
     state_.view = ViewState{};
   }
-  state_.method = session.method;
-  state_.huber_delta = session.huber_delta;
-  state_.max_iterations = session.max_iterations;
-  state_.estimate_range_offset = session.estimate_range_offset;
+  state_.settings = session.settings;
   for (size_t i = 0; i < session.pairs.size() && i < state_.pairs.size(); ++i) {
     PairView& pair = state_.pairs[i];
     const PairState& saved = session.pairs[i];
@@ -210,7 +205,7 @@ void Controller::ApplySessionToState(const Session& session) {
   if (state_.selected < 0 && !state_.pairs.empty()) state_.selected = 0;
   state_.solver = SolverView{};
   if (session.result) {
-    state_.solver.result = SolverResultFromSession(*session.result, session.method);
+    state_.solver.result = SolverResultFromSession(*session.result, session.settings.method);
     state_.solver.notes = session.result->notes;
     state_.solver.targetless_provenance = session.result->targetless_provenance;
     // The recorded convergence, so that the solver panel and the replay look as they did.
@@ -260,11 +255,9 @@ void Controller::RecordWhatFollowed(bool same_step) {
     }
   }
   const std::string view = ViewJson();
-  const double ransac_threshold_m = pipeline_.lidar_plane.ransac_threshold_m;  // detection's
   job_->record().Edit(
       [&](Session* session) {
         session->view_json = view;
-        session->ransac_threshold_m = ransac_threshold_m;
         // The record holds every pair state_ shows, in the same order (Open resumed it over the
         // dataset; AddPair adds each pair that joins to both).
         for (size_t i = 0; i < state_.pairs.size() && i < session->pairs.size(); ++i) {

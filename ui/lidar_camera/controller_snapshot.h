@@ -146,10 +146,7 @@ struct Snapshot : SnapshotHeader {
   SolverView solver;
   std::shared_ptr<const Reprojection> reprojection;
   ViewState view;
-  SolverMethod method = SolverOptions{}.method;
-  double huber_delta = SolverOptions{}.huber_delta;
-  int max_iterations = SolverOptions{}.max_iterations;
-  bool estimate_range_offset = false;  // weighted-ml only
+  JobSettings settings;  // the job record's (Session::settings)
   bool can_undo = false, can_redo = false;
   int loading_done = 0, loading_total = 0;
   // The camera's intrinsics estimated from the loaded pairs' corners (EstimateIntrinsics), what

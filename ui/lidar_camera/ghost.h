@@ -4,8 +4,8 @@
 
 #include <vector>
 
+#include "core/board/board.h"
 #include "core/camera/camera.h"
-#include "core/target/board.h"
 
 namespace calibench::ui {
 

@@ -9,9 +9,9 @@
 #include <sstream>
 #include <thread>
 
-#include "core/io/bag.h"
+#include "core/capture/recording_watch.h"
 #include "core/io/dataset.h"
-#include "core/io/recording_watch.h"
+#include "core/recording/bag.h"
 #include "core/results/export.h"
 #include "ui/lidar_camera/workbench.h"
 #include "ui/widgets/error_popup.h"

@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/io/bag_import.h"
-#include "core/target/board.h"
+#include "core/board/board.h"
+#include "core/capture/bag_import.h"
 #include "ui/lidar_camera/controller.h"
 #include "ui/state/recent_files.h"
 #include "ui/widgets/file_browser.h"

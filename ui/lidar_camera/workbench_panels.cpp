@@ -26,13 +26,13 @@ constexpr const char* kMethodHelp[] = {
     "kim: closed form from the normals (Kim et al. 2020), no refinement"};
 
 // The solver method, with what each does; a change is an intent. Returns the method's index.
-int MethodCombo(const Snapshot& s, std::vector<Intent>* intents) {
+int MethodCombo(const JobSettings& settings, std::vector<Intent>* intents) {
   int method_index = 0;
   for (int i = 0; i < 3; ++i)
-    if (kMethods[i] == s.method) method_index = i;
-  SolverMethod method = s.method;
+    if (kMethods[i] == settings.method) method_index = i;
+  SolverMethod method = settings.method;
   ImGui::SetNextItemWidth(140);
-  if (ImGui::BeginCombo("method", SolverMethodName(s.method).c_str())) {
+  if (ImGui::BeginCombo("method", SolverMethodName(settings.method).c_str())) {
     for (int i = 0; i < 3; ++i) {
       if (ImGui::Selectable(SolverMethodName(kMethods[i]).c_str(), i == method_index))
         method = kMethods[i];
@@ -40,22 +40,23 @@ int MethodCombo(const Snapshot& s, std::vector<Intent>* intents) {
     }
     ImGui::EndCombo();
   }
-  if (method != s.method)
-    intents->push_back(
-        SetSolverOptions{s.huber_delta, s.max_iterations, method, s.estimate_range_offset});
+  if (method != settings.method) {
+    JobSettings changed = settings;
+    changed.method = method;
+    intents->push_back(SetSettings{changed});
+  }
   return method_index;
 }
 
 // Method, range offset, Huber delta and iterations; each change an intent.
 void SolverOptionsRows(const Snapshot& s, std::vector<Intent>* intents) {
-  const int method_index = MethodCombo(s, intents);
-  double delta = s.huber_delta;
-  int iterations = s.max_iterations;
+  const JobSettings& shown = s.settings;
+  const int method_index = MethodCombo(shown, intents);
+  JobSettings edited = shown;
   ImGui::SameLine();
-  ImGui::BeginDisabled(s.method != SolverMethod::kWeightedMl);
-  bool estimate_offset = s.estimate_range_offset;
-  if (ImGui::Checkbox("range offset", &estimate_offset))
-    intents->push_back(SetSolverOptions{delta, iterations, s.method, estimate_offset});
+  ImGui::BeginDisabled(shown.method != SolverMethod::kWeightedMl);
+  if (ImGui::Checkbox("range offset", &edited.estimate_range_offset))
+    intents->push_back(SetSettings{edited});
   if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
     ImGui::SetTooltip(
         "weighted-ml: also estimate a constant LiDAR range offset (measured = true + offset),\n"
@@ -64,13 +65,13 @@ void SolverOptionsRows(const Snapshot& s, std::vector<Intent>* intents) {
   ImGui::SameLine();
   ImGui::TextDisabled("%s", kMethodHelp[method_index]);
   ImGui::SetNextItemWidth(120);
-  ImGui::InputDouble("Huber delta", &delta, 0.01, 0.1, "%.3f");
+  edited = shown;  // the text fields' edits count once done, without the checkbox's
+  ImGui::InputDouble("Huber delta", &edited.huber_delta, 0.01, 0.1, "%.3f");
   const bool delta_done = ImGui::IsItemDeactivatedAfterEdit();
   ImGui::SameLine();
   ImGui::SetNextItemWidth(100);
-  ImGui::InputInt("max iterations", &iterations);
-  if (delta_done || ImGui::IsItemDeactivatedAfterEdit())
-    intents->push_back(SetSolverOptions{delta, iterations, s.method, s.estimate_range_offset});
+  ImGui::InputInt("max iterations", &edited.max_iterations);
+  if (delta_done || ImGui::IsItemDeactivatedAfterEdit()) intents->push_back(SetSettings{edited});
 }
 
 // Iteration, cost and step length of each iteration, the shown one highlighted.

@@ -8,7 +8,7 @@
 
 #include "core/io/cloud_io.h"
 #include "core/io/image_io.h"
-#include "core/lrf/dataset.h"
+#include "core/lrf_data/dataset.h"
 #include "tests/test_support.h"
 
 namespace calibench {

@@ -1,14 +1,14 @@
 // The rig's folder form (core/io/rig_folder.h) and the names a rig import gives its cameras
-// (core/io/rig_import.h).
+// (core/capture/rig_import.h).
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
+#include "core/capture/rig_import.h"
 #include "core/io/camera_file.h"
 #include "core/io/dataset.h"
 #include "core/io/rig_folder.h"
-#include "core/io/rig_import.h"
 #include "core/session/session.h"
 #include "core/sim/sim.h"
 #include "tests/test_support.h"

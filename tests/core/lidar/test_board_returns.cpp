@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "core/base/types.h"
+#include "core/board/board.h"
 #include "core/lidar/board_returns.h"
 #include "core/sim/sim.h"
-#include "core/target/board.h"
 #include "core/target/board_print.h"
 
 namespace calibench {

@@ -165,8 +165,8 @@ TEST(CalibrationJob, ResumedFromASessionItKeepsTheUsersWordAndWritesItBack) {
   saved.pairs[1].brush = BrushMask{image.rows, image.columns, {}};  // erased: no board there
   saved.pairs[2].brush = BrushMask{image.rows, image.columns, {5, 6}};
   saved.pairs[2].brush_from_seed = true;  // a seed's picture, not the user's word
-  saved.huber_delta = 0.25;
-  saved.max_iterations = 40;
+  saved.settings.huber_delta = 0.25;
+  saved.settings.max_iterations = 40;
   saved.view_json = R"({"selected_pair":"0002"})";
 
   // The pairs arrive after the session is resumed, one by one as a capture's.
@@ -188,7 +188,7 @@ TEST(CalibrationJob, ResumedFromASessionItKeepsTheUsersWordAndWritesItBack) {
 
   // `calibrate --session` on the same file: the same solve.
   PipelineOptions options;
-  ApplySessionOptions(saved, &options);
+  saved.settings.Apply(&options);
   const CalibrationOutcome cli = CalibrateDataset(dataset, options, {}, EditsFromSession(saved));
   ASSERT_TRUE(cli.solution) << cli.failure;
   ExpectSamePose(outcome.solution->cam_from_lidar, cli.solution->cam_from_lidar, 1e-12,
@@ -200,8 +200,8 @@ TEST(CalibrationJob, ResumedFromASessionItKeepsTheUsersWordAndWritesItBack) {
   EXPECT_EQ(written.pairs[0].reason, saved.pairs[0].reason);
   EXPECT_EQ(written.pairs[1].brush, saved.pairs[1].brush);
   EXPECT_FALSE(written.pairs[2].brush);  // no seed picture: the seed is the manifest's
-  EXPECT_EQ(written.huber_delta, 0.25);
-  EXPECT_EQ(written.max_iterations, 40);
+  EXPECT_EQ(written.settings.huber_delta, 0.25);
+  EXPECT_EQ(written.settings.max_iterations, 40);
   EXPECT_EQ(written.view_json, saved.view_json);
   EXPECT_EQ(EditsFromSession(written).size(), 2u);  // the rejection and the erased brush
 }

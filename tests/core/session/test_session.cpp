@@ -52,9 +52,9 @@ Session FullSession(const fs::path& dataset) {
   s.pairs[2].brush_from_seed = true;
   s.pairs[3].reason = "clouds/0003.pcd: cannot open \"file\"\n(second line)";
   s.pairs[3].brush = Mask(32, 512, {});
-  s.huber_delta = 1.0 / 3.0;
-  s.max_iterations = 17;
-  s.ransac_threshold_m = 0.1 + 0.2;
+  s.settings.huber_delta = 1.0 / 3.0;
+  s.settings.max_iterations = 17;
+  s.settings.ransac_threshold_m = 0.1 + 0.2;
   // The workbench's view, kept as it is (ui/state/view_state.h reads it); members sorted, as a
   // reread file gives them.
   s.view_json = R"({"orbit_target_m":[0.1,-5e-324,7.0],"point_opacity":0.7,)"
@@ -218,16 +218,16 @@ TEST(SessionTest, NewSessionHasOnePendingPairPerDatasetPair) {
   }
   EXPECT_EQ(s.view_json, "{}");  // the workbench selects the first pair
   EXPECT_FALSE(s.result.has_value());
-  EXPECT_EQ(s.huber_delta, SolverOptions{}.huber_delta);
-  EXPECT_EQ(s.max_iterations, SolverOptions{}.max_iterations);
-  EXPECT_EQ(s.ransac_threshold_m, LidarPlaneOptions{}.ransac_threshold_m);
+  EXPECT_EQ(s.settings.huber_delta, SolverOptions{}.huber_delta);
+  EXPECT_EQ(s.settings.max_iterations, SolverOptions{}.max_iterations);
+  EXPECT_EQ(s.settings.ransac_threshold_m, LidarPlaneOptions{}.ransac_threshold_m);
 
   PipelineOptions options;
   Session edited = s;
-  edited.huber_delta = 0.05;
-  edited.max_iterations = 7;
-  edited.ransac_threshold_m = 0.02;
-  ApplySessionOptions(edited, &options);
+  edited.settings.huber_delta = 0.05;
+  edited.settings.max_iterations = 7;
+  edited.settings.ransac_threshold_m = 0.02;
+  edited.settings.Apply(&options);
   EXPECT_EQ(options.solver.huber_delta, 0.05);
   EXPECT_EQ(options.solver.max_iterations, 7);
   EXPECT_EQ(options.lidar_plane.ransac_threshold_m, 0.02);
@@ -322,7 +322,7 @@ TEST(SessionTest, SaveIsAtomicAndReplacesAnExistingFile) {
 
 TEST(SessionTest, UndoRedoWalksTheEditHistory) {
   std::vector<Session> states(5, FullSession("/d/dataset.json"));
-  for (int i = 0; i < 5; ++i) states[i].max_iterations = 10 + i % 4;
+  for (int i = 0; i < 5; ++i) states[i].settings.max_iterations = 10 + i % 4;
   states[4].pairs[0].status = PairStatus::kAccepted;
   SessionHistory history;
   EXPECT_FALSE(history.CanUndo());
@@ -356,13 +356,13 @@ TEST(SessionTest, HistoryKeepsABoundedNumberOfSteps) {
   SessionHistory history(3);
   Session s = FullSession("/d/dataset.json");
   for (int i = 0; i < 10; ++i) {
-    s.max_iterations = 10 + i;
+    s.settings.max_iterations = 10 + i;
     history.Push(s);
   }
   EXPECT_EQ(history.UndoDepth(), 3u);
   std::optional<Session> restored;
   for (int i = 0; i < 3; ++i) restored = history.Undo();
-  EXPECT_EQ(restored->max_iterations, 16);
+  EXPECT_EQ(restored->settings.max_iterations, 16);
   EXPECT_FALSE(history.CanUndo());
 }
 
@@ -379,7 +379,7 @@ TEST(SessionTest, AutosaverWritesOnlyWhenTheSessionChanged) {
   for (int i = 0; i < 20; ++i) EXPECT_FALSE(saver.Save(s));
   EXPECT_EQ(saver.writes(), 1);
   EXPECT_EQ(fs::last_write_time(path), old_time);
-  s.max_iterations += 1;
+  s.settings.max_iterations += 1;
   EXPECT_TRUE(saver.Save(s));
   EXPECT_EQ(saver.writes(), 2);
   EXPECT_NE(fs::last_write_time(path), old_time);
@@ -403,23 +403,23 @@ TEST(SessionTest, AutosaverKeepsTheLastVersionsAsRotatingBackups) {
   Autosaver saver(path, every_save);
   Session s = FullSession(dir / "dataset.json");
   for (int version = 1; version <= 6; ++version) {
-    s.max_iterations = version;
+    s.settings.max_iterations = version;
     ASSERT_TRUE(saver.Save(s));
   }
-  EXPECT_EQ(LoadSession(path).max_iterations, 6);
+  EXPECT_EQ(LoadSession(path).settings.max_iterations, 6);
   for (int n = 1; n <= 3; ++n)
-    EXPECT_EQ(LoadSession(SessionBackupPath(path, n)).max_iterations, 6 - n) << n;
+    EXPECT_EQ(LoadSession(SessionBackupPath(path, n)).settings.max_iterations, 6 - n) << n;
   EXPECT_FALSE(fs::exists(SessionBackupPath(path, 4)));
 
   // By default the first save of a process keeps the file as it found it; later saves within the
   // interval do not push it out.
   Autosaver reopened(path);
   for (int version = 7; version <= 9; ++version) {
-    s.max_iterations = version;
+    s.settings.max_iterations = version;
     ASSERT_TRUE(reopened.Save(s));
   }
-  EXPECT_EQ(LoadSession(SessionBackupPath(path, 1)).max_iterations, 6);
-  EXPECT_EQ(LoadSession(SessionBackupPath(path, 2)).max_iterations, 5);
+  EXPECT_EQ(LoadSession(SessionBackupPath(path, 1)).settings.max_iterations, 6);
+  EXPECT_EQ(LoadSession(SessionBackupPath(path, 2)).settings.max_iterations, 5);
 
   AutosaveOptions bad;
   bad.backups = -1;
@@ -448,7 +448,7 @@ TEST(SessionTest, AutosaveSurvivesSigkillAtAnyMoment) {
       Autosaver saver(path, every_save);
       Session s = base;
       for (int version = 1;; ++version) {
-        s.max_iterations = kill * 100000 + version;
+        s.settings.max_iterations = kill * 100000 + version;
         saver.Save(s);
       }
     }
@@ -462,7 +462,7 @@ TEST(SessionTest, AutosaveSurvivesSigkillAtAnyMoment) {
       if (file != path && !fs::exists(file)) continue;
       Session loaded;
       ASSERT_NO_THROW(loaded = LoadSession(file)) << "kill " << kill << ": " << file;
-      loaded.max_iterations = base.max_iterations;
+      loaded.settings.max_iterations = base.settings.max_iterations;
       EXPECT_EQ(loaded, base) << "kill " << kill << ": " << file;
     }
     named_temporaries_left += static_cast<int>(test::TemporariesBeside(path).size());

@@ -83,33 +83,34 @@ TEST(SessionRecord, AutosavesWhenItChangedAndSavesAsAnotherFile) {
   record.AutosaveTo(dir / "s.json");
   record.Autosave();
   EXPECT_EQ(LoadSession(dir / "s.json"), record.Current());
-  record.Edit([](Session* s) { s->huber_delta = 0.25; });
+  record.Edit([](Session* s) { s->settings.huber_delta = 0.25; });
   record.Autosave();
-  EXPECT_EQ(LoadSession(dir / "s.json").huber_delta, 0.25);
+  EXPECT_EQ(LoadSession(dir / "s.json").settings.huber_delta, 0.25);
 
   record.SaveAs(dir / "other.json");
-  record.Edit([](Session* s) { s->max_iterations = 7; });
+  record.Edit([](Session* s) { s->settings.max_iterations = 7; });
   record.Autosave();
-  EXPECT_EQ(LoadSession(dir / "other.json").max_iterations, 7);
-  EXPECT_NE(LoadSession(dir / "s.json").max_iterations, 7);  // that file is no longer written
+  EXPECT_EQ(LoadSession(dir / "other.json").settings.max_iterations, 7);
+  EXPECT_NE(LoadSession(dir / "s.json").settings.max_iterations,
+            7);  // that file is no longer written
 
   record.AutosaveTo(dir / "missing" / "folder" / "s.json");
   EXPECT_THROW(record.Autosave(), IoError);
-  EXPECT_EQ(record.Current().max_iterations, 7);  // the failed write loses nothing
+  EXPECT_EQ(record.Current().settings.max_iterations, 7);  // the failed write loses nothing
 }
 
 // The workbench edits the record on its UI thread while the job reads it on the worker: every read
 // sees one whole state, never half of an edit (and ThreadSanitizer sees the lock).
 TEST(SessionRecord, ReadersSeeWholeEditsWhileAnotherThreadEdits) {
   Session start = ThreePairs();
-  start.max_iterations = 0;  // the edits count from 1
+  start.settings.max_iterations = 0;  // the edits count from 1
   SessionRecord record(start);
   std::atomic<bool> done{false};
   std::thread editor([&] {
     for (int i = 1; i <= 2000; ++i)
       record.Edit([i](Session* s) {
         // One edit moves both together: a reader must never see them disagree.
-        s->max_iterations = i;
+        s->settings.max_iterations = i;
         s->pairs[0].brush = BrushMask{1, 4000, std::vector<int>(i % 50, i)};
         s->pairs[0].status = i % 2 ? PairStatus::kRejected : PairStatus::kAccepted;
         s->pairs[0].reason = std::to_string(i);
@@ -120,7 +121,7 @@ TEST(SessionRecord, ReadersSeeWholeEditsWhileAnotherThreadEdits) {
   while (!done || reads == 0) {
     const Session now = record.Current();
     const PairState& a = now.pairs[0];
-    const int i = now.max_iterations;
+    const int i = now.settings.max_iterations;
     if (i > 0 &&
         (a.reason != std::to_string(i) || static_cast<int>(a.brush->pixels.size()) != i % 50))
       ++torn;
@@ -130,7 +131,7 @@ TEST(SessionRecord, ReadersSeeWholeEditsWhileAnotherThreadEdits) {
   }
   editor.join();
   EXPECT_EQ(torn, 0) << "of " << reads << " reads";
-  EXPECT_EQ(record.Current().max_iterations, 2000);
+  EXPECT_EQ(record.Current().settings.max_iterations, 2000);
 }
 
 // The job reads the user's word from its record at each step: an edit made there (as the
@@ -148,7 +149,7 @@ TEST(SessionRecord, TheJobSolvesWithWhatTheRecordSaysNow) {
     job.record().Edit([&](Session* s) {
       s->pairs[0].status = PairStatus::kRejected;
       s->pairs[0].reason = "the board is half in shadow";
-      s->huber_delta = 0.5;
+      s->settings.huber_delta = 0.5;
     });
   });
   ui.join();
@@ -158,7 +159,7 @@ TEST(SessionRecord, TheJobSolvesWithWhatTheRecordSaysNow) {
   EXPECT_EQ(rejected.pairs[0].reason, "the board is half in shadow");
   const Session written = job.ToSession(dataset.manifest);
   EXPECT_EQ(written.pairs[0].reason, "the board is half in shadow");
-  EXPECT_EQ(written.huber_delta, 0.5);
+  EXPECT_EQ(written.settings.huber_delta, 0.5);
 
   // The job's own word (the command line's) is an undo step in the same record.
   job.SetRejected(dataset.pairs[1].id, true);

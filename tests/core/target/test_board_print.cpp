@@ -5,8 +5,8 @@
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/board/charuco_board.h"
 #include "core/target/board_print.h"
-#include "core/target/charuco_board.h"
 
 namespace calibench {
 namespace {

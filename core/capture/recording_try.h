@@ -1,0 +1,45 @@
+// What core/capture/recording_pairs.cpp hands its second thread for one sweep tried (internal to
+// core/io): the sweep's bytes, the nearest image and the others in its stillness window, copied
+// out of the reader's window, and the camera they are judged with.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/base/image.h"
+#include "core/camera/camera.h"
+
+namespace calibench::recording_detail {
+
+using Bytes = std::shared_ptr<const std::vector<std::uint8_t>>;
+
+inline Bytes Copy(std::span<const std::uint8_t> data) {
+  return std::make_shared<const std::vector<std::uint8_t>>(data.begin(), data.end());
+}
+
+struct StampedBytes {
+  std::int64_t stamp_ns = 0;
+  Bytes bytes;
+};
+
+struct Try {
+  int hold = 0;
+  StampedBytes cloud;
+  StampedBytes image;                // the nearest in time
+  std::vector<StampedBytes> others;  // the other images within the stillness window
+  // A ring-less LiDAR's other sweeps within the integration span (PairSelectionOptions::
+  // ringless_integration_s), integrated with `cloud` into the pair's cloud.
+  std::vector<StampedBytes> integrated;
+  CameraModel camera;
+};
+
+// A try with its image decoded (nullopt: unreadable), held while the board is not known.
+struct HeldTry {
+  Try attempt;
+  std::optional<ImageU8> image;
+};
+
+}  // namespace calibench::recording_detail
