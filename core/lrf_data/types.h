@@ -1,6 +1,6 @@
 // Data of the 2D laser rangefinder (LRF) ↔ depth camera method
 // (papers/lrf-depth-camera-vboard.txt, Sections 3–4), and of the LRF ↔ RGB camera checkerboard
-// method (Zhang & Pless 2004). No I/O here: see lrf_dataset.h.
+// method (Zhang & Pless 2004). No I/O here: see core/lrf_data/dataset.h.
 //
 // Frames. LRF: x forward, y left, z up; the scan lies in z = 0. Depth/RGB camera: x right,
 // y down, z forward (optical). The extrinsic is cam_from_lrf: x_cam = cam_from_lrf * x_lrf.
