@@ -9,9 +9,7 @@
 #include <zstd.h>
 
 #include <algorithm>
-#include <array>
 #include <cerrno>
-#include <fstream>
 
 #include "core/base/names.h"
 #include "core/recording/bag_internal.h"
