@@ -185,6 +185,8 @@ struct PairEdit {
   int brush_rows = 0;  // the image layout the brush was painted on
   int brush_columns = 0;
   bool rejected = false;
+
+  bool operator==(const PairEdit&) const = default;
 };
 using PairEdits = std::map<std::string, PairEdit>;  // by pair id
 

@@ -233,35 +233,54 @@ void CalibrationJob::SetHandTolerance(double translation_m, double rotation_deg)
 }
 
 std::vector<PairFeatures> CalibrationJob::DetectedPairs() const {
+  return DetectedPairs(record_.Current());
+}
+
+std::vector<PairFeatures> CalibrationJob::DetectedPairs(const Session& record) const {
   std::vector<PairFeatures> features;
   for (const JobPair& pair : pairs_) {
     features.push_back(pair.detected);
-    std::string reason;
-    if (!record_.Rejected(pair.detected.id, &reason)) continue;
+    const PairState* state = FindPair(record, pair.detected.id);
+    if (!state || state->status != PairStatus::kRejected) continue;
     features.back().status = PairStatus::kRejected;
-    features.back().reason = reason;
+    features.back().reason = state->reason.empty() ? kRejectedByUser : state->reason;
   }
   return features;
 }
 
 const CalibrationOutcome& CalibrationJob::Solve() {
-  PipelineOptions pipeline = Pipeline();
+  // The record read once: the edits, the rejections and the settings of one moment, which
+  // DiscardStaleOutcome compares with the record's when the solve is done.
+  const Session record = record_.Current();
+  PipelineOptions pipeline = options_.advise.pipeline;
+  record.settings.Apply(&pipeline);
   // Warm start: the last solution is a better start than the closed form, and the same minimum.
   if (options_.warm_start && last_solution_ && !pipeline.initial_cam_from_lidar)
     pipeline.initial_cam_from_lidar = last_solution_->cam_from_lidar;
   std::vector<const PairEntry*> entries;
   for (const PairEntry& pair : dataset_.pairs) entries.push_back(&pair);
-  const PairEdits edits = record_.Edits();
+  solved_edits_ = EditsFromSession(record);
+  solved_settings_ = record.settings;
   // Every solve starts from what detection found, as `calibrate` does: a board completion
   // rescued is rescued again, one the camera disagrees with is looked at again.
-  outcome_ =
-      SolveExtractedPairs(dataset_, entries, DetectedPairs(), pipeline, edits, events_.iteration);
+  outcome_ = SolveExtractedPairs(dataset_, entries, DetectedPairs(record), pipeline, solved_edits_,
+                                 events_.iteration);
   outcome_->background_note = background_note_;
   outcome_->estimated_intrinsics = options_.estimated_intrinsics;
   solved_with_ = pipeline.solver;
   if (outcome_->solution) last_solution_ = outcome_->solution;
   advice_.reset();
   return *outcome_;
+}
+
+bool CalibrationJob::DiscardStaleOutcome() {
+  if (!outcome_) return false;
+  const Session record = record_.Current();
+  if (EditsFromSession(record) == solved_edits_ && record.settings == solved_settings_)
+    return false;
+  outcome_.reset();
+  advice_.reset();
+  return true;
 }
 
 void CalibrationJob::ExtractAll(const ProgressCallback& progress) {

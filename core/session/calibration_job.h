@@ -109,6 +109,13 @@ class CalibrationJob final : public Job {
   // `calibrate` runs after extraction (SolveExtractedPairs: solve, camera-guided completion, the
   // intrinsics). The outcome's pairs carry completion's boards and verdicts.
   const CalibrationOutcome& Solve();
+  // The user's word changed while the last Solve ran (a front end undid or edited from its own
+  // thread: the record locks itself, the solve reads it once at its start): that outcome answers
+  // edits or settings that no longer stand. It is then dropped, with its guidance, and true
+  // returned; the caller shows the record as it stands (an undo's restored solve) or solves
+  // again. False, keeping the outcome, when the record's edits and settings are still those the
+  // solve ran with (an edit undone and redone meanwhile is the same word).
+  bool DiscardStaleOutcome();
   // Pre-flight, the meter and the next pose (AdviseCapture) after the last solve; with `at`, at
   // that solution instead (a reopened session's).
   const CaptureAdvice& Advise(const std::optional<SolverResult>& at = std::nullopt);
@@ -154,6 +161,8 @@ class CalibrationJob final : public Job {
   // `edit` into pair `pair_id`'s state (added when the session has no such pair yet); that state.
   static PairState& SetEdit(Session* session, const std::string& pair_id, const PairEdit& edit);
   PipelineOptions Pipeline() const;  // options_'s with the record's settings
+  // The pairs as detection found them, with `record`'s rejections.
+  std::vector<PairFeatures> DetectedPairs(const Session& record) const;
   const SceneBackground* Background() const { return background_ ? &*background_ : nullptr; }
 
   Dataset dataset_;
@@ -168,6 +177,9 @@ class CalibrationJob final : public Job {
   std::optional<CalibrationOutcome> outcome_;
   std::optional<SolverResult> last_solution_;
   SolverOptions solved_with_;  // the solver settings of outcome_'s solve (the record's)
+  // The record's edits and settings outcome_'s solve read (DiscardStaleOutcome).
+  PairEdits solved_edits_;
+  JobSettings solved_settings_;
   std::optional<CaptureAdvice> advice_;
 };
 

@@ -5,15 +5,12 @@
 #include "core/results/pair_status.h"
 
 namespace calibench {
-namespace {
 
 const PairState* FindPair(const Session& session, const std::string& id) {
   for (const PairState& pair : session.pairs)
     if (pair.id == id) return &pair;
   return nullptr;
 }
-
-}  // namespace
 
 PairState* FindPair(Session* session, const std::string& id) {
   return const_cast<PairState*>(FindPair(*session, id));

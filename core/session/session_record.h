@@ -23,6 +23,7 @@ namespace calibench {
 
 // Pair `id`'s state in `session`, or null; and its brush forgotten (painted or from a seed).
 PairState* FindPair(Session* session, const std::string& id);
+const PairState* FindPair(const Session& session, const std::string& id);
 void ForgetBrush(Session* session, const std::string& id);
 
 class SessionRecord {

@@ -115,6 +115,23 @@ void Controller::Solve(bool asked) {
   CalibrationOutcome outcome = job_->Solve();
   const PipelineOptions options = job_->options().advise.pipeline;
   std::lock_guard lock(mutex_);
+  // An undo, redo or edit while it ran (the UI thread edits the record under mutex_, which the
+  // solve does not hold): its outcome answers a word that no longer stands. Written into the
+  // record it would undo the undo (the rejection back, its solve standing) or lose the edit.
+  // After an undo or redo the restored state stands with its own solve (Restore showed it, so
+  // the solver no longer shows this one running); after an edit the edits as they are now are
+  // solved again (auto-solve's, once; the user's Run).
+  if (job_->DiscardStaleOutcome()) {
+    const bool restored = !state_.solver.running;
+    state_.solver.running = false;
+    ++state_.generation;
+    if (restored) return;
+    if (asked)
+      worker_.Enqueue([this] { Solve(); });
+    else
+      RequestSolve();
+    return;
+  }
   state_.solver.running = false;
   // Pairs added meanwhile (a watched folder) are not in this solve; the next one has them.
   if (outcome.pairs.size() <= state_.pairs.size()) ApplyCompletion(outcome.pairs);

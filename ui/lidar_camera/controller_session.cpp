@@ -146,6 +146,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     JobEvents events;
     events.iteration = [this](const IterationReport& it) {
       std::lock_guard lock(mutex_);
+      if (!state_.solver.running) return;  // an undo restored another solve meanwhile
       state_.solver.iterations.push_back(it);
       ++state_.generation;
     };

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <functional>
+#include <utility>
 
 #include "core/lidar/lidar_image.h"
 #include "core/session/calibration_job.h"
@@ -146,6 +148,62 @@ TEST(CalibrationJob, TheUsersRejectionsAndBrushesAreItsWord) {
   ASSERT_TRUE(cli_erased.solution && brushed.solution);
   ExpectSamePose(brushed.solution->cam_from_lidar, cli_erased.solution->cam_from_lidar, 1e-12,
                  "pair 1 erased");
+}
+
+// A front end edits the record from its own thread while the job solves on another (the
+// workbench's ctrl+z while its worker runs the rejection's solve). The solve read the record
+// once; when the word it read no longer stands the outcome is dropped, never kept as the answer
+// to the record as it is now. An edit undone and redone meanwhile is the same word.
+TEST(CalibrationJob, AnUndoWhileItSolvesDropsThatSolveAndTheRecordEndsWhereItStarted) {
+  const auto dir = test::TempDir("calibration_job_undo_race");
+  const Dataset dataset = test::CompletionMattersScene(dir / "set");
+  std::function<void()> during_solve;  // runs at the solve's first iteration, then no more
+  CalibrationJob job(dataset, {}, {}, {.detected = {}, .iteration = [&](const IterationReport&) {
+                                         if (during_solve) std::exchange(during_solve, {})();
+                                       }});
+  job.DetectAll();
+  const CalibrationOutcome all = job.Solve();
+  ASSERT_TRUE(all.solution) << all.failure;
+  EXPECT_FALSE(job.DiscardStaleOutcome());
+  const Session before = job.record().Current();
+  const std::string pair = dataset.pairs[1].id;
+
+  job.SetRejected(pair, true);
+  during_solve = [&] { ASSERT_TRUE(job.record().Undo()); };
+  const CalibrationOutcome raced = job.Solve();
+  ASSERT_TRUE(raced.solution);
+  EXPECT_EQ(raced.pairs[1].status, PairStatus::kRejected);  // it solved the rejection it read
+  EXPECT_FALSE(during_solve);                               // and the undo came meanwhile
+  EXPECT_TRUE(job.DiscardStaleOutcome());
+  EXPECT_FALSE(job.outcome());
+  EXPECT_FALSE(job.advice());
+  EXPECT_EQ(job.record().Current(), before);
+  EXPECT_FALSE(job.DiscardStaleOutcome());  // nothing left to drop
+  // Solved again, the record as it stands gives the first solve, bit for bit.
+  const CalibrationOutcome& again = job.Solve();
+  ASSERT_TRUE(again.solution);
+  EXPECT_EQ(again.solution->cam_from_lidar.matrix(), all.solution->cam_from_lidar.matrix());
+  EXPECT_EQ(again.pairs[1].status, PairStatus::kAccepted);
+
+  // Undone and redone while it solves: the word it read stands, and so does its outcome.
+  job.SetRejected(pair, true);
+  during_solve = [&] {
+    ASSERT_TRUE(job.record().Undo());
+    ASSERT_TRUE(job.record().Redo());
+  };
+  job.Solve();
+  EXPECT_FALSE(job.DiscardStaleOutcome());
+  ASSERT_TRUE(job.outcome());
+  EXPECT_EQ(job.outcome()->pairs[1].status, PairStatus::kRejected);
+
+  // The solver's settings changed while it solves: the same.
+  during_solve = [&] {
+    JobSettings settings = job.record().Current().settings;
+    settings.huber_delta *= 2.0;
+    job.SetSettings(settings);
+  };
+  job.Solve();
+  EXPECT_TRUE(job.DiscardStaleOutcome());
 }
 
 // A session is the job's state on disk: resumed, its brushes, rejections (with their reasons),
