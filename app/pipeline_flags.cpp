@@ -3,7 +3,12 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <functional>
+#include <map>
 #include <sstream>
+#include <string_view>
+#include <type_traits>
+#include <variant>
 
 #include "app/commands.h"
 #include "app/progress_listener.h"
@@ -18,71 +23,101 @@
 
 namespace calibench::app {
 
+namespace {
+
+// One setting's flag, from its declaration (core/session/session.h, JobSettingFields). The method
+// is a name, parsed by FinalizePipelineFlags.
+void AddSettingFlag(CLI::App& app, const JobSettingField& setting, PipelineFlags& flags) {
+  const std::string flag = "--" + std::string(setting.flag);
+  const std::string words(setting.words);
+  JobSettings& settings = flags.settings;
+  std::visit(
+      [&](auto member) {
+        using Value = std::remove_reference_t<decltype(settings.*member)>;
+        if constexpr (std::is_same_v<Value, SolverMethod>) {
+          flags.method = SolverMethodName(settings.*member);
+          app.add_option(flag, flags.method, words)->capture_default_str();
+        } else if constexpr (std::is_same_v<Value, bool>) {
+          app.add_flag(flag, settings.*member, words);
+        } else {
+          app.add_option(flag, settings.*member, words)->capture_default_str();
+        }
+      },
+      setting.field);
+}
+
+}  // namespace
+
 void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) {
   PipelineOptions& o = flags.options;
-  app.add_option("--method", flags.method,
-                 "weighted-ml (default: residuals whitened by both planes' covariances) | "
-                 "ca2lib-gn (the paper's unweighted Gauss-Newton) | kim (Kim et al. 2020: "
-                 "closed form from the normals, the paper's baseline)")
-      ->capture_default_str();
-  app.add_option("--huber-delta", o.solver.huber_delta, "Huber threshold on the plane error")
-      ->capture_default_str();
-  app.add_option("--max-iterations", o.solver.max_iterations, "Gauss-Newton iterations")
-      ->capture_default_str();
-  app.add_flag_callback(
-      "--no-board-edges", [&o] { o.solver.use_board_edges = false; },
-      "weighted-ml: leave out the board-edge constraints (used by default for targets "
-      "whose sheet size is given)");
-  app.add_flag_callback(
-      "--no-edge-dilation", [&o] { o.solver.estimate_edge_dilation = false; },
-      "weighted-ml with board edges: do not estimate how much larger than the sheet the "
-      "LiDAR sees it (the beam's footprint; estimated by default)");
-  app.add_flag("--estimate-range-offset", o.solver.estimate_range_offset,
-               "weighted-ml: also estimate a constant LiDAR range offset (printed with its "
-               "standard deviation and its correlation with the translation)");
-  app.add_option("--range-offset-prior-mm", flags.range_offset_prior_mm,
-                 "weighted-ml: 1σ of the LiDAR range offset known before the data [mm] (0 = "
-                 "none): estimated, a prior on it; left out, the bias it could cause is in the "
-                 "reported σ")
-      ->capture_default_str();
-  app.add_flag("--refine-intrinsics{focal}", flags.refine_intrinsics,
-               "estimate the camera's intrinsics with the extrinsic in one joint problem "
-               "(corners, LiDAR planes and edges), then pose every pair under them: focal "
-               "(fx fy, the default: what the LiDAR's distances tell) | pinhole (+ cx cy) | all "
-               "(+ the distortion), as --refine-intrinsics=all; the result gets an "
-               "\"intrinsics\" entry with both cameras");
-  app.add_flag_callback(
-      "--ignore-intrinsics-covariance", [&o] { o.propagate_intrinsics = false; },
-      "leave the camera file's intrinsics covariance (intrinsics_covariance) out of the "
-      "extrinsic's sigma (it is carried into it by default)");
-  app.add_flag_callback(
-      "--no-jackknife", [&o] { o.solver.jackknife_covariance = false; },
-      "weighted-ml: do not widen the reported covariance to the leave-one-pair-out spread");
-  if (with_selection) {
-    app.add_option("--pairs", flags.pairs, "comma-separated pair ids to use (default: all)");
-    app.add_option("--initial-guess", flags.initial_guess,
-                   "cam_from_lidar to start from: a result.json, or 16 comma-separated numbers "
-                   "(row-major 4x4); default: closed form from the planes");
+  // The settings' flags come from their declaration, each followed by the flags that belong
+  // with it in the help.
+  flags.settings = JobSettings::Of(o);
+  const std::map<std::string_view, std::function<void()>> then = {
+      {"max-iterations",
+       [&] {
+         app.add_flag_callback(
+             "--no-board-edges", [&o] { o.solver.use_board_edges = false; },
+             "weighted-ml: leave out the board-edge constraints (used by default for targets "
+             "whose sheet size is given)");
+         app.add_flag_callback(
+             "--no-edge-dilation", [&o] { o.solver.estimate_edge_dilation = false; },
+             "weighted-ml with board edges: do not estimate how much larger than the sheet the "
+             "LiDAR sees it (the beam's footprint; estimated by default)");
+       }},
+      {"estimate-range-offset",
+       [&] {
+         app.add_option("--range-offset-prior-mm", flags.range_offset_prior_mm,
+                        "weighted-ml: 1σ of the LiDAR range offset known before the data [mm] (0 "
+                        "= none): estimated, a prior on it; left out, the bias it could cause is "
+                        "in the reported σ")
+             ->capture_default_str();
+         app.add_flag("--refine-intrinsics{focal}", flags.refine_intrinsics,
+                      "estimate the camera's intrinsics with the extrinsic in one joint problem "
+                      "(corners, LiDAR planes and edges), then pose every pair under them: focal "
+                      "(fx fy, the default: what the LiDAR's distances tell) | pinhole (+ cx cy) "
+                      "| all (+ the distortion), as --refine-intrinsics=all; the result gets an "
+                      "\"intrinsics\" entry with both cameras");
+         app.add_flag_callback(
+             "--ignore-intrinsics-covariance", [&o] { o.propagate_intrinsics = false; },
+             "leave the camera file's intrinsics covariance (intrinsics_covariance) out of the "
+             "extrinsic's sigma (it is carried into it by default)");
+         app.add_flag_callback(
+             "--no-jackknife", [&o] { o.solver.jackknife_covariance = false; },
+             "weighted-ml: do not widen the reported covariance to the leave-one-pair-out "
+             "spread");
+         if (with_selection) {
+           app.add_option("--pairs", flags.pairs, "comma-separated pair ids to use (default: all)");
+           app.add_option("--initial-guess", flags.initial_guess,
+                          "cam_from_lidar to start from: a result.json, or 16 comma-separated "
+                          "numbers (row-major 4x4); default: closed form from the planes");
+         }
+         app.add_option("--threads", o.threads,
+                        "workers (default: this machine's hardware threads; the result does not "
+                        "depend on it)")
+             ->capture_default_str();
+       }},
+      {"ransac-threshold",
+       [&] {
+         app.add_option("--ransac-seed", o.lidar_plane.seed, "RANSAC seed")->capture_default_str();
+         app.add_option(
+             "--lidar-model", flags.lidar_model,
+             "the LiDAR's noise model: spinning (ranges along rays from one centre, rings: "
+             "ring biases and board edges) | swept (a line scanner turned by a stage, rays "
+             "from a moving mirror) | non-repetitive (Livox-class: ranges along rays from one "
+             "centre, no rings) | segment (board-only clouds); swept and segment fit "
+             "planes point-to-plane with their own covariance. Default: judged from each "
+             "cloud (rings, cones of elevation, the returns' extent), said in the summary");
+         app.add_flag_callback(
+             "--no-board-growing", [&o] { o.grow_to_board = false; },
+             "fit the LiDAR plane on the brushed / seeded returns only, instead of growing the "
+             "region to the whole board (limited by the target's sheet size)");
+       }},
+  };
+  for (const JobSettingField& setting : JobSettingFields()) {
+    AddSettingFlag(app, setting, flags);
+    if (const auto next = then.find(setting.flag); next != then.end()) next->second();
   }
-  app.add_option(
-         "--threads", o.threads,
-         "workers (default: this machine's hardware threads; the result does not depend on it)")
-      ->capture_default_str();
-  app.add_option("--ransac-threshold", o.lidar_plane.ransac_threshold_m,
-                 "LiDAR plane RANSAC inlier distance [m]")
-      ->capture_default_str();
-  app.add_option("--ransac-seed", o.lidar_plane.seed, "RANSAC seed")->capture_default_str();
-  app.add_option("--lidar-model", flags.lidar_model,
-                 "the LiDAR's noise model: spinning (ranges along rays from one centre, rings: "
-                 "ring biases and board edges) | swept (a line scanner turned by a stage, rays "
-                 "from a moving mirror) | non-repetitive (Livox-class: ranges along rays from one "
-                 "centre, no rings) | segment (board-only clouds); swept and segment fit "
-                 "planes point-to-plane with their own covariance. Default: judged from each "
-                 "cloud (rings, cones of elevation, the returns' extent), said in the summary");
-  app.add_flag_callback(
-      "--no-board-growing", [&o] { o.grow_to_board = false; },
-      "fit the LiDAR plane on the brushed / seeded returns only, instead of growing the "
-      "region to the whole board (limited by the target's sheet size)");
 }
 
 void AddGoalFlags(CLI::App& app, AdviseOptions* options) {
@@ -107,7 +142,11 @@ bool FinalizePipelineFlags(PipelineFlags& flags, std::string* why) {
     *why = "--method must be weighted-ml, ca2lib-gn or kim, not '" + flags.method + "'";
     return false;
   }
-  flags.options.solver.method = *method;
+  flags.settings.method = *method;
+  flags.settings.Apply(&flags.options);
+  // As the flags say: a range offset asked of another method is refused (SolverOptions::Check,
+  // below), not dropped as a session's choice is kept for its method (JobSettings::Apply).
+  flags.options.solver.estimate_range_offset = flags.settings.estimate_range_offset;
   flags.options.solver.range_offset_prior_sigma_m = flags.range_offset_prior_mm * 1e-3;
   if (!flags.lidar_model.empty()) {
     const auto model = ParseLidarGeometry(flags.lidar_model);

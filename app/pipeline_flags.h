@@ -7,6 +7,7 @@
 
 #include "core/geometry/geometry.h"
 #include "core/lidar_camera/pipeline.h"
+#include "core/session/session.h"
 
 namespace calibench {
 struct AdviseOptions;
@@ -17,7 +18,10 @@ struct JobVerdict;
 namespace calibench::app {
 
 struct PipelineFlags {
+  // The pipeline's options; the settings' flags (JobSettingFields) are bound to `settings` and
+  // applied over them by FinalizePipelineFlags.
   PipelineOptions options;
+  JobSettings settings;
   std::string pairs;          // comma-separated pair ids
   std::string initial_guess;  // result.json, or 16 numbers (row-major 4x4)
   std::string method = "weighted-ml";

@@ -138,6 +138,25 @@ void JobSettings::Apply(PipelineOptions* options) const {
       estimate_range_offset && method == SolverMethod::kWeightedMl;
 }
 
+const std::vector<JobSettingField>& JobSettingFields() {
+  static const std::vector<JobSettingField> fields = {
+      {"method",
+       "weighted-ml (default: residuals whitened by both planes' covariances) | ca2lib-gn (the "
+       "paper's unweighted Gauss-Newton) | kim (Kim et al. 2020: closed form from the normals, the "
+       "paper's baseline)",
+       &JobSettings::method},
+      {"huber-delta", "Huber threshold on the plane error", &JobSettings::huber_delta},
+      {"max-iterations", "Gauss-Newton iterations", &JobSettings::max_iterations},
+      {"estimate-range-offset",
+       "weighted-ml: also estimate a constant LiDAR range offset (printed with its standard "
+       "deviation and its correlation with the translation)",
+       &JobSettings::estimate_range_offset},
+      {"ransac-threshold", "LiDAR plane RANSAC inlier distance [m]",
+       &JobSettings::ransac_threshold_m},
+  };
+  return fields;
+}
+
 bool JobSettings::Check(std::string* why) const {
   PipelineOptions options;
   Apply(&options);

@@ -12,6 +12,8 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <variant>
 #include <vector>
 
 #include "core/base/file_lock.h"
@@ -114,6 +116,19 @@ struct JobSettings {
   bool Check(std::string* why) const;
   bool operator==(const JobSettings&) const = default;
 };
+
+// The settings' one declaration for the command line, in the order its help lists them: each
+// field's flag (--<flag>; a Python keyword is the flag with '_' for '-'), the words of its help,
+// and the field. app/pipeline_flags.cpp makes the flags of `calibrate`, `advise`, `watch`,
+// `report` and `sweep` from it, so that a setting added here is a flag everywhere.
+struct JobSettingField {
+  std::string_view flag;
+  std::string_view words;
+  std::variant<SolverMethod JobSettings::*, double JobSettings::*, int JobSettings::*,
+               bool JobSettings::*>
+      field;
+};
+const std::vector<JobSettingField>& JobSettingFields();
 
 struct Session {
   int version = 1;  // of the file format; this build reads and writes 1

@@ -300,7 +300,8 @@ class Controller : public ControllerState<Snapshot> {
   // Pair `pair`'s brush as shown (painted or erased) into the job's record: an undo step, or the
   // current one amended (a stroke's later dabs). The pair has its LiDAR image.
   void SetBrushInRecord(const PairView& pair, bool amend);
-  void Restore(const std::optional<Session>& restored);  // undo / redo
+  // Undo / redo (`what`: "undid" / "redid", for the status line).
+  void Restore(const std::optional<Session>& restored, const std::string& what);
 
   std::optional<FileLock> session_lock_;  // held while session_path is open for editing
   // The options the workbench was started with; the session's settings (state_.settings, the

@@ -55,6 +55,9 @@ void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path
                                    ExistingSession existing) {
   Session session = NewSession(dataset);
   session.dataset = dataset.manifest;
+  // A new session starts with the settings the workbench was started with (a resumed one keeps
+  // its own).
+  session.settings = JobSettings::Of(pipeline_);
   if (existing == ExistingSession::kInMemory) {
     Open(dataset, std::move(session), {}, "", std::nullopt);
     return;
@@ -311,16 +314,19 @@ void Controller::Handle(const SaveSessionAs& save) {
 
 template <>
 void Controller::Handle(const Undo&) {
-  if (job_) Restore(job_->record().Undo());
+  if (job_) Restore(job_->record().Undo(), "undid");
 }
 template <>
 void Controller::Handle(const Redo&) {
-  if (job_) Restore(job_->record().Redo());
+  if (job_) Restore(job_->record().Redo(), "redid");
 }
 
 // The record has restored it already, with the pairs that joined since that step as they are.
-void Controller::Restore(const std::optional<Session>& restored) {
-  if (!restored) return;
+void Controller::Restore(const std::optional<Session>& restored, const std::string& what) {
+  if (!restored) {
+    SetStatus("nothing to " + std::string(what == "undid" ? "undo" : "redo"), false);
+    return;
+  }
   std::vector<std::vector<int>> before;
   for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
   ApplySessionToState(*restored);
@@ -328,6 +334,13 @@ void Controller::Restore(const std::optional<Session>& restored) {
   // The meter and the next pose belong to the solve restored (or to none): judged again, asked
   // again (not while following a capture, where Advise's pre-flight would edit the record).
   JudgeMeter(/*record=*/false);
+  // The line no longer speaks of the solve undone ("solved with 39 pairs" over 40 accepted).
+  int accepted = 0;
+  for (const PairView& pair : state_.pairs) accepted += SolvesWith(pair);
+  SetStatus(what + " the last change: " + std::to_string(accepted) + " pairs usable, " +
+                (state_.solver.result ? "the calibration of that step shown"
+                                      : "no calibration at that step"),
+            false);
   state_.next_pose.reset();
   if (state_.solver.result && watching_.empty()) worker_.Enqueue([this] { AdviseFromState(); });
   Autosave();
