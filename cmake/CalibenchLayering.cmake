@@ -5,8 +5,10 @@
 # listed in the target that owns it.
 
 # The target a project header (or source file) belongs to: core/<x>/ -> calibench_<x>; ui/gfx,
-# ui/widgets, ui/state; ui/<method>/controller*.* -> calibench_<method>_controller, the rest of
-# ui/<method>/ -> calibench_<method>_workbench.
+# ui/widgets, ui/state; a file of ui/<method>/ -> the one of calibench_<method>_controller and
+# calibench_<method>_workbench whose list names it (ui/CMakeLists.txt lists headers and sources
+# by name: which side of the controller / workbench line a file is on is the list's word, not its
+# name's). Empty when nothing owns it.
 function(calibench_owner_target path out)
   set(owner "")
   if(path MATCHES "^core/([a-z_]+)/")
@@ -17,10 +19,17 @@ function(calibench_owner_target path out)
     set(owner calibench_widgets)
   elseif(path MATCHES "^ui/state/")
     set(owner calibench_ui_state)
-  elseif(path MATCHES "^ui/([a-z_]+)/controller[a-z_]*\\.")
-    set(owner "calibench_${CMAKE_MATCH_1}_controller")
-  elseif(path MATCHES "^ui/([a-z_]+)/")
-    set(owner "calibench_${CMAKE_MATCH_1}_workbench")
+  elseif(path MATCHES "^ui/(([a-z_]+)/.*)$")
+    set(in_ui "${CMAKE_MATCH_1}")
+    set(method "${CMAKE_MATCH_2}")
+    foreach(candidate calibench_${method}_controller calibench_${method}_workbench)
+      if(TARGET ${candidate})
+        get_target_property(listed ${candidate} SOURCES)
+        if("${in_ui}" IN_LIST listed)
+          set(owner ${candidate})
+        endif()
+      endif()
+    endforeach()
   endif()
   set(${out} "${owner}" PARENT_SCOPE)
 endfunction()
@@ -62,6 +71,11 @@ function(calibench_check_layering)
   set(problems "")
   foreach(file IN LISTS files)
     calibench_owner_target(${file} owner)
+    if(NOT owner AND file MATCHES "^ui/[a-z_]+/" AND NOT file MATCHES "^ui/(gfx|widgets|state)/")
+      list(APPEND problems "${file}: listed in neither its method's controller nor its workbench \
+(ui/CMakeLists.txt lists each header and source of ui/<method>/ on one side)")
+      continue()
+    endif()
     if(NOT owner OR NOT TARGET ${owner})
       continue()
     endif()
