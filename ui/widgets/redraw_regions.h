@@ -6,7 +6,7 @@
 // indices, clip rectangle, texture and the texture's content version), and RegionRedraw turns the
 // draw data into one draw list whose commands are clipped to those regions. Inside a region
 // everything is drawn again in the original order, so the result is the full frame's, pixel for
-// pixel (tests/ui/test_redraw_regions.cpp).
+// pixel (tests/ui/widgets/test_redraw_regions.cpp).
 #pragma once
 
 #include <imgui.h>
