@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <ctime>
+#include <type_traits>
 
 #include "core/base/allocator.h"
 #include "core/base/atomic_file.h"
@@ -17,7 +18,17 @@
 
 namespace calibench::ui {
 
-Controller::Controller(PipelineOptions options) : pipeline_(std::move(options)) {}
+Controller::Controller(PipelineOptions options)
+    : pipeline_(std::move(options)),
+      rig_(Host(), [this] { JudgeMeter(/*record=*/false); }),
+      check_(Host()),
+      intrinsics_(Host()),
+      follow_(Host(), {.open =
+                           [this](const Dataset& read) {
+                             if (!ResumeGrownCapture(read))
+                               OpenLoadedDataset(read, {}, ExistingSession::kResume);
+                           },
+                       .add = [this](const PairEntry& pair) { AddPair(pair); }}) {}
 
 Controller::~Controller() {
   StopWatching();
@@ -143,7 +154,7 @@ void Controller::Solve(bool asked) {
           return p.status == PairStatus::kAccepted && p.lidar && p.camera;
         }));
     // Too few pairs yet is no error while a capture is followed: it says how many are needed.
-    if (!watching_.empty() && usable < options.min_pairs)
+    if (!state_.watching.empty() && usable < options.min_pairs)
       SetStatus("solving once " + std::to_string(options.min_pairs) + " pairs are usable (" +
                     std::to_string(usable) + " so far)",
                 false);
@@ -211,7 +222,7 @@ void Controller::EnsureSelectedImage() {
   state_.selected_image_pair = state_.pairs[state_.selected].id;
   state_.selected_undistorted = undistorted;
   ++state_.generation;
-  if (state_.rig && state_.rig->Several()) worker_.Enqueue([this] { LoadRigFrames(); });
+  if (state_.rig && state_.rig->Several()) worker_.Enqueue([this] { rig_.LoadFrames(); });
 }
 
 bool Controller::ValidPair(int index) const {
@@ -249,7 +260,7 @@ void Controller::Handle(const SetPairStatus& status) {
   pair.status = status.status;
   pair.reason = rejecting ? kRejectedByUser : "";
   SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
-                (state_.solver.result && !auto_solve_ ? "; press Run to re-solve" : ""),
+                (state_.solver.result && !state_.auto_solve ? "; press Run to re-solve" : ""),
             false);
   // The user's word into the job's record (the next solve reads it there), then the status shown.
   if (rejection_changed) job_->SetRejected(pair.id, rejecting);
@@ -303,12 +314,6 @@ void Controller::Handle(const SetView& view) {
   }
 }
 
-std::filesystem::path Controller::NextToSession(const std::filesystem::path& path) const {
-  mutex_.AssertHeld(__func__);
-  if (path.is_absolute() || state_.session_path.empty()) return path;
-  return state_.session_path.parent_path() / path;
-}
-
 template <>
 void Controller::Handle(const ExportResult& export_result) {
   if (!state_.solver.result) {
@@ -320,7 +325,7 @@ void Controller::Handle(const ExportResult& export_result) {
   CalibrationOutcome outcome;
   for (const PairView& pair : state_.pairs) outcome.pairs.push_back(FeaturesOf(pair));
   outcome.solution = ResultForCurrentPairs();
-  const std::filesystem::path path = NextToSession(export_result.path);
+  const std::filesystem::path path = NextToSession(state_, export_result.path);
   try {
     if (export_result.format) {
       const ExportFrames& frames = export_result.frames;
@@ -362,7 +367,34 @@ void Controller::Apply(const Intent& intent) {
   // A stroke is its dabs; anything else in between ends it.
   if (!std::holds_alternative<BrushStroke>(intent) && !std::holds_alternative<PaintPoints>(intent))
     stroke_open_ = false;
-  std::visit([this](const auto& what) { Handle(what); }, intent);
+  // The tasks' intents to their tasks, the rest to the controller's own handlers.
+  std::visit(
+      [this](const auto& what) {
+        using What = std::decay_t<decltype(what)>;
+        if constexpr (std::is_same_v<What, EstimateIntrinsics>)
+          intrinsics_.Estimate(what);
+        else if constexpr (std::is_same_v<What, SaveIntrinsics>)
+          intrinsics_.Save(what);
+        else if constexpr (std::is_same_v<What, RunCheck>)
+          check_.Run(what);
+        else if constexpr (std::is_same_v<What, PickBoard>)
+          follow_.Pick(what);
+        else if constexpr (std::is_same_v<What, SelectCamera>)
+          rig_.Select(what);
+        else if constexpr (std::is_same_v<What, SolveRig>) {
+          if (state_.rig && state_.rig->Several())
+            StartRigSolve();
+          else
+            SetStatus("not a rig: there is one camera", true);
+        } else
+          Handle(what);
+      },
+      intent);
+}
+
+void Controller::StartRigSolve() {
+  mutex_.AssertHeld(__func__);
+  rig_.Start(job_ ? job_->record().Edits() : PairEdits{}, state_.settings.Over(pipeline_));
 }
 
 }  // namespace calibench::ui

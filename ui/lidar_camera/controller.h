@@ -26,108 +26,15 @@
 #include "core/results/export.h"
 #include "core/session/calibration_job.h"  // the job, with the guidance and the session
 #include "core/session/capture_follow.h"
+#include "ui/lidar_camera/check_task.h"
 #include "ui/lidar_camera/controller_snapshot.h"  // Snapshot and the views it holds
+#include "ui/lidar_camera/follow_task.h"
+#include "ui/lidar_camera/intents.h"
+#include "ui/lidar_camera/intrinsics_task.h"
+#include "ui/lidar_camera/rig_task.h"
 #include "ui/state/view_state.h"
 
 namespace calibench::ui {
-
-// What the user asked for. Panels return these; Controller::Apply carries them out.
-struct SelectPair {
-  int index;
-};
-struct SetPairStatus {
-  int index;
-  PairStatus status;
-};
-struct BrushStroke {
-  int index;
-  int row;
-  int column;
-  float radius_px;
-  bool erase;
-};
-struct ClearBrush {
-  int index;
-};
-// The mouse button was released: the brush stroke (BrushStroke / PaintPoints dabs) is complete.
-struct EndStroke {};
-// Forget the pair's brush (and seed) and detect the board again; every pair when `all`.
-struct DetectBoardAgain {
-  int index;
-  bool all = false;
-};
-// LiDAR points painted in the 3D view, as the LiDAR-image pixels they landed in (sorted).
-struct PaintPoints {
-  int index;
-  std::vector<int> pixels;
-  bool erase;
-};
-struct RunSolver {};
-struct ResetSolver {};
-struct SetSettings {  // the solver's settings and the LiDAR plane's RANSAC threshold
-  JobSettings settings;
-};
-struct SetView {
-  ViewState view;
-};
-// Writes the solution: a calibench result (no format), or a file a robot loads in one of the
-// export formats, with the frames named (core/results/export.h). A relative path goes next to
-// the session.
-struct ExportResult {
-  std::filesystem::path path;
-  std::optional<ExportFormat> format = std::nullopt;
-  ExportFrames frames = {};
-};
-struct SaveSessionAs {
-  std::filesystem::path path;
-};
-struct Undo {};
-struct Redo {};
-// The user's goal for the meter (σ per axis), and how precisely the person can hold a suggested
-// pose (GuidanceOptions::hand_tolerance_*: the next pose is chosen robust to it).
-struct SetGoal {
-  CaptureGoal goal;
-  double hand_tolerance_m = 0.10;
-  double hand_tolerance_deg = 10.0;
-};
-// The camera's intrinsics from every loaded pair's board corners (as `calibench intrinsics`),
-// on the worker; the dataset's camera is not changed.
-struct EstimateIntrinsics {
-  CameraModelType model = CameraModelType::kPinholeRadTan;
-};
-// Writes the estimated intrinsics as a camera file (a relative path goes beside the dataset).
-struct SaveIntrinsics {
-  std::filesystem::path path;
-  CameraFileFormat format = CameraFileFormat::kRosCameraInfo;
-};
-// Another camera of the rig into the views (its own session, resumed): the window replaces the
-// controller (WindowShell::SelectCamera); a controller alone says so on its status line.
-struct SelectCamera {
-  std::string camera;
-};
-// The rig's joint solve over every camera, with each camera's session edits (the open one's as
-// they are now), in background steps on the worker; the meter and the frustums follow.
-struct SolveRig {};
-// A followed recording whose board no preset explains (Snapshot::board_problem): the board the
-// user picks, a preset's name (core/board/board.h) or a target file; the pairs held for want of
-// it are searched with it.
-struct PickBoard {
-  std::string board;
-};
-// The targetless check (core/targetless, the step `calibench check` runs) of a calibration over
-// the scenes of the dataset's pairs, on the worker, using no board: `result` a result file or a
-// session (relative: beside the session); empty: the workbench's own calibration.
-struct RunCheck {
-  std::filesystem::path result;
-};
-// The check's estimate becomes the workbench's calibration, its provenance targetless (an export
-// writes a targetless result); one undo step.
-struct AdoptCheckEstimate {};
-using Intent =
-    std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush, DetectBoardAgain,
-                 PaintPoints, RunSolver, ResetSolver, SetSettings, SetView, ExportResult,
-                 SaveSessionAs, Undo, Redo, EstimateIntrinsics, SaveIntrinsics, SetGoal,
-                 SelectCamera, SolveRig, PickBoard, RunCheck, AdoptCheckEstimate>;
 
 class Controller : public ControllerState<Snapshot> {
  public:
@@ -160,7 +67,7 @@ class Controller : public ControllerState<Snapshot> {
                    const std::string& camera = "");
   // Before opening another camera of the same rig: its cameras' solves as `rig` holds them (the
   // window's camera switch), so that they are not solved again.
-  void CarryRig(const RigView& rig);
+  void CarryRig(const RigView& rig) { rig_.Carry(rig); }
   // The same for a dataset already read (a followed capture's, before it has pairs).
   void OpenLoadedDataset(const Dataset& dataset, std::filesystem::path session_path,
                          ExistingSession existing);
@@ -187,22 +94,14 @@ class Controller : public ControllerState<Snapshot> {
   // Stops following; returns once no look runs. Not with mutex_ held (a look takes it).
   void StopWatching();
   // Waits for the rig solve's steps (tests, renders).
-  void WaitRig();
+  void WaitRig() { rig_.Wait(); }
   // One pair more, loaded and detected on the worker (a watched folder; any thread).
   void AddPair(const PairEntry& entry);
 
  private:
-  // Follows the request's source as `watch` does (core/session/capture_follow.h), one look per
-  // background step (FollowStep); the capture followed before stops first.
-  struct FollowRun;
+  // Follows the request's source as `watch` does (FollowTask); the capture followed before stops
+  // first.
   void Follow(const CaptureFollowRequest& request);
-  // One step (worker): a look for the feed until it opens (why it cannot goes to the status
-  // line), then `watch`'s loop's look (FeedFollower); the next step is enqueued 0.2 s on unless
-  // following ended.
-  void FollowStep(const std::shared_ptr<FollowRun>& run);
-  // The feed opened: the loop's handlers open the feed's dataset once its first look caught up
-  // (resuming an earlier watch's session), then add each pair as it lands (worker).
-  void StartLooking(FollowRun* run);
   // The session an earlier watch left, when its pairs are the first of `dataset`'s (a capture that
   // grew while the workbench was closed, a recording read again): opened over them, edits kept.
   bool ResumeGrownCapture(Dataset dataset);
@@ -235,9 +134,6 @@ class Controller : public ControllerState<Snapshot> {
   void ApplyCompletion(const std::vector<PairFeatures>& solved);
   static bool SolvesWith(const PairView& pair);  // accepted, with both planes
   void ComputeReprojection(int index);
-  // A relative path the user typed (export, save as) goes next to the session, never into the
-  // folder the program was started from. Call with mutex_ held.
-  std::filesystem::path NextToSession(const std::filesystem::path& path) const;
   // Writes the session if it changed; a failure goes to the status line in the warning colour
   // (and is retried at the next change). Call with mutex_ held.
   void Autosave();
@@ -267,19 +163,8 @@ class Controller : public ControllerState<Snapshot> {
   void RecordView();
   std::string ViewJson();  // state_'s view, its selected pair's id set, as the session keeps it
   void ApplySessionToState(const Session& session);  // call with mutex_ held
-  // Rig (controller_rig.cpp), with mutex_ held unless said: the rig view with camera `active`
-  // open (true: the other cameras' solves carried from CarryRig); the rig solve started as
-  // background steps (RigStep: the rig read, each camera, the joint solve; RigCalibration), its
-  // outcome published by the last; the open camera's entry from the latest solve and every
-  // camera's meter; the strip's frames of the selected capture (worker, mutex_ not held).
-  struct RigRun;
-  bool SetUpRig(const RigFolder& rig, size_t active);
+  // The rig solve (RigTask::Start) over the open camera's edits and the settings. Mutex held.
   void StartRigSolve();
-  void RigStep(const std::shared_ptr<RigRun>& run);                       // worker, mutex_ not held
-  void PublishRigOutcome(const RigRun& run, const std::string& failure);  // mutex_ not held
-  void CancelRigSolve();  // drops its steps; waits for a running one (mutex_ not held)
-  void UpdateActiveRigCamera();
-  void LoadRigFrames();
   // `note` (how the session came to be opened) joins the status line once the pairs have loaded.
   void Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
             const std::string& note, std::optional<FileLock> lock);
@@ -314,18 +199,15 @@ class Controller : public ControllerState<Snapshot> {
   // autosave), which state_ mirrors for the panels. Its steps run on the worker; its record is
   // edited under mutex_ (it locks itself too). Made anew by Open, after WaitIdle.
   std::optional<CalibrationJob> job_;
-  bool stroke_open_ = false;            // BrushStroke / PaintPoints dabs since the last EndStroke
-  bool auto_solve_ = false;             // mutex_
-  std::filesystem::path watching_;      // the source followed (set before the first look)
-  bool solve_queued_ = false;           // mutex_
-  bool follow_newest_ = true;           // a followed capture's views move to each new pair (mutex_)
-  bool opened_pairs_loaded_ = false;    // every pair Open started with has loaded (mutex_)
-  std::optional<RigView> carried_rig_;  // CarryRig's, for the next Open
-  std::map<std::string, std::shared_ptr<const ImageU8>> rig_frames_;  // "<camera>/<pair>" (worker)
-  std::vector<std::map<std::string, std::filesystem::path>> rig_images_;  // per camera (mutex_)
-  std::atomic<bool> stop_watch_{false};
-  // PickBoard's board and its words, for the next look to give its feed (mutex_).
-  std::optional<std::pair<BoardSpec, std::string>> picked_board_;
+  bool stroke_open_ = false;          // BrushStroke / PaintPoints dabs since the last EndStroke
+  bool solve_queued_ = false;         // mutex_
+  bool follow_newest_ = true;         // a followed capture's views move to each new pair (mutex_)
+  bool opened_pairs_loaded_ = false;  // every pair Open started with has loaded (mutex_)
+  // The tasks Apply routes intents to, each owning its own fields (TaskHost).
+  RigTask rig_;
+  CheckTask check_;
+  IntrinsicsTask intrinsics_;
+  FollowTask follow_;
 };
 
 // The handlers (controller.cpp, controller_pairs.cpp, controller_session.cpp).
@@ -360,20 +242,8 @@ void Controller::Handle(const Undo&);
 template <>
 void Controller::Handle(const Redo&);
 template <>
-void Controller::Handle(const EstimateIntrinsics&);  // controller_intrinsics.cpp
-template <>
-void Controller::Handle(const SaveIntrinsics&);
-template <>
 void Controller::Handle(const SetGoal&);  // controller_meter.cpp
 template <>
-void Controller::Handle(const SelectCamera&);  // controller_rig.cpp
-template <>
-void Controller::Handle(const SolveRig&);
-template <>
-void Controller::Handle(const PickBoard&);  // controller_watch.cpp
-template <>
-void Controller::Handle(const RunCheck&);  // controller_check.cpp
-template <>
-void Controller::Handle(const AdoptCheckEstimate&);
+void Controller::Handle(const AdoptCheckEstimate&);  // controller_check.cpp
 
 }  // namespace calibench::ui

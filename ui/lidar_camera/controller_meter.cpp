@@ -10,7 +10,7 @@ void Controller::JudgeMeter(bool record) {
   mutex_.AssertHeld(__func__);
   if (!state_.solver.result) {
     state_.meter.reset();
-    UpdateActiveRigCamera();
+    rig_.UpdateActiveCamera();
     return;
   }
   // The pairs the solve used; a reopened session's result: the pairs accepted in it.
@@ -20,7 +20,7 @@ void Controller::JudgeMeter(bool record) {
         std::count_if(state_.pairs.begin(), state_.pairs.end(),
                       [](const PairView& p) { return p.status == PairStatus::kAccepted; }));
   state_.meter = JudgeCapture(*state_.solver.result, pairs, state_.goal, StopRuleOptions{});
-  UpdateActiveRigCamera();
+  rig_.UpdateActiveCamera();
   if (!record) return;
   const MeterPoint point{pairs, state_.meter->sigma_t_mm, state_.meter->sigma_r_deg};
   // One point per number of pairs: a solve again at the same count replaces it.

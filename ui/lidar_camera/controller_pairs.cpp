@@ -102,7 +102,7 @@ void Controller::OnAllPairsLoaded() {
 
 bool Controller::FollowsTo(int index) const {
   mutex_.AssertHeld(__func__);
-  return !watching_.empty() && follow_newest_ && index > state_.selected &&
+  return !state_.watching.empty() && follow_newest_ && index > state_.selected &&
          index + 1 == static_cast<int>(state_.pairs.size());
 }
 
@@ -111,7 +111,7 @@ bool Controller::PairsSettled() const {
   // A followed capture is never all loaded (the next pair may land while this one is read):
   // once the pairs it opened with are in, each new pair counts as soon as it is.
   return state_.loading_done == state_.loading_total ||
-         (opened_pairs_loaded_ && !watching_.empty());
+         (opened_pairs_loaded_ && !state_.watching.empty());
 }
 
 void Controller::LoadPair(int index) {

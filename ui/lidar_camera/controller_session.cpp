@@ -113,7 +113,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
       ReadViewAndRig(session, dataset, session_path.empty() ? dataset.manifest : session_path);
   // The last dataset's work first: a rig solve of it is dropped (a new one starts below), its
   // queued jobs run out. From a followed capture's look (on the worker) nothing else is queued.
-  CancelRigSolve();
+  rig_.Cancel();
   WaitIdle();
   {
     std::lock_guard lock(mutex_);
@@ -121,9 +121,11 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
       session_lock_ = std::move(session_lock);
     else if (session_path.empty() || !session_lock_ || session_lock_->locked() != session_path)
       session_lock_.reset();
-    state_ = Snapshot{};
-    state_.auto_solve = auto_solve_;
-    state_.watching = watching_;
+    // What the window set up outlives the dataset: auto-solve, the capture followed.
+    Snapshot opened;
+    opened.auto_solve = state_.auto_solve;
+    opened.watching = state_.watching;
+    state_ = std::move(opened);
     state_.dataset = dataset;
     state_.dataset_path = dataset.manifest;
     state_.session_path = session_path;
@@ -157,7 +159,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     job_->Resume(session);
     job_->record().AutosaveTo(session_path);
     ApplySessionToState(session);
-    if (!SetUpRig(rig, rig_camera)) StartRigSolve();
+    if (!rig_.SetUp(rig, rig_camera)) StartRigSolve();
     SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
                   dataset.manifest.string(),
               false);
@@ -296,7 +298,7 @@ void Controller::Autosave() { AutosaveRecord(job_ ? &job_->record() : nullptr); 
 
 template <>
 void Controller::Handle(const SaveSessionAs& save) {
-  const std::filesystem::path path = NextToSession(save.path);
+  const std::filesystem::path path = NextToSession(state_, save.path);
   try {
     std::string note;
     std::optional<FileLock> lock = LockSession(path, &note);  // throws when another has it open
@@ -342,7 +344,8 @@ void Controller::Restore(const std::optional<Session>& restored, const std::stri
                                       : "no calibration at that step"),
             false);
   state_.next_pose.reset();
-  if (state_.solver.result && watching_.empty()) worker_.Enqueue([this] { AdviseFromState(); });
+  if (state_.solver.result && state_.watching.empty())
+    worker_.Enqueue([this] { AdviseFromState(); });
   Autosave();
   for (int i = 0; i < static_cast<int>(state_.pairs.size()); ++i)
     if (state_.pairs[i].brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });

@@ -180,4 +180,12 @@ struct Snapshot : SnapshotHeader {
   std::optional<RigView> rig;
 };
 
+// A relative path the user typed (export, save as, a result to check) goes next to the session,
+// never into the folder the program was started from.
+inline std::filesystem::path NextToSession(const Snapshot& state,
+                                           const std::filesystem::path& path) {
+  if (path.is_absolute() || state.session_path.empty()) return path;
+  return state.session_path.parent_path() / path;
+}
+
 }  // namespace calibench::ui

@@ -32,6 +32,25 @@ struct SnapshotHeader {
   bool status_is_error = false;
 };
 
+// What a controller's task reaches of its controller: a task is a class of its own owning its own
+// fields (the lidar-camera workbench's rig solve, targetless check, intrinsics), which the
+// controller's Apply routes intents to. It sees the state under the controller's mutex, the
+// worker its jobs run on, and the status line; nothing else. A task lives as long as its
+// controller, whose destructor stops the worker before the tasks go.
+template <typename Snapshot>
+struct TaskHost {
+  CheckedMutex& mutex;  // guards `state`
+  Snapshot& state;
+  WorkQueue& worker;
+  // The user's message; call with mutex held.
+  void SetStatus(const std::string& message, bool error) const {
+    mutex.AssertHeld(__func__);
+    state.status_line = message;
+    state.status_is_error = error;
+    ++state.generation;
+  }
+};
+
 // Snapshot derives from SnapshotHeader. A derived controller must call StopWorker() first in its
 // destructor: queued jobs touch the derived controller's members.
 template <typename Snapshot>
@@ -66,12 +85,9 @@ class ControllerState {
 
   void StopWorker() { worker_.Stop(); }
   // The user's message; call with mutex_ held.
-  void SetStatus(const std::string& message, bool error) {
-    mutex_.AssertHeld(__func__);
-    state_.status_line = message;
-    state_.status_is_error = error;
-    ++state_.generation;
-  }
+  void SetStatus(const std::string& message, bool error) { Host().SetStatus(message, error); }
+  // What a task of the controller reaches (TaskHost).
+  TaskHost<Snapshot> Host() { return {mutex_, state_, worker_}; }
   // Writes the session record's autosave (a SessionRecord, core/session/session_record.h; none
   // when null); a failure shows on the status line and in state_.save_error, and is retried at the
   // next edit. Call with mutex_ held.
