@@ -50,11 +50,10 @@ std::optional<int> ParseFlags(CLI::App& app, int argc, char** argv, const std::s
 
 // Opens the dataset or session the flags name; false (message printed) when neither is given.
 bool OpenInput(ui::Controller& controller, const std::string& dataset, const std::string& session,
-               const char* command,
-               ui::Controller::ExistingSession existing = ui::Controller::ExistingSession::kReplace,
+               const char* command, ui::ExistingSession existing = ui::ExistingSession::kReplace,
                const std::string& camera = "") {
   if (!session.empty()) {
-    controller.OpenSession(session, existing != ui::Controller::ExistingSession::kInMemory);
+    controller.OpenSession(session, existing != ui::ExistingSession::kInMemory);
   } else if (!dataset.empty()) {
     controller.OpenDataset(dataset, {}, existing, camera);
   } else {
@@ -124,8 +123,8 @@ int RunLrfGuiWindow(const std::string& dataset, const std::string& session,
   if (!session.empty())
     controller.OpenSession(session);
   else
-    controller.Open(dataset, fresh ? ui::LrfController::SessionUse::kFresh
-                                   : ui::LrfController::SessionUse::kResume);
+    controller.Open(dataset,
+                    fresh ? ui::ExistingSession::kStartFresh : ui::ExistingSession::kResume);
   std::string error;
   int code = FinishWindow(ui::RunLrfWindow(window, controller, &error), screenshot);
   if (!error.empty()) std::fprintf(stderr, "calibench gui: %s\n", error.c_str());
@@ -173,7 +172,7 @@ int RenderLrfHeadless(const std::string& dataset, const ui::HeadlessShot& shot,
   if (!context) return kInputError;
   ui::LrfController controller;
   // In memory: render leaves the session beside the manifest alone.
-  if (!controller.Open(dataset, ui::LrfController::SessionUse::kInMemory)) {
+  if (!controller.Open(dataset, ui::ExistingSession::kInMemory)) {
     std::fprintf(stderr, "calibench render: %s\n", controller.GetSnapshot().status_line.c_str());
     return kInputError;
   }
@@ -202,8 +201,7 @@ int RunGuiWindow(const std::string& dataset, const std::string& session, int wid
     shell.OpenSession(session);
   } else if (!dataset.empty()) {
     shell.OpenDataset(dataset,
-                      quit.fresh ? ui::Controller::ExistingSession::kStartFresh
-                                 : ui::Controller::ExistingSession::kResume,
+                      quit.fresh ? ui::ExistingSession::kStartFresh : ui::ExistingSession::kResume,
                       quit.camera);
   } else if (!quit.bag.empty()) {
     OpenBag(quit.bag);  // a file that is no recording is refused here, before a window opens
@@ -276,8 +274,7 @@ int RenderCheckHeadless(const std::string& dataset, const std::string& session,
   if (!context) return kInputError;
   ui::Controller controller;
   // In memory: render leaves the session beside the dataset alone.
-  if (!OpenInput(controller, dataset, session, "render",
-                 ui::Controller::ExistingSession::kInMemory))
+  if (!OpenInput(controller, dataset, session, "render", ui::ExistingSession::kInMemory))
     return kUsage;
   controller.WaitIdle();
   if (!shot.pair_id.empty()) {
@@ -333,8 +330,7 @@ int RenderHeadless(const std::string& dataset, const std::string& session, const
   if (!context) return kInputError;
   ui::Controller controller;
   // Render draws; it leaves session files alone (a dataset's session may be an hour of work).
-  if (!OpenInput(controller, dataset, session, "render", ui::Controller::ExistingSession::kInMemory,
-                 camera))
+  if (!OpenInput(controller, dataset, session, "render", ui::ExistingSession::kInMemory, camera))
     return kUsage;
   controller.WaitRig();  // a rig's other cameras: their frustums and meter rows
   if (intrinsics) {

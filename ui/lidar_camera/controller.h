@@ -32,6 +32,7 @@
 #include "ui/lidar_camera/intents.h"
 #include "ui/lidar_camera/intrinsics_task.h"
 #include "ui/lidar_camera/rig_task.h"
+#include "ui/state/session_opening.h"
 #include "ui/state/view_state.h"
 
 namespace calibench::ui {
@@ -48,20 +49,15 @@ class Controller : public ControllerState<Snapshot> {
   // Opens a dataset (new session saved next to it as <dataset folder>/calibench.session.json
   // unless session_path is given) or a saved session. The manifest / session is read here and
   // throws IoError; the pairs load on the worker thread (see loading_done / loading_total).
-  // What to do when `session_path` already holds a session: kReplace starts a new one over it
-  // (headless renders and tests, which own their session files); kResume opens it instead (the
-  // window: an hour of someone's edits is never overwritten by opening the dataset again) and
-  // says so; kStartFresh moves it to `<session>.<date-time>.bak` first and says where. A session
-  // that does not load or belongs to another dataset is backed up the same way under kResume,
-  // after its newest autosave backup that does load is resumed instead. kInMemory leaves any
-  // session file alone and never writes one (render draws; it does not edit).
-  // A session file is locked (FileLock) while open: one that another workbench has open throws
-  // IoError naming that process.
+  // What to do when `session_path` already holds a session is `existing`'s (both workbenches'
+  // ExistingSession, ui/state/session_opening.h): a session that does not load or belongs to
+  // another dataset is backed up under kResume, after its newest autosave backup that does load
+  // is resumed instead. A session file is locked (FileLock) while open: one that another
+  // workbench has open throws IoError naming that process.
   // A rig (a rig folder or manifest) opens one camera: `camera`, else the first; its session is
   // calibench.session.<camera>.json beside the rig, and the rig's other cameras are solved in
   // background steps on the worker, below the edits' jobs (RigView), for the meter, the frustums
   // and the strip.
-  enum class ExistingSession { kReplace, kResume, kStartFresh, kInMemory };
   void OpenDataset(const std::filesystem::path& dataset, std::filesystem::path session_path = {},
                    ExistingSession existing = ExistingSession::kReplace,
                    const std::string& camera = "");

@@ -58,31 +58,20 @@ void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path
   // A new session starts with the settings the workbench was started with (a resumed one keeps
   // its own).
   session.settings = JobSettings::Of(pipeline_);
-  if (existing == ExistingSession::kInMemory) {
-    Open(dataset, std::move(session), {}, "", std::nullopt);
-    return;
-  }
   if (session_path.empty())
     session_path = DefaultSessionPath(dataset.manifest, dataset.camera_name);
-  std::string note;
-  std::optional<FileLock> lock = LockSession(session_path, &note);
-  if (existing != ExistingSession::kReplace && std::filesystem::exists(session_path)) {
-    std::optional<SessionWithDataset> opened;
-    std::string resume_note;
-    const std::filesystem::path resumed = ResumeSessionBeside(
-        session_path, existing == ExistingSession::kStartFresh,
-        [&](const std::filesystem::path& file) {
-          opened = LoadSessionWithDataset(file);
-          ReadViewAndRig(opened->session, opened->dataset, file);  // as Open will: it opens
-        },
-        &resume_note);
-    note += (note.empty() ? "" : "; ") + resume_note;
-    if (!resumed.empty()) {
-      Open(opened->dataset, std::move(opened->session), session_path, note, std::move(lock));
-      return;
-    }
+  std::optional<SessionWithDataset> resumed;
+  OpenedSessionFile file = OpenSessionFileBeside(
+      session_path, existing, session_lock_, [&](const std::filesystem::path& candidate) {
+        resumed = LoadSessionWithDataset(candidate);
+        // As Open will read them: it opens.
+        ReadViewAndRig(resumed->session, resumed->dataset, candidate);
+      });
+  if (file.resumed) {
+    Open(resumed->dataset, std::move(resumed->session), file.path, file.note, std::move(file.lock));
+    return;
   }
-  Open(dataset, std::move(session), session_path, note, std::move(lock));
+  Open(dataset, std::move(session), file.path, file.note, std::move(file.lock));
 }
 
 void Controller::OpenSession(const std::filesystem::path& session_path, bool save) {

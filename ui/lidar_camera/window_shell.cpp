@@ -77,7 +77,7 @@ std::unique_ptr<Controller> WindowShell::NewController() const {
   return controller;
 }
 
-void WindowShell::OpenDataset(const fs::path& dataset, Controller::ExistingSession existing,
+void WindowShell::OpenDataset(const fs::path& dataset, ExistingSession existing,
                               const std::string& camera) {
   auto opened = NewController();
   opened->OpenDataset(dataset, {}, existing, camera);
@@ -162,7 +162,7 @@ void WindowShell::OpenFromUser(const fs::path& path) {
         break;
       case OpenKind::kDataset:
         // Opening a dataset again resumes its session: an hour of edits is never overwritten.
-        OpenDataset(path, Controller::ExistingSession::kResume);
+        OpenDataset(path, ExistingSession::kResume);
         break;
     }
   } catch (const IoError& e) {

@@ -49,7 +49,7 @@ class WindowShell {
 
   // What the window opens with; the command line's errors are thrown (IoError) before a window
   // exists. A recording starts importing and opens when done.
-  void OpenDataset(const std::filesystem::path& dataset, Controller::ExistingSession existing,
+  void OpenDataset(const std::filesystem::path& dataset, ExistingSession existing,
                    const std::string& camera = "");
   void OpenSession(const std::filesystem::path& session);
   void ImportRecording(const std::filesystem::path& recording);

@@ -10,7 +10,7 @@ void WindowShell::SelectCamera(const std::string& camera) {
     auto opened = NewController();
     // While the rig solves, its cameras' solves are not all there: the new controller solves.
     if (!s.rig->solving) opened->CarryRig(*s.rig);
-    opened->OpenDataset(s.rig->path, {}, Controller::ExistingSession::kResume, camera);
+    opened->OpenDataset(s.rig->path, {}, ExistingSession::kResume, camera);
     const std::string pair = s.selected >= 0 ? s.pairs[s.selected].id : "";
     const auto pairs = opened->GetSnapshot().pairs;
     for (size_t i = 0; i < pairs.size(); ++i)

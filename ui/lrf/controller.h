@@ -22,6 +22,7 @@
 #include "core/lrf/pipeline.h"
 #include "core/session/lrf_calibration_job.h"
 #include "ui/state/controller_state.h"
+#include "ui/state/session_opening.h"
 
 namespace calibench::ui {
 
@@ -97,18 +98,14 @@ class LrfController : public ControllerState<LrfSnapshot> {
   LrfController(const LrfController&) = delete;
   LrfController& operator=(const LrfController&) = delete;
 
-  // What Open does with the session beside the manifest (DefaultLrfSessionPath).
-  enum class SessionUse {
-    kResume,    // resumes it, or starts one there; autosaves to it
-    kFresh,     // moves it aside (<session>.<date-time>.bak) and starts a new one there
-    kInMemory,  // neither reads nor writes it (`calibench render`)
-  };
-  // Loads the manifest, opens its session as `use` says, and queues feature extraction of every
-  // pair. A session that does not open gives way to its newest backup that opens, else is moved
-  // aside and a new one starts (ResumeSessionBeside; session_note says which). A manifest that
-  // cannot be read, or a session open in another workbench, leaves the open dataset as it was and
-  // shows the error in the status line (false).
-  bool Open(const std::filesystem::path& manifest, SessionUse use = SessionUse::kResume);
+  // Loads the manifest, opens the session beside it (DefaultLrfSessionPath) as `existing` says
+  // (both workbenches' ExistingSession, ui/state/session_opening.h), and queues feature
+  // extraction of every pair. A session that does not open gives way to its newest backup that
+  // opens, else is moved aside and a new one starts (ResumeSessionBeside; session_note says which).
+  // A manifest that cannot be read, or a session open in another workbench, leaves the open dataset
+  // as it was and shows the error in the status line (false).
+  bool Open(const std::filesystem::path& manifest,
+            ExistingSession existing = ExistingSession::kResume);
   // Opens a saved LRF session (calibench.session.v1 with options.lrf_method) with the manifest it
   // names, and autosaves to it from then on; false with the error shown, as Open.
   bool OpenSession(const std::filesystem::path& session_path);

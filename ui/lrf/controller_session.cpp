@@ -26,38 +26,27 @@ bool LrfController::Fail(const std::string& message) {
   return false;
 }
 
-bool LrfController::Open(const std::filesystem::path& manifest, SessionUse use) {
+bool LrfController::Open(const std::filesystem::path& manifest, ExistingSession existing) {
   std::string why;
   std::shared_ptr<const LrfDataset> dataset;
-  std::filesystem::path session_path;
-  std::optional<FileLock> lock;
   std::optional<Session> saved;
-  std::string note;
+  OpenedSessionFile file;
   try {
     if (!options_.Check(&why)) throw IoError("LRF pipeline options: " + why);
     dataset = std::make_shared<const LrfDataset>(LoadLrfDataset(manifest));
-    if (use != SessionUse::kInMemory) {
-      session_path = DefaultLrfSessionPath(dataset->manifest);
-      lock = LockSessionFile(session_path, session_lock_, &note);
-      if (std::filesystem::exists(session_path)) {
-        std::string resume_note;
-        ResumeSessionBeside(
-            session_path, use == SessionUse::kFresh,
-            [&](const std::filesystem::path& file) {
-              LrfSessionWithDataset opened = LoadLrfSessionWithDataset(file);
-              if (opened.session.dataset != NormalizeSessionPath(dataset->manifest))
-                throw IoError(file.string() + " is the session of " +
-                              opened.session.dataset.string());
-              saved = std::move(opened.session);
-            },
-            &resume_note);
-        note += (note.empty() ? "" : "; ") + resume_note;
-      }
-    }
+    file = OpenSessionFileBeside(
+        DefaultLrfSessionPath(dataset->manifest), existing, session_lock_,
+        [&](const std::filesystem::path& candidate) {
+          LrfSessionWithDataset opened = LoadLrfSessionWithDataset(candidate);
+          if (opened.session.dataset != NormalizeSessionPath(dataset->manifest))
+            throw IoError(candidate.string() + " is the session of " +
+                          opened.session.dataset.string());
+          saved = std::move(opened.session);
+        });
   } catch (const IoError& e) {
     return Fail(std::string("cannot open: ") + e.what());
   }
-  Start(dataset, std::move(saved), session_path, std::move(lock), note);
+  Start(dataset, std::move(saved), file.path, std::move(file.lock), file.note);
   return true;
 }
 

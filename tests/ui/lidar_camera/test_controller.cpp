@@ -359,7 +359,7 @@ TEST(Controller, ABrushOfTheWrongSizeIsDroppedWithAMessageAndTheRestLoads) {
 TEST(Controller, ReopeningADatasetResumesItsSessionOrBacksItUp) {
   const auto dir = test::TempDir("controller_resume");
   const auto session_path = dir / "calibench.session.json";
-  using Existing = Controller::ExistingSession;
+  using Existing = ExistingSession;
   {
     Controller controller;
     controller.OpenDataset(test::UiDataset(), session_path, Existing::kResume);
@@ -449,7 +449,7 @@ TEST(Controller, ACorruptSessionIsReportedAndLeftUntouched) {
 TEST(Controller, AnUnreadableSessionIsResumedFromItsNewestBackup) {
   const auto dir = test::TempDir("controller_resume_backup");
   const auto session_path = dir / "calibench.session.json";
-  using Existing = Controller::ExistingSession;
+  using Existing = ExistingSession;
   for (int pair : {3, 2}) {  // two sittings: the second's first save backs up the first's file
     Controller controller;
     controller.OpenDataset(test::UiDataset(), session_path, Existing::kResume);
@@ -473,7 +473,7 @@ TEST(Controller, AnUnreadableSessionIsResumedFromItsNewestBackup) {
 // Two workbenches never edit one session: the second is refused, naming the first.
 TEST(Controller, ASecondWorkbenchOnTheSameSessionIsRefused) {
   const auto session_path = test::TempDir("controller_lock") / "calibench.session.json";
-  using Existing = Controller::ExistingSession;
+  using Existing = ExistingSession;
   auto first = std::make_unique<Controller>();
   first->OpenDataset(test::UiDataset(), session_path, Existing::kResume);
   Loaded(*first);
@@ -501,7 +501,7 @@ TEST(Controller, AnInMemorySessionLeavesTheSessionFileAlone) {
   const auto session_path = dir / "calibench.session.json";
   std::ofstream(session_path) << "an hour of someone's work";
   Controller controller;
-  controller.OpenDataset(test::UiDataset(), session_path, Controller::ExistingSession::kInMemory);
+  controller.OpenDataset(test::UiDataset(), session_path, ExistingSession::kInMemory);
   Loaded(controller);
   controller.Apply(SetPairStatus{1, PairStatus::kRejected});
   controller.Apply(RunSolver{});
@@ -545,7 +545,7 @@ TEST(Controller, AReadOnlyDatasetFolderOpensAndSaysItCannotSave) {
   ReadOnlyFolder read_only(dir);
   if (!read_only.readonly()) GTEST_SKIP() << "cannot make a folder read-only here";
   Controller controller;
-  controller.OpenDataset(dir / "dataset.json", {}, Controller::ExistingSession::kResume);
+  controller.OpenDataset(dir / "dataset.json", {}, ExistingSession::kResume);
   Snapshot s = Loaded(controller);
   // Loading already saves (the detected boards): the status line says at once that it cannot.
   EXPECT_TRUE(s.status_is_error);

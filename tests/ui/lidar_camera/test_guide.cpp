@@ -38,7 +38,7 @@ std::vector<Vec3> SheetCorners(const BoardSpec& board) {
 
 TEST(Guide, TheGhostBoardInTheCameraViewLiesWhereAdvisesPoseProjects) {
   Controller controller;
-  controller.OpenDataset(test::UiDataset(), {}, Controller::ExistingSession::kInMemory);
+  controller.OpenDataset(test::UiDataset(), {}, ExistingSession::kInMemory);
   controller.WaitIdle();
   controller.Apply(RunSolver{});
   const Snapshot s = Loaded(controller);

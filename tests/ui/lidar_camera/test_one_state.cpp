@@ -59,7 +59,7 @@ const PairState* StateOf(const Session& session, const std::string& id) {
 
 // The workbench as the window opens a folder: the session beside it resumed when there is one.
 Snapshot OpenLikeTheWindow(Controller& controller, const fs::path& capture) {
-  controller.OpenDataset(capture, {}, Controller::ExistingSession::kResume);
+  controller.OpenDataset(capture, {}, ExistingSession::kResume);
   return Loaded(controller);
 }
 

@@ -64,7 +64,7 @@ ui::Snapshot Settled(ui::Controller& controller) {
 TEST(RigWorkbench, ACameraOpensWithTheRigsOtherCamerasSolvedBesideIt) {
   const fs::path rig_path = CopyOfRig("rig_workbench_open");
   ui::Controller controller;
-  controller.OpenDataset(rig_path, {}, ui::Controller::ExistingSession::kReplace, "cam0");
+  controller.OpenDataset(rig_path, {}, ui::ExistingSession::kReplace, "cam0");
   Settled(controller);
   controller.Apply(ui::RunSolver{});
   const ui::Snapshot s = Settled(controller);
@@ -136,7 +136,7 @@ TEST(RigWorkbench, SwitchingCamerasKeepsEachCamerasEditsAndTheRigSolveTakesThem)
   options.auto_solve = false;
   options.recent_file = rig_path.parent_path() / "recent.json";
   ui::WindowShell shell(options);
-  shell.OpenDataset(rig_path, ui::Controller::ExistingSession::kReplace, "cam0");
+  shell.OpenDataset(rig_path, ui::ExistingSession::kReplace, "cam0");
   ui::Snapshot s = Settled(shell.controller());
   ASSERT_TRUE(s.rig.has_value());
   const int cam1_pairs = s.rig->cameras[1].pairs_used;
@@ -202,7 +202,7 @@ TEST(RigWorkbench, SwitchingCamerasKeepsEachCamerasEditsAndTheRigSolveTakesThem)
 TEST(RigWorkbench, ACameraTheRigHasNotIsAnErrorNamingItsCameras) {
   ui::Controller controller;
   try {
-    controller.OpenDataset(Rig().folder, {}, ui::Controller::ExistingSession::kInMemory, "left");
+    controller.OpenDataset(Rig().folder, {}, ui::ExistingSession::kInMemory, "left");
     ADD_FAILURE() << "opened a camera the rig has not";
   } catch (const IoError& e) {
     EXPECT_NE(std::string(e.what()).find("no camera 'left' (its cameras: cam0, cam1)"),
@@ -217,7 +217,7 @@ TEST(RigWorkbench, ACameraTheRigHasNotIsAnErrorNamingItsCameras) {
 TEST(RigWorkbench, AnEditWhileTheRigSolvesWaitsForOneStepNotForTheSolve) {
   const fs::path rig_path = CopyOfRig("rig_workbench_steps");
   ui::Controller controller;
-  controller.OpenDataset(rig_path, {}, ui::Controller::ExistingSession::kReplace, "cam0");
+  controller.OpenDataset(rig_path, {}, ui::ExistingSession::kReplace, "cam0");
   // The open camera's pairs load first (queued jobs); the rig's steps wait below them.
   ui::Snapshot s = controller.GetSnapshot();
   for (int i = 0; i < 60000 && s.loading_done < s.loading_total; ++i) {
@@ -260,7 +260,7 @@ TEST(RigWorkbench, AnEditWhileTheRigSolvesWaitsForOneStepNotForTheSolve) {
 // strip) need a second camera. A report's snapshot of the same solve sees the same rig of one.
 TEST(RigWorkbench, OneCameraIsARigOfOne) {
   ui::Controller controller;
-  controller.OpenDataset(test::UiDataset(), {}, ui::Controller::ExistingSession::kInMemory);
+  controller.OpenDataset(test::UiDataset(), {}, ui::ExistingSession::kInMemory);
   ui::Loaded(controller);
   controller.Apply(ui::RunSolver{});
   const ui::Snapshot s = Settled(controller);

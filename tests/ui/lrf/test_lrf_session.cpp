@@ -25,7 +25,7 @@ std::filesystem::path LrfDatasetIn(const std::string& folder) {
 }
 
 void OpenAndWait(LrfController& controller, const std::filesystem::path& manifest,
-                 LrfController::SessionUse use = LrfController::SessionUse::kResume) {
+                 ExistingSession use = ExistingSession::kResume) {
   ASSERT_TRUE(controller.Open(manifest, use)) << controller.GetSnapshot().status_line;
   controller.WaitIdle();
 }
@@ -166,7 +166,7 @@ TEST(LrfSession, ASessionThatDoesNotOpenIsMovedAsideOrItsBackupResumedAndFreshSt
   EXPECT_TRUE(IsLrfSession(session_file));  // a new session in its place
 
   controller.Apply(LrfSetPairStatus{0, PairStatus::kRejected});
-  ASSERT_TRUE(controller.Open(manifest, LrfController::SessionUse::kFresh));
+  ASSERT_TRUE(controller.Open(manifest, ExistingSession::kStartFresh));
   controller.WaitIdle();
   s = controller.GetSnapshot();
   EXPECT_TRUE(Says(s.session_note, "started over")) << s.session_note;

@@ -43,7 +43,7 @@ std::filesystem::path LrfUiDataset() {
 // the dataset, and a session one of them left beside it would carry into the next (the session's
 // own tests are in test_lrf_session.cpp).
 void OpenAndWait(LrfController& controller) {
-  ASSERT_TRUE(controller.Open(LrfUiDataset(), LrfController::SessionUse::kInMemory))
+  ASSERT_TRUE(controller.Open(LrfUiDataset(), ExistingSession::kInMemory))
       << controller.GetSnapshot().status_line;
   controller.WaitIdle();
 }
