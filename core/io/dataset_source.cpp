@@ -24,8 +24,11 @@ constexpr char kLookedFor[] =
     "any other *.json), the folder form (clouds/ and images/ beside camera.yaml and "
     "target.json) and a recording (ROS 1 .bag, MCAP, rosbag2 .db3 or its folder)";
 
-// The manifest kind of a JSON file, or nullopt with *why (the file and the problem).
-std::optional<DatasetKind> ManifestKind(const fs::path& file, std::string* why) {
+// The manifest kind of a JSON file, or nullopt with *why (the file and the problem). *broken
+// (optional) is set when the file is no JSON at all (cut mid-object, a stray comma): *why then
+// holds the parser's words, with the line and the column.
+std::optional<DatasetKind> ManifestKind(const fs::path& file, std::string* why,
+                                        bool* broken = nullptr) {
   std::error_code ec;
   const std::uintmax_t size = fs::file_size(file, ec);
   if (ec || size > kMaxManifestBytes) {
@@ -37,8 +40,15 @@ std::optional<DatasetKind> ManifestKind(const fs::path& file, std::string* why) 
     *why = file.string() + ": cannot be opened";
     return std::nullopt;
   }
-  const nlohmann::json root = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (root.is_discarded() || !root.is_object()) {
+  nlohmann::json root;
+  try {
+    root = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    *why = file.string() + ": not valid JSON: " + e.what();
+    if (broken) *broken = true;
+    return std::nullopt;
+  }
+  if (!root.is_object()) {
     *why = file.string() + ": not a JSON object";
     return std::nullopt;
   }
@@ -67,7 +77,15 @@ std::optional<DatasetSource> RecogniseFolder(const fs::path& folder, std::string
     std::error_code ec;
     if (!fs::exists(file, ec)) continue;
     std::string problem;
-    if (const auto kind = ManifestKind(file, &problem)) return DatasetSource{*kind, file, false};
+    bool broken = false;
+    if (const auto kind = ManifestKind(file, &problem, &broken))
+      return DatasetSource{*kind, file, false};
+    // The folder's own manifest, damaged: its parse error, never another file opened silently
+    // in its place (the edits the user made to it would be lost without a word).
+    if (broken) {
+      *why = problem + " (the folder's manifest: fix it, or name the manifest to open)";
+      return std::nullopt;
+    }
     problems.push_back(problem);
   }
   std::vector<DatasetSource> others;

@@ -136,6 +136,28 @@ TEST_F(DatasetResolver, RecognisesEachKindByContentWhateverItsName) {
   EXPECT_NE(why.find("rig_a.json, rig_b.json"), std::string::npos) << why;
 }
 
+// A folder's dataset.json cut mid-object (a copy interrupted, an editor's crash) beside another
+// manifest: the folder's own manifest is broken, and the command says so with the parser's line
+// and column; it never calibrates from the other file in its place.
+TEST_F(DatasetResolver, ABrokenDatasetJsonIsRefusedNotSkippedForAnotherManifest) {
+  Copy("lidar_camera", "broken_beside_another", "dataset.json", "rig_2026.json");
+  const std::string good = test::ReadFileBytes(*dir_ / "broken_beside_another/rig_2026.json");
+  std::ofstream(*dir_ / "broken_beside_another/dataset.json") << good.substr(0, good.size() / 2);
+  const std::string folder = Path("broken_beside_another");
+  std::string out;
+  const std::string result = Path("broken_result.json");
+  EXPECT_NE(Run("calibrate --dataset " + folder + " --out " + result, &out), 0) << out;
+  EXPECT_NE(out.find(folder + "/dataset.json: not valid JSON"), std::string::npos) << out;
+  EXPECT_NE(out.find("line "), std::string::npos) << out;
+  EXPECT_NE(out.find("column "), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(result));
+  EXPECT_NE(Run("advise --json --dataset " + folder, &out), 0) << out;
+  EXPECT_NE(out.find("dataset.json: not valid JSON"), std::string::npos) << out;
+  // Named outright, the other manifest opens.
+  EXPECT_EQ(Run("calibrate --dataset " + folder + "/rig_2026.json --out " + result, &out), 0)
+      << out;
+}
+
 TEST_F(DatasetResolver, LidarCameraCommandsOpenEveryManifestName) {
   ExpectLidarCameraOpens(Path("lidar_camera"));
   ExpectLidarCameraOpens(Path("lidar_camera_manifest"));
