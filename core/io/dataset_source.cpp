@@ -43,7 +43,7 @@ std::optional<DatasetKind> ManifestKind(const fs::path& file, std::string* why,
   nlohmann::json root;
   try {
     root = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // a syntax error, a number out of range
     *why = file.string() + ": not valid JSON: " + e.what();
     if (broken) *broken = true;
     return std::nullopt;
