@@ -20,14 +20,10 @@ namespace {
 using recording_detail::BoardDecision;
 using recording_detail::Copy;
 using recording_detail::HeldTry;
+using recording_detail::Ns;
 using recording_detail::StampedBytes;
+using recording_detail::StampOr;
 using recording_detail::Try;
-
-std::int64_t Ns(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e9)); }
-
-std::int64_t StampOr(const RosHeader& header, std::int64_t log_time_ns) {
-  return header.stamp_ns != 0 ? header.stamp_ns : log_time_ns;
-}
 
 // Sweeps and images stay this long beyond the stillness window and the pairing offset behind
 // the newest stamp: a sweep is judged kJudgeLagS after its window has passed, and its try needs
@@ -87,6 +83,10 @@ struct RecordingPairFinder::Impl {
     std::lock_guard lock(mutex);
     ++stats.dropped[reason];
   }
+  void Count(std::int64_t PairFinderStats::*messages) {
+    std::lock_guard lock(mutex);
+    ++(stats.*messages);
+  }
 
   void RethrowWorkerError() {
     std::lock_guard lock(mutex);
@@ -95,10 +95,7 @@ struct RecordingPairFinder::Impl {
 
   void AddCloud(std::span<const std::uint8_t> data, std::int64_t log_time_ns) {
     RethrowWorkerError();
-    {
-      std::lock_guard lock(mutex);
-      ++stats.clouds;
-    }
+    Count(&PairFinderStats::clouds);
     CloudMessage message;
     try {
       message = DecodeCloudMessage(data, topics.livox_cloud, topics.cloud, options.limits);
@@ -126,10 +123,7 @@ struct RecordingPairFinder::Impl {
 
   void AddImage(std::span<const std::uint8_t> data, std::int64_t log_time_ns) {
     RethrowWorkerError();
-    {
-      std::lock_guard lock(mutex);
-      ++stats.images;
-    }
+    Count(&PairFinderStats::images);
     std::int64_t stamp = log_time_ns;
     try {
       stamp = StampOr(DecodeRosHeader(data, topics.image), log_time_ns);
@@ -192,8 +186,8 @@ struct RecordingPairFinder::Impl {
     cloud->judged = true;
     const std::int64_t stamp = cloud->cloud.stamp_ns;
     const LidarView view = SeenByLidar(*cloud);
-    if (view == LidarView::kStill) last_still_ns = stamp;
     if (view == LidarView::kStill) {
+      last_still_ns = stamp;
       Hold& hold = holds[cloud->hold];
       // The hold's last try decides whether more are needed: waiting for it (once per try, a
       // search's time) keeps the tries, and so the pairs and every count, the same for any
@@ -349,10 +343,6 @@ struct RecordingPairFinder::Impl {
     }
   }
 
-  ImageU8 DecodeTryImage(const StampedBytes& image) const {
-    return DecodeTryMessageImage(image, topics, options.limits);
-  }
-
   void Process(Try attempt) {
     if (!board) AdoptGivenBoard();
     if (board) {
@@ -361,7 +351,7 @@ struct RecordingPairFinder::Impl {
     }
     HeldTry sample{std::move(attempt), std::nullopt};
     try {
-      sample.image = DecodeTryImage(sample.attempt.image);
+      sample.image = DecodeTryMessageImage(sample.attempt.image, topics, options.limits);
     } catch (const std::invalid_argument&) {
     }
     Decide(board_choice.Offer(std::move(sample)));

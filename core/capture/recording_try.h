@@ -3,6 +3,7 @@
 // out of the reader's window, and the camera they are judged with.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -11,6 +12,7 @@
 
 #include "core/base/image.h"
 #include "core/camera/camera.h"
+#include "core/recording/ros_messages.h"
 
 namespace calibench::recording_detail {
 
@@ -24,6 +26,12 @@ struct StampedBytes {
   std::int64_t stamp_ns = 0;
   Bytes bytes;
 };
+
+inline std::int64_t Ns(double seconds) { return std::llround(seconds * 1e9); }
+// A message's stamp: its header's, or the time the recorder logged it when the header has none.
+inline std::int64_t StampOr(const RosHeader& header, std::int64_t log_time_ns) {
+  return header.stamp_ns != 0 ? header.stamp_ns : log_time_ns;
+}
 
 struct Try {
   int hold = 0;

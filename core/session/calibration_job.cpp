@@ -240,10 +240,10 @@ std::vector<PairFeatures> CalibrationJob::DetectedPairs(const Session& record) c
   std::vector<PairFeatures> features;
   for (const JobPair& pair : pairs_) {
     features.push_back(pair.detected);
-    const PairState* state = FindPair(record, pair.detected.id);
-    if (!state || state->status != PairStatus::kRejected) continue;
+    std::string reason;
+    if (!IsRejected(record, pair.detected.id, &reason)) continue;
     features.back().status = PairStatus::kRejected;
-    features.back().reason = state->reason.empty() ? kRejectedByUser : state->reason;
+    features.back().reason = reason;
   }
   return features;
 }

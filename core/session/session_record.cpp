@@ -56,12 +56,16 @@ PairEdits SessionRecord::Edits() const {
   return EditsFromSession(session_);
 }
 
-bool SessionRecord::Rejected(const std::string& id, std::string* reason) const {
-  std::lock_guard lock(mutex_);
-  const PairState* pair = FindPair(session_, id);
+bool IsRejected(const Session& session, const std::string& id, std::string* reason) {
+  const PairState* pair = FindPair(session, id);
   if (!pair || pair->status != PairStatus::kRejected) return false;
   if (reason) *reason = pair->reason.empty() ? kRejectedByUser : pair->reason;
   return true;
+}
+
+bool SessionRecord::Rejected(const std::string& id, std::string* reason) const {
+  std::lock_guard lock(mutex_);
+  return IsRejected(session_, id, reason);
 }
 
 void SessionRecord::ApplyOptions(PipelineOptions* options) const {

@@ -24,6 +24,9 @@ namespace calibench {
 // Pair `id`'s state in `session`, or null; and its brush forgotten (painted or from a seed).
 PairState* FindPair(Session* session, const std::string& id);
 const PairState* FindPair(const Session& session, const std::string& id);
+// Whether pair `id` is rejected in `session`; *reason (optional) gets the reason shown for it
+// (kRejectedByUser when none was given).
+bool IsRejected(const Session& session, const std::string& id, std::string* reason = nullptr);
 void ForgetBrush(Session* session, const std::string& id);
 
 class SessionRecord {

@@ -5,16 +5,9 @@
 // No GL, GLFW or ImGui here: the controller is driven by tests without a window.
 #pragma once
 
-#include <atomic>
 #include <filesystem>
-#include <functional>
-#include <map>
-#include <memory>
-#include <mutex>
 #include <optional>
-#include <set>
 #include <string>
-#include <variant>
 #include <vector>
 
 #include "core/base/file_lock.h"
