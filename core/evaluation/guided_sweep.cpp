@@ -63,8 +63,8 @@ std::optional<SensorGeometry> SensorsFromData(const SimOptions& sim,
 }
 
 // A simulated pair through the pipeline's steps, the LiDAR side from the seed a brush would give.
-PairFeatures FeaturesOf(const Dataset& dataset, const SimulatedPair& pair, const std::string& id,
-                        const PipelineOptions& pipeline) {
+PairFeatures SimulatedPairFeatures(const Dataset& dataset, const SimulatedPair& pair,
+                                   const std::string& id, const PipelineOptions& pipeline) {
   PairFeatures f;
   f.id = id;
   std::string lidar_failure;
@@ -120,7 +120,7 @@ GuidedRun RunGuidedCapture(const GuidedSweepOptions& options, std::uint64_t seed
     }
     seen.push_back(cam_from_board);
     SimulatedPair pair = SimulatePairAt(sim, cam_from_board, k);
-    PairFeatures f = FeaturesOf(dataset, pair, std::to_string(k), pipeline);
+    PairFeatures f = SimulatedPairFeatures(dataset, pair, std::to_string(k), pipeline);
     features.push_back(std::move(f));
     if (clouds.size() < 8 && features.back().status == PairStatus::kAccepted)
       clouds.push_back(std::move(pair.cloud));

@@ -1,11 +1,17 @@
 #include "core/session/calibration_job.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "core/io/cloud_io.h"
 #include "core/lidar_camera/result_io.h"
 
 namespace calibench {
+namespace {
+
+constexpr const char* kNoBoardToFind = "no board to find: the dataset has no target.json";
+
+}  // namespace
 
 bool CalibrationJobOptions::Check(std::string* why) const {
   if (!advise.Check(why)) return false;
@@ -87,10 +93,18 @@ void CalibrationJob::DetectAll() {
   for (auto& [id, edit] : brushes) edit.rejected = false;
   std::vector<PairFeatures> features = ExtractDatasetPairs(
       dataset_, entries, Pipeline(), events_.detected, brushes, &background_note_);
-  for (size_t i = 0; i < features.size(); ++i) {
-    pairs_[i].detected = std::move(features[i]);
-    pairs_[i].lidar_failure = pairs_[i].camera_failure = pairs_[i].detected.reason;
+  {
+    std::lock_guard lock(pairs_mutex_);
+    for (size_t i = 0; i < features.size(); ++i) {
+      JobPair& pair = pairs_[i];
+      pair.detected = std::move(features[i]);
+      pair.completed.reset();
+      pair.lidar_failure = pair.camera_failure = pair.detected.reason;
+      pair.lidar_tried = true;
+      ++pair.detections;
+    }
   }
+  RecordStatuses();
 }
 
 bool CalibrationJob::AddToBackground(int index, const LidarCloud& cloud) {
@@ -125,18 +139,26 @@ const PairFeatures& CalibrationJob::AddPair(const PairEntry& entry, const PairFe
     } catch (const IoError&) {  // the pair reports it when it is extracted
     }
   }
-  JobPair& pair = pairs_[index];
+  PairFeatures features;
   if (cached) {
-    pair.detected = *cached;
+    features = *cached;
   } else {
     PairEdit edit = EditOf(entry.id);
     edit.rejected = false;  // applies at the solve
-    pair.detected = ExtractPairFeatures(dataset_, entry, pipeline, edit, Background(),
-                                        cloud ? &*cloud : nullptr);
+    features = ExtractPairFeatures(dataset_, entry, pipeline, edit, Background(),
+                                   cloud ? &*cloud : nullptr);
   }
-  pair.lidar_failure = pair.camera_failure = pair.detected.reason;
+  {
+    std::lock_guard lock(pairs_mutex_);
+    JobPair& pair = pairs_[index];
+    pair.detected = std::move(features);
+    pair.lidar_failure = pair.camera_failure = pair.detected.reason;
+    pair.lidar_tried = true;
+    ++pair.detections;
+  }
+  RecordStatuses();
   if (events_.detected) events_.detected(size(), size(), entry.id);
-  return pair.detected;
+  return pairs_[index].detected;  // only this thread writes it
 }
 
 int CalibrationJob::AppendPair(const PairEntry& entry) {
@@ -144,30 +166,78 @@ int CalibrationJob::AppendPair(const PairEntry& entry) {
   record_.AddPair(entry.id);
   JobPair pair;
   pair.detected.id = entry.id;
+  std::lock_guard lock(pairs_mutex_);
   pairs_.push_back(std::move(pair));
   return size() - 1;
 }
 
 std::optional<PairInputs> CalibrationJob::ReadPair(int index, CameraFeatures* camera,
                                                    std::string* why) {
-  JobPair& pair = pairs_.at(index);
-  std::optional<PairInputs> inputs = LoadPairInputs(dataset_, dataset_.pairs[index], why);
-  if (!inputs) {
-    pair.detected.input_error = true;
-    pair.lidar_failure = pair.camera_failure = *why;
-  } else {
+  std::optional<PairInputs> inputs = LoadPairInputs(dataset_, dataset_.pairs.at(index), why);
+  // No target (a drive opened for the targetless check): no board to see on either side.
+  const bool no_target = !dataset_.missing_target_file.empty();
+  if (inputs && !no_target)
     *camera = ExtractCameraFeatures(dataset_, inputs->image, options_.advise.pipeline);
-    pair.detected.camera = camera->observation;
-    pair.detected.edge_width_px = camera->edge_width_px;
-    pair.camera_failure = camera->failure;
+  {
+    std::lock_guard lock(pairs_mutex_);
+    JobPair& pair = pairs_[index];
+    if (!inputs) {
+      pair.detected.input_error = true;
+      pair.lidar_failure = pair.camera_failure = *why;
+      pair.lidar_tried = true;
+    } else if (no_target) {
+      pair.camera_failure = pair.lidar_failure = kNoBoardToFind;
+      pair.lidar_tried = true;
+    } else {
+      pair.detected.camera = camera->observation;
+      pair.detected.edge_width_px = camera->edge_width_px;
+      pair.detection = camera->detection;
+      pair.camera_failure = camera->failure;
+    }
+    Restatus(&pair);
   }
-  Restatus(&pair);
+  RecordStatuses();
   return inputs;
+}
+
+std::string CalibrationJob::PictureOn(int index, const LidarCloud& cloud,
+                                      std::shared_ptr<const LidarImage> image) {
+  const PairEntry& entry = dataset_.pairs.at(index);
+  const std::optional<PairState> saved = record_.Pair(entry.id);
+  std::string dropped;
+  if (saved && saved->brush && !saved->brush_from_seed &&
+      !BrushFitsImage(*saved->brush, image->rows, image->columns, &dropped)) {
+    record_.Adjust([&](Session* session) { ForgetBrush(session, entry.id); });
+    dropped = "pair " + entry.id +
+              ": its brush from the session was dropped: " + entry.cloud.string() + ": " + dropped;
+  } else {
+    dropped.clear();
+  }
+  // The seed's region pictured as its brush: the session file keeps the picture, and reopening
+  // pictures it again (EditsFromSession skips it). Not over a brush the user painted.
+  const bool painted = saved && saved->brush && !saved->brush_from_seed && dropped.empty();
+  if (entry.lidar_seed && !painted) {
+    std::vector<int> pixels;
+    for (int i : SelectSeedRegion(cloud, *entry.lidar_seed))
+      if (image->pixel_of_point[i] >= 0) pixels.push_back(image->pixel_of_point[i]);
+    std::sort(pixels.begin(), pixels.end());
+    pixels.erase(std::unique(pixels.begin(), pixels.end()), pixels.end());
+    record_.Edit(
+        [&](Session* session) {
+          PairState* pair = FindPair(session, entry.id);
+          if (!pair) return;
+          pair->brush = BrushMask{image->rows, image->columns, std::move(pixels)};
+          pair->brush_from_seed = true;
+        },
+        /*amend=*/true);
+  }
+  std::lock_guard lock(pairs_mutex_);
+  pairs_[index].image = std::move(image);
+  return dropped;
 }
 
 const PairFeatures& CalibrationJob::DetectLidar(int index, const LidarCloud& cloud,
                                                 const LidarImage* image, bool use_seed) {
-  JobPair& pair = pairs_.at(index);
   PairEntry entry = dataset_.pairs[index];
   if (!use_seed) entry.lidar_seed.reset();
   std::string why;
@@ -177,11 +247,40 @@ const PairFeatures& CalibrationJob::DetectLidar(int index, const LidarCloud& clo
     hint->background = Background();
     fit = ExtractLidarFeatures(dataset_, cloud, *hint, Pipeline(), &why, &origin);
   }
-  pair.detected.lidar = std::move(fit);
-  pair.detected.board_origin = origin;
-  pair.lidar_failure = pair.detected.lidar ? "" : why;
-  Restatus(&pair);
-  return pair.detected;
+  {
+    std::lock_guard lock(pairs_mutex_);
+    JobPair& pair = pairs_.at(index);
+    pair.detected.lidar = std::move(fit);
+    pair.detected.board_origin = origin;
+    pair.lidar_failure = pair.detected.lidar ? "" : why;
+    pair.lidar_tried = true;
+    pair.completed.reset();  // completion's board answered the detection before this one
+    ++pair.detections;
+    Restatus(&pair);
+  }
+  RecordStatuses();
+  return pairs_[index].detected;  // only this thread writes it
+}
+
+void CalibrationJob::RecordStatuses() {
+  std::vector<std::pair<std::string, PairFeatures>> now;
+  {
+    std::lock_guard lock(pairs_mutex_);
+    for (const JobPair& pair : pairs_) {
+      if (!pair.lidar_tried) continue;  // pending until both sides were looked at
+      now.emplace_back(pair.detected.id, pair.Now());
+    }
+  }
+  record_.Edit(
+      [&](Session* session) {
+        for (const auto& [id, features] : now) {
+          PairState* saved = FindPair(session, id);
+          if (!saved || saved->status == PairStatus::kRejected) continue;  // the user's word
+          saved->status = features.status;
+          saved->reason = features.reason;
+        }
+      },
+      /*amend=*/true);
 }
 
 void CalibrationJob::SetBrush(const std::string& pair_id, std::optional<PairEdit> brush,
@@ -213,6 +312,7 @@ void CalibrationJob::SetRejected(const std::string& pair_id, bool rejected,
     pair->status = PairStatus::kPending;
     pair->reason.clear();
   });
+  if (!rejected) RecordStatuses();
 }
 
 void CalibrationJob::Resume(const Session& session) {
@@ -233,7 +333,105 @@ void CalibrationJob::SetHandTolerance(double translation_m, double rotation_deg)
 }
 
 std::vector<PairFeatures> CalibrationJob::DetectedPairs() const {
-  return DetectedPairs(record_.Current());
+  const Session record = record_.Current();
+  std::lock_guard lock(pairs_mutex_);
+  return DetectedPairs(record);
+}
+
+std::vector<PairFeatures> CalibrationJob::PairsNow(const Session& record) const {
+  std::vector<PairFeatures> pairs;
+  for (const JobPair& job_pair : pairs_) {
+    PairFeatures features = job_pair.Now();
+    // The record's status: what the steps left (a reopened session's until its pairs are read
+    // again) and the user's rejections.
+    const PairState* saved = FindPair(record, features.id);
+    features.status = saved ? saved->status : PairStatus::kPending;
+    features.reason = saved ? saved->reason : "";
+    // An accepted pair that lost a plane cannot be solved with.
+    if (features.status == PairStatus::kAccepted && !(features.lidar && features.camera))
+      features.status = PairStatus::kFailed;
+    pairs.push_back(std::move(features));
+  }
+  return pairs;
+}
+
+CalibrationOutcome CalibrationJob::OutcomeAt(const SolverResult& shown,
+                                             const std::vector<std::string>& solved_ids) const {
+  const Session record = record_.Current();
+  std::lock_guard lock(pairs_mutex_);
+  return OutcomeAt(record, shown, solved_ids);
+}
+
+CalibrationOutcome CalibrationJob::OutcomeAt(const Session& record, const SolverResult& shown,
+                                             const std::vector<std::string>& solved_ids) const {
+  CalibrationOutcome outcome;
+  outcome.pairs = PairsNow(record);
+  outcome.solution = shown;
+  std::vector<std::string> accepted;
+  for (const PairFeatures& pair : outcome.pairs)
+    if (pair.status == PairStatus::kAccepted) accepted.push_back(pair.id);
+  // The solve's own figures while its pairs are still the accepted ones (they include the
+  // outliers it gated); after accept/reject since, or after a reload, the solver's residuals at
+  // the shown estimate over the pairs accepted now.
+  if (accepted == solved_ids && shown.residuals.size() == accepted.size()) return outcome;
+  PipelineOptions pipeline = options_.advise.pipeline;
+  record.settings.Apply(&pipeline);
+  EvaluateAtSolution(outcome.pairs, pipeline.solver, &*outcome.solution);
+  return outcome;
+}
+
+std::vector<PairRecord> CalibrationJob::Records(const SolverResult* shown,
+                                                const std::vector<std::string>& solved_ids) const {
+  const Session record = record_.Current();
+  std::lock_guard lock(pairs_mutex_);
+  std::optional<CalibrationOutcome> at;
+  if (shown) at = OutcomeAt(record, *shown, solved_ids);
+  const std::vector<PairFeatures> now = at ? at->pairs : PairsNow(record);
+  std::vector<PairRecord> records;
+  size_t solved = 0;  // the solution's residuals follow the pairs solved with, in order
+  for (size_t i = 0; i < pairs_.size(); ++i) {
+    const JobPair& pair = pairs_[i];
+    const PairFeatures& features = now[i];
+    PairRecord& r = records.emplace_back();
+    r.id = features.id;
+    r.status = features.status;
+    r.reason = features.reason;
+    // An accepted pair without both planes (a reopened session's, before its files are read
+    // again) shows the record's status; the solver leaves it out.
+    if (const PairState* saved = FindPair(record, r.id)) r.status = saved->status;
+    r.lidar = features.lidar;
+    r.board_origin = features.board_origin;
+    r.lidar_failure =
+        pair.completed ? (features.lidar ? "" : pair.completed->reason) : pair.lidar_failure;
+    r.camera = features.camera;
+    r.detection = pair.detection;
+    r.camera_failure = pair.camera_failure;
+    // The brush: the user's, the seed's picture, or the board found (detection's or completion's)
+    // drawn on the pair's image.
+    const PairState* saved = FindPair(record, r.id);
+    if (saved && saved->brush) {
+      r.brush_origin = saved->brush_from_seed ? BrushOrigin::kSeeded : BrushOrigin::kPainted;
+      r.brush_pixels = saved->brush->pixels;
+    } else if (pair.image && features.lidar &&
+               (features.board_origin.source == BoardSource::kDetected ||
+                features.board_origin.source == BoardSource::kCameraGuided)) {
+      for (int k : features.lidar->inliers)
+        if (pair.image->pixel_of_point[k] >= 0)
+          r.brush_pixels.push_back(pair.image->pixel_of_point[k]);
+      std::sort(r.brush_pixels.begin(), r.brush_pixels.end());
+      r.brush_pixels.erase(std::unique(r.brush_pixels.begin(), r.brush_pixels.end()),
+                           r.brush_pixels.end());
+    }
+    if (at && features.status == PairStatus::kAccepted) {
+      if (solved < at->solution->residuals.size()) r.residual = at->solution->residuals[solved];
+      if (solved < at->solution->robust_weights.size())
+        r.robust_weight = at->solution->robust_weights[solved];
+      ++solved;
+    }
+    if (advice_ && i < advice_->pairs.size() && advice_->pairs[i].id == r.id)
+      r.findings = advice_->pairs[i].findings;
+  }
+  return records;
 }
 
 std::vector<PairFeatures> CalibrationJob::DetectedPairs(const Session& record) const {
@@ -250,7 +448,7 @@ std::vector<PairFeatures> CalibrationJob::DetectedPairs(const Session& record) c
 
 const CalibrationOutcome& CalibrationJob::Solve() {
   // The record read once: the edits, the rejections and the settings of one moment, which
-  // DiscardStaleOutcome compares with the record's when the solve is done.
+  // CommitOutcome compares with the record's when the solve is done.
   const Session record = record_.Current();
   PipelineOptions pipeline = options_.advise.pipeline;
   record.settings.Apply(&pipeline);
@@ -261,10 +459,22 @@ const CalibrationOutcome& CalibrationJob::Solve() {
   for (const PairEntry& pair : dataset_.pairs) entries.push_back(&pair);
   solved_edits_ = EditsFromSession(record);
   solved_settings_ = record.settings;
+  std::vector<PairFeatures> detected;
+  {
+    std::lock_guard lock(pairs_mutex_);
+    detected = DetectedPairs(record);
+    solved_detections_.clear();
+    for (const JobPair& pair : pairs_) solved_detections_.push_back(pair.detections);
+  }
+  iterations_.clear();
+  const IterationCallback on_iteration = [this](const IterationReport& it) {
+    iterations_.push_back(it);
+    if (events_.iteration) events_.iteration(it);
+  };
   // Every solve starts from what detection found, as `calibrate` does: a board completion
   // rescued is rescued again, one the camera disagrees with is looked at again.
-  outcome_ = SolveExtractedPairs(dataset_, entries, DetectedPairs(record), pipeline, solved_edits_,
-                                 events_.iteration);
+  outcome_ = SolveExtractedPairs(dataset_, entries, std::move(detected), pipeline, solved_edits_,
+                                 on_iteration);
   outcome_->background_note = background_note_;
   outcome_->estimated_intrinsics = options_.estimated_intrinsics;
   solved_with_ = pipeline.solver;
@@ -273,14 +483,77 @@ const CalibrationOutcome& CalibrationJob::Solve() {
   return *outcome_;
 }
 
-bool CalibrationJob::DiscardStaleOutcome() {
+bool CalibrationJob::CommitOutcome(bool own_step) {
   if (!outcome_) return false;
   const Session record = record_.Current();
-  if (EditsFromSession(record) == solved_edits_ && record.settings == solved_settings_)
+  if (EditsFromSession(record) != solved_edits_ || record.settings != solved_settings_) {
+    outcome_.reset();
+    advice_.reset();
     return false;
-  outcome_.reset();
-  advice_.reset();
+  }
+  // Completion's boards and verdicts, for the pairs still on the detection the solve started from.
+  std::vector<std::pair<std::string, PairFeatures>> verdicts;
+  {
+    std::lock_guard lock(pairs_mutex_);
+    for (size_t i = 0; i < outcome_->pairs.size() && i < pairs_.size(); ++i) {
+      JobPair& pair = pairs_[i];
+      if (i >= solved_detections_.size() || pair.detections != solved_detections_[i]) continue;
+      pair.completed = outcome_->pairs[i];
+      verdicts.emplace_back(pair.detected.id, outcome_->pairs[i]);
+    }
+  }
+  std::optional<SessionResult> result;
+  if (outcome_->solution) {
+    result = SessionResultFromSolver(*outcome_->solution);
+    for (const std::string& note :
+         {DescribeLidarModel(*outcome_), DescribeLearnedLidarNoise(*outcome_),
+          CountResiduals(*outcome_).note})
+      if (!note.empty()) result->notes.push_back(note);
+    for (const IterationReport& it : iterations_) {
+      result->step_history.push_back(it.step_norm);
+      result->estimate_history.push_back(it.cam_from_lidar);
+      if (it.reweighted) result->reweighted_iterations.push_back(it.iteration);
+    }
+  }
+  record_.Edit(
+      [&](Session* session) {
+        for (const auto& [id, features] : verdicts) {
+          PairState* saved = FindPair(session, id);
+          if (!saved || saved->status == PairStatus::kRejected) continue;  // the user's word
+          saved->status = features.status;
+          saved->reason = features.reason;
+        }
+        session->result = std::move(result);
+      },
+      /*amend=*/!own_step);
   return true;
+}
+
+void CalibrationJob::AdoptSolution(const SolverResult& solution, const std::string& provenance,
+                                   const std::vector<std::string>& notes) {
+  SessionResult result = SessionResultFromSolver(solution);
+  result.targetless_provenance = provenance;
+  result.notes = notes;
+  record_.Edit([&](Session* session) { session->result = result; });
+}
+
+bool CalibrationJob::ApplyPreflightRejections() {
+  if (!advice_) return false;
+  bool rejected = false;
+  record_.Edit(
+      [&](Session* session) {
+        for (const PairAdvice& judged : advice_->pairs) {
+          PairState* saved = FindPair(session, judged.id);
+          if (!saved || judged.status != PairStatus::kRejected ||
+              saved->status != PairStatus::kAccepted)
+            continue;
+          saved->status = PairStatus::kRejected;
+          saved->reason = judged.reason;
+          rejected = true;
+        }
+      },
+      /*amend=*/true);
+  return rejected;
 }
 
 void CalibrationJob::ExtractAll(const ProgressCallback& progress) {
@@ -324,7 +597,11 @@ Session CalibrationJob::ToSession(const std::filesystem::path& dataset_path) con
   session.settings = record.settings;
   session.view_json = record.view_json;
   // NewSession's pairs, pairs_, the outcome's and the advice's pairs all follow dataset_.pairs.
-  const std::vector<PairFeatures> detected = DetectedPairs();
+  std::vector<PairFeatures> detected;
+  {
+    std::lock_guard lock(pairs_mutex_);
+    detected = DetectedPairs(record);
+  }
   for (size_t i = 0; i < session.pairs.size(); ++i) {
     const PairFeatures* last = &detected[i];
     if (outcome_ && i < outcome_->pairs.size()) last = &outcome_->pairs[i];

@@ -17,6 +17,8 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
@@ -24,6 +26,7 @@
 
 #include "core/guidance/advise.h"
 #include "core/session/job.h"
+#include "core/session/pair_record.h"
 #include "core/session/session.h"
 #include "core/session/session_record.h"
 #include "core/target/scene_background.h"
@@ -83,6 +86,14 @@ class CalibrationJob final : public Job {
   const PairFeatures& DetectLidar(int index, const LidarCloud& cloud, const LidarImage* image,
                                   bool use_seed = true);
 
+  // Pair `index` is pictured on `image` (its cloud's ProjectById, kept for the views): its seed's
+  // region and its detected board are drawn there (PairRecord::brush_pixels), the seed's into the
+  // record as the session file keeps it. A brush the record holds that was painted on another
+  // image layout would mark other returns: it is forgotten (no undo step) and the returned text
+  // says why; empty otherwise.
+  std::string PictureOn(int index, const LidarCloud& cloud,
+                        std::shared_ptr<const LidarImage> image);
+
   // The user's word, each an undo step in the record. A brush applies at the pair's next
   // detection; a rejection (with the reason shown for it) at the next solve. A brush's pixels
   // (an empty list: erased, the pair then has no board until painted again) replace the seed and
@@ -109,13 +120,24 @@ class CalibrationJob final : public Job {
   // `calibrate` runs after extraction (SolveExtractedPairs: solve, camera-guided completion, the
   // intrinsics). The outcome's pairs carry completion's boards and verdicts.
   const CalibrationOutcome& Solve();
-  // The user's word changed while the last Solve ran (a front end undid or edited from its own
-  // thread: the record locks itself, the solve reads it once at its start): that outcome answers
-  // edits or settings that no longer stand. It is then dropped, with its guidance, and true
-  // returned; the caller shows the record as it stands (an undo's restored solve) or solves
-  // again. False, keeping the outcome, when the record's edits and settings are still those the
-  // solve ran with (an edit undone and redone meanwhile is the same word).
-  bool DiscardStaleOutcome();
+  // What the last Solve found, into the record beside the edits it answers, as the session file
+  // keeps them: each pair's status and reason (completion's boards, its verdicts) and the
+  // solution with its convergence and the summary's notes; an undo step of its own with
+  // `own_step` (a Run), else the same step as the edit it followed from (an auto-solve: one undo
+  // takes back the edit and its solve). Unless the user's word changed while the solve ran (a
+  // front end undid or edited from its own thread: the record locks itself, the solve reads it
+  // once at its start): that outcome answers edits or settings that no longer stand. It is then
+  // dropped, with its guidance, and false returned; the caller shows the record as it stands (an
+  // undo's restored solve) or solves again. An edit undone and redone meanwhile is the same
+  // word: that outcome stands.
+  bool CommitOutcome(bool own_step);
+  // `solution` (not a board solve: the targetless check's estimate) becomes the record's result
+  // with `provenance` and `notes`, as one undo step.
+  void AdoptSolution(const SolverResult& solution, const std::string& provenance,
+                     const std::vector<std::string>& notes);
+  // Following a capture, pre-flight's rejections after the last Advise apply (as `watch` applies
+  // them), on the same undo step as the edit that led to them; true when a pair was rejected.
+  bool ApplyPreflightRejections();
   // Pre-flight, the meter and the next pose (AdviseCapture) after the last solve; with `at`, at
   // that solution instead (a reopened session's).
   const CaptureAdvice& Advise(const std::optional<SolverResult>& at = std::nullopt);
@@ -123,6 +145,18 @@ class CalibrationJob final : public Job {
   const Dataset& dataset() const { return dataset_; }
   // The pairs as detection found them (status from their planes and the user's rejections).
   std::vector<PairFeatures> DetectedPairs() const;
+  // Every pair as the job holds it now (PairRecord: the record's status, reason and brush, the
+  // fits with completion's boards, pre-flight's findings), with the residuals and robust weights
+  // at `shown` (the solution a front end shows: the last solve, an undo step's, an adopted
+  // estimate; `solved_ids` the pairs it was solved with, empty when unknown) for the pairs that
+  // solve with it now. Any thread.
+  std::vector<PairRecord> Records(const SolverResult* shown = nullptr,
+                                  const std::vector<std::string>& solved_ids = {}) const;
+  // The pairs as they stand with `shown` as the solution: its own residuals while its pairs are
+  // still those accepted, else the solver's at its estimate over the pairs accepted now (what
+  // export writes and guidance judges). Any thread.
+  CalibrationOutcome OutcomeAt(const SolverResult& shown,
+                               const std::vector<std::string>& solved_ids) const;
   const std::optional<CalibrationOutcome>& outcome() const { return outcome_; }
   const std::optional<CaptureAdvice>& advice() const { return advice_; }
   // The job's options with the record's solver and RANSAC settings: what the next step runs with.
@@ -153,22 +187,44 @@ class CalibrationJob final : public Job {
  private:
   struct JobPair {
     PairFeatures detected;  // planes as detection found them, status from them
+    // Completion's board and verdict where the last committed solve ran on this detection.
+    std::optional<PairFeatures> completed;
     std::string lidar_failure = "not detected yet";
     std::string camera_failure = "not detected yet";
+    bool lidar_tried = false;  // its LiDAR side was looked at (or its files failed to read)
+    int detections = 0;        // counts its LiDAR detections: completion's applies to one
+    std::optional<BoardDetection> detection;  // the board's corners in the image
+    std::shared_ptr<const LidarImage> image;  // PictureOn's
+    const PairFeatures& Now() const { return completed ? *completed : detected; }
   };
   void Restatus(JobPair* pair) const;  // status and reason from the planes and the rejection
   PairEdit EditOf(const std::string& pair_id) const;
   // `edit` into pair `pair_id`'s state (added when the session has no such pair yet); that state.
   static PairState& SetEdit(Session* session, const std::string& pair_id, const PairEdit& edit);
   PipelineOptions Pipeline() const;  // options_'s with the record's settings
-  // The pairs as detection found them, with `record`'s rejections.
+  // The pairs as detection found them, with `record`'s rejections (pairs_mutex_ held).
   std::vector<PairFeatures> DetectedPairs(const Session& record) const;
+  // The pairs as they stand, an accepted one without both planes failed (pairs_mutex_ held).
+  std::vector<PairFeatures> PairsNow(const Session& record) const;
+  CalibrationOutcome OutcomeAt(const Session& record, const SolverResult& shown,
+                               const std::vector<std::string>& solved_ids) const;  // lock held
+  // Every pair's status and reason as its steps left them into the record (a rejection stands),
+  // on the current undo step.
+  void RecordStatuses();
   const SceneBackground* Background() const { return background_ ? &*background_ : nullptr; }
 
   Dataset dataset_;
   CalibrationJobOptions options_;
   SessionRecord record_;  // a copied job's record has no autosave file (SessionRecord's copy)
   JobEvents events_;
+  // A mutex a copied job has its own of (a job is copied on its driving thread, to try a step).
+  struct OwnMutex : std::mutex {
+    OwnMutex() = default;
+    OwnMutex(const OwnMutex&) : std::mutex() {}
+  };
+  // The pairs, written on the driving thread and read from any (Records): under pairs_mutex_,
+  // never held while the record is called.
+  mutable OwnMutex pairs_mutex_;
   std::vector<JobPair> pairs_;
   SceneBackground background_accumulator_;
   std::set<int> in_background_;
@@ -177,9 +233,11 @@ class CalibrationJob final : public Job {
   std::optional<CalibrationOutcome> outcome_;
   std::optional<SolverResult> last_solution_;
   SolverOptions solved_with_;  // the solver settings of outcome_'s solve (the record's)
-  // The record's edits and settings outcome_'s solve read (DiscardStaleOutcome).
+  // The record's edits and settings outcome_'s solve read (CommitOutcome).
   PairEdits solved_edits_;
   JobSettings solved_settings_;
+  std::vector<int> solved_detections_;       // each pair's JobPair::detections at that solve
+  std::vector<IterationReport> iterations_;  // that solve's, as its events reported them
   std::optional<CaptureAdvice> advice_;
 };
 

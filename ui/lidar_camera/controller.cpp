@@ -35,82 +35,21 @@ Controller::~Controller() {
   StopWorker();  // drops a rig solve's steps not yet run
 }
 
-bool Controller::SolvesWith(const PairView& pair) {
-  return pair.status == PairStatus::kAccepted && pair.lidar && pair.camera;
-}
-
-SolverResult Controller::ResultForCurrentPairs() const {
+void Controller::Publish() {
   mutex_.AssertHeld(__func__);
-  SolverResult result = *state_.solver.result;
-  std::vector<std::string> accepted;
-  for (const PairView& pair : state_.pairs)
-    if (SolvesWith(pair)) accepted.push_back(pair.id);
-  // The solve's own figures while its pairs are still the accepted ones (they include the
-  // outliers it gated); after accept/reject since, or after a reload, the solver's residuals at
-  // the shown estimate over the pairs accepted now.
-  if (accepted == state_.solver.solved_pair_ids && result.residuals.size() == accepted.size())
-    return result;
-  std::vector<PairFeatures> features;
-  for (const PairView& pair : state_.pairs) features.push_back(FeaturesOf(pair));
-  EvaluateAtSolution(features, state_.settings.Over(pipeline_).solver, &result);
-  return result;
-}
-
-void Controller::RecomputeResiduals() {
-  mutex_.AssertHeld(__func__);
-  for (PairView& pair : state_.pairs) pair.residual.reset();
-  if (!state_.solver.result) return;
-  const SolverResult at_estimate = ResultForCurrentPairs();
-  size_t solved = 0;
-  for (PairView& pair : state_.pairs) {
-    if (!SolvesWith(pair)) continue;
-    pair.residual = at_estimate.residuals[solved];
-    pair.robust_weight = at_estimate.robust_weights[solved];
-    ++solved;
-  }
-}
-
-PairFeatures Controller::FeaturesOf(const PairView& pair) {
-  PairFeatures features;
-  features.id = pair.id;
-  features.status = pair.status;
-  features.reason = pair.reason;
-  features.lidar = pair.lidar;
-  features.camera = pair.camera;
-  features.board_origin = pair.board_origin;
-  // An accepted pair that lost a plane cannot be solved with.
-  if (features.status == PairStatus::kAccepted && !SolvesWith(pair))
-    features.status = PairStatus::kFailed;
-  return features;
-}
-
-void Controller::ApplyCompletion(const std::vector<PairFeatures>& solved) {
-  mutex_.AssertHeld(__func__);
-  for (size_t i = 0; i < solved.size() && i < state_.pairs.size(); ++i) {
+  if (!job_) return;
+  const SolverResult* shown = state_.solver.result ? &*state_.solver.result : nullptr;
+  std::vector<PairRecord> records = job_->Records(shown, state_.solver.solved_pair_ids);
+  // The job's record of each pair, whole (pairs that joined the view before the job are shown as
+  // they are until they load).
+  for (size_t i = 0; i < records.size() && i < state_.pairs.size(); ++i) {
     PairView& pair = state_.pairs[i];
-    const PairFeatures& after = solved[i];
-    if (pair.awaiting_detection) continue;  // its board is still to be found
-    const bool same_board = after.lidar.has_value() == pair.lidar.has_value() &&
-                            (!after.lidar || after.lidar->inliers == pair.lidar->inliers);
-    if (same_board && after.status == pair.status && after.reason == pair.reason) continue;
-    pair.lidar = after.lidar;
-    pair.board_origin = after.board_origin;
-    pair.status = after.status;
-    pair.reason = after.reason;
-    pair.lidar_failure = after.lidar ? "" : after.reason;
-    // A board found at the camera's prediction shows as a detected one.
-    if (after.lidar && after.board_origin.source == BoardSource::kCameraGuided &&
-        pair.lidar_image) {
-      pair.brush_pixels.clear();
-      for (int k : after.lidar->inliers)
-        if (pair.lidar_image->pixel_of_point[k] >= 0)
-          pair.brush_pixels.push_back(pair.lidar_image->pixel_of_point[k]);
-      std::sort(pair.brush_pixels.begin(), pair.brush_pixels.end());
-      pair.brush_pixels.erase(std::unique(pair.brush_pixels.begin(), pair.brush_pixels.end()),
-                              pair.brush_pixels.end());
-      pair.brush_detected = true;
-    }
+    static_cast<PairRecord&>(pair) = std::move(records[i]);
+    if (pair.awaiting_detection)
+      pair.lidar_failure = PairsSettled() ? "finding the board ..."
+                                          : "finding the board once every pair is loaded ...";
   }
+  ++state_.generation;
 }
 
 void Controller::Solve(bool asked) {
@@ -131,8 +70,9 @@ void Controller::Solve(bool asked) {
   // record it would undo the undo (the rejection back, its solve standing) or lose the edit.
   // After an undo or redo the restored state stands with its own solve (Restore showed it, so
   // the solver no longer shows this one running); after an edit the edits as they are now are
-  // solved again (auto-solve's, once; the user's Run).
-  if (job_->DiscardStaleOutcome()) {
+  // solved again (auto-solve's, once; the user's Run). Else what it found goes into the record
+  // (an undo step of its own when asked; auto-solve's on the edit's).
+  if (!job_->CommitOutcome(/*own_step=*/asked)) {
     const bool restored = !state_.solver.running;
     state_.solver.running = false;
     ++state_.generation;
@@ -144,11 +84,10 @@ void Controller::Solve(bool asked) {
     return;
   }
   state_.solver.running = false;
-  // Pairs added meanwhile (a watched folder) are not in this solve; the next one has them.
-  if (outcome.pairs.size() <= state_.pairs.size()) ApplyCompletion(outcome.pairs);
   if (!outcome.solution) {
     state_.solver.iterations.clear();
     state_.solver.failure = outcome.failure;
+    Publish();
     const int usable = static_cast<int>(
         std::count_if(outcome.pairs.begin(), outcome.pairs.end(), [](const PairFeatures& p) {
           return p.status == PairStatus::kAccepted && p.lidar && p.camera;
@@ -160,6 +99,7 @@ void Controller::Solve(bool asked) {
                 false);
     else
       SetStatus("no calibration: " + outcome.failure, true);
+    AfterEdit();  // after the line: a failed autosave says so there
     return;
   }
   const SolverResult& result = *outcome.solution;
@@ -167,16 +107,16 @@ void Controller::Solve(bool asked) {
   state_.solver.solved_pair_ids.clear();
   for (const PairFeatures& p : outcome.pairs)
     if (p.status == PairStatus::kAccepted) state_.solver.solved_pair_ids.push_back(p.id);
-  for (const std::string& note : {DescribeLidarModel(outcome), DescribeLearnedLidarNoise(outcome),
-                                  CountResiduals(outcome).note})
-    if (!note.empty()) state_.solver.notes.push_back(note);
-  RecomputeResiduals();
+  // The summary's notes, as the job recorded them beside the result.
+  if (const Session record = job_->record().Current(); record.result)
+    state_.solver.notes = record.result->notes;
+  Publish();
   JudgeMeter(/*record=*/true);
   SetStatus("solved with " + std::to_string(state_.solver.solved_pair_ids.size()) + " pairs in " +
                 std::to_string(result.iterations) + " iterations" +
                 (result.observability.well_constrained ? "" : " (NOT well constrained)"),
             !result.observability.well_constrained);
-  RecordWhatFollowed(/*same_step=*/!asked);
+  AfterEdit();
   const int selected = state_.selected;
   if (selected >= 0) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
   // Pre-flight and the next pose (the ghost board) from this solve.
@@ -247,7 +187,7 @@ void Controller::Handle(const SelectPair& select) {
 template <>
 void Controller::Handle(const SetPairStatus& status) {
   if (!ValidPair(status.index)) return;
-  PairView& pair = state_.pairs[status.index];
+  const PairView& pair = state_.pairs[status.index];
   if (status.status == PairStatus::kAccepted && !(pair.lidar && pair.camera)) {
     SetStatus("pair " + pair.id + " cannot be accepted: " +
                   (!pair.camera ? "no camera plane (" + pair.camera_failure + ")"
@@ -256,15 +196,14 @@ void Controller::Handle(const SetPairStatus& status) {
     return;
   }
   const bool rejecting = status.status == PairStatus::kRejected;
-  const bool rejection_changed = rejecting != (pair.status == PairStatus::kRejected);
-  pair.status = status.status;
-  pair.reason = rejecting ? kRejectedByUser : "";
-  SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
+  const std::string id = pair.id;
+  // The user's word into the job's record (the next solve reads it there), then shown.
+  if (rejecting != (pair.status == PairStatus::kRejected)) job_->SetRejected(id, rejecting);
+  Publish();
+  SetStatus("pair " + id + " " + PairStatusName(state_.pairs[status.index].status) +
                 (state_.solver.result && !state_.auto_solve ? "; press Run to re-solve" : ""),
             false);
-  // The user's word into the job's record (the next solve reads it there), then the status shown.
-  if (rejection_changed) job_->SetRejected(pair.id, rejecting);
-  RecordWhatFollowed(/*same_step=*/rejection_changed);
+  AfterEdit();  // after the line: a failed autosave says so there
   RequestSolve();
 }
 
@@ -277,9 +216,9 @@ template <>
 void Controller::Handle(const ResetSolver&) {
   state_.solver = SolverView{};
   state_.reprojection.reset();
-  RecomputeResiduals();
-  JudgeMeter(/*record=*/false);
   job_->record().Edit([](Session* session) { session->result.reset(); });
+  Publish();
+  JudgeMeter(/*record=*/false);
   AfterEdit();
 }
 
@@ -299,7 +238,7 @@ void Controller::Handle(const SetSettings& intent) {
   job_->SetSettings(settings);
   AfterEdit();
   // Residuals and weights shown for the current estimate depend on the method.
-  if (method_changed) RecomputeResiduals();
+  if (method_changed) Publish();
 }
 
 template <>
@@ -322,9 +261,8 @@ void Controller::Handle(const ExportResult& export_result) {
   }
   // What `calibench calibrate` writes: the pairs as they stand, the solution with the solver's
   // residuals at it for the accepted ones.
-  CalibrationOutcome outcome;
-  for (const PairView& pair : state_.pairs) outcome.pairs.push_back(FeaturesOf(pair));
-  outcome.solution = ResultForCurrentPairs();
+  const CalibrationOutcome outcome =
+      job_->OutcomeAt(*state_.solver.result, state_.solver.solved_pair_ids);
   const std::filesystem::path path = NextToSession(state_, export_result.path);
   try {
     if (export_result.format) {

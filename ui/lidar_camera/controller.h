@@ -110,48 +110,39 @@ class Controller : public ControllerState<Snapshot> {
   bool FollowsTo(int index) const;
   void OnLivePairLoaded(int index);  // LoadPair's part for a followed capture (mutex_ held)
   // After pair `index` loaded (mutex_ held): its board refitted from its brush or seed (true:
-  // now, by the caller, as the selected pair), or left to detection; a pair without a cloud fails.
-  bool ScheduleBoard(int index, bool painted);
+  // now, by the caller, as the selected pair), or left to detection.
+  bool ScheduleBoard(int index);
   void RefitLidar(int index);
   // The background model over the loaded clouds, then detection where no seed or brush is.
   void DetectWithBackground();
   // `asked`: the user's Run, an undo step of its own; otherwise auto-solve's, on the same undo
   // step as the edit that asked for it (undoing a rejection undoes its solve too).
   void Solve(bool asked = true);
-  static PairFeatures FeaturesOf(const PairView& pair);  // the pipeline's view of a pair
-  // The solve's pairs back into the view: completion's boards and verdicts. Call with mutex_ held.
-  void ApplyCompletion(const std::vector<PairFeatures>& solved);
-  static bool SolvesWith(const PairView& pair);  // accepted, with both planes
   void ComputeReprojection(int index);
   // Writes the session if it changed; a failure goes to the status line in the warning colour
   // (and is retried at the next change). Call with mutex_ held.
   void Autosave();
   void EnsureSelectedImage();
-  // The solve's result with residuals and robust weights for the pairs accepted now, in order
-  // (state_.solver.result must be set); call with mutex_ held.
-  SolverResult ResultForCurrentPairs() const;
-  void RecomputeResiduals();  // call with mutex_ held
+  // The job's record of every pair into the view (PairRecord, whole), with the residuals at the
+  // solution shown. Call with mutex_ held.
+  void Publish();
   // The meter from the current result and goal; `record` adds the point to the history (a solve).
   // Call with mutex_ held.
   void JudgeMeter(bool record);
   // The user's edits go to the job's record first (record-first, as the LRF workbench's): the job's
   // SetRejected, SetBrush and SetSettings, the record's Edit for the view and a reset solve;
-  // state_ shows what the handler asked for, and undo restores state_ from the record
-  // (ApplySessionToState). Then AfterEdit: the undo buttons, autosave, a new generation. Call
-  // these with mutex_ held.
+  // what followed from them (statuses, completion, the solve) the job records beside them, and
+  // the view shows the job's pairs (Publish); undo restores the view from the record
+  // (ShowSession). Then AfterEdit: the undo buttons, autosave, a new generation. Call these with
+  // mutex_ held.
   void AfterEdit();
-  // What followed from the edits, into the record beside them as the session file keeps it: each
-  // pair's status and reason as detection, the solve and pre-flight left them, a seed's region as
-  // its brush picture, the solution with its convergence, the view. An undo step of its own (a
-  // Run, an adopted estimate) or, with `same_step` or within an open brush stroke, the same as
-  // the edit it followed from (its refit, its auto-solve, pre-flight's verdicts on it: one undo
-  // takes back the edit and all that followed from it).
-  void RecordWhatFollowed(bool same_step);
   // The view (the selected pair, the camera, visibility) into the record: saved with the session,
   // no undo step (undo steps through edits only).
   void RecordView();
   std::string ViewJson();  // state_'s view, its selected pair's id set, as the session keeps it
-  void ApplySessionToState(const Session& session);  // call with mutex_ held
+  // A session's view, settings and solve shown, its pairs as the job holds them (Open, undo,
+  // redo); call with mutex_ held.
+  void ShowSession(const Session& session);
   // The rig solve (RigTask::Start) over the open camera's edits and the settings. Mutex held.
   void StartRigSolve();
   // `note` (how the session came to be opened) joins the status line once the pairs have loaded.
@@ -171,9 +162,9 @@ class Controller : public ControllerState<Snapshot> {
   // Adds (or, erasing, removes) LiDAR-image pixels to a pair's brush and refits: both brushes'
   // dabs. Call with mutex_ held.
   void Paint(int index, const std::vector<int>& pixels, bool erase);
-  // Pair `pair`'s brush as shown (painted or erased) into the job's record: an undo step, or the
-  // current one amended (a stroke's later dabs). The pair has its LiDAR image.
-  void SetBrushInRecord(const PairView& pair, bool amend);
+  // Pair `index`'s brush painted (or erased: `pixels` empty) into the job's record: an undo step,
+  // or the current one amended (a stroke's later dabs). The pair has its LiDAR image.
+  void SetBrushInRecord(int index, std::vector<int> pixels, bool amend);
   // Undo / redo (`what`: "undid" / "redid", for the status line).
   void Restore(const std::optional<Session>& restored, const std::string& what);
 

@@ -28,15 +28,16 @@ void Controller::Handle(const AdoptCheckEstimate&) {
       CheckVerdictName(report->verdict) + ", change " + CheckChangeWords(*report) + ")";
   state_.solver.notes = {"targetless estimate adopted: not a board solve; " +
                          state_.solver.targetless_provenance};
-  RecomputeResiduals();
+  job_->AdoptSolution(result, state_.solver.targetless_provenance, state_.solver.notes);
+  Publish();
   // The meter judges board captures; an estimate from the scene is not one.
   state_.meter.reset();
   rig_.UpdateActiveCamera();
-  RecordWhatFollowed(/*same_step=*/false);  // an undo step of its own
   SetStatus(
       "adopted the targetless estimate as the workbench's calibration (Undo restores the "
       "one before)",
       false);
+  AfterEdit();  // after the line: a failed autosave says so there
   const int selected = state_.selected;
   if (selected >= 0) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
 }

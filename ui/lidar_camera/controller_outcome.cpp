@@ -48,9 +48,11 @@ Snapshot SnapshotOfOutcome(const Dataset& dataset, const CalibrationOutcome& out
     pair.reason = features.reason;
     pair.lidar = features.lidar;
     pair.board_origin = features.board_origin;
-    // Its inliers drawn as a found board's (cyan), not a brushed one's.
-    pair.brush_detected = features.board_origin.source == BoardSource::kDetected ||
-                          features.board_origin.source == BoardSource::kCameraGuided;
+    // Its inliers drawn as a found board's (cyan) unless a brush or seed chose them.
+    pair.brush_origin = features.board_origin.source == BoardSource::kBrush ? BrushOrigin::kPainted
+                        : features.board_origin.source == BoardSource::kSeed
+                            ? BrushOrigin::kSeeded
+                            : BrushOrigin::kDetected;
     pair.camera = features.camera;
     if (features.camera) pair.detection = features.camera->corners;
     if (!features.lidar) pair.lidar_failure = features.reason;

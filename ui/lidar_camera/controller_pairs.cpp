@@ -16,16 +16,6 @@ namespace {
 
 constexpr int kThumbnailWidth = 160;  // pixels
 
-std::vector<int> SeedBrush(const LidarCloud& cloud, const LidarImage& image,
-                           const LidarSeed& seed) {
-  std::vector<int> pixels;
-  for (int i : SelectSeedRegion(cloud, seed))
-    if (image.pixel_of_point[i] >= 0) pixels.push_back(image.pixel_of_point[i]);
-  std::sort(pixels.begin(), pixels.end());
-  pixels.erase(std::unique(pixels.begin(), pixels.end()), pixels.end());
-  return pixels;
-}
-
 // Pixels of a circle on the LiDAR image; columns wrap around (azimuth is periodic).
 std::vector<int> CirclePixels(int rows, int columns, int row, int column, float radius) {
   std::vector<int> pixels;
@@ -43,32 +33,6 @@ std::vector<int> CirclePixels(int rows, int columns, int row, int column, float 
   return pixels;
 }
 
-// The brush a loading pair starts with: the session's painted brush (`painted`, null when none)
-// replaces the seed; otherwise the seed selects the region and the brush only pictures it (as
-// EditsFromSession tells `calibench calibrate --session`). A mask painted on another image layout
-// would mark other returns: it is refused, not reread, and the returned text says why (empty
-// when nothing was refused).
-std::string StartBrush(const PairEntry& entry, const LidarCloud& cloud, const LidarImage& image,
-                       const BrushMask* painted, const std::vector<int>& painted_pixels,
-                       PairView* loaded) {
-  std::string dropped;
-  if (painted && BrushFitsImage(*painted, image.rows, image.columns, &dropped)) {
-    // Still the user's word once loaded: the job refits from it, the next autosave keeps it.
-    loaded->brush_pixels = painted_pixels;
-    loaded->brush_edited = true;
-    return "";
-  }
-  if (entry.lidar_seed) {
-    loaded->brush_pixels = SeedBrush(cloud, image, *entry.lidar_seed);
-    loaded->brush_from_seed = true;
-  }
-  if (!painted) return "";
-  return "pair " + entry.id + ": its brush from the session was dropped: " + entry.cloud.string() +
-         ": " + dropped;
-}
-
-constexpr const char* kNoTarget = "no board to find: the dataset has no target.json";
-
 }  // namespace
 
 void Controller::OnAllPairsLoaded() {
@@ -76,13 +40,10 @@ void Controller::OnAllPairsLoaded() {
   if (state_.dataset->missing_target_file.empty()) {
     worker_.Enqueue([this] { DetectWithBackground(); });
   } else {
-    // No board to find (a drive opened for the targetless check): no detection, said per pair.
-    for (PairView& pair : state_.pairs) {
-      if (!pair.awaiting_detection) continue;
-      pair.awaiting_detection = false;
-      pair.status = PairStatus::kFailed;
-      pair.reason = pair.lidar_failure = kNoTarget;
-    }
+    // No board to find (a drive opened for the targetless check): no detection (the job said
+    // so per pair).
+    for (PairView& pair : state_.pairs) pair.awaiting_detection = false;
+    Publish();
   }
   // What went wrong while loading stays on the status line (in the warning colour).
   std::string loaded_line = "loaded " + std::to_string(state_.loading_total) + " pairs";
@@ -116,26 +77,21 @@ bool Controller::PairsSettled() const {
 
 void Controller::LoadPair(int index) {
   Dataset dataset;
-  std::vector<int> saved_brush;
-  std::optional<BrushMask> saved_mask;
-  bool painted = false;  // the session holds a brush the user painted (or erased)
   {
     std::lock_guard lock(mutex_);
     dataset = *state_.dataset;
-    saved_brush = state_.pairs[index].brush_pixels;
-    if (const std::optional<PairState> saved = job_->record().Pair(state_.pairs[index].id)) {
-      painted = saved->brush.has_value() && !saved->brush_from_seed;
-      saved_mask = saved->brush;
-    }
   }
   const PairEntry& entry = dataset.pairs[index];
   // The job knows the pairs in the order they load (a followed capture's arrive one by one).
   while (job_->size() <= index) job_->AppendPair(dataset.pairs[job_->size()]);
-  std::string brush_dropped;  // why the session's brush does not fit this pair's cloud
-  // The job reads the pair and finds the board in its image, as for `calibench calibrate`.
-  PairView loaded;
+  // The job reads the pair and finds the board in its image, as for `calibench calibrate`; the
+  // view keeps the decoded files.
+  std::shared_ptr<const LidarCloud> cloud;
+  std::shared_ptr<const LidarImage> lidar_image;
+  std::shared_ptr<const ImageU8> thumbnail;  // small BGR picture of the camera image
   std::string why;
-  CameraFeatures camera;  // the job's camera side, its corners shown in the camera view
+  std::string brush_dropped;  // why the session's brush does not fit this pair's cloud
+  CameraFeatures camera;      // the job keeps its corners (PairRecord::detection)
   auto inputs = job_->ReadPair(index, &camera, &why);
   bool selected = false;
   {
@@ -143,66 +99,48 @@ void Controller::LoadPair(int index) {
     selected = index == state_.selected || FollowsTo(index);
   }
   if (inputs) {
-    auto cloud = std::make_shared<LidarCloud>(std::move(inputs->cloud));
-    auto lidar_image = std::make_shared<LidarImage>(ProjectById(*cloud, LidarImageOptions{}));
-    loaded.thumbnail = std::make_shared<ImageU8>(ResizeImage(inputs->image, kThumbnailWidth));
-    loaded.detection = std::move(camera.detection);
-    loaded.camera = std::move(camera.observation);
-    loaded.camera_failure = camera.failure;
-    // No target (a drive for the targetless check): no board to see, whatever the default says.
-    if (!dataset.missing_target_file.empty()) {
-      loaded.detection.reset();
-      loaded.camera.reset();
-      loaded.camera_failure = kNoTarget;
-    }
-    brush_dropped = StartBrush(entry, *cloud, *lidar_image, painted ? &*saved_mask : nullptr,
-                               saved_brush, &loaded);
-    painted = painted && brush_dropped.empty();
-    loaded.cloud = cloud;
-    loaded.lidar_image = lidar_image;
+    cloud = std::make_shared<const LidarCloud>(std::move(inputs->cloud));
+    lidar_image = std::make_shared<const LidarImage>(ProjectById(*cloud, LidarImageOptions{}));
+    thumbnail = std::make_shared<const ImageU8>(ResizeImage(inputs->image, kThumbnailWidth));
+    // The seed's region and the detected board are drawn on the LiDAR image (the job's).
+    brush_dropped = job_->PictureOn(index, *cloud, lidar_image);
     // The camera view shows the selected pair's image: decoded once, here.
     if (selected)
       KeepDecodedImage(entry.image, std::make_shared<const ImageU8>(std::move(inputs->image)));
-  } else {
-    loaded.camera_failure = why;
   }
   bool refit_now = false;  // the selected pair's plane comes before the other pairs load
   {
     std::lock_guard lock(mutex_);
     PairView& pair = state_.pairs[index];
-    // Loading is the pair's first job after Open: besides its header nothing was derived yet.
-    static_cast<PairHeader&>(loaded) = pair;
-    loaded.loaded = true;
-    pair = std::move(loaded);
+    pair.loaded = true;
+    pair.cloud = std::move(cloud);
+    pair.lidar_image = std::move(lidar_image);
+    pair.thumbnail = std::move(thumbnail);
     ++state_.loading_done;
-    ++state_.generation;
+    Publish();
     OnLivePairLoaded(index);  // a followed capture: follow it, match it against the ghost
     if (!brush_dropped.empty()) {
-      job_->record().Adjust([&id = pair.id](Session* session) { ForgetBrush(session, id); });
       load_warnings_.push_back(brush_dropped);
       SetStatus(brush_dropped, true);
     }
-    refit_now = ScheduleBoard(index, painted);
+    refit_now = ScheduleBoard(index);
     if (state_.loading_done == state_.loading_total) opened_pairs_loaded_ = true;
     if (PairsSettled()) OnAllPairsLoaded();
   }
   if (refit_now) RefitLidar(index);
 }
 
-bool Controller::ScheduleBoard(int index, bool painted) {
+bool Controller::ScheduleBoard(int index) {
   mutex_.AssertHeld(__func__);
   PairView& pair = state_.pairs[index];
-  if (!pair.cloud) {
-    pair.status = PairStatus::kFailed;
-    pair.reason = pair.camera_failure;
-    return false;
-  }
+  if (!pair.cloud) return false;  // it failed with the reason (the job's)
+  // No target: nothing to detect (OnAllPairsLoaded says so).
+  if (!state_.dataset->missing_target_file.empty()) return false;
   // Detection waits for every cloud: the background model over them keeps static board-sized
   // panels out (as CalibrateDataset does).
-  if (!pair.brush_from_seed && !painted) {
-    pair.lidar_failure = PairsSettled() ? "finding the board ..."
-                                        : "finding the board once every pair is loaded ...";
+  if (pair.brush_origin == BrushOrigin::kDetected) {
     pair.awaiting_detection = true;
+    Publish();
     return false;
   }
   // A brush or seed: the selected pair's plane comes before the other pairs load.
@@ -220,7 +158,7 @@ void Controller::DetectWithBackground() {
       const PairView& pair = state_.pairs[i];
       if (!pair.cloud) continue;
       clouds.emplace_back(static_cast<int>(i), pair.cloud);
-      if (pair.brush_from_seed || pair.brush_edited) continue;
+      if (pair.brush_origin != BrushOrigin::kDetected) continue;
       (pair.awaiting_detection ? awaiting : detected_before).push_back(static_cast<int>(i));
     }
   }
@@ -249,48 +187,30 @@ void Controller::DetectWithBackground() {
 void Controller::RefitLidar(int index) {
   std::shared_ptr<const LidarCloud> cloud;
   std::shared_ptr<const LidarImage> image;
-  std::vector<int> brush;
-  bool brush_from_seed = false;
+  std::optional<std::vector<int>> brush;  // the record's, to tell a newer stroke's refit
+  bool seeded = false;
+  std::string id;
   {
     std::lock_guard lock(mutex_);
     cloud = state_.pairs[index].cloud;
     image = state_.pairs[index].lidar_image;
-    brush = state_.pairs[index].brush_pixels;
-    brush_from_seed = state_.pairs[index].brush_from_seed;
+    seeded = state_.pairs[index].brush_origin == BrushOrigin::kSeeded;
+    id = state_.pairs[index].id;
+    brush = job_->record().EditOf(id).brush_pixels;
   }
   if (!cloud || !image) return;
   // The same choice of region as `calibench calibrate` (the job's BoardHintFor): once painted
   // (or erased), the brush, which the edit put in the job's record before this refit was
   // queued; else the seed while the brush only pictures it ("detect again" forgot it); else
   // detection.
-  const PairFeatures features = job_->DetectLidar(index, *cloud, image.get(), brush_from_seed);
+  job_->DetectLidar(index, *cloud, image.get(), seeded);
   std::lock_guard lock(mutex_);
+  if (job_->record().EditOf(id).brush_pixels != brush) return;  // a newer stroke refits again
   PairView& pair = state_.pairs[index];
-  if (pair.brush_pixels != brush) return;  // a newer stroke queued its own refit
-  pair.lidar = features.lidar;
-  pair.lidar_failure = features.lidar ? "" : features.reason;
   pair.awaiting_detection = false;
-  pair.board_origin = features.board_origin;
-  // A detected board shows as the brush (in its own colour) until the user edits it.
-  if (features.board_origin.source == BoardSource::kDetected) {
-    pair.brush_pixels.clear();
-    if (features.lidar)
-      for (int i : features.lidar->inliers)
-        if (pair.lidar_image->pixel_of_point[i] >= 0)
-          pair.brush_pixels.push_back(pair.lidar_image->pixel_of_point[i]);
-    std::sort(pair.brush_pixels.begin(), pair.brush_pixels.end());
-    pair.brush_detected = true;
-  }
-  // A pair with both planes is usable and accepted unless the user rejected it; one that lost a
-  // plane fails with the reason (the job's verdict from both sides).
-  if (pair.status != PairStatus::kRejected) {
-    pair.status = features.status;
-    pair.reason = features.reason;
-  }
-  ++state_.generation;
+  Publish();
   if (PairsSettled()) {
-    RecomputeResiduals();
-    RecordWhatFollowed(/*same_step=*/true);
+    AfterEdit();  // the statuses the job recorded, autosaved
     RequestSolve();
   }
 }
@@ -307,13 +227,8 @@ void Controller::Handle(const BrushStroke& stroke) {
 template <>
 void Controller::Handle(const ClearBrush& clear) {
   if (!ValidPair(clear.index)) return;
-  PairView& pair = state_.pairs[clear.index];
-  if (!pair.lidar_image) return;
-  pair.brush_pixels.clear();
-  pair.brush_from_seed = false;
-  pair.brush_edited = true;
-  pair.brush_detected = false;
-  SetBrushInRecord(pair, /*amend=*/false);  // erased: no board until painted again
+  if (!state_.pairs[clear.index].lidar_image) return;
+  SetBrushInRecord(clear.index, {}, /*amend=*/false);  // erased: no board until painted again
   const int index = clear.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });
 }
@@ -329,18 +244,16 @@ void Controller::Handle(const DetectBoardAgain& again) {
   bool first = true;  // every pair's brush forgotten in one undo step
   for (size_t i = 0; i < state_.pairs.size(); ++i) {
     if (!again.all && static_cast<int>(i) != again.index) continue;
-    PairView& pair = state_.pairs[i];
+    const PairView& pair = state_.pairs[i];
     if (!pair.lidar_image) continue;
-    pair.brush_pixels.clear();
-    pair.brush_from_seed = false;
-    pair.brush_edited = false;
-    pair.brush_detected = false;
     job_->SetBrush(pair.id, std::nullopt, /*amend=*/!first);
     first = false;
     const int index = static_cast<int>(i);
     worker_.Enqueue([this, index] { RefitLidar(index); });
   }
-  if (!first) AfterEdit();
+  if (first) return;
+  Publish();
+  AfterEdit();
 }
 
 template <>
@@ -349,19 +262,21 @@ void Controller::Handle(const PaintPoints& paint) {
     Paint(paint.index, paint.pixels, paint.erase);
 }
 
-void Controller::SetBrushInRecord(const PairView& pair, bool amend) {
+void Controller::SetBrushInRecord(int index, std::vector<int> pixels, bool amend) {
   mutex_.AssertHeld(__func__);
+  const PairView& pair = state_.pairs[index];
   PairEdit brush;
-  brush.brush_pixels = pair.brush_pixels;
+  brush.brush_pixels = std::move(pixels);
   brush.brush_rows = pair.lidar_image->rows;
   brush.brush_columns = pair.lidar_image->columns;
   job_->SetBrush(pair.id, brush, amend);
+  Publish();
   AfterEdit();
 }
 
 void Controller::Paint(int index, const std::vector<int>& pixels, bool erase) {
   mutex_.AssertHeld(__func__);
-  PairView& pair = state_.pairs[index];
+  const PairView& pair = state_.pairs[index];
   std::vector<int> merged;
   if (erase)
     std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), pixels.begin(),
@@ -370,11 +285,8 @@ void Controller::Paint(int index, const std::vector<int>& pixels, bool erase) {
     std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), pixels.begin(), pixels.end(),
                    std::back_inserter(merged));
   if (merged == pair.brush_pixels) return;
-  pair.brush_pixels = std::move(merged);
-  pair.brush_from_seed = false;  // painted: the brush replaces the seed from now on
-  pair.brush_edited = true;
-  pair.brush_detected = false;
-  SetBrushInRecord(pair, /*amend=*/stroke_open_);
+  // Painted: the brush replaces the seed and any detection from now on.
+  SetBrushInRecord(index, std::move(merged), /*amend=*/stroke_open_);
   stroke_open_ = true;  // the stroke's later dabs amend this undo step
   worker_.Enqueue([this, index] { RefitLidar(index); });
 }

@@ -135,8 +135,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     CalibrationJobOptions job_options;
     job_options.advise.pipeline = session.settings.Over(pipeline_);
     job_options.advise.pipeline.pair_ids.clear();  // the workbench shows every pair
-    Dataset setup = dataset;
-    setup.pairs.clear();
+    Dataset setup = dataset;  // followed captures' pairs join as they load (LoadPair)
     JobEvents events;
     events.iteration = [this](const IterationReport& it) {
       std::lock_guard lock(mutex_);
@@ -147,7 +146,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     job_.emplace(std::move(setup), job_options, PairEdits{}, std::move(events));
     job_->Resume(session);
     job_->record().AutosaveTo(session_path);
-    ApplySessionToState(session);
+    ShowSession(session);
     if (!rig_.SetUp(rig, rig_camera)) StartRigSolve();
     SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
                   dataset.manifest.string(),
@@ -167,7 +166,7 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     if (i != first) worker_.Enqueue([this, i] { LoadPair(i); });
 }
 
-void Controller::ApplySessionToState(const Session& session) {
+void Controller::ShowSession(const Session& session) {
   mutex_.AssertHeld(__func__);
   std::vector<std::string> ids;
   for (const PairState& pair : session.pairs) ids.push_back(pair.id);
@@ -177,23 +176,6 @@ void Controller::ApplySessionToState(const Session& session) {
     state_.view = ViewState{};
   }
   state_.settings = session.settings;
-  for (size_t i = 0; i < session.pairs.size() && i < state_.pairs.size(); ++i) {
-    PairView& pair = state_.pairs[i];
-    const PairState& saved = session.pairs[i];
-    pair.status = saved.status;
-    pair.reason = saved.reason;
-    if (saved.brush) {  // painted, erased, or a seed's region pictured
-      pair.brush_pixels = saved.brush->pixels;
-      pair.brush_detected = false;
-    } else if (pair.brush_edited || pair.brush_from_seed) {
-      // Undone back to detection (a board painted over a detected one, "detect again" redone):
-      // the brush goes, and Restore has the board detected again.
-      pair.brush_pixels.clear();
-      pair.brush_detected = false;
-    }
-    pair.brush_from_seed = saved.brush_from_seed;
-    pair.brush_edited = saved.brush.has_value() && !pair.brush_from_seed;
-  }
   state_.selected = -1;
   for (size_t i = 0; i < state_.pairs.size(); ++i)
     if (state_.pairs[i].id == state_.view.selected_pair) state_.selected = static_cast<int>(i);
@@ -214,9 +196,9 @@ void Controller::ApplySessionToState(const Session& session) {
       if (k >= 0 && k < static_cast<int>(state_.solver.iterations.size()))
         state_.solver.iterations[k].reweighted = true;
   }
+  Publish();  // the pairs as the job holds them, with residuals at that solve
   state_.can_undo = job_ && job_->record().CanUndo();
   state_.can_redo = job_ && job_->record().CanRedo();
-  ++state_.generation;
 }
 
 std::string Controller::ViewJson() {
@@ -232,46 +214,6 @@ void Controller::RecordView() {
   if (!job_) return;
   const std::string view = ViewJson();
   job_->record().Edit([&](Session* session) { session->view_json = view; }, /*amend=*/true);
-  AfterEdit();
-}
-
-void Controller::RecordWhatFollowed(bool same_step) {
-  mutex_.AssertHeld(__func__);
-  if (!job_) return;
-  std::optional<SessionResult> result;
-  if (state_.solver.result) {
-    result = SessionResultFromSolver(*state_.solver.result);
-    result->notes = state_.solver.notes;
-    result->targetless_provenance = state_.solver.targetless_provenance;
-    for (const IterationReport& it : state_.solver.iterations) {
-      result->step_history.push_back(it.step_norm);
-      result->estimate_history.push_back(it.cam_from_lidar);
-      if (it.reweighted) result->reweighted_iterations.push_back(it.iteration);
-    }
-  }
-  const std::string view = ViewJson();
-  job_->record().Edit(
-      [&](Session* session) {
-        session->view_json = view;
-        // The record holds every pair state_ shows, in the same order (Open resumed it over the
-        // dataset; AddPair adds each pair that joins to both).
-        for (size_t i = 0; i < state_.pairs.size() && i < session->pairs.size(); ++i) {
-          PairState& saved = session->pairs[i];
-          const PairView& shown = state_.pairs[i];
-          saved.status = shown.status;
-          saved.reason = shown.reason;
-          // A painted (or erased) brush is the user's, in the record already. A seed's region is
-          // saved as its picture, which reopening pictures again (EditsFromSession skips it).
-          const bool painted = saved.brush && !saved.brush_from_seed;
-          if (!painted && shown.lidar_image && shown.brush_from_seed) {
-            saved.brush =
-                BrushMask{shown.lidar_image->rows, shown.lidar_image->columns, shown.brush_pixels};
-            saved.brush_from_seed = true;
-          }
-        }
-        session->result = std::move(result);
-      },
-      /*amend=*/stroke_open_ || same_step);
   AfterEdit();
 }
 
@@ -320,14 +262,13 @@ void Controller::Restore(const std::optional<Session>& restored, const std::stri
   }
   std::vector<std::vector<int>> before;
   for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
-  ApplySessionToState(*restored);
-  RecomputeResiduals();
+  ShowSession(*restored);
   // The meter and the next pose belong to the solve restored (or to none): judged again, asked
   // again (not while following a capture, where Advise's pre-flight would edit the record).
   JudgeMeter(/*record=*/false);
   // The line no longer speaks of the solve undone ("solved with 39 pairs" over 40 accepted).
   int accepted = 0;
-  for (const PairView& pair : state_.pairs) accepted += SolvesWith(pair);
+  for (const PairView& pair : state_.pairs) accepted += pair.SolvesWith();
   SetStatus(what + " the last change: " + std::to_string(accepted) + " pairs usable, " +
                 (state_.solver.result ? "the calibration of that step shown"
                                       : "no calibration at that step"),

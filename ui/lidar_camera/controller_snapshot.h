@@ -18,6 +18,7 @@
 #include "core/lidar_camera/rig.h"
 #include "core/reproject/reproject.h"
 #include "core/session/calibration_job.h"
+#include "core/session/pair_record.h"
 #include "core/target/board_camera.h"
 #include "core/target/lidar_plane.h"
 #include "core/targetless/check.h"
@@ -26,29 +27,15 @@
 
 namespace calibench::ui {
 
-// Everything the panels show about one pair. Heavy members are shared, immutable buffers.
-struct PairView : PairHeader {
+// Everything the panels show about one pair: the job's record of it (PairRecord, whole, as the
+// job composed it) and the decoded files the views draw. Heavy members are shared, immutable
+// buffers.
+struct PairView : PairRecord {
   bool loaded = false;
   std::shared_ptr<const LidarCloud> cloud;
   std::shared_ptr<const LidarImage> lidar_image;
   std::shared_ptr<const ImageU8> thumbnail;  // small BGR picture of the camera image
-  std::vector<int> brush_pixels;             // sorted LiDAR-image pixel indices
-  bool brush_from_seed = false;  // brush_pixels picture the manifest's lidar_seed (not painted)
-  // The user painted or erased: the brush is the region. Neither edited nor seeded: the board is
-  // detected (BoardOrigin says so).
-  bool brush_edited = false;
-  bool brush_detected = false;  // brush_pixels picture the detected board (not painted)
-  std::optional<LidarPlaneFit> lidar;
-  BoardOrigin board_origin;
-  std::string lidar_failure;
-  std::optional<BoardDetection> detection;
-  std::optional<CameraBoardObservation> camera;
-  std::string camera_failure;
-  std::optional<Vec4> residual;  // after a solve
-  double robust_weight = 1.0;
   bool awaiting_detection = false;  // loaded, its board to be found once the background allows
-  // Pre-flight's findings after the last solve, as `advise` lists them (shown on its row).
-  std::vector<PreflightFinding> findings;
 };
 
 struct SolverView {

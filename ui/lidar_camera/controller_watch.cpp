@@ -114,7 +114,7 @@ void Controller::AdviseFromState() {
   {
     std::lock_guard lock(mutex_);
     if (!job_ || !state_.solver.result || state_.next_pose) return;
-    at = ResultForCurrentPairs();
+    at = job_->OutcomeAt(*state_.solver.result, state_.solver.solved_pair_ids).solution;
   }
   Advise(at);
 }
@@ -133,24 +133,12 @@ void Controller::Advise(const std::optional<SolverResult>& at) {
   state_.next_pose_failure = advice.state && advice.state->done
                                  ? "the goal is met: no more poses needed"
                                  : advice.next_failure;
-  bool rejected = false;
-  for (size_t i = 0; i < advice.pairs.size() && i < state_.pairs.size(); ++i) {
-    PairView& pair = state_.pairs[i];
-    const PairAdvice& judged = advice.pairs[i];
-    if (pair.id != judged.id) continue;
-    pair.findings = judged.findings;
-    // Following a capture, pre-flight's rejections apply, as `watch` applies them; on a dataset
-    // they are shown on the rows and the user decides.
-    if (!state_.watching.empty() && judged.status == PairStatus::kRejected &&
-        pair.status == PairStatus::kAccepted) {
-      pair.status = PairStatus::kRejected;
-      pair.reason = judged.reason;
-      rejected = true;
-    }
-  }
-  ++state_.generation;
+  // Following a capture, pre-flight's rejections apply, as `watch` applies them; on a dataset
+  // they are shown on the rows (the findings) and the user decides.
+  const bool rejected = !state_.watching.empty() && job_->ApplyPreflightRejections();
+  Publish();
   if (!rejected) return;
-  RecordWhatFollowed(/*same_step=*/true);
+  AfterEdit();
   RequestSolve();
 }
 

@@ -25,13 +25,15 @@ ImageU8 ComposeLidarPicture(const PairView& pair, LidarChannel channel) {
   };
   // A detected board's region in cyan until the user edits it; a painted or seeded one in white.
   for (int pixel : pair.brush_pixels)
-    pair.brush_detected ? blend(pixel, 40, 220, 255, 0.55f) : blend(pixel, 255, 255, 255, 0.45f);
+    pair.brush_origin == BrushOrigin::kDetected ? blend(pixel, 40, 220, 255, 0.55f)
+                                                : blend(pixel, 255, 255, 255, 0.45f);
   // Inliers magenta, or cyan while the region is the detected one (not yet edited by the user).
   if (pair.lidar)
     for (int i : pair.lidar->inliers)
       if (pair.lidar_image->pixel_of_point[i] >= 0)
-        pair.brush_detected ? blend(pair.lidar_image->pixel_of_point[i], 40, 220, 255, 0.9f)
-                            : blend(pair.lidar_image->pixel_of_point[i], 255, 40, 220, 0.9f);
+        pair.brush_origin == BrushOrigin::kDetected
+            ? blend(pair.lidar_image->pixel_of_point[i], 40, 220, 255, 0.9f)
+            : blend(pair.lidar_image->pixel_of_point[i], 255, 40, 220, 0.9f);
   return picture;
 }
 
@@ -40,7 +42,7 @@ std::uint64_t LidarPictureKey(const PairView& pair, LidarChannel channel) {
   return reinterpret_cast<std::uintptr_t>(pair.lidar_image.get()) ^
          (pair.brush_pixels.size() * 2654435761ull) ^
          ((pair.lidar ? pair.lidar->inliers.size() + 1 : 0) << 20) ^
-         (static_cast<std::uint64_t>(pair.brush_detected) << 36) ^
+         (static_cast<std::uint64_t>(pair.brush_origin == BrushOrigin::kDetected) << 36) ^
          (static_cast<std::uint64_t>(channel) << 40);
 }
 

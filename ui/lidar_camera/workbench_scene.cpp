@@ -217,13 +217,14 @@ void Workbench::UploadSceneCloud(const Snapshot& s, const PairView& pair, bool c
       reinterpret_cast<std::uintptr_t>(&cloud) ^ (static_cast<std::uint64_t>(coloring) << 56) ^
       (camera_colors ? reinterpret_cast<std::uintptr_t>(s.reprojection.get()) << 3 : 0) ^
       ((pair.lidar ? pair.lidar->inliers.size() + 1 : 0) << 36) ^
-      (static_cast<std::uint64_t>(pair.brush_detected) << 60);
+      (static_cast<std::uint64_t>(pair.brush_origin == BrushOrigin::kDetected) << 60);
   if (key == scene_key_) return;
   scene_key_ = key;
   std::vector<gfx::Rgba> colors =
       camera_colors ? ImageColors(s, cloud) : ChannelColors(cloud, coloring);
-  const gfx::Rgba inlier = pair.brush_detected ? gfx::Rgba{40, 220, 255, 255}  // detected
-                                               : gfx::Rgba{255, 40, 220, 255};
+  const gfx::Rgba inlier = pair.brush_origin == BrushOrigin::kDetected
+                               ? gfx::Rgba{40, 220, 255, 255}  // detected
+                               : gfx::Rgba{255, 40, 220, 255};
   if (pair.lidar)
     for (int i : pair.lidar->inliers) colors[i] = inlier;
   gl_->scene_points.Upload(cloud.points, colors);

@@ -5,6 +5,8 @@
 
 #include <cstdio>
 #include <functional>
+#include <memory>
+#include <set>
 #include <utility>
 
 #include "core/lidar/lidar_image.h"
@@ -150,6 +152,88 @@ TEST(CalibrationJob, TheUsersRejectionsAndBrushesAreItsWord) {
                  "pair 1 erased");
 }
 
+// The job's record of each pair (PairRecord) is what a workbench shows, with no window: the
+// brush and where it came from, completion's board, the residual at the solution, the user's
+// word and its undo.
+TEST(CalibrationJob, ItsRecordsShowTheBrushCompletionAndUndoWithoutAWindow) {
+  const auto dir = test::TempDir("calibration_job_records");
+  const Dataset dataset = test::CompletionMattersScene(dir / "set");
+  Dataset setup = dataset;
+  setup.pairs.clear();
+  CalibrationJob job(setup, {});
+  std::vector<LidarCloud> clouds;
+  std::vector<std::shared_ptr<const LidarImage>> images;
+  for (const PairEntry& entry : dataset.pairs) {
+    const int index = job.AppendPair(entry);
+    std::string why;
+    CameraFeatures camera;
+    auto inputs = job.ReadPair(index, &camera, &why);
+    ASSERT_TRUE(inputs) << why;
+    // Read, not yet looked for in the cloud: pending, its corners kept.
+    EXPECT_EQ(job.Records()[index].status, PairStatus::kPending);
+    EXPECT_TRUE(job.Records()[index].detection);
+    images.push_back(std::make_shared<const LidarImage>(ProjectById(inputs->cloud, {})));
+    EXPECT_EQ(job.PictureOn(index, inputs->cloud, images.back()), "");
+    clouds.push_back(std::move(inputs->cloud));
+  }
+  for (size_t i = 0; i < clouds.size(); ++i) job.AddToBackground(static_cast<int>(i), clouds[i]);
+  for (size_t i = 0; i < clouds.size(); ++i)
+    job.DetectLidar(static_cast<int>(i), clouds[i], images[i].get());
+
+  // Detected: the board's inliers drawn on each image; pair 3 (the decoy) fails, naming why.
+  std::vector<PairRecord> detected = job.Records();
+  ASSERT_EQ(detected.size(), dataset.pairs.size());
+  EXPECT_EQ(detected[3].status, PairStatus::kFailed);
+  EXPECT_FALSE(detected[3].lidar);
+  EXPECT_FALSE(detected[3].lidar_failure.empty());
+  EXPECT_TRUE(detected[3].brush_pixels.empty());
+  for (int i : {0, 1, 2, 4}) {
+    EXPECT_EQ(detected[i].status, PairStatus::kAccepted) << i << " " << detected[i].reason;
+    EXPECT_EQ(detected[i].brush_origin, BrushOrigin::kDetected);
+    ASSERT_TRUE(detected[i].lidar);
+    std::set<int> pixels;
+    for (int k : detected[i].lidar->inliers) pixels.insert(images[i]->pixel_of_point[k]);
+    pixels.erase(-1);
+    EXPECT_EQ(detected[i].brush_pixels, std::vector<int>(pixels.begin(), pixels.end())) << i;
+  }
+
+  // Solved and committed: completion found pair 3's board at the camera's prediction, and every
+  // pair solved with has the solver's residual.
+  const CalibrationOutcome solved = job.Solve();
+  ASSERT_TRUE(solved.solution) << solved.failure;
+  ASSERT_TRUE(job.CommitOutcome(/*own_step=*/true));
+  const std::vector<PairRecord> after = job.Records(&*solved.solution, {});
+  EXPECT_EQ(after[3].status, PairStatus::kAccepted) << after[3].reason;
+  EXPECT_EQ(after[3].board_origin.source, BoardSource::kCameraGuided);
+  EXPECT_FALSE(after[3].brush_pixels.empty());
+  EXPECT_EQ(job.record().Current().pairs[3].status, PairStatus::kAccepted);
+  for (const PairRecord& pair : after) {
+    ASSERT_TRUE(pair.residual) << pair.id;
+    EXPECT_LT(pair.residual->head<3>().norm(), 0.05) << pair.id;  // normal difference (rad)
+  }
+
+  // A brush painted over pair 1's detected board is the user's, and its undo gives the detection
+  // back; a rejection and its undo the same.
+  std::vector<int> painted(detected[1].brush_pixels.begin(),
+                           detected[1].brush_pixels.begin() + detected[1].brush_pixels.size() / 2);
+  job.SetBrush(dataset.pairs[1].id, PairEdit{painted, images[1]->rows, images[1]->columns});
+  job.DetectLidar(1, clouds[1], images[1].get());
+  EXPECT_EQ(job.Records()[1].brush_origin, BrushOrigin::kPainted);
+  EXPECT_EQ(job.Records()[1].brush_pixels, painted);
+  EXPECT_EQ(job.Records()[1].board_origin.source, BoardSource::kBrush);
+  ASSERT_TRUE(job.record().Undo());
+  job.DetectLidar(1, clouds[1], images[1].get());
+  EXPECT_EQ(job.Records()[1].brush_origin, BrushOrigin::kDetected);
+  EXPECT_EQ(job.Records()[1].brush_pixels, detected[1].brush_pixels);
+  job.SetRejected(dataset.pairs[2].id, true);
+  EXPECT_EQ(job.Records()[2].status, PairStatus::kRejected);
+  EXPECT_EQ(job.Records()[2].reason, kRejectedByUser);
+  ASSERT_TRUE(job.record().Undo());
+  EXPECT_EQ(job.Records()[2].status, PairStatus::kAccepted);
+  ASSERT_TRUE(job.record().Redo());
+  EXPECT_EQ(job.Records()[2].status, PairStatus::kRejected);
+}
+
 // A front end edits the record from its own thread while the job solves on another (the
 // workbench's ctrl+z while its worker runs the rejection's solve). The solve read the record
 // once; when the word it read no longer stands the outcome is dropped, never kept as the answer
@@ -164,8 +248,16 @@ TEST(CalibrationJob, AnUndoWhileItSolvesDropsThatSolveAndTheRecordEndsWhereItSta
   job.DetectAll();
   const CalibrationOutcome all = job.Solve();
   ASSERT_TRUE(all.solution) << all.failure;
-  EXPECT_FALSE(job.DiscardStaleOutcome());
+  EXPECT_TRUE(job.CommitOutcome(/*own_step=*/true));
   const Session before = job.record().Current();
+  // What it found is in the record beside the edits: the solution, each pair's verdict.
+  ASSERT_TRUE(before.result);
+  EXPECT_EQ(before.result->cam_from_lidar.matrix(), all.solution->cam_from_lidar.matrix());
+  EXPECT_EQ(before.result->step_history.size(), all.solution->cost_history.size());
+  for (size_t i = 0; i < all.pairs.size(); ++i) {
+    EXPECT_EQ(before.pairs[i].status, all.pairs[i].status) << all.pairs[i].id;
+    EXPECT_EQ(job.Records()[i].status, all.pairs[i].status) << all.pairs[i].id;
+  }
   const std::string pair = dataset.pairs[1].id;
 
   job.SetRejected(pair, true);
@@ -174,11 +266,12 @@ TEST(CalibrationJob, AnUndoWhileItSolvesDropsThatSolveAndTheRecordEndsWhereItSta
   ASSERT_TRUE(raced.solution);
   EXPECT_EQ(raced.pairs[1].status, PairStatus::kRejected);  // it solved the rejection it read
   EXPECT_FALSE(during_solve);                               // and the undo came meanwhile
-  EXPECT_TRUE(job.DiscardStaleOutcome());
+  EXPECT_FALSE(job.CommitOutcome(/*own_step=*/false));
   EXPECT_FALSE(job.outcome());
   EXPECT_FALSE(job.advice());
   EXPECT_EQ(job.record().Current(), before);
-  EXPECT_FALSE(job.DiscardStaleOutcome());  // nothing left to drop
+  EXPECT_EQ(job.Records()[1].status, PairStatus::kAccepted);
+  EXPECT_FALSE(job.CommitOutcome(/*own_step=*/false));  // nothing left to commit
   // Solved again, the record as it stands gives the first solve, bit for bit.
   const CalibrationOutcome& again = job.Solve();
   ASSERT_TRUE(again.solution);
@@ -192,9 +285,10 @@ TEST(CalibrationJob, AnUndoWhileItSolvesDropsThatSolveAndTheRecordEndsWhereItSta
     ASSERT_TRUE(job.record().Redo());
   };
   job.Solve();
-  EXPECT_FALSE(job.DiscardStaleOutcome());
+  EXPECT_TRUE(job.CommitOutcome(/*own_step=*/false));
   ASSERT_TRUE(job.outcome());
   EXPECT_EQ(job.outcome()->pairs[1].status, PairStatus::kRejected);
+  EXPECT_EQ(job.Records()[1].status, PairStatus::kRejected);
 
   // The solver's settings changed while it solves: the same.
   during_solve = [&] {
@@ -203,7 +297,7 @@ TEST(CalibrationJob, AnUndoWhileItSolvesDropsThatSolveAndTheRecordEndsWhereItSta
     job.SetSettings(settings);
   };
   job.Solve();
-  EXPECT_TRUE(job.DiscardStaleOutcome());
+  EXPECT_FALSE(job.CommitOutcome(/*own_step=*/false));
 }
 
 // A session is the job's state on disk: resumed, its brushes, rejections (with their reasons),

@@ -244,7 +244,7 @@ TEST(Controller, EachEditIsInTheJobsRecordAndUndoingABrushDetectsTheBoardAgain) 
   const Snapshot detected = Loaded(controller);
   ASSERT_TRUE(detected.pairs[1].lidar) << detected.pairs[1].lidar_failure;
   EXPECT_EQ(detected.pairs[1].board_origin.source, BoardSource::kDetected);
-  EXPECT_TRUE(detected.pairs[1].brush_detected);
+  EXPECT_EQ(detected.pairs[1].brush_origin, BrushOrigin::kDetected);
   ASSERT_FALSE(detected.pairs[1].brush_pixels.empty());
 
   controller.Apply(SetPairStatus{2, PairStatus::kRejected});
@@ -270,7 +270,7 @@ TEST(Controller, EachEditIsInTheJobsRecordAndUndoingABrushDetectsTheBoardAgain) 
   controller.Apply(BrushStroke{1, pixel / columns, pixel % columns, 4.0f, true});
   controller.Apply(EndStroke{});
   const Snapshot painted = Loaded(controller);
-  EXPECT_TRUE(painted.pairs[1].brush_edited);
+  EXPECT_EQ(painted.pairs[1].brush_origin, BrushOrigin::kPainted);
   EXPECT_LT(painted.pairs[1].brush_pixels.size(), detected.pairs[1].brush_pixels.size());
   saved = LoadSession(session_path);
   ASSERT_TRUE(saved.pairs[1].brush);
@@ -280,8 +280,8 @@ TEST(Controller, EachEditIsInTheJobsRecordAndUndoingABrushDetectsTheBoardAgain) 
 
   controller.Apply(Undo{});  // the brush
   const Snapshot undone = Loaded(controller);
-  EXPECT_FALSE(undone.pairs[1].brush_edited);
-  EXPECT_TRUE(undone.pairs[1].brush_detected);
+  EXPECT_NE(undone.pairs[1].brush_origin, BrushOrigin::kPainted);
+  EXPECT_EQ(undone.pairs[1].brush_origin, BrushOrigin::kDetected);
   EXPECT_EQ(undone.pairs[1].brush_pixels, detected.pairs[1].brush_pixels);
   ASSERT_TRUE(undone.pairs[1].lidar);
   EXPECT_EQ(undone.pairs[1].board_origin.source, BoardSource::kDetected);
@@ -348,7 +348,7 @@ TEST(Controller, ABrushOfTheWrongSizeIsDroppedWithAMessageAndTheRestLoads) {
       << s.status_line;
   EXPECT_TRUE(s.status_is_error);
   EXPECT_TRUE(s.pairs[0].lidar);  // back on its seed
-  EXPECT_TRUE(s.pairs[0].brush_from_seed);
+  EXPECT_EQ(s.pairs[0].brush_origin, BrushOrigin::kSeeded);
   EXPECT_EQ(s.pairs[1].brush_pixels, session.pairs[1].brush->pixels);
   EXPECT_EQ(s.pairs[3].status, PairStatus::kRejected);
 }

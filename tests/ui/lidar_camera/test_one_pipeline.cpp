@@ -73,7 +73,7 @@ TEST(OnePipeline, WorkbenchAndCalibrateAgreeBitForBit) {
   Controller controller;
   const Snapshot gui = EditedAndSolved(controller, session_path);
   ASSERT_TRUE(gui.solver.result) << gui.solver.failure;
-  EXPECT_FALSE(gui.pairs[1].brush_from_seed);
+  EXPECT_NE(gui.pairs[1].brush_origin, BrushOrigin::kSeeded);
   EXPECT_EQ(gui.pairs[2].status, PairStatus::kRejected);
 
   // The CLI's path over what the workbench autosaved: `calibench calibrate --session`.

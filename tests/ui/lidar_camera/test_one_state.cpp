@@ -105,7 +105,7 @@ TEST(OneState, AWorkbenchEditHoldsInTheReopenedSessionInWatchAndInCalibrate) {
     const Snapshot solved = Loaded(controller);
     ASSERT_TRUE(solved.solver.result) << solved.solver.failure;
     ASSERT_TRUE(solved.pairs[pose2].lidar) << solved.pairs[pose2].lidar_failure;
-    ASSERT_TRUE(solved.pairs[pose2].brush_edited);
+    ASSERT_EQ(solved.pairs[pose2].brush_origin, BrushOrigin::kPainted);
     painted = solved.pairs[pose2].brush_pixels;
     ASSERT_FALSE(painted.empty());
     workbench_solution = solved.solver.result->cam_from_lidar.matrix();
@@ -118,7 +118,7 @@ TEST(OneState, AWorkbenchEditHoldsInTheReopenedSessionInWatchAndInCalibrate) {
     ASSERT_EQ(reopened.pairs.size(), 12u);
     EXPECT_EQ(reopened.pairs[IndexOf(reopened, "pose2")].brush_pixels, painted);
     // Still painted once loaded: its plane from the brush, the session keeping it.
-    EXPECT_TRUE(reopened.pairs[IndexOf(reopened, "pose2")].brush_edited);
+    EXPECT_EQ(reopened.pairs[IndexOf(reopened, "pose2")].brush_origin, BrushOrigin::kPainted);
     EXPECT_EQ(reopened.pairs[IndexOf(reopened, "pose2")].board_origin.source, BoardSource::kBrush);
     EXPECT_EQ(reopened.pairs[IndexOf(reopened, "pose3")].status, PairStatus::kRejected);
     EXPECT_EQ(reopened.settings.huber_delta, kHuberDelta);
@@ -188,7 +188,7 @@ TEST(OneState, AWorkbenchEditHoldsInTheReopenedSessionInWatchAndInCalibrate) {
   const Snapshot last = OpenLikeTheWindow(controller, capture);
   ASSERT_EQ(last.pairs.size(), 18u) << last.status_line;
   EXPECT_EQ(last.pairs[IndexOf(last, "pose2")].brush_pixels, painted);
-  EXPECT_TRUE(last.pairs[IndexOf(last, "pose2")].brush_edited);
+  EXPECT_EQ(last.pairs[IndexOf(last, "pose2")].brush_origin, BrushOrigin::kPainted);
   EXPECT_EQ(last.pairs[IndexOf(last, "pose3")].status, PairStatus::kRejected);
   EXPECT_EQ(last.settings.huber_delta, kHuberDelta);
   controller.Apply(RunSolver{});
