@@ -71,7 +71,7 @@ void LrfController::Extract(LrfCalibrationJob* job, std::uint64_t open_count, in
   LrfPairView& pair = state_.pairs[index];
   pair.features = features;
   pair.extracted = true;
-  if (pair.status != PairStatus::kRejected) SetExtractedStatus(&pair);
+  Restatus();
   if (++state_.extracted_done == state_.extracted_total) {
     const int accepted = static_cast<int>(
         std::count_if(state_.pairs.begin(), state_.pairs.end(),
@@ -134,16 +134,23 @@ void LrfController::Solve() {
   SetStatus(line, !well);
 }
 
-void LrfController::SetExtractedStatus(LrfPairView* pair) {
-  // Usable pairs are accepted unless the user rejected them; the others fail with the reason.
-  if (!pair->features) {
-    pair->status = PairStatus::kPending;
-    pair->reason.clear();
-    return;
+void LrfController::Restatus() {
+  mutex_.AssertHeld(__func__);
+  for (LrfPairView& pair : state_.pairs) {
+    if (job_->record().Rejected(pair.id, &pair.reason)) {
+      pair.status = PairStatus::kRejected;
+    } else if (!pair.features) {
+      pair.status = PairStatus::kPending;
+      pair.reason.clear();
+    } else {
+      const bool usable = HasFeatures(*pair.features);
+      pair.status = usable ? PairStatus::kAccepted : PairStatus::kFailed;
+      pair.reason = usable ? "" : FeatureFailure(*pair.features);
+    }
   }
-  const bool usable = HasFeatures(*pair->features);
-  pair->status = usable ? PairStatus::kAccepted : PairStatus::kFailed;
-  pair->reason = usable ? "" : FeatureFailure(*pair->features);
+  state_.can_undo = job_->record().CanUndo();
+  state_.can_redo = job_->record().CanRedo();
+  ++state_.generation;
 }
 
 void LrfController::UpdatePairFigures() {
@@ -202,9 +209,8 @@ void LrfController::Handle(const LrfSetPairStatus& status) {
               true);
     return;
   }
-  pair.status = status.status;
-  pair.reason = status.status == PairStatus::kRejected ? kRejectedByUser : "";
   job_->SetRejected(pair.id, status.status == PairStatus::kRejected);
+  Restatus();
   AfterEdit();
   SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
                 (state_.solver.solution ? "; press Run to re-solve" : ""),

@@ -119,9 +119,6 @@ class LrfController : public ControllerState<LrfSnapshot> {
   void Start(std::shared_ptr<const LrfDataset> dataset, std::optional<Session> saved,
              const std::filesystem::path& session_path, std::optional<FileLock> lock,
              const std::string& note);
-  // The record's rejections and method onto the rows and the solver panel (mutex_ held); the
-  // selected pair is the view's, read once at Start (an undo does not move it).
-  void ApplySessionToState(const Session& session);
   void Autosave();   // call with mutex_ held; a failure shows, and is retried at the next edit
   void AfterEdit();  // undo state and autosave after a record change (mutex_ held)
   bool Fail(const std::string& message);  // the status line says it; false
@@ -130,9 +127,11 @@ class LrfController : public ControllerState<LrfSnapshot> {
   void Solve();
   void LoadSelectedImage();
   void UpdatePairFigures();  // call with mutex_ held
-  // A pair not rejected: accepted when extraction gave what the solver needs, failed with the
-  // reason when not, pending before.
-  static void SetExtractedStatus(LrfPairView* pair);
+  // Every row's status from the one rule: rejected (with its reason) where the job's record says
+  // so, else accepted when extraction gave what the solver needs, failed with the reason when
+  // not, pending before; and the undo buttons (mutex_ held). The rows never keep a status of
+  // their own: an undo, an edit and an extraction all come here.
+  void Restatus();
   bool ValidPair(int index) const;
   // One handler per intent type, as the lidar-camera controller has (Apply visits them with
   // mutex_ held and a dataset open).

@@ -97,7 +97,8 @@ void LrfController::Start(std::shared_ptr<const LrfDataset> dataset, std::option
     job_ = job;
     job_->record().AutosaveTo(session_path);
     const Session session = job_->record().Current();
-    ApplySessionToState(session);
+    state_.solver.method = *ParseLrfMethod(session.lrf_method);
+    Restatus();
     state_.selected = SelectedInView(session);
     Autosave();
     SetStatus((note.empty() ? "" : note + "; ") + "extracting features of " +
@@ -109,23 +110,6 @@ void LrfController::Start(std::shared_ptr<const LrfDataset> dataset, std::option
   if (dataset->target_type == LrfTargetType::kCheckerboard)
     worker_.Enqueue([this] { LoadSelectedImage(); });
   if (resolve) worker_.Enqueue([this] { Solve(); });  // the same features and word: the same solve
-}
-
-void LrfController::ApplySessionToState(const Session& session) {
-  mutex_.AssertHeld(__func__);
-  state_.solver.method = *ParseLrfMethod(session.lrf_method);
-  for (size_t i = 0; i < state_.pairs.size() && i < session.pairs.size(); ++i) {
-    LrfPairView& pair = state_.pairs[i];
-    if (session.pairs[i].status == PairStatus::kRejected) {
-      pair.status = PairStatus::kRejected;
-      pair.reason = session.pairs[i].reason.empty() ? kRejectedByUser : session.pairs[i].reason;
-    } else if (pair.status == PairStatus::kRejected) {
-      SetExtractedStatus(&pair);
-    }
-  }
-  state_.can_undo = job_->record().CanUndo();
-  state_.can_redo = job_->record().CanRedo();
-  ++state_.generation;
 }
 
 void LrfController::Autosave() { AutosaveRecord(job_ ? &job_->record() : nullptr); }
@@ -146,7 +130,8 @@ void LrfController::Restore(const std::optional<Session>& restored, const char* 
     SetStatus(std::string("nothing to ") + (what[0] == 'u' ? "undo" : "redo"), false);
     return;
   }
-  ApplySessionToState(*restored);
+  state_.solver.method = *ParseLrfMethod(restored->lrf_method);
+  Restatus();
   Autosave();
   // The solve shown is the restored state's: solved again from its word (the same features give
   // the same solve), or none when that state had none.
