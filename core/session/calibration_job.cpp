@@ -11,6 +11,18 @@ namespace {
 
 constexpr const char* kNoBoardToFind = "no board to find: the dataset has no target.json";
 
+// Each pair's status and reason as its steps left them (`verdicts`, by pair id) into `session`;
+// a rejection stands (the user's word, or pre-flight's while following a capture).
+void WriteVerdicts(const std::vector<std::pair<std::string, PairFeatures>>& verdicts,
+                   Session* session) {
+  for (const auto& [id, features] : verdicts) {
+    PairState* saved = FindPair(session, id);
+    if (!saved || saved->status == PairStatus::kRejected) continue;
+    saved->status = features.status;
+    saved->reason = features.reason;
+  }
+}
+
 }  // namespace
 
 bool CalibrationJobOptions::Check(std::string* why) const {
@@ -271,16 +283,7 @@ void CalibrationJob::RecordStatuses() {
       now.emplace_back(pair.detected.id, pair.Now());
     }
   }
-  record_.Edit(
-      [&](Session* session) {
-        for (const auto& [id, features] : now) {
-          PairState* saved = FindPair(session, id);
-          if (!saved || saved->status == PairStatus::kRejected) continue;  // the user's word
-          saved->status = features.status;
-          saved->reason = features.reason;
-        }
-      },
-      /*amend=*/true);
+  record_.Edit([&](Session* session) { WriteVerdicts(now, session); }, /*amend=*/true);
 }
 
 void CalibrationJob::SetBrush(const std::string& pair_id, std::optional<PairEdit> brush,
@@ -517,12 +520,7 @@ bool CalibrationJob::CommitOutcome(bool own_step) {
   }
   record_.Edit(
       [&](Session* session) {
-        for (const auto& [id, features] : verdicts) {
-          PairState* saved = FindPair(session, id);
-          if (!saved || saved->status == PairStatus::kRejected) continue;  // the user's word
-          saved->status = features.status;
-          saved->reason = features.reason;
-        }
+        WriteVerdicts(verdicts, session);
         session->result = std::move(result);
       },
       /*amend=*/!own_step);
