@@ -32,18 +32,19 @@ void AddSettingFlag(CLI::App& app, const JobSettingField& setting, PipelineFlags
   const std::string words(setting.words);
   JobSettings& settings = flags.settings;
   std::visit(
-      [&](auto member) {
-        using Value = std::remove_reference_t<decltype(settings.*member)>;
+      [&](auto slot) {
+        auto& value = settings.*slot.setting;
+        using Value = std::remove_reference_t<decltype(value)>;
         if constexpr (std::is_same_v<Value, SolverMethod>) {
-          flags.method = SolverMethodName(settings.*member);
+          flags.method = SolverMethodName(value);
           app.add_option(flag, flags.method, words)->capture_default_str();
         } else if constexpr (std::is_same_v<Value, bool>) {
-          app.add_flag(flag, settings.*member, words);
+          app.add_flag(flag, value, words);
         } else {
-          app.add_option(flag, settings.*member, words)->capture_default_str();
+          app.add_option(flag, value, words)->capture_default_str();
         }
       },
-      setting.field);
+      setting.slot);
 }
 
 }  // namespace

@@ -120,39 +120,48 @@ Session NewSession(const Dataset& dataset) {
 
 JobSettings JobSettings::Of(const PipelineOptions& options) {
   JobSettings settings;
-  settings.method = options.solver.method;
-  settings.huber_delta = options.solver.huber_delta;
-  settings.max_iterations = options.solver.max_iterations;
-  settings.estimate_range_offset = options.solver.estimate_range_offset;
-  settings.ransac_threshold_m = options.lidar_plane.ransac_threshold_m;
+  PipelineOptions read = options;  // the slots' accessors take the options to write as well
+  for (const JobSettingField& field : JobSettingFields())
+    std::visit([&](auto slot) { settings.*slot.setting = slot.in_pipeline(read); }, field.slot);
   return settings;
 }
 
 void JobSettings::Apply(PipelineOptions* options) const {
-  options->solver.method = method;
-  options->solver.huber_delta = huber_delta;
-  options->solver.max_iterations = max_iterations;
-  options->lidar_plane.ransac_threshold_m = ransac_threshold_m;
+  for (const JobSettingField& field : JobSettingFields())
+    std::visit([&](auto slot) { slot.in_pipeline(*options) = this->*slot.setting; }, field.slot);
   // Only the weighted method has a range offset to estimate (SolverOptions); the choice stays.
   options->solver.estimate_range_offset =
       estimate_range_offset && method == SolverMethod::kWeightedMl;
 }
 
+std::string JobSettingField::Key() const {
+  if (!file_key.empty()) return std::string(file_key);
+  std::string key(flag);
+  std::replace(key.begin(), key.end(), '-', '_');
+  return key;
+}
+
 const std::vector<JobSettingField>& JobSettingFields() {
   static const std::vector<JobSettingField> fields = {
-      {"method",
+      {"method", "", "",
        "weighted-ml (default: residuals whitened by both planes' covariances) | ca2lib-gn (the "
        "paper's unweighted Gauss-Newton) | kim (Kim et al. 2020: closed form from the normals, the "
        "paper's baseline)",
-       &JobSettings::method},
-      {"huber-delta", "Huber threshold on the plane error", &JobSettings::huber_delta},
-      {"max-iterations", "Gauss-Newton iterations", &JobSettings::max_iterations},
-      {"estimate-range-offset",
+       true, SettingSlot<SolverMethod>{&JobSettings::method, InSolver<&SolverOptions::method>}},
+      {"huber-delta", "", "Huber delta", "Huber threshold on the plane error", false,
+       SettingSlot<double>{&JobSettings::huber_delta, InSolver<&SolverOptions::huber_delta>}},
+      {"max-iterations", "", "max iterations", "Gauss-Newton iterations", false,
+       SettingSlot<int>{&JobSettings::max_iterations, InSolver<&SolverOptions::max_iterations>}},
+      {"estimate-range-offset", "", "",
        "weighted-ml: also estimate a constant LiDAR range offset (printed with its standard "
        "deviation and its correlation with the translation)",
-       &JobSettings::estimate_range_offset},
-      {"ransac-threshold", "LiDAR plane RANSAC inlier distance [m]",
-       &JobSettings::ransac_threshold_m},
+       true,
+       SettingSlot<bool>{&JobSettings::estimate_range_offset,
+                         InSolver<&SolverOptions::estimate_range_offset>}},
+      {"ransac-threshold", "ransac_threshold_m", "", "LiDAR plane RANSAC inlier distance [m]",
+       false,
+       SettingSlot<double>{&JobSettings::ransac_threshold_m,
+                           InLidarPlane<&LidarPlaneOptions::ransac_threshold_m>}},
   };
   return fields;
 }

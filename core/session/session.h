@@ -117,16 +117,38 @@ struct JobSettings {
   bool operator==(const JobSettings&) const = default;
 };
 
-// The settings' one declaration for the command line, in the order its help lists them: each
-// field's flag (--<flag>; a Python keyword is the flag with '_' for '-'), the words of its help,
-// and the field. app/pipeline_flags.cpp makes the flags of `calibrate`, `advise`, `watch`,
-// `report` and `sweep` from it, so that a setting added here is a flag everywhere.
+// Where one setting lives in the job's settings and in the pipeline's options: Of and Apply copy
+// it between them, so that a setting is named once, in its declaration (JobSettingFields).
+template <typename T>
+struct SettingSlot {
+  T JobSettings::*setting;
+  T& (*in_pipeline)(PipelineOptions&);
+};
+template <auto kMember>
+auto& InSolver(PipelineOptions& options) {
+  return options.solver.*kMember;
+}
+template <auto kMember>
+auto& InLidarPlane(PipelineOptions& options) {
+  return options.lidar_plane.*kMember;
+}
+
+// The settings' one declaration, in the order the command line's help lists them: each field's
+// flag (--<flag>; a Python keyword is the flag with '_' for '-'), its key in the session file's
+// "options", its input field in the workbench, the words of its help, and where it lives.
+// app/pipeline_flags.cpp makes the flags of `calibrate`, `advise`, `watch`, `report` and `sweep`
+// from it, session_json.cpp the file's "options", the workbench's solver panel its inputs; a
+// setting added here is a flag, a key and (with a label) an input everywhere.
 struct JobSettingField {
   std::string_view flag;
+  std::string_view file_key;  // empty: the flag with '_' for '-' (Key)
+  std::string_view label;     // the workbench's input; empty: drawn by a widget of its own
   std::string_view words;
-  std::variant<SolverMethod JobSettings::*, double JobSettings::*, int JobSettings::*,
-               bool JobSettings::*>
-      field;
+  // Sessions written before the setting existed lack it: the default applies. Else required.
+  bool optional_in_file = false;
+  std::variant<SettingSlot<SolverMethod>, SettingSlot<double>, SettingSlot<int>, SettingSlot<bool>>
+      slot;
+  std::string Key() const;
 };
 const std::vector<JobSettingField>& JobSettingFields();
 

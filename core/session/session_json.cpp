@@ -5,7 +5,9 @@
 #include <cstdint>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <type_traits>
 #include <utility>
+#include <variant>
 
 #include "core/base/names.h"
 #include "core/io/json_fields.h"
@@ -88,12 +90,23 @@ Json RangeOffsetToJson(const RangeOffsetEstimate& o) {
           {"well_determined", o.well_determined}};
 }
 
+// The settings under their file keys (JobSettingFields), in the order the help lists them.
 Json OptionsToJson(const JobSettings& settings) {
-  return {{"method", SolverMethodName(settings.method)},
-          {"huber_delta", Number(settings.huber_delta)},
-          {"estimate_range_offset", settings.estimate_range_offset},
-          {"max_iterations", settings.max_iterations},
-          {"ransac_threshold_m", Number(settings.ransac_threshold_m)}};
+  Json options = Json::object();
+  for (const JobSettingField& field : JobSettingFields())
+    std::visit(
+        [&](auto slot) {
+          const auto& value = settings.*slot.setting;
+          using Value = std::decay_t<decltype(value)>;
+          if constexpr (std::is_same_v<Value, SolverMethod>)
+            options[field.Key()] = SolverMethodName(value);
+          else if constexpr (std::is_same_v<Value, double>)
+            options[field.Key()] = Number(value);
+          else
+            options[field.Key()] = value;
+        },
+        field.slot);
+  return options;
 }
 
 Json ResultToJson(const SessionResult& r) {
@@ -318,22 +331,33 @@ SessionResult ReadResult(const Fields& f) {
   return r;
 }
 
+// Each setting under its file key (JobSettingFields): a method by name, a number > 0, a count
+// >= 1, a flag; one written before a later setting existed keeps that setting's default.
 void ReadOptions(const Fields& f, Session* s) {
   JobSettings& settings = s->settings;
-  // Sessions written before the method was selectable have no "method": the default applies.
-  if (f.Has("method")) {
-    const std::string name = f.String("method");
-    const auto method = ParseSolverMethod(name);
-    if (!method) f.Fail("method", "'" + name + "' is not weighted-ml, ca2lib-gn or kim");
-    settings.method = *method;
+  for (const JobSettingField& field : JobSettingFields()) {
+    const std::string key = field.Key();
+    if (field.optional_in_file && !f.Has(key)) continue;
+    std::visit(
+        [&](auto slot) {
+          auto& value = settings.*slot.setting;
+          using Value = std::decay_t<decltype(value)>;
+          if constexpr (std::is_same_v<Value, SolverMethod>) {
+            const std::string name = f.String(key);
+            const auto method = ParseSolverMethod(name);
+            if (!method) f.Fail(key, "'" + name + "' is not weighted-ml, ca2lib-gn or kim");
+            value = *method;
+          } else if constexpr (std::is_same_v<Value, double>) {
+            value = f.Positive(key);
+          } else if constexpr (std::is_same_v<Value, int>) {
+            value = f.Int(key);
+            if (value < 1) f.Fail(key, "must be at least 1");
+          } else {
+            value = f.Bool(key);
+          }
+        },
+        field.slot);
   }
-  // Optional: sessions written before the range offset existed do not estimate it.
-  if (f.Has("estimate_range_offset"))
-    settings.estimate_range_offset = f.Bool("estimate_range_offset");
-  settings.huber_delta = f.Positive("huber_delta");
-  settings.max_iterations = f.Int("max_iterations");
-  if (settings.max_iterations < 1) f.Fail("max_iterations", "must be at least 1");
-  settings.ransac_threshold_m = f.Positive("ransac_threshold_m");
   // Only an LRF session has it (Session::lrf_method).
   if (f.Has("lrf_method")) {
     s->lrf_method = f.String("lrf_method");

@@ -175,6 +175,29 @@ void BM_WorkbenchFirstPairReal40(benchmark::State& state) {
 }
 BENCHMARK(BM_WorkbenchFirstPairReal40)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
+// What a panel frame pays to read the state: one GetSnapshot of the real 40-pair VLP-16 + fisheye
+// set, loaded, detected and solved (the window takes one per frame).
+void BM_SnapshotReal40(benchmark::State& state) {
+  const char* env = std::getenv("CALIBENCH_SHARED_DIR");
+  const std::filesystem::path shared = env ? env : CALIBENCH_SHARED_DIR_DEFAULT;
+  const auto dir = shared / "datasets/acfr-vlp16-chessboard";
+  if (!std::filesystem::exists(dir)) {
+    state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
+    return;
+  }
+  const auto work = std::filesystem::temp_directory_path() / "calibench_bench" / "snapshot";
+  std::filesystem::create_directories(work);
+  std::filesystem::remove(work / "snapshot.session.json");
+  ui::Controller controller;
+  controller.OpenDataset(test::WriteAcfrManifest(dir, work), work / "snapshot.session.json");
+  controller.WaitIdle();
+  controller.Apply(ui::RunSolver{});
+  controller.WaitIdle();
+  for (auto _ : state) benchmark::DoNotOptimize(controller.GetSnapshot());
+  state.counters["pairs"] = static_cast<double>(controller.GetSnapshot().pairs.size());
+}
+BENCHMARK(BM_SnapshotReal40)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
 void BM_Session40PairsMemory(benchmark::State& state) {
   ReleaseFreedMemory();  // what earlier benchmarks left
   const auto manifest = SimulatedDemo(40);

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <string>
+#include <type_traits>
+#include <variant>
 
 #include "core/estimation/uncertainty.h"
 #include "core/lidar_camera/result_io.h"
@@ -65,13 +67,29 @@ void SolverOptionsRows(const Snapshot& s, std::vector<Intent>* intents) {
   ImGui::SameLine();
   ImGui::TextDisabled("%s", kMethodHelp[method_index]);
   ImGui::SetNextItemWidth(120);
-  edited = shown;  // the text fields' edits count once done, without the checkbox's
-  ImGui::InputDouble("Huber delta", &edited.huber_delta, 0.01, 0.1, "%.3f");
-  const bool delta_done = ImGui::IsItemDeactivatedAfterEdit();
-  ImGui::SameLine();
-  ImGui::SetNextItemWidth(100);
-  ImGui::InputInt("max iterations", &edited.max_iterations);
-  if (delta_done || ImGui::IsItemDeactivatedAfterEdit()) intents->push_back(SetSettings{edited});
+  // The settings with an input of their own (JobSettingFields' labels) on one line; their
+  // edits count once done, without the checkbox's.
+  edited = shown;
+  bool done = false, first = true;
+  for (const JobSettingField& field : JobSettingFields()) {
+    if (field.label.empty()) continue;
+    if (!first) ImGui::SameLine();
+    first = false;
+    const std::string label(field.label);
+    ImGui::SetNextItemWidth(110);
+    std::visit(
+        [&](auto slot) {
+          auto& value = edited.*slot.setting;
+          using Value = std::remove_reference_t<decltype(value)>;
+          if constexpr (std::is_same_v<Value, double>)
+            ImGui::InputDouble(label.c_str(), &value, 0.01, 0.1, "%.3f");
+          else if constexpr (std::is_same_v<Value, int>)
+            ImGui::InputInt(label.c_str(), &value);
+        },
+        field.slot);
+    done = done || ImGui::IsItemDeactivatedAfterEdit();
+  }
+  if (done) intents->push_back(SetSettings{edited});
 }
 
 // Iteration, cost and step length of each iteration, the shown one highlighted.
