@@ -42,8 +42,9 @@ void Controller::Publish() {
   std::vector<PairRecord> records = job_->Records(shown, state_.solver.solved_pair_ids);
   // The job's record of each pair, whole (pairs that joined the view before the job are shown as
   // they are until they load).
-  for (size_t i = 0; i < records.size() && i < state_.pairs.size(); ++i) {
-    PairView& pair = state_.pairs[i];
+  std::vector<PairView>& pairs = state_.pairs.Edit();
+  for (size_t i = 0; i < records.size() && i < pairs.size(); ++i) {
+    PairView& pair = pairs[i];
     static_cast<PairRecord&>(pair) = std::move(records[i]);
     if (pair.awaiting_detection)
       pair.lidar_failure = PairsSettled() ? "finding the board ..."
@@ -133,11 +134,11 @@ void Controller::ComputeReprojection(int index) {
     std::lock_guard lock(mutex_);
     if (index < 0 || index >= static_cast<int>(state_.pairs.size()) || !state_.solver.result)
       return;
-    cloud = state_.pairs[index].cloud;
+    cloud = state_.pairs.at(index).cloud;
     cam_from_lidar = state_.solver.result->cam_from_lidar;
     camera = state_.dataset->camera;
     view = state_.view;
-    id = state_.pairs[index].id;
+    id = state_.pairs.at(index).id;
   }
   if (!cloud) return;
   auto reprojection = ReprojectPair(camera, *cam_from_lidar, *cloud, view, id);
@@ -159,7 +160,7 @@ void Controller::EnsureSelectedImage() {
   std::lock_guard lock(mutex_);
   if (!StillSelected(path)) return;
   state_.selected_image = image;
-  state_.selected_image_pair = state_.pairs[state_.selected].id;
+  state_.selected_image_pair = state_.pairs.at(state_.selected).id;
   state_.selected_undistorted = undistorted;
   ++state_.generation;
   if (state_.rig && state_.rig->Several()) worker_.Enqueue([this] { rig_.LoadFrames(); });
@@ -187,7 +188,7 @@ void Controller::Handle(const SelectPair& select) {
 template <>
 void Controller::Handle(const SetPairStatus& status) {
   if (!ValidPair(status.index)) return;
-  const PairView& pair = state_.pairs[status.index];
+  const PairView& pair = state_.pairs.at(status.index);
   if (status.status == PairStatus::kAccepted && !(pair.lidar && pair.camera)) {
     SetStatus("pair " + pair.id + " cannot be accepted: " +
                   (!pair.camera ? "no camera plane (" + pair.camera_failure + ")"
@@ -200,7 +201,7 @@ void Controller::Handle(const SetPairStatus& status) {
   // The user's word into the job's record (the next solve reads it there), then shown.
   if (rejecting != (pair.status == PairStatus::kRejected)) job_->SetRejected(id, rejecting);
   Publish();
-  SetStatus("pair " + id + " " + PairStatusName(state_.pairs[status.index].status) +
+  SetStatus("pair " + id + " " + PairStatusName(state_.pairs.at(status.index).status) +
                 (state_.solver.result && !state_.auto_solve ? "; press Run to re-solve" : ""),
             false);
   AfterEdit();  // after the line: a failed autosave says so there

@@ -41,6 +41,7 @@ Snapshot SnapshotOfOutcome(const Dataset& dataset, const CalibrationOutcome& out
     s.rig->cameras[0].single = std::make_shared<const SolverResult>(*outcome.solution);
   // The solution's residuals and weights follow its accepted pairs in order (SolveExtractedPairs).
   size_t solved = 0;
+  std::vector<PairView> pairs;
   for (const PairFeatures& features : outcome.pairs) {
     PairView pair;
     pair.id = features.id;
@@ -64,8 +65,9 @@ Snapshot SnapshotOfOutcome(const Dataset& dataset, const CalibrationOutcome& out
       s.solver.solved_pair_ids.push_back(features.id);
       ++solved;
     }
-    s.pairs.push_back(std::move(pair));
+    pairs.push_back(std::move(pair));
   }
+  s.pairs = SharedPairs<PairView>(std::move(pairs));
   if (outcome.solution) {
     s.solver.result = outcome.solution;
     for (const std::string& note : {DescribeLidarModel(outcome), DescribeLearnedLidarNoise(outcome),
@@ -108,7 +110,7 @@ void ReprojectOutcomePair(const Snapshot& snapshot, int index, OutcomePair* pair
 
 void ShowOutcomePair(Snapshot* snapshot, int index, const OutcomePair& pair) {
   snapshot->selected = index;
-  PairView& view = snapshot->pairs.at(index);
+  PairView& view = snapshot->pairs.Edit(index);
   view.loaded = true;
   view.cloud = pair.cloud;
   snapshot->selected_image = pair.image;

@@ -42,7 +42,7 @@ void Controller::OnAllPairsLoaded() {
   } else {
     // No board to find (a drive opened for the targetless check): no detection (the job said
     // so per pair).
-    for (PairView& pair : state_.pairs) pair.awaiting_detection = false;
+    for (PairView& pair : state_.pairs.Edit()) pair.awaiting_detection = false;
     Publish();
   }
   // What went wrong while loading stays on the status line (in the warning colour).
@@ -111,7 +111,7 @@ void Controller::LoadPair(int index) {
   bool refit_now = false;  // the selected pair's plane comes before the other pairs load
   {
     std::lock_guard lock(mutex_);
-    PairView& pair = state_.pairs[index];
+    PairView& pair = state_.pairs.Edit(index);
     pair.loaded = true;
     pair.cloud = std::move(cloud);
     pair.lidar_image = std::move(lidar_image);
@@ -132,14 +132,13 @@ void Controller::LoadPair(int index) {
 
 bool Controller::ScheduleBoard(int index) {
   mutex_.AssertHeld(__func__);
-  PairView& pair = state_.pairs[index];
-  if (!pair.cloud) return false;  // it failed with the reason (the job's)
+  if (!state_.pairs.at(index).cloud) return false;  // it failed with the reason (the job's)
   // No target: nothing to detect (OnAllPairsLoaded says so).
   if (!state_.dataset->missing_target_file.empty()) return false;
   // Detection waits for every cloud: the background model over them keeps static board-sized
   // panels out (as CalibrateDataset does).
-  if (pair.brush_origin == BrushOrigin::kDetected) {
-    pair.awaiting_detection = true;
+  if (state_.pairs.at(index).brush_origin == BrushOrigin::kDetected) {
+    state_.pairs.Edit(index).awaiting_detection = true;
     Publish();
     return false;
   }
@@ -155,7 +154,7 @@ void Controller::DetectWithBackground() {
   {
     std::lock_guard lock(mutex_);
     for (size_t i = 0; i < state_.pairs.size(); ++i) {
-      const PairView& pair = state_.pairs[i];
+      const PairView& pair = state_.pairs.at(i);
       if (!pair.cloud) continue;
       clouds.emplace_back(static_cast<int>(i), pair.cloud);
       if (pair.brush_origin != BrushOrigin::kDetected) continue;
@@ -192,10 +191,10 @@ void Controller::RefitLidar(int index) {
   std::string id;
   {
     std::lock_guard lock(mutex_);
-    cloud = state_.pairs[index].cloud;
-    image = state_.pairs[index].lidar_image;
-    seeded = state_.pairs[index].brush_origin == BrushOrigin::kSeeded;
-    id = state_.pairs[index].id;
+    cloud = state_.pairs.at(index).cloud;
+    image = state_.pairs.at(index).lidar_image;
+    seeded = state_.pairs.at(index).brush_origin == BrushOrigin::kSeeded;
+    id = state_.pairs.at(index).id;
     brush = job_->record().EditOf(id).brush_pixels;
   }
   if (!cloud || !image) return;
@@ -206,8 +205,7 @@ void Controller::RefitLidar(int index) {
   job_->DetectLidar(index, *cloud, image.get(), seeded);
   std::lock_guard lock(mutex_);
   if (job_->record().EditOf(id).brush_pixels != brush) return;  // a newer stroke refits again
-  PairView& pair = state_.pairs[index];
-  pair.awaiting_detection = false;
+  state_.pairs.Edit(index).awaiting_detection = false;
   Publish();
   if (PairsSettled()) {
     AfterEdit();  // the statuses the job recorded, autosaved
@@ -217,8 +215,8 @@ void Controller::RefitLidar(int index) {
 
 template <>
 void Controller::Handle(const BrushStroke& stroke) {
-  if (!ValidPair(stroke.index) || !state_.pairs[stroke.index].lidar_image) return;
-  const LidarImage& image = *state_.pairs[stroke.index].lidar_image;
+  if (!ValidPair(stroke.index) || !state_.pairs.at(stroke.index).lidar_image) return;
+  const LidarImage& image = *state_.pairs.at(stroke.index).lidar_image;
   Paint(stroke.index,
         CirclePixels(image.rows, image.columns, stroke.row, stroke.column, stroke.radius_px),
         stroke.erase);
@@ -227,7 +225,7 @@ void Controller::Handle(const BrushStroke& stroke) {
 template <>
 void Controller::Handle(const ClearBrush& clear) {
   if (!ValidPair(clear.index)) return;
-  if (!state_.pairs[clear.index].lidar_image) return;
+  if (!state_.pairs.at(clear.index).lidar_image) return;
   SetBrushInRecord(clear.index, {}, /*amend=*/false);  // erased: no board until painted again
   const int index = clear.index;
   worker_.Enqueue([this, index] { RefitLidar(index); });
@@ -244,7 +242,7 @@ void Controller::Handle(const DetectBoardAgain& again) {
   bool first = true;  // every pair's brush forgotten in one undo step
   for (size_t i = 0; i < state_.pairs.size(); ++i) {
     if (!again.all && static_cast<int>(i) != again.index) continue;
-    const PairView& pair = state_.pairs[i];
+    const PairView& pair = state_.pairs.at(i);
     if (!pair.lidar_image) continue;
     job_->SetBrush(pair.id, std::nullopt, /*amend=*/!first);
     first = false;
@@ -258,13 +256,13 @@ void Controller::Handle(const DetectBoardAgain& again) {
 
 template <>
 void Controller::Handle(const PaintPoints& paint) {
-  if (ValidPair(paint.index) && state_.pairs[paint.index].lidar_image)
+  if (ValidPair(paint.index) && state_.pairs.at(paint.index).lidar_image)
     Paint(paint.index, paint.pixels, paint.erase);
 }
 
 void Controller::SetBrushInRecord(int index, std::vector<int> pixels, bool amend) {
   mutex_.AssertHeld(__func__);
-  const PairView& pair = state_.pairs[index];
+  const PairView& pair = state_.pairs.at(index);
   PairEdit brush;
   brush.brush_pixels = std::move(pixels);
   brush.brush_rows = pair.lidar_image->rows;
@@ -276,7 +274,7 @@ void Controller::SetBrushInRecord(int index, std::vector<int> pixels, bool amend
 
 void Controller::Paint(int index, const std::vector<int>& pixels, bool erase) {
   mutex_.AssertHeld(__func__);
-  const PairView& pair = state_.pairs[index];
+  const PairView& pair = state_.pairs.at(index);
   std::vector<int> merged;
   if (erase)
     std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), pixels.begin(),

@@ -118,8 +118,9 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     state_.dataset = dataset;
     state_.dataset_path = dataset.manifest;
     state_.session_path = session_path;
-    state_.pairs.resize(dataset.pairs.size());
-    for (size_t i = 0; i < dataset.pairs.size(); ++i) state_.pairs[i].id = dataset.pairs[i].id;
+    std::vector<PairView> pairs(dataset.pairs.size());
+    for (size_t i = 0; i < dataset.pairs.size(); ++i) pairs[i].id = dataset.pairs[i].id;
+    state_.pairs = SharedPairs<PairView>(std::move(pairs));
     state_.loading_total = static_cast<int>(dataset.pairs.size());
     load_warnings_.clear();
     opened_pairs_loaded_ = dataset.pairs.empty();
@@ -178,7 +179,7 @@ void Controller::ShowSession(const Session& session) {
   state_.settings = session.settings;
   state_.selected = -1;
   for (size_t i = 0; i < state_.pairs.size(); ++i)
-    if (state_.pairs[i].id == state_.view.selected_pair) state_.selected = static_cast<int>(i);
+    if (state_.pairs.at(i).id == state_.view.selected_pair) state_.selected = static_cast<int>(i);
   if (state_.selected < 0 && !state_.pairs.empty()) state_.selected = 0;
   state_.solver = SolverView{};
   if (session.result) {
@@ -205,7 +206,7 @@ std::string Controller::ViewJson() {
   mutex_.AssertHeld(__func__);
   const bool had_selected =
       state_.selected >= 0 && state_.selected < static_cast<int>(state_.pairs.size());
-  state_.view.selected_pair = had_selected ? state_.pairs[state_.selected].id : "";
+  state_.view.selected_pair = had_selected ? state_.pairs.at(state_.selected).id : "";
   return ViewToJson(state_.view);
 }
 
@@ -278,7 +279,7 @@ void Controller::Restore(const std::optional<Session>& restored, const std::stri
     worker_.Enqueue([this] { AdviseFromState(); });
   Autosave();
   for (int i = 0; i < static_cast<int>(state_.pairs.size()); ++i)
-    if (state_.pairs[i].brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });
+    if (state_.pairs.at(i).brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });
 }
 
 }  // namespace calibench::ui

@@ -23,13 +23,14 @@
 #include "core/target/lidar_plane.h"
 #include "core/targetless/check.h"
 #include "ui/state/controller_state.h"
+#include "ui/state/shared_pairs.h"
 #include "ui/state/view_state.h"
 
 namespace calibench::ui {
 
 // Everything the panels show about one pair: the job's record of it (PairRecord, whole, as the
 // job composed it) and the decoded files the views draw. Heavy members are shared, immutable
-// buffers.
+// buffers; the list of them is one immutable view every snapshot shares (SharedPairs).
 struct PairView : PairRecord {
   bool loaded = false;
   std::shared_ptr<const LidarCloud> cloud;
@@ -124,7 +125,9 @@ struct Snapshot : SnapshotHeader {
   std::filesystem::path session_path;  // empty: the session lives in memory only (render)
   std::string save_error;  // the last save's failure (autosave, save as); empty once one succeeds
   std::optional<Dataset> dataset;
-  std::vector<PairView> pairs;
+  // The job's pairs as the views show them: one list shared with the controller's state, which
+  // Publish replaces (ui/state/shared_pairs.h); a snapshot copies a pointer.
+  SharedPairs<PairView> pairs;
   int selected = -1;
   std::shared_ptr<const ImageU8> selected_image;  // full-resolution camera image of `selected`
   std::shared_ptr<const UndistortedView> selected_undistorted;  // the same, distortion removed

@@ -75,7 +75,7 @@ bool Controller::ResumeGrownCapture(Dataset dataset) {
 
 void Controller::OnLivePairLoaded(int index) {
   mutex_.AssertHeld(__func__);
-  const PairView& pair = state_.pairs[index];
+  const PairView& pair = state_.pairs.at(index);
   // The views move to the newest pair once it is loaded (not before: they would show nothing
   // meanwhile), unless the user looks at an older one.
   if (FollowsTo(index)) {
@@ -101,7 +101,7 @@ void Controller::AddPair(const PairEntry& entry) {
   state_.dataset->pairs.push_back(entry);
   PairView view;
   view.id = entry.id;
-  state_.pairs.push_back(std::move(view));
+  state_.pairs.Edit().push_back(std::move(view));
   if (job_) job_->record().AddPair(entry.id);
   ++state_.loading_total;
   const int index = static_cast<int>(state_.pairs.size()) - 1;

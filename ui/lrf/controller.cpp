@@ -68,7 +68,7 @@ void LrfController::Extract(LrfCalibrationJob* job, std::uint64_t open_count, in
   const std::shared_ptr<const LrfPairFeatures> features = job->ExtractPair(index);
   std::lock_guard lock(mutex_);
   if (open_count != open_count_) return;
-  LrfPairView& pair = state_.pairs[index];
+  LrfPairView& pair = state_.pairs.Edit(index);
   pair.features = features;
   pair.extracted = true;
   Restatus();
@@ -136,7 +136,7 @@ void LrfController::Solve() {
 
 void LrfController::Restatus() {
   mutex_.AssertHeld(__func__);
-  for (LrfPairView& pair : state_.pairs) {
+  for (LrfPairView& pair : state_.pairs.Edit()) {
     if (job_->record().Rejected(pair.id, &pair.reason)) {
       pair.status = PairStatus::kRejected;
     } else if (!pair.features) {
@@ -156,7 +156,7 @@ void LrfController::Restatus() {
 void LrfController::UpdatePairFigures() {
   mutex_.AssertHeld(__func__);
   const LrfSolution* solution = state_.solver.solution ? &*state_.solver.solution : nullptr;
-  for (LrfPairView& pair : state_.pairs) {
+  for (LrfPairView& pair : state_.pairs.Edit()) {
     pair.point_to_line_m.reset();
     pair.point_to_plane_rms_m.reset();
     if (!solution || !pair.features || !HasFeatures(*pair.features)) continue;
@@ -193,7 +193,8 @@ void LrfController::Handle(const LrfSelectPair& select) {
   state_.selected_image.reset();
   ++state_.generation;
   // Saved with the session, but no undo step (as in the LiDAR-camera workbench).
-  const std::string view = nlohmann::json{{"selected_pair", state_.pairs[select.index].id}}.dump();
+  const std::string view =
+      nlohmann::json{{"selected_pair", state_.pairs.at(select.index).id}}.dump();
   job_->record().Edit([&](Session* session) { session->view_json = view; }, /*amend=*/true);
   Autosave();
   if (state_.dataset->target_type == LrfTargetType::kCheckerboard)
@@ -202,7 +203,7 @@ void LrfController::Handle(const LrfSelectPair& select) {
 
 void LrfController::Handle(const LrfSetPairStatus& status) {
   if (!ValidPair(status.index)) return;
-  LrfPairView& pair = state_.pairs[status.index];
+  LrfPairView& pair = state_.pairs.Edit(status.index);
   if (status.status == PairStatus::kAccepted && !(pair.features && HasFeatures(*pair.features))) {
     SetStatus("pair " + pair.id + " cannot be accepted: " +
                   (pair.features ? FeatureFailure(*pair.features) : "features not extracted yet"),

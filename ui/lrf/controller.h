@@ -23,6 +23,7 @@
 #include "core/session/lrf_calibration_job.h"
 #include "ui/state/controller_state.h"
 #include "ui/state/session_opening.h"
+#include "ui/state/shared_pairs.h"
 
 namespace calibench::ui {
 
@@ -52,7 +53,7 @@ struct LrfSolverView {
 struct LrfSnapshot : SnapshotHeader {
   std::filesystem::path manifest;
   std::shared_ptr<const LrfDataset> dataset;  // null until a manifest opened
-  std::vector<LrfPairView> pairs;
+  SharedPairs<LrfPairView> pairs;  // one list the snapshots share (ui/state/shared_pairs.h)
   int selected = -1;
   std::shared_ptr<const ImageU8> selected_image;  // checkerboard case: the RGB image of `selected`
   LrfSolverView solver;

@@ -91,7 +91,8 @@ void LrfController::Start(std::shared_ptr<const LrfDataset> dataset, std::option
     state_.dataset = dataset;
     state_.session_path = session_path;
     state_.session_note = note;
-    for (const LrfPairEntry& entry : dataset->pairs) state_.pairs.emplace_back().id = entry.id;
+    for (const LrfPairEntry& entry : dataset->pairs)
+      state_.pairs.Edit().emplace_back().id = entry.id;
     state_.extracted_total = static_cast<int>(state_.pairs.size());
     outcome_.reset();
     job_ = job;

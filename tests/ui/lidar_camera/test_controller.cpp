@@ -32,6 +32,26 @@ TEST(Controller, LoadsEveryPairAndExtractsBothPlanes) {
   }
 }
 
+// A snapshot views the job's pairs: snapshots of an unchanged state share one list (a pointer
+// copied, not the pairs), and an edit after a snapshot leaves that snapshot as it was.
+TEST(Controller, SnapshotsShareOneImmutableViewOfThePairs) {
+  Controller controller;
+  controller.OpenDataset(test::UiDataset(), test::TempDir("controller_shared") / "s.json");
+  const Snapshot before = Loaded(controller);
+  ASSERT_EQ(before.pairs.size(), 4u);
+  const Snapshot again = controller.GetSnapshot();
+  EXPECT_TRUE(again.pairs.SharesWith(before.pairs));
+  EXPECT_EQ(&again.pairs[1], &before.pairs[1]);
+  controller.Apply(SetPairStatus{1, PairStatus::kRejected});
+  const Snapshot after = controller.GetSnapshot();
+  EXPECT_FALSE(after.pairs.SharesWith(before.pairs));
+  EXPECT_EQ(after.pairs[1].status, PairStatus::kRejected);
+  EXPECT_EQ(before.pairs[1].status, PairStatus::kAccepted);  // the old view stands
+  EXPECT_EQ(again.pairs[1].status, PairStatus::kAccepted);
+  EXPECT_EQ(after.pairs[0].cloud, before.pairs[0].cloud);  // the decoded files are shared too
+  EXPECT_THROW(after.pairs.at(4), std::out_of_range);
+}
+
 TEST(Controller, BrushStrokesRefitThePlaneAndErasingRemovesIt) {
   Controller controller;
   controller.OpenDataset(test::UiDataset(), test::TempDir("controller_brush") / "s.json");
