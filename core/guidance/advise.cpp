@@ -99,7 +99,6 @@ std::vector<PairFeatures> PreflightPairs(const Dataset& dataset, const Calibrati
   *rejected_any = false;
   for (PairFeatures& p : pairs) {
     PairAdvice pair;
-    pair.id = p.id;
     PreflightInputs in;
     in.pair = &p;
     in.camera = &dataset.camera;
@@ -116,8 +115,7 @@ std::vector<PairFeatures> PreflightPairs(const Dataset& dataset, const Calibrati
       p.reason = "pre-flight: " + f.words;
       *rejected_any = true;
     }
-    pair.status = p.status;
-    pair.reason = p.reason;
+    static_cast<PairStanding&>(pair) = p;  // where pre-flight left it
     advice->pairs.push_back(std::move(pair));
     earlier.push_back(p);
   }

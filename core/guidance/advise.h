@@ -13,6 +13,7 @@
 #include "core/intrinsics/intrinsics.h"
 #include "core/io/dataset.h"
 #include "core/lidar_camera/pipeline.h"
+#include "core/results/pair_status.h"
 
 namespace calibench {
 
@@ -33,10 +34,7 @@ struct AdviseOptions {
   bool Check(std::string* why) const;
 };
 
-struct PairAdvice {
-  std::string id;
-  PairStatus status = PairStatus::kPending;
-  std::string reason;
+struct PairAdvice : PairStanding {
   std::vector<PreflightFinding> findings;
 };
 

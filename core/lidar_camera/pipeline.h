@@ -94,10 +94,7 @@ struct BoardOrigin {
   std::string detail;
 };
 
-struct PairFeatures {
-  std::string id;
-  PairStatus status = PairStatus::kPending;
-  std::string reason;        // why failed / rejected, human-readable
+struct PairFeatures : PairStanding {
   bool input_error = false;  // the pair's files could not be read
   std::optional<LidarPlaneFit> lidar;
   std::optional<CameraBoardObservation> camera;

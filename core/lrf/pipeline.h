@@ -39,10 +39,7 @@ struct LrfPipelineOptions {
   bool Check(std::string* why) const;
 };
 
-struct LrfPairFeatures {
-  std::string id;
-  PairStatus status = PairStatus::kPending;
-  std::string reason;
+struct LrfPairFeatures : PairStanding {
   bool input_error = false;
   LaserScan scan;                                // as loaded (empty on input error)
   std::optional<LrfObservation> three_face;      // features (ok or not) for the three-face target

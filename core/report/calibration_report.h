@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/lidar_camera/pipeline.h"
+#include "core/results/pair_status.h"
 
 namespace calibench {
 
@@ -28,10 +29,7 @@ struct ReportOptions {
 };
 
 // One row per pair of the dataset, in the dataset's order.
-struct PairReportRow {
-  std::string id;
-  PairStatus status = PairStatus::kPending;
-  std::string reason;   // why failed / rejected
+struct PairReportRow : PairStanding {
   BoardOrigin origin;   // where its LiDAR board came from
   bool solved = false;  // it took part in the solve
   double weight = 0.0;  // its planes' robust weight (0 = gated)

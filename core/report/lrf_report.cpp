@@ -298,9 +298,7 @@ LrfReport AnalyseLrfCalibration(const LrfDataset& dataset, const LrfCalibrationO
   for (size_t i = 0; i < outcome.pairs.size(); ++i) {
     const LrfPairFeatures& p = outcome.pairs[i];
     LrfPairReportRow row;
-    row.id = p.id;
-    row.status = p.status;
-    row.reason = p.reason;
+    static_cast<PairStanding&>(row) = p;
     row.solved = p.status == PairStatus::kAccepted && Solvable(p);
     if (row.solved) {
       if (const auto residual = Residual(p, s.cam_from_lrf)) row.residual_mm = 1e3 * *residual;

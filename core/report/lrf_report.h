@@ -11,6 +11,7 @@
 
 #include "core/lrf/pipeline.h"
 #include "core/report/report_html.h"
+#include "core/results/pair_status.h"
 
 namespace calibench {
 
@@ -23,10 +24,7 @@ struct LrfReportOptions {
   bool Check(std::string* why) const;
 };
 
-struct LrfPairReportRow {
-  std::string id;
-  PairStatus status = PairStatus::kPending;
-  std::string reason;
+struct LrfPairReportRow : PairStanding {
   bool solved = false;
   // The target's own residual at the solution (mm): Eq. (12)'s mean corner-to-line distance for
   // the three-face target, the board scan points' RMS distance to the camera's board plane for

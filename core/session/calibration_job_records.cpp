@@ -62,9 +62,7 @@ std::vector<PairRecord> CalibrationJob::Records(const SolverResult* shown,
     const JobPair& pair = pairs_[i];
     const PairFeatures& features = now[i];
     PairRecord& r = records.emplace_back();
-    r.id = features.id;
-    r.status = features.status;
-    r.reason = features.reason;
+    static_cast<PairStanding&>(r) = features;
     // An accepted pair without both planes (a reopened session's, before its files are read
     // again) shows the record's status; the solver leaves it out.
     if (const PairState* saved = FindPair(record, r.id)) r.status = saved->status;

@@ -31,10 +31,7 @@ std::string JobKindName(JobKind kind);
 JobKind JobKindOf(const std::filesystem::path& dataset, const std::filesystem::path& session);
 
 // One pair as the last solve left it, in any method's words.
-struct JobPair {
-  std::string id;
-  PairStatus status = PairStatus::kPending;
-  std::string reason;        // why failed or rejected
+struct JobPair : PairStanding {
   bool input_error = false;  // its files could not be read (the reason names them)
 };
 
@@ -70,7 +67,7 @@ JobVerdict VerdictOf(const Outcome& outcome, PoseOf pose_of, std::string summary
     verdict.well_constrained = outcome.solution->observability.well_constrained;
   }
   for (const auto& pair : outcome.pairs)
-    verdict.pairs.push_back({pair.id, pair.status, pair.reason, pair.input_error});
+    verdict.pairs.push_back({{pair}, pair.input_error});  // its standing, sliced
   verdict.summary = std::move(summary);
   verdict.ground_truth = std::move(ground_truth);
   return verdict;

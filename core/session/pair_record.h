@@ -11,6 +11,7 @@
 
 #include "core/guidance/preflight.h"
 #include "core/lidar_camera/pipeline.h"
+#include "core/results/pair_status.h"
 #include "core/target/board_camera.h"
 #include "core/target/lidar_plane.h"
 
@@ -20,10 +21,7 @@ namespace calibench {
 // completion's), the manifest's lidar_seed, or the user's brush (painted or erased).
 enum class BrushOrigin { kDetected, kSeeded, kPainted };
 
-struct PairRecord {
-  std::string id;
-  PairStatus status = PairStatus::kPending;
-  std::string reason;  // why failed / rejected, human-readable
+struct PairRecord : PairStanding {
   BrushOrigin brush_origin = BrushOrigin::kDetected;
   // Sorted LiDAR-image pixel indices (ProjectById) of the region: painted, the seed's, or the
   // detected board's inliers; empty where no image pictures the pair (the CLI's job).

@@ -22,6 +22,7 @@
 #include "core/lidar/colormap.h"
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/solver.h"
+#include "core/results/pair_status.h"
 
 namespace calibench {
 
@@ -41,10 +42,7 @@ struct BrushMask {
 // False (with *why naming both layouts) when the mask was painted on another image layout.
 bool BrushFitsImage(const BrushMask& mask, int rows, int columns, std::string* why);
 
-struct PairState {
-  std::string id;  // the dataset's pair id
-  PairStatus status = PairStatus::kPending;
-  std::string reason;  // why rejected / failed, human-readable; empty otherwise
+struct PairState : PairStanding {
   std::optional<BrushMask> brush;
   bool brush_from_seed = false;  // brush generated from the manifest's lidar_seed, not painted
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -136,20 +137,30 @@ BENCHMARK(BM_WorkbenchFrameAfterEdit1600x900)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-// Opening the real 40-pair VLP-16 + fisheye set in the workbench: how long until the selected
-// pair is on screen (its cloud, its LiDAR plane and its camera image), and until every pair has
-// loaded behind it.
-void BM_WorkbenchFirstPairReal40(benchmark::State& state) {
+// The real 40-pair VLP-16 + fisheye set's manifest, written into a work folder `name` (nullopt
+// after marking the benchmark skipped where ../shared is absent).
+std::optional<std::filesystem::path> RealAcfr40(benchmark::State& state, const char* name,
+                                                std::filesystem::path* work) {
   const char* env = std::getenv("CALIBENCH_SHARED_DIR");
   const std::filesystem::path shared = env ? env : CALIBENCH_SHARED_DIR_DEFAULT;
   const auto dir = shared / "datasets/acfr-vlp16-chessboard";
   if (!std::filesystem::exists(dir)) {
     state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
-    return;
+    return std::nullopt;
   }
-  const auto work = std::filesystem::temp_directory_path() / "calibench_bench" / "first_pair";
-  std::filesystem::create_directories(work);
-  const auto manifest = test::WriteAcfrManifest(dir, work);
+  *work = std::filesystem::temp_directory_path() / "calibench_bench" / name;
+  std::filesystem::create_directories(*work);
+  return test::WriteAcfrManifest(dir, *work);
+}
+
+// Opening the real 40-pair VLP-16 + fisheye set in the workbench: how long until the selected
+// pair is on screen (its cloud, its LiDAR plane and its camera image), and until every pair has
+// loaded behind it.
+void BM_WorkbenchFirstPairReal40(benchmark::State& state) {
+  std::filesystem::path work;
+  const auto found = RealAcfr40(state, "first_pair", &work);
+  if (!found) return;
+  const std::filesystem::path manifest = *found;
   double first_s = 0, all_s = 0;
   for (auto _ : state) {
     std::filesystem::remove(work / "first_pair.session.json");
@@ -178,18 +189,12 @@ BENCHMARK(BM_WorkbenchFirstPairReal40)->Unit(benchmark::kSecond)->Iterations(1)-
 // What a panel frame pays to read the state: one GetSnapshot of the real 40-pair VLP-16 + fisheye
 // set, loaded, detected and solved (the window takes one per frame).
 void BM_SnapshotReal40(benchmark::State& state) {
-  const char* env = std::getenv("CALIBENCH_SHARED_DIR");
-  const std::filesystem::path shared = env ? env : CALIBENCH_SHARED_DIR_DEFAULT;
-  const auto dir = shared / "datasets/acfr-vlp16-chessboard";
-  if (!std::filesystem::exists(dir)) {
-    state.SkipWithError("../shared/datasets/acfr-vlp16-chessboard not found");
-    return;
-  }
-  const auto work = std::filesystem::temp_directory_path() / "calibench_bench" / "snapshot";
-  std::filesystem::create_directories(work);
+  std::filesystem::path work;
+  const auto manifest = RealAcfr40(state, "snapshot", &work);
+  if (!manifest) return;
   std::filesystem::remove(work / "snapshot.session.json");
   ui::Controller controller;
-  controller.OpenDataset(test::WriteAcfrManifest(dir, work), work / "snapshot.session.json");
+  controller.OpenDataset(*manifest, work / "snapshot.session.json");
   controller.WaitIdle();
   controller.Apply(ui::RunSolver{});
   controller.WaitIdle();

@@ -44,9 +44,7 @@ Snapshot SnapshotOfOutcome(const Dataset& dataset, const CalibrationOutcome& out
   std::vector<PairView> pairs;
   for (const PairFeatures& features : outcome.pairs) {
     PairView pair;
-    pair.id = features.id;
-    pair.status = features.status;
-    pair.reason = features.reason;
+    static_cast<PairStanding&>(pair) = features;
     pair.lidar = features.lidar;
     pair.board_origin = features.board_origin;
     // Its inliers drawn as a found board's (cyan) unless a brush or seed chose them.

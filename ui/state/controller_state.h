@@ -18,11 +18,7 @@
 namespace calibench::ui {
 
 // The part of a pair every workbench lists: which pair, where it stands and why.
-struct PairHeader {
-  std::string id;
-  PairStatus status = PairStatus::kPending;
-  std::string reason;  // why failed / rejected, human-readable
-};
+using PairHeader = PairStanding;
 
 // The part of a snapshot every workbench shows: the status line and whether work is running.
 struct SnapshotHeader {
