@@ -20,6 +20,15 @@ namespace calibench::ui {
 
 Controller::Controller(PipelineOptions options)
     : pipeline_(std::move(options)),
+      brush_(
+          Host(),
+          {.job = [this] { return &*job_; },
+           .edited =
+               [this] {
+                 Publish();
+                 AfterEdit();
+               },
+           .refit = [this](int index) { worker_.Enqueue([this, index] { RefitLidar(index); }); }}),
       rig_(Host(), [this] { JudgeMeter(/*record=*/false); }),
       check_(Host()),
       intrinsics_(Host()),
@@ -305,12 +314,20 @@ void Controller::Apply(const Intent& intent) {
   if (!state_.dataset && !std::holds_alternative<PickBoard>(intent)) return;
   // A stroke is its dabs; anything else in between ends it.
   if (!std::holds_alternative<BrushStroke>(intent) && !std::holds_alternative<PaintPoints>(intent))
-    stroke_open_ = false;
+    brush_.EndStroke();
   // The tasks' intents to their tasks, the rest to the controller's own handlers.
   std::visit(
       [this](const auto& what) {
         using What = std::decay_t<decltype(what)>;
-        if constexpr (std::is_same_v<What, EstimateIntrinsics>)
+        if constexpr (std::is_same_v<What, BrushStroke> || std::is_same_v<What, PaintPoints>)
+          brush_.Paint(what);
+        else if constexpr (std::is_same_v<What, ClearBrush>)
+          brush_.Clear(what);
+        else if constexpr (std::is_same_v<What, DetectBoardAgain>)
+          brush_.DetectAgain(what);
+        else if constexpr (std::is_same_v<What, EndStroke>)
+          brush_.EndStroke();
+        else if constexpr (std::is_same_v<What, EstimateIntrinsics>)
           intrinsics_.Estimate(what);
         else if constexpr (std::is_same_v<What, SaveIntrinsics>)
           intrinsics_.Save(what);

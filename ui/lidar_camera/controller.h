@@ -19,6 +19,7 @@
 #include "core/results/export.h"
 #include "core/session/calibration_job.h"  // the job, with the guidance and the session
 #include "core/session/capture_follow.h"
+#include "ui/lidar_camera/brush_task.h"
 #include "ui/lidar_camera/check_task.h"
 #include "ui/lidar_camera/controller_snapshot.h"  // Snapshot and the views it holds
 #include "ui/lidar_camera/follow_task.h"
@@ -159,12 +160,6 @@ class Controller : public ControllerState<Snapshot> {
   template <typename IntentType>
   void Handle(const IntentType& intent);
   bool ValidPair(int index) const;
-  // Adds (or, erasing, removes) LiDAR-image pixels to a pair's brush and refits: both brushes'
-  // dabs. Call with mutex_ held.
-  void Paint(int index, const std::vector<int>& pixels, bool erase);
-  // Pair `index`'s brush painted (or erased: `pixels` empty) into the job's record: an undo step,
-  // or the current one amended (a stroke's later dabs). The pair has its LiDAR image.
-  void SetBrushInRecord(int index, std::vector<int> pixels, bool amend);
   // Undo / redo (`what`: "undid" / "redid", for the status line).
   void Restore(const std::optional<Session>& restored, const std::string& what);
 
@@ -179,11 +174,11 @@ class Controller : public ControllerState<Snapshot> {
   // autosave), which state_ mirrors for the panels. Its steps run on the worker; its record is
   // edited under mutex_ (it locks itself too). Made anew by Open, after WaitIdle.
   std::optional<CalibrationJob> job_;
-  bool stroke_open_ = false;          // BrushStroke / PaintPoints dabs since the last EndStroke
   bool solve_queued_ = false;         // mutex_
   bool follow_newest_ = true;         // a followed capture's views move to each new pair (mutex_)
   bool opened_pairs_loaded_ = false;  // every pair Open started with has loaded (mutex_)
   // The tasks Apply routes intents to, each owning its own fields (TaskHost).
+  BrushTask brush_;
   RigTask rig_;
   CheckTask check_;
   IntrinsicsTask intrinsics_;
@@ -195,16 +190,6 @@ template <>
 void Controller::Handle(const SelectPair&);
 template <>
 void Controller::Handle(const SetPairStatus&);
-template <>
-void Controller::Handle(const BrushStroke&);
-template <>
-void Controller::Handle(const EndStroke&);
-template <>
-void Controller::Handle(const ClearBrush&);
-template <>
-void Controller::Handle(const DetectBoardAgain&);
-template <>
-void Controller::Handle(const PaintPoints&);
 template <>
 void Controller::Handle(const RunSolver&);
 template <>

@@ -1,5 +1,6 @@
 // The controller's pairs: loading each pair's files on the worker, the board's detection (with
-// the scene's background), the LiDAR refit after a brush edit, and the brush intents.
+// the scene's background), and the LiDAR refit after a brush edit (the brush's intents are
+// BrushTask's).
 #include <algorithm>
 #include <cmath>
 #include <ctime>
@@ -15,23 +16,6 @@ namespace calibench::ui {
 namespace {
 
 constexpr int kThumbnailWidth = 160;  // pixels
-
-// Pixels of a circle on the LiDAR image; columns wrap around (azimuth is periodic).
-std::vector<int> CirclePixels(int rows, int columns, int row, int column, float radius) {
-  std::vector<int> pixels;
-  const int r = static_cast<int>(std::ceil(radius));
-  for (int dr = -r; dr <= r; ++dr) {
-    const int y = row + dr;
-    if (y < 0 || y >= rows) continue;
-    for (int dc = -r; dc <= r; ++dc) {
-      if (dr * dr + dc * dc > radius * radius) continue;
-      const int x = ((column + dc) % columns + columns) % columns;
-      pixels.push_back(y * columns + x);
-    }
-  }
-  std::sort(pixels.begin(), pixels.end());
-  return pixels;
-}
 
 }  // namespace
 
@@ -211,82 +195,6 @@ void Controller::RefitLidar(int index) {
     AfterEdit();  // the statuses the job recorded, autosaved
     RequestSolve();
   }
-}
-
-template <>
-void Controller::Handle(const BrushStroke& stroke) {
-  if (!ValidPair(stroke.index) || !state_.pairs.at(stroke.index).lidar_image) return;
-  const LidarImage& image = *state_.pairs.at(stroke.index).lidar_image;
-  Paint(stroke.index,
-        CirclePixels(image.rows, image.columns, stroke.row, stroke.column, stroke.radius_px),
-        stroke.erase);
-}
-
-template <>
-void Controller::Handle(const ClearBrush& clear) {
-  if (!ValidPair(clear.index)) return;
-  if (!state_.pairs.at(clear.index).lidar_image) return;
-  SetBrushInRecord(clear.index, {}, /*amend=*/false);  // erased: no board until painted again
-  const int index = clear.index;
-  worker_.Enqueue([this, index] { RefitLidar(index); });
-}
-
-template <>
-void Controller::Handle(const EndStroke&) {
-  stroke_open_ = false;
-}
-
-template <>
-void Controller::Handle(const DetectBoardAgain& again) {
-  if (!again.all && !ValidPair(again.index)) return;
-  bool first = true;  // every pair's brush forgotten in one undo step
-  for (size_t i = 0; i < state_.pairs.size(); ++i) {
-    if (!again.all && static_cast<int>(i) != again.index) continue;
-    const PairView& pair = state_.pairs.at(i);
-    if (!pair.lidar_image) continue;
-    job_->SetBrush(pair.id, std::nullopt, /*amend=*/!first);
-    first = false;
-    const int index = static_cast<int>(i);
-    worker_.Enqueue([this, index] { RefitLidar(index); });
-  }
-  if (first) return;
-  Publish();
-  AfterEdit();
-}
-
-template <>
-void Controller::Handle(const PaintPoints& paint) {
-  if (ValidPair(paint.index) && state_.pairs.at(paint.index).lidar_image)
-    Paint(paint.index, paint.pixels, paint.erase);
-}
-
-void Controller::SetBrushInRecord(int index, std::vector<int> pixels, bool amend) {
-  mutex_.AssertHeld(__func__);
-  const PairView& pair = state_.pairs.at(index);
-  PairEdit brush;
-  brush.brush_pixels = std::move(pixels);
-  brush.brush_rows = pair.lidar_image->rows;
-  brush.brush_columns = pair.lidar_image->columns;
-  job_->SetBrush(pair.id, brush, amend);
-  Publish();
-  AfterEdit();
-}
-
-void Controller::Paint(int index, const std::vector<int>& pixels, bool erase) {
-  mutex_.AssertHeld(__func__);
-  const PairView& pair = state_.pairs.at(index);
-  std::vector<int> merged;
-  if (erase)
-    std::set_difference(pair.brush_pixels.begin(), pair.brush_pixels.end(), pixels.begin(),
-                        pixels.end(), std::back_inserter(merged));
-  else
-    std::set_union(pair.brush_pixels.begin(), pair.brush_pixels.end(), pixels.begin(), pixels.end(),
-                   std::back_inserter(merged));
-  if (merged == pair.brush_pixels) return;
-  // Painted: the brush replaces the seed and any detection from now on.
-  SetBrushInRecord(index, std::move(merged), /*amend=*/stroke_open_);
-  stroke_open_ = true;  // the stroke's later dabs amend this undo step
-  worker_.Enqueue([this, index] { RefitLidar(index); });
 }
 
 }  // namespace calibench::ui
