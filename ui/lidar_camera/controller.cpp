@@ -22,14 +22,22 @@ Controller::Controller(PipelineOptions options)
     : pipeline_(std::move(options)),
       brush_(
           Host(),
-          {.job = [this] { return &*job_; },
+          {.job = [this] { return job_ ? &*job_ : nullptr; },
            .edited =
                [this] {
                  Publish();
                  AfterEdit();
                },
            .refit = [this](int index) { worker_.Enqueue([this, index] { RefitLidar(index); }); }}),
-      rig_(Host(), [this] { JudgeMeter(/*record=*/false); }),
+      guidance_(Host(), {.job = [this] { return job_ ? &*job_ : nullptr; },
+                         .judged = [this] { rig_.UpdateActiveCamera(); },
+                         .publish = [this] { Publish(); },
+                         .rejected =
+                             [this] {
+                               AfterEdit();
+                               RequestSolve();
+                             }}),
+      rig_(Host(), [this] { guidance_.Judge(/*record=*/false); }),
       check_(Host()),
       intrinsics_(Host()),
       follow_(Host(), {.open =
@@ -121,7 +129,7 @@ void Controller::Solve(bool asked) {
   if (const Session record = job_->record().Current(); record.result)
     state_.solver.notes = record.result->notes;
   Publish();
-  JudgeMeter(/*record=*/true);
+  guidance_.Judge(/*record=*/true);
   SetStatus("solved with " + std::to_string(state_.solver.solved_pair_ids.size()) + " pairs in " +
                 std::to_string(result.iterations) + " iterations" +
                 (result.observability.well_constrained ? "" : " (NOT well constrained)"),
@@ -130,7 +138,7 @@ void Controller::Solve(bool asked) {
   const int selected = state_.selected;
   if (selected >= 0) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
   // Pre-flight and the next pose (the ghost board) from this solve.
-  worker_.Enqueue([this] { Advise(); });
+  worker_.Enqueue([this] { guidance_.Advise(); });
 }
 
 void Controller::ComputeReprojection(int index) {
@@ -228,7 +236,7 @@ void Controller::Handle(const ResetSolver&) {
   state_.reprojection.reset();
   job_->record().Edit([](Session* session) { session->result.reset(); });
   Publish();
-  JudgeMeter(/*record=*/false);
+  guidance_.Judge(/*record=*/false);
   AfterEdit();
 }
 
@@ -327,6 +335,8 @@ void Controller::Apply(const Intent& intent) {
           brush_.DetectAgain(what);
         else if constexpr (std::is_same_v<What, EndStroke>)
           brush_.EndStroke();
+        else if constexpr (std::is_same_v<What, SetGoal>)
+          guidance_.Apply(what);
         else if constexpr (std::is_same_v<What, EstimateIntrinsics>)
           intrinsics_.Estimate(what);
         else if constexpr (std::is_same_v<What, SaveIntrinsics>)

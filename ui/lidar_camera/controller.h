@@ -23,6 +23,7 @@
 #include "ui/lidar_camera/check_task.h"
 #include "ui/lidar_camera/controller_snapshot.h"  // Snapshot and the views it holds
 #include "ui/lidar_camera/follow_task.h"
+#include "ui/lidar_camera/guidance_task.h"
 #include "ui/lidar_camera/intents.h"
 #include "ui/lidar_camera/intrinsics_task.h"
 #include "ui/lidar_camera/rig_task.h"
@@ -97,10 +98,6 @@ class Controller : public ControllerState<Snapshot> {
   bool ResumeGrownCapture(Dataset dataset);
   // Enqueues a solve unless one is queued (auto-solve; mutex_ held).
   void RequestSolve();
-  // After a solve (worker): pre-flight and the next pose (the job's Advise), at `at` if given.
-  void Advise(const std::optional<SolverResult>& at = std::nullopt);
-  // The same for a reopened session's result, over the pairs as detected again (worker).
-  void AdviseFromState();
   void LoadPair(int index);
   // After the last pair loaded (mutex_ held): detection, the status line with what loading
   // noted or refused, the reopened session's reprojection.
@@ -127,9 +124,6 @@ class Controller : public ControllerState<Snapshot> {
   // The job's record of every pair into the view (PairRecord, whole), with the residuals at the
   // solution shown. Call with mutex_ held.
   void Publish();
-  // The meter from the current result and goal; `record` adds the point to the history (a solve).
-  // Call with mutex_ held.
-  void JudgeMeter(bool record);
   // The user's edits go to the job's record first (record-first, as the LRF workbench's): the job's
   // SetRejected, SetBrush and SetSettings, the record's Edit for the view and a reset solve;
   // what followed from them (statuses, completion, the solve) the job records beside them, and
@@ -179,6 +173,7 @@ class Controller : public ControllerState<Snapshot> {
   bool opened_pairs_loaded_ = false;  // every pair Open started with has loaded (mutex_)
   // The tasks Apply routes intents to, each owning its own fields (TaskHost).
   BrushTask brush_;
+  GuidanceTask guidance_;
   RigTask rig_;
   CheckTask check_;
   IntrinsicsTask intrinsics_;
@@ -206,8 +201,6 @@ template <>
 void Controller::Handle(const Undo&);
 template <>
 void Controller::Handle(const Redo&);
-template <>
-void Controller::Handle(const SetGoal&);  // controller_meter.cpp
 template <>
 void Controller::Handle(const AdoptCheckEstimate&);  // controller_check.cpp
 

@@ -38,8 +38,8 @@ void Controller::OnAllPairsLoaded() {
   // A reopened session with a result shows its reprojection, its meter and (once its boards are
   // found again) its next pose again.
   if (state_.solver.result && !state_.meter) {
-    JudgeMeter(/*record=*/true);
-    worker_.Enqueue([this] { AdviseFromState(); });
+    guidance_.Judge(/*record=*/true);
+    worker_.Enqueue([this] { guidance_.AdviseFromState(); });
   }
   const int selected = state_.selected;
   if (state_.solver.result) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });

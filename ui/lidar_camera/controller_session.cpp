@@ -266,7 +266,7 @@ void Controller::Restore(const std::optional<Session>& restored, const std::stri
   ShowSession(*restored);
   // The meter and the next pose belong to the solve restored (or to none): judged again, asked
   // again (not while following a capture, where Advise's pre-flight would edit the record).
-  JudgeMeter(/*record=*/false);
+  guidance_.Judge(/*record=*/false);
   // The line no longer speaks of the solve undone ("solved with 39 pairs" over 40 accepted).
   int accepted = 0;
   for (const PairView& pair : state_.pairs) accepted += pair.SolvesWith();
@@ -276,7 +276,7 @@ void Controller::Restore(const std::optional<Session>& restored, const std::stri
             false);
   state_.next_pose.reset();
   if (state_.solver.result && state_.watching.empty())
-    worker_.Enqueue([this] { AdviseFromState(); });
+    worker_.Enqueue([this] { guidance_.AdviseFromState(); });
   Autosave();
   for (int i = 0; i < static_cast<int>(state_.pairs.size()); ++i)
     if (state_.pairs.at(i).brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });

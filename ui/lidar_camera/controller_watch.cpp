@@ -109,37 +109,4 @@ void Controller::AddPair(const PairEntry& entry) {
   worker_.Enqueue([this, index] { LoadPair(index); });  // selects it when it follows (FollowsTo)
 }
 
-void Controller::AdviseFromState() {
-  std::optional<SolverResult> at;
-  {
-    std::lock_guard lock(mutex_);
-    if (!job_ || !state_.solver.result || state_.next_pose) return;
-    at = job_->OutcomeAt(*state_.solver.result, state_.solver.solved_pair_ids).solution;
-  }
-  Advise(at);
-}
-
-void Controller::Advise(const std::optional<SolverResult>& at) {
-  if (!job_) return;
-  {
-    std::lock_guard lock(mutex_);
-    job_->SetGoal(state_.goal);
-    job_->SetHandTolerance(state_.hand_tolerance_m, state_.hand_tolerance_deg);
-  }
-  // The job's solve (pairs that joined since are judged after the next solve).
-  const CaptureAdvice& advice = job_->Advise(at);
-  std::lock_guard lock(mutex_);
-  state_.next_pose = advice.next;
-  state_.next_pose_failure = advice.state && advice.state->done
-                                 ? "the goal is met: no more poses needed"
-                                 : advice.next_failure;
-  // Following a capture, pre-flight's rejections apply, as `watch` applies them; on a dataset
-  // they are shown on the rows (the findings) and the user decides.
-  const bool rejected = !state_.watching.empty() && job_->ApplyPreflightRejections();
-  Publish();
-  if (!rejected) return;
-  AfterEdit();
-  RequestSolve();
-}
-
 }  // namespace calibench::ui
