@@ -52,8 +52,8 @@ void BrushTask::Clear(const ClearBrush& clear) {
 }
 
 void BrushTask::DetectAgain(const DetectBoardAgain& again) {
+  if (!again.all && !ImageOf(again.index)) return;
   const SharedPairs<PairView>& pairs = host_.state.pairs;
-  if (!again.all && !(again.index >= 0 && again.index < static_cast<int>(pairs.size()))) return;
   bool first = true;  // every pair's brush forgotten in one undo step
   for (size_t i = 0; i < pairs.size(); ++i) {
     if (!again.all && static_cast<int>(i) != again.index) continue;

@@ -334,7 +334,7 @@ void Controller::Apply(const Intent& intent) {
         else if constexpr (std::is_same_v<What, DetectBoardAgain>)
           brush_.DetectAgain(what);
         else if constexpr (std::is_same_v<What, EndStroke>)
-          brush_.EndStroke();
+          ;  // ended above, as by any intent but a dab
         else if constexpr (std::is_same_v<What, SetGoal>)
           guidance_.Apply(what);
         else if constexpr (std::is_same_v<What, EstimateIntrinsics>)

@@ -30,7 +30,6 @@ class SharedPairs {
       throw std::out_of_range("pair " + std::to_string(index) + " of " + std::to_string(size()));
     return (*pairs_)[index];
   }
-  const Pair& back() const { return pairs_->back(); }
   typename std::vector<Pair>::const_iterator begin() const { return All().begin(); }
   typename std::vector<Pair>::const_iterator end() const { return All().end(); }
 
