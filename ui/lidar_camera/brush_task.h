@@ -20,7 +20,7 @@ class BrushTask {
   // What the controller does after a brush edit (mutex held).
   struct Controls {
     std::function<CalibrationJob*()> job;  // the open dataset's job
-    std::function<void()> edited;          // the record shown (Publish), then AfterEdit
+    std::function<void()> edited;          // the record shown (Publish), then the autosave
     std::function<void(int)> refit;        // pair `index`'s board fitted again, on the worker
   };
   BrushTask(TaskHost<Snapshot> host, Controls controls)

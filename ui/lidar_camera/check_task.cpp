@@ -1,3 +1,5 @@
+// The workbench's targetless check and its estimate adopted, a task of the controller
+// (ui/lidar_camera/check_task.h).
 #include "ui/lidar_camera/check_task.h"
 
 #include <cstdio>
@@ -78,6 +80,39 @@ void CheckTask::Run(const RunCheck& request) {
             (report.has_estimate ? ", change " + CheckChangeWords(report) : std::string()),
         report.verdict == CheckVerdict::kMiscalibrated);
   });
+}
+
+void CheckTask::Adopt() {
+  Snapshot& state = host_.state;
+  const std::shared_ptr<const CheckReport> report = state.check.report;
+  if (!report || !report->has_estimate) {
+    host_.SetStatus("no targetless estimate to adopt: run the check first", true);
+    return;
+  }
+  SolverResult result;
+  result.cam_from_lidar = report->estimate;
+  result.covariance = RightPerturbationCovariance(report->covariance, report->estimate);
+  result.observability.well_constrained = report->unconstrained_axes.empty();
+  for (int axis : report->unconstrained_axes)
+    result.observability.weak_directions.push_back(CameraAxisName(axis));
+  state.solver = SolverView{};
+  state.solver.result = result;
+  state.solver.targetless_provenance =
+      TargetlessProvenanceText(state.check.checked, "the workbench's check") + " (" +
+      std::to_string(report->frames_used) + " frames; verdict " +
+      CheckVerdictName(report->verdict) + ", change " + CheckChangeWords(*report) + ")";
+  state.solver.notes = {"targetless estimate adopted: not a board solve; " +
+                        state.solver.targetless_provenance};
+  controls_.job()->AdoptSolution(result, state.solver.targetless_provenance, state.solver.notes);
+  controls_.publish();
+  // The meter judges board captures; an estimate from the scene is not one.
+  state.meter.reset();
+  host_.SetStatus(
+      "adopted the targetless estimate as the workbench's calibration (Undo restores the "
+      "one before)",
+      false);
+  controls_.edited();  // after the line: a failed autosave says so there
+  controls_.adopted();
 }
 
 }  // namespace calibench::ui

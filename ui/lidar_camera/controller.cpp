@@ -1,5 +1,5 @@
-// The controller's solve and the intents that are neither pairs' nor the session's: selection,
-// accept/reject, solver runs and options, view, export; Apply dispatches every intent.
+// The controller's own intents (selection, accept/reject, the view) and Apply, which routes every
+// other intent to its task.
 #include "ui/lidar_camera/controller.h"
 
 #include <algorithm>
@@ -20,32 +20,81 @@ namespace calibench::ui {
 
 Controller::Controller(PipelineOptions options)
     : pipeline_(std::move(options)),
-      brush_(
-          Host(),
-          {.job = [this] { return job_ ? &*job_ : nullptr; },
-           .edited =
-               [this] {
-                 Publish();
-                 AfterEdit();
-               },
-           .refit = [this](int index) { worker_.Enqueue([this, index] { RefitLidar(index); }); }}),
+      session_(Host()),
+      view_(Host(),
+            {.job = [this] { return job_ ? &*job_ : nullptr; },
+             .edited = [this] { session_.Edited(); },
+             .follow_newest = [this](bool on) { loading_.FollowNewest(on); },
+             .load_image =
+                 [this](std::filesystem::path* path) { return LoadSelectedImageFile(path); },
+             .image_shown =
+                 [this] {
+                   if (state_.rig && state_.rig->Several())
+                     worker_.Enqueue([this] { rig_.LoadFrames(); });
+                 }}),
+      brush_(Host(), {.job = [this] { return job_ ? &*job_ : nullptr; },
+                      .edited =
+                          [this] {
+                            Publish();
+                            session_.Edited();
+                          },
+                      .refit =
+                          [this](int index) {
+                            worker_.Enqueue([this, index] { loading_.Refit(index); });
+                          }}),
       guidance_(Host(), {.job = [this] { return job_ ? &*job_ : nullptr; },
                          .judged = [this] { rig_.UpdateActiveCamera(); },
                          .publish = [this] { Publish(); },
                          .rejected =
                              [this] {
-                               AfterEdit();
-                               RequestSolve();
+                               session_.Edited();
+                               solve_.Request();
                              }}),
+      solve_(
+          Host(), guidance_,
+          {.job = [this] { return job_ ? &*job_ : nullptr; },
+           .publish = [this] { Publish(); },
+           .edited = [this] { session_.Edited(); },
+           .reproject =
+               [this](int index) { worker_.Enqueue([this, index] { view_.Reproject(index); }); }}),
+      loading_(
+          Host(), guidance_,
+          {.job = [this] { return job_ ? &*job_ : nullptr; },
+           .publish = [this] { Publish(); },
+           .settled =
+               [this] {
+                 session_.Edited();
+                 solve_.Request();
+               },
+           .show_image = [this] { worker_.Enqueue([this] { view_.ShowImage(); }); },
+           .reproject =
+               [this](int index) { worker_.Enqueue([this, index] { view_.Reproject(index); }); },
+           .keep_image =
+               [this](const std::filesystem::path& path, std::shared_ptr<const ImageU8> image) {
+                 KeepDecodedImage(path, std::move(image));
+               }}),
       rig_(Host(), [this] { guidance_.Judge(/*record=*/false); }),
-      check_(Host()),
+      check_(Host(), {.job = [this] { return job_ ? &*job_ : nullptr; },
+                      .publish = [this] { Publish(); },
+                      .adopted =
+                          [this] {
+                            rig_.UpdateActiveCamera();
+                            const int selected = state_.selected;
+                            if (selected >= 0)
+                              worker_.Enqueue([this, selected] { view_.Reproject(selected); });
+                          },
+                      .edited = [this] { session_.Edited(); }}),
       intrinsics_(Host()),
       follow_(Host(), {.open =
                            [this](const Dataset& read) {
                              if (!ResumeGrownCapture(read))
                                OpenLoadedDataset(read, {}, ExistingSession::kResume);
                            },
-                       .add = [this](const PairEntry& pair) { AddPair(pair); }}) {}
+                       .add =
+                           [this](const PairEntry& pair) {
+                             std::lock_guard lock(mutex_);
+                             loading_.Add(pair);
+                           }}) {}
 
 Controller::~Controller() {
   StopWatching();
@@ -64,147 +113,14 @@ void Controller::Publish() {
     PairView& pair = pairs[i];
     static_cast<PairRecord&>(pair) = std::move(records[i]);
     if (pair.awaiting_detection)
-      pair.lidar_failure = PairsSettled() ? "finding the board ..."
-                                          : "finding the board once every pair is loaded ...";
+      pair.lidar_failure = loading_.Settled() ? "finding the board ..."
+                                              : "finding the board once every pair is loaded ...";
   }
   ++state_.generation;
 }
 
-void Controller::Solve(bool asked) {
-  {
-    std::lock_guard lock(mutex_);
-    if (!state_.dataset || !job_) return;
-    state_.solver = SolverView{};
-    state_.solver.running = true;
-    ++state_.generation;
-  }
-  // The job's solve from what detection found: the CLI's steps after extraction (solve,
-  // camera-guided completion, the intrinsics' σ), watched iteration by iteration (its events).
-  CalibrationOutcome outcome = job_->Solve();
-  const PipelineOptions options = job_->options().advise.pipeline;
-  std::lock_guard lock(mutex_);
-  // An undo, redo or edit while it ran (the UI thread edits the record under mutex_, which the
-  // solve does not hold): its outcome answers a word that no longer stands. Written into the
-  // record it would undo the undo (the rejection back, its solve standing) or lose the edit.
-  // After an undo or redo the restored state stands with its own solve (Restore showed it, so
-  // the solver no longer shows this one running); after an edit the edits as they are now are
-  // solved again (auto-solve's, once; the user's Run). Else what it found goes into the record
-  // (an undo step of its own when asked; auto-solve's on the edit's).
-  if (!job_->CommitOutcome(/*own_step=*/asked)) {
-    const bool restored = !state_.solver.running;
-    state_.solver.running = false;
-    ++state_.generation;
-    if (restored) return;
-    if (asked)
-      worker_.Enqueue([this] { Solve(); });
-    else
-      RequestSolve();
-    return;
-  }
-  state_.solver.running = false;
-  if (!outcome.solution) {
-    state_.solver.iterations.clear();
-    state_.solver.failure = outcome.failure;
-    Publish();
-    const int usable = static_cast<int>(
-        std::count_if(outcome.pairs.begin(), outcome.pairs.end(), [](const PairFeatures& p) {
-          return p.status == PairStatus::kAccepted && p.lidar && p.camera;
-        }));
-    // Too few pairs yet is no error while a capture is followed: it says how many are needed.
-    if (!state_.watching.empty() && usable < options.min_pairs)
-      SetStatus("solving once " + std::to_string(options.min_pairs) + " pairs are usable (" +
-                    std::to_string(usable) + " so far)",
-                false);
-    else
-      SetStatus("no calibration: " + outcome.failure, true);
-    AfterEdit();  // after the line: a failed autosave says so there
-    return;
-  }
-  const SolverResult& result = *outcome.solution;
-  state_.solver.result = result;
-  state_.solver.solved_pair_ids.clear();
-  for (const PairFeatures& p : outcome.pairs)
-    if (p.status == PairStatus::kAccepted) state_.solver.solved_pair_ids.push_back(p.id);
-  // The summary's notes, as the job recorded them beside the result.
-  if (const Session record = job_->record().Current(); record.result)
-    state_.solver.notes = record.result->notes;
-  Publish();
-  guidance_.Judge(/*record=*/true);
-  SetStatus("solved with " + std::to_string(state_.solver.solved_pair_ids.size()) + " pairs in " +
-                std::to_string(result.iterations) + " iterations" +
-                (result.observability.well_constrained ? "" : " (NOT well constrained)"),
-            !result.observability.well_constrained);
-  AfterEdit();
-  const int selected = state_.selected;
-  if (selected >= 0) worker_.Enqueue([this, selected] { ComputeReprojection(selected); });
-  // Pre-flight and the next pose (the ghost board) from this solve.
-  worker_.Enqueue([this] { guidance_.Advise(); });
-}
-
-void Controller::ComputeReprojection(int index) {
-  std::shared_ptr<const LidarCloud> cloud;
-  std::optional<Pose> cam_from_lidar;
-  CameraModel camera;
-  ViewState view;
-  std::string id;
-  {
-    std::lock_guard lock(mutex_);
-    if (index < 0 || index >= static_cast<int>(state_.pairs.size()) || !state_.solver.result)
-      return;
-    cloud = state_.pairs.at(index).cloud;
-    cam_from_lidar = state_.solver.result->cam_from_lidar;
-    camera = state_.dataset->camera;
-    view = state_.view;
-    id = state_.pairs.at(index).id;
-  }
-  if (!cloud) return;
-  auto reprojection = ReprojectPair(camera, *cam_from_lidar, *cloud, view, id);
-  std::lock_guard lock(mutex_);
-  state_.reprojection = reprojection;
-  ++state_.generation;
-}
-
-void Controller::EnsureSelectedImage() {
-  std::filesystem::path path;
-  const std::shared_ptr<const ImageU8> image = LoadSelectedImageFile(&path);
-  if (!image) return;
-  CameraModel camera;
-  {
-    std::lock_guard lock(mutex_);
-    camera = state_.dataset->camera;
-  }
-  auto undistorted = std::make_shared<const UndistortedView>(Undistort(camera, *image));
-  std::lock_guard lock(mutex_);
-  if (!StillSelected(path)) return;
-  state_.selected_image = image;
-  state_.selected_image_pair = state_.pairs.at(state_.selected).id;
-  state_.selected_undistorted = undistorted;
-  ++state_.generation;
-  if (state_.rig && state_.rig->Several()) worker_.Enqueue([this] { rig_.LoadFrames(); });
-}
-
-bool Controller::ValidPair(int index) const {
-  return index >= 0 && index < static_cast<int>(state_.pairs.size());
-}
-
-template <>
-void Controller::Handle(const SelectPair& select) {
-  if (!ValidPair(select.index) || select.index == state_.selected) return;
-  // Following a capture: looking at an older pair stops following; the newest resumes it.
-  follow_newest_ = select.index + 1 == static_cast<int>(state_.pairs.size());
-  state_.selected = select.index;
-  state_.selected_image.reset();
-  state_.selected_undistorted.reset();
-  state_.reprojection.reset();
-  RecordView();
-  worker_.Enqueue([this] { EnsureSelectedImage(); });
-  const int index = select.index;
-  worker_.Enqueue([this, index] { ComputeReprojection(index); });
-}
-
-template <>
-void Controller::Handle(const SetPairStatus& status) {
-  if (!ValidPair(status.index)) return;
+void Controller::Review(const SetPairStatus& status) {
+  if (!state_.HasPair(status.index)) return;
   const PairView& pair = state_.pairs.at(status.index);
   if (status.status == PairStatus::kAccepted && !(pair.lidar && pair.camera)) {
     SetStatus("pair " + pair.id + " cannot be accepted: " +
@@ -221,99 +137,8 @@ void Controller::Handle(const SetPairStatus& status) {
   SetStatus("pair " + id + " " + PairStatusName(state_.pairs.at(status.index).status) +
                 (state_.solver.result && !state_.auto_solve ? "; press Run to re-solve" : ""),
             false);
-  AfterEdit();  // after the line: a failed autosave says so there
-  RequestSolve();
-}
-
-template <>
-void Controller::Handle(const RunSolver&) {
-  worker_.Enqueue([this] { Solve(); });
-}
-
-template <>
-void Controller::Handle(const ResetSolver&) {
-  state_.solver = SolverView{};
-  state_.reprojection.reset();
-  job_->record().Edit([](Session* session) { session->result.reset(); });
-  Publish();
-  guidance_.Judge(/*record=*/false);
-  AfterEdit();
-}
-
-template <>
-void Controller::Handle(const SetSettings& intent) {
-  const JobSettings& settings = intent.settings;
-  std::string why;
-  if (!settings.Check(&why)) {
-    SetStatus("solver options: " + why, true);
-    return;
-  }
-  const bool method_changed =
-      state_.settings.method != settings.method ||
-      state_.settings.estimate_range_offset != settings.estimate_range_offset;
-  state_.settings = settings;
-  // Into the job's record as the user set them (JobSettings::Apply reads them).
-  job_->SetSettings(settings);
-  AfterEdit();
-  // Residuals and weights shown for the current estimate depend on the method.
-  if (method_changed) Publish();
-}
-
-template <>
-void Controller::Handle(const SetView& view) {
-  const bool visibility_changed = view.view.visibility != state_.view.visibility ||
-                                  view.view.hpr_radius_exponent != state_.view.hpr_radius_exponent;
-  state_.view = view.view;
-  RecordView();
-  if (visibility_changed) {
-    const int index = state_.selected;
-    worker_.Enqueue([this, index] { ComputeReprojection(index); });
-  }
-}
-
-template <>
-void Controller::Handle(const ExportResult& export_result) {
-  if (!state_.solver.result) {
-    SetStatus("nothing to export: run the solver first", true);
-    return;
-  }
-  // What `calibench calibrate` writes: the pairs as they stand, the solution with the solver's
-  // residuals at it for the accepted ones.
-  const CalibrationOutcome outcome =
-      job_->OutcomeAt(*state_.solver.result, state_.solver.solved_pair_ids);
-  const std::filesystem::path path = NextToSession(state_, export_result.path);
-  try {
-    if (export_result.format) {
-      const ExportFrames& frames = export_result.frames;
-      std::string why;
-      if (!frames.Check(&why)) {
-        SetStatus("export: " + why, true);
-        return;
-      }
-      const std::string source =
-          state_.session_path.empty() ? "the workbench" : state_.session_path.filename().string();
-      WriteFileAtomically(path, ExportCalibration(*export_result.format,
-                                                  outcome.solution->cam_from_lidar, frames, source)
-                                    .text);
-      SetStatus("exported " + path.string() + " (" + ExportFormatName(*export_result.format) +
-                    "): the pose of '" + frames.child() + "' in '" + frames.parent() +
-                    "', camera frame " + CameraFrameName(frames.camera_frame),
-                false);
-      return;
-    }
-    if (!state_.solver.targetless_provenance.empty()) {
-      // An adopted targetless estimate: no board solve stands behind it, and the file says so.
-      WriteTargetlessResult(path, outcome.solution->cam_from_lidar, outcome.solution->covariance,
-                            outcome.solution->observability.weak_directions,
-                            state_.solver.targetless_provenance);
-      SetStatus("exported " + path.string() + " (the adopted targetless estimate)", false);
-      return;
-    }
-    WriteResult(path, outcome, state_.settings.Over(pipeline_).solver);
-    SetStatus("exported " + path.string(), false);
-  } catch (const IoError& e) {
-    SetStatus(e.what(), true);
-  }
+  session_.Edited();  // after the line: a failed autosave says so there
+  solve_.Request();
 }
 
 void Controller::Apply(const Intent& intent) {
@@ -323,7 +148,7 @@ void Controller::Apply(const Intent& intent) {
   // A stroke is its dabs; anything else in between ends it.
   if (!std::holds_alternative<BrushStroke>(intent) && !std::holds_alternative<PaintPoints>(intent))
     brush_.EndStroke();
-  // The tasks' intents to their tasks, the rest to the controller's own handlers.
+  // Each intent to the task that owns what it changes; accept/reject is the controller's own.
   std::visit(
       [this](const auto& what) {
         using What = std::decay_t<decltype(what)>;
@@ -335,6 +160,24 @@ void Controller::Apply(const Intent& intent) {
           brush_.DetectAgain(what);
         else if constexpr (std::is_same_v<What, EndStroke>)
           ;  // ended above, as by any intent but a dab
+        else if constexpr (std::is_same_v<What, Undo> || std::is_same_v<What, Redo>) {
+          const bool undo = std::is_same_v<What, Undo>;
+          if (std::optional<Session> restored = session_.Step(undo))
+            Restore(*restored, undo ? "undid" : "redid");
+        } else if constexpr (std::is_same_v<What, SaveSessionAs>)
+          session_.SaveAs(NextToSession(state_, what.path));
+        else if constexpr (std::is_same_v<What, SelectPair>)
+          view_.Select(what);
+        else if constexpr (std::is_same_v<What, SetView>)
+          view_.Set(what);
+        else if constexpr (std::is_same_v<What, RunSolver>)
+          solve_.Run();
+        else if constexpr (std::is_same_v<What, ResetSolver>)
+          solve_.Reset();
+        else if constexpr (std::is_same_v<What, SetSettings>)
+          solve_.Set(what);
+        else if constexpr (std::is_same_v<What, ExportResult>)
+          solve_.Export(what);
         else if constexpr (std::is_same_v<What, SetGoal>)
           guidance_.Apply(what);
         else if constexpr (std::is_same_v<What, EstimateIntrinsics>)
@@ -343,6 +186,8 @@ void Controller::Apply(const Intent& intent) {
           intrinsics_.Save(what);
         else if constexpr (std::is_same_v<What, RunCheck>)
           check_.Run(what);
+        else if constexpr (std::is_same_v<What, AdoptCheckEstimate>)
+          check_.Adopt();
         else if constexpr (std::is_same_v<What, PickBoard>)
           follow_.Pick(what);
         else if constexpr (std::is_same_v<What, SelectCamera>)
@@ -352,8 +197,10 @@ void Controller::Apply(const Intent& intent) {
             StartRigSolve();
           else
             SetStatus("not a rig: there is one camera", true);
-        } else
-          Handle(what);
+        } else {
+          static_assert(std::is_same_v<What, SetPairStatus>, "an intent nobody handles");
+          Review(what);
+        }
       },
       intent);
 }

@@ -26,7 +26,10 @@
 #include "ui/lidar_camera/guidance_task.h"
 #include "ui/lidar_camera/intents.h"
 #include "ui/lidar_camera/intrinsics_task.h"
+#include "ui/lidar_camera/loading_task.h"
 #include "ui/lidar_camera/rig_task.h"
+#include "ui/lidar_camera/solve_task.h"
+#include "ui/lidar_camera/view_task.h"
 #include "ui/state/session_opening.h"
 #include "ui/state/view_state.h"
 
@@ -86,41 +89,11 @@ class Controller : public ControllerState<Snapshot> {
   void StopWatching();
   // Waits for the rig solve's steps (tests, renders).
   void WaitRig() { rig_.Wait(); }
-  // One pair more, loaded and detected on the worker (a watched folder; any thread).
-  void AddPair(const PairEntry& entry);
 
  private:
-  // Follows the request's source as `watch` does (FollowTask); the capture followed before stops
-  // first.
-  void Follow(const CaptureFollowRequest& request);
   // The session an earlier watch left, when its pairs are the first of `dataset`'s (a capture that
   // grew while the workbench was closed, a recording read again): opened over them, edits kept.
   bool ResumeGrownCapture(Dataset dataset);
-  // Enqueues a solve unless one is queued (auto-solve; mutex_ held).
-  void RequestSolve();
-  void LoadPair(int index);
-  // After the last pair loaded (mutex_ held): detection, the status line with what loading
-  // noted or refused, the reopened session's reprojection.
-  void OnAllPairsLoaded();
-  // All pairs loaded, or in a followed capture those it opened with (mutex_ held).
-  bool PairsSettled() const;
-  // A followed capture's views move to its newest pair `index` once loaded (mutex_ held).
-  bool FollowsTo(int index) const;
-  void OnLivePairLoaded(int index);  // LoadPair's part for a followed capture (mutex_ held)
-  // After pair `index` loaded (mutex_ held): its board refitted from its brush or seed (true:
-  // now, by the caller, as the selected pair), or left to detection.
-  bool ScheduleBoard(int index);
-  void RefitLidar(int index);
-  // The background model over the loaded clouds, then detection where no seed or brush is.
-  void DetectWithBackground();
-  // `asked`: the user's Run, an undo step of its own; otherwise auto-solve's, on the same undo
-  // step as the edit that asked for it (undoing a rejection undoes its solve too).
-  void Solve(bool asked = true);
-  void ComputeReprojection(int index);
-  // Writes the session if it changed; a failure goes to the status line in the warning colour
-  // (and is retried at the next change). Call with mutex_ held.
-  void Autosave();
-  void EnsureSelectedImage();
   // The job's record of every pair into the view (PairRecord, whole), with the residuals at the
   // solution shown. Call with mutex_ held.
   void Publish();
@@ -128,13 +101,7 @@ class Controller : public ControllerState<Snapshot> {
   // SetRejected, SetBrush and SetSettings, the record's Edit for the view and a reset solve;
   // what followed from them (statuses, completion, the solve) the job records beside them, and
   // the view shows the job's pairs (Publish); undo restores the view from the record
-  // (ShowSession). Then AfterEdit: the undo buttons, autosave, a new generation. Call these with
-  // mutex_ held.
-  void AfterEdit();
-  // The view (the selected pair, the camera, visibility) into the record: saved with the session,
-  // no undo step (undo steps through edits only).
-  void RecordView();
-  std::string ViewJson();  // state_'s view, its selected pair's id set, as the session keeps it
+  // (ShowSession). Then session_.Edited(): the undo buttons, autosave, a new generation.
   // A session's view, settings and solve shown, its pairs as the job holds them (Open, undo,
   // redo); call with mutex_ held.
   void ShowSession(const Session& session);
@@ -143,65 +110,33 @@ class Controller : public ControllerState<Snapshot> {
   // `note` (how the session came to be opened) joins the status line once the pairs have loaded.
   void Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
             const std::string& note, std::optional<FileLock> lock);
-  void OpenSessionFile(const std::filesystem::path& session, const std::string& note,
-                       std::optional<FileLock>* lock);
-  // Locks `session` for this controller (kept when it holds that lock already). Throws IoError
-  // when another process holds it; *note says so when the folder cannot hold a lock file.
-  std::optional<FileLock> LockSession(const std::filesystem::path& session, std::string* note);
 
-  // One handler per intent type, each an explicit specialization declared after the class and
-  // defined by concern in controller*.cpp (Apply visits them with mutex_ held).
-  template <typename IntentType>
-  void Handle(const IntentType& intent);
-  bool ValidPair(int index) const;
-  // Undo / redo (`what`: "undid" / "redid", for the status line).
-  void Restore(const std::optional<Session>& restored, const std::string& what);
+  // SetPairStatus: the user's accept or reject into the job's record, then shown and solved again
+  // (auto-solve); refused when the pair lacks a plane to accept. Mutex held.
+  void Review(const SetPairStatus& status);
+  // Undo / redo's session shown (`what`: "undid" / "redid", for the status line).
+  void Restore(const Session& restored, const std::string& what);
 
-  std::optional<FileLock> session_lock_;  // held while session_path is open for editing
   // The options the workbench was started with; the session's settings (state_.settings, the
   // record's) apply over them: JobSettings::Over.
   PipelineOptions pipeline_;
-  std::string open_note_;  // how the session was opened, for the status line once loaded (mutex_)
-  std::vector<std::string> load_warnings_;  // what loading refused, for the status line (mutex_)
   // The pipeline job (core/session/calibration_job.h) over the opened dataset: detection with
   // the background, the solve, guidance, and the session's one record (the user's word, undo,
   // autosave), which state_ mirrors for the panels. Its steps run on the worker; its record is
   // edited under mutex_ (it locks itself too). Made anew by Open, after WaitIdle.
   std::optional<CalibrationJob> job_;
-  bool solve_queued_ = false;         // mutex_
-  bool follow_newest_ = true;         // a followed capture's views move to each new pair (mutex_)
-  bool opened_pairs_loaded_ = false;  // every pair Open started with has loaded (mutex_)
+  // The open session's file, lock, autosave, undo and redo (both workbenches', session_opening.h).
+  EditedSession<Snapshot> session_;
+  ViewTask view_;  // what the views show of the selected pair
   // The tasks Apply routes intents to, each owning its own fields (TaskHost).
   BrushTask brush_;
   GuidanceTask guidance_;
+  SolveTask solve_;
+  LoadingTask loading_;
   RigTask rig_;
   CheckTask check_;
   IntrinsicsTask intrinsics_;
   FollowTask follow_;
 };
-
-// The handlers (controller.cpp, controller_pairs.cpp, controller_session.cpp).
-template <>
-void Controller::Handle(const SelectPair&);
-template <>
-void Controller::Handle(const SetPairStatus&);
-template <>
-void Controller::Handle(const RunSolver&);
-template <>
-void Controller::Handle(const ResetSolver&);
-template <>
-void Controller::Handle(const SetSettings&);
-template <>
-void Controller::Handle(const SetView&);
-template <>
-void Controller::Handle(const ExportResult&);
-template <>
-void Controller::Handle(const SaveSessionAs&);
-template <>
-void Controller::Handle(const Undo&);
-template <>
-void Controller::Handle(const Redo&);
-template <>
-void Controller::Handle(const AdoptCheckEstimate&);  // controller_check.cpp
 
 }  // namespace calibench::ui

@@ -1,6 +1,6 @@
-// The controller's session lifecycle: opening a dataset or a session (lock, backup, resume),
-// the session mirrored into the view state, committing edits to the undo history, autosave,
-// save-as, undo and redo.
+// The controller's session lifecycle: opening a dataset or a session (its file, lock, backup and
+// resume are EditedSession's, ui/state/session_opening.h), the session shown in the view state,
+// the view recorded, save-as, and what undo and redo restored shown.
 #include <algorithm>
 #include <cmath>
 
@@ -61,8 +61,8 @@ void Controller::OpenLoadedDataset(const Dataset& dataset, std::filesystem::path
   if (session_path.empty())
     session_path = DefaultSessionPath(dataset.manifest, dataset.camera_name);
   std::optional<SessionWithDataset> resumed;
-  OpenedSessionFile file = OpenSessionFileBeside(
-      session_path, existing, session_lock_, [&](const std::filesystem::path& candidate) {
+  OpenedSessionFile file =
+      session_.OpenBeside(session_path, existing, [&](const std::filesystem::path& candidate) {
         resumed = LoadSessionWithDataset(candidate);
         // As Open will read them: it opens.
         ReadViewAndRig(resumed->session, resumed->dataset, candidate);
@@ -81,19 +81,9 @@ void Controller::OpenSession(const std::filesystem::path& session_path, bool sav
     return;
   }
   std::string note;
-  std::optional<FileLock> lock = LockSession(session_path, &note);
-  OpenSessionFile(session_path, note, &lock);
-}
-
-std::optional<FileLock> Controller::LockSession(const std::filesystem::path& session,
-                                                std::string* note) {
-  return LockSessionFile(session, session_lock_, note);
-}
-
-void Controller::OpenSessionFile(const std::filesystem::path& session_path, const std::string& note,
-                                 std::optional<FileLock>* lock) {
+  std::optional<FileLock> lock = session_.Lock(session_path, &note);
   auto [session, dataset] = LoadSessionWithDataset(session_path);
-  Open(dataset, std::move(session), session_path, note, std::move(*lock));
+  Open(dataset, std::move(session), session_path, note, std::move(lock));
 }
 
 void Controller::Open(const Dataset& dataset, Session session, std::filesystem::path session_path,
@@ -106,10 +96,6 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
   WaitIdle();
   {
     std::lock_guard lock(mutex_);
-    if (session_lock)
-      session_lock_ = std::move(session_lock);
-    else if (session_path.empty() || !session_lock_ || session_lock_->locked() != session_path)
-      session_lock_.reset();
     // What the window set up outlives the dataset: auto-solve, the capture followed.
     Snapshot opened;
     opened.auto_solve = state_.auto_solve;
@@ -117,19 +103,9 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     state_ = std::move(opened);
     state_.dataset = dataset;
     state_.dataset_path = dataset.manifest;
-    state_.session_path = session_path;
     std::vector<PairView> pairs(dataset.pairs.size());
     for (size_t i = 0; i < dataset.pairs.size(); ++i) pairs[i].id = dataset.pairs[i].id;
     state_.pairs = SharedPairs<PairView>(std::move(pairs));
-    state_.loading_total = static_cast<int>(dataset.pairs.size());
-    load_warnings_.clear();
-    opened_pairs_loaded_ = dataset.pairs.empty();
-    open_note_ = note;
-    if (!dataset.missing_target_file.empty())
-      open_note_ += (note.empty() ? "" : "; ") + std::string("no ") +
-                    dataset.missing_target_file.string() +
-                    ": no board to find in these pairs (the targetless check needs none: "
-                    "Targetless check... in the solver panel)";
     // The pipeline job over the dataset's pairs as they load (LoadPair appends them), with the
     // session's options and the session as its record; every solver iteration shows as it
     // happens.
@@ -146,25 +122,11 @@ void Controller::Open(const Dataset& dataset, Session session, std::filesystem::
     };
     job_.emplace(std::move(setup), job_options, PairEdits{}, std::move(events));
     job_->Resume(session);
-    job_->record().AutosaveTo(session_path);
+    session_.Attach(&job_->record(), session_path, std::move(session_lock));
     ShowSession(session);
     if (!rig_.SetUp(rig, rig_camera)) StartRigSolve();
-    SetStatus("loading " + std::to_string(dataset.pairs.size()) + " pairs from " +
-                  dataset.manifest.string(),
-              false);
+    loading_.Start(note);
   }
-  // The selected pair and its image first, so that it is on screen while the others load.
-  int first = 0;
-  {
-    std::lock_guard lock(mutex_);
-    first = std::max(0, state_.selected);
-  }
-  if (!dataset.pairs.empty()) {
-    worker_.Enqueue([this, first] { LoadPair(first); });
-    worker_.Enqueue([this] { EnsureSelectedImage(); });
-  }
-  for (int i = 0; i < static_cast<int>(dataset.pairs.size()); ++i)
-    if (i != first) worker_.Enqueue([this, i] { LoadPair(i); });
 }
 
 void Controller::ShowSession(const Session& session) {
@@ -198,72 +160,13 @@ void Controller::ShowSession(const Session& session) {
         state_.solver.iterations[k].reweighted = true;
   }
   Publish();  // the pairs as the job holds them, with residuals at that solve
-  state_.can_undo = job_ && job_->record().CanUndo();
-  state_.can_redo = job_ && job_->record().CanRedo();
-}
-
-std::string Controller::ViewJson() {
-  mutex_.AssertHeld(__func__);
-  const bool had_selected =
-      state_.selected >= 0 && state_.selected < static_cast<int>(state_.pairs.size());
-  state_.view.selected_pair = had_selected ? state_.pairs.at(state_.selected).id : "";
-  return ViewToJson(state_.view);
-}
-
-void Controller::RecordView() {
-  mutex_.AssertHeld(__func__);
-  if (!job_) return;
-  const std::string view = ViewJson();
-  job_->record().Edit([&](Session* session) { session->view_json = view; }, /*amend=*/true);
-  AfterEdit();
-}
-
-void Controller::AfterEdit() {
-  mutex_.AssertHeld(__func__);
-  state_.can_undo = job_->record().CanUndo();
-  state_.can_redo = job_->record().CanRedo();
-  Autosave();
-  ++state_.generation;
-}
-
-void Controller::Autosave() { AutosaveRecord(job_ ? &job_->record() : nullptr); }
-
-template <>
-void Controller::Handle(const SaveSessionAs& save) {
-  const std::filesystem::path path = NextToSession(state_, save.path);
-  try {
-    std::string note;
-    std::optional<FileLock> lock = LockSession(path, &note);  // throws when another has it open
-    if (!job_) throw IoError("no session to save: open a dataset first");
-    job_->record().SaveAs(path);
-    if (lock) session_lock_ = std::move(lock);
-    state_.session_path = path;
-    state_.save_error.clear();
-    SetStatus("saved session " + path.string(), false);
-  } catch (const IoError& e) {
-    state_.save_error = e.what();
-    SetStatus(e.what(), true);
-  }
-}
-
-template <>
-void Controller::Handle(const Undo&) {
-  if (job_) Restore(job_->record().Undo(), "undid");
-}
-template <>
-void Controller::Handle(const Redo&) {
-  if (job_) Restore(job_->record().Redo(), "redid");
 }
 
 // The record has restored it already, with the pairs that joined since that step as they are.
-void Controller::Restore(const std::optional<Session>& restored, const std::string& what) {
-  if (!restored) {
-    SetStatus("nothing to " + std::string(what == "undid" ? "undo" : "redo"), false);
-    return;
-  }
+void Controller::Restore(const Session& restored, const std::string& what) {
   std::vector<std::vector<int>> before;
   for (const PairView& p : state_.pairs) before.push_back(p.brush_pixels);
-  ShowSession(*restored);
+  ShowSession(restored);
   // The meter and the next pose belong to the solve restored (or to none): judged again, asked
   // again (not while following a capture, where Advise's pre-flight would edit the record).
   guidance_.Judge(/*record=*/false);
@@ -277,9 +180,10 @@ void Controller::Restore(const std::optional<Session>& restored, const std::stri
   state_.next_pose.reset();
   if (state_.solver.result && state_.watching.empty())
     worker_.Enqueue([this] { guidance_.AdviseFromState(); });
-  Autosave();
+  session_.Autosave();
   for (int i = 0; i < static_cast<int>(state_.pairs.size()); ++i)
-    if (state_.pairs.at(i).brush_pixels != before[i]) worker_.Enqueue([this, i] { RefitLidar(i); });
+    if (state_.pairs.at(i).brush_pixels != before[i])
+      worker_.Enqueue([this, i] { loading_.Refit(i); });
 }
 
 }  // namespace calibench::ui

@@ -129,6 +129,7 @@ struct Snapshot : SnapshotHeader {
   // Publish replaces (ui/state/shared_pairs.h); a snapshot copies a pointer.
   SharedPairs<PairView> pairs;
   int selected = -1;
+  bool HasPair(int index) const { return index >= 0 && index < static_cast<int>(pairs.size()); }
   std::shared_ptr<const ImageU8> selected_image;  // full-resolution camera image of `selected`
   std::shared_ptr<const UndistortedView> selected_undistorted;  // the same, distortion removed
   // The pair they show (a followed capture's last one until the newest pair's is decoded).

@@ -51,7 +51,8 @@ double PointToPlaneRms(const LrfPairFeatures& features, const Pose& cam_from_lrf
 
 }  // namespace
 
-LrfController::LrfController(LrfPipelineOptions options) : options_(std::move(options)) {
+LrfController::LrfController(LrfPipelineOptions options)
+    : options_(std::move(options)), session_(Host()) {
   state_.solver.method = options_.solver.method;
   state_.status_line = "open an LRF dataset manifest";
 }
@@ -103,7 +104,7 @@ void LrfController::Solve() {
   auto outcome = std::make_shared<LrfCalibrationOutcome>(job->Solve());
   std::lock_guard lock(mutex_);
   if (job != job_) return;  // another dataset opened while it solved
-  Autosave();               // the solve is the record's now
+  session_.Edited();        // the solve is the record's now
   LrfSolverView& solver = state_.solver;
   solver.running = false;
   if (!outcome->solution || !outcome->solution->ok) {
@@ -148,8 +149,6 @@ void LrfController::Restatus() {
       pair.reason = usable ? "" : FeatureFailure(*pair.features);
     }
   }
-  state_.can_undo = job_->record().CanUndo();
-  state_.can_redo = job_->record().CanRedo();
   ++state_.generation;
 }
 
@@ -172,7 +171,7 @@ void LrfController::LoadSelectedImage() {
   const std::shared_ptr<const ImageU8> image = LoadSelectedImageFile(&path);
   if (!image) return;
   std::lock_guard lock(mutex_);
-  if (!StillSelected(path)) return;
+  if (!StillSelected(state_, path)) return;
   state_.selected_image = image;
   ++state_.generation;
 }
@@ -196,7 +195,7 @@ void LrfController::Handle(const LrfSelectPair& select) {
   const std::string view =
       nlohmann::json{{"selected_pair", state_.pairs.at(select.index).id}}.dump();
   job_->record().Edit([&](Session* session) { session->view_json = view; }, /*amend=*/true);
-  Autosave();
+  session_.Autosave();
   if (state_.dataset->target_type == LrfTargetType::kCheckerboard)
     worker_.Enqueue([this] { LoadSelectedImage(); });
 }
@@ -212,7 +211,7 @@ void LrfController::Handle(const LrfSetPairStatus& status) {
   }
   job_->SetRejected(pair.id, status.status == PairStatus::kRejected);
   Restatus();
-  AfterEdit();
+  session_.Edited();
   SetStatus("pair " + pair.id + " " + PairStatusName(pair.status) +
                 (state_.solver.solution ? "; press Run to re-solve" : ""),
             false);
@@ -232,14 +231,14 @@ void LrfController::Handle(const LrfResetSolver&) {
   outcome_.reset();
   UpdatePairFigures();
   job_->record().Edit([](Session* session) { session->result.reset(); }, /*amend=*/true);
-  Autosave();
+  session_.Edited();
 }
 
 void LrfController::Handle(const LrfSetMethod& method) {
   if (method.method == state_.solver.method) return;
   state_.solver.method = method.method;
   job_->SetMethod(method.method);
-  AfterEdit();
+  session_.Edited();
   SetStatus("method " + LrfMethodName(method.method) + "; press Run to solve with it", false);
 }
 

@@ -120,8 +120,6 @@ class LrfController : public ControllerState<LrfSnapshot> {
   void Start(std::shared_ptr<const LrfDataset> dataset, std::optional<Session> saved,
              const std::filesystem::path& session_path, std::optional<FileLock> lock,
              const std::string& note);
-  void Autosave();   // call with mutex_ held; a failure shows, and is retried at the next edit
-  void AfterEdit();  // undo state and autosave after a record change (mutex_ held)
   bool Fail(const std::string& message);  // the status line says it; false
   // Pair `index` extracted by `job` (worker; the job of the Open that queued it).
   void Extract(LrfCalibrationJob* job, std::uint64_t open_count, int index);
@@ -130,7 +128,7 @@ class LrfController : public ControllerState<LrfSnapshot> {
   void UpdatePairFigures();  // call with mutex_ held
   // Every row's status from the one rule: rejected (with its reason) where the job's record says
   // so, else accepted when extraction gave what the solver needs, failed with the reason when
-  // not, pending before; and the undo buttons (mutex_ held). The rows never keep a status of
+  // not, pending before (mutex_ held). The rows never keep a status of
   // their own: an undo, an edit and an extraction all come here.
   void Restatus();
   bool ValidPair(int index) const;
@@ -144,14 +142,16 @@ class LrfController : public ControllerState<LrfSnapshot> {
   void Handle(const LrfExportResult& intent);
   void Handle(const LrfUndo& intent);
   void Handle(const LrfRedo& intent);
-  void Restore(const std::optional<Session>& restored, const char* what);
+  // Undo / redo's session shown (`what`: "undid" / "redid").
+  void Restore(const Session& restored, const char* what);
 
   LrfPipelineOptions options_;
   // The pipeline job over the open dataset (core/session/lrf_calibration_job.h), as
   // `lrf-calibrate` runs it: extraction and the solve, driven by the worker only; its record is
   // edited here too (it locks itself). Replaced by Open (mutex_ for the pointer).
   std::shared_ptr<LrfCalibrationJob> job_;
-  std::optional<FileLock> session_lock_;                  // held while the session is open here
+  // The open session's file, lock, autosave, undo and redo (both workbenches', session_opening.h).
+  EditedSession<LrfSnapshot> session_;
   std::shared_ptr<const LrfCalibrationOutcome> outcome_;  // of the shown solution, for export
   std::uint64_t open_count_ = 0;  // a job of an earlier Open() discards its result
 };

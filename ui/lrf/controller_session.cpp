@@ -1,6 +1,7 @@
 // The LRF controller's session lifecycle: opening a manifest (its session resumed, else its newest
-// backup that opens, else moved aside) or a session file, the record mirrored into the rows,
-// autosave, undo and redo. The record is the LRF job's (core/session/lrf_calibration_job.h).
+// backup that opens, else moved aside) or a session file, the record shown in the rows, undo and
+// redo shown. The record is the LRF job's (core/session/lrf_calibration_job.h); its file, lock and
+// autosave are EditedSession's (ui/state/session_opening.h).
 #include <nlohmann/json.hpp>
 
 #include "ui/lrf/controller.h"
@@ -34,15 +35,15 @@ bool LrfController::Open(const std::filesystem::path& manifest, ExistingSession 
   try {
     if (!options_.Check(&why)) throw IoError("LRF pipeline options: " + why);
     dataset = std::make_shared<const LrfDataset>(LoadLrfDataset(manifest));
-    file = OpenSessionFileBeside(
-        DefaultLrfSessionPath(dataset->manifest), existing, session_lock_,
-        [&](const std::filesystem::path& candidate) {
-          LrfSessionWithDataset opened = LoadLrfSessionWithDataset(candidate);
-          if (opened.session.dataset != NormalizeSessionPath(dataset->manifest))
-            throw IoError(candidate.string() + " is the session of " +
-                          opened.session.dataset.string());
-          saved = std::move(opened.session);
-        });
+    file =
+        session_.OpenBeside(DefaultLrfSessionPath(dataset->manifest), existing,
+                            [&](const std::filesystem::path& candidate) {
+                              LrfSessionWithDataset opened = LoadLrfSessionWithDataset(candidate);
+                              if (opened.session.dataset != NormalizeSessionPath(dataset->manifest))
+                                throw IoError(candidate.string() + " is the session of " +
+                                              opened.session.dataset.string());
+                              saved = std::move(opened.session);
+                            });
   } catch (const IoError& e) {
     return Fail(std::string("cannot open: ") + e.what());
   }
@@ -56,7 +57,7 @@ bool LrfController::OpenSession(const std::filesystem::path& session_path) {
   LrfSessionWithDataset opened;
   try {
     if (!options_.Check(&why)) throw IoError("LRF pipeline options: " + why);
-    lock = LockSessionFile(session_path, session_lock_, &note);
+    lock = session_.Lock(session_path, &note);
     opened = LoadLrfSessionWithDataset(session_path);
     note += std::string(note.empty() ? "" : "; ") + "opened the session " + session_path.string();
   } catch (const IoError& e) {
@@ -80,28 +81,23 @@ void LrfController::Start(std::shared_ptr<const LrfDataset> dataset, std::option
   {
     std::lock_guard guard(mutex_);
     open_count = ++open_count_;
-    if (lock)
-      session_lock_ = std::move(lock);
-    else if (!session_lock_ || session_lock_->locked() != session_path)
-      session_lock_.reset();
     const std::uint64_t generation = state_.generation;
     state_ = LrfSnapshot{};
     state_.generation = generation;
     state_.manifest = dataset->manifest;
     state_.dataset = dataset;
-    state_.session_path = session_path;
     state_.session_note = note;
     for (const LrfPairEntry& entry : dataset->pairs)
       state_.pairs.Edit().emplace_back().id = entry.id;
     state_.extracted_total = static_cast<int>(state_.pairs.size());
     outcome_.reset();
     job_ = job;
-    job_->record().AutosaveTo(session_path);
+    session_.Attach(&job_->record(), session_path, std::move(lock));
     const Session session = job_->record().Current();
     state_.solver.method = *ParseLrfMethod(session.lrf_method);
     Restatus();
     state_.selected = SelectedInView(session);
-    Autosave();
+    session_.Autosave();
     SetStatus((note.empty() ? "" : note + "; ") + "extracting features of " +
                   std::to_string(state_.pairs.size()) + " pairs from " + dataset->manifest.string(),
               false);
@@ -113,30 +109,20 @@ void LrfController::Start(std::shared_ptr<const LrfDataset> dataset, std::option
   if (resolve) worker_.Enqueue([this] { Solve(); });  // the same features and word: the same solve
 }
 
-void LrfController::Autosave() { AutosaveRecord(job_ ? &job_->record() : nullptr); }
-
-void LrfController::AfterEdit() {
-  mutex_.AssertHeld(__func__);
-  state_.can_undo = job_->record().CanUndo();
-  state_.can_redo = job_->record().CanRedo();
-  Autosave();
-  ++state_.generation;
+void LrfController::Handle(const LrfUndo&) {
+  if (std::optional<Session> restored = session_.Step(/*undo=*/true)) Restore(*restored, "undid");
+}
+void LrfController::Handle(const LrfRedo&) {
+  if (std::optional<Session> restored = session_.Step(/*undo=*/false)) Restore(*restored, "redid");
 }
 
-void LrfController::Handle(const LrfUndo&) { Restore(job_->record().Undo(), "undid"); }
-void LrfController::Handle(const LrfRedo&) { Restore(job_->record().Redo(), "redid"); }
-
-void LrfController::Restore(const std::optional<Session>& restored, const char* what) {
-  if (!restored) {
-    SetStatus(std::string("nothing to ") + (what[0] == 'u' ? "undo" : "redo"), false);
-    return;
-  }
-  state_.solver.method = *ParseLrfMethod(restored->lrf_method);
+void LrfController::Restore(const Session& restored, const char* what) {
+  state_.solver.method = *ParseLrfMethod(restored.lrf_method);
   Restatus();
-  Autosave();
+  session_.Autosave();
   // The solve shown is the restored state's: solved again from its word (the same features give
   // the same solve), or none when that state had none.
-  if (restored->result) {
+  if (restored.result) {
     state_.solver.running = true;
     worker_.Enqueue([this] { Solve(); });
   } else {

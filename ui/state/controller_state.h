@@ -47,6 +47,13 @@ struct TaskHost {
   }
 };
 
+// True while `path` is still the selected pair's image in `state` (a newer selection drops the
+// old image); with the controller's mutex held.
+template <typename Snapshot>
+bool StillSelected(const Snapshot& state, const std::filesystem::path& path) {
+  return state.selected >= 0 && state.dataset->pairs[state.selected].image == path;
+}
+
 // Snapshot derives from SnapshotHeader. A derived controller must call StopWorker() first in its
 // destructor: queued jobs touch the derived controller's members.
 template <typename Snapshot>
@@ -84,20 +91,6 @@ class ControllerState {
   void SetStatus(const std::string& message, bool error) { Host().SetStatus(message, error); }
   // What a task of the controller reaches (TaskHost).
   TaskHost<Snapshot> Host() { return {mutex_, state_, worker_}; }
-  // Writes the session record's autosave (a SessionRecord, core/session/session_record.h; none
-  // when null); a failure shows on the status line and in state_.save_error, and is retried at the
-  // next edit. Call with mutex_ held.
-  template <typename Record>
-  void AutosaveRecord(Record* record) {
-    mutex_.AssertHeld(__func__);
-    try {
-      if (record) record->Autosave();
-      state_.save_error.clear();
-    } catch (const IoError& e) {
-      state_.save_error = e.what();
-      SetStatus(std::string("autosave failed: ") + e.what(), true);
-    }
-  }
   // The selected pair's image, read on the worker: *path gets its file (empty when nothing with
   // an image is selected); nullptr with the status line set when the file cannot be read.
   std::shared_ptr<const ImageU8> LoadSelectedImageFile(std::filesystem::path* path) {
@@ -121,12 +114,6 @@ class ControllerState {
   void KeepDecodedImage(const std::filesystem::path& path, std::shared_ptr<const ImageU8> image) {
     decoded_image_path_ = path;
     decoded_image_ = std::move(image);
-  }
-  // True while `path` is still the selected pair's image (a newer selection drops the old
-  // image); call with mutex_ held.
-  bool StillSelected(const std::filesystem::path& path) const {
-    mutex_.AssertHeld(__func__);
-    return state_.selected >= 0 && state_.dataset->pairs[state_.selected].image == path;
   }
   // What else a failed job resets (with mutex_ held), before its message is shown.
   virtual void OnJobError() {}

@@ -1,4 +1,4 @@
-// The workbench's targetless check (ui/lidar_camera/controller_check.cpp) without a window: a
+// The workbench's targetless check (ui/lidar_camera/check_task.h) without a window: a
 // drive through a simulated textured room opened as a folder without a board; a calibration
 // turned by 1° checked from its file is judged miscalibrated, the estimate adopted comes back to
 // the truth with its provenance, exports as a targetless result, survives the session's reopening
