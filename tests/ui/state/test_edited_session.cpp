@@ -40,9 +40,9 @@ class EditedSessionTest : public ::testing::Test {
   }
 
   // A folder of each test's own.
-  const std::filesystem::path dir_ = test::TempDir(
-      std::string("edited_session_") +
-      ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  const std::filesystem::path dir_ =
+      test::TempDir(std::string("edited_session_") +
+                    ::testing::UnitTest::GetInstance()->current_test_info()->name());
   CheckedMutex mutex_;
   FakeSnapshot state_;
   WorkQueue worker_;
