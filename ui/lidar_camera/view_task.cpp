@@ -15,9 +15,7 @@ void ViewTask::Reproject(int index) {
   std::string id;
   {
     std::lock_guard lock(host_.mutex);
-    if (index < 0 || index >= static_cast<int>(host_.state.pairs.size()) ||
-        !host_.state.solver.result)
-      return;
+    if (!host_.state.HasPair(index) || !host_.state.solver.result) return;
     cloud = host_.state.pairs.at(index).cloud;
     cam_from_lidar = host_.state.solver.result->cam_from_lidar;
     camera = host_.state.dataset->camera;
