@@ -116,6 +116,7 @@ void Controller::Publish() {
       pair.lidar_failure = loading_.Settled() ? "finding the board ..."
                                               : "finding the board once every pair is loaded ...";
   }
+  view_.Frame(/*forced=*/false);  // the selected pair's cloud loaded or its board found
   ++state_.generation;
 }
 
@@ -170,7 +171,10 @@ void Controller::Apply(const Intent& intent) {
           view_.Select(what);
         else if constexpr (std::is_same_v<What, SetView>)
           view_.Set(what);
-        else if constexpr (std::is_same_v<What, RunSolver>)
+        else if constexpr (std::is_same_v<What, FrameView>) {
+          view_.Frame(/*forced=*/true);
+          view_.Record();
+        } else if constexpr (std::is_same_v<What, RunSolver>)
           solve_.Run();
         else if constexpr (std::is_same_v<What, ResetSolver>)
           solve_.Reset();

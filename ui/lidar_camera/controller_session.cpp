@@ -143,6 +143,7 @@ void Controller::ShowSession(const Session& session) {
   for (size_t i = 0; i < state_.pairs.size(); ++i)
     if (state_.pairs.at(i).id == state_.view.selected_pair) state_.selected = static_cast<int>(i);
   if (state_.selected < 0 && !state_.pairs.empty()) state_.selected = 0;
+  view_.Restored();
   state_.solver = SolverView{};
   if (session.result) {
     state_.solver.result = SolverResultFromSession(*session.result, session.settings.method);

@@ -55,6 +55,9 @@ struct SetSettings {  // the solver's settings and the LiDAR plane's RANSAC thre
 struct SetView {
   ViewState view;
 };
+// The 3D view turned onto the selected pair's board (its cloud before the board is found): the
+// F key and the view's "frame" button (ViewTask::Frame).
+struct FrameView {};
 // Writes the solution: a calibench result (no format), or a file a robot loads in one of the
 // export formats, with the frames named (core/results/export.h). A relative path goes next to
 // the session.
@@ -110,7 +113,7 @@ struct RunCheck {
 struct AdoptCheckEstimate {};
 using Intent =
     std::variant<SelectPair, SetPairStatus, BrushStroke, EndStroke, ClearBrush, DetectBoardAgain,
-                 PaintPoints, RunSolver, ResetSolver, SetSettings, SetView, ExportResult,
+                 PaintPoints, RunSolver, ResetSolver, SetSettings, SetView, FrameView, ExportResult,
                  SaveSessionAs, Undo, Redo, EstimateIntrinsics, SaveIntrinsics, SetGoal,
                  SelectCamera, SolveRig, PickBoard, RunCheck, AdoptCheckEstimate>;
 

@@ -35,6 +35,16 @@ class ViewTask {
   void Select(const SelectPair& select);
   // SetView: the view's settings; the reprojection again when visibility changed (mutex held).
   void Set(const SetView& view);
+  // The 3D view turned onto the selected pair (FramedOn): its board's inliers once the board is
+  // found, its cloud's bulk before. Done when the selection moves to another pair and again when
+  // what it is framed on improves (the cloud loaded, the board found: after each Publish), unless
+  // the user has turned the view since; always when `forced` (FrameView). Not an edit: the
+  // session records the orbit with the user's next change of the view. Mutex held.
+  void Frame(bool forced);
+  // The view restored from the session (open, undo, redo): an orbit of its own (saved by the
+  // user's turn, or as framed when recorded) is kept until the selection moves; the default
+  // one is framed. Mutex held.
+  void Restored();
   // The view (the selected pair, the camera, visibility) into the record, amending the current
   // step (mutex held).
   void Record();
@@ -46,6 +56,13 @@ class ViewTask {
  private:
   TaskHost<Snapshot> host_;
   Controls controls_;
+  // What the view was last framed on: the pair, how well (0 nothing, 1 its cloud, 2 its board),
+  // and the view as framed (a view that differs from it was turned by the user).
+  struct Framed {
+    std::string pair_id;
+    int quality = 0;
+    ViewState view;
+  } framed_;
 };
 
 }  // namespace calibench::ui

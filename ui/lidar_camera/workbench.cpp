@@ -48,6 +48,7 @@ void Workbench::HandleKeys(const Snapshot& s, std::vector<Intent>* intents) {
   const bool ctrl = ImGui::GetIO().KeyCtrl;
   if (ctrl && KeyPressed('Z')) intents->push_back(Undo{});
   if (ctrl && KeyPressed('Y')) intents->push_back(Redo{});
+  if (!ctrl && KeyPressed('F')) intents->push_back(FrameView{});
   ViewState view = s.view;
   if (KeyPressed('[')) view.brush_radius_px = std::max(1.0, view.brush_radius_px - 1);
   if (KeyPressed(']')) view.brush_radius_px = std::min(60.0, view.brush_radius_px + 1);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/lidar/colormap.h"
 #include "ui/lidar_camera/workbench.h"
@@ -35,6 +36,27 @@ ImageU8 ComposeLidarPicture(const PairView& pair, LidarChannel channel) {
             ? blend(pair.lidar_image->pixel_of_point[i], 40, 220, 255, 0.9f)
             : blend(pair.lidar_image->pixel_of_point[i], 255, 40, 220, 0.9f);
   return picture;
+}
+
+// The shares of the image's width (of 360 degrees) and of its rows the brush spans: the circle of
+// its columns less the widest gap between them (a board may straddle the left/right seam), and
+// its first to last row; zeros without a brush.
+std::pair<double, double> BrushShares(const PairView& pair) {
+  const LidarImage& image = *pair.lidar_image;
+  if (pair.brush_pixels.empty() || image.columns <= 0 || image.rows <= 0) return {0.0, 0.0};
+  std::vector<int> used;
+  int first_row = image.rows, last_row = -1;
+  for (int pixel : pair.brush_pixels) {
+    used.push_back(pixel % image.columns);
+    first_row = std::min(first_row, pixel / image.columns);
+    last_row = std::max(last_row, pixel / image.columns);
+  }
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  int widest_gap = used.front() + image.columns - used.back();  // across the seam
+  for (size_t i = 1; i < used.size(); ++i) widest_gap = std::max(widest_gap, used[i] - used[i - 1]);
+  return {static_cast<double>(image.columns - widest_gap + 1) / image.columns,
+          static_cast<double>(last_row - first_row + 1) / image.rows};
 }
 
 // What the composed picture depends on.
@@ -159,12 +181,23 @@ void Workbench::LidarPicture(const Snapshot& s, const PairView& pair,
   const LidarImage& image = *pair.lidar_image;
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const double vertical_rad = image.VerticalSpanRad();
-  if (lidar_zoom_ <= 0)  // fit: the rows fill the height
+  if (lidar_zoom_ <= 0) {  // fit: the rows fill the height
     lidar_zoom_ =
         vertical_rad > 0
             ? std::clamp(static_cast<float>(2 * M_PI * avail.y / (avail.x * vertical_rad)), 1.0f,
                          40.0f)
             : 3.0f;
+    // A ring-less cloud (a swept or non-repetitive scanner) is rasterised over all it saw, its
+    // rows as fine as its returns: the rows' fit can leave the board a sliver or crop it. The
+    // board then fills 60 % of the width, its rows at most 80 % of the height.
+    const auto [width_share, row_share] = BrushShares(pair);
+    if (pair.cloud && pair.cloud->ring.empty() && width_share > 0) {
+      double zoom = 0.6 / width_share;
+      if (vertical_rad > 0)
+        zoom = std::min(zoom, 0.8 * 2 * M_PI * avail.y / (avail.x * vertical_rad * row_share));
+      lidar_zoom_ = std::clamp(static_cast<float>(zoom), 1.0f, 40.0f);
+    }
+  }
   const float span = 1.0f / std::max(1.0f, lidar_zoom_);
   lidar_center_ = std::clamp(lidar_center_, span / 2, 1 - span / 2);
   float height = avail.y, v0 = 0.0f, v1 = 1.0f;

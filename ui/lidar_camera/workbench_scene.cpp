@@ -69,8 +69,13 @@ std::array<Vec3, 4> InlierExtent(const LidarCloud& cloud, const LidarPlaneFit& f
 }
 
 // "camera colours", the brush, and what the view shows otherwise; the mouse's use.
-void SceneToolbar(const Snapshot& s, bool* camera_colors, bool* brush, gfx::SceneLayers* layers) {
+void SceneToolbar(const Snapshot& s, bool* camera_colors, bool* brush, gfx::SceneLayers* layers,
+                  std::vector<Intent>* intents) {
   static const char* kColorings[] = {"intensity", "range", "ring"};
+  if (ImGui::SmallButton("frame [F]")) intents->push_back(FrameView{});
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("turn the view onto this pair's board (its cloud before the board is found)");
+  ImGui::SameLine();
   LayerToggles(layers);
   ImGui::SameLine();
   ImGui::Checkbox("camera colours", camera_colors);
@@ -152,7 +157,7 @@ void Workbench::SceneView(const Snapshot& s, const Rect& r, std::vector<Intent>*
   }
   const bool can_use_camera =
       s.reprojection && s.reprojection->pair_id == pair->id && s.selected_image && s.solver.result;
-  SceneToolbar(s, &scene_camera_colors_, &scene_brush_, &gl_->scene_layers);
+  SceneToolbar(s, &scene_camera_colors_, &scene_brush_, &gl_->scene_layers, intents);
   const ImVec2 avail = ImGui::GetContentRegionAvail();
   const int tw = std::max(1, static_cast<int>(avail.x)),
             th = std::max(1, static_cast<int>(avail.y));

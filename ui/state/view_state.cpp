@@ -89,4 +89,14 @@ ViewState ViewFromJson(const std::string& text, const std::filesystem::path& sou
   return v;
 }
 
+ViewState FramedOn(ViewState view, const std::array<double, 3>& center, double radius_m) {
+  view.orbit_target = center;
+  // Within 0.2 m of the LiDAR's z axis the bearing says nothing: the user's yaw stays.
+  if (std::hypot(center[0], center[1]) > 0.2) view.orbit_yaw_rad = std::atan2(center[1], center[0]);
+  // The orbit camera's vertical field of view is 0.9 rad (ui/widgets/orbit_camera.h): a sphere
+  // of radius r fills it from r / sin(0.45). Within the wheel's range (0.5 to 200 m).
+  view.orbit_distance_m = std::clamp(radius_m / std::sin(0.45), 0.5, 200.0);
+  return view;
+}
+
 }  // namespace calibench::ui

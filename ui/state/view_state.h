@@ -51,4 +51,10 @@ std::string ViewToJson(const ViewState& view);
 ViewState ViewFromJson(const std::string& text, const std::filesystem::path& source,
                        const std::vector<std::string>& pair_ids);
 
+// The 3D view's orbit turned onto `center` (LiDAR frame, metres): the target there, the eye on
+// the LiDAR's side of it (yaw along the LiDAR-to-centre bearing, whatever way the LiDAR's axes
+// point; kept when the centre lies above the LiDAR), far enough that a sphere of `radius_m` about
+// it fits the view's height. Pitch and everything else stay the user's.
+ViewState FramedOn(ViewState view, const std::array<double, 3>& center, double radius_m);
+
 }  // namespace calibench::ui

@@ -80,5 +80,24 @@ TEST(ViewState, AMalformedViewNamesTheFileAndTheField) {
   ExpectRejected("[1]", "must be a JSON object");
 }
 
+// FramedOn: the target on the centre, looking from the LiDAR's side (behind its x axis as in
+// front of it), as far as a sphere of the radius fills the 0.9 rad view; pitch and the rest kept.
+TEST(ViewState, FramingLooksAtTheCentreFromTheLidarsSide) {
+  ViewState view = EveryFieldSet();
+  const ViewState framed = FramedOn(view, {-1.5, 0.0, -0.4}, 1.0);
+  EXPECT_EQ(framed.orbit_target, (std::array<double, 3>{-1.5, 0.0, -0.4}));
+  EXPECT_NEAR(std::abs(framed.orbit_yaw_rad), M_PI, 1e-12);  // looking along -x
+  EXPECT_NEAR(framed.orbit_distance_m, 1.0 / std::sin(0.45), 1e-12);
+  EXPECT_EQ(framed.orbit_pitch_rad, view.orbit_pitch_rad);
+  EXPECT_EQ(framed.point_size_px, view.point_size_px);
+  EXPECT_EQ(framed.selected_pair, view.selected_pair);
+  EXPECT_NEAR(FramedOn(view, {0.0, 2.0, 0.0}, 1.0).orbit_yaw_rad, M_PI / 2, 1e-12);
+  // Straight above the LiDAR the bearing says nothing: the yaw stays; the distance is clamped.
+  const ViewState above = FramedOn(view, {0.05, 0.0, 3.0}, 1e4);
+  EXPECT_EQ(above.orbit_yaw_rad, view.orbit_yaw_rad);
+  EXPECT_EQ(above.orbit_distance_m, 200.0);
+  EXPECT_EQ(FramedOn(view, {1.0, 0.0, 0.0}, 0.01).orbit_distance_m, 0.5);
+}
+
 }  // namespace
 }  // namespace calibench::ui
