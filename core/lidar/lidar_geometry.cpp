@@ -209,4 +209,47 @@ LidarGeometryVerdict ClassifyLidarGeometry(const LidarCloud& cloud,
   return verdict;
 }
 
+bool LidarModelEvidenceOptions::Check(std::string* why) const {
+  auto fail = [&](const char* message) {
+    if (why) *why = message;
+    return false;
+  };
+  if (folds < 2) return fail("lidar model evidence: folds must be >= 2");
+  if (min_pairs < 3) return fail("lidar model evidence: min_pairs must be >= 3");
+  if (!(tie_ratio >= 1)) return fail("lidar model evidence: tie_ratio must be >= 1");
+  if (!(min_significance_z >= 0))
+    return fail("lidar model evidence: min_significance_z must be >= 0");
+  return true;
+}
+
+std::string LidarModelEvidence::Describe() const {
+  if (candidates.size() < 2) return "";
+  auto words = [](const LidarModelCandidate& c) {
+    return c.along_rays ? "ranges along rays (" + LidarGeometryName(c.geometry) + ")"
+                        : std::string("point-to-plane");
+  };
+  const LidarModelCandidate& best = candidates[0];
+  const LidarModelCandidate& other = candidates[1];
+  char text[600];
+  if (tie)
+    std::snprintf(text, sizeof(text),
+                  "The held-out pairs cannot tell %s from %s (%.2fx, %.1f standard "
+                  "errors, over %d pairs; median %.1f mm against %.1f mm): the cloud's look "
+                  "decides (%s)",
+                  words(best).c_str(), words(other).c_str(), margin, significance_z,
+                  best.heldout_pairs, best.heldout_rms_m * 1e3, other.heldout_rms_m * 1e3,
+                  LidarGeometryName(chosen).c_str());
+  else
+    std::snprintf(text, sizeof(text),
+                  "Chosen by the held-out pairs: %s, their boards %.2fx closer to its "
+                  "planes than with %s (%.1f standard errors, over %d pairs; median %.1f mm "
+                  "against %.1f mm)",
+                  words(best).c_str(), margin, words(other).c_str(), significance_z,
+                  best.heldout_pairs, best.heldout_rms_m * 1e3, other.heldout_rms_m * 1e3);
+  std::string out = text;
+  if (switched_pairs > 0)
+    out += "; " + std::to_string(switched_pairs) + " pair(s) refitted against the cloud's look";
+  return out;
+}
+
 }  // namespace calibench

@@ -13,6 +13,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/lidar/cloud.h"
 
@@ -58,6 +59,46 @@ struct LidarGeometryVerdict {
   LidarGeometry geometry = LidarGeometry::kSpinning;
   std::string why;      // what in the cloud decided it, in words
   bool forced = false;  // chosen by the user (--lidar-model), not from the cloud
+};
+
+// The model chosen by the data (core/lidar_camera/lidar_model_evidence.h): its options and what it
+// found.
+struct LidarModelEvidenceOptions {
+  bool enabled = true;  // ring-less clouds' pairs fitted under both models and cross-validated
+  int folds = 5;        // cross-validation folds over the usable pairs (at most one per pair)
+  // Fewer usable pairs with both fits than this: the classifier's model stands (said so).
+  int min_pairs = 6;
+  // The models are told apart when the held-out pairs' log-ratio of their errors is this many
+  // standard errors from 0 (a paired z) and their geometric mean ratio is at least tie_ratio;
+  // otherwise the data cannot tell them apart: the look's model stands, and the summary says so.
+  double min_significance_z = 2.0;
+  double tie_ratio = 1.05;
+  bool Check(std::string* why) const;
+};
+
+struct LidarModelCandidate {
+  LidarGeometry geometry = LidarGeometry::kSegment;  // as the pairs' fits name it
+  bool along_rays =
+      false;  // ranges along rays (from an origin given or estimated), or point-to-plane
+  // The median over held-out pairs of their board corners' RMS distance to the LiDAR plane moved
+  // into the camera by the solve without them (metres); +inf when a fold could not be solved.
+  double heldout_rms_m = 0.0;
+  int heldout_pairs = 0;
+};
+
+struct LidarModelEvidence {
+  // The criterion in words, as the result file's lidar_model.evidence.criterion.
+  std::string criterion;
+  std::vector<LidarModelCandidate> candidates;  // the winner first
+  // The loser's held-out error over the winner's, the geometric mean over the held-out pairs
+  // (>= 1), and how many standard errors its log is from 0.
+  double margin = 1.0;
+  double significance_z = 0.0;
+  bool tie = false;  // below min_significance_z or tie_ratio: the data could not tell them apart
+  LidarGeometry chosen = LidarGeometry::kSegment;
+  int switched_pairs = 0;  // pairs holding the held-out pairs' choice against their cloud's look
+  // The summary's sentence ("ranges along rays: held-out boards 1.9x closer than ...").
+  std::string Describe() const;
 };
 
 LidarGeometryVerdict ClassifyLidarGeometry(const LidarCloud& cloud,

@@ -12,12 +12,14 @@
 #include "core/io/image_io.h"
 #include "core/lidar/cloud.h"
 #include "core/lidar_camera/joint_intrinsics.h"
+#include "core/lidar_camera/lidar_model_evidence.h"
 
 namespace calibench {
 
 bool PipelineOptions::Check(std::string* why) const {
   if (!lidar_plane.Check(why) || !detection.Check(why) || !pnp.Check(why) || !solver.Check(why) ||
-      !board_detection.Check(why) || !lidar_geometry.Check(why) || !swept_origin.Check(why))
+      !board_detection.Check(why) || !lidar_geometry.Check(why) || !swept_origin.Check(why) ||
+      !lidar_model_evidence.Check(why))
     return false;
   if (!(guided_max_sigmas > 0 && guided_floor_sigma_deg >= 0 && guided_floor_sigma_m >= 0)) {
     if (why) *why = "guided_max_sigmas must be > 0 and the guided floors >= 0";
@@ -57,18 +59,14 @@ LidarPlaneOptions LidarPlaneOptionsFor(const PipelineOptions& options, const Boa
 
 PlanePair MakePlanePair(const std::string& id, const LidarPlaneFit& lidar,
                         const CameraBoardObservation& camera) {
-  return {id,
-          lidar.plane,
-          camera.plane,
-          lidar.lidar_model.geometry == LidarGeometry::kSegment
+  return {id, lidar.plane, camera.plane,
+          // A ring-less crop's ring biases found in its elevations (whatever model fits it); a
+          // spinning scan's rings enter the solve through their edges and the gate instead.
+          lidar.lidar_model.geometry != LidarGeometry::kSpinning
               ? Mat4(lidar.covariance + lidar.ring_bias_covariance)
               : lidar.covariance,
-          camera.plane_covariance,
-          lidar.range_offset_jacobian,
-          lidar.edge_points,
-          camera.cam_from_board,
-          0.5 * lidar.sheet_size_m,
-          camera.pose_covariance};
+          camera.plane_covariance, lidar.range_offset_jacobian, lidar.edge_points,
+          camera.cam_from_board, 0.5 * lidar.sheet_size_m, camera.pose_covariance};
 }
 
 std::optional<PairInputs> LoadPairInputs(const Dataset& dataset, const PairEntry& pair,
@@ -171,6 +169,7 @@ std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const 
   else
     model = ClassifyLidarGeometry(cloud, options.lidar_geometry);
   plane_options.geometry = model.geometry;
+  plane_options.board_only_crop = model.geometry == LidarGeometry::kSegment;
   // A swept scan's rays start on a mirror the stage turns: where the cloud does not say, the
   // estimate from the scan gives each return its ray (never the origin, assumed).
   std::optional<LidarCloud> with_rays;
@@ -187,6 +186,19 @@ std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const 
   auto fit = FitBoardPlane(with_rays ? *with_rays : cloud, region, plane_options, &fit_failure);
   if (fit) {
     fit->lidar_model = model;
+    // A ring-less cloud's look cannot say how its rays run: the other candidate model's fit of
+    // the same region too, for the data to choose between (ChooseLidarModelByEvidence).
+    if (!options.lidar_model && !cloud.HasRing() && options.lidar_model_evidence.enabled) {
+      const bool along_rays = RaysFromOrigin(model.geometry) || fit->range_moments.count > 0;
+      LidarPlaneOptions other = plane_options;
+      other.geometry = along_rays ? LidarGeometry::kSegment : LidarGeometry::kNonRepetitive;
+      std::string other_failure;
+      if (auto alternative = FitBoardPlane(cloud, region, other, &other_failure)) {
+        // Said only where the held-out pairs choose it over the cloud's look.
+        alternative->lidar_model = {other.geometry, kChosenByHeldOutPairs + model.why, false};
+        fit->alternative = std::make_shared<const LidarPlaneFit>(std::move(*alternative));
+      }
+    }
     return fit;
   }
   *why = "LiDAR: " + fit_failure;
@@ -364,6 +376,12 @@ CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,
   std::vector<PlanePair> planes;
   for (PairFeatures& p : outcome.pairs) {
     if (p.status == PairStatus::kPending && p.lidar && p.camera) p.status = PairStatus::kAccepted;
+  }
+  // A ring-less LiDAR's model, as its pairs' held-out boards choose it.
+  if (options.lidar_model_evidence.enabled)
+    outcome.lidar_model_evidence =
+        ChooseLidarModelByEvidence(&outcome.pairs, options, options.lidar_model_evidence);
+  for (const PairFeatures& p : outcome.pairs) {
     if (p.status != PairStatus::kAccepted) continue;
     planes.push_back(MakePlanePair(p.id, *p.lidar, *p.camera));
   }

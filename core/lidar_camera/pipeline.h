@@ -38,6 +38,9 @@ struct PipelineOptions {
   // (ClassifyLidarGeometry) unless the user forces one (--lidar-model).
   std::optional<LidarGeometry> lidar_model;
   LidarGeometryOptions lidar_geometry;
+  // A ring-less cloud's pairs fitted under both candidate models and the one their held-out
+  // boards support kept (core/lidar_camera/lidar_model_evidence.h); not with lidar_model.
+  LidarModelEvidenceOptions lidar_model_evidence;
   // A swept cloud without viewpoints: where its rays start, estimated from the scan
   // (core/lidar/swept_origin.h), its planes then fitted along them.
   SweptOriginOptions swept_origin;
@@ -220,6 +223,9 @@ struct CalibrationOutcome {
   // (`calibrate --estimate-intrinsics`), for the result file to say so; absent when a camera
   // file gave them.
   std::optional<IntrinsicsResult> estimated_intrinsics;
+  // How the data chose a ring-less LiDAR's noise model (ChooseLidarModelByEvidence); absent when
+  // they were not asked (rings, a forced model, too few pairs).
+  std::optional<LidarModelEvidence> lidar_model_evidence;
 };
 // The outcome's pairs accepted for the solve.
 int AcceptedPairs(const CalibrationOutcome& outcome);

@@ -22,6 +22,8 @@ struct ModelGroup {
   // A model without rays from the origin whose planes were fitted along each return's own ray
   // (the cloud carried viewpoints): FitPlaneRangeMl alone fills a fit's range sums.
   bool given_rays = false;
+  // Board-only crops fitted along the rays (the held-out pairs chose them over point-to-plane).
+  bool crop = false;
 };
 
 std::vector<ModelGroup> GroupByLidarModel(const CalibrationOutcome& outcome) {
@@ -35,11 +37,15 @@ std::vector<ModelGroup> GroupByLidarModel(const CalibrationOutcome& outcome) {
       it = groups.insert(groups.end(), {model.geometry, {}, model.why, model.forced});
     it->pairs.push_back(p.id);
     it->given_rays |= !RaysFromOrigin(model.geometry) && p.lidar->range_moments.count > 0;
+    it->crop |= p.lidar->no_edge_search.rfind("the cloud is a board-only crop", 0) == 0;
   }
   return groups;
 }
 
-std::string ModelMeaning(LidarGeometry geometry, bool given_rays) {
+std::string ModelMeaning(LidarGeometry geometry, bool given_rays, bool crop) {
+  if (crop && RaysFromOrigin(geometry))
+    return "planes fitted on the ranges along the rays of board-only crops: ring biases where "
+           "their elevations fall into rings, no board edges (a crop ends where it was cut)";
   if (given_rays)
     return "planes fitted on the ranges along each return's own ray (from the viewpoint the cloud "
            "gives it, or from the mirror's position estimated from the scan), no ring biases or "
@@ -95,11 +101,30 @@ json LidarModelJson(const CalibrationOutcome& outcome) {
       [](const ModelGroup& a, const ModelGroup& b) { return a.pairs.size() < b.pairs.size(); });
   json counts = json::object();
   for (const ModelGroup& g : groups) counts[LidarGeometryName(g.geometry)] = g.pairs.size();
-  return {{"geometry", LidarGeometryName(main.geometry)},
-          {"why", main.why},
-          {"forced", main.forced},
-          {"meaning", ModelMeaning(main.geometry, main.given_rays)},
-          {"pairs", counts}};
+  json model = {{"geometry", LidarGeometryName(main.geometry)},
+                {"why", main.why},
+                {"forced", main.forced},
+                {"meaning", ModelMeaning(main.geometry, main.given_rays, main.crop)},
+                {"pairs", counts}};
+  if (const auto& e = outcome.lidar_model_evidence) {
+    json candidates = json::array();
+    for (const LidarModelCandidate& c : e->candidates)
+      candidates.push_back({{"geometry", LidarGeometryName(c.geometry)},
+                            {"along_rays", c.along_rays},
+                            {"heldout_rms_m", std::isfinite(c.heldout_rms_m) ? json(c.heldout_rms_m)
+                                                                             : json(nullptr)},
+                            {"heldout_pairs", c.heldout_pairs}});
+    model["evidence"] = {
+        {"criterion", e->criterion},
+        {"candidates", candidates},
+        {"chosen", LidarGeometryName(e->chosen)},
+        {"margin", std::isfinite(e->margin) ? json(e->margin) : json(nullptr)},
+        {"significance_z",
+         std::isfinite(e->significance_z) ? json(e->significance_z) : json(nullptr)},
+        {"tie", e->tie},
+        {"switched_pairs", e->switched_pairs}};
+  }
+  return model;
 }
 
 json LidarNoiseJson(const CalibrationOutcome& outcome) {
@@ -120,8 +145,10 @@ std::string DescribeLidarModel(const CalibrationOutcome& outcome) {
       for (size_t k = 0; k < g.pairs.size() && k < 5; ++k) text += (k ? ", " : "") + g.pairs[k];
       text += g.pairs.size() > 5 ? ", ...)" : ")";
     }
-    text += " (" + g.why + "): " + ModelMeaning(g.geometry, g.given_rays);
+    text += " (" + g.why + "): " + ModelMeaning(g.geometry, g.given_rays, g.crop);
   }
+  if (outcome.lidar_model_evidence && !text.empty())
+    text += ". " + outcome.lidar_model_evidence->Describe();
   return text;
 }
 

@@ -14,7 +14,8 @@ namespace {
 
 // v2: the LiDAR fits carry their ring-bias covariance, what their rings' ends showed and their
 // noise model. v4: their range residuals' sums (the LiDAR's noise is learned from them).
-constexpr const char* kFeatureCacheFormat = "calibench.features.v4";
+// v5: a ring-less cloud's fit under the other candidate model (LidarPlaneFit::alternative).
+constexpr const char* kFeatureCacheFormat = "calibench.features.v5";
 
 // A matrix as its rows, flattened row by row.
 template <typename Matrix>
@@ -84,6 +85,7 @@ json LidarToJson(const LidarPlaneFit& fit) {
   for (const LidarEdgePoint& e : fit.edge_points)
     edges.push_back({MatrixToJson(e.point), MatrixToJson(e.along_ring), e.sigma_along_m});
   return {
+      {"alternative", fit.alternative ? LidarToJson(*fit.alternative) : json(nullptr)},
       {"range_moments", MomentsToJson(fit.range_moments)},
       {"plane", PlaneToJson(fit.plane)},
       {"covariance", MatrixToJson(fit.covariance)},
@@ -134,6 +136,8 @@ LidarPlaneFit LidarFromJson(const json& j) {
   const auto geometry = ParseLidarGeometry(model.at(0).get<std::string>());
   if (!geometry) throw std::invalid_argument("unknown LiDAR model");
   fit.lidar_model = {*geometry, model.at(1).get<std::string>(), model.at(2).get<bool>()};
+  if (const json& other = j.at("alternative"); !other.is_null())
+    fit.alternative = std::make_shared<const LidarPlaneFit>(LidarFromJson(other));
   return fit;
 }
 

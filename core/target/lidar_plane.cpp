@@ -261,7 +261,11 @@ void AddBoardExtent(const LidarCloud& cloud, const LidarPlaneOptions& options, L
   const bool beam_path = options.geometry == LidarGeometry::kNonRepetitive;
   // Edge points need the whole board's returns (the ends of a brushed patch are not its edges)
   // and rings, or a beam's path, whose ends they are.
-  if (!spinning && !beam_path) {
+  if (options.board_only_crop) {
+    fit->no_edge_search =
+        "the cloud is a board-only crop: its returns end where the crop did, not at the sheet's "
+        "edges";
+  } else if (!spinning && !beam_path) {
     fit->no_edge_search =
         "the LiDAR model is " + LidarGeometryName(options.geometry) + ": no rings to end on it";
   } else if (fit->grown && options.sheet_size_m.minCoeff() > 0) {
@@ -282,7 +286,8 @@ void AddBoardExtent(const LidarCloud& cloud, const LidarPlaneOptions& options, L
   // plane as on the whole scan (the real ACFR segments scatter about twice their point-to-plane
   // σ without it; docs/results.md).
   const bool segment_with_rings =
-      options.geometry == LidarGeometry::kSegment && ElevationRings(cloud, fit->inliers) >= 3;
+      (options.geometry == LidarGeometry::kSegment || options.board_only_crop) &&
+      ElevationRings(cloud, fit->inliers) >= 3;
   if (options.ring_bias_sigma_m > 0 && (spinning || segment_with_rings))
     fit->ring_bias_covariance =
         RingBiasCovariance(cloud, fit->inliers, fit->plane, options.ring_bias_sigma_m);

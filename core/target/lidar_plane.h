@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -53,6 +54,10 @@ struct LidarPlaneOptions {
   // the rings' direction that is far less certain than its fit's residuals say
   // (LidarPlaneFit::ring_bias_covariance). 0 = none.
   double ring_bias_sigma_m = 0.005;
+  // The cloud is a board-only crop (judged a segment from its look), whatever model fits it: its
+  // returns end where the crop did, not at the sheet's edges (no edge points), and where their
+  // elevations fall into rings they carry the rings' range biases as a spinning scan's would.
+  bool board_only_crop = false;
   bool Check(std::string* why) const;
 };
 
@@ -85,6 +90,10 @@ struct LidarPlaneFit {
   LidarGeometryVerdict lidar_model;  // the noise model it was fitted with, and why
   double rms_m = 0.0;                // point-to-plane RMS of the inliers
   int num_rings = 0;  // distinct rings among the inliers (0 = the cloud has no rings)
+  // The same region fitted under the other candidate noise model (along rays / point-to-plane),
+  // for a ring-less cloud whose model the data choose (core/lidar_camera/lidar_model_evidence.h);
+  // null otherwise.
+  std::shared_ptr<const LidarPlaneFit> alternative;
 };
 
 // Points on rays within the cone that a disc of `seed.radius` (metres) around `seed.point`

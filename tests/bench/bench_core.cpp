@@ -84,6 +84,30 @@ const Dataset& SimulatedPair(LidarModel lidar) {
   return cache[lidar] = SimulateDataset(sim, BenchDir("pair_" + LidarModelName(lidar)));
 }
 
+// The solve of 15 ring-less pairs (a nodding scanner's board-only crops) with the LiDAR model
+// chosen by the held-out pairs (Arg 1: two candidates x 5 folds solved first) and without (Arg 0).
+void BM_SolveWithLidarModelEvidence(benchmark::State& state) {
+  static const std::vector<PairFeatures> features = [] {
+    SimOptions sim = SimPreset("default");
+    sim.lidar = LidarModel::kNodding2d;
+    sim.num_pairs = 15;
+    sim.min_distance_m = 0.9;
+    sim.max_distance_m = 1.4;
+    sim.lidar_range_noise_m = 0.01;
+    sim.board_only_clouds = true;
+    const Dataset dataset = SimulateDataset(sim, BenchDir("model_evidence"));
+    std::vector<PairFeatures> pairs;
+    for (const PairEntry& pair : dataset.pairs)
+      pairs.push_back(ExtractPairFeatures(dataset, pair, PipelineOptions{}));
+    return pairs;
+  }();
+  PipelineOptions options;
+  options.lidar_model_evidence.enabled = state.range(0) != 0;
+  state.SetLabel(options.lidar_model_evidence.enabled ? "evidence" : "the look's model");
+  for (auto _ : state) benchmark::DoNotOptimize(SolveFromFeatures(features, options));
+}
+BENCHMARK(BM_SolveWithLidarModelEvidence)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 void BM_LidarPlaneExtraction(benchmark::State& state) {
   const Dataset& dataset = SimulatedPair(static_cast<LidarModel>(state.range(0)));
   const LidarCloud cloud = LoadCloud(dataset.pairs[0].cloud);

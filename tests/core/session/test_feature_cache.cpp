@@ -1,5 +1,6 @@
 // The feature cache of `watch`: features read back are the features written, a line cut short by
-// a kill is ignored, and a pair whose file changed is detected again.
+// a kill is ignored, and a pair whose file changed is detected again; a ring-less cloud's fit
+// under the other candidate model comes back with it.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -68,6 +69,41 @@ TEST(FeatureCache, ReadsBackWhatItWroteAndDropsWhatNoLongerHolds) {
   EXPECT_EQ(read.count(dataset.pairs[1].id), 0u);
   EXPECT_EQ(skipped, 2);
   EXPECT_TRUE(LoadFeatureCache(dir / "none.jsonl").empty());
+}
+
+// A ring-less cloud's pair carries the other candidate model's fit
+// (LidarPlaneFit::alternative) for the held-out pairs to choose from: it comes back exactly, so a
+// session reopened chooses as the first run did.
+TEST(FeatureCache, AnAlternativeModelsFitComesBack) {
+  const fs::path dir = test::TempDir("feature_cache_alternative");
+  SimOptions sim = SimPreset("default");
+  sim.num_pairs = 1;
+  sim.board_only_clouds = true;
+  const Dataset dataset = SimulateDataset(sim, dir / "sim");
+  const PairFeatures written = ExtractPairFeatures(dataset, dataset.pairs[0], PipelineOptions{});
+  ASSERT_TRUE(written.lidar) << written.reason;
+  ASSERT_TRUE(written.lidar->alternative);
+  EXPECT_EQ(written.lidar->lidar_model.geometry, LidarGeometry::kSegment);
+  EXPECT_EQ(written.lidar->alternative->lidar_model.geometry, LidarGeometry::kNonRepetitive);
+  EXPECT_GT(written.lidar->alternative->range_moments.count, 0);
+  const fs::path cache = dir / "features.jsonl";
+  FeatureCacheWriter(cache).Append(dataset.pairs[0], written);
+  const auto read = LoadFeatureCache(cache);
+  ASSERT_EQ(read.size(), 1u);
+  const LidarPlaneFit& back = *read.at(dataset.pairs[0].id).features.lidar;
+  ASSERT_TRUE(back.alternative);
+  EXPECT_EQ(back.alternative->plane.Coefficients(),
+            written.lidar->alternative->plane.Coefficients());
+  EXPECT_EQ(back.alternative->covariance, written.lidar->alternative->covariance);
+  EXPECT_EQ(back.alternative->ring_bias_covariance,
+            written.lidar->alternative->ring_bias_covariance);
+  EXPECT_EQ(back.alternative->lidar_model.why, written.lidar->alternative->lidar_model.why);
+  EXPECT_EQ(back.alternative->range_moments.sum_z_e2,
+            written.lidar->alternative->range_moments.sum_z_e2);
+  // With a model the user forces there is nothing to choose: no alternative.
+  PipelineOptions forced;
+  forced.lidar_model = LidarGeometry::kSegment;
+  EXPECT_FALSE(ExtractPairFeatures(dataset, dataset.pairs[0], forced).lidar->alternative);
 }
 
 }  // namespace
