@@ -2,6 +2,9 @@
 // (core/targetless).
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
 
 #include "app/commands.h"
 #include "app/machine_stdout.h"
@@ -22,7 +25,7 @@ namespace calibench::app {
 namespace {
 
 struct CheckFlags {
-  std::string dataset, result, write_result, camera, views;
+  std::string dataset, result, guess, camera_frame, write_result, camera, views;
   int max_views = 6;
   bool json = false;
   CheckOptions check;
@@ -35,9 +38,17 @@ void AddCheckFlags(CLI::App& app, CheckFlags& f) {
                    "not used)")
       ->required();
   app.add_option("--result,-r", f.result,
-                 "the calibration to check: a calibench.result.v1 file, or a session with a "
-                 "result")
-      ->required();
+                 "the calibration to check: a calibench.result.v1 file, a session with a "
+                 "result, or any export (URDF, TF, Autoware, OpenCV YAML, Kalibr, txt)");
+  app.add_option("--guess", f.guess,
+                 "a rough guess instead of a calibration: 'x y z roll pitch yaw' (the camera in "
+                 "the LiDAR frame as a URDF joint's origin gives it: metres, degrees), or a file "
+                 "as --result takes; refined and reported (verdict 'refined'), never judged "
+                 "miscalibrated. Widen --search-deg / --search-m to how far off it may be");
+  app.add_option("--camera-frame", f.camera_frame,
+                 "the camera frame of --guess's numbers and of an exported file: link (x forward, "
+                 "REP 103) or optical (z forward). Default: link for typed numbers, optical for "
+                 "files (as `calibench export` writes them)");
   app.add_flag("--json", f.json, "print exactly one JSON object on stdout");
   app.add_option("--search-deg", f.check.alignment.search_deg,
                  "how far the rotation may be off the calibration [deg] (3 for a CAD mount)")
@@ -128,8 +139,38 @@ int RunCheck(int argc, char** argv) {
     std::fprintf(stderr, "calibench check: %s\n", why.c_str());
     return kUsage;
   }
+  if (f.result.empty() == f.guess.empty()) {
+    std::fprintf(stderr,
+                 "calibench check: give the calibration to check (--result) or a rough "
+                 "guess to refine (--guess), one of them\n");
+    return kUsage;
+  }
+  std::optional<CameraFrame> camera_frame;
+  if (!f.camera_frame.empty() && !(camera_frame = ParseCameraFrame(f.camera_frame))) {
+    std::fprintf(stderr, "calibench check: --camera-frame must be link or optical, got '%s'\n",
+                 f.camera_frame.c_str());
+    return kUsage;
+  }
+  CheckedCalibration checked;
+  const std::string source = f.result.empty() ? f.guess : f.result;
+  if (!f.guess.empty() && !std::filesystem::exists(f.guess)) {
+    try {
+      checked = GuessFromJointOrigin(f.guess, camera_frame.value_or(CameraFrame::kLink));
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "calibench check: --guess: %s (or no such file)\n", e.what());
+      return kUsage;
+    }
+  } else {
+    ExportFrames frames;
+    frames.camera_frame = camera_frame.value_or(CameraFrame::kOptical);
+    checked = LoadCheckedCalibration(source, frames);
+  }
+  // A guess has no covariance to weigh a change against: it is refined, never judged.
+  f.check.reference_is_guess = !f.guess.empty();
+  if (f.check.reference_is_guess) checked.camera_axes_covariance.setZero();
+  std::fprintf(stderr, "calibench check: %s: %s\n", f.guess.empty() ? "checking" : "refining",
+               checked.how.c_str());
   MachineStdout out(f.json);  // from here on, only the JSON object reaches stdout
-  const CheckedCalibration checked = LoadCheckedCalibration(f.result);
   const Pose& reference = checked.cam_from_lidar;
   const Mat6& reference_covariance = checked.camera_axes_covariance;
   const ProgressCallback progress = StderrProgress("read");
@@ -157,7 +198,7 @@ int RunCheck(int argc, char** argv) {
                    report.why.c_str());
       return kNoCalibration;
     }
-    WriteCheckResult(f.write_result, report, f.result);
+    WriteCheckResult(f.write_result, report, f.result.empty() ? checked.how : f.result);
     std::fprintf(stderr, "calibench check: wrote the targetless estimate to %s\n",
                  f.write_result.c_str());
   }

@@ -145,7 +145,16 @@ void Decide(const CheckOptions& options, const Mat6& reference_covariance, Check
   const std::string evidence =
       Fmt("%.0f frames, %.0f matched edge points in %.0f image cells", report->frames_used,
           report->alignment.points_matched, report->alignment.clusters);
-  if (significant && large) {
+  if (significant && large && options.reference_is_guess) {
+    // A guess was never a calibration: what the scene supports refines it.
+    report->verdict = CheckVerdict::kRefined;
+    report->why = "the guess refined: the scene's edges align " + change + " away from it (" +
+                  Fmt("%.1f", report->change_sigmas) + " sigma over the constrained axes; " +
+                  evidence + "); the estimate below is the refined calibration";
+    if (!report->unconstrained_axes.empty())
+      report->why += ", though this scene cannot tell the " + AxesList(report->unconstrained_axes) +
+                     ", which keep the guess's values";
+  } else if (significant && large) {
     report->verdict = CheckVerdict::kMiscalibrated;
     report->why = "the scene's edges align " + change + " away from the calibration (" +
                   Fmt("%.1f", report->change_sigmas) + " sigma over the constrained axes; " +
@@ -321,6 +330,37 @@ void AddRivalMinima(const std::vector<EdgeFrame>& frames, const CameraModel& cam
   for (const Vec6& d : report->rival_offsets) report->covariance += d * d.transpose();
 }
 
+// The rival alignments in one sentence: one named as it is, several by their range (the largest
+// offset first: it is what widened the sigma most).
+std::string DescribeRivals(const CheckReport& report) {
+  const size_t n = report.rival_offsets.size();
+  if (n == 0) return "";
+  auto degrees = [&](size_t r) { return report.rival_offsets[r].tail<3>().norm() * kRadToDeg; };
+  auto millimetres = [&](size_t r) { return 1e3 * report.rival_offsets[r].head<3>().norm(); };
+  if (n == 1)
+    return Fmt(". The edges also fit an alignment %.2f deg / %.1f mm from the estimate about as "
+               "well",
+               degrees(0), millimetres(0)) +
+           Fmt(" (better in %.0f of %.0f frames); its offset is counted in the sigma",
+               report.rival_frames_preferring[0], report.rival_frames_decided[0]);
+  double min_deg = 1e9, max_deg = 0, min_mm = 1e9, max_mm = 0;
+  int most_preferring = 0, decided = 0;
+  for (size_t r = 0; r < n; ++r) {
+    min_deg = std::min(min_deg, degrees(r));
+    max_deg = std::max(max_deg, degrees(r));
+    min_mm = std::min(min_mm, millimetres(r));
+    max_mm = std::max(max_mm, millimetres(r));
+    most_preferring = std::max(most_preferring, report.rival_frames_preferring[r]);
+    decided = std::max(decided, report.rival_frames_decided[r]);
+  }
+  return Fmt(". The edges also fit %.0f other alignments about as well, ", n) +
+         Fmt("%.2f-%.2f deg / ", min_deg, max_deg) +
+         Fmt("%.1f-%.1f mm from the estimate", min_mm, max_mm) +
+         Fmt(" (each better in at most %.0f of %.0f frames): the scene has several answers "
+             "nearly as good, and their offsets are counted in the sigma",
+             most_preferring, decided);
+}
+
 }  // namespace
 
 bool CheckOptions::Check(std::string* why) const {
@@ -345,6 +385,8 @@ std::string CheckVerdictName(CheckVerdict verdict) {
       return "miscalibrated";
     case CheckVerdict::kCannotTell:
       return "cannot tell";
+    case CheckVerdict::kRefined:
+      return "refined";
   }
   return "cannot tell";
 }
@@ -384,6 +426,7 @@ CheckReport CheckCalibration(const std::vector<EdgeFrame>& frames, const CameraM
                              const CheckOptions& options) {
   CheckReport report;
   report.reference = reference;
+  report.reference_is_guess = options.reference_is_guess;
   report.frames_given = static_cast<int>(frames.size());
   for (const EdgeFrame& f : frames) {
     report.frame_ids.push_back(f.id);
@@ -416,14 +459,7 @@ CheckReport CheckCalibration(const std::vector<EdgeFrame>& frames, const CameraM
   report.change_t_m = delta.head<3>();
   report.change_r_deg = delta.tail<3>() * kRadToDeg;
   Decide(options, reference_covariance, &report);
-  for (size_t r = 0; r < report.rival_offsets.size(); ++r) {
-    const Vec6& d = report.rival_offsets[r];
-    report.why += Fmt(". The edges also fit an alignment %.2f deg / %.1f mm from the estimate "
-                      "about as well",
-                      d.tail<3>().norm() * kRadToDeg, 1e3 * d.head<3>().norm()) +
-                  Fmt(" (better in %.0f of %.0f frames); its offset is counted in the sigma",
-                      report.rival_frames_preferring[r], report.rival_frames_decided[r]);
-  }
+  report.why += DescribeRivals(report);
   WeakestProfile(frames, camera, options, &report);
   return report;
 }

@@ -30,19 +30,24 @@ struct CheckOptions {
   int min_clusters = 20;
   // A frame counts as used when this many of its LiDAR edges matched an image edge.
   int min_frame_matches = 20;
+  // The pose checked is a rough guess (a CAD mount, a pose typed in), not a calibration: a change
+  // the scene supports refines it ("refined"), never judges it "miscalibrated".
+  bool reference_is_guess = false;
 
   bool Check(std::string* why) const;
 };
 
-enum class CheckVerdict { kConsistent, kMiscalibrated, kCannotTell };
-std::string CheckVerdictName(CheckVerdict verdict);  // "consistent", "miscalibrated", "cannot tell"
+enum class CheckVerdict { kConsistent, kMiscalibrated, kCannotTell, kRefined };
+// "consistent", "miscalibrated", "cannot tell", "refined"
+std::string CheckVerdictName(CheckVerdict verdict);
 
 // The six camera axes of a change, for words: "translation along camera x (right)", ...
 std::string CameraAxisName(int axis);  // 0..5: tx ty tz rx ry rz
 
 struct CheckReport {
   CheckVerdict verdict = CheckVerdict::kCannotTell;
-  std::string why;  // one paragraph, in words
+  std::string why;                  // one paragraph, in words
+  bool reference_is_guess = false;  // CheckOptions::reference_is_guess
   int frames_given = 0;
   int frames_used = 0;
   Pose reference = Pose::Identity();  // R, the calibration checked

@@ -42,7 +42,9 @@ std::string FormatCheckReport(const CheckReport& report) {
                 report.alignment.converged ? "converged" : "NOT converged",
                 report.alignment.rms_sigma, std::sqrt(report.model_dispersion));
   out += buffer;
-  out += Line("change from the calibration: t [%+.1f %+.1f %+.1f] mm", report.change_t_m * 1e3);
+  out += Line(report.reference_is_guess ? "change from the guess: t [%+.1f %+.1f %+.1f] mm"
+                                        : "change from the calibration: t [%+.1f %+.1f %+.1f] mm",
+              report.change_t_m * 1e3);
   out += Line(", r [%+.3f %+.3f %+.3f] deg (camera axes)\n", report.change_r_deg);
   out += Line("targetless estimate sigma:   t [%.1f %.1f %.1f] mm", report.sigma_t_m * 1e3);
   out += Line(", r [%.3f %.3f %.3f] deg\n", report.sigma_r_deg);
@@ -59,6 +61,7 @@ std::string FormatCheckReport(const CheckReport& report) {
 std::string CheckReportJson(const CheckReport& report) {
   nlohmann::json j;
   j["verdict"] = CheckVerdictName(report.verdict);
+  j["guess"] = report.reference_is_guess;
   j["frames_used"] = report.frames_used;
   j["frames_given"] = report.frames_given;
   j["why"] = report.why;
@@ -136,6 +139,7 @@ void WriteCheckResult(const std::filesystem::path& path, const CheckReport& repo
       TargetlessProvenanceText(checked_result.string(), "`calibench check`"));
   root["provenance"]["checked_result"] = checked_result.string();
   root["provenance"]["verdict"] = CheckVerdictName(report.verdict);
+  root["provenance"]["guess"] = report.reference_is_guess;
   root["provenance"]["why"] = report.why;
   root["provenance"]["frames_used"] = report.frames_used;
   root["provenance"]["frames"] = report.frame_ids;

@@ -25,6 +25,8 @@ ImVec4 VerdictColor(CheckVerdict verdict) {
       return kConsistent;
     case CheckVerdict::kMiscalibrated:
       return kMiscalibrated;
+    case CheckVerdict::kRefined:  // a guess refined: a result, as a consistent check is
+      return kConsistent;
     case CheckVerdict::kCannotTell:
       break;
   }
