@@ -20,6 +20,7 @@ bool AlongRays(const LidarPlaneFit& fit) {
   return RaysFromOrigin(fit.lidar_model.geometry) || fit.range_moments.count > 0;
 }
 
+// Whether a fit holds the held-out pairs' choice against its cloud's look (its reason says so).
 bool ChosenByEvidence(const LidarGeometryVerdict& model) {
   return model.why.rfind(kChosenByHeldOutPairs, 0) == 0;
 }
