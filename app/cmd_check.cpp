@@ -120,6 +120,44 @@ void DrawViews(const CheckFlags& f, const CheckInput& input, const CheckReport& 
   std::fprintf(stderr, "calibench check: drew %d frames into %s\n", drawn, f.views.c_str());
 }
 
+// The pose checked (--result) or refined (--guess, which sets f->check.reference_is_guess);
+// nullopt after saying what is wrong with the flags. A file that cannot be read throws IoError.
+std::optional<CheckedCalibration> ReadCheckedPose(CheckFlags* flags) {
+  const CheckFlags& f = *flags;
+  if (f.result.empty() == f.guess.empty()) {
+    std::fprintf(stderr,
+                 "calibench check: give the calibration to check (--result) or a rough "
+                 "guess to refine (--guess), one of them\n");
+    return std::nullopt;
+  }
+  std::optional<CameraFrame> camera_frame;
+  if (!f.camera_frame.empty() && !(camera_frame = ParseCameraFrame(f.camera_frame))) {
+    std::fprintf(stderr, "calibench check: --camera-frame must be link or optical, got '%s'\n",
+                 f.camera_frame.c_str());
+    return std::nullopt;
+  }
+  CheckedCalibration checked;
+  const std::string source = f.result.empty() ? f.guess : f.result;
+  if (!f.guess.empty() && !std::filesystem::exists(f.guess)) {
+    try {
+      checked = GuessFromJointOrigin(f.guess, camera_frame.value_or(CameraFrame::kLink));
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "calibench check: --guess: %s (or no such file)\n", e.what());
+      return std::nullopt;
+    }
+  } else {
+    ExportFrames frames;
+    frames.camera_frame = camera_frame.value_or(CameraFrame::kOptical);
+    checked = LoadCheckedCalibration(source, frames);
+  }
+  // A guess has no covariance to weigh a change against: it is refined, never judged.
+  flags->check.reference_is_guess = !f.guess.empty();
+  if (f.check.reference_is_guess) checked.camera_axes_covariance.setZero();
+  std::fprintf(stderr, "calibench check: %s: %s\n", f.guess.empty() ? "checking" : "refining",
+               checked.how.c_str());
+  return checked;
+}
+
 }  // namespace
 
 int RunCheck(int argc, char** argv) {
@@ -139,40 +177,11 @@ int RunCheck(int argc, char** argv) {
     std::fprintf(stderr, "calibench check: %s\n", why.c_str());
     return kUsage;
   }
-  if (f.result.empty() == f.guess.empty()) {
-    std::fprintf(stderr,
-                 "calibench check: give the calibration to check (--result) or a rough "
-                 "guess to refine (--guess), one of them\n");
-    return kUsage;
-  }
-  std::optional<CameraFrame> camera_frame;
-  if (!f.camera_frame.empty() && !(camera_frame = ParseCameraFrame(f.camera_frame))) {
-    std::fprintf(stderr, "calibench check: --camera-frame must be link or optical, got '%s'\n",
-                 f.camera_frame.c_str());
-    return kUsage;
-  }
-  CheckedCalibration checked;
-  const std::string source = f.result.empty() ? f.guess : f.result;
-  if (!f.guess.empty() && !std::filesystem::exists(f.guess)) {
-    try {
-      checked = GuessFromJointOrigin(f.guess, camera_frame.value_or(CameraFrame::kLink));
-    } catch (const std::invalid_argument& e) {
-      std::fprintf(stderr, "calibench check: --guess: %s (or no such file)\n", e.what());
-      return kUsage;
-    }
-  } else {
-    ExportFrames frames;
-    frames.camera_frame = camera_frame.value_or(CameraFrame::kOptical);
-    checked = LoadCheckedCalibration(source, frames);
-  }
-  // A guess has no covariance to weigh a change against: it is refined, never judged.
-  f.check.reference_is_guess = !f.guess.empty();
-  if (f.check.reference_is_guess) checked.camera_axes_covariance.setZero();
-  std::fprintf(stderr, "calibench check: %s: %s\n", f.guess.empty() ? "checking" : "refining",
-               checked.how.c_str());
+  const std::optional<CheckedCalibration> checked = ReadCheckedPose(&f);
+  if (!checked) return kUsage;
   MachineStdout out(f.json);  // from here on, only the JSON object reaches stdout
-  const Pose& reference = checked.cam_from_lidar;
-  const Mat6& reference_covariance = checked.camera_axes_covariance;
+  const Pose& reference = checked->cam_from_lidar;
+  const Mat6& reference_covariance = checked->camera_axes_covariance;
   const ProgressCallback progress = StderrProgress("read");
   const CheckInput input =
       LoadCheckInput(f.dataset, f.check, f.input, [&](int done, int total, const std::string& id) {
@@ -198,7 +207,7 @@ int RunCheck(int argc, char** argv) {
                    report.why.c_str());
       return kNoCalibration;
     }
-    WriteCheckResult(f.write_result, report, f.result.empty() ? checked.how : f.result);
+    WriteCheckResult(f.write_result, report, f.result.empty() ? checked->how : f.result);
     std::fprintf(stderr, "calibench check: wrote the targetless estimate to %s\n",
                  f.write_result.c_str());
   }

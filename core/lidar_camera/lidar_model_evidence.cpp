@@ -102,14 +102,11 @@ LidarModelCandidate Summarize(LidarGeometry geometry, bool along_rays,
   return candidate;
 }
 
-}  // namespace
-
-std::optional<LidarModelEvidence> ChooseLidarModelByEvidence(
-    std::vector<PairFeatures>* pairs, const PipelineOptions& options,
-    const LidarModelEvidenceOptions& evidence_options) {
+// The accepted pairs that hold one fit of each candidate.
+std::vector<Candidates> UsablePairs(const std::vector<PairFeatures>& pairs) {
   std::vector<Candidates> usable;
-  for (size_t i = 0; i < pairs->size(); ++i) {
-    const PairFeatures& p = (*pairs)[i];
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const PairFeatures& p = pairs[i];
     if (p.status != PairStatus::kAccepted || !p.lidar || !p.camera || !p.lidar->alternative)
       continue;
     Candidates c;
@@ -120,36 +117,71 @@ std::optional<LidarModelEvidence> ChooseLidarModelByEvidence(
     if (AlongRays(*c.fit[1 - own]) == (own == 0)) continue;  // both of one kind: nothing to ask
     usable.push_back(c);
   }
+  return usable;
+}
+
+// The two candidates' held-out errors compared pair by pair: the camera's own error of a pair's
+// board is common to both, so the log-ratio of the two errors on one pair is what tells them
+// apart. mean > 0: the rays' errors are the smaller.
+struct PairedLogRatio {
+  int pairs = 0;
+  double mean = 0.0;
+  double standard_error = 0.0;
+};
+PairedLogRatio CompareByPair(const std::vector<double>& rays_errors,
+                             const std::vector<double>& flat_errors) {
+  std::vector<double> log_ratios;
+  for (size_t j = 0; j < rays_errors.size(); ++j)
+    if (std::isfinite(rays_errors[j]) && std::isfinite(flat_errors[j]) && rays_errors[j] > 0 &&
+        flat_errors[j] > 0)
+      log_ratios.push_back(std::log(flat_errors[j] / rays_errors[j]));
+  PairedLogRatio paired;
+  paired.pairs = static_cast<int>(log_ratios.size());
+  if (paired.pairs < 2) return paired;
+  for (double l : log_ratios) paired.mean += l / paired.pairs;
+  double variance = 0;
+  for (double l : log_ratios)
+    variance += (l - paired.mean) * (l - paired.mean) / (paired.pairs - 1);
+  paired.standard_error = std::sqrt(variance / paired.pairs);
+  return paired;
+}
+
+// The pair's alternative becomes its fit, and its fit the alternative (a second call decides
+// alike).
+void TakeAlternative(PairFeatures* pair) {
+  LidarPlaneFit former = *pair->lidar;
+  former.alternative.reset();
+  LidarPlaneFit chosen = *pair->lidar->alternative;
+  chosen.alternative = std::make_shared<const LidarPlaneFit>(std::move(former));
+  pair->lidar = std::move(chosen);
+}
+
+}  // namespace
+
+std::optional<LidarModelEvidence> ChooseLidarModelByEvidence(
+    std::vector<PairFeatures>* pairs, const PipelineOptions& options,
+    const LidarModelEvidenceOptions& evidence_options) {
+  const std::vector<Candidates> usable = UsablePairs(*pairs);
   if (usable.empty() || static_cast<int>(usable.size()) < evidence_options.min_pairs)
     return std::nullopt;
   const int folds = std::min<int>(evidence_options.folds, static_cast<int>(usable.size()));
   const std::vector<double> rays_errors = HeldOutErrors(*pairs, usable, 0, folds, options);
   const std::vector<double> flat_errors = HeldOutErrors(*pairs, usable, 1, folds, options);
-  // Paired over the held-out pairs: the camera's own error of a pair's board is common to both
-  // candidates, so the log-ratio of the two errors on one pair is what tells them apart.
-  std::vector<double> log_ratios;
-  for (size_t j = 0; j < usable.size(); ++j)
-    if (std::isfinite(rays_errors[j]) && std::isfinite(flat_errors[j]) && rays_errors[j] > 0 &&
-        flat_errors[j] > 0)
-      log_ratios.push_back(std::log(flat_errors[j] / rays_errors[j]));
-  if (static_cast<int>(log_ratios.size()) < evidence_options.min_pairs) return std::nullopt;
-  double mean = 0;
-  for (double l : log_ratios) mean += l / log_ratios.size();
-  double variance = 0;
-  for (double l : log_ratios) variance += (l - mean) * (l - mean) / (log_ratios.size() - 1);
-  const double standard_error = std::sqrt(variance / log_ratios.size());
+  const PairedLogRatio paired = CompareByPair(rays_errors, flat_errors);
+  if (paired.pairs < evidence_options.min_pairs) return std::nullopt;
   LidarModelEvidence evidence;
   char text[240];
   std::snprintf(text, sizeof(text),
                 "each held-out pair's board corners (the camera's) against its LiDAR plane at the "
                 "solve without it, RMS distance, the two models compared pair by pair (geometric "
-                "mean ratio over %zu pairs, %d folds)",
-                log_ratios.size(), folds);
+                "mean ratio over %d pairs, %d folds)",
+                paired.pairs, folds);
   evidence.criterion = text;
-  const bool rays_win = mean >= 0;
-  evidence.margin = std::exp(std::abs(mean));
-  evidence.significance_z = standard_error > 0 ? std::abs(mean) / standard_error
-                                               : std::numeric_limits<double>::infinity();
+  const bool rays_win = paired.mean >= 0;
+  evidence.margin = std::exp(std::abs(paired.mean));
+  evidence.significance_z = paired.standard_error > 0
+                                ? std::abs(paired.mean) / paired.standard_error
+                                : std::numeric_limits<double>::infinity();
   evidence.tie = evidence.significance_z < evidence_options.min_significance_z ||
                  evidence.margin < evidence_options.tie_ratio;
   LidarModelCandidate rays =
@@ -162,19 +194,9 @@ std::optional<LidarModelEvidence> ChooseLidarModelByEvidence(
   // segments (0.0-0.1 standard errors) the rays would move the result 31.5 -> 35.9 mm from the
   // authors' reference and its subsets' coverage 39 -> 37 of 42; on the rotary-stage simulation
   // it fell to point-to-plane on three of four tied seeds (docs/results.md).
-  if (!evidence.tie) {
-    const int winner = rays_win ? 0 : 1;
-    for (const Candidates& c : usable) {
-      PairFeatures& p = (*pairs)[c.index];
-      if (c.fit[winner] == &*p.lidar) continue;
-      // The alternative becomes the fit; the fit its alternative (a second call decides alike).
-      LidarPlaneFit former = *p.lidar;
-      former.alternative.reset();
-      LidarPlaneFit chosen = *p.lidar->alternative;
-      chosen.alternative = std::make_shared<const LidarPlaneFit>(std::move(former));
-      p.lidar = std::move(chosen);
-    }
-  }
+  if (!evidence.tie)
+    for (const Candidates& c : usable)
+      if (c.fit[rays_win ? 0 : 1] != &*(*pairs)[c.index].lidar) TakeAlternative(&(*pairs)[c.index]);
   // What the pairs now hold: the model most of them have, and how many hold the held-out pairs'
   // choice against their cloud's look (this call's or an earlier one's).
   int along_rays = 0;

@@ -37,7 +37,7 @@ std::vector<ModelGroup> GroupByLidarModel(const CalibrationOutcome& outcome) {
       it = groups.insert(groups.end(), {model.geometry, {}, model.why, model.forced});
     it->pairs.push_back(p.id);
     it->given_rays |= !RaysFromOrigin(model.geometry) && p.lidar->range_moments.count > 0;
-    it->crop |= p.lidar->no_edge_search.rfind("the cloud is a board-only crop", 0) == 0;
+    it->crop |= p.lidar->no_edge_search == kBoardOnlyCropNoEdges;
   }
   return groups;
 }

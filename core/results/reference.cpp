@@ -6,7 +6,11 @@ namespace calibench {
 
 Pose ReadReferenceCamFromLidar(const std::filesystem::path& path, const ExportFrames& frames,
                                std::string* how) {
-  const ImportedTransform imported = ReadExportedTransform(path);
+  return ReferenceCamFromLidar(ReadExportedTransform(path), frames, how);
+}
+
+Pose ReferenceCamFromLidar(const ImportedTransform& imported, const ExportFrames& frames,
+                           std::string* how) {
   if (!imported.format) {
     *how = "a calibench result: cam_from_lidar";
     return imported.parent_from_child.inverse();

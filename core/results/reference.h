@@ -18,6 +18,9 @@ namespace calibench {
 // says in words how it was read. Throws IoError naming the file.
 Pose ReadReferenceCamFromLidar(const std::filesystem::path& path, const ExportFrames& frames,
                                std::string* how);
+// The same of a transform already read (ReadExportedTransform).
+Pose ReferenceCamFromLidar(const ImportedTransform& imported, const ExportFrames& frames,
+                           std::string* how);
 
 struct ReferenceDifference {
   PoseError error;               // result against the reference

@@ -262,9 +262,7 @@ void AddBoardExtent(const LidarCloud& cloud, const LidarPlaneOptions& options, L
   // Edge points need the whole board's returns (the ends of a brushed patch are not its edges)
   // and rings, or a beam's path, whose ends they are.
   if (options.board_only_crop) {
-    fit->no_edge_search =
-        "the cloud is a board-only crop: its returns end where the crop did, not at the sheet's "
-        "edges";
+    fit->no_edge_search = kBoardOnlyCropNoEdges;
   } else if (!spinning && !beam_path) {
     fit->no_edge_search =
         "the LiDAR model is " + LidarGeometryName(options.geometry) + ": no rings to end on it";

@@ -61,6 +61,11 @@ struct LidarPlaneOptions {
   bool Check(std::string* why) const;
 };
 
+// LidarPlaneFit::no_edge_search of a board-only crop's fit (LidarPlaneOptions::board_only_crop):
+// how the result's model line tells a crop fitted along its rays.
+inline constexpr const char* kBoardOnlyCropNoEdges =
+    "the cloud is a board-only crop: its returns end where the crop did, not at the sheet's edges";
+
 // The grow radius for a target: half the sheet's diagonal, 5% and 2 cm more so that the corners'
 // returns stay in while the centre estimate settles.
 double BoardGrowRadius(const BoardSpec& board);

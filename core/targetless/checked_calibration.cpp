@@ -27,8 +27,9 @@ CheckedCalibration LoadCheckedCalibration(const std::filesystem::path& path,
     return checked;
   }
   // Any export format, a calibench result among them (its covariance read below).
-  checked.cam_from_lidar = ReadReferenceCamFromLidar(path, frames, &checked.how);
-  if (!ReadExportedTransform(path).format) {
+  const ImportedTransform imported = ReadExportedTransform(path);
+  checked.cam_from_lidar = ReferenceCamFromLidar(imported, frames, &checked.how);
+  if (!imported.format) {
     const LoadedResult loaded = LoadResult(path);
     checked.cam_from_lidar = loaded.cam_from_source;
     checked.camera_axes_covariance =
