@@ -110,6 +110,9 @@ void PrintSummary(const BagImportSummary& summary, const BagImportOptions& optio
                 summary.cut_short.c_str());
   std::printf("clouds  %-28s %lld messages\n", summary.cloud_topic.c_str(),
               static_cast<long long>(summary.clouds));
+  if (!summary.point_times.empty())
+    std::printf("        %s (%d of the pairs written keep them, field t)\n",
+                summary.point_times.c_str(), summary.pairs_with_point_times);
   std::printf("images  %-28s %lld messages; searched %d for the board, found in %d\n",
               summary.image_topic.c_str(), static_cast<long long>(summary.images),
               summary.images_searched, summary.boards_seen);

@@ -108,7 +108,8 @@ std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int
   std::vector<Field> fields = {{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}};
   if (cloud.HasIntensity()) fields.push_back({"intensity", 16, 7});
   if (cloud.HasRing()) fields.push_back({ring_field, 20, 4});
-  if (cloud.HasViewpoint())  // PCL's PointWithViewpoint names
+  if (cloud.HasTime()) fields.push_back({"time", 24, 7});  // velodyne_pointcloud's XYZIRT
+  if (cloud.HasViewpoint())                                // PCL's PointWithViewpoint names
     for (const auto& [name, offset] : {std::pair{"vp_x", 32u}, {"vp_y", 36u}, {"vp_z", 40u}})
       fields.push_back({name, offset, 7});
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(fields.size()));
@@ -131,6 +132,10 @@ std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int
     if (cloud.HasIntensity()) PutRaw<float>(&points, cloud.intensity[i], big_endian);
     if (cloud.HasRing())
       PutRaw<std::uint16_t>(&points, static_cast<std::uint16_t>(cloud.ring[i]), big_endian);
+    if (cloud.HasTime()) {
+      points.resize(start + 24, 0);
+      PutRaw<float>(&points, cloud.time_s[i], big_endian);
+    }
     if (cloud.HasViewpoint()) {
       points.resize(start + 32, 0);
       for (int axis = 0; axis < 3; ++axis)

@@ -148,7 +148,14 @@ SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding enc
       scan.azimuth_offset_rad =
           beams.risley ? 2.0 * M_PI * static_cast<double>(t - kStart) / kSecond : phase(rng);
       scan.seed = options.seed * 7919 + ++sweep;
-      const LidarCloud cloud = SimulateLidarScan(beams, print, scene, scan).ToCloud();
+      LidarCloud cloud = SimulateLidarScan(beams, print, scene, scan).ToCloud();
+      if (options.point_times && !beams.risley)
+        for (const Eigen::Vector3f& p : cloud.points) {
+          const double turned =
+              std::remainder(std::atan2(p.y(), p.x()) - scan.azimuth_offset_rad, 2.0 * M_PI);
+          cloud.time_s.push_back(static_cast<float>((turned < 0 ? turned + 2.0 * M_PI : turned) /
+                                                    (2.0 * M_PI) * cloud_period / kSecond));
+        }
       // The driver stamps a sweep at its start and publishes it when complete.
       if (beams.risley) {
         const char* type = encoding == MessageEncoding::kRos1 ? "livox_ros_driver/CustomMsg"

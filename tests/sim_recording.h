@@ -39,6 +39,10 @@ struct SimRecordingOptions {
   // livox_ros_driver2/CustomMsg (ROS 2) on /livox/lidar, each frame a new stretch of its
   // rosette.
   LidarModel lidar = LidarModel::kVlp16;
+  // A spinning LiDAR's returns with their own times, as velodyne_pointcloud's XYZIRT gives them:
+  // a float32 field `time`, seconds after the sweep's stamp (its start), from each return's
+  // azimuth after the sweep's firing phase.
+  bool point_times = false;
 };
 
 struct SimRecordingTruth {

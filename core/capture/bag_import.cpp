@@ -24,6 +24,7 @@ namespace {
 struct WrittenPair {
   int found = 0;  // its place among the pairs found
   std::int64_t cloud_stamp_ns = 0, image_stamp_ns = 0;
+  bool point_times = false;  // its cloud carries per-point times
 };
 
 std::string PairId(int index) {
@@ -124,7 +125,9 @@ class Importer {
         rings_ =
             std::max(rings_, *std::max_element(pair.cloud.ring.begin(), pair.cloud.ring.end()) + 1);
       WriteFoundPair(pair, out_dir_, id);
-      written_.push_back({index, pair.cloud_stamp_ns, pair.image_stamp_ns});
+      // Said once: the first pair's reading stands for the recording's LiDAR.
+      if (summary_.point_times.empty()) summary_.point_times = pair.point_times;
+      written_.push_back({index, pair.cloud_stamp_ns, pair.image_stamp_ns, pair.cloud.HasTime()});
     }
   }
 
@@ -173,7 +176,9 @@ class Importer {
       entry.id = id;
       entry.cloud = fs::absolute(out_dir_ / "clouds" / (id + ".pcd"));
       entry.image = fs::absolute(out_dir_ / "images" / (id + ".png"));
+      entry.lidar_stamp_ns = pair.cloud_stamp_ns;
       dataset.pairs.push_back(entry);
+      summary_.pairs_with_point_times += pair.point_times;
       summary_.pair_ids.push_back(id);
       summary_.pair_cloud_stamps_ns.push_back(pair.cloud_stamp_ns);
       pairs.push_back({{"id", id},
@@ -192,6 +197,7 @@ class Importer {
     record["board"] = summary_.board_source;
     record["tries"] = summary_.tries;
     record["images_searched"] = summary_.images_searched;
+    record["point_times"] = summary_.point_times;
     if (!summary_.cut_short.empty()) record["cut_short"] = summary_.cut_short;
     WriteFileAtomically(out_dir_ / "import.json", record.dump(2) + "\n");
   }
@@ -264,6 +270,7 @@ PairEntry WriteFoundPair(const FoundPair& pair, const fs::path& dir, const std::
   entry.id = id;
   entry.cloud = fs::absolute(dir / "clouds" / (id + ".pcd"));
   entry.image = fs::absolute(dir / "images" / (id + ".png"));
+  entry.lidar_stamp_ns = pair.cloud_stamp_ns;  // what the cloud's field `t` counts from
   SavePcd(entry.cloud, pair.cloud, PcdEncoding::kBinary);
   SaveImage(entry.image, pair.image);
   return entry;

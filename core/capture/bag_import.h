@@ -57,6 +57,10 @@ struct BagImportSummary {
   double recording_seconds = 0.0;  // from the first to the last message read
   std::filesystem::path manifest;  // the dataset.json written
   std::int64_t bytes_read = 0;
+  // How the LiDAR's per-point times were read (core/lidar/point_times.h), or why the clouds have
+  // none and are taken as instantaneous; said once, from the first pair written.
+  std::string point_times;
+  int pairs_with_point_times = 0;  // of the pairs kept, their clouds' field `t` written
 };
 
 // Topics to import when the options name none: exactly one PointCloud2 topic; one image topic

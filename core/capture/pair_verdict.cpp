@@ -49,10 +49,11 @@ std::string MillisecondsText(double seconds) {
 namespace {
 
 // A still hold's other sweeps appended to the tried one (returns and intensities; a ring-less
-// cloud has no rings to keep), as long as the cloud stays within the load limit. An unreadable
-// sweep among them is left out.
+// cloud has no rings to keep; each return's time after the tried sweep's stamp, `stamp_ns`), as
+// long as the cloud stays within the load limit. An unreadable sweep among them is left out.
 void IntegrateSweeps(const std::vector<recording_detail::StampedBytes>& sweeps,
-                     const PairTopics& topics, const LoadLimits& limits, LidarCloud* cloud) {
+                     const PairTopics& topics, const LoadLimits& limits, std::int64_t stamp_ns,
+                     LidarCloud* cloud) {
   for (const recording_detail::StampedBytes& sweep : sweeps) {
     LidarCloud more;
     try {
@@ -72,6 +73,13 @@ void IntegrateSweeps(const std::vector<recording_detail::StampedBytes>& sweeps,
       cloud->viewpoint.insert(cloud->viewpoint.end(), more.viewpoint.begin(), more.viewpoint.end());
     else
       cloud->viewpoint.clear();
+    // Times only when every sweep has them: a return without one would pass for the stamp's.
+    if (cloud->HasTime() && more.HasTime()) {
+      const float shift = static_cast<float>((sweep.stamp_ns - stamp_ns) * 1e-9);
+      for (const float t : more.time_s) cloud->time_s.push_back(t + shift);
+    } else {
+      cloud->time_s.clear();
+    }
     cloud->points.insert(cloud->points.end(), more.points.begin(), more.points.end());
     if (intensity)
       cloud->intensity.insert(cloud->intensity.end(), more.intensity.begin(), more.intensity.end());
@@ -189,10 +197,12 @@ TryOutcome JudgeTry(const recording_detail::Try& attempt, std::optional<ImageU8>
   }
   FoundPair pair;
   try {
-    pair.cloud =
-        DecodeCloudMessage(*attempt.cloud.bytes, topics.livox_cloud, topics.cloud, options.limits)
-            .cloud;
-    IntegrateSweeps(attempt.integrated, topics, options.limits, &pair.cloud);
+    CloudMessage message =
+        DecodeCloudMessage(*attempt.cloud.bytes, topics.livox_cloud, topics.cloud, options.limits);
+    pair.cloud = std::move(message.cloud);
+    pair.point_times = std::move(message.point_times);
+    IntegrateSweeps(attempt.integrated, topics, options.limits, attempt.cloud.stamp_ns,
+                    &pair.cloud);
   } catch (const std::invalid_argument&) {
     outcome.dropped = "cloud message unreadable";
     return outcome;

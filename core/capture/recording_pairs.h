@@ -72,7 +72,8 @@ struct PairTopics {
 
 struct FoundPair {
   std::int64_t cloud_stamp_ns = 0, image_stamp_ns = 0;
-  LidarCloud cloud;
+  LidarCloud cloud;         // time_s after cloud_stamp_ns, where the driver gives them
+  std::string point_times;  // how its per-point times were read, or why it has none
   ImageU8 image;
   Pose cam_from_board = Pose::Identity();
   bool stillness_checked = true;  // false: no other image within the window

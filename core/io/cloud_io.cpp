@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/base/notice.h"
 #include "core/io/cloud_io_internal.h"
 #include "core/lidar/cloud.h"
 
@@ -30,6 +31,7 @@ FieldRole RoleOfName(std::string_view name) {
   if (name == "vp_x") return kVpX;
   if (name == "vp_y") return kVpY;
   if (name == "vp_z") return kVpZ;
+  if (name == "t" || name == "time") return kTime;
   return kIgnored;
 }
 
@@ -136,12 +138,14 @@ CloudBuilder::CloudBuilder(const std::filesystem::path& path, const bool has[kNu
       has_intensity_(has[kIntensity]),
       has_ring_(has[kRing]),
       has_range_(has[kRange]),
-      has_viewpoint_(has[kVpX] && has[kVpY] && has[kVpZ]) {
+      has_viewpoint_(has[kVpX] && has[kVpY] && has[kVpZ]),
+      has_time_(has[kTime]) {
   cloud_.points.reserve(expected);
   if (has_intensity_) cloud_.intensity.reserve(expected);
   if (has_ring_) cloud_.ring.reserve(expected);
   if (has_range_) cloud_.range.reserve(expected);
   if (has_viewpoint_) cloud_.viewpoint.reserve(expected);
+  if (has_time_) raw_times_.reserve(expected);
 }
 
 void CloudBuilder::Add(const double values[kNumRoles]) {
@@ -173,12 +177,19 @@ void CloudBuilder::Add(const double values[kNumRoles]) {
       Fail(path_, "point " + std::to_string(index) + " has a viewpoint that is not finite");
     cloud_.viewpoint.push_back(viewpoint);
   }
+  if (has_time_) raw_times_.push_back(values[kTime]);
 }
 
 LidarCloud CloudBuilder::Finish(int width, int height) {
   if (cloud_.points.empty()) {
     Fail(path_, seen_ == 0 ? "contains no points"
                            : "none of its " + std::to_string(seen_) + " points has finite x, y, z");
+  }
+  if (has_time_) {
+    // A file has no clock of its own: its times count from the pair's lidar_stamp_ns.
+    const PointTimeReading reading = ReadPointTimes(time_field_, raw_times_, std::nullopt);
+    cloud_.time_s = PointTimesAfterStamp(raw_times_, reading, std::nullopt);
+    if (!reading.ok) NoteOnce("cloud-point-times", path_.string() + ": " + reading.words);
   }
   const bool keep_grid = dropped_ == 0 && height > 1 &&
                          static_cast<size_t>(width) * static_cast<size_t>(height) == seen_;
@@ -201,6 +212,9 @@ void CheckCloudForWriting(const std::filesystem::path& path, const LidarCloud& c
   if (cloud.HasViewpoint() && cloud.viewpoint.size() != n)
     Fail(path, "cannot write: viewpoint has " + std::to_string(cloud.viewpoint.size()) +
                    " values for " + std::to_string(n) + " points");
+  if (cloud.HasTime() && cloud.time_s.size() != n)
+    Fail(path, "cannot write: time has " + std::to_string(cloud.time_s.size()) + " values for " +
+                   std::to_string(n) + " points");
 }
 
 uint16_t RingAsU16(const std::filesystem::path& path, int ring) {

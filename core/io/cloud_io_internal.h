@@ -11,6 +11,7 @@
 
 #include "core/io/load_limits.h"
 #include "core/lidar/cloud.h"
+#include "core/lidar/point_times.h"
 
 namespace calibench::cloud_io_detail {
 
@@ -21,9 +22,10 @@ struct ScalarType {
 };
 
 // What a named field/property becomes in LidarCloud; the first six index value arrays.
-enum FieldRole { kX = 0, kY, kZ, kIntensity, kRing, kRange, kVpX, kVpY, kVpZ, kIgnored };
-inline constexpr int kNumRoles = 9;
-// x, y, z, intensity (or "i"), ring, range; anything else (rgb, t, reflectivity, ...) is ignored.
+enum FieldRole { kX = 0, kY, kZ, kIntensity, kRing, kRange, kVpX, kVpY, kVpZ, kTime, kIgnored };
+inline constexpr int kNumRoles = 10;
+// x, y, z, intensity (or "i"), ring, range, vp_x/y/z, the per-point time (`t`, as the dataset
+// contract writes it, or velodyne's `time`); anything else (rgb, reflectivity, ...) is ignored.
 FieldRole RoleOfName(std::string_view name);
 
 // Reads one scalar stored at `data` in the given byte order, widened to double.
@@ -49,12 +51,17 @@ class CloudBuilder {
   CloudBuilder(const std::filesystem::path& path, const bool has[kNumRoles], size_t expected);
   // values[role] for the roles present; others are ignored.
   void Add(const double values[kNumRoles]);
+  // The time field as the file declares it (when `has[kTime]`): how its values read as seconds
+  // after the pair's lidar_stamp_ns is decided at Finish (core/lidar/point_times.h).
+  void TimeFieldIs(PointTimeField field) { time_field_ = std::move(field); }
   // Keeps width x height only when it matches and nothing was dropped; IoError on no points.
   LidarCloud Finish(int width, int height);
 
  private:
   const std::filesystem::path& path_;
-  bool has_intensity_, has_ring_, has_range_, has_viewpoint_;
+  bool has_intensity_, has_ring_, has_range_, has_viewpoint_, has_time_;
+  PointTimeField time_field_{"t", false, "float"};
+  std::vector<double> raw_times_;
   size_t seen_ = 0;
   size_t dropped_ = 0;
   LidarCloud cloud_;

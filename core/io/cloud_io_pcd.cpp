@@ -33,7 +33,8 @@ struct PcdHeader {
   PcdData data = PcdData::kAscii;
   size_t data_start = 0;  // byte offset of the first data byte
   size_t data_line = 0;   // 1-based line number of the first ascii row
-  int field_of_role[kNumRoles] = {-1, -1, -1, -1, -1, -1, -1, -1, -1};
+  int field_of_role[kNumRoles] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
+  static_assert(kNumRoles == 10, "one -1 per role above");
 };
 
 // The header keywords, each a list of words, as they appear before DATA.
@@ -328,6 +329,14 @@ LidarCloud LoadPcd(const std::filesystem::path& path, const LoadLimits& limits) 
   bool has[kNumRoles];
   HasRoles(header, has);
   CloudBuilder builder(path, has, std::min<size_t>(header.points, bytes.size()));
+  if (has[kTime]) {
+    const PcdField& time = header.fields[header.field_of_role[kTime]];
+    const bool integer = time.type.kind != ScalarKind::kFloat;
+    builder.TimeFieldIs(
+        {time.name, integer,
+         std::string(integer ? (time.type.kind == ScalarKind::kSigned ? "I" : "U") : "F") +
+             std::to_string(time.type.bytes)});
+  }
   switch (header.data) {
     case PcdData::kAscii:
       ReadAscii(path, bytes, header, &builder);
@@ -374,6 +383,7 @@ std::vector<OutField> OutFields(const LidarCloud& cloud) {
   if (!cloud.range.empty()) fields.push_back({"range", 4, 'F'});
   if (cloud.HasViewpoint())
     for (const char* name : {"vp_x", "vp_y", "vp_z"}) fields.push_back({name, 4, 'F'});
+  if (cloud.HasTime()) fields.push_back({"t", 4, 'F'});  // seconds after lidar_stamp_ns
   return fields;
 }
 
@@ -412,6 +422,7 @@ std::string AsciiBody(const std::filesystem::path& path, const LidarCloud& cloud
     if (!cloud.range.empty()) AppendNumber(&(body += ' '), cloud.range[i]);
     if (cloud.HasViewpoint())
       for (int k = 0; k < 3; ++k) AppendNumber(&(body += ' '), cloud.viewpoint[i][k]);
+    if (cloud.HasTime()) AppendNumber(&(body += ' '), cloud.time_s[i]);
     body += '\n';
   }
   return body;
@@ -431,14 +442,17 @@ std::string BinaryBody(const std::filesystem::path& path, const LidarCloud& clou
       AppendBytes(&body, RingAsU16(path, cloud.ring[i]));
     else if (channel == 5)
       AppendBytes(&body, cloud.range[i]);
-    else
+    else if (channel < 9)
       AppendBytes(&body, cloud.viewpoint[i][channel - 6]);
+    else
+      AppendBytes(&body, cloud.time_s[i]);
   };
   std::vector<int> channels = {0, 1, 2};
   if (cloud.HasIntensity()) channels.push_back(3);
   if (cloud.HasRing()) channels.push_back(4);
   if (!cloud.range.empty()) channels.push_back(5);
   if (cloud.HasViewpoint()) channels.insert(channels.end(), {6, 7, 8});
+  if (cloud.HasTime()) channels.push_back(9);
   if (field_major) {
     for (const int c : channels)
       for (size_t i = 0; i < n; ++i) append_channel(i, c);

@@ -211,6 +211,10 @@ LidarCloud LoadPly(const std::filesystem::path& path, const LoadLimits& limits) 
     CheckLoadLimit(path, "the vertex count", static_cast<std::int64_t>(element.count),
                    limits.max_cloud_points, "max_cloud_points");
     CloudBuilder builder(path, has, std::min<uint64_t>(element.count, bytes.size()));
+    for (const PlyProperty& property : element.properties)
+      if (property.role == kTime && !property.is_list)
+        builder.TimeFieldIs({property.name, property.type.kind != ScalarKind::kFloat,
+                             property.type.kind == ScalarKind::kFloat ? "float" : "integer"});
     for (uint64_t row = 0; row < element.count; ++row) {
       reader.ReadRow(element, row, values);
       builder.Add(values);
@@ -236,6 +240,7 @@ void SavePly(const std::filesystem::path& path, const LidarCloud& cloud) {
   if (has_range) header << "property float range\n";
   if (cloud.HasViewpoint())
     header << "property float vp_x\nproperty float vp_y\nproperty float vp_z\n";
+  if (cloud.HasTime()) header << "property float t\n";  // seconds after lidar_stamp_ns
   header << "end_header\n";
   std::string body = header.str();
   for (size_t i = 0; i < cloud.size(); ++i) {
@@ -245,6 +250,7 @@ void SavePly(const std::filesystem::path& path, const LidarCloud& cloud) {
     if (has_range) AppendBytes(&body, cloud.range[i]);
     if (cloud.HasViewpoint())
       for (int k = 0; k < 3; ++k) AppendBytes(&body, cloud.viewpoint[i][k]);
+    if (cloud.HasTime()) AppendBytes(&body, cloud.time_s[i]);
   }
   std::ofstream out = OpenForWriting(path);
   out.write(body.data(), static_cast<std::streamsize>(body.size()));

@@ -1,6 +1,8 @@
 #include "core/io/dataset.h"
 
 #include <algorithm>
+#include <charconv>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -32,14 +34,56 @@ constexpr char kFormat[] = "calibench.dataset.v1";
                  "of them");
 }
 
+// "lidar_stamp_ns": nanoseconds as a decimal string (what JSON readers that hold numbers as
+// doubles keep exactly) or an integer.
+std::optional<std::int64_t> ParseStampNs(const json_io::Fields& p, const std::string& key) {
+  if (!p.Has(key)) return std::nullopt;
+  const json& value = p.At(key);
+  if (value.is_number_integer()) return value.get<std::int64_t>();
+  if (value.is_string()) {
+    const std::string text = value.get<std::string>();
+    std::int64_t ns = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), ns);
+    if (error == std::errc() && end == text.data() + text.size() && !text.empty()) return ns;
+  }
+  p.Fail(key, "must be nanoseconds as an integer or a decimal string (\"1604515190231000000\")");
+}
+
 PairEntry ParsePair(const json_io::Fields& p, std::set<std::string>* seen) {
   const fs::path base = p.file().parent_path();
   PairEntry pair;
   pair.id = p.String("id");
   json_io::CheckUniquePairId(pair.id, seen, p.file());
   pair.cloud = json_io::Resolve(base, p.String("cloud"));
-  pair.image = json_io::Resolve(base, p.String("image"));
   pair.lidar_seed = json_io::ParseLidarSeed(p);
+  pair.lidar_stamp_ns = ParseStampNs(p, "lidar_stamp_ns");
+  if (!p.Has("images")) {
+    pair.image = json_io::Resolve(base, p.String("image"));
+    return pair;
+  }
+  // A moving capture: the frames around the sweep, each with its stamp on the camera's clock.
+  if (p.Has("image")) p.Fail("images", "a pair gives \"image\" or \"images\", not both");
+  if (!pair.lidar_stamp_ns)
+    p.Fail("images",
+           "needs the pair's \"lidar_stamp_ns\": the frames' stamps are compared with it");
+  const json& frames = p.Array("images");
+  if (frames.empty()) p.Fail("images", "is empty");
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const json_io::Fields frame(frames[k], p.file(),
+                                p.Path("images") + "[" + std::to_string(k) + "]");
+    const std::optional<std::int64_t> stamp = ParseStampNs(frame, "stamp_ns");
+    if (!stamp) frame.Fail("stamp_ns", "missing");
+    pair.images.push_back({json_io::Resolve(base, frame.String("image")), *stamp});
+  }
+  std::stable_sort(
+      pair.images.begin(), pair.images.end(),
+      [](const StampedImage& a, const StampedImage& b) { return a.stamp_ns < b.stamp_ns; });
+  const auto nearest = std::min_element(pair.images.begin(), pair.images.end(),
+                                        [&](const StampedImage& a, const StampedImage& b) {
+                                          return std::llabs(a.stamp_ns - *pair.lidar_stamp_ns) <
+                                                 std::llabs(b.stamp_ns - *pair.lidar_stamp_ns);
+                                        });
+  pair.image = nearest->image;
   return pair;
 }
 
@@ -167,11 +211,21 @@ void SaveDataset(const fs::path& manifest_path, const Dataset& dataset) {
   if (dataset.lidar_rings > 0) root["lidar"] = {{"rings", dataset.lidar_rings}};
   json pairs = json::array();
   for (const PairEntry& p : dataset.pairs) {
-    json entry = {{"id", p.id}, {"cloud", relative(p.cloud)}, {"image", relative(p.image)}};
+    json entry = {{"id", p.id}, {"cloud", relative(p.cloud)}};
+    if (p.images.empty()) {
+      entry["image"] = relative(p.image);
+    } else {
+      json frames = json::array();
+      for (const StampedImage& frame : p.images)
+        frames.push_back(
+            {{"image", relative(frame.image)}, {"stamp_ns", std::to_string(frame.stamp_ns)}});
+      entry["images"] = frames;
+    }
     if (p.lidar_seed)
       entry["lidar_seed"] = {
           {"point", {p.lidar_seed->point.x(), p.lidar_seed->point.y(), p.lidar_seed->point.z()}},
           {"radius", p.lidar_seed->radius}};
+    if (p.lidar_stamp_ns) entry["lidar_stamp_ns"] = std::to_string(*p.lidar_stamp_ns);
     pairs.push_back(entry);
   }
   root["pairs"] = pairs;

@@ -15,11 +15,26 @@
 
 namespace calibench {
 
+// One camera frame of a moving capture: the image and its stamp on the camera's clock.
+struct StampedImage {
+  std::filesystem::path image;  // absolute after loading
+  std::int64_t stamp_ns = 0;
+};
+
 struct PairEntry {
   std::string id;
   std::filesystem::path cloud;  // absolute after loading
-  std::filesystem::path image;  // absolute after loading
+  // Absolute after loading. A moving capture's pair: the frame of `images` nearest its
+  // lidar_stamp_ns (what a view of one image shows).
+  std::filesystem::path image;
   std::optional<LidarSeed> lidar_seed;
+  // The cloud's stamp on the LiDAR's clock (nanoseconds; the manifest's "lidar_stamp_ns", a
+  // decimal string or an integer): what the cloud's per-point times (LidarCloud::time_s, a PCD /
+  // PLY field `t`) count from. Absent: the pair is instantaneous.
+  std::optional<std::int64_t> lidar_stamp_ns;
+  // A moving capture (the manifest's "images" instead of "image", with lidar_stamp_ns): every
+  // camera frame around the sweep, in stamp order (camera clock). Empty: one image, `image`.
+  std::vector<StampedImage> images;
 };
 
 // What `calibench simulate` was asked for, so that every pair's noise-free geometry can be

@@ -1,4 +1,4 @@
-// LiDAR point clouds with optional per-point intensity, ring and range (files: core/io/cloud_io.h).
+// LiDAR point clouds with optional per-point intensity, ring, range, ray origin and time (files: core/io/cloud_io.h).
 #pragma once
 
 #include <vector>
@@ -16,6 +16,10 @@ struct LidarCloud {
   // turned it, written by its driver (PCD / PLY / PointCloud2 fields vp_x, vp_y, vp_z, as PCL's
   // PointWithViewpoint). Empty: every ray starts at the LiDAR's origin.
   std::vector<Eigen::Vector3f> viewpoint;
+  // Each return's time, seconds after the cloud's stamp (the pair's lidar_stamp_ns; negative for
+  // returns before it, as a driver that stamps the sweep's end gives them): the drivers' fields
+  // read by core/lidar/point_times.h, a PCD / PLY field `t`. Empty: the cloud is instantaneous.
+  std::vector<float> time_s;
   // Organized clouds (height > 1) store rows = rings, columns = firing order.
   int width = 0;
   int height = 1;
@@ -24,6 +28,7 @@ struct LidarCloud {
   bool HasIntensity() const { return !intensity.empty(); }
   bool HasRing() const { return !ring.empty(); }
   bool HasViewpoint() const { return !viewpoint.empty(); }
+  bool HasTime() const { return !time_s.empty(); }
   // Where return i's ray starts (see viewpoint).
   Eigen::Vector3d RayOrigin(size_t i) const {
     if (viewpoint.empty()) return Eigen::Vector3d::Zero();

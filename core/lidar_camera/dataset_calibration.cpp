@@ -49,9 +49,9 @@ bool DatasetExtraction::Step() {
         const size_t i = first + k;
         const auto edit = edits_.find(selected_[i]->id);
         LidarCloud* preloaded = i < clouds_.size() && clouds_[i] ? &*clouds_[i] : nullptr;
-        features_[i] = ExtractPairFeatures(dataset_, *selected_[i], options_,
-                                           edit == edits_.end() ? PairEdit{} : edit->second,
-                                           background_ ? &*background_ : nullptr, preloaded);
+        features_[i] = ExtractPairFeatures(
+            dataset_, *selected_[i], options_, edit == edits_.end() ? PairEdit{} : edit->second,
+            background_ ? &*background_ : nullptr, preloaded, &frames_);
         if (preloaded) clouds_[i].reset();  // its memory goes with the pair
       },
       [&](int finished, size_t k) {

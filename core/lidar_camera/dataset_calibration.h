@@ -48,6 +48,7 @@ class DatasetExtraction {
   std::optional<SceneBackground> background_;
   std::string background_note_;
   std::vector<std::optional<LidarCloud>> clouds_;  // read once, for the background and the pair
+  FrameBoards frames_;                             // a moving capture's frames, each posed once
   std::vector<PairFeatures> features_;
   size_t pairs_per_step_ = 0;  // 0: every pair in one step
   size_t next_pair_ = 0;

@@ -13,13 +13,14 @@
 #include "core/lidar/cloud.h"
 #include "core/lidar_camera/joint_intrinsics.h"
 #include "core/lidar_camera/lidar_model_evidence.h"
+#include "core/lidar_camera/time_offset.h"
 
 namespace calibench {
 
 bool PipelineOptions::Check(std::string* why) const {
   if (!lidar_plane.Check(why) || !detection.Check(why) || !pnp.Check(why) || !solver.Check(why) ||
       !board_detection.Check(why) || !lidar_geometry.Check(why) || !swept_origin.Check(why) ||
-      !lidar_model_evidence.Check(why))
+      !lidar_model_evidence.Check(why) || !time_offset.Check(why))
     return false;
   if (!(guided_max_sigmas > 0 && guided_floor_sigma_deg >= 0 && guided_floor_sigma_m >= 0)) {
     if (why) *why = "guided_max_sigmas must be > 0 and the guided floors >= 0";
@@ -147,6 +148,19 @@ std::vector<int> RegionFor(const Dataset& dataset, const LidarCloud& cloud, cons
   return found.board->indices;
 }
 
+// A moving capture's frames: the board in each that shows it, stamps after the pair's
+// lidar_stamp_ns (seconds). A frame that cannot be read or shows no board leaves a gap.
+std::vector<TimedObservation> TrackBoard(const Dataset& dataset, const PairEntry& pair,
+                                         const PipelineOptions& options, FrameBoards* frames) {
+  FrameBoards own;
+  std::vector<TimedObservation> track;
+  for (const StampedImage& frame : pair.images)
+    if (auto board = (frames ? frames : &own)->Of(dataset, frame.image, options))
+      track.push_back(
+          {(frame.stamp_ns - pair.lidar_stamp_ns.value_or(0)) * 1e-9, std::move(*board)});
+  return track;
+}
+
 }  // namespace
 
 std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const LidarCloud& cloud,
@@ -238,9 +252,29 @@ std::optional<BoardHint> BoardHintFor(const PairEntry& pair, const PairEdit& edi
   return hint;
 }
 
+std::optional<CameraBoardObservation> FrameBoards::Of(const Dataset& dataset,
+                                                      const std::filesystem::path& image,
+                                                      const PipelineOptions& options) {
+  {
+    std::lock_guard lock(mutex_);
+    if (const auto seen = seen_.find(image); seen != seen_.end()) return seen->second;
+  }
+  // Posed outside the lock: two workers asking for one frame at once both pose it, alike.
+  std::optional<CameraBoardObservation> board;
+  try {
+    const ImageU8 frame = LoadImage(image);
+    if (frame.width == dataset.camera.width && frame.height == dataset.camera.height)
+      board = ExtractCameraFeatures(dataset, frame, options).observation;
+  } catch (const IoError&) {
+  }
+  std::lock_guard lock(mutex_);
+  return seen_.emplace(image, std::move(board)).first->second;
+}
+
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
                                  const PipelineOptions& options, const PairEdit& edit,
-                                 const SceneBackground* background, LidarCloud* preloaded_cloud) {
+                                 const SceneBackground* background, LidarCloud* preloaded_cloud,
+                                 FrameBoards* frames) {
   PairFeatures features;
   features.id = pair.id;
   std::string why;
@@ -263,6 +297,7 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
   CameraFeatures camera = ExtractCameraFeatures(dataset, inputs->image, options);
   features.camera = std::move(camera.observation);
   features.edge_width_px = camera.edge_width_px;
+  if (!pair.images.empty()) features.camera_track = TrackBoard(dataset, pair, options, frames);
   SetStatusFromFeatures(&features, lidar_failure, camera.failure);
   if (edit.rejected) {
     features.status = PairStatus::kRejected;
@@ -381,6 +416,7 @@ CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,
   if (options.lidar_model_evidence.enabled)
     outcome.lidar_model_evidence =
         ChooseLidarModelByEvidence(&outcome.pairs, options, options.lidar_model_evidence);
+  PlaceBoardsInTime(options, &outcome);
   for (const PairFeatures& p : outcome.pairs) {
     if (p.status != PairStatus::kAccepted) continue;
     planes.push_back(MakePlanePair(p.id, *p.lidar, *p.camera));
@@ -404,6 +440,11 @@ CalibrationOutcome SolveFromFeatures(std::vector<PairFeatures> pairs,
   }
   PlaneAlignmentSolver solver(planes, options.solver, outcome.initial_cam_from_lidar);
   outcome.solution = solver.Run(on_iteration);
+  // The offset's own uncertainty moves the pose along how the pose follows it.
+  const TimeOffsetEstimate& offset = outcome.time_offset;
+  if (offset.camera_minus_lidar_s && !offset.fixed)
+    outcome.solution->covariance +=
+        offset.std_s * offset.std_s * offset.pose_rate * offset.pose_rate.transpose();
   return outcome;
 }
 

@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "core/lidar/cloud.h"
 #include "core/lidar/lidar_image.h"
 #include "core/lidar/swept_origin.h"
+#include "core/lidar_camera/board_track.h"
 #include "core/lidar_camera/solver.h"
 #include "core/results/pair_status.h"
 #include "core/target/board_camera.h"
@@ -78,6 +80,9 @@ struct PipelineOptions {
   // The extrinsic's covariance includes the intrinsics' (the camera file's, or the refined
   // camera's), propagated through the solve (AddIntrinsicsUncertainty).
   bool propagate_intrinsics = true;
+  // A moving capture's offset between the camera's and the LiDAR's clocks: searched, or given
+  // (core/lidar_camera/time_offset.h).
+  TimeOffsetOptions time_offset;
   // Sees each pair's files once the extraction has read them, on the extraction's workers (so it
   // must be safe to call from several threads): whoever needs them later (the report's figures)
   // keeps what it needs instead of reading them again. Optional.
@@ -103,6 +108,10 @@ struct PairFeatures : PairStanding {
   std::optional<CameraBoardObservation> camera;
   BoardOrigin board_origin;
   std::optional<double> edge_width_px;  // ChessboardEdgeWidthPx of its detection (blur)
+  // A moving capture's pair (PairEntry::images): the board in each of its frames that showed
+  // it, stamps after the pair's lidar_stamp_ns; `camera` is then the board at the LiDAR's
+  // instant under the time offset (PlaceCameraBoardAt). Empty: one image.
+  std::vector<TimedObservation> camera_track;
 };
 
 // options.lidar_plane for `target`: its grow radius (when options.grow_to_board) and its sheet size
@@ -226,9 +235,40 @@ struct CalibrationOutcome {
   // How the data chose a ring-less LiDAR's noise model (ChooseLidarModelByEvidence); absent when
   // they were not asked (rings, a forced model, too few pairs).
   std::optional<LidarModelEvidence> lidar_model_evidence;
+  // The camera's clock against the LiDAR's (EstimateTimeOffset): estimated from a moving
+  // capture, given, or why not.
+  TimeOffsetEstimate time_offset;
 };
 // The outcome's pairs accepted for the solve.
 int AcceptedPairs(const CalibrationOutcome& outcome);
+
+// The boards of a moving capture's frames, each frame read and posed once however many pairs
+// list it (thread-safe: one per extraction of a dataset).
+class FrameBoards {
+ public:
+  FrameBoards() = default;
+  // A copy (of a job, say) keeps what was posed, with a lock of its own.
+  FrameBoards(const FrameBoards& other) : seen_(other.Copy()) {}
+  FrameBoards& operator=(const FrameBoards& other) {
+    auto seen = other.Copy();
+    std::lock_guard lock(mutex_);
+    seen_ = std::move(seen);
+    return *this;
+  }
+  // The board in `image` (nullopt: unreadable, not the camera's size, or no board in it).
+  std::optional<CameraBoardObservation> Of(const Dataset& dataset,
+                                           const std::filesystem::path& image,
+                                           const PipelineOptions& options);
+
+ private:
+  using Boards = std::map<std::filesystem::path, std::optional<CameraBoardObservation>>;
+  Boards Copy() const {
+    std::lock_guard lock(mutex_);
+    return seen_;
+  }
+  mutable std::mutex mutex_;
+  Boards seen_;
+};
 
 // Loads the pair's files and extracts both planes (the steps above; the hint is the pair's edited
 // brush, else its seed). Never throws for bad data: the pair comes back kFailed with the reason
@@ -236,7 +276,8 @@ int AcceptedPairs(const CalibrationOutcome& outcome);
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
                                  const PipelineOptions& options, const PairEdit& edit = {},
                                  const SceneBackground* background = nullptr,
-                                 LidarCloud* preloaded_cloud = nullptr);
+                                 LidarCloud* preloaded_cloud = nullptr,
+                                 FrameBoards* frames = nullptr);
 
 // The background model over the selected pairs' clouds (for detection); nullopt with *why when it
 // cannot be built (fewer than 3 readable clouds, or they repeat no static scene). `clouds`

@@ -9,6 +9,7 @@
 
 #include "core/lidar_camera/result_intrinsics_json.h"
 #include "core/lidar_camera/result_lidar.h"
+#include "core/lidar_camera/time_offset.h"
 #include "core/results/result_json.h"
 
 namespace calibench {
@@ -138,6 +139,21 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
   root["solver"]["residuals_available"] = ResidualsAvailable(outcome);
   if (json model = LidarModelJson(outcome); !model.is_null()) root["lidar_model"] = model;
   if (json noise = LidarNoiseJson(outcome); !noise.is_null()) root["lidar_noise"] = noise;
+  if (json times = LidarTimesJson(outcome); !times.is_null()) root["lidar_times"] = times;
+  const TimeOffsetEstimate& offset = outcome.time_offset;
+  if (offset.camera_minus_lidar_s) {
+    root["time_offset"] = {
+        {"camera_minus_lidar_s", *offset.camera_minus_lidar_s},
+        {"std_s", offset.std_s},
+        {"given", offset.fixed},
+        {"moving_pairs", offset.profiled_pairs},
+        {"meaning",
+         "a camera stamp minus the LiDAR clock's time of the same instant (+0.040: the camera's "
+         "stamps are 40 ms late); std_s is in the pose's covariance too"}};
+  } else {
+    root["time_offset"] = nullptr;
+    root["time_offset_why"] = offset.why;
+  }
   return root;
 }
 
@@ -398,6 +414,9 @@ std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& 
   if (const std::string model = DescribeLidarModel(outcome); !model.empty()) out << model << "\n";
   if (const std::string noise = DescribeLearnedLidarNoise(outcome); !noise.empty())
     out << noise << "\n";
+  if (const std::string times = DescribeLidarTimes(outcome); !times.empty()) out << times << "\n";
+  if (outcome.time_offset.moving_pairs > 0 || outcome.time_offset.fixed)
+    out << DescribeTimeOffset(outcome.time_offset) << "\n";
   const ResidualCounts counts = CountResiduals(outcome);
   out << "residuals: board planes from " << counts.plane_pairs << " pairs";
   if (counts.edges_in_model)

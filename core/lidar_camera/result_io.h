@@ -34,6 +34,9 @@ std::string DescribeLidarModel(const CalibrationOutcome& outcome);
 // The LiDAR's noise learned from the accepted pairs' boards (core/target/lidar_noise.h), in
 // words: the summary's line and the workbench's note. "" without boards fitted along their rays.
 std::string DescribeLearnedLidarNoise(const CalibrationOutcome& outcome);
+// "LiDAR times: ...": whether the boards' returns carry their own times, and their span; said once
+// per result ("" without LiDAR fits).
+std::string DescribeLidarTimes(const CalibrationOutcome& outcome);
 
 // Human-readable summary: both directions in words, standard deviations, observability, pairs.
 std::string FormatSummary(const CalibrationOutcome& outcome, const ResultNames& names = {});

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "core/lidar_camera/result_io.h"
@@ -90,7 +91,69 @@ json NoiseJson(const LidarNoiseEstimate& e) {
            "angular_sigma_upper_deg is a 95% bound"}};
 }
 
+// The accepted boards' returns in time (LidarPlaneFit::inlier_times_s): per pair with times, its
+// span and its centre after the cloud's stamp.
+struct BoardTimes {
+  int accepted = 0;  // accepted pairs with a LiDAR fit
+  std::vector<double> spans_s, centres_s;
+};
+
+BoardTimes AcceptedBoardTimes(const CalibrationOutcome& outcome) {
+  BoardTimes times;
+  for (const PairFeatures& p : outcome.pairs) {
+    if (p.status != PairStatus::kAccepted || !p.lidar) continue;
+    ++times.accepted;
+    const std::vector<float>& t = p.lidar->inlier_times_s;
+    if (t.empty()) continue;
+    const auto [low, high] = std::minmax_element(t.begin(), t.end());
+    times.spans_s.push_back(*high - *low);
+    times.centres_s.push_back(0.5 * (*high + *low));
+  }
+  return times;
+}
+
+double MedianOf(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
 }  // namespace
+
+json LidarTimesJson(const CalibrationOutcome& outcome) {
+  const BoardTimes times = AcceptedBoardTimes(outcome);
+  if (times.accepted == 0) return nullptr;
+  json out = {{"pairs", times.accepted}, {"pairs_with_point_times", times.spans_s.size()}};
+  if (!times.spans_s.empty()) {
+    out["board_span_s"] = {{"median", MedianOf(times.spans_s)},
+                           {"max", *std::max_element(times.spans_s.begin(), times.spans_s.end())}};
+    out["board_centre_after_stamp_s"] = {{"median", MedianOf(times.centres_s)}};
+  }
+  out["meaning"] =
+      "each board's LiDAR returns in time (the clouds' per-point times, seconds after each pair's "
+      "lidar_stamp_ns); a pair without them is taken as seen at its stamp";
+  return out;
+}
+
+std::string DescribeLidarTimes(const CalibrationOutcome& outcome) {
+  const BoardTimes times = AcceptedBoardTimes(outcome);
+  if (times.accepted == 0) return "";
+  if (times.spans_s.empty())
+    return "LiDAR times: the clouds carry no per-point times; each board is taken as seen at its "
+           "cloud's stamp";
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "LiDAR times: %zu of %d boards' returns carry their own times; a board's returns "
+                "span %.1f ms (median; longest %.1f ms), centred %+.1f ms after their cloud's "
+                "stamp (median)",
+                times.spans_s.size(), times.accepted, MedianOf(times.spans_s) * 1e3,
+                *std::max_element(times.spans_s.begin(), times.spans_s.end()) * 1e3,
+                MedianOf(times.centres_s) * 1e3);
+  std::string words = text;
+  if (static_cast<int>(times.spans_s.size()) < times.accepted)
+    words += "; the others are taken as seen at their stamps";
+  return words;
+}
 
 json LidarModelJson(const CalibrationOutcome& outcome) {
   const std::vector<ModelGroup> groups = GroupByLidarModel(outcome);

@@ -16,4 +16,8 @@ nlohmann::json LidarModelJson(const CalibrationOutcome& outcome);
 // none was.
 nlohmann::json LidarNoiseJson(const CalibrationOutcome& outcome);
 
+// `lidar_times`: the accepted boards' returns in time (their clouds' per-point times): how many
+// pairs carry them, a board's span and its centre after its cloud's stamp; null without fits.
+nlohmann::json LidarTimesJson(const CalibrationOutcome& outcome);
+
 }  // namespace calibench

@@ -7,10 +7,13 @@
 #include <stdexcept>
 
 #include "core/io/camera_file.h"
+#include "core/lidar/point_times.h"
 #include "core/recording/ros_message_cursor.h"
 
 namespace calibench {
 namespace {
+
+constexpr const char* kNoTimeFieldWords = "each cloud is treated as instantaneous";
 
 // The cursor over a message and its checks: core/recording/ros_message_cursor.h.
 using ros_detail::Bad;
@@ -116,12 +119,47 @@ void OrderByLaserLine(const std::vector<int>& line, LidarCloud* cloud, std::vect
   };
   permute(cloud->points);
   permute(cloud->intensity);
+  permute(cloud->time_s);
   if (extra) permute(*extra);
 }
 
+bool IsIntegerField(const PointField& field) {
+  return field.type != kFloat32 && field.type != kFloat64;
+}
+
+// The driver's per-point time field (point_times.h): Luminar's two fields as one value in seconds
+// on the clock, else the first of PointTimeFieldNames.
+struct TimeFields {
+  const PointField* seconds = nullptr;      // time_sec (Luminar), else the one field
+  const PointField* nanoseconds = nullptr;  // time_nsec (Luminar)
+  PointTimeField declared;
+
+  explicit TimeFields(const std::vector<PointField>& fields) {
+    const PointField* sec = FindField(fields, {"time_sec"});
+    const PointField* nsec = FindField(fields, {"time_nsec"});
+    if (sec && nsec) {
+      seconds = sec, nanoseconds = nsec;
+      declared = {"time_sec+time_nsec", false,
+                  std::string(kPointFieldNames[sec->type]) + "+" + kPointFieldNames[nsec->type]};
+      return;
+    }
+    for (const std::string& name : PointTimeFieldNames())
+      if (const PointField* field = FindField(fields, {name.c_str()})) {
+        seconds = field;
+        declared = {field->name, IsIntegerField(*field), kPointFieldNames[field->type]};
+        return;
+      }
+  }
+  double Read(const std::uint8_t* point, bool swap) const {
+    const double value = ReadField(point, *seconds, swap);
+    return nanoseconds ? value + 1e-9 * ReadField(point, *nanoseconds, swap) : value;
+  }
+};
+
 void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>& fields,
                std::uint32_t width, std::uint32_t height, std::uint32_t point_step,
-               std::uint32_t row_step, bool swap, LidarCloud* cloud) {
+               std::uint32_t row_step, bool swap, std::int64_t stamp_ns, LidarCloud* cloud,
+               std::string* point_times) {
   const PointField* x = FindField(fields, {"x"});
   const PointField* y = FindField(fields, {"y"});
   const PointField* z = FindField(fields, {"z"});
@@ -136,6 +174,8 @@ void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>
   const PointField* vp_y = FindField(fields, {"vp_y"});
   const PointField* vp_z = FindField(fields, {"vp_z"});
   const bool viewpoint = vp_x && vp_y && vp_z;
+  const TimeFields time(fields);
+  std::vector<double> raw_times;
   std::vector<int> lines;
   const std::size_t total = static_cast<std::size_t>(width) * height;
   if (total == 0) return;  // no points: not 4 billion empty rows walked through
@@ -163,6 +203,7 @@ void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>
         cloud->ring.push_back(static_cast<int>(index));
       }
       if (line) lines.push_back(static_cast<int>(ReadField(point, *line, swap)));
+      if (time.seconds) raw_times.push_back(time.Read(point, swap));
       if (viewpoint) {
         const Eigen::Vector3f origin(static_cast<float>(ReadField(point, *vp_x, swap)),
                                      static_cast<float>(ReadField(point, *vp_y, swap)),
@@ -173,6 +214,14 @@ void FillCloud(std::span<const std::uint8_t> data, const std::vector<PointField>
         cloud->viewpoint.push_back(origin);
       }
     }
+  }
+  if (time.seconds) {
+    const std::optional<double> stamp_s = static_cast<double>(stamp_ns) * 1e-9;
+    const PointTimeReading reading = ReadPointTimes(time.declared, raw_times, stamp_s);
+    cloud->time_s = PointTimesAfterStamp(raw_times, reading, stamp_s);
+    *point_times = reading.words;
+  } else {
+    *point_times = "no per-point time field (" + std::string(kNoTimeFieldWords) + ")";
   }
   OrderByLaserLine<int>(lines, cloud, nullptr);
   const bool complete = cloud->points.size() == total;
@@ -218,7 +267,8 @@ PointCloud2Message DecodePointCloud2(std::span<const std::uint8_t> data, Message
             static_cast<std::uint64_t>(width) * point_step, height, points.size());
   message.declared_points = static_cast<int>(declared);
   const bool swap = big_endian != (std::endian::native == std::endian::big);
-  FillCloud(points, fields, width, height, point_step, row_step, swap, &message.cloud);
+  FillCloud(points, fields, width, height, point_step, row_step, swap, message.header.stamp_ns,
+            &message.cloud, &message.point_times);
   return message;
 }
 
@@ -293,6 +343,13 @@ LivoxCustomMessage DecodeLivoxCustomMsg(std::span<const std::uint8_t> data,
     message.offset_time_ns.push_back(offset_time);
     lines.push_back(laser);
   }
+  // Each return at its own time: timebase + offset_time, after the header's stamp.
+  const double after_stamp_s =
+      (static_cast<double>(message.timebase_ns) - static_cast<double>(message.header.stamp_ns)) *
+      1e-9;
+  cloud.time_s.reserve(message.offset_time_ns.size());
+  for (const std::uint32_t offset : message.offset_time_ns)
+    cloud.time_s.push_back(static_cast<float>(after_stamp_s + 1e-9 * offset));
   OrderByLaserLine(lines, &cloud, &message.offset_time_ns);
   cloud.width = static_cast<int>(cloud.size());
   cloud.height = 1;
@@ -307,10 +364,14 @@ CloudMessage DecodeCloudMessage(std::span<const std::uint8_t> data, bool livox,
                                 MessageEncoding encoding, const LoadLimits& limits) {
   if (livox) {
     LivoxCustomMessage message = DecodeLivoxCustomMsg(data, encoding, limits);
-    return {std::move(message.header), std::move(message.cloud)};
+    std::string words =
+        "per-point times from 'offset_time' (UINT32), nanoseconds after the "
+        "message's timebase: " +
+        DescribePointTimes(message.cloud.time_s);
+    return {std::move(message.header), std::move(message.cloud), std::move(words)};
   }
   PointCloud2Message message = DecodePointCloud2(data, encoding, limits);
-  return {std::move(message.header), std::move(message.cloud)};
+  return {std::move(message.header), std::move(message.cloud), std::move(message.point_times)};
 }
 
 }  // namespace calibench

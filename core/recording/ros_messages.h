@@ -31,9 +31,13 @@ struct PointCloud2Message {
   LidarCloud cloud;         // finite points only; organized when nothing was dropped
   std::string fields;       // "x:FLOAT32@0 y:FLOAT32@4 ..." as the message declares them
   int declared_points = 0;  // width x height
+  // How the per-point times were read into cloud.time_s, or why there are none (point_times.h).
+  std::string point_times;
 };
 // Any field layout: x, y, z of any numeric type; intensity from `intensity` (else
-// `reflectivity`, `i`); ring from `ring` (else `laser_id`, `channel`, `line`); either byte order.
+// `reflectivity`, `i`); ring from `ring` (else `laser_id`, `channel`, `line`); each return's time
+// from the driver's field (core/lidar/point_times.h: `t`, `time`, `timestamp`, ..., Luminar's
+// `time_sec` + `time_nsec`), as seconds after header.stamp; either byte order.
 // Throws std::invalid_argument naming what is wrong (no x/y/z, fields beyond point_step, data
 // shorter than row_step x height, more points than limits.max_cloud_points, ...).
 PointCloud2Message DecodePointCloud2(std::span<const std::uint8_t> data, MessageEncoding encoding,
@@ -78,7 +82,7 @@ struct LivoxCustomMessage {
   // returns follow the rosette, not a cone. The driver interleaves its lasers (an Avia's 6, a
   // Mid-360's 4); the returns are stored laser by laser, each in firing order, so that
   // consecutive returns are neighbours on one beam's path (board edges from its crossings).
-  LidarCloud cloud;
+  LidarCloud cloud;  // time_s: timebase + offset_time after header.stamp
   std::vector<std::uint32_t> offset_time_ns;  // per kept return
   int noise_dropped = 0;                      // returns tagged as noise
 };
@@ -102,6 +106,7 @@ bool IsCloudType(const std::string& type);
 struct CloudMessage {
   RosHeader header;
   LidarCloud cloud;
+  std::string point_times;  // how cloud.time_s was read, or why it is empty (for a summary)
 };
 CloudMessage DecodeCloudMessage(std::span<const std::uint8_t> data, bool livox,
                                 MessageEncoding encoding, const LoadLimits& limits = {});

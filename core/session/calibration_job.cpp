@@ -158,7 +158,7 @@ const PairFeatures& CalibrationJob::AddPair(const PairEntry& entry, const PairFe
     PairEdit edit = EditOf(entry.id);
     edit.rejected = false;  // applies at the solve
     features = ExtractPairFeatures(dataset_, entry, pipeline, edit, Background(),
-                                   cloud ? &*cloud : nullptr);
+                                   cloud ? &*cloud : nullptr, &frames_);
   }
   {
     std::lock_guard lock(pairs_mutex_);
@@ -402,7 +402,7 @@ bool CalibrationJob::CommitOutcome(bool own_step) {
     result = SessionResultFromSolver(*outcome_->solution);
     for (const std::string& note :
          {DescribeLidarModel(*outcome_), DescribeLearnedLidarNoise(*outcome_),
-          CountResiduals(*outcome_).note})
+          DescribeLidarTimes(*outcome_), CountResiduals(*outcome_).note})
       if (!note.empty()) result->notes.push_back(note);
     for (const IterationReport& it : iterations_) {
       result->step_history.push_back(it.step_norm);

@@ -229,6 +229,8 @@ class CalibrationJob final : public Job {
   SceneBackground background_accumulator_;
   std::set<int> in_background_;
   std::optional<SceneBackground> background_;  // finished, when usable
+  // A moving capture's frames, each posed once for every pair that lists it (thread-safe).
+  FrameBoards frames_;
   std::string background_note_ = "fewer than 3 clouds so far";
   std::optional<CalibrationOutcome> outcome_;
   std::optional<SolverResult> last_solution_;

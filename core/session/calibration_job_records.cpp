@@ -3,6 +3,7 @@
 // makes for them beyond the steps (an adopted estimate, a followed capture's rejections).
 #include <algorithm>
 
+#include "core/lidar_camera/time_offset.h"
 #include "core/session/calibration_job.h"
 
 namespace calibench {
@@ -36,6 +37,16 @@ CalibrationOutcome CalibrationJob::OutcomeAt(const Session& record, const Solver
   CalibrationOutcome outcome;
   outcome.pairs = PairsNow(record);
   outcome.solution = shown;
+  PipelineOptions pipeline = options_.advise.pipeline;
+  record.settings.Apply(&pipeline);
+  // The clocks as the last solve found them (a still capture's "cannot tell" costs nothing to
+  // say again), each moving pair's camera board placed in time as that solve placed it.
+  outcome.time_offset = outcome_
+                            ? outcome_->time_offset
+                            : EstimateTimeOffset(outcome.pairs, pipeline, shown.cam_from_lidar);
+  if (const auto offset = outcome.time_offset.camera_minus_lidar_s)
+    for (PairFeatures& pair : outcome.pairs)
+      PlaceCameraBoardAt(&pair, *offset, pipeline.time_offset);
   std::vector<std::string> accepted;
   for (const PairFeatures& pair : outcome.pairs)
     if (pair.status == PairStatus::kAccepted) accepted.push_back(pair.id);
@@ -43,8 +54,6 @@ CalibrationOutcome CalibrationJob::OutcomeAt(const Session& record, const Solver
   // outliers it gated); after accept/reject since, or after a reload, the solver's residuals at
   // the shown estimate over the pairs accepted now.
   if (accepted == solved_ids && shown.residuals.size() == accepted.size()) return outcome;
-  PipelineOptions pipeline = options_.advise.pipeline;
-  record.settings.Apply(&pipeline);
   EvaluateAtSolution(outcome.pairs, pipeline.solver, &*outcome.solution);
   return outcome;
 }

@@ -15,7 +15,8 @@ namespace {
 // v2: the LiDAR fits carry their ring-bias covariance, what their rings' ends showed and their
 // noise model. v4: their range residuals' sums (the LiDAR's noise is learned from them).
 // v5: a ring-less cloud's fit under the other candidate model (LidarPlaneFit::alternative).
-constexpr const char* kFeatureCacheFormat = "calibench.features.v5";
+// v6: each inlier's time (LidarPlaneFit::inlier_times_s).
+constexpr const char* kFeatureCacheFormat = "calibench.features.v6";
 
 // A matrix as its rows, flattened row by row.
 template <typename Matrix>
@@ -90,6 +91,7 @@ json LidarToJson(const LidarPlaneFit& fit) {
       {"plane", PlaneToJson(fit.plane)},
       {"covariance", MatrixToJson(fit.covariance)},
       {"inliers", fit.inliers},
+      {"inlier_times_s", fit.inlier_times_s},
       {"inlier_centroid", MatrixToJson(fit.inlier_centroid)},
       {"num_candidates", fit.num_candidates},
       {"grown", fit.grown},
@@ -112,6 +114,9 @@ LidarPlaneFit LidarFromJson(const json& j) {
   fit.plane = PlaneFromJson(j.at("plane"));
   MatrixFromJson(j.at("covariance"), &fit.covariance);
   fit.inliers = j.at("inliers").get<std::vector<int>>();
+  fit.inlier_times_s = j.at("inlier_times_s").get<std::vector<float>>();
+  if (!fit.inlier_times_s.empty() && fit.inlier_times_s.size() != fit.inliers.size())
+    throw std::invalid_argument("inlier times do not match the inliers");
   MatrixFromJson(j.at("inlier_centroid"), &fit.inlier_centroid);
   fit.num_candidates = j.at("num_candidates").get<int>();
   fit.grown = j.at("grown").get<bool>();

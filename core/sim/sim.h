@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -78,6 +79,9 @@ struct ScenePanel {
 
 struct LidarScene {
   Pose lidar_from_board = Pose::Identity();
+  // A board that moves during the sweep (a waved board): its pose at each return's time, seconds
+  // after the sweep's start (LidarScanOptions::sweep_s); empty: lidar_from_board throughout.
+  std::function<Pose(double seconds)> lidar_from_board_at;
   std::vector<ScenePanel> panels;  // hit as walls are (SimSurface::kWall)
   bool clutter = true;
   double floor_z_m = -1.5;       // floor plane z = floor_z_m (metres, LiDAR frame)
@@ -93,6 +97,9 @@ struct LidarScanOptions {
   double range_offset_m = 0.0;      // added to every range (metres)
   double azimuth_offset_rad = 0.0;  // azimuth of step 0 (the firing phase of this sweep)
   std::uint64_t seed = 1;           // range and intensity noise
+  // A spinning LiDAR's sweep time (seconds; > 0): each return's time after the sweep's start,
+  // step / steps of it, kept (LidarScan::time_s). 0: the sweep is instantaneous.
+  double sweep_s = 0.0;
 };
 
 enum class SimSurface : std::uint8_t { kBoard, kFloor, kWall };
@@ -105,12 +112,13 @@ struct LidarScan {
   std::vector<int> ring;            // 0 = lowest beam
   std::vector<SimSurface> surface;  // what each return hit
   std::vector<Vec3> origin;         // where each return's ray started (a swept scanner's mirror)
+  std::vector<float> time_s;        // after the sweep's start (LidarScanOptions::sweep_s > 0)
   bool has_rings = true;            // false for a swept scanner: its cloud has no ring field
 
   size_t size() const { return points.size(); }
   // Unorganized cloud (height 1) with intensity and ring (when it has rings); board_only: the
   // sheet's returns alone, without rings (SimOptions::board_only_clouds); viewpoints: each
-  // return's ray origin (SimOptions::lidar_viewpoints).
+  // return's ray origin (SimOptions::lidar_viewpoints); each return's time when the scan has them.
   LidarCloud ToCloud(bool board_only = false, bool viewpoints = false) const;
 };
 

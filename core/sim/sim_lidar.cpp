@@ -79,6 +79,7 @@ LidarCloud LidarScan::ToCloud(bool board_only, bool viewpoints) const {
     cloud.intensity.push_back(intensity[i]);
     if (has_rings && !board_only) cloud.ring.push_back(ring[i]);
     if (viewpoints) cloud.viewpoint.push_back(origin[i].cast<float>());
+    if (!time_s.empty()) cloud.time_s.push_back(time_s[i]);
   }
   cloud.width = static_cast<int>(cloud.size());
   cloud.height = 1;
@@ -107,8 +108,8 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
   CALIBENCH_CHECK(beams.risley || (beams.azimuth_steps > 0 && !beams.elevations_rad.empty()));
   CALIBENCH_CHECK(options.range_noise_m >= 0.0);
   // The sheet as the print has it (centred on the pattern), the panels as they stand.
-  const LidarRectangle sheet{scene.lidar_from_board,
-                             0.5 * Vec2(print.board().SheetWidth(), print.board().SheetHeight())};
+  const Vec2 half_sheet = 0.5 * Vec2(print.board().SheetWidth(), print.board().SheetHeight());
+  LidarRectangle sheet{scene.lidar_from_board, half_sheet};
   std::vector<LidarRectangle> panels;
   for (const ScenePanel& panel : scene.panels)
     panels.push_back({panel.lidar_from_panel, panel.size_m / 2});
@@ -117,7 +118,10 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
   std::normal_distribution<double> unit_normal(0.0, 1.0);
   LidarScan scan;
   scan.has_rings = beams.HasRings();
+  CALIBENCH_CHECK(!scene.lidar_from_board_at || options.sweep_s > 0.0);
   for (int step = 0; step < rays.steps(); ++step) {
+    const double step_s = options.sweep_s * step / rays.steps();
+    if (scene.lidar_from_board_at) sheet = {scene.lidar_from_board_at(step_s), half_sheet};
     for (int r = 0; r < rays.rings(); ++r) {
       const BeamRay ray = rays.Ray(r, step);
       const BeamRay cast = options.angular_noise_rad > 0.0
@@ -138,6 +142,7 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
       scan.ring.push_back(r);
       scan.surface.push_back(hit.surface);
       scan.origin.push_back(ray.origin);
+      if (options.sweep_s > 0.0) scan.time_s.push_back(static_cast<float>(step_s));
     }
   }
   return scan;

@@ -89,6 +89,11 @@ std::optional<CameraBoardObservation> EstimateBoardPose(const CameraModel& camer
                                                         const PnpOptions& options,
                                                         std::string* why);
 
+// The board's plane (z = 0, oriented towards the camera) and its covariance from the observation's
+// cam_from_board and pose_covariance: what a pose interpolated between frames (a waved board,
+// core/lidar_camera/board_track.h) gives the solver.
+void SetBoardPlaneFromPose(CameraBoardObservation* observation);
+
 // Motion blur: OpenCV's estimateChessboardSharpness over a checkerboard's full detection, the
 // mean width of the squares' edges in pixels (a sharp print: 1.5-2.5 px); nullopt for ChArUco
 // or a partial detection.

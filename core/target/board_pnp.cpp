@@ -214,13 +214,18 @@ std::optional<CameraBoardObservation> EstimateBoardPose(const CameraModel& camer
   }
   obs.pose_covariance = sigma2 * lu.inverse();
 
-  // Board plane z = 0 in the camera frame, oriented towards the camera (d > 0).
-  const Plane in_cam = TransformPlane(pose, Plane{Vec3::UnitZ(), 0.0});
-  obs.plane = OrientTowardsOrigin(in_cam);
-  const double sign = obs.plane.normal.dot(in_cam.normal) > 0.0 ? 1.0 : -1.0;
-  const Eigen::Matrix<double, 4, 6> jp = PlaneJacobian(pose, sign);
-  obs.plane_covariance = jp * obs.pose_covariance * jp.transpose();
+  SetBoardPlaneFromPose(&obs);
   return obs;
+}
+
+void SetBoardPlaneFromPose(CameraBoardObservation* observation) {
+  // Board plane z = 0 in the camera frame, oriented towards the camera (d > 0).
+  const Pose& pose = observation->cam_from_board;
+  const Plane in_cam = TransformPlane(pose, Plane{Vec3::UnitZ(), 0.0});
+  observation->plane = OrientTowardsOrigin(in_cam);
+  const double sign = observation->plane.normal.dot(in_cam.normal) > 0.0 ? 1.0 : -1.0;
+  const Eigen::Matrix<double, 4, 6> jp = PlaneJacobian(pose, sign);
+  observation->plane_covariance = jp * observation->pose_covariance * jp.transpose();
 }
 
 }  // namespace calibench

@@ -408,6 +408,10 @@ std::optional<LidarPlaneFit> FitBoardPlane(const LidarCloud& cloud,
   if (options.grow_radius_m > 0 && (options.fit_ranges_ml || !RaysKnown(options, cloud)))
     fit = GrowToBoard(cloud, *fit, options);
   AddBoardExtent(cloud, options, &*fit);
+  if (cloud.HasTime()) {
+    fit->inlier_times_s.reserve(fit->inliers.size());
+    for (const int i : fit->inliers) fit->inlier_times_s.push_back(cloud.time_s[i]);
+  }
   return fit;
 }
 

@@ -74,6 +74,9 @@ struct LidarPlaneFit {
   Plane plane;                          // LiDAR frame, normal towards the LiDAR (d > 0)
   Mat4 covariance = Mat4::Zero();       // of (n, d) from the least-squares refit; rank 3
   std::vector<int> inliers;             // indices into the cloud
+  // Each inlier's time after the cloud's stamp (LidarCloud::time_s), as `inliers`; empty when
+  // the cloud has no per-point times (the board then counts as seen at the stamp).
+  std::vector<float> inlier_times_s;
   Vec3 inlier_centroid = Vec3::Zero();  // mean of the inliers (LiDAR frame, metres)
   int num_candidates = 0;               // points in the brushed / seeded region
   bool grown = false;                   // inliers extend beyond the region (grow_radius_m)

@@ -4,6 +4,7 @@
 // chosen right without --board, and a refusal that says what to pass when no preset fits.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -48,7 +49,8 @@ nlohmann::json ImportRecord(const BagImportSummary& summary) {
 
 TEST(RecordingImport, OnePairPerHoldTheSameFromMcapAndBag) {
   const fs::path dir = test::TempDir("recording_import_holds");
-  const test::SimRecordingOptions options = test::SmallSimRecording(6);
+  test::SimRecordingOptions options = test::SmallSimRecording(6);
+  options.point_times = true;  // velodyne's XYZIRT: each return's `time` after the stamp
   std::vector<nlohmann::json> records;
   for (const char* name : {"capture.mcap", "capture.bag"}) {
     SCOPED_TRACE(name);
@@ -67,8 +69,27 @@ TEST(RecordingImport, OnePairPerHoldTheSameFromMcapAndBag) {
       holds.push_back(hold);
     }
     EXPECT_EQ(holds, (std::vector<int>{0, 1, 2, 3, 4, 5}));
+    // Each return keeps its time, said once: the field `t` after the manifest's lidar_stamp_ns.
+    EXPECT_EQ(summary.point_times.rfind("per-point times from 'time' (FLOAT32), read as seconds "
+                                        "after the stamp: 0.0",
+                                        0),
+              0u)
+        << summary.point_times;
+    EXPECT_EQ(summary.pairs_with_point_times, 6);
+    EXPECT_EQ(record["point_times"], summary.point_times);
     // Each pair's image shows its hold's pose.
     const Dataset dataset = LoadDataset(summary.manifest);
+    for (std::size_t i = 0; i < dataset.pairs.size(); ++i) {
+      ASSERT_TRUE(dataset.pairs[i].lidar_stamp_ns);
+      EXPECT_EQ(*dataset.pairs[i].lidar_stamp_ns,
+                record["pairs"][i]["cloud_stamp_ns"].get<std::int64_t>());
+      const LidarCloud cloud = LoadCloud(dataset.pairs[i].cloud);
+      ASSERT_EQ(cloud.time_s.size(), cloud.size());
+      const auto [low, high] = std::minmax_element(cloud.time_s.begin(), cloud.time_s.end());
+      EXPECT_GE(*low, 0.0f);  // a 10 Hz sweep stamped at its start
+      EXPECT_LE(*high, 0.1f);
+      EXPECT_GE(*high - *low, 0.09f);
+    }
     for (std::size_t i = 0; i < dataset.pairs.size(); ++i) {
       std::string why;
       const auto detection = DetectBoard(LoadImage(dataset.pairs[i].image), truth.board, {}, &why);
@@ -83,6 +104,10 @@ TEST(RecordingImport, OnePairPerHoldTheSameFromMcapAndBag) {
     pipeline.threads = 2;
     const CalibrationOutcome outcome = CalibrateDataset(dataset, pipeline);
     ASSERT_TRUE(outcome.solution) << outcome.failure;
+    EXPECT_NE(FormatSummary(outcome).find("LiDAR times: 6 of 6 boards' returns carry their own "
+                                          "times"),
+              std::string::npos)
+        << FormatSummary(outcome);
     const Pose error = truth.cam_from_lidar.inverse() * outcome.solution->cam_from_lidar;
     EXPECT_LT(error.translation().norm(), 0.03);
     EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle() * kRadToDeg, 1.0);
@@ -113,9 +138,14 @@ TEST(RecordingImport, ALivoxCustomMsgRecordingIntegratesEachHold) {
       holds.push_back(HoldOf(truth, pair["cloud_stamp_ns"].get<std::int64_t>()));
     EXPECT_EQ(holds, (std::vector<int>{0, 1, 2, 3, 4, 5}));
     const Dataset dataset = LoadDataset(summary.manifest);
+    // The hold's frames integrated, each return at its own time after the tried frame's stamp.
+    EXPECT_EQ(summary.pairs_with_point_times, 6);
     for (const PairEntry& pair : dataset.pairs) {
       const LidarCloud cloud = LoadCloud(pair.cloud);
       EXPECT_FALSE(cloud.HasRing());
+      ASSERT_EQ(cloud.time_s.size(), cloud.size());
+      const auto [low, high] = std::minmax_element(cloud.time_s.begin(), cloud.time_s.end());
+      EXPECT_GE(*high - *low, 0.5f) << pair.id << ": the frames of about a second";
       // A Mid-40 frame holds 10 k returns in a closed room; the second about a try 100 k (the
       // first hold's try comes half a second after the recording starts: 60 k).
       EXPECT_GE(cloud.size(), 50'000u) << pair.id;

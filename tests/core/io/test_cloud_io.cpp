@@ -45,6 +45,7 @@ void ExpectSameCloud(const LidarCloud& actual, const LidarCloud& expected) {
   EXPECT_EQ(actual.ring, expected.ring);
   EXPECT_EQ(actual.range, expected.range);
   EXPECT_EQ(actual.viewpoint, expected.viewpoint);
+  EXPECT_EQ(actual.time_s, expected.time_s);
   EXPECT_EQ(actual.width, expected.width);
   EXPECT_EQ(actual.height, expected.height);
 }
@@ -99,6 +100,45 @@ TEST(CloudIo, PcdRoundTripOptionalChannels) {
       ExpectSameCloud(LoadCloud(path), cloud);
     }
   }
+}
+
+// Each return's own time as the dataset contract keeps it (a field `t`, float32 seconds after
+// the pair's lidar_stamp_ns) through every writer bit for bit; a driver's own PCD fields read as
+// the driver wrote them (Ouster's integer nanoseconds `t`, velodyne's float seconds `time`).
+TEST(CloudIo, PointTimesRoundTripEveryWriterAndDriversFieldsRead) {
+  const fs::path dir = test::TempDir("cloud_io_point_times");
+  LidarCloud cloud = RandomCloud(64, true, true, false, 22);
+  for (size_t i = 0; i < cloud.size(); ++i) cloud.time_s.push_back(-0.1f + 0.0015f * i);
+  for (const auto encoding :
+       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+    SavePcd(dir / "cloud.pcd", cloud, encoding);
+    ExpectSameCloud(LoadCloud(dir / "cloud.pcd"), cloud);
+  }
+  EXPECT_NE(test::ReadFileBytes(dir / "cloud.pcd").find("FIELDS x y z intensity ring t\n"),
+            std::string::npos);
+  SavePly(dir / "cloud.ply", cloud);
+  ExpectSameCloud(LoadCloud(dir / "cloud.ply"), cloud);
+  WriteFile(dir / "ouster.pcd",
+            "VERSION .7\nFIELDS x y z t\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n"
+            "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3 0\n4 5 6 48828125\n");
+  const LidarCloud ouster = LoadCloud(dir / "ouster.pcd");
+  ASSERT_TRUE(ouster.HasTime());
+  EXPECT_FLOAT_EQ(ouster.time_s[1], 0.048828125f);
+  WriteFile(dir / "velodyne.pcd",
+            "VERSION .7\nFIELDS x y z intensity ring time\nSIZE 4 4 4 4 2 4\nTYPE F F F F U F\n"
+            "COUNT 1 1 1 1 1 1\nWIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n"
+            "1 2 3 7 0 -0.0995\n4 5 6 9 1 -0.05\n");
+  const LidarCloud velodyne = LoadCloud(dir / "velodyne.pcd");
+  ASSERT_TRUE(velodyne.HasTime());
+  EXPECT_FLOAT_EQ(velodyne.time_s[0], -0.0995f);
+  // Seconds on a clock where the contract keeps seconds after the stamp: said, and not read.
+  WriteFile(dir / "clock.pcd",
+            "VERSION .7\nFIELDS x y z t\nSIZE 4 4 4 8\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+            "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3 1604515190.25\n");
+  EXPECT_FALSE(LoadCloud(dir / "clock.pcd").HasTime());
+  // A writer refuses times that are not one per point.
+  cloud.time_s.pop_back();
+  EXPECT_THROW(SavePcd(dir / "short.pcd", cloud, PcdEncoding::kBinary), IoError);
 }
 
 // Each return's ray origin (a swept scanner's mirror) as PCL's PointWithViewpoint stores it:

@@ -34,6 +34,8 @@ Dataset SmallDataset(const fs::path& dir) {
     p.cloud = dir / "clouds" / (p.id + ".pcd");
     p.image = dir / "images" / (p.id + ".png");
     if (i != 1) p.lidar_seed = LidarSeed{Vec3(2.0 + i, 0.1, -0.2), 0.25};
+    // Past 2^53: a stamp a double would round (JSON readers that hold numbers as doubles).
+    if (i != 0) p.lidar_stamp_ns = 1604515190231000001LL + i;
     d.pairs.push_back(p);
   }
   Pose gt = Pose::Identity();
@@ -57,6 +59,10 @@ TEST(Dataset, ManifestRoundTripKeepsEverythingAndWritesRelativePaths) {
   EXPECT_FALSE(read.pairs[1].lidar_seed);
   ASSERT_TRUE(read.pairs[2].lidar_seed);
   EXPECT_TRUE(test::MatrixNear(read.pairs[2].lidar_seed->point, Vec3(4.0, 0.1, -0.2), 0));
+  EXPECT_FALSE(read.pairs[0].lidar_stamp_ns);
+  EXPECT_EQ(j["pairs"][2]["lidar_stamp_ns"], "1604515190231000003");  // exact as a string
+  ASSERT_TRUE(read.pairs[2].lidar_stamp_ns);
+  EXPECT_EQ(*read.pairs[2].lidar_stamp_ns, 1604515190231000003LL);
   EXPECT_EQ(read.camera.distortion, written.camera.distortion);
   EXPECT_EQ(read.target.cols, 7);
   EXPECT_DOUBLE_EQ(read.target.board_height, 0.297);
@@ -166,6 +172,16 @@ TEST(Dataset, BadManifestsNameTheFileAndTheProblem) {
   m = good;
   m["pairs"][0]["lidar_seed"]["radius"] = -1;
   ExpectRejected(m, "negative_radius", "radius > 0");
+  m = good;
+  m["pairs"][1]["lidar_stamp_ns"] = "12.5 s";
+  ExpectRejected(m, "stamp_words", "pairs[1].lidar_stamp_ns: must be nanoseconds");
+  m = good;
+  m["pairs"][1]["lidar_stamp_ns"] = 1604515190231000001LL;  // an integer reads as well
+  {
+    const fs::path integer = test::TempDir("dataset_stamp_integer") / "dataset.json";
+    std::ofstream(integer) << m.dump();
+    EXPECT_EQ(*LoadDataset(integer).pairs[1].lidar_stamp_ns, 1604515190231000001LL);
+  }
   m = good;
   m["ground_truth"]["cam_from_lidar"] = {{2, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
   ExpectRejected(m, "not_rigid", "not a rigid transform");

@@ -4,6 +4,8 @@
 // it declares (VALIDATE.txt).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 
@@ -199,6 +201,48 @@ TEST(RealBags, McapOrganizedOusterCloud) {
     EXPECT_EQ(*std::max_element(cloud.cloud.ring.begin(), cloud.cloud.ring.end()), 63);
     return false;
   });
+}
+
+// Each return keeps the time its driver gave it (core/lidar/point_times.h), read from real
+// recordings: the Ouster's `t` (uint32 ns after the stamp) and Luminar's time_sec + time_nsec
+// (seconds on the clock, two uint32: its sweeps' 88 ms end at their stamps).
+TEST(RealBags, EachReturnKeepsTheTimeItsDriverGaveIt) {
+  CALIBENCH_REQUIRE_SHARED_DIR(shared);
+  struct Expect {
+    const char* file;
+    const char* topic;
+    const char* words;
+    double min_span_s, max_span_s;
+  };
+  // An OS1-64 at 10 Hz: 2048 columns over 0.1 s (the last column 2047/2048 of it after the first).
+  const Expect expected[] = {
+      {"mcap_ros1_ouster_os1_zstd.mcap", "/os1_cloud_node/points",
+       "per-point times from 't' (UINT32), read as nanoseconds after the stamp", 0.0990, 0.1000},
+      {"ros1_luminar_lidar_lz4.bag", "/luminar_pointcloud",
+       "per-point times from 'time_sec+time_nsec' (UINT32+UINT32), read as seconds on the "
+       "LiDAR's clock: -0.08",
+       0.080, 0.095}};
+  for (const Expect& e : expected) {
+    SCOPED_TRACE(e.file);
+    auto bag = OpenBag(shared / "datasets/ros-bags" / e.file);
+    const int topic = bag->FindTopic(e.topic);
+    int clouds = 0;
+    bag->ForEachMessage({}, [&](const BagMessage& message) {
+      if (message.topic != topic) return true;
+      const PointCloud2Message m = DecodePointCloud2(message.data, MessageEncoding::kRos1);
+      ++clouds;
+      EXPECT_EQ(m.point_times.rfind(e.words, 0), 0u) << m.point_times;
+      EXPECT_EQ(m.cloud.time_s.size(), m.cloud.size());
+      if (m.cloud.time_s.empty()) return false;
+      const auto [low, high] = std::minmax_element(m.cloud.time_s.begin(), m.cloud.time_s.end());
+      EXPECT_GE(*high - *low, e.min_span_s);
+      EXPECT_LE(*high - *low, e.max_span_s);
+      EXPECT_LE(std::abs(*low), 0.2f) << "the returns lie near their stamp";
+      std::printf("%s: %s\n", e.file, m.point_times.c_str());
+      return true;
+    });
+    EXPECT_GT(clouds, 0);
+  }
 }
 
 TEST(RealBags, McapRos2HumbleSensorMessages) {

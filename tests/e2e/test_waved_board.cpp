@@ -1,0 +1,153 @@
+// A board waved in front of the rig, never still (core/sim/sim_wave.h): every LiDAR return at
+// its own time, the camera's boards between its frames, and the offset between the two clocks
+// estimated with the extrinsic (core/lidar_camera/time_offset.h) — against the same sweeps with
+// the offset ignored, which is what every tool that pairs by nearest stamp does.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/evaluation/crlb.h"
+#include "core/geometry/geometry.h"
+#include "core/io/cloud_io.h"
+#include "core/io/dataset.h"
+#include "core/lidar_camera/pipeline.h"
+#include "core/lidar_camera/result_io.h"
+#include "core/lidar_camera/time_offset.h"
+#include "core/sim/sim_wave.h"
+#include "tests/test_support.h"
+
+namespace calibench {
+namespace {
+namespace fs = std::filesystem;
+
+// 10 s of a board waved at 0.4-0.5 m/s in front of a VLP-16 (10 Hz sweeps, each return at its
+// own time) and a 1440 x 1080 camera at 10 Hz whose stamps are `camera_minus_lidar_s` off.
+WavedDataset WaveAtOffset(const std::string& name, double camera_minus_lidar_s) {
+  WaveOptions wave;
+  wave.rig.lidar = LidarModel::kVlp16;
+  wave.rig.lidar_range_noise_m = 0.01;
+  wave.rig.seed = 11;
+  wave.duration_s = 10.0;
+  wave.camera_minus_lidar_s = camera_minus_lidar_s;
+  return SimulateWavedDataset(wave, test::TempDir(name));
+}
+
+struct WavedCalibration {
+  CalibrationOutcome outcome;
+  PoseError error;
+};
+
+// The dataset's pairs extracted once, solved with the offset searched and with it fixed at 0.
+std::pair<WavedCalibration, WavedCalibration> CalibrateWaved(const Dataset& dataset) {
+  PipelineOptions options;
+  options.threads = 2;
+  const std::vector<const PairEntry*> selected = SelectedPairs(dataset, options);
+  std::string note;
+  const std::vector<PairFeatures> features =
+      ExtractDatasetPairs(dataset, selected, options, {}, {}, &note);
+  auto solve = [&](std::optional<double> fixed_offset_s) {
+    PipelineOptions with = options;
+    with.time_offset.fixed_s = fixed_offset_s;
+    WavedCalibration c{SolveExtractedPairs(dataset, selected, features, with), {}};
+    if (c.outcome.solution)
+      c.error = ComputePoseError(c.outcome.solution->cam_from_lidar,
+                                 *dataset.cam_from_lidar_ground_truth);
+    return c;
+  };
+  return {solve(std::nullopt), solve(0.0)};
+}
+
+// The error's largest ratio to its own σ, per camera axis of translation and of rotation.
+double WorstAxisSigmas(const CalibrationOutcome& outcome, const Pose& truth) {
+  const Pose& estimate = outcome.solution->cam_from_lidar;
+  const Vec6 delta = LogSE3(estimate.inverse() * truth);  // right perturbation, as the covariance
+  double worst = 0.0;
+  for (int k = 0; k < 6; ++k)
+    worst = std::max(worst, std::abs(delta(k)) / std::sqrt(outcome.solution->covariance(k, k)));
+  return worst;
+}
+
+TEST(WavedBoard, TheOffsetBetweenTheClocksIsFoundWithTheExtrinsic) {
+  for (const double offset : {0.040, -0.120}) {
+    SCOPED_TRACE(offset);
+    const WavedDataset waved = WaveAtOffset(offset > 0 ? "wave_late" : "wave_early", offset);
+    EXPECT_GE(waved.median_speed_mps, 0.3);
+    EXPECT_LE(waved.median_speed_mps, 0.6);
+    ASSERT_GE(waved.dataset.pairs.size(), 60u) << "of " << waved.sweeps << " sweeps";
+    // Each pair: its sweep's stamp, its returns' own times, every frame around it (0.25 s and
+    // one frame either side of a 0.1 s sweep at 10 Hz: 7, fewer at the recording's ends).
+    const Dataset dataset = LoadDataset(waved.dataset.manifest);
+    const PairEntry& middle = dataset.pairs[dataset.pairs.size() / 2];
+    ASSERT_TRUE(middle.lidar_stamp_ns);
+    EXPECT_GE(middle.images.size(), 7u);
+    EXPECT_TRUE(LoadCloud(middle.cloud).HasTime());
+
+    const auto [found, ignored] = CalibrateWaved(dataset);
+    ASSERT_TRUE(found.outcome.solution) << found.outcome.failure;
+    const TimeOffsetEstimate& t = found.outcome.time_offset;
+    ASSERT_TRUE(t.camera_minus_lidar_s) << t.why;
+    // The bound of the same sweeps: each board where it was at its returns' median time, seen
+    // by the camera there (the offset known).
+    SimulationBoundInput bound_input;
+    bound_input.pairs = waved.truth;
+    bound_input.camera = dataset.camera;
+    bound_input.board = dataset.target;
+    bound_input.cam_from_lidar = *dataset.cam_from_lidar_ground_truth;
+    bound_input.range_sigma_m = 0.01;
+    double sigma_sum = 0.0;  // the renderer's corner noise, as PnP's residuals measure it
+    int posed = 0;
+    for (const PairFeatures& p : found.outcome.pairs)
+      for (const TimedObservation& frame : p.camera_track)
+        sigma_sum += frame.observation.corner_sigma_px, ++posed;
+    bound_input.corner_sigma_px = sigma_sum / std::max(posed, 1);
+    const CramerRaoBound bound = SimulationBound(bound_input);
+    std::printf(
+        "offset %+.0f ms: found %+.2f ms +- %.2f ms from %d moving pairs; extrinsic "
+        "%.2f mm %.3f deg (%.1f sigma; bound %.2f mm %.3f deg)\n",
+        offset * 1e3, *t.camera_minus_lidar_s * 1e3, t.std_s * 1e3, t.profiled_pairs,
+        found.error.translation_m * 1e3, found.error.rotation_rad * kRadToDeg,
+        WorstAxisSigmas(found.outcome, *dataset.cam_from_lidar_ground_truth),
+        bound.translation_rms_m * 1e3, bound.rotation_rms_deg);
+    EXPECT_NEAR(*t.camera_minus_lidar_s, offset, 0.002);
+    EXPECT_LE(std::abs(*t.camera_minus_lidar_s - offset), 3 * t.std_s + 1e-4);
+    EXPECT_GT(t.std_s, 0.0);
+    EXPECT_LT(found.error.translation_m, 0.005);
+    EXPECT_LT(found.error.rotation_rad * kRadToDeg, 0.2);
+    EXPECT_LE(WorstAxisSigmas(found.outcome, *dataset.cam_from_lidar_ground_truth), 3.0);
+    EXPECT_NE(FormatSummary(found.outcome).find("time offset: camera - LiDAR"), std::string::npos);
+
+    // The same sweeps with the offset ignored: each board taken where the camera's clock says.
+    ASSERT_TRUE(ignored.outcome.solution) << ignored.outcome.failure;
+    std::printf("  with the offset ignored (--time-offset 0): %.2f mm %.3f deg\n",
+                ignored.error.translation_m * 1e3, ignored.error.rotation_rad * kRadToDeg);
+    EXPECT_GT(ignored.error.translation_m, 3 * found.error.translation_m);
+  }
+}
+
+// Still holds are the special case of a slow trajectory: nothing to tell the clocks apart, said
+// as such, and the result as it was.
+TEST(WavedBoard, StillHoldsSayTheMotionCannotTellTheOffset) {
+  SimOptions still;
+  still.num_pairs = 12;
+  still.seed = 3;
+  const Dataset dataset = SimulateDataset(still, test::TempDir("wave_still_holds"));
+  PipelineOptions options;
+  options.threads = 2;
+  const CalibrationOutcome outcome = CalibrateDataset(dataset, options);
+  ASSERT_TRUE(outcome.solution) << outcome.failure;
+  EXPECT_FALSE(outcome.time_offset.camera_minus_lidar_s);
+  EXPECT_EQ(outcome.time_offset.why,
+            "every pair is a still hold (one image, or a board its frames saw still): the motion "
+            "cannot tell the two clocks apart");
+  const fs::path result = test::TempDir("wave_still_holds") / "result.json";
+  WriteResult(result, outcome, options.solver);
+  std::ifstream in(result);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_TRUE(j.at("time_offset").is_null());
+  EXPECT_EQ(j.at("time_offset_why"), outcome.time_offset.why);
+}
+
+}  // namespace
+}  // namespace calibench
