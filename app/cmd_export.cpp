@@ -110,6 +110,7 @@ int RunExport(int argc, char** argv) {
   frames.camera_frame = *camera;
   if (IsRigResultFile(result)) return ExportRigResult(result, *format, frames, out);
   const Pose cam_from_lidar = CalibrationOf(result);
+  if (!IsSessionFile(result)) frames.camera_minus_lidar_s = LoadResult(result).camera_minus_lidar_s;
   const ExportedCalibration exported =
       ExportCalibration(*format, cam_from_lidar, frames, std::filesystem::path(result).filename());
   const std::filesystem::path path =

@@ -6,6 +6,7 @@
 #include "app/sim_flags.h"
 #include "core/sim/rig_sim.h"
 #include "core/sim/sim.h"
+#include "core/sim/sim_wave.h"
 
 namespace calibench::app {
 
@@ -143,6 +144,17 @@ int RunSimulate(int argc, char** argv) {
   app.add_option("--second-camera-yaw", second_yaw_deg,
                  "with --rig: how far cam1 is turned to the left of cam0 (degrees)")
       ->capture_default_str();
+  double wave_s = 0.0;
+  WaveOptions wave;
+  app.add_option("--wave", wave_s,
+                 "a waved board instead: this many seconds of a board never still (an ellipse in "
+                 "front of the camera at --wave-speed), each sweep that sees it a pair with "
+                 "every camera frame around it (\"images\"), each return at its own time [s]");
+  app.add_option("--wave-speed", wave.speed_mps, "with --wave: the board's speed [m/s]")
+      ->capture_default_str();
+  app.add_option("--camera-minus-lidar", wave.camera_minus_lidar_s,
+                 "with --wave: the camera's stamps minus the LiDAR's clock [s] (+0.04: 40 ms late)")
+      ->capture_default_str();
   if (const auto code = ParseFlags(app, argc, argv)) return *code;
   SimOptions options;
   std::string why;
@@ -162,6 +174,21 @@ int RunSimulate(int argc, char** argv) {
     const RigSimTruth truth = SimulateRigFolder(rig_options, out_dir);
     std::printf("wrote a rig of 2 cameras, %d captures (%d seen by both), to %s\n",
                 rig_options.num_captures, truth.shared_captures, out_dir.c_str());
+    return kOk;
+  }
+  if (wave_s > 0) {
+    wave.rig = options;
+    wave.duration_s = wave_s;
+    if (!wave.Check(&why)) {
+      std::fprintf(stderr, "calibench simulate: --wave: %s\n", why.c_str());
+      return kUsage;
+    }
+    const WavedDataset waved = SimulateWavedDataset(wave, out_dir);
+    std::printf(
+        "wrote %zu pairs of a board waved at %.2f m/s (median) for %.1f s, %d sweeps and %d "
+        "frames, the camera's stamps %+.0f ms off, to %s\n",
+        waved.dataset.pairs.size(), waved.median_speed_mps, wave_s, waved.sweeps, waved.frames,
+        wave.camera_minus_lidar_s * 1e3, waved.dataset.manifest.string().c_str());
     return kOk;
   }
   const Dataset dataset = SimulateDataset(options, out_dir);

@@ -120,6 +120,12 @@ ExportedCalibration Kalibr(const Pose& pose, const ExportFrames& frames,
   text += "cam0:\n  " + key + ":\n" + MatrixRows(pose.inverse().matrix(), "  ");
   text += "  parent_frame: " + frames.parent() + "\n  child_frame: " + frames.child() + "\n";
   text += "  camera_frame: " + CameraFrameName(frames.camera_frame) + "\n";
+  // Kalibr's sign: t_lidar = t_cam + timeshift_cam_lidar (as its timeshift_cam_imu).
+  if (frames.camera_minus_lidar_s) {
+    char shift[48];
+    std::snprintf(shift, sizeof(shift), "%.9g", -*frames.camera_minus_lidar_s);
+    text += "  timeshift_cam_lidar: " + std::string(shift) + "\n";
+  }
   return {text, ""};
 }
 

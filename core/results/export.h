@@ -42,6 +42,10 @@ struct ExportFrames {
   std::string camera = "camera";  // the camera's frame name
   bool camera_is_parent = false;  // the user swapped them: parent = camera, child = LiDAR
   CameraFrame camera_frame = CameraFrame::kOptical;
+  // A waved capture's clocks (result.json "time_offset"): the camera's stamps minus the LiDAR's
+  // clock, seconds. Kalibr's file holds it as its timeshift (t_lidar = t_cam + shift, so shift =
+  // -camera_minus_lidar_s); the others say it in their header.
+  std::optional<double> camera_minus_lidar_s;
 
   const std::string& parent() const { return camera_is_parent ? camera : lidar; }
   const std::string& child() const { return camera_is_parent ? lidar : camera; }

@@ -26,11 +26,21 @@ std::string CameraFrameWords(CameraFrame frame) {
 std::vector<std::string> HeaderLines(const ExportFrames& frames, const std::string& source) {
   const std::string& parent = frames.parent();
   const std::string& child = frames.child();
-  return {"Calibench extrinsic calibration" + (source.empty() ? "" : " from " + source),
-          "The pose of '" + child + "' in '" + parent + "': x_in_" + parent + " = " + parent +
-              "_from_" + child + " * x_in_" + child + " (a point in " + child +
-              " coordinates mapped into " + parent + " coordinates)",
-          "The camera frame '" + frames.camera + "' is " + CameraFrameWords(frames.camera_frame)};
+  std::vector<std::string> lines = {
+      "Calibench extrinsic calibration" + (source.empty() ? "" : " from " + source),
+      "The pose of '" + child + "' in '" + parent + "': x_in_" + parent + " = " + parent +
+          "_from_" + child + " * x_in_" + child + " (a point in " + child +
+          " coordinates mapped into " + parent + " coordinates)",
+      "The camera frame '" + frames.camera + "' is " + CameraFrameWords(frames.camera_frame)};
+  if (frames.camera_minus_lidar_s) {
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  "Time offset: the camera's stamps minus the LiDAR's clock %+.6f s (t_lidar = "
+                  "t_camera %+.6f s)",
+                  *frames.camera_minus_lidar_s, -*frames.camera_minus_lidar_s);
+    lines.push_back(text);
+  }
+  return lines;
 }
 
 std::string Commented(const std::vector<std::string>& lines, const std::string& prefix) {

@@ -110,6 +110,8 @@ LoadedResult LoadResult(const std::filesystem::path& path) {
   }
   if (root.Has("observability"))
     result.well_constrained = root.Object("observability").Bool("well_constrained");
+  if (root.Has("time_offset"))
+    result.camera_minus_lidar_s = root.Object("time_offset").Number("camera_minus_lidar_s");
   return result;
 }
 

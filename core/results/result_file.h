@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "core/base/types.h"
@@ -21,6 +22,8 @@ struct LoadedResult {
   Pose cam_from_source = Pose::Identity();  // cam_from_lidar (or cam_from_lrf)
   Mat6 covariance = Mat6::Zero();
   bool well_constrained = false;
+  // A waved capture's "time_offset" (camera_minus_lidar_s); absent when null or not written.
+  std::optional<double> camera_minus_lidar_s;
 };
 // Reads cam_from_lidar (or cam_from_lrf) and the covariance. Throws IoError naming the file.
 LoadedResult LoadResult(const std::filesystem::path& path);

@@ -2,6 +2,7 @@
 // docs/results.md.
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -21,6 +22,7 @@
 #include "core/session/calibration_job.h"
 #include "core/sim/lrf_sim.h"
 #include "core/sim/sim.h"
+#include "core/sim/sim_wave.h"
 #include "core/target/board_camera.h"
 #include "core/target/lidar_board_detect.h"
 #include "core/target/lidar_plane.h"
@@ -254,6 +256,33 @@ void BM_CalibrateReal40Pairs2Threads(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(CalibrateDataset(dataset, options));
 }
 BENCHMARK(BM_CalibrateReal40Pairs2Threads)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+// A waved board's recording (core/sim/sim_wave.h: `state.range(0)` seconds at 0.45 m/s, a VLP-16
+// and a 1440 x 1080 camera at 10 Hz, its stamps 40 ms late): `calibrate` of its folder, every
+// sweep that sees the board a pair with its frames, the offset searched. The label says the
+// calibration's time per second recorded (below 1: faster than the capture).
+void BM_CalibrateWavedBoard2Threads(benchmark::State& state) {
+  WaveOptions wave;
+  wave.rig.lidar_range_noise_m = 0.01;
+  wave.duration_s = static_cast<double>(state.range(0));
+  const WavedDataset waved = SimulateWavedDataset(wave, BenchDir("waved"));
+  PipelineOptions options;
+  options.threads = 2;
+  double seconds = 0.0;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(CalibrateDataset(waved.dataset, options));
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  state.SetLabel(std::to_string(waved.dataset.pairs.size()) + " pairs, " +
+                 std::to_string(seconds / wave.duration_s).substr(0, 4) + " s per second recorded");
+}
+BENCHMARK(BM_CalibrateWavedBoard2Threads)
+    ->Arg(10)
+    ->Arg(40)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
 
 // The real ACFR capture as a rig of two cameras (cam0: all 40 frames, cam1: every other one;
 // links, not copies): `calibrate --dataset <rig>`, each camera's own calibration and the rig

@@ -15,6 +15,8 @@
 #include "core/lidar_camera/pipeline.h"
 #include "core/lidar_camera/result_io.h"
 #include "core/lidar_camera/time_offset.h"
+#include "core/results/export.h"
+#include "core/results/result_file.h"
 #include "core/sim/sim_wave.h"
 #include "tests/test_support.h"
 
@@ -117,6 +119,23 @@ TEST(WavedBoard, TheOffsetBetweenTheClocksIsFoundWithTheExtrinsic) {
     EXPECT_LT(found.error.rotation_rad * kRadToDeg, 0.2);
     EXPECT_LE(WorstAxisSigmas(found.outcome, *dataset.cam_from_lidar_ground_truth), 3.0);
     EXPECT_NE(FormatSummary(found.outcome).find("time offset: camera - LiDAR"), std::string::npos);
+    // Into the result file and out to Kalibr with Kalibr's sign (t_lidar = t_cam + shift).
+    const fs::path result = dataset.manifest.parent_path() / "result.json";
+    WriteResult(result, found.outcome, SolverOptions{});
+    const LoadedResult loaded = LoadResult(result);
+    ASSERT_TRUE(loaded.camera_minus_lidar_s);
+    EXPECT_DOUBLE_EQ(*loaded.camera_minus_lidar_s, *t.camera_minus_lidar_s);
+    ExportFrames frames;
+    frames.camera_minus_lidar_s = loaded.camera_minus_lidar_s;
+    const std::string kalibr =
+        ExportCalibration(ExportFormat::kKalibr, loaded.cam_from_source, frames, "result.json")
+            .text;
+    char shift[64];
+    std::snprintf(shift, sizeof(shift), "timeshift_cam_lidar: %.9g\n", -*t.camera_minus_lidar_s);
+    EXPECT_NE(kalibr.find(shift), std::string::npos) << kalibr;
+    EXPECT_NE(ExportCalibration(ExportFormat::kUrdf, loaded.cam_from_source, frames, "result.json")
+                  .text.find("Time offset: the camera's stamps minus the LiDAR's clock"),
+              std::string::npos);
 
     // The same sweeps with the offset ignored: each board taken where the camera's clock says.
     ASSERT_TRUE(ignored.outcome.solution) << ignored.outcome.failure;
