@@ -148,19 +148,6 @@ std::vector<int> RegionFor(const Dataset& dataset, const LidarCloud& cloud, cons
   return found.board->indices;
 }
 
-// A moving capture's frames: the board in each that shows it, stamps after the pair's
-// lidar_stamp_ns (seconds). A frame that cannot be read or shows no board leaves a gap.
-std::vector<TimedObservation> TrackBoard(const Dataset& dataset, const PairEntry& pair,
-                                         const PipelineOptions& options, FrameBoards* frames) {
-  FrameBoards own;
-  std::vector<TimedObservation> track;
-  for (const StampedImage& frame : pair.images)
-    if (auto board = (frames ? frames : &own)->Of(dataset, frame.image, options))
-      track.push_back(
-          {(frame.stamp_ns - pair.lidar_stamp_ns.value_or(0)) * 1e-9, std::move(*board)});
-  return track;
-}
-
 }  // namespace
 
 std::optional<LidarPlaneFit> ExtractLidarFeatures(const Dataset& dataset, const LidarCloud& cloud,
@@ -269,6 +256,17 @@ std::optional<CameraBoardObservation> FrameBoards::Of(const Dataset& dataset,
   }
   std::lock_guard lock(mutex_);
   return seen_.emplace(image, std::move(board)).first->second;
+}
+
+std::vector<TimedObservation> TrackBoard(const Dataset& dataset, const PairEntry& pair,
+                                         const PipelineOptions& options, FrameBoards* frames) {
+  FrameBoards own;
+  std::vector<TimedObservation> track;
+  for (const StampedImage& frame : pair.images)
+    if (auto board = (frames ? frames : &own)->Of(dataset, frame.image, options))
+      track.push_back(
+          {(frame.stamp_ns - pair.lidar_stamp_ns.value_or(0)) * 1e-9, std::move(*board)});
+  return track;
 }
 
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,

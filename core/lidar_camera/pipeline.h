@@ -270,6 +270,13 @@ class FrameBoards {
   Boards seen_;
 };
 
+// A moving capture's frames (PairEntry::images): the board in each that shows it, stamps after
+// the pair's lidar_stamp_ns (seconds); a frame that cannot be read or shows no board leaves a gap.
+// `frames` (optional) poses each frame once across the pairs that list it.
+std::vector<TimedObservation> TrackBoard(const Dataset& dataset, const PairEntry& pair,
+                                         const PipelineOptions& options,
+                                         FrameBoards* frames = nullptr);
+
 // Loads the pair's files and extracts both planes (the steps above; the hint is the pair's edited
 // brush, else its seed). Never throws for bad data: the pair comes back kFailed with the reason
 // (unreadable files name the file); a rejected pair comes back kRejected with its features.

@@ -188,8 +188,13 @@ std::optional<PairInputs> CalibrationJob::ReadPair(int index, CameraFeatures* ca
   std::optional<PairInputs> inputs = LoadPairInputs(dataset_, dataset_.pairs.at(index), why);
   // No target (a drive opened for the targetless check): no board to see on either side.
   const bool no_target = !dataset_.missing_target_file.empty();
-  if (inputs && !no_target)
+  std::vector<TimedObservation> track;  // a moving capture's frames, as ExtractPairFeatures
+  if (inputs && !no_target) {
     *camera = ExtractCameraFeatures(dataset_, inputs->image, options_.advise.pipeline);
+    const PairEntry& entry = dataset_.pairs.at(index);
+    if (!entry.images.empty())
+      track = TrackBoard(dataset_, entry, options_.advise.pipeline, &frames_);
+  }
   {
     std::lock_guard lock(pairs_mutex_);
     JobPair& pair = pairs_[index];
@@ -202,6 +207,7 @@ std::optional<PairInputs> CalibrationJob::ReadPair(int index, CameraFeatures* ca
       pair.lidar_tried = true;
     } else {
       pair.detected.camera = camera->observation;
+      pair.detected.camera_track = std::move(track);
       pair.detected.edge_width_px = camera->edge_width_px;
       pair.detection = camera->detection;
       pair.camera_failure = camera->failure;

@@ -17,6 +17,7 @@
 #include "core/lidar_camera/time_offset.h"
 #include "core/results/export.h"
 #include "core/results/result_file.h"
+#include "core/session/calibration_job.h"
 #include "core/sim/sim_wave.h"
 #include "tests/test_support.h"
 
@@ -137,6 +138,29 @@ TEST(WavedBoard, TheOffsetBetweenTheClocksIsFoundWithTheExtrinsic) {
                   .text.find("Time offset: the camera's stamps minus the LiDAR's clock"),
               std::string::npos);
 
+    // The workbench's and watch's job on the same folder finds the same clocks and pose.
+    if (offset > 0) {
+      Dataset setup = dataset;
+      setup.pairs.clear();
+      CalibrationJobOptions job_options;
+      job_options.advise.pipeline.threads = 2;
+      CalibrationJob job(setup, job_options);
+      for (const PairEntry& pair : dataset.pairs) job.AddPair(pair);
+      const CalibrationOutcome& in_job = job.Solve();
+      ASSERT_TRUE(in_job.solution) << in_job.failure;
+      ASSERT_TRUE(in_job.time_offset.camera_minus_lidar_s) << in_job.time_offset.why;
+      // Not bit for bit on a moving capture, a difference not yet traced (one candidate: the
+      // job's background model holds the first 40 clouds, CalibrationJobOptions::
+      // max_background_clouds, `calibrate`'s all of them); the two agree within the offset's σ.
+      const PoseError apart =
+          ComputePoseError(in_job.solution->cam_from_lidar, found.outcome.solution->cam_from_lidar);
+      std::printf("  the job: %+.2f ms, %.2f mm %.3f deg from calibrate's pose\n",
+                  *in_job.time_offset.camera_minus_lidar_s * 1e3, apart.translation_m * 1e3,
+                  apart.rotation_rad * kRadToDeg);
+      EXPECT_NEAR(*in_job.time_offset.camera_minus_lidar_s, *t.camera_minus_lidar_s, t.std_s);
+      EXPECT_LT(apart.translation_m, 0.002);
+      EXPECT_LT(apart.rotation_rad * kRadToDeg, 0.05);
+    }
     // The same sweeps with the offset ignored: each board taken where the camera's clock says.
     ASSERT_TRUE(ignored.outcome.solution) << ignored.outcome.failure;
     std::printf("  with the offset ignored (--time-offset 0): %.2f mm %.3f deg\n",

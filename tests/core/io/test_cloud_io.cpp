@@ -50,6 +50,19 @@ void ExpectSameCloud(const LidarCloud& actual, const LidarCloud& expected) {
   EXPECT_EQ(actual.height, expected.height);
 }
 
+// Through the three PCD encodings and PLY and back bit for bit; the PCD header lists `fields`.
+void ExpectEveryWriterRoundTrips(const fs::path& dir, const LidarCloud& cloud,
+                                 const std::string& fields) {
+  for (const auto encoding :
+       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+    SavePcd(dir / "cloud.pcd", cloud, encoding);
+    ExpectSameCloud(LoadCloud(dir / "cloud.pcd"), cloud);
+  }
+  EXPECT_NE(test::ReadFileBytes(dir / "cloud.pcd").find(fields), std::string::npos);
+  SavePly(dir / "cloud.ply", cloud);
+  ExpectSameCloud(LoadCloud(dir / "cloud.ply"), cloud);
+}
+
 void WriteFile(const fs::path& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
   out << bytes;
@@ -109,15 +122,7 @@ TEST(CloudIo, PointTimesRoundTripEveryWriterAndDriversFieldsRead) {
   const fs::path dir = test::TempDir("cloud_io_point_times");
   LidarCloud cloud = RandomCloud(64, true, true, false, 22);
   for (size_t i = 0; i < cloud.size(); ++i) cloud.time_s.push_back(-0.1f + 0.0015f * i);
-  for (const auto encoding :
-       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
-    SavePcd(dir / "cloud.pcd", cloud, encoding);
-    ExpectSameCloud(LoadCloud(dir / "cloud.pcd"), cloud);
-  }
-  EXPECT_NE(test::ReadFileBytes(dir / "cloud.pcd").find("FIELDS x y z intensity ring t\n"),
-            std::string::npos);
-  SavePly(dir / "cloud.ply", cloud);
-  ExpectSameCloud(LoadCloud(dir / "cloud.ply"), cloud);
+  ExpectEveryWriterRoundTrips(dir, cloud, "FIELDS x y z intensity ring t\n");
   WriteFile(dir / "ouster.pcd",
             "VERSION .7\nFIELDS x y z t\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n"
             "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3 0\n4 5 6 48828125\n");
@@ -150,15 +155,7 @@ TEST(CloudIo, ViewpointsRoundTripEveryWriter) {
   std::uniform_real_distribution<float> offset(-0.1f, 0.1f);
   for (size_t i = 0; i < cloud.size(); ++i)
     cloud.viewpoint.emplace_back(offset(rng), offset(rng), offset(rng));
-  for (const auto encoding :
-       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
-    SavePcd(dir / "cloud.pcd", cloud, encoding);
-    ExpectSameCloud(LoadCloud(dir / "cloud.pcd"), cloud);
-  }
-  EXPECT_NE(test::ReadFileBytes(dir / "cloud.pcd").find("FIELDS x y z intensity vp_x vp_y vp_z"),
-            std::string::npos);
-  SavePly(dir / "cloud.ply", cloud);
-  ExpectSameCloud(LoadCloud(dir / "cloud.ply"), cloud);
+  ExpectEveryWriterRoundTrips(dir, cloud, "FIELDS x y z intensity vp_x vp_y vp_z");
   // PCL writes PointWithViewpoint's fields in its own order; only a complete triple counts.
   WriteFile(dir / "pcl.pcd",
             "VERSION .7\nFIELDS x y z vp_x vp_y vp_z\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\n"
