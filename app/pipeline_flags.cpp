@@ -47,6 +47,19 @@ void AddSettingFlag(CLI::App& app, const JobSettingField& setting, PipelineFlags
       setting.slot);
 }
 
+// A moving capture's clocks (core/lidar_camera/time_offset.h).
+void AddTimeOffsetFlags(CLI::App& app, TimeOffsetOptions* offset) {
+  app.add_option("--time-offset-search", offset->search_s,
+                 "a waved board's capture (pairs with \"images\"): half-width of the "
+                 "search for the camera's clock against the LiDAR's [s]")
+      ->capture_default_str();
+  app.add_option_function<double>(
+      "--time-offset", [offset](double seconds) { offset->fixed_s = seconds; },
+      "a waved board's capture: the camera's stamps minus the LiDAR's clock, known [s] "
+      "(+0.04: the camera's stamps 40 ms late); not searched then. 0 pairs each sweep "
+      "with the camera's boards at the same stamps");
+}
+
 }  // namespace
 
 void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) {
@@ -113,16 +126,7 @@ void AddPipelineFlags(CLI::App& app, PipelineFlags& flags, bool with_selection) 
              "--no-board-growing", [&o] { o.grow_to_board = false; },
              "fit the LiDAR plane on the brushed / seeded returns only, instead of growing the "
              "region to the whole board (limited by the target's sheet size)");
-         // A moving capture's clocks (core/lidar_camera/time_offset.h).
-         app.add_option("--time-offset-search", o.time_offset.search_s,
-                        "a waved board's capture (pairs with \"images\"): half-width of the "
-                        "search for the camera's clock against the LiDAR's [s]")
-             ->capture_default_str();
-         app.add_option_function<double>(
-             "--time-offset", [&o](double seconds) { o.time_offset.fixed_s = seconds; },
-             "a waved board's capture: the camera's stamps minus the LiDAR's clock, known [s] "
-             "(+0.04: the camera's stamps 40 ms late); not searched then. 0 pairs each sweep "
-             "with the camera's boards at the same stamps");
+         AddTimeOffsetFlags(app, &o.time_offset);
        }},
   };
   for (const JobSettingField& setting : JobSettingFields()) {

@@ -25,8 +25,9 @@ struct RecordedMessage {
 };
 
 // Little-endian float32 x y z [intensity float32] [ring uint16] [time float32 at byte 24, as
-// velodyne_pointcloud's XYZIRT]; point_step padded to 32 bytes like Velodyne's driver. With big_endian the same layout in network order (CDR only). The ring
-// field is named `ring_field` ("line": a Livox driver's laser index).
+// velodyne_pointcloud's XYZIRT]; point_step padded to 32 bytes like Velodyne's driver. With
+// big_endian the same layout in network order (CDR only). The ring field is named `ring_field`
+// ("line": a Livox driver's laser index).
 std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int64_t stamp_ns,
                                                const std::string& frame, MessageEncoding encoding,
                                                bool big_endian = false,

@@ -1,4 +1,5 @@
-// LiDAR point clouds with optional per-point intensity, ring, range, ray origin and time (files: core/io/cloud_io.h).
+// LiDAR point clouds with optional per-point intensity, ring, range, ray origin and time (files:
+// core/io/cloud_io.h).
 #pragma once
 
 #include <vector>

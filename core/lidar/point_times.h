@@ -36,7 +36,7 @@ const std::vector<std::string>& PointTimeFieldNames();
 struct PointTimeReading {
   bool ok = false;
   double seconds_per_unit = 1.0;
-  bool on_the_clock = false;  // values are times on the LiDAR's clock, not after the stamp
+  bool on_the_clock = false;           // values are times on the LiDAR's clock, not after the stamp
   double first_s = 0.0, last_s = 0.0;  // the returns' span after the stamp
   // "per-point times from 'time' (FLOAT32): seconds after the stamp, -0.0995 .. 0.0000 s" or, when
   // !ok, why the field was not read ("... fits no unit: each cloud is treated as instantaneous").

@@ -75,6 +75,24 @@ json PairsJson(const CalibrationOutcome& outcome) {
   return pairs;
 }
 
+// `time_offset` {camera_minus_lidar_s, std_s, ...}, or null with `time_offset_why`.
+void AddTimeOffsetJson(const TimeOffsetEstimate& offset, json* root_json) {
+  json& root = *root_json;
+  if (offset.camera_minus_lidar_s) {
+    root["time_offset"] = {
+        {"camera_minus_lidar_s", *offset.camera_minus_lidar_s},
+        {"std_s", offset.std_s},
+        {"given", offset.fixed},
+        {"moving_pairs", offset.profiled_pairs},
+        {"meaning",
+         "a camera stamp minus the LiDAR clock's time of the same instant (+0.040: the camera's "
+         "stamps are 40 ms late); std_s is in the pose's covariance too"}};
+  } else {
+    root["time_offset"] = nullptr;
+    root["time_offset_why"] = offset.why;
+  }
+}
+
 json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& options,
                   const ResultNames& names) {
   CALIBENCH_CHECK(outcome.solution.has_value());
@@ -140,20 +158,7 @@ json ResultToJson(const CalibrationOutcome& outcome, const SolverOptions& option
   if (json model = LidarModelJson(outcome); !model.is_null()) root["lidar_model"] = model;
   if (json noise = LidarNoiseJson(outcome); !noise.is_null()) root["lidar_noise"] = noise;
   if (json times = LidarTimesJson(outcome); !times.is_null()) root["lidar_times"] = times;
-  const TimeOffsetEstimate& offset = outcome.time_offset;
-  if (offset.camera_minus_lidar_s) {
-    root["time_offset"] = {
-        {"camera_minus_lidar_s", *offset.camera_minus_lidar_s},
-        {"std_s", offset.std_s},
-        {"given", offset.fixed},
-        {"moving_pairs", offset.profiled_pairs},
-        {"meaning",
-         "a camera stamp minus the LiDAR clock's time of the same instant (+0.040: the camera's "
-         "stamps are 40 ms late); std_s is in the pose's covariance too"}};
-  } else {
-    root["time_offset"] = nullptr;
-    root["time_offset_why"] = offset.why;
-  }
+  AddTimeOffsetJson(outcome.time_offset, &root);
   return root;
 }
 

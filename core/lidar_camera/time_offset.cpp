@@ -78,6 +78,65 @@ Vec3 FitParabola(const std::vector<ProfilePoint>& points, double centre) {
   return a.colPivHouseholderQr().solve(b);
 }
 
+// The coarse grid over the window: a moving pair takes part where its frames hold its instant at
+// every offset of it (the same pairs at every offset, or the costs would not compare); still
+// pairs always. Counts the moving ones into e->profiled_pairs.
+std::vector<const PairFeatures*> CoveredPairs(const std::vector<const PairFeatures*>& accepted,
+                                              const TimeOffsetOptions& o, int steps,
+                                              TimeOffsetEstimate* e) {
+  std::vector<const PairFeatures*> profiled;
+  for (const PairFeatures* p : accepted) {
+    const bool moved = BoardMoved(*p, o);
+    bool covered = true;
+    for (int k = -steps; k <= steps && covered && moved; ++k)
+      covered = BoardAtTime(p->camera_track, LidarInstantS(*p) + k * o.step_s, o.track).has_value();
+    if (!covered) continue;
+    profiled.push_back(p);
+    e->profiled_pairs += moved;
+  }
+  return profiled;
+}
+
+// About the coarse grid's best: a fifth of its step, a parabola through it, the offset and its σ,
+// and how the pose follows the offset there; e->why says why not where it fails.
+void Refine(const Profile& profile, const ProfilePoint& best, const TimeOffsetOptions& o,
+            TimeOffsetEstimate* out) {
+  TimeOffsetEstimate& e = *out;
+  // A fifth of the step about the best, and a parabola through it.
+  std::vector<ProfilePoint> fine;
+  for (int k = -5; k <= 5; ++k)
+    if (auto point = profile.At(best.offset_s + k * o.step_s / 5, best.cam_from_lidar))
+      fine.push_back(*point);
+  const Vec3 c = FitParabola(fine, best.offset_s);
+  if (fine.size() < 5 || !(c(2) > 0)) {
+    e.why = "the planes' agreement does not curve about its best offset: the motion cannot tell it";
+    return;
+  }
+  const double offset = best.offset_s - c(1) / (2 * c(2));
+  const std::optional<ProfilePoint> at = profile.At(offset, best.cam_from_lidar);
+  if (!at) {
+    e.why = "the frames do not hold the best offset's instants";
+    return;
+  }
+  // cost = ½χ²: the profile's curvature is the inverse of the offset's variance, scaled by the
+  // fit's variance factor where the planes scatter more than their covariances say.
+  const int dof = std::max(1, at->residuals - 7);
+  const double variance_factor = std::max(1.0, 2.0 * at->cost / dof);
+  e.camera_minus_lidar_s = offset;
+  e.std_s = std::sqrt(variance_factor / (2.0 * c(2)));
+  const double h = o.step_s / 5;
+  const auto ahead = profile.At(offset + h, at->cam_from_lidar);
+  const auto behind = profile.At(offset - h, at->cam_from_lidar);
+  if (ahead && behind)
+    e.pose_rate = (LogSE3(at->cam_from_lidar.inverse() * ahead->cam_from_lidar) -
+                   LogSE3(at->cam_from_lidar.inverse() * behind->cam_from_lidar)) /
+                  (2 * h);
+  e.why = Words(
+      "searched over +-%.0f ms: the planes of %.0f moving pairs agree best there "
+      "(variance factor %.2f)",
+      o.search_s * 1e3, e.profiled_pairs, variance_factor);
+}
+
 }  // namespace
 
 bool TimeOffsetOptions::Check(std::string* why) const {
@@ -143,21 +202,8 @@ TimeOffsetEstimate EstimateTimeOffset(const std::vector<PairFeatures>& pairs,
                       e.moving_pairs, o.min_moving_pairs);
     return e;
   }
-  // The coarse grid over the window; a moving pair takes part where its frames hold its
-  // instant at every offset of it (the same pairs at every offset, or the costs would not
-  // compare).
   const int steps = std::max(1, static_cast<int>(std::lround(o.search_s / o.step_s)));
-  std::vector<const PairFeatures*> profiled;
-  for (const PairFeatures* p : accepted) {
-    bool covered = true;
-    if (BoardMoved(*p, o))
-      for (int k = -steps; k <= steps && covered; ++k)
-        covered =
-            BoardAtTime(p->camera_track, LidarInstantS(*p) + k * o.step_s, o.track).has_value();
-    if (!covered) continue;
-    profiled.push_back(p);
-    e.profiled_pairs += BoardMoved(*p, o);
-  }
+  const std::vector<const PairFeatures*> profiled = CoveredPairs(accepted, o, steps, &e);
   if (e.profiled_pairs < o.min_moving_pairs) {
     e.why = Words(
         "the frames around only %.0f of %.0f moving pairs cover the whole search "
@@ -185,39 +231,7 @@ TimeOffsetEstimate EstimateTimeOffset(const std::vector<PairFeatures>& pairs,
         best == coarse.end() ? 0.0 : best->offset_s * 1e3);
     return e;
   }
-  // A fifth of the step about the best, and a parabola through it.
-  std::vector<ProfilePoint> fine;
-  for (int k = -5; k <= 5; ++k)
-    if (auto point = profile.At(best->offset_s + k * o.step_s / 5, best->cam_from_lidar))
-      fine.push_back(*point);
-  const Vec3 c = FitParabola(fine, best->offset_s);
-  if (fine.size() < 5 || !(c(2) > 0)) {
-    e.why = "the planes' agreement does not curve about its best offset: the motion cannot tell it";
-    return e;
-  }
-  const double offset = best->offset_s - c(1) / (2 * c(2));
-  const std::optional<ProfilePoint> at = profile.At(offset, best->cam_from_lidar);
-  if (!at) {
-    e.why = "the frames do not hold the best offset's instants";
-    return e;
-  }
-  // cost = ½χ²: the profile's curvature is the inverse of the offset's variance, scaled by the
-  // fit's variance factor where the planes scatter more than their covariances say.
-  const int dof = std::max(1, at->residuals - 7);
-  const double variance_factor = std::max(1.0, 2.0 * at->cost / dof);
-  e.camera_minus_lidar_s = offset;
-  e.std_s = std::sqrt(variance_factor / (2.0 * c(2)));
-  const double h = o.step_s / 5;
-  const auto ahead = profile.At(offset + h, at->cam_from_lidar);
-  const auto behind = profile.At(offset - h, at->cam_from_lidar);
-  if (ahead && behind)
-    e.pose_rate = (LogSE3(at->cam_from_lidar.inverse() * ahead->cam_from_lidar) -
-                   LogSE3(at->cam_from_lidar.inverse() * behind->cam_from_lidar)) /
-                  (2 * h);
-  e.why = Words(
-      "searched over +-%.0f ms: the planes of %.0f moving pairs agree best there "
-      "(variance factor %.2f)",
-      o.search_s * 1e3, e.profiled_pairs, variance_factor);
+  Refine(profile, *best, o, &e);
   return e;
 }
 

@@ -82,7 +82,7 @@ struct LivoxCustomMessage {
   // returns follow the rosette, not a cone. The driver interleaves its lasers (an Avia's 6, a
   // Mid-360's 4); the returns are stored laser by laser, each in firing order, so that
   // consecutive returns are neighbours on one beam's path (board edges from its crossings).
-  LidarCloud cloud;  // time_s: timebase + offset_time after header.stamp
+  LidarCloud cloud;                           // time_s: timebase + offset_time after header.stamp
   std::vector<std::uint32_t> offset_time_ns;  // per kept return
   int noise_dropped = 0;                      // returns tagged as noise
 };

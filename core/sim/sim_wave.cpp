@@ -78,23 +78,13 @@ Pose WavedCamFromBoard(const WaveOptions& o, double t) {
   return pose;
 }
 
-WavedDataset SimulateWavedDataset(const WaveOptions& options,
-                                  const std::filesystem::path& out_dir) {
-  std::string why;
-  if (!options.Check(&why)) throw std::invalid_argument("wave: " + why);
-  const SimOptions r = ResolveSimOptions(options.rig);
-  const BeamTable beams = MakeBeamTable(r.lidar);
-  const BoardPrint print(r.board);
-  const Pose lidar_from_cam = r.cam_from_lidar.inverse();
-  const std::filesystem::path root = std::filesystem::absolute(out_dir);
-  std::filesystem::create_directories(root / "clouds");
-  std::filesystem::create_directories(root / "images");
-  const int threads = DefaultThreads();
+namespace {
 
-  // The camera's frames at their true instants, stamped on the camera's clock.
-  const int frames = static_cast<int>(std::floor(options.duration_s * options.camera_hz));
+// The camera's frames at their true instants, stamped on the camera's clock.
+std::vector<StampedImage> RenderFrames(const WaveOptions& options, const SimOptions& r,
+                                       const std::filesystem::path& root, int frames) {
   std::vector<StampedImage> images(frames);
-  ParallelFor(frames, threads, [&](size_t k) {
+  ParallelFor(frames, DefaultThreads(), [&](size_t k) {
     const double t = (static_cast<double>(k) + 0.37) / options.camera_hz;
     RenderOptions render;
     render.image_noise = r.image_noise;
@@ -104,46 +94,70 @@ WavedDataset SimulateWavedDataset(const WaveOptions& options,
     SaveImage(images[k].image,
               RenderBoardImage(r.camera, r.board, WavedCamFromBoard(options, t), render));
   });
+  return images;
+}
 
-  // The LiDAR's sweeps, each return at its own time with the board where it was then.
+// Sweep `j`, each return at its own time with the board where it was then; its cloud written
+// (clouds/sweep_<j>.pcd) and the bound's truth kept when it sees the board.
+Sweep SimulateSweep(const WaveOptions& options, const SimOptions& r, const BeamTable& beams,
+                    const BoardPrint& print, int j, const std::filesystem::path& root) {
+  const double sweep_s = 1.0 / options.lidar_hz;
+  const double start = j * sweep_s;
+  const Pose lidar_from_cam = r.cam_from_lidar.inverse();
+  std::mt19937_64 rng(r.seed * 7919 + j);
+  LidarScene scene = WaveRoom(r);
+  scene.lidar_from_board_at = [&](double s) {
+    return lidar_from_cam * WavedCamFromBoard(options, start + s);
+  };
+  scene.lidar_from_board = scene.lidar_from_board_at(0.5 * sweep_s);
+  LidarScanOptions scan;
+  scan.range_noise_m = r.lidar_range_noise_m;
+  scan.range_offset_m = r.lidar_range_offset_m;
+  scan.angular_noise_rad = r.lidar_angular_noise_rad;
+  scan.azimuth_offset_rad =
+      beams.PhaseSpanRad() * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+  scan.seed = rng();
+  scan.sweep_s = sweep_s;
+  const LidarScan lidar = SimulateLidarScan(beams, print, scene, scan);
+  std::vector<float> board_times;
+  for (size_t i = 0; i < lidar.size(); ++i)
+    if (lidar.surface[i] == SimSurface::kBoard) board_times.push_back(lidar.time_s[i]);
+  Sweep sweep;
+  sweep.stamp_ns = kStartNs + Ns(start);
+  sweep.board_seen = static_cast<int>(board_times.size()) >= options.min_board_returns;
+  if (!sweep.board_seen) return sweep;
+  std::nth_element(board_times.begin(), board_times.begin() + board_times.size() / 2,
+                   board_times.end());
+  sweep.truth.cam_from_board =
+      WavedCamFromBoard(options, start + board_times[board_times.size() / 2]);
+  const LidarRectangle sheet{lidar_from_cam * sweep.truth.cam_from_board,
+                             0.5 * Vec2(r.board.SheetWidth(), r.board.SheetHeight())};
+  sweep.truth.lidar_board_points = CastBoardReturns(beams, sheet, scan.azimuth_offset_rad).points;
+  SavePcd(root / "clouds" / Numbered("sweep_", j, ".pcd"),
+          lidar.ToCloud(r.board_only_clouds, r.lidar_viewpoints), PcdEncoding::kBinary);
+  return sweep;
+}
+
+}  // namespace
+
+WavedDataset SimulateWavedDataset(const WaveOptions& options,
+                                  const std::filesystem::path& out_dir) {
+  std::string why;
+  if (!options.Check(&why)) throw std::invalid_argument("wave: " + why);
+  const SimOptions r = ResolveSimOptions(options.rig);
+  const BeamTable beams = MakeBeamTable(r.lidar);
+  const BoardPrint print(r.board);
+  const std::filesystem::path root = std::filesystem::absolute(out_dir);
+  std::filesystem::create_directories(root / "clouds");
+  std::filesystem::create_directories(root / "images");
+
+  const int frames = static_cast<int>(std::floor(options.duration_s * options.camera_hz));
+  const std::vector<StampedImage> images = RenderFrames(options, r, root, frames);
   const double sweep_s = 1.0 / options.lidar_hz;
   const int sweeps = static_cast<int>(std::floor(options.duration_s * options.lidar_hz));
   std::vector<Sweep> seen(sweeps);
-  ParallelFor(sweeps, threads, [&](size_t j) {
-    const double start = static_cast<double>(j) * sweep_s;
-    std::mt19937_64 rng(r.seed * 7919 + j);
-    LidarScene scene = WaveRoom(r);
-    scene.lidar_from_board_at = [&](double s) {
-      return lidar_from_cam * WavedCamFromBoard(options, start + s);
-    };
-    scene.lidar_from_board = scene.lidar_from_board_at(0.5 * sweep_s);
-    LidarScanOptions scan;
-    scan.range_noise_m = r.lidar_range_noise_m;
-    scan.range_offset_m = r.lidar_range_offset_m;
-    scan.angular_noise_rad = r.lidar_angular_noise_rad;
-    scan.azimuth_offset_rad =
-        beams.PhaseSpanRad() * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
-    scan.seed = rng();
-    scan.sweep_s = sweep_s;
-    const LidarScan lidar = SimulateLidarScan(beams, print, scene, scan);
-    std::vector<float> board_times;
-    for (size_t i = 0; i < lidar.size(); ++i)
-      if (lidar.surface[i] == SimSurface::kBoard) board_times.push_back(lidar.time_s[i]);
-    seen[j].stamp_ns = kStartNs + Ns(start);
-    seen[j].board_seen = static_cast<int>(board_times.size()) >= options.min_board_returns;
-    if (seen[j].board_seen) {
-      std::nth_element(board_times.begin(), board_times.begin() + board_times.size() / 2,
-                       board_times.end());
-      const double instant = start + board_times[board_times.size() / 2];
-      seen[j].truth.cam_from_board = WavedCamFromBoard(options, instant);
-      LidarRectangle sheet{lidar_from_cam * seen[j].truth.cam_from_board,
-                           0.5 * Vec2(r.board.SheetWidth(), r.board.SheetHeight())};
-      seen[j].truth.lidar_board_points =
-          CastBoardReturns(beams, sheet, scan.azimuth_offset_rad).points;
-    }
-    if (seen[j].board_seen)
-      SavePcd(root / "clouds" / Numbered("sweep_", static_cast<int>(j), ".pcd"),
-              lidar.ToCloud(r.board_only_clouds, r.lidar_viewpoints), PcdEncoding::kBinary);
+  ParallelFor(sweeps, DefaultThreads(), [&](size_t j) {
+    seen[j] = SimulateSweep(options, r, beams, print, static_cast<int>(j), root);
   });
 
   WavedDataset out;

@@ -44,7 +44,7 @@ struct WaveOptions {
 Pose WavedCamFromBoard(const WaveOptions& options, double t);
 
 struct WavedDataset {
-  Dataset dataset;                // as written (dataset.json under the folder)
+  Dataset dataset;  // as written (dataset.json under the folder)
   // Per pair, as dataset.pairs: the board at its returns' median time and its noise-free returns
   // there (for the Cramér–Rao bound of the same sweeps, core/evaluation/crlb.h).
   std::vector<SimPairTruth> truth;

@@ -71,9 +71,9 @@ inline constexpr const char* kBoardOnlyCropNoEdges =
 double BoardGrowRadius(const BoardSpec& board);
 
 struct LidarPlaneFit {
-  Plane plane;                          // LiDAR frame, normal towards the LiDAR (d > 0)
-  Mat4 covariance = Mat4::Zero();       // of (n, d) from the least-squares refit; rank 3
-  std::vector<int> inliers;             // indices into the cloud
+  Plane plane;                     // LiDAR frame, normal towards the LiDAR (d > 0)
+  Mat4 covariance = Mat4::Zero();  // of (n, d) from the least-squares refit; rank 3
+  std::vector<int> inliers;        // indices into the cloud
   // Each inlier's time after the cloud's stamp (LidarCloud::time_s), as `inliers`; empty when
   // the cloud has no per-point times (the board then counts as seen at the stamp).
   std::vector<float> inlier_times_s;

@@ -9,7 +9,8 @@
 namespace calibench {
 namespace {
 
-constexpr double kLuminarStampS = 1604515190.231;  // a real recording's stamp (ros1_luminar_lidar_lz4)
+constexpr double kLuminarStampS =
+    1604515190.231;  // a real recording's stamp (ros1_luminar_lidar_lz4)
 
 // n values from `first` to `last`, evenly.
 std::vector<double> TimesFromTo(double first, double last, int n = 1000) {
@@ -59,7 +60,8 @@ TEST(PointTimes, HesaisFloatSecondsOnTheClockBecomeTimesAfterTheStamp) {
 }
 
 TEST(PointTimes, LivoxDriver2sFloatNanosecondsOnTheClock) {
-  const std::vector<double> raw = TimesFromTo((kLuminarStampS + 0.002) * 1e9, (kLuminarStampS + 0.102) * 1e9);
+  const std::vector<double> raw =
+      TimesFromTo((kLuminarStampS + 0.002) * 1e9, (kLuminarStampS + 0.102) * 1e9);
   const PointTimeReading r = ReadPointTimes({"timestamp", false, "FLOAT64"}, raw, kLuminarStampS);
   ASSERT_TRUE(r.ok) << r.words;
   EXPECT_TRUE(r.on_the_clock);
@@ -72,14 +74,17 @@ TEST(PointTimes, LivoxDriver2sFloatNanosecondsOnTheClock) {
 TEST(PointTimes, ValuesNoUnitExplainsAreRefusedWithTheirReason) {
   // Seconds on the clock without a clock to read them against (a file's field): not after the
   // stamp either, so not read — and said, never silently zero.
-  const PointTimeReading file =
-      ReadPointTimes({"t", false, "F4"}, TimesFromTo(kLuminarStampS, kLuminarStampS + 0.1), std::nullopt);
+  const PointTimeReading file = ReadPointTimes(
+      {"t", false, "F4"}, TimesFromTo(kLuminarStampS, kLuminarStampS + 0.1), std::nullopt);
   EXPECT_FALSE(file.ok);
   EXPECT_NE(file.words.find("treated as instantaneous"), std::string::npos) << file.words;
-  EXPECT_TRUE(PointTimesAfterStamp(TimesFromTo(kLuminarStampS, kLuminarStampS + 0.1), file, std::nullopt).empty());
+  EXPECT_TRUE(
+      PointTimesAfterStamp(TimesFromTo(kLuminarStampS, kLuminarStampS + 0.1), file, std::nullopt)
+          .empty());
   // A day away from the stamp in every unit.
   EXPECT_FALSE(ReadPointTimes({"timestamp", false, "FLOAT64"},
-                              TimesFromTo(kLuminarStampS + 86400, kLuminarStampS + 86400.1), kLuminarStampS)
+                              TimesFromTo(kLuminarStampS + 86400, kLuminarStampS + 86400.1),
+                              kLuminarStampS)
                    .ok);
   // A value that is not finite.
   std::vector<double> broken = TimesFromTo(0, 0.1);
