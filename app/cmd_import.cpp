@@ -101,6 +101,11 @@ void AddSelectionFlags(CLI::App& app, PairSelectionOptions* options_out) {
   app.add_option("--duplicate-rotation", options.duplicate_rotation_deg,
                  "see --duplicate-translation [deg]")
       ->capture_default_str();
+  app.add_option("--moving-after", options.moving_after_s,
+                 "a board that never stops (waved): once the LiDAR has seen nothing still for "
+                 "this long, every sweep that sees the board is a pair with the camera frames "
+                 "around it (0: still holds only) [s]")
+      ->capture_default_str();
 }
 
 void PrintSummary(const BagImportSummary& summary, const BagImportOptions& options) {
@@ -119,6 +124,11 @@ void PrintSummary(const BagImportSummary& summary, const BagImportOptions& optio
   std::printf("board   %s\n", summary.board_source.c_str());
   std::printf("camera  %s\n", summary.camera_source.c_str());
   std::printf("pairs written: %zu\n", summary.pair_ids.size());
+  if (summary.moving_pairs > 0)
+    std::printf(
+        "  %d of them moving: sweeps of a board that never stopped, each with the camera "
+        "frames around it\n",
+        summary.moving_pairs);
   for (const auto& [reason, count] : summary.dropped)
     std::printf("  dropped %5d  %s\n", count, reason.c_str());
   if (summary.kept_without_stillness_check > 0)

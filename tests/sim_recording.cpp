@@ -4,6 +4,9 @@
 #include <cmath>
 #include <random>
 
+#include "core/io/cloud_io.h"
+#include "core/io/image_io.h"
+
 namespace calibench::test {
 
 namespace {
@@ -181,13 +184,15 @@ SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding enc
       } else {
         image = RenderBoardImage(truth.camera, truth.board, BoardAt(truth, t), moving_render);
       }
-      const std::int64_t received = t + 15'000'000;
+      // The camera's stamp of the instant t, on its own clock.
+      const std::int64_t stamp = t + std::llround(options.camera_minus_lidar_s * 1e9);
+      const std::int64_t received = stamp + 15'000'000;
       const std::string first = truth.second_cam_from_lidar ? "cam0" : "camera";
       writer->Add(
           {"/" + first + "/image_raw", "sensor_msgs/Image", received,
-           SerializeImage(image, image.channels == 1 ? "mono8" : "bgr8", t, first, encoding)});
+           SerializeImage(image, image.channels == 1 ? "mono8" : "bgr8", stamp, first, encoding)});
       writer->Add({"/" + first + "/camera_info", "sensor_msgs/CameraInfo", received,
-                   SerializeCameraInfo(truth.camera, t, first, encoding)});
+                   SerializeCameraInfo(truth.camera, stamp, first, encoding)});
       truth.messages += 2;
       if (!truth.second_cam_from_lidar) continue;
       // The rig's second camera, triggered with the first: the same board from its mount.
@@ -203,15 +208,40 @@ SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding enc
       } else {
         second = RenderBoardImage(truth.camera, truth.board, second_from_board, moving_render);
       }
-      writer->Add(
-          {"/cam1/image_raw", "sensor_msgs/Image", received,
-           SerializeImage(second, second.channels == 1 ? "mono8" : "bgr8", t, "cam1", encoding)});
+      writer->Add({"/cam1/image_raw", "sensor_msgs/Image", received,
+                   SerializeImage(second, second.channels == 1 ? "mono8" : "bgr8", stamp, "cam1",
+                                  encoding)});
       writer->Add({"/cam1/camera_info", "sensor_msgs/CameraInfo", received,
-                   SerializeCameraInfo(truth.camera, t, "cam1", encoding)});
+                   SerializeCameraInfo(truth.camera, stamp, "cam1", encoding)});
       truth.messages += 2;
     }
   }
   return truth;
+}
+
+WavedDataset WriteWavedRecording(RecordingWriter* writer, MessageEncoding encoding,
+                                 WaveOptions wave, const std::filesystem::path& scratch) {
+  wave.every_sweep = true;
+  const WavedDataset waved = SimulateWavedDataset(wave, scratch);
+  const std::int64_t sweep_ns = std::llround(1e9 / wave.lidar_hz);
+  std::vector<RecordedMessage> messages;
+  for (const auto& [file, stamp] : waved.sweep_files)
+    messages.push_back({"/velodyne_points", "sensor_msgs/PointCloud2", stamp + sweep_ns,
+                        SerializePointCloud2(LoadCloud(file), stamp, "velodyne", encoding)});
+  for (const StampedImage& frame : waved.frame_files) {
+    const ImageU8 image = LoadImage(frame.image);
+    const std::int64_t received = frame.stamp_ns + 15'000'000;
+    messages.push_back({"/camera/image_raw", "sensor_msgs/Image", received,
+                        SerializeImage(image, image.channels == 1 ? "mono8" : "bgr8",
+                                       frame.stamp_ns, "camera", encoding)});
+    messages.push_back(
+        {"/camera/camera_info", "sensor_msgs/CameraInfo", received,
+         SerializeCameraInfo(waved.dataset.camera, frame.stamp_ns, "camera", encoding)});
+  }
+  std::stable_sort(messages.begin(), messages.end(),
+                   [](const auto& a, const auto& b) { return a.log_time_ns < b.log_time_ns; });
+  for (const RecordedMessage& message : messages) writer->Add(message);
+  return waved;
 }
 
 }  // namespace calibench::test

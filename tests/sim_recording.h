@@ -15,6 +15,7 @@
 #include "core/camera/camera.h"
 #include "core/recording/bag.h"
 #include "core/sim/sim.h"
+#include "core/sim/sim_wave.h"
 #include "tests/bag_writers.h"
 
 namespace calibench::test {
@@ -43,6 +44,8 @@ struct SimRecordingOptions {
   // a float32 field `time`, seconds after the sweep's stamp (its start), from each return's
   // azimuth after the sweep's firing phase.
   bool point_times = false;
+  // The camera's stamps off the LiDAR's clock (seconds; +0.080: 80 ms late), as a USB camera's.
+  double camera_minus_lidar_s = 0.0;
 };
 
 struct SimRecordingTruth {
@@ -86,5 +89,13 @@ SimRecordingTruth PlanSimRecording(const SimRecordingOptions& options);
 // writer's (ROS 1 for .bag, CDR for ROS 2 MCAP).
 SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding encoding,
                                     const SimRecordingOptions& options);
+
+// A waved board's recording (core/sim/sim_wave.h, simulated under `scratch` with every sweep
+// written): each sweep a PointCloud2 on /velodyne_points with velodyne's per-point `time`, stamped
+// at its start on the LiDAR's clock and logged once complete; each frame an Image on
+// /camera/image_raw stamped on the camera's clock (wave.camera_minus_lidar_s off), with its
+// CameraInfo. Written through `writer` (not closed) in log-time order.
+WavedDataset WriteWavedRecording(RecordingWriter* writer, MessageEncoding encoding,
+                                 WaveOptions wave, const std::filesystem::path& scratch);
 
 }  // namespace calibench::test

@@ -24,7 +24,8 @@ namespace {
 struct WrittenPair {
   int found = 0;  // its place among the pairs found
   std::int64_t cloud_stamp_ns = 0, image_stamp_ns = 0;
-  bool point_times = false;  // its cloud carries per-point times
+  bool point_times = false;          // its cloud carries per-point times
+  std::vector<StampedImage> frames;  // a moving pair's (images/frame_<stamp>.png, shared)
 };
 
 std::string PairId(int index) {
@@ -124,10 +125,11 @@ class Importer {
       if (pair.cloud.HasRing())
         rings_ =
             std::max(rings_, *std::max_element(pair.cloud.ring.begin(), pair.cloud.ring.end()) + 1);
-      WriteFoundPair(pair, out_dir_, id);
+      const PairEntry entry = WriteFoundPair(pair, out_dir_, id);
       // Said once: the first pair's reading stands for the recording's LiDAR.
       if (summary_.point_times.empty()) summary_.point_times = pair.point_times;
-      written_.push_back({index, pair.cloud_stamp_ns, pair.image_stamp_ns, pair.cloud.HasTime()});
+      written_.push_back(
+          {index, pair.cloud_stamp_ns, pair.image_stamp_ns, pair.cloud.HasTime(), entry.images});
     }
   }
 
@@ -141,6 +143,10 @@ class Importer {
     std::vector<bool> keep(written_.size(), false);
     for (std::size_t i = 0; i < cap; ++i)
       keep[cap == 1 ? 0 : i * (written_.size() - 1) / (cap - 1)] = true;
+    std::set<fs::path> kept_frames;  // a moving pair's frames may be another's too
+    for (std::size_t i = 0; i < written_.size(); ++i)
+      if (keep[i])
+        for (const StampedImage& frame : written_[i].frames) kept_frames.insert(frame.image);
     for (std::size_t i = 0; i < written_.size(); ++i) {
       const std::string id = PairId(written_[i].found);
       if (keep[i]) {
@@ -149,13 +155,16 @@ class Importer {
       }
       fs::remove(out_dir_ / "clouds" / (id + ".pcd"));
       fs::remove(out_dir_ / "images" / (id + ".png"));
+      for (const StampedImage& frame : written_[i].frames)
+        if (!kept_frames.count(frame.image)) fs::remove(frame.image);
       ++summary_.dropped["over the cap of " + std::to_string(cap) + " pairs"];
     }
     for (std::size_t i = 0; i < spread.size(); ++i) {
       const std::string from = PairId(spread[i].found), to = PairId(static_cast<int>(i));
       if (from == to) continue;
       fs::rename(out_dir_ / "clouds" / (from + ".pcd"), out_dir_ / "clouds" / (to + ".pcd"));
-      fs::rename(out_dir_ / "images" / (from + ".png"), out_dir_ / "images" / (to + ".png"));
+      if (spread[i].frames.empty())
+        fs::rename(out_dir_ / "images" / (from + ".png"), out_dir_ / "images" / (to + ".png"));
       spread[i].found = static_cast<int>(i);
     }
     written_ = std::move(spread);
@@ -177,13 +186,18 @@ class Importer {
       entry.cloud = fs::absolute(out_dir_ / "clouds" / (id + ".pcd"));
       entry.image = fs::absolute(out_dir_ / "images" / (id + ".png"));
       entry.lidar_stamp_ns = pair.cloud_stamp_ns;
+      entry.images = pair.frames;
+      for (const StampedImage& frame : pair.frames)
+        if (frame.stamp_ns == pair.image_stamp_ns) entry.image = frame.image;
       dataset.pairs.push_back(entry);
       summary_.pairs_with_point_times += pair.point_times;
+      summary_.moving_pairs += !pair.frames.empty();
       summary_.pair_ids.push_back(id);
       summary_.pair_cloud_stamps_ns.push_back(pair.cloud_stamp_ns);
       pairs.push_back({{"id", id},
                        {"cloud_stamp_ns", pair.cloud_stamp_ns},
                        {"image_stamp_ns", pair.image_stamp_ns}});
+      if (!pair.frames.empty()) pairs.back()["frames"] = pair.frames.size();
     }
     summary_.manifest = out_dir_ / "dataset.json";
     SaveDataset(summary_.manifest, dataset);
@@ -198,6 +212,7 @@ class Importer {
     record["tries"] = summary_.tries;
     record["images_searched"] = summary_.images_searched;
     record["point_times"] = summary_.point_times;
+    record["moving_pairs"] = summary_.moving_pairs;
     if (!summary_.cut_short.empty()) record["cut_short"] = summary_.cut_short;
     WriteFileAtomically(out_dir_ / "import.json", record.dump(2) + "\n");
   }
@@ -269,10 +284,22 @@ PairEntry WriteFoundPair(const FoundPair& pair, const fs::path& dir, const std::
   PairEntry entry;
   entry.id = id;
   entry.cloud = fs::absolute(dir / "clouds" / (id + ".pcd"));
-  entry.image = fs::absolute(dir / "images" / (id + ".png"));
   entry.lidar_stamp_ns = pair.cloud_stamp_ns;  // what the cloud's field `t` counts from
   SavePcd(entry.cloud, pair.cloud, PcdEncoding::kBinary);
-  SaveImage(entry.image, pair.image);
+  if (!pair.Moving()) {
+    entry.image = fs::absolute(dir / "images" / (id + ".png"));
+    SaveImage(entry.image, pair.image);
+    return entry;
+  }
+  // A moving pair's frames, named by stamp: a frame around several sweeps is one file, written
+  // by the first pair that holds its pixels.
+  for (const FoundFrame& frame : pair.frames) {
+    const fs::path path =
+        fs::absolute(dir / "images" / ("frame_" + std::to_string(frame.stamp_ns) + ".png"));
+    if (!frame.image.empty()) SaveImage(path, frame.image);
+    entry.images.push_back({path, frame.stamp_ns});
+    if (frame.stamp_ns == pair.image_stamp_ns) entry.image = path;
+  }
   return entry;
 }
 

@@ -1,5 +1,6 @@
 // A recording -> a dataset folder: the LiDAR and camera topics chosen, clouds paired with images
-// by stamp, only moments when the board stood still, no near-duplicate poses, at most a cap;
+// by stamp, the moments when the board stood still (no near-duplicate poses) or, where it never
+// stops, every sweep that sees it with the frames around it; at most a cap;
 // written as binary PCD + PNG + camera.yaml + dataset.json, with a record of every dropped frame.
 // The pairs themselves are chosen by core/capture/recording_pairs.h, which `watch` shares.
 #pragma once
@@ -61,6 +62,9 @@ struct BagImportSummary {
   // none and are taken as instantaneous; said once, from the first pair written.
   std::string point_times;
   int pairs_with_point_times = 0;  // of the pairs kept, their clouds' field `t` written
+  // Of the pairs kept, sweeps of a board that never stopped, each with the frames around it
+  // (the manifest's "images"; PairSelectionOptions::moving_after_s).
+  int moving_pairs = 0;
 };
 
 // Topics to import when the options name none: exactly one PointCloud2 topic; one image topic

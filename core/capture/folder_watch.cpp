@@ -156,7 +156,9 @@ std::vector<FolderEvent> GrowingFolder::Poll(double now_s) {
     FolderEvent event;
     event.kind = FolderEvent::Kind::kPairComplete;
     event.stem = r.stem;
-    event.pair = PairEntry{r.stem, clouds_.at(r.stem).path, images_.at(r.stem).path, std::nullopt};
+    event.pair.id = r.stem;
+    event.pair.cloud = clouds_.at(r.stem).path;
+    event.pair.image = images_.at(r.stem).path;
     complete.push_back(std::move(event));
   }
   complete.insert(complete.end(), events.begin(), events.end());

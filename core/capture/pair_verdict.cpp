@@ -1,6 +1,9 @@
 #include "core/capture/pair_verdict.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <utility>
 
 #include "core/geometry/geometry.h"
 #include "core/recording/ros_messages.h"
@@ -89,6 +92,37 @@ void IntegrateSweeps(const std::vector<recording_detail::StampedBytes>& sweeps,
   cloud->height = 1;
 }
 
+// The try's sweep (and a ring-less hold's others) into `pair`; false with *dropped set when it
+// cannot be read or holds no point.
+bool DecodeTryCloud(const recording_detail::Try& attempt, const PairTopics& topics,
+                    const LoadLimits& limits, FoundPair* pair, std::string* dropped) {
+  try {
+    CloudMessage message =
+        DecodeCloudMessage(*attempt.cloud.bytes, topics.livox_cloud, topics.cloud, limits);
+    pair->cloud = std::move(message.cloud);
+    pair->point_times = std::move(message.point_times);
+    IntegrateSweeps(attempt.integrated, topics, limits, attempt.cloud.stamp_ns, &pair->cloud);
+  } catch (const std::invalid_argument&) {
+    *dropped = "cloud message unreadable";
+    return false;
+  }
+  if (pair->cloud.size() == 0) {
+    *dropped = "cloud has no finite point";
+    return false;
+  }
+  return true;
+}
+
+// The images must be the intrinsics' size: a recording that says otherwise is refused whole.
+void CheckImageSize(const ImageU8& image, const CameraModel& camera, const PairTopics& topics,
+                    const std::string& source) {
+  if (camera.width != image.width || camera.height != image.height)
+    throw IoError(source + ": the images on " + topics.image_topic + " are " +
+                  std::to_string(image.width) + " x " + std::to_string(image.height) +
+                  " but the camera intrinsics are for " + std::to_string(camera.width) + " x " +
+                  std::to_string(camera.height));
+}
+
 }  // namespace
 
 bool PairSelectionOptions::Check(std::string* why) const {
@@ -111,6 +145,13 @@ bool PairSelectionOptions::Check(std::string* why) const {
   }
   if (board_sample_images < 1) {
     *why = "board_sample_images must be >= 1";
+    return false;
+  }
+  if (!(moving_after_s >= 0.0) || !(moving_images_s > 0.0 && moving_images_s <= 5.0) ||
+      moving_min_frames < 2 || !(moving_min_travel_m > 0.0) || !(moving_min_turn_deg > 0.0)) {
+    *why =
+        "moving_after_s must be >= 0, moving_images_s in (0, 5] s, moving_min_frames >= 2, "
+        "moving_min_travel_m and moving_min_turn_deg > 0";
     return false;
   }
   return lidar_motion.Check(why) && limits.Check(why);
@@ -174,11 +215,7 @@ TryOutcome JudgeTry(const recording_detail::Try& attempt, std::optional<ImageU8>
     outcome.dropped = "image unreadable";
     return outcome;
   }
-  if (attempt.camera.width != image.width || attempt.camera.height != image.height)
-    throw IoError(source + ": the images on " + topics.image_topic + " are " +
-                  std::to_string(image.width) + " x " + std::to_string(image.height) +
-                  " but the camera intrinsics are for " + std::to_string(attempt.camera.width) +
-                  " x " + std::to_string(attempt.camera.height));
+  CheckImageSize(image, attempt.camera, topics, source);
   const CameraVerdict verdict = JudgeCameraSide(
       image, attempt.others.size(),
       [&](std::size_t i) -> std::optional<ImageU8> {
@@ -196,26 +233,117 @@ TryOutcome JudgeTry(const recording_detail::Try& attempt, std::optional<ImageU8>
     return outcome;
   }
   FoundPair pair;
-  try {
-    CloudMessage message =
-        DecodeCloudMessage(*attempt.cloud.bytes, topics.livox_cloud, topics.cloud, options.limits);
-    pair.cloud = std::move(message.cloud);
-    pair.point_times = std::move(message.point_times);
-    IntegrateSweeps(attempt.integrated, topics, options.limits, attempt.cloud.stamp_ns,
-                    &pair.cloud);
-  } catch (const std::invalid_argument&) {
-    outcome.dropped = "cloud message unreadable";
-    return outcome;
-  }
-  if (pair.cloud.size() == 0) {
-    outcome.dropped = "cloud has no finite point";
-    return outcome;
-  }
+  if (!DecodeTryCloud(attempt, topics, options.limits, &pair, &outcome.dropped)) return outcome;
   pair.cloud_stamp_ns = attempt.cloud.stamp_ns;
   pair.image_stamp_ns = attempt.image.stamp_ns;
   pair.image = std::move(image);
   pair.cam_from_board = *verdict.cam_from_board;
   pair.stillness_checked = verdict.stillness_checked;
+  outcome.pair = std::move(pair);
+  return outcome;
+}
+
+const FrameSearches::Search& FrameSearches::Of(const recording_detail::StampedBytes& frame,
+                                               const PairTopics& topics, const CameraModel& camera,
+                                               const BoardSpec& board, const LoadLimits& limits,
+                                               const std::string& source, bool* searched_now) {
+  *searched_now = false;
+  if (const auto known = searches_.find(frame.stamp_ns); known != searches_.end())
+    return known->second;
+  Search& search = searches_[frame.stamp_ns];
+  ImageU8 image;
+  try {
+    image = DecodeTryMessageImage(frame, topics, limits);
+  } catch (const std::invalid_argument&) {
+    return search;  // unreadable: no board there
+  }
+  CheckImageSize(image, camera, topics, source);
+  *searched_now = true;
+  std::string why;
+  const auto detection = DetectBoard(image, board, BoardDetectionOptions{}, &why);
+  if (!detection) return search;
+  if (const auto observation = EstimateBoardPose(camera, *detection, PnpOptions{}, &why)) {
+    search.cam_from_board = observation->cam_from_board;
+    search.image = std::move(image);
+  }
+  return search;
+}
+
+ImageU8 FrameSearches::HandOut(std::int64_t stamp_ns) {
+  const auto known = searches_.find(stamp_ns);
+  if (known == searches_.end() || known->second.handed_out) return ImageU8{};
+  known->second.handed_out = true;
+  return known->second.image;
+}
+
+ImageU8 FrameSearches::Pixels(std::int64_t stamp_ns) const {
+  const auto known = searches_.find(stamp_ns);
+  return known == searches_.end() ? ImageU8{} : known->second.image;
+}
+
+void FrameSearches::Forget(std::int64_t oldest_ns) {
+  searches_.erase(searches_.begin(), searches_.lower_bound(oldest_ns));
+}
+
+TryOutcome JudgeMovingTry(const recording_detail::Try& attempt, const PairTopics& topics,
+                          const BoardSpec& board, const std::vector<Pose>& kept,
+                          const PairSelectionOptions& options, const std::string& source,
+                          FrameSearches* searches) {
+  const std::int64_t stamp = attempt.cloud.stamp_ns;
+  searches->Forget(stamp - recording_detail::Ns(2 * options.moving_images_s));
+  std::vector<const recording_detail::StampedBytes*> frames{&attempt.image};
+  for (const recording_detail::StampedBytes& other : attempt.others) frames.push_back(&other);
+  std::sort(frames.begin(), frames.end(),
+            [](const auto* a, const auto* b) { return a->stamp_ns < b->stamp_ns; });
+  TryOutcome outcome;
+  FoundPair pair;
+  bool before = false, after = false;
+  std::vector<Pose> poses;
+  for (const recording_detail::StampedBytes* frame : frames) {
+    bool searched_now = false;
+    const FrameSearches::Search& search =
+        searches->Of(*frame, topics, attempt.camera, board, options.limits, source, &searched_now);
+    outcome.searched += searched_now;
+    if (!search.cam_from_board) continue;
+    outcome.found += searched_now;
+    before |= frame->stamp_ns <= stamp;
+    after |= frame->stamp_ns >= stamp;
+    pair.frames.push_back({frame->stamp_ns, ImageU8{}});
+    poses.push_back(*search.cam_from_board);
+    if (pair.frames.size() == 1 ||
+        std::llabs(frame->stamp_ns - stamp) < std::llabs(pair.image_stamp_ns - stamp)) {
+      pair.image_stamp_ns = frame->stamp_ns;
+      pair.cam_from_board = *search.cam_from_board;
+    }
+  }
+  if (static_cast<int>(pair.frames.size()) < options.moving_min_frames || !before || !after) {
+    outcome.dropped = "moving: the board not in " + std::to_string(options.moving_min_frames) +
+                      " frames around the sweep, on both sides of it";
+    return outcome;
+  }
+  // Still: the board travels less over the frames than a wave does (PnP's own jitter at a
+  // hold reaches the stillness thresholds, frame to frame, on a small image).
+  const bool still = std::all_of(poses.begin(), poses.end(), [&](const Pose& pose) {
+    return Within(BoardPoseError(pose, pair.cam_from_board, board), options.moving_min_travel_m,
+                  options.moving_min_turn_deg);
+  });
+  outcome.camera_still = still;
+  if (still && std::any_of(kept.begin(), kept.end(), [&](const Pose& kept_pose) {
+        return Within(BoardPoseError(kept_pose, pair.cam_from_board, board),
+                      options.duplicate_translation_m, options.duplicate_rotation_deg);
+      })) {
+    outcome.dropped = "near-duplicate board pose";
+    return outcome;
+  }
+  if (!DecodeTryCloud(attempt, topics, options.limits, &pair, &outcome.dropped)) return outcome;
+  pair.cloud_stamp_ns = stamp;
+  if (still) {  // a hold after all: its nearest frame, as a still pair's image
+    pair.image = searches->Pixels(pair.image_stamp_ns);
+    pair.frames.clear();
+    outcome.pair = std::move(pair);
+    return outcome;
+  }
+  for (FoundFrame& frame : pair.frames) frame.image = searches->HandOut(frame.stamp_ns);
   outcome.pair = std::move(pair);
   return outcome;
 }

@@ -1,454 +1,150 @@
+// The pair finder's second thread: each try judged (the board searched, the sweep decoded), the
+// board chosen among the presets when none was given; and the finder's public face.
 #include "core/capture/recording_pairs.h"
 
-#include <algorithm>
-#include <cmath>
-#include <condition_variable>
-#include <deque>
 #include <exception>
 #include <mutex>
-#include <set>
-#include <thread>
+#include <utility>
 
 #include "core/capture/pair_verdict.h"
-#include "core/capture/recording_board.h"
-#include "core/recording/ros_messages.h"
+#include "core/capture/recording_pairs_impl.h"
 
 namespace calibench {
 
-namespace {
-
-using recording_detail::BoardDecision;
-using recording_detail::Copy;
-using recording_detail::HeldTry;
-using recording_detail::Ns;
-using recording_detail::StampedBytes;
-using recording_detail::StampOr;
-using recording_detail::Try;
-
-// Sweeps and images stay this long beyond the stillness window and the pairing offset behind
-// the newest stamp: a sweep is judged kJudgeLagS after its window has passed, and its try needs
-// the images back to the window's start.
-constexpr double kKeepBeyondWindowS = 0.5;
-// A sweep is judged once stamps this far past its window have arrived: the recorder may store
-// an image a little after a later sweep.
-constexpr double kJudgeLagS = 0.25;
-// Tries waiting for the camera intrinsics (CameraInfo late in the recording); older ones drop.
-constexpr std::size_t kMaxWaitingForCamera = 8;
-// Tries queued for the second thread (each holds its window's images: ~20 MB at 720p); the
-// reader waits beyond that, so memory stays bounded whatever the recording's length.
-constexpr std::size_t kMaxQueuedTries = 2;
-constexpr const char* kHoldDone = "not needed: its hold already gave a pair";
-
-}  // namespace
-
-struct RecordingPairFinder::Impl {
-  Impl(std::string source_in, PairTopics topics_in, std::optional<BoardSpec> board_in,
-       std::optional<CameraModel> camera_in, PairSelectionOptions options_in)
-      : source(std::move(source_in)),
-        topics(std::move(topics_in)),
-        board(std::move(board_in)),
-        camera(std::move(camera_in)),
-        options(std::move(options_in)) {
-    std::string why;
-    if (!options.Check(&why)) throw IoError(source + ": pair selection options: " + why);
-    keep_ns = Ns(std::max(options.still_window_s, options.ringless_integration_s) +
-                 options.max_pair_offset_s + kKeepBeyondWindowS);
-    worker = std::thread([this] { Work(); });
-  }
-
-  ~Impl() {
-    {
-      std::lock_guard lock(mutex);
-      stopping = true;
-    }
-    wake_worker.notify_all();
-    if (worker.joinable()) worker.join();
-  }
-
-  // ---- reader side ---------------------------------------------------------------------------
-
-  struct RecentCloud {
-    StampedBytes cloud;
-    int hold = 0;
-    bool judged = false;
-  };
-  struct Hold {
-    int tries = 0;
-    std::int64_t last_try_ns = 0;
-    std::uint64_t last_try_serial = 0;  // 0: none queued yet
-    bool gave_a_pair = false;
-  };
-
-  void Drop(const std::string& reason) {
-    std::lock_guard lock(mutex);
-    ++stats.dropped[reason];
-  }
-  void Count(std::int64_t PairFinderStats::*messages) {
-    std::lock_guard lock(mutex);
-    ++(stats.*messages);
-  }
-
-  void RethrowWorkerError() {
-    std::lock_guard lock(mutex);
-    if (worker_error) std::rethrow_exception(worker_error);
-  }
-
-  void AddCloud(std::span<const std::uint8_t> data, std::int64_t log_time_ns) {
-    RethrowWorkerError();
-    Count(&PairFinderStats::clouds);
-    CloudMessage message;
-    try {
-      message = DecodeCloudMessage(data, topics.livox_cloud, topics.cloud, options.limits);
-    } catch (const std::invalid_argument&) {
-      Drop("cloud message unreadable");
-      return;
-    }
-    if (!message.cloud.HasRing() && !ringless && options.ringless_integration_s > 0) {
-      // Decided on the first sweep that lacks rings (a recording's LiDAR does not change).
-      ringless = true;
-      window_s = std::max(options.still_window_s, options.ringless_integration_s);
-    }
-    const std::int64_t stamp = StampOr(message.header, log_time_ns);
-    SweepGrid grid = MakeSweepGrid(message.cloud, options.lidar_motion);
-    if (previous_grid) noise_floor.Add(CompareSweeps(*previous_grid, grid, options.lidar_motion));
-    if (!hold_reference ||
-        !CompareSweeps(*hold_reference, grid, options.lidar_motion, noise_floor.Fraction()).agree) {
-      ++current_hold;
-      hold_reference = grid;
-    }
-    previous_grid = std::move(grid);
-    recent_clouds.push_back({{stamp, Copy(data)}, current_hold, false});
-    Advance(stamp);
-  }
-
-  void AddImage(std::span<const std::uint8_t> data, std::int64_t log_time_ns) {
-    RethrowWorkerError();
-    Count(&PairFinderStats::images);
-    std::int64_t stamp = log_time_ns;
-    try {
-      stamp = StampOr(DecodeRosHeader(data, topics.image), log_time_ns);
-    } catch (const std::invalid_argument&) {
-      // Kept by its log time: the try that picks it reports it unreadable.
-    }
-    const auto at = std::upper_bound(
-        recent_images.begin(), recent_images.end(), stamp,
-        [](std::int64_t t, const StampedBytes& image) { return t < image.stamp_ns; });
-    recent_images.insert(at, {stamp, Copy(data)});
-    Advance(stamp);
-  }
-
-  void AddCameraInfo(std::span<const std::uint8_t> data) {
-    RethrowWorkerError();
-    if (camera) return;
-    try {
-      camera = DecodeCameraInfo(data, topics.camera_info).camera;
-    } catch (const std::invalid_argument& error) {
-      camera_problem = error.what();
-      return;
-    }
-    for (Try& waiting : waiting_for_camera) {
-      waiting.camera = *camera;
-      Queue(std::move(waiting));
-    }
-    waiting_for_camera.clear();
-  }
-
-  void Advance(std::int64_t stamp) {
-    horizon_ns = std::max(horizon_ns, stamp);
-    const std::int64_t ready =
-        horizon_ns - Ns(window_s / 2 + options.max_pair_offset_s + kJudgeLagS);
-    for (RecentCloud& cloud : recent_clouds)
-      if (!cloud.judged && cloud.cloud.stamp_ns <= ready) Judge(&cloud);
-    const std::int64_t oldest = horizon_ns - keep_ns;
-    while (!recent_clouds.empty() && recent_clouds.front().judged &&
-           recent_clouds.front().cloud.stamp_ns < oldest)
-      recent_clouds.pop_front();
-    while (!recent_images.empty() && recent_images.front().stamp_ns < oldest)
-      recent_images.pop_front();
-  }
-
-  // Whether the LiDAR saw the scene still around `cloud`: kStill when every other sweep within
-  // the window is of its hold, kMoving when one is not, kUnknown with no other sweep there.
-  enum class LidarView { kStill, kMoving, kUnknown };
-  LidarView SeenByLidar(const RecentCloud& cloud) const {
-    const std::int64_t half = Ns(options.still_window_s / 2);
-    LidarView view = LidarView::kUnknown;
-    for (const RecentCloud& other : recent_clouds) {
-      if (&other == &cloud || std::abs(other.cloud.stamp_ns - cloud.cloud.stamp_ns) > half)
-        continue;
-      if (other.hold != cloud.hold) return LidarView::kMoving;
-      view = LidarView::kStill;
-    }
-    return view;
-  }
-
-  void Judge(RecentCloud* cloud) {
-    cloud->judged = true;
-    const std::int64_t stamp = cloud->cloud.stamp_ns;
-    const LidarView view = SeenByLidar(*cloud);
-    if (view == LidarView::kStill) {
-      last_still_ns = stamp;
-      Hold& hold = holds[cloud->hold];
-      // The hold's last try decides whether more are needed: waiting for it (once per try, a
-      // search's time) keeps the tries, and so the pairs and every count, the same for any
-      // timing of the two threads.
-      if (hold.last_try_serial > 0 && !hold.gave_a_pair) {
-        WaitForTry(hold.last_try_serial);
-        hold.gave_a_pair = HoldGaveAPair(cloud->hold);
-      }
-      if (hold.gave_a_pair) {
-        Drop(kHoldDone);
-        return;
-      }
-      if (hold.tries > 0 && stamp - hold.last_try_ns < Ns(options.retry_s)) {
-        Drop("not tried: its hold was tried within " + MillisecondsText(options.retry_s));
-        return;
-      }
-      ++hold.tries;
-      hold.last_try_ns = stamp;
-      hold.last_try_serial = MakeTry(*cloud, cloud->hold);
-    } else if (view == LidarView::kUnknown) {
-      MakeTry(*cloud, --lone_hold);  // a sweep alone in its window: the camera judges
-    } else if (stamp - last_still_ns >= Ns(options.lidar_blind_s) &&
-               stamp - last_blind_try_ns >= Ns(options.retry_s)) {
-      last_blind_try_ns = stamp;
-      MakeTry(*cloud, --lone_hold);
-    } else {
-      Drop("not tried: the LiDAR saw the scene move");
-    }
-  }
-
-  void WaitForTry(std::uint64_t serial) {
-    std::unique_lock lock(mutex);
-    worker_idle.wait(lock, [&] { return tries_done >= serial || worker_error; });
-    if (worker_error) std::rethrow_exception(worker_error);
-  }
-
-  bool HoldGaveAPair(int hold) {
-    std::lock_guard lock(mutex);
-    return satisfied_holds.count(hold) > 0;
-  }
-
-  // The try's serial once queued for the second thread; 0 when it was not (no image, or waiting
-  // for the camera intrinsics).
-  std::uint64_t MakeTry(const RecentCloud& cloud, int hold) {
-    {
-      std::lock_guard lock(mutex);
-      ++stats.tries;
-    }
-    const std::int64_t stamp = cloud.cloud.stamp_ns;
-    const StampedBytes* nearest = nullptr;
-    for (const StampedBytes& image : recent_images)
-      if (!nearest || std::abs(image.stamp_ns - stamp) < std::abs(nearest->stamp_ns - stamp))
-        nearest = &image;
-    if (!nearest || std::abs(nearest->stamp_ns - stamp) > Ns(options.max_pair_offset_s)) {
-      Drop("no image within " + MillisecondsText(options.max_pair_offset_s));
-      return 0;
-    }
-    Try attempt;
-    attempt.hold = hold;
-    attempt.cloud = cloud.cloud;
-    attempt.image = *nearest;
-    const std::int64_t half = Ns(window_s / 2);
-    for (const StampedBytes& image : recent_images)
-      if (&image != nearest && std::abs(image.stamp_ns - stamp) <= half)
-        attempt.others.push_back(image);
-    // A ring-less LiDAR's sweeps of the span, for the pair's cloud: the camera checks that the
-    // board held still over the same span.
-    if (ringless)
-      for (const RecentCloud& other : recent_clouds)
-        if (&other != &cloud && std::abs(other.cloud.stamp_ns - stamp) <= half)
-          attempt.integrated.push_back(other.cloud);
-    if (!camera) {
-      if (waiting_for_camera.size() == kMaxWaitingForCamera) {
-        waiting_for_camera.pop_front();
-        Drop("no camera intrinsics yet");
-      }
-      waiting_for_camera.push_back(std::move(attempt));
-      return 0;
-    }
-    attempt.camera = *camera;
-    return Queue(std::move(attempt));
-  }
-
-  std::uint64_t Queue(Try attempt) {
-    std::unique_lock lock(mutex);
-    worker_idle.wait(lock, [&] { return queue.size() < kMaxQueuedTries || worker_error; });
-    if (worker_error) std::rethrow_exception(worker_error);
-    queue.push_back(std::move(attempt));
-    wake_worker.notify_all();
-    return ++tries_queued;
-  }
-
-  void Finish() {
-    RethrowWorkerError();
-    for (RecentCloud& cloud : recent_clouds)
-      if (!cloud.judged) Judge(&cloud);
-    if (!camera && !waiting_for_camera.empty())
-      throw IoError(source + ": no usable camera intrinsics on " + topics.camera_info_topic +
-                    (camera_problem.empty() ? "" : " (" + camera_problem + ")") +
-                    ": give them with --camera FILE");
-    std::unique_lock lock(mutex);
-    finishing = true;
-    wake_worker.notify_all();
-    worker_idle.wait(lock, [&] { return finished || worker_error; });
-    if (worker_error) std::rethrow_exception(worker_error);
-  }
-
-  // ---- second thread -------------------------------------------------------------------------
-
-  void Work() {
-    std::unique_lock lock(mutex);
-    while (true) {
-      wake_worker.wait(lock,
-                       [&] { return stopping || !queue.empty() || (finishing && !finished); });
-      if (stopping) return;
-      if (!queue.empty()) {
-        Try attempt = std::move(queue.front());
-        queue.pop_front();
-        worker_idle.notify_all();
-        if (worker_error) {  // the reader rethrows it; nothing more is tried
-          ++tries_done;
-          continue;
-        }
-        lock.unlock();
-        Guard([&] { Process(std::move(attempt)); });
-        lock.lock();
+void RecordingPairFinder::Impl::Work() {
+  std::unique_lock lock(mutex);
+  while (true) {
+    wake_worker.wait(lock, [&] { return stopping || !queue.empty() || (finishing && !finished); });
+    if (stopping) return;
+    if (!queue.empty()) {
+      Try attempt = std::move(queue.front());
+      queue.pop_front();
+      worker_idle.notify_all();
+      if (worker_error) {  // the reader rethrows it; nothing more is tried
         ++tries_done;
-        worker_idle.notify_all();
         continue;
       }
-      // Finishing and nothing queued: the board is chosen from whatever tries came (or taken
-      // as given at the last moment).
-      if (!board && !worker_error) {
-        lock.unlock();
-        Guard([&] {
-          if (!AdoptGivenBoard()) Decide(board_choice.Finish());
-        });
-        lock.lock();
-      }
-      finished = true;
+      lock.unlock();
+      Guard([&] { Process(std::move(attempt)); });
+      lock.lock();
+      ++tries_done;
       worker_idle.notify_all();
+      continue;
     }
+    // Finishing and nothing queued: the board is chosen from whatever tries came (or taken
+    // as given at the last moment).
+    if (!board && !worker_error) {
+      lock.unlock();
+      Guard([&] {
+        if (!AdoptGivenBoard()) Decide(board_choice.Finish());
+      });
+      lock.lock();
+    }
+    DropWave();  // a motion that ended with the recording short of a wave
+    finished = true;
+    worker_idle.notify_all();
   }
+}
 
-  template <typename F>
-  void Guard(F&& work) {
-    try {
-      work();
-    } catch (...) {
-      std::lock_guard lock(mutex);
-      if (!worker_error) worker_error = std::current_exception();
-      worker_idle.notify_all();
-    }
-  }
-
-  void Process(Try attempt) {
-    if (!board) AdoptGivenBoard();
-    if (board) {
-      ProcessWithBoard(attempt, std::nullopt);
-      return;
-    }
-    HeldTry sample{std::move(attempt), std::nullopt};
-    try {
-      sample.image = DecodeTryMessageImage(sample.attempt.image, topics, options.limits);
-    } catch (const std::invalid_argument&) {
-    }
-    Decide(board_choice.Offer(std::move(sample)));
+template <typename F>
+void RecordingPairFinder::Impl::Guard(F&& work) {
+  try {
+    work();
+  } catch (...) {
     std::lock_guard lock(mutex);
-    board_problem = board_choice.Problem();
+    if (!worker_error) worker_error = std::current_exception();
+    worker_idle.notify_all();
   }
+}
 
-  // A board given while following (SetBoard), taken at the next try; true when taken.
-  bool AdoptGivenBoard() {
-    std::optional<std::pair<BoardSpec, std::string>> given;
-    {
-      std::lock_guard lock(mutex);
-      given = std::exchange(given_board, std::nullopt);
-    }
-    if (!given) return false;
-    Decide(board_choice.Give(given->first, given->second));
-    return true;
+void RecordingPairFinder::Impl::Process(Try attempt) {
+  if (!board) AdoptGivenBoard();
+  if (board) {
+    ProcessWithBoard(attempt, std::nullopt);
+    return;
   }
-
-  // What the board choice decided: the board once known, the held tries searched with it.
-  void Decide(BoardDecision decision) {
-    for (const std::string& reason : decision.dropped) Drop(reason);
-    if (!decision.board) return;
-    {
-      std::lock_guard lock(mutex);
-      board = decision.board;
-      stats.board_choice = decision.board_choice;
-      board_problem.clear();
-    }
-    for (HeldTry& sample : decision.release)
-      ProcessWithBoard(sample.attempt, std::move(sample.image));
+  HeldTry sample{std::move(attempt), std::nullopt};
+  try {
+    sample.image = DecodeTryMessageImage(sample.attempt.image, topics, options.limits);
+  } catch (const std::invalid_argument&) {
   }
+  Decide(board_choice.Offer(std::move(sample)));
+  std::lock_guard lock(mutex);
+  board_problem = board_choice.Problem();
+}
 
-  void ProcessWithBoard(const Try& attempt, std::optional<ImageU8> decoded) {
-    if (HoldGaveAPair(attempt.hold)) {  // tries held while the board was chosen
-      Drop(kHoldDone);
-      return;
-    }
-    TryOutcome outcome =
-        JudgeTry(attempt, std::move(decoded), topics, *board, kept_poses, options, source);
+bool RecordingPairFinder::Impl::AdoptGivenBoard() {
+  std::optional<std::pair<BoardSpec, std::string>> given;
+  {
     std::lock_guard lock(mutex);
-    stats.images_searched += outcome.searched;
-    stats.boards_found += outcome.found;
-    if (!outcome.pair) {
-      ++stats.dropped[outcome.dropped];
-      return;
-    }
-    kept_poses.push_back(outcome.pair->cam_from_board);
-    if (attempt.hold > 0) satisfied_holds.insert(attempt.hold);
-    if (!outcome.pair->stillness_checked) ++stats.kept_without_stillness_check;
-    found.push_back(std::move(*outcome.pair));
+    given = std::exchange(given_board, std::nullopt);
   }
+  if (!given) return false;
+  Decide(board_choice.Give(given->first, given->second));
+  return true;
+}
 
-  // ---- state ---------------------------------------------------------------------------------
+void RecordingPairFinder::Impl::Decide(BoardDecision decision) {
+  for (const std::string& reason : decision.dropped) Drop(reason);
+  if (!decision.board) return;
+  {
+    std::lock_guard lock(mutex);
+    board = decision.board;
+    stats.board_choice = decision.board_choice;
+    board_problem.clear();
+  }
+  for (HeldTry& sample : decision.release)
+    ProcessWithBoard(sample.attempt, std::move(sample.image));
+}
 
-  const std::string source;
-  const PairTopics topics;
-  std::optional<BoardSpec> board;     // set by the worker (under `mutex`) once chosen
-  std::optional<CameraModel> camera;  // the reader's
-  std::string camera_problem;
-  const PairSelectionOptions options;
-  std::int64_t keep_ns = 0;
-  bool ringless = false;                     // the sweeps carry no rings: holds are integrated
-  double window_s = options.still_window_s;  // the stillness (and integration) window [s]
+void RecordingPairFinder::Impl::ProcessWithBoard(const Try& attempt,
+                                                 std::optional<ImageU8> decoded) {
+  if (HoldGaveAPair(attempt.hold)) {  // tries held while the board was chosen
+    Drop(kHoldDone);
+    return;
+  }
+  TryOutcome outcome =
+      attempt.moving
+          ? JudgeMovingTry(attempt, topics, *board, kept_poses, options, source, &frame_searches)
+          : JudgeTry(attempt, std::move(decoded), topics, *board, kept_poses, options, source);
+  std::lock_guard lock(mutex);
+  stats.images_searched += outcome.searched;
+  stats.boards_found += outcome.found;
+  // The camera's word on the motion: a board it saw still ends a motion short of a wave.
+  if (outcome.camera_still || (outcome.pair && !outcome.pair->Moving())) DropWave();
+  if (!outcome.pair) {
+    ++stats.dropped[outcome.dropped];
+    return;
+  }
+  if (outcome.pair->Moving()) {
+    KeepMoving(std::move(*outcome.pair));
+    return;
+  }
+  kept_poses.push_back(outcome.pair->cam_from_board);
+  if (attempt.hold > 0) satisfied_holds.insert(attempt.hold);
+  if (!outcome.pair->stillness_checked) ++stats.kept_without_stillness_check;
+  found.push_back(std::move(*outcome.pair));
+}
 
-  // Reader.
-  std::deque<RecentCloud> recent_clouds;
-  std::deque<StampedBytes> recent_images;  // by stamp
-  std::optional<SweepGrid> hold_reference, previous_grid;
-  SweepNoiseFloor noise_floor{options.lidar_motion};
-  int current_hold = 0;
-  int lone_hold = 0;  // negative ids: tries that belong to no hold
-  std::map<int, Hold> holds;
-  std::int64_t horizon_ns = INT64_MIN;
-  std::int64_t last_still_ns = 0;
-  std::int64_t last_blind_try_ns = INT64_MIN / 2;
-  std::deque<Try> waiting_for_camera;
+void RecordingPairFinder::Impl::KeepMoving(FoundPair pair) {
+  const std::int64_t stamp = pair.cloud_stamp_ns;
+  if (!wave_start_ns) wave_start_ns = stamp;
+  wave.push_back(std::move(pair));
+  if (stamp - *wave_start_ns < Ns(options.moving_after_s)) return;  // not yet a wave
+  // A moving pair's pose is one instant of a wave: it makes no later hold a duplicate.
+  stats.moving_pairs += static_cast<int>(wave.size());
+  for (FoundPair& moving : wave) found.push_back(std::move(moving));
+  wave.clear();
+}
 
-  // Worker.
-  recording_detail::RecordingBoardChoice board_choice{source, options.board_sample_images,
-                                                      options.stop_on_unknown_board};
-  std::vector<Pose> kept_poses;
-
-  // Shared, under `mutex`.
-  mutable std::mutex mutex;
-  std::condition_variable wake_worker, worker_idle;
-  std::deque<Try> queue;
-  bool finishing = false, finished = false, stopping = false;
-  std::exception_ptr worker_error;
-  std::vector<FoundPair> found;
-  std::set<int> satisfied_holds;  // holds that gave a pair
-  std::uint64_t tries_queued = 0, tries_done = 0;
-  PairFinderStats stats;
-  std::string board_problem;  // the board choice's Problem(), for the reader
-  std::optional<std::pair<BoardSpec, std::string>> given_board;  // SetBoard's, until taken
-  std::thread worker;  // last: started once everything above exists
-};
+void RecordingPairFinder::Impl::DropWave() {
+  if (!wave.empty())
+    stats.dropped["moving: the camera saw the board move for less than " +
+                  MillisecondsText(options.moving_after_s) + " (a carry between holds)"] +=
+        static_cast<int>(wave.size());
+  wave.clear();
+  wave_start_ns.reset();
+}
 
 RecordingPairFinder::RecordingPairFinder(std::string source, PairTopics topics,
                                          std::optional<BoardSpec> board,

@@ -45,6 +45,24 @@ struct PairSelectionOptions {
   // A LiDAR that never sees the scene still (a non-repeating scan, a busy street) must not hide
   // the board: after this long without a still sweep, a sweep is tried every `retry_s` anyway.
   double lidar_blind_s = 3.0;
+  // A board that never stops (a waved capture; docs/architecture.md "Time"): once a spinning
+  // LiDAR has seen nothing still for this long, every sweep is tried as a moving pair — the board
+  // searched in each frame within `moving_images_s` of the sweep's stamp, the frames where it is
+  // found kept with the pair (the camera's board track), with no stillness check and no
+  // near-duplicate rule [s]; the motion's sweeps before that are tried too, once it has lasted
+  // that long (the reader keeps that much more of the recording: moving_after_s + 1.5 s). Shorter
+  // carries between still holds give no moving pair. 0: never.
+  double moving_after_s = 2.0;
+  // Either side of a moving sweep's stamp [s]: the offset's search window (0.25 s), the sweep's
+  // own 0.1 s and a frame beyond.
+  double moving_images_s = 0.45;
+  // A moving sweep is a pair when its board is found in this many frames around it, at least
+  // one on either side of its stamp (a track to place its returns on).
+  int moving_min_frames = 3;
+  // A moving try's board that travels less than both of these over its frames (from the nearest
+  // frame's pose) was held still: a hold, where something else moved before the LiDAR.
+  double moving_min_travel_m = 0.05;
+  double moving_min_turn_deg = 3.0;
   // A LiDAR whose sweeps carry no rings (Livox-class: a 0.1 s frame leaves a far board a few
   // strokes of its rosette): the sweeps within this span centred on the tried one are integrated
   // into the pair's cloud, and the camera's stillness check spans it too [s]. 0: one sweep.
@@ -70,13 +88,24 @@ struct PairTopics {
   std::string image_topic, camera_info_topic;  // for messages
 };
 
+// A camera frame of a moving pair: its stamp and, the first time a pair holds it, its pixels
+// (empty: handed out with an earlier pair, whose writer has it).
+struct FoundFrame {
+  std::int64_t stamp_ns = 0;
+  ImageU8 image;
+};
+
 struct FoundPair {
   std::int64_t cloud_stamp_ns = 0, image_stamp_ns = 0;
   LidarCloud cloud;         // time_s after cloud_stamp_ns, where the driver gives them
   std::string point_times;  // how its per-point times were read, or why it has none
-  ImageU8 image;
-  Pose cam_from_board = Pose::Identity();
-  bool stillness_checked = true;  // false: no other image within the window
+  ImageU8 image;            // a still pair's; a moving pair's nearest frame is in `frames`
+  Pose cam_from_board = Pose::Identity();  // a moving pair's: at its nearest frame
+  bool stillness_checked = true;           // false: no other image within the window
+  // A moving pair's frames that show the board, by stamp (the nearest is image_stamp_ns's);
+  // empty for a still pair.
+  std::vector<FoundFrame> frames;
+  bool Moving() const { return !frames.empty(); }
 };
 
 struct PairFinderStats {
@@ -86,6 +115,7 @@ struct PairFinderStats {
   int boards_found = 0;                 // of those, the board found
   std::map<std::string, int> dropped;   // reason -> sweeps not paired for it
   int kept_without_stillness_check = 0;
+  int moving_pairs = 0;      // of the pairs found, sweeps of a board that never stopped
   std::string board_choice;  // how the board was chosen, when it was not given
 };
 

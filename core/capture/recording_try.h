@@ -35,6 +35,9 @@ inline std::int64_t StampOr(const RosHeader& header, std::int64_t log_time_ns) {
 
 struct Try {
   int hold = 0;
+  // A sweep of a board that never stopped (PairSelectionOptions::moving_after_s): `others` are
+  // then every other frame within moving_images_s, searched each for the board.
+  bool moving = false;
   StampedBytes cloud;
   StampedBytes image;                // the nearest in time
   std::vector<StampedBytes> others;  // the other images within the stillness window

@@ -239,36 +239,6 @@ std::optional<BoardHint> BoardHintFor(const PairEntry& pair, const PairEdit& edi
   return hint;
 }
 
-std::optional<CameraBoardObservation> FrameBoards::Of(const Dataset& dataset,
-                                                      const std::filesystem::path& image,
-                                                      const PipelineOptions& options) {
-  {
-    std::lock_guard lock(mutex_);
-    if (const auto seen = seen_.find(image); seen != seen_.end()) return seen->second;
-  }
-  // Posed outside the lock: two workers asking for one frame at once both pose it, alike.
-  std::optional<CameraBoardObservation> board;
-  try {
-    const ImageU8 frame = LoadImage(image);
-    if (frame.width == dataset.camera.width && frame.height == dataset.camera.height)
-      board = ExtractCameraFeatures(dataset, frame, options).observation;
-  } catch (const IoError&) {
-  }
-  std::lock_guard lock(mutex_);
-  return seen_.emplace(image, std::move(board)).first->second;
-}
-
-std::vector<TimedObservation> TrackBoard(const Dataset& dataset, const PairEntry& pair,
-                                         const PipelineOptions& options, FrameBoards* frames) {
-  FrameBoards own;
-  std::vector<TimedObservation> track;
-  for (const StampedImage& frame : pair.images)
-    if (auto board = (frames ? frames : &own)->Of(dataset, frame.image, options))
-      track.push_back(
-          {(frame.stamp_ns - pair.lidar_stamp_ns.value_or(0)) * 1e-9, std::move(*board)});
-  return track;
-}
-
 PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
                                  const PipelineOptions& options, const PairEdit& edit,
                                  const SceneBackground* background, LidarCloud* preloaded_cloud,

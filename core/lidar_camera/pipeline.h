@@ -270,6 +270,11 @@ class FrameBoards {
   Boards seen_;
 };
 
+// The same view of a checkerboard in its other corner order: the board frame turned 180 degrees
+// about its normal (the origin is the pattern's centre). Pixels stay; each corner's board point
+// and id become its opposite's, and the pose's covariance (right perturbation) follows the turn.
+void TurnCheckerboardObservation(const BoardSpec& board, CameraBoardObservation* observation);
+
 // A moving capture's frames (PairEntry::images): the board in each that shows it, stamps after
 // the pair's lidar_stamp_ns (seconds); a frame that cannot be read or shows no board leaves a gap.
 // `frames` (optional) poses each frame once across the pairs that list it.

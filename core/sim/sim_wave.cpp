@@ -125,6 +125,9 @@ Sweep SimulateSweep(const WaveOptions& options, const SimOptions& r, const BeamT
   Sweep sweep;
   sweep.stamp_ns = kStartNs + Ns(start);
   sweep.board_seen = static_cast<int>(board_times.size()) >= options.min_board_returns;
+  const std::filesystem::path cloud = root / "clouds" / Numbered("sweep_", j, ".pcd");
+  if (options.every_sweep || sweep.board_seen)
+    SavePcd(cloud, lidar.ToCloud(r.board_only_clouds, r.lidar_viewpoints), PcdEncoding::kBinary);
   if (!sweep.board_seen) return sweep;
   std::nth_element(board_times.begin(), board_times.begin() + board_times.size() / 2,
                    board_times.end());
@@ -133,8 +136,6 @@ Sweep SimulateSweep(const WaveOptions& options, const SimOptions& r, const BeamT
   const LidarRectangle sheet{lidar_from_cam * sweep.truth.cam_from_board,
                              0.5 * Vec2(r.board.SheetWidth(), r.board.SheetHeight())};
   sweep.truth.lidar_board_points = CastBoardReturns(beams, sheet, scan.azimuth_offset_rad).points;
-  SavePcd(root / "clouds" / Numbered("sweep_", j, ".pcd"),
-          lidar.ToCloud(r.board_only_clouds, r.lidar_viewpoints), PcdEncoding::kBinary);
   return sweep;
 }
 
@@ -163,6 +164,11 @@ WavedDataset SimulateWavedDataset(const WaveOptions& options,
   WavedDataset out;
   out.sweeps = sweeps;
   out.frames = frames;
+  out.frame_files = images;
+  for (int j = 0; j < sweeps; ++j)
+    if (options.every_sweep || seen[j].board_seen)
+      out.sweep_files.emplace_back(root / "clouds" / Numbered("sweep_", j, ".pcd"),
+                                   kStartNs + Ns(j * sweep_s));
   Dataset& dataset = out.dataset;
   dataset.manifest = root / "dataset.json";
   dataset.camera = r.camera;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/io/dataset.h"
@@ -36,6 +37,9 @@ struct WaveOptions {
   double images_window_s = 0.25;
   // A sweep is a pair when this many of its returns lie on the sheet.
   int min_board_returns = 60;
+  // Every sweep's cloud written, those without the board too (for a recording of the stream,
+  // tests/sim_recording.h); else only the pairs'.
+  bool every_sweep = false;
 
   bool Check(std::string* why) const;
 };
@@ -48,8 +52,12 @@ struct WavedDataset {
   // Per pair, as dataset.pairs: the board at its returns' median time and its noise-free returns
   // there (for the Cramér–Rao bound of the same sweeps, core/evaluation/crlb.h).
   std::vector<SimPairTruth> truth;
-  int sweeps = 0;                 // LiDAR sweeps simulated
-  int frames = 0;                 // camera frames rendered
+  int sweeps = 0;  // LiDAR sweeps simulated
+  int frames = 0;  // camera frames rendered
+  // Every frame rendered (images/frame_<k>.png, stamped on the camera's clock) and every sweep
+  // written (clouds/sweep_<j>.pcd, stamped at its start on the LiDAR's), in time order.
+  std::vector<StampedImage> frame_files;
+  std::vector<std::pair<std::filesystem::path, std::int64_t>> sweep_files;
   double median_speed_mps = 0.0;  // the board's centre, over the recording
 };
 
