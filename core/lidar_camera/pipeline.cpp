@@ -262,7 +262,10 @@ PairFeatures ExtractPairFeatures(const Dataset& dataset, const PairEntry& pair,
     features.lidar = ExtractLidarFeatures(dataset, inputs->cloud, *hint, options, &lidar_failure,
                                           &features.board_origin);
   }
-  CameraFeatures camera = ExtractCameraFeatures(dataset, inputs->image, options);
+  // A moving capture's image is one of its frames: searched once for the pair and its track.
+  CameraFeatures camera = frames && !pair.images.empty()
+                              ? frames->Features(dataset, pair.image, options, &inputs->image)
+                              : ExtractCameraFeatures(dataset, inputs->image, options);
   features.camera = std::move(camera.observation);
   features.edge_width_px = camera.edge_width_px;
   if (!pair.images.empty()) features.camera_track = TrackBoard(dataset, pair, options, frames);

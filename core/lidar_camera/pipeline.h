@@ -259,9 +259,13 @@ class FrameBoards {
   std::optional<CameraBoardObservation> Of(const Dataset& dataset,
                                            const std::filesystem::path& image,
                                            const PipelineOptions& options);
+  // The whole camera side of `image` (ExtractCameraFeatures), searched once: a pair's own image
+  // is one of its frames, and often another pair's. `decoded`: its pixels, already read.
+  CameraFeatures Features(const Dataset& dataset, const std::filesystem::path& image,
+                          const PipelineOptions& options, const ImageU8* decoded);
 
  private:
-  using Boards = std::map<std::filesystem::path, std::optional<CameraBoardObservation>>;
+  using Boards = std::map<std::filesystem::path, CameraFeatures>;
   Boards Copy() const {
     std::lock_guard lock(mutex_);
     return seen_;

@@ -12,20 +12,29 @@ namespace calibench {
 std::optional<CameraBoardObservation> FrameBoards::Of(const Dataset& dataset,
                                                       const std::filesystem::path& image,
                                                       const PipelineOptions& options) {
+  return Features(dataset, image, options, nullptr).observation;
+}
+
+CameraFeatures FrameBoards::Features(const Dataset& dataset, const std::filesystem::path& image,
+                                     const PipelineOptions& options, const ImageU8* decoded) {
   {
     std::lock_guard lock(mutex_);
     if (const auto seen = seen_.find(image); seen != seen_.end()) return seen->second;
   }
   // Posed outside the lock: two workers asking for one frame at once both pose it, alike.
-  std::optional<CameraBoardObservation> board;
+  CameraFeatures features;
   try {
-    const ImageU8 frame = LoadImage(image);
-    if (frame.width == dataset.camera.width && frame.height == dataset.camera.height)
-      board = ExtractCameraFeatures(dataset, frame, options).observation;
-  } catch (const IoError&) {
+    const ImageU8 frame = decoded ? ImageU8{} : LoadImage(image);
+    const ImageU8& pixels = decoded ? *decoded : frame;
+    if (pixels.width == dataset.camera.width && pixels.height == dataset.camera.height)
+      features = ExtractCameraFeatures(dataset, pixels, options);
+    else
+      features.failure = image.string() + ": not the camera's size";
+  } catch (const IoError& error) {
+    features.failure = error.what();
   }
   std::lock_guard lock(mutex_);
-  return seen_.emplace(image, std::move(board)).first->second;
+  return seen_.emplace(image, std::move(features)).first->second;
 }
 
 void TurnCheckerboardObservation(const BoardSpec& board, CameraBoardObservation* observation) {
@@ -40,7 +49,6 @@ void TurnCheckerboardObservation(const BoardSpec& board, CameraBoardObservation*
   const int count = board.cols * board.rows;
   for (int& id : corners.ids) id = count - 1 - id;
 }
-
 
 std::vector<TimedObservation> TrackBoard(const Dataset& dataset, const PairEntry& pair,
                                          const PipelineOptions& options, FrameBoards* frames) {
