@@ -6,6 +6,7 @@
 #include <zstd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -95,7 +96,8 @@ std::vector<std::uint8_t> SerializeLivoxCustomMsg(const LidarCloud& cloud, std::
 
 std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int64_t stamp_ns,
                                                const std::string& frame, MessageEncoding encoding,
-                                               bool big_endian, const char* ring_field) {
+                                               bool big_endian, const char* ring_field,
+                                               PointLayout layout) {
   MessageWriter out(encoding, big_endian);
   out.Header(stamp_ns, frame);
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(cloud.height));
@@ -103,15 +105,25 @@ std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int
   struct Field {
     const char* name;
     std::uint32_t offset;
-    std::uint8_t type;
+    std::uint8_t type;  // sensor_msgs/PointField: 4 UINT16, 6 UINT32, 7 FLOAT32
   };
+  const bool ouster = layout == PointLayout::kOuster;
+  CALIBENCH_CHECK(!ouster || !cloud.HasViewpoint());
   std::vector<Field> fields = {{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}};
   if (cloud.HasIntensity()) fields.push_back({"intensity", 16, 7});
-  if (cloud.HasRing()) fields.push_back({ring_field, 20, 4});
-  if (cloud.HasTime()) fields.push_back({"time", 24, 7});  // velodyne_pointcloud's XYZIRT
-  if (cloud.HasViewpoint())                                // PCL's PointWithViewpoint names
-    for (const auto& [name, offset] : {std::pair{"vp_x", 32u}, {"vp_y", 36u}, {"vp_z", 40u}})
-      fields.push_back({name, offset, 7});
+  if (ouster) {
+    if (cloud.HasTime()) fields.push_back({"t", 20, 6});
+    fields.push_back({"reflectivity", 24, 4});
+    if (cloud.HasRing()) fields.push_back({"ring", 26, 4});
+    fields.push_back({"ambient", 28, 4});
+    fields.push_back({"range", 32, 6});
+  } else {
+    if (cloud.HasRing()) fields.push_back({ring_field, 20, 4});
+    if (cloud.HasTime()) fields.push_back({"time", 24, 7});  // velodyne_pointcloud's XYZIRT
+    if (cloud.HasViewpoint())                                // PCL's PointWithViewpoint names
+      for (const auto& [name, offset] : {std::pair{"vp_x", 32u}, {"vp_y", 36u}, {"vp_z", 40u}})
+        fields.push_back({name, offset, 7});
+  }
   out.Put<std::uint32_t>(static_cast<std::uint32_t>(fields.size()));
   for (const Field& field : fields) {
     out.String(field.name);
@@ -120,7 +132,7 @@ std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int
     out.Put<std::uint32_t>(1);
   }
   out.Put<std::uint8_t>(big_endian ? 1 : 0);
-  const std::uint32_t kStep = cloud.HasViewpoint() ? 48 : 32;
+  const std::uint32_t kStep = ouster || cloud.HasViewpoint() ? 48 : 32;
   out.Put<std::uint32_t>(kStep);
   out.Put<std::uint32_t>(kStep * static_cast<std::uint32_t>(cloud.width));
   Bytes points;
@@ -130,16 +142,31 @@ std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int
     for (int axis = 0; axis < 3; ++axis) PutRaw<float>(&points, cloud.points[i][axis], big_endian);
     PutRaw<float>(&points, 0.0f, big_endian);  // padding, as PCL's PointXYZ has
     if (cloud.HasIntensity()) PutRaw<float>(&points, cloud.intensity[i], big_endian);
-    if (cloud.HasRing())
-      PutRaw<std::uint16_t>(&points, static_cast<std::uint16_t>(cloud.ring[i]), big_endian);
-    if (cloud.HasTime()) {
-      points.resize(start + 24, 0);
-      PutRaw<float>(&points, cloud.time_s[i], big_endian);
-    }
-    if (cloud.HasViewpoint()) {
+    points.resize(start + 20, 0);
+    if (ouster) {
+      const std::uint32_t t_ns =
+          cloud.HasTime() ? static_cast<std::uint32_t>(std::llround(cloud.time_s[i] * 1e9)) : 0;
+      PutRaw<std::uint32_t>(&points, t_ns, big_endian);
+      PutRaw<std::uint16_t>(&points, 0, big_endian);  // reflectivity
+      PutRaw<std::uint16_t>(
+          &points, cloud.HasRing() ? static_cast<std::uint16_t>(cloud.ring[i]) : 0, big_endian);
+      PutRaw<std::uint16_t>(&points, 0, big_endian);  // ambient
       points.resize(start + 32, 0);
-      for (int axis = 0; axis < 3; ++axis)
-        PutRaw<float>(&points, cloud.viewpoint[i][axis], big_endian);
+      PutRaw<std::uint32_t>(&points,
+                            static_cast<std::uint32_t>(std::llround(cloud.points[i].norm() * 1e3)),
+                            big_endian);  // range (mm)
+    } else {
+      if (cloud.HasRing())
+        PutRaw<std::uint16_t>(&points, static_cast<std::uint16_t>(cloud.ring[i]), big_endian);
+      if (cloud.HasTime()) {
+        points.resize(start + 24, 0);
+        PutRaw<float>(&points, cloud.time_s[i], big_endian);
+      }
+      if (cloud.HasViewpoint()) {
+        points.resize(start + 32, 0);
+        for (int axis = 0; axis < 3; ++axis)
+          PutRaw<float>(&points, cloud.viewpoint[i][axis], big_endian);
+      }
     }
     points.resize(start + kStep, 0);
   }

@@ -24,14 +24,25 @@ struct RecordedMessage {
   std::vector<std::uint8_t> data;  // serialized in the recording's encoding
 };
 
-// Little-endian float32 x y z [intensity float32] [ring uint16] [time float32 at byte 24, as
-// velodyne_pointcloud's XYZIRT]; point_step padded to 32 bytes like Velodyne's driver. With
-// big_endian the same layout in network order (CDR only). The ring field is named `ring_field`
-// ("line": a Livox driver's laser index).
+// A driver's point layout.
+enum class PointLayout {
+  // velodyne_pointcloud's XYZIRT: float32 x y z, intensity float32 at 16, ring uint16 at 20, time
+  // float32 (seconds after the stamp) at 24; point_step 32.
+  kVelodyne,
+  // ouster_ros's PointOS: float32 x y z, intensity float32 at 16, t uint32 (nanoseconds after the
+  // stamp) at 20, reflectivity uint16 at 24, ring uint16 at 26, ambient uint16 at 28, range uint32
+  // at 32; point_step 48.
+  kOuster,
+};
+
+// Little-endian, in `layout` (the fields the cloud has; PCL's viewpoint names at 32 for a
+// velodyne layout, step 48). With big_endian the same layout in network order (CDR only). A
+// velodyne layout's ring field is named `ring_field` ("line": a Livox driver's laser index).
 std::vector<std::uint8_t> SerializePointCloud2(const LidarCloud& cloud, std::int64_t stamp_ns,
                                                const std::string& frame, MessageEncoding encoding,
                                                bool big_endian = false,
-                                               const char* ring_field = "ring");
+                                               const char* ring_field = "ring",
+                                               PointLayout layout = PointLayout::kVelodyne);
 // livox_ros_driver(2)/CustomMsg from its definition: the cloud's points in order, offset_time
 // from `offsets_ns` (or 10 µs apart), reflectivity from the intensity, tag 0, line from the
 // cloud's ring (the laser; 0 without); `tags` (optional) per point.

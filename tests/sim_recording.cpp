@@ -220,14 +220,19 @@ SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding enc
 }
 
 WavedDataset WriteWavedRecording(RecordingWriter* writer, MessageEncoding encoding,
-                                 WaveOptions wave, const std::filesystem::path& scratch) {
+                                 WaveOptions wave, const std::filesystem::path& scratch,
+                                 PointLayout layout) {
   wave.every_sweep = true;
   const WavedDataset waved = SimulateWavedDataset(wave, scratch);
   const std::int64_t sweep_ns = std::llround(1e9 / wave.lidar_hz);
+  const bool ouster = layout == PointLayout::kOuster;
   std::vector<RecordedMessage> messages;
   for (const auto& [file, stamp] : waved.sweep_files)
-    messages.push_back({"/velodyne_points", "sensor_msgs/PointCloud2", stamp + sweep_ns,
-                        SerializePointCloud2(LoadCloud(file), stamp, "velodyne", encoding)});
+    messages.push_back(
+        {ouster ? "/os_cloud_node/points" : "/velodyne_points", "sensor_msgs/PointCloud2",
+         stamp + sweep_ns,
+         SerializePointCloud2(LoadCloud(file), stamp, ouster ? "os_sensor" : "velodyne", encoding,
+                              false, "ring", layout)});
   for (const StampedImage& frame : waved.frame_files) {
     const ImageU8 image = LoadImage(frame.image);
     const std::int64_t received = frame.stamp_ns + 15'000'000;

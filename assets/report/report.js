@@ -57,6 +57,24 @@ function draw(REPORT, prefix) {
     data: { datasets: [{ label: "board centre seen from the LiDAR", data: solved.filter(p => p.lidar).map(p => ({ x: p.lidar[0], y: p.lidar[1], id: p.id })), backgroundColor: solved.filter(p => p.lidar).map(colour), pointRadius: 5 }] },
     options: { plugins: { title: title("Coverage: the LiDAR's field"), tooltip: { callbacks: { label: c => c.raw.id } } },
                scales: { x: { reverse: true, title: title("azimuth [deg] (left is +)") }, y: { title: title("elevation [deg]") } } } });
+  const offset = REPORT.time_offset;
+  if (offset) {
+    // Δχ² + 1, so that the best offset (Δχ² = 0) has a place on the log scale.
+    const profile = offset.offset_ms.map((x, i) => ({ x: x, y: offset.chi2_above_lowest[i] + 1 }));
+    const sets = [{ label: "Δχ² + 1: the planes' disagreement above the best offset's", data: profile, borderColor: "#3b6ea5", backgroundColor: "#3b6ea5", showLine: true, pointRadius: 2 }];
+    if (offset.estimate_ms !== undefined) {
+      const top = Math.max(...offset.chi2_above_lowest) + 1;
+      sets.push({ label: "estimate " + offset.estimate_ms.toFixed(1) + " ms", data: [{ x: offset.estimate_ms, y: 1 }, { x: offset.estimate_ms, y: top }], borderColor: "#c0392b", showLine: true, pointRadius: 0 });
+      const low = offset.estimate_ms - 3 * offset.std_ms, high = offset.estimate_ms + 3 * offset.std_ms;
+      sets.push({ label: "± 3σ (" + (3 * offset.std_ms).toFixed(1) + " ms)", data: [{ x: low, y: 1 }, { x: low, y: top }], borderColor: "#d98c2b", borderDash: [5, 4], showLine: true, pointRadius: 0 });
+      sets.push({ label: "", data: [{ x: high, y: 1 }, { x: high, y: top }], borderColor: "#d98c2b", borderDash: [5, 4], showLine: true, pointRadius: 0 });
+    }
+    chart("time-offset-profile", {
+      type: "scatter",
+      data: { datasets: sets },
+      options: { plugins: { title: title("The planes' disagreement against the camera - LiDAR time offset"), legend: { labels: { filter: item => item.text !== "" } } },
+                 scales: { x: { title: title("camera - LiDAR [ms]") }, y: { type: "logarithmic", title: title("Δχ² + 1 (log)") } } } });
+  }
 }
 
 // A 2D LRF report: the target's residual per observation (training and held out), the robust

@@ -184,6 +184,7 @@ CameraVerdict JudgeCameraSide(const ImageU8& image, std::size_t others,
     if (!StillIn(image, *detection, *other, camera, pose, options)) {
       verdict.dropped =
           "board moving (within " + MillisecondsText(options.still_window_s / 2) + ")";
+      verdict.moving = true;
       return verdict;
     }
   }
@@ -228,6 +229,7 @@ TryOutcome JudgeTry(const recording_detail::Try& attempt, std::optional<ImageU8>
       attempt.camera, board, kept, options);
   outcome.searched = verdict.searched;
   outcome.found = verdict.found;
+  outcome.camera_moving = verdict.moving;
   if (!verdict.cam_from_board) {
     outcome.dropped = verdict.dropped;
     return outcome;
@@ -321,8 +323,9 @@ TryOutcome JudgeMovingTry(const recording_detail::Try& attempt, const PairTopics
                       " frames around the sweep, on both sides of it";
     return outcome;
   }
-  // Still: the board travels less over the frames than a wave does (PnP's own jitter at a
-  // hold reaches the stillness thresholds, frame to frame, on a small image).
+  // Still: the board travels less over the frames than any wave does (a wave at 0.3 m/s moves
+  // it 13 cm over +-0.45 s; the floor leaves PnP's own jitter room); a checkerboard's two corner
+  // orders are one pose.
   const bool still = std::all_of(poses.begin(), poses.end(), [&](const Pose& pose) {
     return Within(BoardPoseError(pose, pair.cam_from_board, board), options.moving_min_travel_m,
                   options.moving_min_turn_deg);

@@ -27,6 +27,7 @@ struct CameraVerdict {
   bool searched = false;               // the board was searched for (the image was readable)
   bool found = false;                  // and found
   bool stillness_checked = false;      // another image of the window was there to compare
+  bool moving = false;                 // dropped because the board moved between the images
 };
 
 // `other_image(i)` decodes the window's i-th other image (nullopt: unreadable, skipped); it is
@@ -47,6 +48,7 @@ struct TryOutcome {
   std::string dropped;            // why not, otherwise
   int searched = 0, found = 0;    // images searched for the board, and of those, found in
   bool camera_still = false;      // a moving try whose frames show the board still
+  bool camera_moving = false;     // a still try whose images show the board move
 };
 // `decoded`: the try's image when already decoded. Throws IoError naming `source` when the
 // images contradict the intrinsics (another size).

@@ -112,6 +112,7 @@ void RecordingPairFinder::Impl::ProcessWithBoard(const Try& attempt,
   stats.boards_found += outcome.found;
   // The camera's word on the motion: a board it saw still ends a motion short of a wave.
   if (outcome.camera_still || (outcome.pair && !outcome.pair->Moving())) DropWave();
+  if (outcome.camera_moving) moving_sweeps.insert(attempt.cloud.stamp_ns);
   if (!outcome.pair) {
     ++stats.dropped[outcome.dropped];
     return;

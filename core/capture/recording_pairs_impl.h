@@ -9,6 +9,7 @@
 #include <deque>
 #include <exception>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -219,40 +220,69 @@ struct RecordingPairFinder::Impl {
     }
   }
 
+  // A sweep the LiDAR saw still: its hold's tries, the first at once, then one every retry_s
+  // until one gives a pair. It ends a motion (the sweeps held back dropped as a carry's) — but
+  // amid a motion only once its hold's try has not shown the board move: a dense LiDAR's learnt
+  // noise floor can be a steady wave's own change (a recording that is all wave has no still sweep
+  // to learn it from: an OS0-128 took 7 of a wave's 80 sweeps for holds, and the 16 held back
+  // before them were dropped as a carry's), so there the camera's word decides, its try waited
+  // for at once. The tries are those of any hold, so a still-hold recording's pairs stay as they
+  // were.
+  void JudgeStill(const RecentCloud& cloud) {
+    const std::int64_t stamp = cloud.cloud.stamp_ns;
+    const bool ask_camera = in_motion && !ringless && options.moving_after_s > 0;
+    auto end_motion = [&] {
+      in_motion = false;
+      last_still_ns = stamp;
+      still_since_ns = stamp;
+      SettleDeferred(false);  // the motion stopped short of a wave
+    };
+    if (!ask_camera) end_motion();
+    Hold& hold = holds[cloud.hold];
+    // The hold's last try decides whether more are needed: waiting for it (once per try, a
+    // search's time) keeps the tries, and so the pairs and every count, the same for any
+    // timing of the two threads.
+    if (hold.last_try_serial > 0 && !hold.gave_a_pair) {
+      WaitForTry(hold.last_try_serial);
+      hold.gave_a_pair = HoldGaveAPair(cloud.hold);
+    }
+    if (hold.gave_a_pair) {
+      if (ask_camera) end_motion();
+      Drop(kHoldDone);
+      return;
+    }
+    if (hold.tries > 0 && stamp - hold.last_try_ns < Ns(options.retry_s)) {
+      Drop("not tried: its hold was tried within " + MillisecondsText(options.retry_s));
+      return;
+    }
+    ++hold.tries;
+    hold.last_try_ns = stamp;
+    hold.last_try_serial = MakeTry(cloud, cloud.hold);
+    if (!ask_camera) return;
+    bool camera_moving = false;
+    if (hold.last_try_serial > 0) {
+      WaitForTry(hold.last_try_serial);
+      std::lock_guard lock(mutex);
+      hold.gave_a_pair = satisfied_holds.count(cloud.hold) > 0;
+      camera_moving = moving_sweeps.count(stamp) > 0;
+    }
+    if (!camera_moving) end_motion();
+  }
+
   void Judge(RecentCloud* cloud) {
     cloud->judged = true;
     const std::int64_t stamp = cloud->cloud.stamp_ns;
     if (still_since_ns == INT64_MIN) still_since_ns = stamp;  // the recording's first sweep
     const LidarView view = SeenByLidar(*cloud);
     if (view == LidarView::kStill) {
-      last_still_ns = stamp;
-      still_since_ns = stamp;
-      SettleDeferred(false);  // the motion stopped short of a wave
-      Hold& hold = holds[cloud->hold];
-      // The hold's last try decides whether more are needed: waiting for it (once per try, a
-      // search's time) keeps the tries, and so the pairs and every count, the same for any
-      // timing of the two threads.
-      if (hold.last_try_serial > 0 && !hold.gave_a_pair) {
-        WaitForTry(hold.last_try_serial);
-        hold.gave_a_pair = HoldGaveAPair(cloud->hold);
-      }
-      if (hold.gave_a_pair) {
-        Drop(kHoldDone);
-        return;
-      }
-      if (hold.tries > 0 && stamp - hold.last_try_ns < Ns(options.retry_s)) {
-        Drop("not tried: its hold was tried within " + MillisecondsText(options.retry_s));
-        return;
-      }
-      ++hold.tries;
-      hold.last_try_ns = stamp;
-      hold.last_try_serial = MakeTry(*cloud, cloud->hold);
+      JudgeStill(*cloud);
     } else if (view == LidarView::kUnknown) {
       MakeTry(*cloud, --lone_hold);  // a sweep alone in its window: the camera judges
     } else if (!ringless && options.moving_after_s > 0) {
       // A board that never stops: each sweep a moving pair, from the motion's start (a ring-less
       // LiDAR sees nothing still even at a hold, so its sweeps are not taken for a wave). A board
       // held still where something else moves is told apart by the camera (JudgeMovingTry).
+      in_motion = true;
       if (stamp - still_since_ns < Ns(options.moving_after_s)) {
         cloud->deferred = true;
         return;
@@ -389,6 +419,7 @@ struct RecordingPairFinder::Impl {
   std::int64_t horizon_ns = INT64_MIN;
   std::int64_t last_still_ns = 0;
   std::int64_t still_since_ns = INT64_MIN;  // the last still sweep's stamp, else the first's
+  bool in_motion = false;  // the last sweep judged was a motion's (deferred or tried as moving)
   std::int64_t last_blind_try_ns = INT64_MIN / 2;
   std::deque<Try> waiting_for_camera;
 
@@ -407,7 +438,8 @@ struct RecordingPairFinder::Impl {
   bool finishing = false, finished = false, stopping = false;
   std::exception_ptr worker_error;
   std::vector<FoundPair> found;
-  std::set<int> satisfied_holds;  // holds that gave a pair
+  std::set<int> satisfied_holds;         // holds that gave a pair
+  std::set<std::int64_t> moving_sweeps;  // sweeps whose still try's images showed the board move
   std::uint64_t tries_queued = 0, tries_done = 0;
   PairFinderStats stats;
   std::string board_problem;  // the board choice's Problem(), for the reader

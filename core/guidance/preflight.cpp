@@ -75,12 +75,15 @@ Finding Oblique(const char* sensor, const Plane& plane, const Vec3& point,
                           TooOblique(sensor, angle, options.max_incidence_deg)};
 }
 
+// A pair of a moving capture: its board seen in several frames (a wave), not held.
+bool Waved(const PairFeatures& pair) { return pair.camera_track.size() >= 2; }
+
 Finding Blur(const PairFeatures& pair, const PreflightOptions& options) {
   if (!pair.edge_width_px || *pair.edge_width_px <= options.max_edge_width_px) return std::nullopt;
   return Say("blur", PreflightSeverity::kReject,
-             "motion blur: the squares' edges are %.1f px wide (a still board: under %.1f px); "
-             "hold it still",
-             *pair.edge_width_px, options.max_edge_width_px);
+             "motion blur: the squares' edges are %.1f px wide (a still board: under %.1f px); %s",
+             *pair.edge_width_px, options.max_edge_width_px,
+             Waved(pair) ? "wave it slower, or shorten the camera's exposure" : "hold it still");
 }
 
 Finding Stamps(std::optional<double> offset_s, const PreflightOptions& options) {
@@ -102,11 +105,15 @@ Finding Moved(const LidarPlaneFit& lidar, const CameraBoardObservation& camera,
              disagreement.c_str());
 }
 
-// A near duplicate of an earlier pose adds almost nothing.
-Finding Duplicate(const CameraBoardObservation& camera, const std::vector<PairFeatures>& earlier,
+// A near duplicate of an earlier pose adds almost nothing. Not among a wave's sweeps: each comes
+// a sweep after the last, near it by design, and each tells the clocks' offset (a board at 0.5
+// m/s moves 5 cm a sweep); a wave passing a held pose again is a duplicate of the hold as ever.
+Finding Duplicate(const PairFeatures& pair, const std::vector<PairFeatures>& earlier,
                   const PreflightOptions& options) {
+  const CameraBoardObservation& camera = *pair.camera;
   for (const PairFeatures& other : earlier) {
     if (!other.camera || other.status != PairStatus::kAccepted) continue;
+    if (Waved(pair) && Waved(other)) continue;
     const Pose& there = other.camera->cam_from_board;
     const double distance = (there.translation() - camera.cam_from_board.translation()).norm();
     const double angle = RotationAngle(there.linear(), camera.cam_from_board.linear()) * kRadToDeg;
@@ -138,7 +145,7 @@ std::vector<PreflightFinding> PreflightPair(const PreflightInputs& in,
   found.push_back(Stamps(in.stamp_offset_s, options));
   if (lidar && camera && in.cam_from_lidar && in.board && in.pipeline)
     found.push_back(Moved(*lidar, *camera, in));
-  if (camera && in.earlier) found.push_back(Duplicate(*camera, *in.earlier, options));
+  if (camera && in.earlier) found.push_back(Duplicate(pair, *in.earlier, options));
   std::vector<PreflightFinding> findings;
   for (Finding& f : found)
     if (f) findings.push_back(std::move(*f));

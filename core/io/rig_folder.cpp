@@ -162,8 +162,13 @@ RigFolder LoadRigFolder(const fs::path& path) {
       Fail(rig.folder, "camera '" + name + "' has no images/" + name + "/ folder");
     const auto frames = FilesByStem(images);
     for (const auto& [stem, cloud] : clouds)
-      if (const auto frame = frames.find(stem); frame != frames.end())
-        camera.pairs.push_back(PairEntry{stem, cloud, frame->second, std::nullopt});
+      if (const auto frame = frames.find(stem); frame != frames.end()) {
+        PairEntry pair;
+        pair.id = stem;
+        pair.cloud = cloud;
+        pair.image = frame->second;
+        camera.pairs.push_back(std::move(pair));
+      }
     if (camera.pairs.empty())
       Fail(images, "no frame shares a stem with a cloud in clouds/ (camera '" + name + "')");
     rig.camera_names.push_back(name);

@@ -12,13 +12,16 @@ BeamRays::BeamRays(const BeamTable& beams, double azimuth_offset_rad)
     : steps_(beams.azimuth_steps),
       azimuth_offset_rad_(azimuth_offset_rad),
       mirror_offset_m_(beams.swept ? beams.mirror_offset_m : Vec3::Zero()) {
+  if (beams.rays) {
+    fired_ = beams.rays;
+  } else if (beams.risley) {
+    RisleyRays fired =
+        FireRisleyPattern(*beams.risley, azimuth_offset_rad / (2.0 * M_PI), beams.frame_s);
+    for (double& t : fired.time_offsets_s) t /= beams.frame_s;
+    fired_ = std::make_shared<const std::vector<Vec3>>(std::move(fired.directions));
+    fired_fraction_ = std::make_shared<const std::vector<double>>(std::move(fired.time_offsets_s));
+  }
   if (beams.Fired()) {
-    fired_ =
-        beams.rays
-            ? beams.rays
-            : std::make_shared<const std::vector<Vec3>>(
-                  FireRisleyPattern(*beams.risley, azimuth_offset_rad / (2.0 * M_PI), beams.frame_s)
-                      .directions);
     steps_ = static_cast<int>(fired_->size());
     cos_elevation_ = {1.0};  // one "ring"
     sin_elevation_ = {0.0};
@@ -36,6 +39,12 @@ BeamRays::BeamRays(const BeamTable& beams, double azimuth_offset_rad)
     cos_elevation_.push_back(std::cos(elevation));
     sin_elevation_.push_back(std::sin(elevation));
   }
+}
+
+double BeamRays::FiredFraction(int step) const {
+  if (steps_ <= 0) return 0.0;
+  const int wrapped = ((step % steps_) + steps_) % steps_;
+  return fired_fraction_ ? (*fired_fraction_)[wrapped] : static_cast<double>(wrapped) / steps_;
 }
 
 double BeamRays::StepRad() const { return steps_ > 0 ? 2.0 * M_PI / steps_ : 0.0; }

@@ -46,10 +46,15 @@ class BeamRays {
   double StepRad() const;
   // Step may be any integer: it wraps around the sweep.
   BeamRay Ray(int ring, int step) const;
+  // When a step fires, as the fraction of the sweep after its start: a Risley pattern's rays at
+  // their own times (its lasers' rays interleave in time though listed laser by laser), any
+  // other's step / steps.
+  double FiredFraction(int step) const;
 
  private:
   // A Risley pattern's directions, or a table's learnt rays.
   std::shared_ptr<const std::vector<Vec3>> fired_;
+  std::shared_ptr<const std::vector<double>> fired_fraction_;  // a Risley pattern's, per ray
   bool nodding_ = false;  // steps tilt a fan (BeamTable::nodding) rather than turn it
   double tilt_first_rad_ = 0.0, tilt_step_rad_ = 0.0;
   std::vector<double> fan_rad_;

@@ -46,7 +46,10 @@ TrackMotion MotionOf(const std::vector<TimedObservation>& track);
 struct TimeOffsetOptions {
   double search_s = 0.25;         // --time-offset-search: half-width of the search (seconds)
   std::optional<double> fixed_s;  // --time-offset: known, not searched
-  double step_s = 0.005;          // the coarse grid's step; the fine one a fifth of it
+  double step_s = 0.005;          // the grid's step about the best; the finest a fifth of it
+  // The whole window is first searched this many steps apart (a board at 0.5 m/s moves 1.25 cm
+  // in 25 ms: the profile's basin spans several such steps), then every step about its best.
+  int coarse_steps = 5;
   // A pair tells the offset when the camera saw its board move at least this fast (m/s).
   double min_speed_mps = 0.05;
   int min_moving_pairs = 6;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 
 #include "core/geometry/geometry.h"
 
@@ -78,7 +79,22 @@ Vec3 FitParabola(const std::vector<ProfilePoint>& points, double centre) {
   return a.colPivHouseholderQr().solve(b);
 }
 
-// The coarse grid over the window: a moving pair takes part where its frames hold its instant at
+// `points` into the estimate's profile, kept in the offset's order (one point per offset).
+void KeepInProfile(const std::vector<ProfilePoint>& points, TimeOffsetEstimate* e) {
+  std::map<double, double> profile;
+  for (size_t k = 0; k < e->profile_offsets_s.size(); ++k)
+    profile[e->profile_offsets_s[k]] = e->profile_costs[k];
+  for (const ProfilePoint& p : points) profile.emplace(p.offset_s, p.cost);
+  e->profile_offsets_s.clear();
+  e->profile_costs.clear();
+  for (const auto& [offset_s, cost] : profile) {
+    if (!e->profile_offsets_s.empty() && offset_s - e->profile_offsets_s.back() < 1e-9) continue;
+    e->profile_offsets_s.push_back(offset_s);
+    e->profile_costs.push_back(cost);
+  }
+}
+
+// The grid over the window: a moving pair takes part where its frames hold its instant at
 // every offset of it (the same pairs at every offset, or the costs would not compare); still
 // pairs always. Counts the moving ones into e->profiled_pairs.
 std::vector<const PairFeatures*> CoveredPairs(const std::vector<const PairFeatures*>& accepted,
@@ -97,8 +113,8 @@ std::vector<const PairFeatures*> CoveredPairs(const std::vector<const PairFeatur
   return profiled;
 }
 
-// About the coarse grid's best: a fifth of its step, a parabola through it, the offset and its σ,
-// and how the pose follows the offset there; e->why says why not where it fails.
+// About the grid's best: a fifth of its step (kept in the profile), a parabola through it, the
+// offset and its σ, and how the pose follows the offset there; e->why says why not where it fails.
 void Refine(const Profile& profile, const ProfilePoint& best, const TimeOffsetOptions& o,
             TimeOffsetEstimate* out) {
   TimeOffsetEstimate& e = *out;
@@ -107,6 +123,7 @@ void Refine(const Profile& profile, const ProfilePoint& best, const TimeOffsetOp
   for (int k = -5; k <= 5; ++k)
     if (auto point = profile.At(best.offset_s + k * o.step_s / 5, best.cam_from_lidar))
       fine.push_back(*point);
+  KeepInProfile(fine, &e);
   const Vec3 c = FitParabola(fine, best.offset_s);
   if (fine.size() < 5 || !(c(2) > 0)) {
     e.why = "the planes' agreement does not curve about its best offset: the motion cannot tell it";
@@ -149,6 +166,7 @@ bool TimeOffsetOptions::Check(std::string* why) const {
   if (fixed_s && !(std::abs(*fixed_s) <= 60.0)) return fail("a time offset must be within 60 s");
   if (!(step_s > 0 && step_s <= search_s))
     return fail("the time offset's step must be in (0, search]");
+  if (coarse_steps < 1) return fail("the time offset's coarse_steps must be >= 1");
   if (!(min_speed_mps >= 0)) return fail("min_speed_mps must be >= 0");
   if (min_moving_pairs < 3) return fail("min_moving_pairs must be >= 3");
   return track.Check(why);
@@ -212,25 +230,48 @@ TimeOffsetEstimate EstimateTimeOffset(const std::vector<PairFeatures>& pairs,
     return e;
   }
   const Profile profile(profiled, options);
-  std::vector<ProfilePoint> coarse;
+  // The window coarse_steps apart, then every step about the coarse best: the profile's basin is
+  // wider than the coarse step, so the best of the whole grid is among them (about 45 solves
+  // where every step would take 2 * steps + 1).
+  const int stride = std::clamp(o.coarse_steps, 1, steps);
+  std::map<int, ProfilePoint> grid;  // by step index
   Pose start = initial;
-  for (int k = -steps; k <= steps; ++k) {
-    const std::optional<ProfilePoint> point = profile.At(k * o.step_s, start);
-    if (!point) continue;
-    coarse.push_back(*point);
-    start = point->cam_from_lidar;  // the next offset's solve starts near
-    e.profile_offsets_s.push_back(point->offset_s);
-    e.profile_costs.push_back(point->cost);
+  auto solve_at = [&](int k, const Pose& from) {
+    if (grid.count(k)) return;
+    const std::optional<ProfilePoint> point = profile.At(k * o.step_s, from);
+    if (point) grid.emplace(k, *point);
+  };
+  for (int k = -steps; k <= steps; k = k < steps ? std::min(k + stride, steps) : k + 1) {
+    solve_at(k, start);
+    if (grid.count(k)) start = grid.at(k).cam_from_lidar;  // the next offset's solve starts near
   }
-  const auto best = std::min_element(coarse.begin(), coarse.end(),
-                                     [](const auto& a, const auto& b) { return a.cost < b.cost; });
-  if (best == coarse.begin() || best + 1 >= coarse.end()) {
+  auto lowest = [&] {
+    return std::min_element(grid.begin(), grid.end(), [](const auto& a, const auto& b) {
+      return a.second.cost < b.second.cost;
+    });
+  };
+  if (grid.empty()) {
+    e.why = "no solve converged over the search window";
+    return e;
+  }
+  const auto coarse_best = lowest();
+  const int centre = coarse_best->first;
+  const Pose from = coarse_best->second.cam_from_lidar;
+  for (int k = std::max(-steps, centre - stride + 1); k <= std::min(steps, centre + stride - 1);
+       ++k)
+    solve_at(k, from);
+  std::vector<ProfilePoint> solved;
+  for (const auto& [k, point] : grid) solved.push_back(point);
+  KeepInProfile(solved, &e);
+  const auto best_at = lowest();
+  if (best_at == grid.begin() || std::next(best_at) == grid.end()) {
     e.why = Words(
         "the planes agree best at the search window's edge (%+.0f ms): widen "
         "--time-offset-search",
-        best == coarse.end() ? 0.0 : best->offset_s * 1e3);
+        best_at->second.offset_s * 1e3);
     return e;
   }
+  const ProfilePoint* best = &best_at->second;
   Refine(profile, *best, o, &e);
   return e;
 }

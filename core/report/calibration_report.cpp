@@ -294,6 +294,7 @@ CalibrationReport AnalyseCalibration(const Dataset& dataset, const CalibrationOu
   report.summary = FormatSummary(outcome);
   report.termination = s.termination.Describe();
   report.cost_history = s.cost_history;
+  report.time_offset = outcome.time_offset;
   report.image_width = dataset.camera.width;
   report.image_height = dataset.camera.height;
   std::vector<size_t> solved;

@@ -86,6 +86,9 @@ struct CalibrationReport {
   std::vector<SigmaStep> sigma_history;
   int image_width = 0, image_height = 0;
   std::string distrust;  // which pairs to distrust, in words ("" when none stands out)
+  // The clocks' offset as the solve found it, with its profile (the planes' disagreement against
+  // the offset; empty for still holds or a given offset): the report plots it.
+  TimeOffsetEstimate time_offset;
 };
 
 // Analyses a solved outcome (outcome.solution present; throws std::invalid_argument otherwise).

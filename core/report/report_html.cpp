@@ -1,12 +1,15 @@
 // ReportHtml: the report's body written here, its look and plots in assets/report/.
 #include "core/report/report_html.h"
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "core/estimation/uncertainty.h"
+#include "core/lidar_camera/time_offset.h"
 #include "core/report/html_parts.h"
 #include "core/results/export.h"
 
@@ -81,6 +84,43 @@ std::string CrossValidationSection(const CalibrationReport& r, const std::string
          Num(cv.heldout_rms_distance_mm, 2) + "</td></tr></table></section>";
 }
 
+// The time offset's profile for its plot: χ² above its lowest (twice the cost: the solve's cost is
+// ½χ²) against the offset in ms, with the estimate and its σ.
+json TimeOffsetData(const TimeOffsetEstimate& e) {
+  if (e.profile_costs.empty()) return nullptr;
+  const double lowest = *std::min_element(e.profile_costs.begin(), e.profile_costs.end());
+  json offsets = json::array(), chi2 = json::array();
+  for (size_t k = 0; k < e.profile_costs.size(); ++k) {
+    offsets.push_back(e.profile_offsets_s[k] * 1e3);
+    chi2.push_back(2.0 * (e.profile_costs[k] - lowest));
+  }
+  json data = {{"offset_ms", offsets}, {"chi2_above_lowest", chi2}};
+  if (e.camera_minus_lidar_s) {
+    data["estimate_ms"] = *e.camera_minus_lidar_s * 1e3;
+    data["std_ms"] = e.std_s * 1e3;
+  }
+  return data;
+}
+
+// The clocks' offset in words, and its plot where the motion gave it a profile.
+std::string TimeOffsetSection(const CalibrationReport& r, const std::string& prefix) {
+  const TimeOffsetEstimate& e = r.time_offset;
+  if (!e.camera_minus_lidar_s && e.moving_pairs == 0) return "";
+  std::string how = e.camera_minus_lidar_s ? e.why : "";
+  if (!how.empty()) how[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(how[0])));
+  std::string html = "<section id=\"" + prefix + "time-offset\"><h2>Time offset</h2><p>" +
+                     Escape(DescribeTimeOffset(e)) + "." +
+                     (how.empty() ? "" : " " + Escape(how) + ".") + "</p>";
+  if (!e.profile_costs.empty())
+    html +=
+        "<p>Each offset's solve of the moving pairs (planes whitened by both covariances, no "
+        "robust weights): how much worse the planes agree than at the best offset. The "
+        "estimate is the parabola's lowest point through the finest grid; its σ the "
+        "curvature's.</p><div class=\"plots\"><div class=\"plot wide\"><canvas id=\"" +
+        prefix + "time-offset-profile\"></canvas></div></div>";
+  return html + "</section>";
+}
+
 json ChartData(const CalibrationReport& r) {
   json pairs = json::array();
   for (const PairReportRow& p : r.pairs) {
@@ -109,7 +149,8 @@ json ChartData(const CalibrationReport& r) {
   return {{"pairs", pairs},
           {"cost", r.cost_history},
           {"sigma", sigma},
-          {"image_size", {r.image_width, r.image_height}}};
+          {"image_size", {r.image_width, r.image_height}},
+          {"time_offset", TimeOffsetData(r.time_offset)}};
 }
 
 }  // namespace
@@ -188,7 +229,8 @@ std::string CameraBody(const CalibrationReport& report, const std::vector<Report
           Escape(gaps.empty() ? "the boards cover the image's 3 x 3 grid and a wide LiDAR field."
                               : gaps + " More poses there would help.") +
           "</p></section>";
-  return body + PairTable(report, prefix) + FiguresSection(figures, prefix);
+  return body + TimeOffsetSection(report, prefix) + PairTable(report, prefix) +
+         FiguresSection(figures, prefix);
 }
 
 std::string SigmaCells(const Vec3& t_mm, const Vec3& r_deg) {

@@ -97,8 +97,9 @@ struct LidarScanOptions {
   double range_offset_m = 0.0;      // added to every range (metres)
   double azimuth_offset_rad = 0.0;  // azimuth of step 0 (the firing phase of this sweep)
   std::uint64_t seed = 1;           // range and intensity noise
-  // A spinning LiDAR's sweep time (seconds; > 0): each return's time after the sweep's start,
-  // step / steps of it, kept (LidarScan::time_s). 0: the sweep is instantaneous.
+  // The sweep's time (seconds; > 0): each return's time after the sweep's start, when its step
+  // fired (BeamRays::FiredFraction: a spinning LiDAR's step / steps of it, a Risley pattern's rays
+  // at their own times), kept (LidarScan::time_s). 0: the sweep is instantaneous.
   double sweep_s = 0.0;
 };
 

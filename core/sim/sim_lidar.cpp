@@ -120,7 +120,7 @@ LidarScan SimulateLidarScan(const BeamTable& beams, const BoardPrint& print,
   scan.has_rings = beams.HasRings();
   CALIBENCH_CHECK(!scene.lidar_from_board_at || options.sweep_s > 0.0);
   for (int step = 0; step < rays.steps(); ++step) {
-    const double step_s = options.sweep_s * step / rays.steps();
+    const double step_s = options.sweep_s * rays.FiredFraction(step);
     if (scene.lidar_from_board_at) sheet = {scene.lidar_from_board_at(step_s), half_sheet};
     for (int r = 0; r < rays.rings(); ++r) {
       const BeamRay ray = rays.Ray(r, step);

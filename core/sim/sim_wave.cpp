@@ -48,10 +48,9 @@ bool WaveOptions::Check(std::string* why) const {
     return false;
   };
   if (!rig.Check(why)) return false;
-  if (MakeBeamTable(rig.lidar).risley)
-    return fail(
-        "a waved board is simulated for spinning LiDARs (a Livox-class rosette's returns "
-        "are not timed here)");
+  const BeamTable beams = MakeBeamTable(rig.lidar);
+  if (beams.Fired() && !beams.risley)
+    return fail("a waved board is simulated for spinning LiDARs and Risley patterns");
   if (!(duration_s > 0) || !(speed_mps > 0) || !(lidar_hz > 0) || !(camera_hz > 0))
     return fail("the wave's duration, speed and rates must be > 0");
   if (!(centre_distance_m > depth_m + 0.5) || !(across_m >= 0) || !(depth_m >= 0))
@@ -114,8 +113,11 @@ Sweep SimulateSweep(const WaveOptions& options, const SimOptions& r, const BeamT
   scan.range_noise_m = r.lidar_range_noise_m;
   scan.range_offset_m = r.lidar_range_offset_m;
   scan.angular_noise_rad = r.lidar_angular_noise_rad;
+  // A spinning LiDAR's firing phase drifts from sweep to sweep; a Risley pattern's rosette goes
+  // on where the last frame left it (BeamRays reads its phase as seconds into the pattern).
   scan.azimuth_offset_rad =
-      beams.PhaseSpanRad() * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+      beams.risley ? 2.0 * M_PI * std::fmod(start, 1.0)
+                   : beams.PhaseSpanRad() * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
   scan.seed = rng();
   scan.sweep_s = sweep_s;
   const LidarScan lidar = SimulateLidarScan(beams, print, scene, scan);
@@ -146,7 +148,8 @@ WavedDataset SimulateWavedDataset(const WaveOptions& options,
   std::string why;
   if (!options.Check(&why)) throw std::invalid_argument("wave: " + why);
   const SimOptions r = ResolveSimOptions(options.rig);
-  const BeamTable beams = MakeBeamTable(r.lidar);
+  BeamTable beams = MakeBeamTable(r.lidar);
+  if (beams.risley) beams.frame_s = 1.0 / options.lidar_hz;  // a frame per sweep
   const BoardPrint print(r.board);
   const std::filesystem::path root = std::filesystem::absolute(out_dir);
   std::filesystem::create_directories(root / "clouds");

@@ -1,5 +1,6 @@
 // A board waved in front of the rig, never still (docs/architecture.md "Time"): a spinning
-// LiDAR's sweeps, each return at its own time with the board where it was then, and a camera
+// LiDAR's sweeps (or a Risley pattern's frames, the rosette going on from frame to frame), each
+// return at its own time with the board where it was then, and a camera
 // whose stamps are off the LiDAR's clock by a set offset. Written as a moving capture's dataset:
 // each sweep that sees the board a pair with its `lidar_stamp_ns`, its cloud's field `t`, and
 // every camera frame within a window of its stamp (the manifest's "images").
@@ -17,7 +18,8 @@
 namespace calibench {
 
 struct WaveOptions {
-  // The rig, the board and the noise (lidar: a spinning model; its pairs are the wave's sweeps).
+  // The rig, the board and the noise (lidar: a spinning model or a Risley pattern, a frame per
+  // 1 / lidar_hz; its pairs are the wave's sweeps).
   SimOptions rig;
   double duration_s = 40.0;
   // The board's centre runs an ellipse in front of the camera at this speed (m/s), with a slow

@@ -455,6 +455,22 @@ TEST(GuidancePreflight, EachReasonIsFoundAndSaidInWords) {
   ASSERT_EQ(Checks(findings), std::vector<std::string>{"duplicate"});
   EXPECT_NE(findings[0].words.find("adds almost nothing"), std::string::npos);
   EXPECT_NE(findings[0].words.find("pair a"), std::string::npos);
+
+  // A wave's sweeps come near each other by design: not duplicates of one another, though a wave
+  // passing a hold's pose is; its blur asks for a slower wave, not a still board.
+  auto waved = [](PairFeatures pair) {
+    TimedObservation frame{0.0, *pair.camera};
+    pair.camera_track = {frame, frame};
+    pair.camera_track[1].stamp_s = 0.1;
+    return pair;
+  };
+  EXPECT_TRUE(run(waved(again), {waved(clean)}).empty());
+  EXPECT_EQ(Checks(run(waved(again), {clean})), std::vector<std::string>{"duplicate"});
+  PairFeatures waved_blur = waved(clean);
+  waved_blur.edge_width_px = 6.5;
+  findings = run(waved_blur, {});
+  ASSERT_EQ(Checks(findings), std::vector<std::string>{"blur"});
+  EXPECT_NE(findings[0].words.find("wave it slower"), std::string::npos);
 }
 
 TEST(GuidancePreflight, BlurIsMeasuredOnTheImage) {
