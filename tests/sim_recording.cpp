@@ -226,13 +226,28 @@ WavedDataset WriteWavedRecording(RecordingWriter* writer, MessageEncoding encodi
   const WavedDataset waved = SimulateWavedDataset(wave, scratch);
   const std::int64_t sweep_ns = std::llround(1e9 / wave.lidar_hz);
   const bool ouster = layout == PointLayout::kOuster;
+  const bool livox = MakeBeamTable(wave.rig.lidar).risley.has_value();
   std::vector<RecordedMessage> messages;
-  for (const auto& [file, stamp] : waved.sweep_files)
-    messages.push_back(
-        {ouster ? "/os_cloud_node/points" : "/velodyne_points", "sensor_msgs/PointCloud2",
-         stamp + sweep_ns,
-         SerializePointCloud2(LoadCloud(file), stamp, ouster ? "os_sensor" : "velodyne", encoding,
-                              false, "ring", layout)});
+  for (const auto& [file, stamp] : waved.sweep_files) {
+    const LidarCloud cloud = LoadCloud(file);
+    if (livox) {
+      // livox_ros_driver's CustomMsg: each point's offset_time (ns) after the frame's timebase.
+      std::vector<std::uint32_t> offsets_ns;
+      for (const float t : cloud.time_s)
+        offsets_ns.push_back(static_cast<std::uint32_t>(std::llround(t * 1e9)));
+      messages.push_back(
+          {"/livox/lidar",
+           encoding == MessageEncoding::kRos1 ? "livox_ros_driver/CustomMsg"
+                                              : "livox_ros_driver2/CustomMsg",
+           stamp + sweep_ns,
+           SerializeLivoxCustomMsg(cloud, stamp, "livox_frame", encoding, offsets_ns)});
+      continue;
+    }
+    messages.push_back({ouster ? "/os_cloud_node/points" : "/velodyne_points",
+                        "sensor_msgs/PointCloud2", stamp + sweep_ns,
+                        SerializePointCloud2(cloud, stamp, ouster ? "os_sensor" : "velodyne",
+                                             encoding, false, "ring", layout)});
+  }
   for (const StampedImage& frame : waved.frame_files) {
     const ImageU8 image = LoadImage(frame.image);
     const std::int64_t received = frame.stamp_ns + 15'000'000;

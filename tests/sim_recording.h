@@ -93,7 +93,8 @@ SimRecordingTruth WriteSimRecording(RecordingWriter* writer, MessageEncoding enc
 // A waved board's recording (core/sim/sim_wave.h, simulated under `scratch` with every sweep
 // written): each sweep a PointCloud2 stamped at its start on the LiDAR's clock and logged once
 // complete, on /velodyne_points with velodyne's per-point `time` (float32 s), or with
-// PointLayout::kOuster on /os_cloud_node/points with Ouster's `t` (uint32 ns); each frame an
+// PointLayout::kOuster on /os_cloud_node/points with Ouster's `t` (uint32 ns), or for a
+// Livox-class LiDAR a CustomMsg on /livox/lidar with its points' offset_time; each frame an
 // Image on /camera/image_raw stamped on the camera's clock (wave.camera_minus_lidar_s off), with
 // its CameraInfo. Written through `writer` (not closed) in log-time order.
 WavedDataset WriteWavedRecording(RecordingWriter* writer, MessageEncoding encoding,

@@ -331,6 +331,12 @@ TryOutcome JudgeMovingTry(const recording_detail::Try& attempt, const PairTopics
                   options.moving_min_turn_deg);
   });
   outcome.camera_still = still;
+  if (still && attempt.ringless) {
+    outcome.dropped =
+        "moving: the camera saw the board still (a ring-less LiDAR's hold is tried blind, "
+        "integrated)";
+    return outcome;
+  }
   if (still && std::any_of(kept.begin(), kept.end(), [&](const Pose& kept_pose) {
         return Within(BoardPoseError(kept_pose, pair.cam_from_board, board),
                       options.duplicate_translation_m, options.duplicate_rotation_deg);

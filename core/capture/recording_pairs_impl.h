@@ -269,6 +269,42 @@ struct RecordingPairFinder::Impl {
     if (!camera_moving) end_motion();
   }
 
+  // A ring-less (Livox-class) LiDAR sees nothing still, even at a hold: a sweep is tried blind
+  // every retry_s (the sweeps around it integrated) and the camera says whether the board was
+  // held. Its word on a blind try is also a wave's: the sweeps between blind tries are held back
+  // (RecentCloud::deferred), and once blind tries have shown the board move for moving_after_s
+  // since the last that did not, they and every later sweep are tried as moving (each frame
+  // alone); a blind try whose images do not show it move ends the motion, the sweeps held back
+  // dropped as they always were. The blind try's sweep is its say, in a wave too.
+  void JudgeRingless(RecentCloud* cloud) {
+    const std::int64_t stamp = cloud->cloud.stamp_ns;
+    if (stamp - last_still_ns >= Ns(options.lidar_blind_s) &&
+        stamp - last_blind_try_ns >= Ns(options.retry_s)) {
+      last_blind_try_ns = stamp;
+      const std::uint64_t serial = MakeTry(*cloud, --lone_hold);
+      bool camera_moving = false;
+      if (serial > 0) {
+        WaitForTry(serial);
+        std::lock_guard lock(mutex);
+        camera_moving = moving_sweeps.count(stamp) > 0;
+      }
+      in_motion = camera_moving;
+      if (!camera_moving) {
+        still_since_ns = stamp;
+        SettleDeferred(false);
+      } else if (stamp - still_since_ns >= Ns(options.moving_after_s)) {
+        SettleDeferred(true);
+      }
+      return;
+    }
+    if (in_motion && stamp - still_since_ns >= Ns(options.moving_after_s)) {
+      SettleDeferred(true);
+      MakeTry(*cloud, --lone_hold, /*moving=*/true);
+      return;
+    }
+    cloud->deferred = true;
+  }
+
   void Judge(RecentCloud* cloud) {
     cloud->judged = true;
     const std::int64_t stamp = cloud->cloud.stamp_ns;
@@ -289,6 +325,8 @@ struct RecordingPairFinder::Impl {
       }
       SettleDeferred(true);
       MakeTry(*cloud, --lone_hold, /*moving=*/true);
+    } else if (ringless && options.moving_after_s > 0) {
+      JudgeRingless(cloud);
     } else if (stamp - last_still_ns >= Ns(options.lidar_blind_s) &&
                stamp - last_blind_try_ns >= Ns(options.retry_s)) {
       last_blind_try_ns = stamp;
@@ -337,7 +375,8 @@ struct RecordingPairFinder::Impl {
         attempt.others.push_back(image);
     // A ring-less LiDAR's sweeps of the span, for the pair's cloud: the camera checks that the
     // board held still over the same span.
-    if (ringless)
+    attempt.ringless = ringless;
+    if (ringless && !moving)
       for (const RecentCloud& other : recent_clouds)
         if (&other != &cloud && std::abs(other.cloud.stamp_ns - stamp) <= half)
           attempt.integrated.push_back(other.cloud);

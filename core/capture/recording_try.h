@@ -38,6 +38,9 @@ struct Try {
   // A sweep of a board that never stopped (PairSelectionOptions::moving_after_s): `others` are
   // then every other frame within moving_images_s, searched each for the board.
   bool moving = false;
+  // A ring-less LiDAR's moving sweep: a board its frames show still is a hold, tried blind with
+  // the hold's sweeps integrated, not this sweep alone.
+  bool ringless = false;
   StampedBytes cloud;
   StampedBytes image;                // the nearest in time
   std::vector<StampedBytes> others;  // the other images within the stillness window

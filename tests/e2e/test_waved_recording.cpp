@@ -149,6 +149,58 @@ TEST(WavedRecording, AnOustersOwnTFieldTellsACameraRunningEarly) {
   EXPECT_LT(error.rotation_rad * kRadToDeg, 0.3);
 }
 
+// A Livox-class rosette waved (Mid-40 frames as livox_ros_driver's CustomMsg, each point's
+// offset_time after the frame's timebase): its LiDAR sees nothing still, so the camera's word on
+// the blind tries tells the wave, and each frame alone is a moving pair.
+TEST(WavedRecording, ALivoxCustomMsgWaveIsTakenFrameByFrame) {
+  const fs::path dir = test::TempDir("waved_livox");
+  WaveOptions wave;
+  wave.rig.lidar = LidarModel::kMid40;
+  wave.rig.lidar_range_noise_m = 0.01;
+  wave.rig.seed = 13;
+  wave.duration_s = 10.0;
+  wave.across_m = 0.4;  // within the 38.4 deg circle
+  wave.camera_minus_lidar_s = 0.040;
+  auto writer = test::OpenRos1BagWriter(dir / "wave.bag", "lz4");
+  const WavedDataset waved =
+      test::WriteWavedRecording(writer.get(), MessageEncoding::kRos1, wave, dir / "sim");
+  writer->Close();
+
+  BagImportOptions options;
+  options.max_pairs = 0;
+  const BagImportSummary summary =
+      ImportBag(dir / "wave.bag", dir / "wave.dataset", waved.dataset.target, options);
+  std::printf("Livox wave: %zu of %d frames see the board; %d moving pairs imported\n",
+              waved.dataset.pairs.size(), waved.sweeps, summary.moving_pairs);
+  EXPECT_EQ(summary.moving_pairs, static_cast<int>(summary.pair_ids.size()));
+  // Every frame but the blind tries' (one a second) and the wave's ends.
+  EXPECT_GE(summary.moving_pairs, static_cast<int>(waved.dataset.pairs.size()) * 3 / 4);
+  const Dataset dataset = LoadDataset(summary.manifest);
+  ASSERT_FALSE(dataset.pairs.empty());
+  const LidarCloud middle = LoadCloud(dataset.pairs[dataset.pairs.size() / 2].cloud);
+  ASSERT_TRUE(middle.HasTime());
+  const auto [lo, hi] = std::minmax_element(middle.time_s.begin(), middle.time_s.end());
+  EXPECT_GE(*lo, 0.0f);
+  EXPECT_LE(*hi, 0.1f);
+  EXPECT_GT(*hi - *lo, 0.09f);  // one frame, not a hold's integration
+
+  PipelineOptions pipeline;
+  pipeline.threads = 2;
+  const CalibrationOutcome outcome = CalibrateDataset(dataset, pipeline);
+  ASSERT_TRUE(outcome.solution) << outcome.failure;
+  const TimeOffsetEstimate& t = outcome.time_offset;
+  ASSERT_TRUE(t.camera_minus_lidar_s) << t.why;
+  const PoseError error = ComputePoseError(outcome.solution->cam_from_lidar,
+                                           *waved.dataset.cam_from_lidar_ground_truth);
+  std::printf("Livox wave: offset %+.2f +- %.2f ms (true +40), extrinsic %.2f mm %.3f deg\n",
+              *t.camera_minus_lidar_s * 1e3, t.std_s * 1e3, error.translation_m * 1e3,
+              error.rotation_rad * kRadToDeg);
+  EXPECT_NEAR(*t.camera_minus_lidar_s, wave.camera_minus_lidar_s, 0.003);
+  EXPECT_LE(std::abs(*t.camera_minus_lidar_s - wave.camera_minus_lidar_s), 3 * t.std_s + 1e-4);
+  EXPECT_LT(error.translation_m, 0.01);
+  EXPECT_LT(error.rotation_rad * kRadToDeg, 0.3);
+}
+
 // Issue 77's Show: a still-hold recording whose camera stamps run 80 ms late. The holds are
 // found by stillness, so the pairs are the holds as ever; the offset is not claimed.
 TEST(WavedRecording, StillHoldsWithLateCameraStampsPairByStillnessAndTellNoOffset) {
