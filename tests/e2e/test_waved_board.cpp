@@ -181,7 +181,7 @@ TEST(WavedBoard, TheOffsetBetweenTheClocksIsFoundWithTheExtrinsic) {
 }
 
 // Issue 77's 40 s: several seeds of 40 s of waving, the extrinsic against the bound of the same
-// sweeps. About 2.5 min a seed on 2 cores: run from scripts/wave_sweep.sh, not CI
+// sweeps. About 1 min a seed on 2 cores: run from scripts/wave_sweep.sh, not CI
 // (--gtest_also_run_disabled_tests); CALIBENCH_WAVE_SEEDS="21 22 23" chooses the seeds.
 TEST(WavedBoard, DISABLED_FortySecondsAgainstTheBoundOfTheSameSweeps) {
   const char* seeds_env = std::getenv("CALIBENCH_WAVE_SEEDS");
