@@ -5,6 +5,7 @@
 
 #include "core/io/cloud_io.h"
 #include "core/lidar_camera/result_io.h"
+#include "core/lidar_camera/time_offset.h"
 
 namespace calibench {
 namespace {
@@ -410,6 +411,9 @@ bool CalibrationJob::CommitOutcome(bool own_step) {
          {DescribeLidarModel(*outcome_), DescribeLearnedLidarNoise(*outcome_),
           DescribeLidarTimes(*outcome_), CountResiduals(*outcome_).note})
       if (!note.empty()) result->notes.push_back(note);
+    // A moving capture's clocks, as the summary says them (still holds: nothing to say).
+    if (outcome_->time_offset.camera_minus_lidar_s || outcome_->time_offset.moving_pairs > 0)
+      result->notes.push_back(DescribeTimeOffset(outcome_->time_offset));
     for (const IterationReport& it : iterations_) {
       result->step_history.push_back(it.step_norm);
       result->estimate_history.push_back(it.cam_from_lidar);

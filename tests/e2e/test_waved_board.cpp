@@ -169,6 +169,13 @@ TEST(WavedBoard, TheOffsetBetweenTheClocksIsFoundWithTheExtrinsic) {
                   *in_job.time_offset.camera_minus_lidar_s * 1e3, apart.translation_m * 1e3,
                   apart.rotation_rad * kRadToDeg);
       EXPECT_NEAR(*in_job.time_offset.camera_minus_lidar_s, *t.camera_minus_lidar_s, t.std_s);
+      // The workbench's solver panel says the clocks (the record's notes, as the summary).
+      ASSERT_TRUE(job.CommitOutcome(/*own_step=*/true));
+      const std::optional<SessionResult> said = job.record().Current().result;
+      ASSERT_TRUE(said);
+      EXPECT_NE(
+          std::find(said->notes.begin(), said->notes.end(), DescribeTimeOffset(in_job.time_offset)),
+          said->notes.end());
       EXPECT_LT(apart.translation_m, 0.002);
       EXPECT_LT(apart.rotation_rad * kRadToDeg, 0.05);
     }
