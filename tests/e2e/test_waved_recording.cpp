@@ -28,6 +28,37 @@ nlohmann::json ReadImportRecord(const BagImportSummary& summary) {
   return nlohmann::json::parse(in);
 }
 
+// The imported wave calibrated as `calibrate` would: the clocks within 3 ms and 3 sigma of the
+// simulated offset, the extrinsic within 1 cm and 0.3 deg of the truth.
+void ExpectTheImportedWaveCalibrates(const Dataset& dataset, const WavedDataset& waved,
+                                     const WaveOptions& wave, const char* label) {
+  PipelineOptions pipeline;
+  pipeline.threads = 2;
+  const CalibrationOutcome outcome = CalibrateDataset(dataset, pipeline);
+  ASSERT_TRUE(outcome.solution) << outcome.failure;
+  const TimeOffsetEstimate& t = outcome.time_offset;
+  ASSERT_TRUE(t.camera_minus_lidar_s) << t.why;
+  const PoseError error = ComputePoseError(outcome.solution->cam_from_lidar,
+                                           *waved.dataset.cam_from_lidar_ground_truth);
+  std::printf("%s: offset %+.2f +- %.2f ms (true %+.0f), extrinsic %.2f mm %.3f deg\n", label,
+              *t.camera_minus_lidar_s * 1e3, t.std_s * 1e3, wave.camera_minus_lidar_s * 1e3,
+              error.translation_m * 1e3, error.rotation_rad * kRadToDeg);
+  EXPECT_NEAR(*t.camera_minus_lidar_s, wave.camera_minus_lidar_s, 0.003);
+  EXPECT_LE(std::abs(*t.camera_minus_lidar_s - wave.camera_minus_lidar_s), 3 * t.std_s + 1e-4);
+  EXPECT_LT(error.translation_m, 0.01);
+  EXPECT_LT(error.rotation_rad * kRadToDeg, 0.3);
+}
+
+// A pair's cloud of one 0.1 s sweep, each return at its own time after the stamp.
+void ExpectOneSweepsTimes(const PairEntry& pair) {
+  const LidarCloud cloud = LoadCloud(pair.cloud);
+  ASSERT_TRUE(cloud.HasTime()) << pair.id;
+  const auto [lo, hi] = std::minmax_element(cloud.time_s.begin(), cloud.time_s.end());
+  EXPECT_GE(*lo, 0.0f);
+  EXPECT_LE(*hi, 0.1f);
+  EXPECT_GT(*hi - *lo, 0.09f);  // a whole sweep, not a hold's integration
+}
+
 TEST(WavedRecording, ImportKeepsEverySweepThatSeesTheBoardWithItsFrames) {
   const fs::path dir = test::TempDir("waved_recording");
   WaveOptions wave;
@@ -83,21 +114,7 @@ TEST(WavedRecording, ImportKeepsEverySweepThatSeesTheBoardWithItsFrames) {
     EXPECT_TRUE(LoadCloud(pair.cloud).HasTime());
   }
 
-  PipelineOptions pipeline;
-  pipeline.threads = 2;
-  const CalibrationOutcome outcome = CalibrateDataset(dataset, pipeline);
-  ASSERT_TRUE(outcome.solution) << outcome.failure;
-  const TimeOffsetEstimate& t = outcome.time_offset;
-  ASSERT_TRUE(t.camera_minus_lidar_s) << t.why;
-  const PoseError error = ComputePoseError(outcome.solution->cam_from_lidar,
-                                           *waved.dataset.cam_from_lidar_ground_truth);
-  std::printf("imported wave: offset %+.2f +- %.2f ms (true +40), extrinsic %.2f mm %.3f deg\n",
-              *t.camera_minus_lidar_s * 1e3, t.std_s * 1e3, error.translation_m * 1e3,
-              error.rotation_rad * kRadToDeg);
-  EXPECT_NEAR(*t.camera_minus_lidar_s, wave.camera_minus_lidar_s, 0.003);
-  EXPECT_LE(std::abs(*t.camera_minus_lidar_s - wave.camera_minus_lidar_s), 3 * t.std_s + 1e-4);
-  EXPECT_LT(error.translation_m, 0.01);
-  EXPECT_LT(error.rotation_rad * kRadToDeg, 0.3);
+  ExpectTheImportedWaveCalibrates(dataset, waved, wave, "imported wave");
 }
 
 // An Ouster's per-point `t` (uint32 ns after the stamp, ouster_ros's PointOS) in a ROS 2 MCAP,
@@ -125,28 +142,9 @@ TEST(WavedRecording, AnOustersOwnTFieldTellsACameraRunningEarly) {
   const Dataset dataset = LoadDataset(summary.manifest);
   ASSERT_FALSE(dataset.pairs.empty());
   // The times as the sim gave them, through the driver's integer nanoseconds.
-  const LidarCloud first = LoadCloud(dataset.pairs.front().cloud);
-  ASSERT_TRUE(first.HasTime());
-  const auto [lo, hi] = std::minmax_element(first.time_s.begin(), first.time_s.end());
-  EXPECT_GE(*lo, 0.0f);
-  EXPECT_LE(*hi, 0.1f);
-  EXPECT_GT(*hi - *lo, 0.09f);
+  ExpectOneSweepsTimes(dataset.pairs.front());
 
-  PipelineOptions pipeline;
-  pipeline.threads = 2;
-  const CalibrationOutcome outcome = CalibrateDataset(dataset, pipeline);
-  ASSERT_TRUE(outcome.solution) << outcome.failure;
-  const TimeOffsetEstimate& t = outcome.time_offset;
-  ASSERT_TRUE(t.camera_minus_lidar_s) << t.why;
-  const PoseError error = ComputePoseError(outcome.solution->cam_from_lidar,
-                                           *waved.dataset.cam_from_lidar_ground_truth);
-  std::printf("Ouster wave: offset %+.2f +- %.2f ms (true -120), extrinsic %.2f mm %.3f deg\n",
-              *t.camera_minus_lidar_s * 1e3, t.std_s * 1e3, error.translation_m * 1e3,
-              error.rotation_rad * kRadToDeg);
-  EXPECT_NEAR(*t.camera_minus_lidar_s, wave.camera_minus_lidar_s, 0.003);
-  EXPECT_LE(std::abs(*t.camera_minus_lidar_s - wave.camera_minus_lidar_s), 3 * t.std_s + 1e-4);
-  EXPECT_LT(error.translation_m, 0.01);
-  EXPECT_LT(error.rotation_rad * kRadToDeg, 0.3);
+  ExpectTheImportedWaveCalibrates(dataset, waved, wave, "Ouster wave");
 }
 
 // A Livox-class rosette waved (Mid-40 frames as livox_ros_driver's CustomMsg, each point's
@@ -177,28 +175,9 @@ TEST(WavedRecording, ALivoxCustomMsgWaveIsTakenFrameByFrame) {
   EXPECT_GE(summary.moving_pairs, static_cast<int>(waved.dataset.pairs.size()) * 3 / 4);
   const Dataset dataset = LoadDataset(summary.manifest);
   ASSERT_FALSE(dataset.pairs.empty());
-  const LidarCloud middle = LoadCloud(dataset.pairs[dataset.pairs.size() / 2].cloud);
-  ASSERT_TRUE(middle.HasTime());
-  const auto [lo, hi] = std::minmax_element(middle.time_s.begin(), middle.time_s.end());
-  EXPECT_GE(*lo, 0.0f);
-  EXPECT_LE(*hi, 0.1f);
-  EXPECT_GT(*hi - *lo, 0.09f);  // one frame, not a hold's integration
+  ExpectOneSweepsTimes(dataset.pairs[dataset.pairs.size() / 2]);
 
-  PipelineOptions pipeline;
-  pipeline.threads = 2;
-  const CalibrationOutcome outcome = CalibrateDataset(dataset, pipeline);
-  ASSERT_TRUE(outcome.solution) << outcome.failure;
-  const TimeOffsetEstimate& t = outcome.time_offset;
-  ASSERT_TRUE(t.camera_minus_lidar_s) << t.why;
-  const PoseError error = ComputePoseError(outcome.solution->cam_from_lidar,
-                                           *waved.dataset.cam_from_lidar_ground_truth);
-  std::printf("Livox wave: offset %+.2f +- %.2f ms (true +40), extrinsic %.2f mm %.3f deg\n",
-              *t.camera_minus_lidar_s * 1e3, t.std_s * 1e3, error.translation_m * 1e3,
-              error.rotation_rad * kRadToDeg);
-  EXPECT_NEAR(*t.camera_minus_lidar_s, wave.camera_minus_lidar_s, 0.003);
-  EXPECT_LE(std::abs(*t.camera_minus_lidar_s - wave.camera_minus_lidar_s), 3 * t.std_s + 1e-4);
-  EXPECT_LT(error.translation_m, 0.01);
-  EXPECT_LT(error.rotation_rad * kRadToDeg, 0.3);
+  ExpectTheImportedWaveCalibrates(dataset, waved, wave, "Livox wave");
 }
 
 // Issue 77's Show: a still-hold recording whose camera stamps run 80 ms late. The holds are
