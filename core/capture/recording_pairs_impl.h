@@ -316,8 +316,8 @@ struct RecordingPairFinder::Impl {
       MakeTry(*cloud, --lone_hold);  // a sweep alone in its window: the camera judges
     } else if (!ringless && options.moving_after_s > 0) {
       // A board that never stops: each sweep a moving pair, from the motion's start (a ring-less
-      // LiDAR sees nothing still even at a hold, so its sweeps are not taken for a wave). A board
-      // held still where something else moves is told apart by the camera (JudgeMovingTry).
+      // LiDAR's wave is the camera's to tell: JudgeRingless). A board held still where something
+      // else moves is told apart by the camera (JudgeMovingTry).
       in_motion = true;
       if (stamp - still_since_ns < Ns(options.moving_after_s)) {
         cloud->deferred = true;
