@@ -259,14 +259,18 @@ struct RecordingPairFinder::Impl {
     hold.last_try_ns = stamp;
     hold.last_try_serial = MakeTry(cloud, cloud.hold);
     if (!ask_camera) return;
-    bool camera_moving = false;
-    if (hold.last_try_serial > 0) {
-      WaitForTry(hold.last_try_serial);
-      std::lock_guard lock(mutex);
-      hold.gave_a_pair = satisfied_holds.count(cloud.hold) > 0;
-      camera_moving = moving_sweeps.count(stamp) > 0;
-    }
+    const bool camera_moving = TryShowedMotion(hold.last_try_serial, stamp);
+    hold.gave_a_pair = HoldGaveAPair(cloud.hold);
     if (!camera_moving) end_motion();
+  }
+
+  // Whether the still try `serial` of the sweep stamped `stamp` showed the board move, once the
+  // worker has judged it (0: a try not queued, which showed nothing).
+  bool TryShowedMotion(std::uint64_t serial, std::int64_t stamp) {
+    if (serial == 0) return false;
+    WaitForTry(serial);
+    std::lock_guard lock(mutex);
+    return moving_sweeps.count(stamp) > 0;
   }
 
   // A ring-less (Livox-class) LiDAR sees nothing still, even at a hold: a sweep is tried blind
@@ -281,15 +285,8 @@ struct RecordingPairFinder::Impl {
     if (stamp - last_still_ns >= Ns(options.lidar_blind_s) &&
         stamp - last_blind_try_ns >= Ns(options.retry_s)) {
       last_blind_try_ns = stamp;
-      const std::uint64_t serial = MakeTry(*cloud, --lone_hold);
-      bool camera_moving = false;
-      if (serial > 0) {
-        WaitForTry(serial);
-        std::lock_guard lock(mutex);
-        camera_moving = moving_sweeps.count(stamp) > 0;
-      }
-      in_motion = camera_moving;
-      if (!camera_moving) {
+      in_motion = TryShowedMotion(MakeTry(*cloud, --lone_hold), stamp);
+      if (!in_motion) {
         still_since_ns = stamp;
         SettleDeferred(false);
       } else if (stamp - still_since_ns >= Ns(options.moving_after_s)) {

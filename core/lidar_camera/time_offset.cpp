@@ -154,6 +154,53 @@ void Refine(const Profile& profile, const ProfilePoint& best, const TimeOffsetOp
       o.search_s * 1e3, e.profiled_pairs, variance_factor);
 }
 
+// The grid over +-steps: the window coarse_steps apart, then every step about the coarse best
+// (the profile's basin is wider than the coarse step, so the best of the whole grid is among
+// them: about 45 solves where every step would take 2 * steps + 1), each point kept in the
+// profile. Its best, or nullopt with e->why where it lies on the window's edge.
+std::optional<ProfilePoint> SearchGrid(const Profile& profile, const TimeOffsetOptions& o,
+                                       int steps, const Pose& initial, TimeOffsetEstimate* e) {
+  const int stride = std::clamp(o.coarse_steps, 1, steps);
+  std::map<int, ProfilePoint> grid;  // by step index
+  auto solve_at = [&](int k, const Pose& from) {
+    if (grid.count(k)) return;
+    if (std::optional<ProfilePoint> point = profile.At(k * o.step_s, from)) grid.emplace(k, *point);
+  };
+  auto lowest = [&] {
+    return std::min_element(grid.begin(), grid.end(), [](const auto& a, const auto& b) {
+      return a.second.cost < b.second.cost;
+    });
+  };
+  Pose start = initial;
+  for (int k = -steps; k <= steps; k = k < steps ? std::min(k + stride, steps) : k + 1) {
+    solve_at(k, start);
+    if (const auto at = grid.find(k); at != grid.end())
+      start = at->second.cam_from_lidar;  // the next offset's solve starts near
+  }
+  if (grid.empty()) {
+    e->why = "no solve converged over the search window";
+    return std::nullopt;
+  }
+  const auto coarse_best = lowest();
+  const int centre = coarse_best->first;
+  const Pose from = coarse_best->second.cam_from_lidar;
+  for (int k = std::max(-steps, centre - stride + 1); k <= std::min(steps, centre + stride - 1);
+       ++k)
+    solve_at(k, from);
+  std::vector<ProfilePoint> solved;
+  for (const auto& [k, point] : grid) solved.push_back(point);
+  KeepInProfile(solved, e);
+  const auto best = lowest();
+  if (best == grid.begin() || std::next(best) == grid.end()) {
+    e->why = Words(
+        "the planes agree best at the search window's edge (%+.0f ms): widen "
+        "--time-offset-search",
+        best->second.offset_s * 1e3);
+    return std::nullopt;
+  }
+  return best->second;
+}
+
 }  // namespace
 
 bool TimeOffsetOptions::Check(std::string* why) const {
@@ -230,49 +277,8 @@ TimeOffsetEstimate EstimateTimeOffset(const std::vector<PairFeatures>& pairs,
     return e;
   }
   const Profile profile(profiled, options);
-  // The window coarse_steps apart, then every step about the coarse best: the profile's basin is
-  // wider than the coarse step, so the best of the whole grid is among them (about 45 solves
-  // where every step would take 2 * steps + 1).
-  const int stride = std::clamp(o.coarse_steps, 1, steps);
-  std::map<int, ProfilePoint> grid;  // by step index
-  Pose start = initial;
-  auto solve_at = [&](int k, const Pose& from) {
-    if (grid.count(k)) return;
-    const std::optional<ProfilePoint> point = profile.At(k * o.step_s, from);
-    if (point) grid.emplace(k, *point);
-  };
-  for (int k = -steps; k <= steps; k = k < steps ? std::min(k + stride, steps) : k + 1) {
-    solve_at(k, start);
-    if (grid.count(k)) start = grid.at(k).cam_from_lidar;  // the next offset's solve starts near
-  }
-  auto lowest = [&] {
-    return std::min_element(grid.begin(), grid.end(), [](const auto& a, const auto& b) {
-      return a.second.cost < b.second.cost;
-    });
-  };
-  if (grid.empty()) {
-    e.why = "no solve converged over the search window";
-    return e;
-  }
-  const auto coarse_best = lowest();
-  const int centre = coarse_best->first;
-  const Pose from = coarse_best->second.cam_from_lidar;
-  for (int k = std::max(-steps, centre - stride + 1); k <= std::min(steps, centre + stride - 1);
-       ++k)
-    solve_at(k, from);
-  std::vector<ProfilePoint> solved;
-  for (const auto& [k, point] : grid) solved.push_back(point);
-  KeepInProfile(solved, &e);
-  const auto best_at = lowest();
-  if (best_at == grid.begin() || std::next(best_at) == grid.end()) {
-    e.why = Words(
-        "the planes agree best at the search window's edge (%+.0f ms): widen "
-        "--time-offset-search",
-        best_at->second.offset_s * 1e3);
-    return e;
-  }
-  const ProfilePoint* best = &best_at->second;
-  Refine(profile, *best, o, &e);
+  const std::optional<ProfilePoint> best = SearchGrid(profile, o, steps, initial, &e);
+  if (best) Refine(profile, *best, o, &e);
   return e;
 }
 
